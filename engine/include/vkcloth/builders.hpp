@@ -1,0 +1,62 @@
+// Builders for the report's systems: a chain of springs (§2) and a cloth grid (§3).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+#include "vkcloth/result.hpp"
+#include "vkcloth/system.hpp"
+
+namespace vkcloth {
+
+/// A fixed anchor (particle 0, pinned) followed by masses joined in a line: spring k joins
+/// particle k and k+1. Coordinates: z is up and the anchor is the ceiling; the report's
+/// mass position (0, 0, 0.4) is a distance BELOW the ceiling, so here it is anchor + (0, 0, -0.4).
+/// Defaults are the report's single spring (§2.1): K = 20, L0 = 0.4, m = 1, started at rest length.
+struct ChainDesc {
+  glm::dvec3 anchor{0.0, 0.0, 0.0};
+  std::vector<double> masses{1.0};
+  std::vector<double> stiffness{20.0};
+  std::vector<double> rest_lengths{0.4};
+  std::vector<glm::dvec3> positions{{0.0, 0.0, -0.4}};
+};
+
+Result<ParticleSystem> make_chain(const ChainDesc& desc);
+
+enum class ClothOrientation : std::uint32_t {
+  vertical = 0,   ///< spans x (i) and z (j); row j = ny-1 is the top
+  horizontal = 1, ///< spans x (i) and y (j), at constant z
+};
+
+struct ClothStiffness {
+  double structural = 40.0; ///< 4 direct neighbours, rest length = spacing
+  double shear = 8.0;       ///< 4 diagonal neighbours, rest length = diagonal
+  double bend = 8.0;        ///< neighbours 2 apart, rest length = 2 spacings
+};
+
+/// An nx x ny grid over a w x h rectangle; particle (i, j) sits at origin + i dx e_u + j dy e_v
+/// with dx = w/(nx-1), dy = h/(ny-1). A spring kind with zero stiffness is left out.
+struct ClothDesc {
+  std::uint32_t nx = 10;
+  std::uint32_t ny = 10;
+  glm::dvec2 size{1.0, 1.0};
+  glm::dvec3 origin{0.0, 0.0, 0.0};
+  ClothOrientation orientation = ClothOrientation::vertical;
+  double particle_mass = 0.05; ///< with 40/8/8 at dt 0.02 a 10 x 10 cloth diverges past K_struct ~ 50, as in the report
+  ClothStiffness stiffness;
+  /// Pinned (i, j) cells; empty means the two top corners (0, ny-1) and (nx-1, ny-1).
+  std::vector<std::array<std::uint32_t, 2>> pins;
+  bool pin_default_corners = true; ///< when false and `pins` is empty, nothing is pinned
+};
+
+/// Largest grid the builders accept (per side and in total): beyond this a scene is refused.
+inline constexpr std::uint32_t max_cloth_side = 8192;
+inline constexpr std::uint64_t max_particles = 1ull << 24;
+
+Result<ParticleSystem> make_cloth(const ClothDesc& desc);
+
+} // namespace vkcloth

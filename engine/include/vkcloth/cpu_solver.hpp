@@ -1,0 +1,94 @@
+// The CPU reference solver: deterministic (same input -> bit-identical output), float by default,
+// double for accuracy studies. The Vulkan solver is checked against it.
+//
+// One step, in this order (the GPU passes do the same per particle):
+//   1. normals   n_p = normalize(sum of the fan triangles' cross products around p)  [cloth only]
+//   2. force     F_p = sum over p's springs in gather order (SpringAdjacency)
+//                      + m g - mu m v + Kw <n, u_w> n
+//   3. contact   for each collider the particle touches (distance < 2 eps): remove the normal
+//                part of v and F only where it points into the collider (report §4, Figure 12)
+//   4. integrate explicit / semi-implicit Euler, or RK4 (steps 1-3 at each stage)
+//   5. project   a particle inside a collider is put back at surface + eps, and its inward
+//                velocity removed; pinned particles are left where they are
+//   6. check     NaN/inf or |p| > divergence_limit -> Error{diverged} naming the step and time
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "vkcloth/params.hpp"
+#include "vkcloth/result.hpp"
+#include "vkcloth/system.hpp"
+
+namespace vkcloth {
+
+template <typename Real> class CpuSolver {
+public:
+  using Vec3 = glm::vec<3, Real, glm::defaultp>;
+
+  /// Validates `params` against `system` and copies the initial state.
+  static Result<CpuSolver> create(const ParticleSystem& system, SimParams params);
+
+  /// Advances one time step. On a blow-up the state is left as it was after the bad step.
+  Result<void> step();
+  /// Advances `steps` steps, stopping at the first error.
+  Result<void> run(std::uint64_t steps);
+
+  /// Replaces the parameters between steps (validated; the topology stays).
+  Result<void> set_params(SimParams params);
+  const SimParams& params() const { return params_; }
+
+  std::span<const Vec3> positions() const { return pos_; }
+  std::span<const Vec3> velocities() const { return vel_; }
+  /// Forces of the last evaluation (after contact filtering); for RK4 the first stage's.
+  std::span<const Vec3> forces() const { return force_; }
+  /// Unit normals of the last evaluation (zero for chains and degenerate fans).
+  std::span<const Vec3> normals() const { return normal_; }
+
+  std::uint64_t step_index() const { return step_; }
+  double time() const { return static_cast<double>(step_) * params_.dt; }
+  const ParticleSystem& system() const { return *system_; }
+
+  /// Moves one particle (a "hand"): sets its position and velocity for the next step.
+  void set_particle(std::uint32_t index, Vec3 position, Vec3 velocity);
+
+  /// Kinetic energy sum 1/2 m v^2, gravitational and spring potential energies (for studies).
+  struct Energy {
+    double kinetic = 0, gravity = 0, spring = 0;
+    double total() const { return kinetic + gravity + spring; }
+  };
+  Energy energy() const;
+
+private:
+  CpuSolver() = default;
+  void compute_normals(std::span<const Vec3> pos);
+  void compute_forces(std::span<const Vec3> pos, std::span<const Vec3> vel, std::vector<Vec3>& out);
+  void apply_contacts(std::span<const Vec3> pos, std::vector<Vec3>& vel, std::vector<Vec3>& force) const;
+  void project(std::vector<Vec3>& pos, std::vector<Vec3>& vel) const;
+  Result<void> check_finite() const;
+
+  struct Edge {
+    std::uint32_t other;
+    Real rest_length;
+    Real stiffness;
+  };
+
+  std::shared_ptr<const ParticleSystem> system_;
+  SimParams params_;
+  std::vector<std::uint32_t> edge_offsets_;
+  std::vector<Edge> edges_;
+  std::vector<Real> mass_;
+  std::vector<std::uint8_t> pinned_;
+  std::vector<Vec3> pos_, vel_, force_, normal_;
+  std::vector<Vec3> k_pos_[4], k_vel_[4], stage_pos_, stage_vel_; // RK4 scratch
+  std::uint64_t step_ = 0;
+};
+
+extern template class CpuSolver<float>;
+extern template class CpuSolver<double>;
+
+} // namespace vkcloth

@@ -1,0 +1,66 @@
+// Simulation parameters shared by every solver: integrator, time step, forces, colliders.
+// Units: metres, seconds, kilograms; z is up.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "vkcloth/result.hpp"
+
+namespace vkcloth {
+
+/// Time integrators, each named for what it is (see docs/scene-format.md).
+enum class Integrator : std::uint32_t {
+  explicit_euler = 0,      ///< p += dt v_old; v += dt a   (report eq. 3 as written)
+  semi_implicit_euler = 1, ///< v += dt a; p += dt v_new   (what the report observed; the default)
+  rk4 = 2,                 ///< classic 4-stage Runge-Kutta on (p, v)
+};
+
+const char* to_string(Integrator integrator);
+std::optional<Integrator> parse_integrator(std::string_view name);
+
+/// A collider: a plane {p : n.p = offset} (outside where n.p > offset) or a sphere.
+struct Collider {
+  enum class Type : std::uint32_t { plane = 0, sphere = 1 };
+  Type type = Type::plane;
+  glm::dvec3 normal{0.0, 0.0, 1.0}; ///< plane: unit outward normal (normalised by validate())
+  double offset = 0.0;              ///< plane: n.p on the surface
+  glm::dvec3 center{0.0};           ///< sphere
+  double radius = 0.0;              ///< sphere
+
+  static Collider plane(glm::dvec3 normal, double offset) { return {Type::plane, normal, offset, {}, 0.0}; }
+  static Collider sphere(glm::dvec3 center, double radius) {
+    return {Type::sphere, {0, 0, 1}, 0.0, center, radius};
+  }
+};
+
+/// Wind F = Kw <n, u_w> n on each cloth vertex, n its unit normal, u_w the unit wind direction.
+struct Wind {
+  double strength = 0.0;            ///< Kw
+  glm::dvec3 direction{1.0, 0.0, 0.0}; ///< normalised by validate()
+};
+
+struct SimParams {
+  Integrator integrator = Integrator::semi_implicit_euler;
+  double dt = 0.02;
+  glm::dvec3 gravity{0.0, 0.0, -9.81};
+  /// Fluid damping mu (1/s): the force -mu m v. With m = 1 it is the report's -mu v (§2);
+  /// on a cloth it is eq. 4's (1 - dt mu) velocity factor.
+  double damping = 0.5;
+  Wind wind;
+  std::vector<Collider> colliders;
+  /// Projection distance eps: a particle found inside a collider is put back at surface + eps.
+  /// A particle closer than 2 eps to a surface is "in contact" (its inward v and F are removed).
+  double contact_epsilon = 1e-3;
+  /// A position farther than this from the origin (or non-finite) counts as a blow-up.
+  double divergence_limit = 1e4;
+
+  /// Checks every field (finite, in range) and normalises directions. The message names the field.
+  Result<void> validate();
+};
+
+} // namespace vkcloth

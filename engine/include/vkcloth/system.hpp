@@ -1,0 +1,69 @@
+// The particle-spring system description that every solver consumes (CPU and Vulkan).
+// Topology (springs, rest lengths, the per-particle gather lists, the grid shape for normals) is
+// built once here; solvers copy the initial state and own their runtime state.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+namespace vkcloth {
+
+/// The report's spring families (Figure 4); `plain` is a chain spring (§2).
+enum class SpringKind : std::uint32_t { plain = 0, structural = 1, shear = 2, bend = 3 };
+
+const char* to_string(SpringKind kind);
+
+/// Hooke spring between particles a and b (report eq. 2): F_a = K (|u| - L0) u/|u|, u = p_b - p_a.
+struct Spring {
+  std::uint32_t a = 0;
+  std::uint32_t b = 0;
+  double rest_length = 0.0;
+  double stiffness = 0.0;
+  SpringKind kind = SpringKind::plain;
+};
+
+/// Initial state of one particle. A pinned particle never moves (its velocity stays zero).
+struct Particle {
+  glm::dvec3 position{0.0};
+  glm::dvec3 velocity{0.0};
+  double mass = 1.0;
+  bool pinned = false;
+};
+
+/// Shape of a cloth grid: particle (i, j) has index j * nx + i. Used for normals (wind, drawing).
+struct Grid {
+  std::uint32_t nx = 0;
+  std::uint32_t ny = 0;
+};
+
+/// One entry of a particle's gather list: the spring's other end and its constants.
+struct SpringRef {
+  std::uint32_t other = 0;
+  std::uint32_t spring = 0; ///< index into ParticleSystem::springs
+};
+
+/// Per-particle incident springs in compressed-row form. Particle p's springs are
+/// refs[offsets[p] .. offsets[p+1]), in increasing spring index: this is THE force summation
+/// order, shared by the CPU reference and the GPU gather pass.
+struct SpringAdjacency {
+  std::vector<std::uint32_t> offsets;
+  std::vector<SpringRef> refs;
+};
+
+/// A complete particle-spring system: state, topology and (for cloth) its grid.
+struct ParticleSystem {
+  std::vector<Particle> particles;
+  std::vector<Spring> springs;
+  std::optional<Grid> grid; ///< set for cloth; chains have no surface (no normals, no wind)
+  SpringAdjacency adjacency; ///< filled by finalize()
+
+  std::size_t size() const { return particles.size(); }
+
+  /// Builds `adjacency` from `springs`. Builders call it; call it again after editing springs.
+  void finalize();
+};
+
+} // namespace vkcloth

@@ -1,0 +1,8 @@
+// Umbrella header of the vkcloth library.
+#pragma once
+
+#include "vkcloth/builders.hpp"
+#include "vkcloth/cpu_solver.hpp"
+#include "vkcloth/params.hpp"
+#include "vkcloth/result.hpp"
+#include "vkcloth/system.hpp"

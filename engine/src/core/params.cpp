@@ -1,0 +1,69 @@
+#include "vkcloth/params.hpp"
+
+#include <cmath>
+#include <fmt/format.h>
+
+#include <glm/geometric.hpp>
+
+namespace vkcloth {
+namespace {
+
+bool finite(glm::dvec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+std::string str(glm::dvec3 v) { return fmt::format("[{}, {}, {}]", v.x, v.y, v.z); }
+Error bad(std::string message) { return make_error(ErrorCode::invalid_argument, std::move(message)); }
+
+} // namespace
+
+const char* to_string(Integrator integrator) {
+  switch (integrator) {
+  case Integrator::explicit_euler: return "explicit_euler";
+  case Integrator::semi_implicit_euler: return "semi_implicit_euler";
+  case Integrator::rk4: return "rk4";
+  }
+  return "?";
+}
+
+std::optional<Integrator> parse_integrator(std::string_view name) {
+  for (Integrator i : {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::rk4})
+    if (name == to_string(i)) return i;
+  return std::nullopt;
+}
+
+Result<void> SimParams::validate() {
+  if (static_cast<std::uint32_t>(integrator) > static_cast<std::uint32_t>(Integrator::rk4))
+    return bad(fmt::format("integrator.method: unknown integrator {}", static_cast<std::uint32_t>(integrator)));
+  if (!std::isfinite(dt) || dt <= 0.0) return bad(fmt::format("integrator.dt must be finite and > 0, got {}", dt));
+  if (!finite(gravity)) return bad("physics.gravity must be finite, got " + str(gravity));
+  if (!std::isfinite(damping) || damping < 0.0)
+    return bad(fmt::format("physics.damping must be finite and >= 0, got {}", damping));
+  if (!std::isfinite(wind.strength)) return bad(fmt::format("wind.strength must be finite, got {}", wind.strength));
+  if (!finite(wind.direction)) return bad("wind.direction must be finite, got " + str(wind.direction));
+  if (wind.strength != 0.0) {
+    const double len = glm::length(wind.direction);
+    if (!(len > 0.0)) return bad("wind.direction must be non-zero when wind.strength != 0, got " + str(wind.direction));
+    wind.direction /= len;
+  }
+  if (!std::isfinite(contact_epsilon) || contact_epsilon < 0.0)
+    return bad(fmt::format("contact_epsilon must be finite and >= 0, got {}", contact_epsilon));
+  if (!std::isfinite(divergence_limit) || divergence_limit <= 0.0)
+    return bad(fmt::format("divergence_limit must be finite and > 0, got {}", divergence_limit));
+  for (std::size_t k = 0; k < colliders.size(); ++k) {
+    Collider& c = colliders[k];
+    if (c.type == Collider::Type::plane) {
+      if (!finite(c.normal)) return bad(fmt::format("colliders[{}].normal must be finite, got {}", k, str(c.normal)));
+      const double len = glm::length(c.normal);
+      if (!(len > 0.0)) return bad(fmt::format("colliders[{}].normal must be non-zero, got {}", k, str(c.normal)));
+      c.normal /= len;
+      if (!std::isfinite(c.offset)) return bad(fmt::format("colliders[{}].offset must be finite, got {}", k, c.offset));
+    } else if (c.type == Collider::Type::sphere) {
+      if (!finite(c.center)) return bad(fmt::format("colliders[{}].center must be finite, got {}", k, str(c.center)));
+      if (!std::isfinite(c.radius) || c.radius <= 0.0)
+        return bad(fmt::format("colliders[{}].radius must be finite and > 0, got {}", k, c.radius));
+    } else {
+      return bad(fmt::format("colliders[{}].type is unknown", k));
+    }
+  }
+  return {};
+}
+
+} // namespace vkcloth

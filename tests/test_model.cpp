@@ -1,0 +1,4 @@
+#include <doctest/doctest.h>
+#include "vkcloth/vkcloth.hpp"
+using namespace vkcloth;
+TEST_CASE("placeholder") { CHECK(make_chain({}).ok()); }

@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# Installs the Debian packages vkcloth needs. Idempotent; prints nothing when all is present.
+set -euo pipefail
+packages=(
+  cmake ninja-build g++ pkg-config
+  libvulkan-dev libvulkan-volk-dev glslang-tools glslang-dev spirv-tools
+  libglm-dev doctest-dev nlohmann-json3-dev libfmt-dev libcli11-dev
+  mesa-vulkan-drivers vulkan-validationlayers vulkan-tools
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+((${#missing[@]} == 0)) && exit 0
+echo "setup: installing ${missing[*]}" >&2
+sudo=""; [[ $(id -u) -ne 0 ]] && sudo="sudo"
+$sudo apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
