@@ -1,0 +1,10 @@
+#!/usr/bin/env bash
+# Builds vkcloth and runs the whole test suite (CPU physics, scene files, CLI, GPU on lavapipe
+# with the Khronos validation layer). Usage: tools/test.sh [preset]   (release | debug | asan)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+preset=${1:-release}
+tools/setup.sh
+cmake --preset "$preset" >/dev/null
+cmake --build --preset "$preset"
+ctest --preset "$preset" -j "$(nproc)"
