@@ -6,3 +6,4 @@
 #include "vkcloth/params.hpp"
 #include "vkcloth/result.hpp"
 #include "vkcloth/system.hpp"
+#include "vkcloth/scene.hpp"

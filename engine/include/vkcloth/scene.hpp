@@ -1,0 +1,40 @@
+// Scene files: a JSON description of a system (chain or cloth) and its simulation parameters.
+// The format is documented key by key in docs/scene-format.md.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "vkcloth/params.hpp"
+#include "vkcloth/result.hpp"
+#include "vkcloth/system.hpp"
+
+namespace vkcloth {
+
+/// A loaded, validated scene: ready to hand to a solver.
+struct Scene {
+  std::string name;        ///< "name" key, else the file stem (or the source name)
+  ParticleSystem system;   ///< finalized
+  SimParams params;        ///< validated (directions normalised)
+  std::uint64_t steps = 500;
+  std::string system_kind; ///< "chain" | "cloth"
+};
+
+/// Largest "integrator.steps" a scene may ask for.
+inline constexpr std::uint64_t max_scene_steps = 1'000'000'000;
+
+/// Parses and validates a scene. `overrides` are "key.path=value" strings (e.g.
+/// "cloth.stiffness.bend=15", "colliders.0.radius=0.3", "colliders[0].radius=0.3"); each value is
+/// parsed as JSON, or taken as a plain string when it is not JSON. They are applied to the document
+/// before validation, so errors name the key. Errors: ErrorCode::parse (bad JSON, unknown key,
+/// wrong type, bad override) or ErrorCode::invalid_argument (a value out of range). Never throws.
+Result<Scene> parse_scene(std::string_view json_text, std::string_view source_name,
+                          std::span<const std::string> overrides = {});
+
+/// Reads `path` and calls parse_scene(). A missing or unreadable file is ErrorCode::io.
+Result<Scene> load_scene_file(const std::filesystem::path& path, std::span<const std::string> overrides = {});
+
+} // namespace vkcloth

@@ -1,0 +1,26 @@
+// JSON text -> document, with errors a person can act on: file:line:column, and for a number that
+// overflows a double (1e999) the key path it was written under.
+#pragma once
+
+#include <string_view>
+
+#include <nlohmann/json.hpp>
+
+#include "vkcloth/result.hpp"
+
+namespace vkcloth::scene_detail {
+
+struct JsonParseFailure {
+  std::size_t byte = 0;   ///< 0-based offset of the offending character
+  std::string path;       ///< key path of the value being read ("" at top level)
+  std::string message;    ///< what nlohmann reported, without its prefix
+  bool overflow = false;  ///< a number out of the double range
+};
+
+/// Parses `text`; on failure fills `failure` and returns false. Never throws (except bad_alloc).
+bool parse_json(std::string_view text, nlohmann::json& out, JsonParseFailure& failure);
+
+/// 1-based line and column of a byte offset.
+std::pair<std::size_t, std::size_t> line_col(std::string_view text, std::size_t byte);
+
+} // namespace vkcloth::scene_detail

@@ -1,0 +1,47 @@
+// Typed, path-aware reads from a nlohmann::json document. Every error names the full key path
+// ("cloth.stiffness.bend", "colliders[1].radius") and the offending JSON value.
+#pragma once
+
+#include <cstdint>
+#include <initializer_list>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+#include <nlohmann/json.hpp>
+
+#include "vkcloth/result.hpp"
+
+namespace vkcloth::scene_detail {
+
+using json = nlohmann::json;
+
+/// "a.b" + "c" -> "a.b.c"; "" + "c" -> "c".
+std::string join(std::string_view path, std::string_view key);
+/// A JSON value as a short string for messages (long values are cut).
+std::string show(const json& v);
+/// ErrorCode::parse: the document has the wrong shape.
+Error shape_error(std::string message);
+
+/// Errors on the first key of `obj` not in `allowed`, naming its full path.
+Result<void> check_keys(const json& obj, std::string_view path, std::initializer_list<std::string_view> allowed);
+
+/// Readers: absent key -> `out` keeps its default. Wrong type or non-finite -> error.
+/// `obj` must be an object.
+Result<const json*> read_object(const json& obj, std::string_view path, const char* key);
+Result<const json*> read_array(const json& obj, std::string_view path, const char* key);
+Result<void> read(const json& obj, std::string_view path, const char* key, double& out);
+Result<void> read(const json& obj, std::string_view path, const char* key, std::string& out);
+Result<void> read(const json& obj, std::string_view path, const char* key, glm::dvec3& out);
+Result<void> read(const json& obj, std::string_view path, const char* key, glm::dvec2& out);
+/// A number or an array of numbers (a single number becomes a one-element array).
+Result<void> read(const json& obj, std::string_view path, const char* key, std::vector<double>& out);
+
+/// Value readers (the value itself, at `path`).
+Result<double> as_number(const json& v, std::string_view path);
+Result<std::uint64_t> as_integer(const json& v, std::string_view path, std::uint64_t max);
+Result<glm::dvec3> as_vec3(const json& v, std::string_view path);
+
+} // namespace vkcloth::scene_detail
