@@ -1,0 +1,59 @@
+#include "backend.hpp"
+
+#include <fmt/format.h>
+
+#include "vkcloth/cpu_solver.hpp"
+
+namespace vkcloth::cli {
+namespace {
+
+template <typename Real> class CpuBackend final : public SimBackend {
+public:
+  explicit CpuBackend(CpuSolver<Real> solver) : solver_(std::move(solver)) {}
+
+  Result<void> step(std::uint64_t n) override { return solver_.run(n); }
+
+  Result<void> read_state(std::vector<glm::dvec3>& positions, std::vector<glm::dvec3>& velocities) override {
+    const auto p = solver_.positions();
+    const auto v = solver_.velocities();
+    positions.assign(p.begin(), p.end());
+    velocities.assign(v.begin(), v.end());
+    return {};
+  }
+
+  std::uint64_t step_index() const override { return solver_.step_index(); }
+  double time() const override { return solver_.time(); }
+
+private:
+  CpuSolver<Real> solver_;
+};
+
+template <typename Real> Result<std::unique_ptr<SimBackend>> make_cpu(const Scene& scene) {
+  auto solver = CpuSolver<Real>::create(scene.system, scene.params);
+  if (!solver) return solver.error();
+  return std::unique_ptr<SimBackend>(std::make_unique<CpuBackend<Real>>(std::move(*solver)));
+}
+
+} // namespace
+
+std::optional<Precision> parse_precision(std::string_view name) {
+  if (name == "float") return Precision::float32;
+  if (name == "double") return Precision::float64;
+  return std::nullopt;
+}
+
+const char* to_string(Precision p) { return p == Precision::float32 ? "float" : "double"; }
+
+Result<std::unique_ptr<SimBackend>> make_backend(std::string_view name, const Scene& scene, Precision precision) {
+  if (name == "cpu") return precision == Precision::float32 ? make_cpu<float>(scene) : make_cpu<double>(scene);
+  if (name == "vulkan") {
+#if defined(VKCLOTH_CLI_HAS_VULKAN)
+    return make_vulkan_backend(scene, precision);
+#else
+    return make_error(ErrorCode::no_device, "the vulkan backend is not available in this build");
+#endif
+  }
+  return make_error(ErrorCode::invalid_argument, fmt::format("unknown backend \"{}\" (known: cpu, vulkan)", name));
+}
+
+} // namespace vkcloth::cli

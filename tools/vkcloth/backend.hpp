@@ -1,0 +1,44 @@
+// The solver behind `vkcloth run`, behind a small interface so that backends (CPU today, Vulkan
+// later) live in their own files. To add one: implement SimBackend in backend_<name>.cpp, give it a
+// factory, and dispatch to it from make_backend() (backend.cpp).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string_view>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "vkcloth/result.hpp"
+#include "vkcloth/scene.hpp"
+
+namespace vkcloth::cli {
+
+/// Arithmetic the solver runs in (`--precision float|double`).
+enum class Precision { float32, float64 };
+std::optional<Precision> parse_precision(std::string_view name); ///< "float" | "double"
+const char* to_string(Precision p);                               ///< "float" | "double"
+
+class SimBackend {
+public:
+  virtual ~SimBackend() = default;
+  /// Advances `n` steps, stopping at the first error. A blow-up is ErrorCode::diverged with a
+  /// message naming the step and the time.
+  virtual Result<void> step(std::uint64_t n) = 0;
+  /// Copies the current state out (the vectors are resized to the particle count).
+  virtual Result<void> read_state(std::vector<glm::dvec3>& positions, std::vector<glm::dvec3>& velocities) = 0;
+  /// Steps taken so far, and the simulated time step_index() * dt.
+  virtual std::uint64_t step_index() const = 0;
+  virtual double time() const = 0;
+};
+
+/// "cpu" (or "vulkan" where built in). Unknown name: ErrorCode::invalid_argument; a backend that is
+/// not built in or finds no device: ErrorCode::no_device.
+Result<std::unique_ptr<SimBackend>> make_backend(std::string_view name, const Scene& scene, Precision precision);
+
+/// Defined in backend_vulkan.cpp when that file exists (tools/CMakeLists.txt sets VKCLOTH_CLI_HAS_VULKAN).
+Result<std::unique_ptr<SimBackend>> make_vulkan_backend(const Scene& scene, Precision precision);
+
+} // namespace vkcloth::cli
