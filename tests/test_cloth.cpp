@@ -239,3 +239,29 @@ TEST_CASE("a blow-up is reported with the step and time, and runs are bit-identi
   REQUIRE(b->run(300).ok());
   for (std::size_t k = 0; k < a->positions().size(); ++k) CHECK(a->positions()[k] == b->positions()[k]);
 }
+
+TEST_CASE("the CPU solver gives bit-identical results for any thread count") {
+  ClothDesc d;
+  d.nx = 64;
+  d.ny = 48;
+  d.particle_mass = 0.2;
+  d.origin = {-0.5, 0.0, 0.5};
+  SimParams p;
+  p.wind = {0.05, {0, 1, 0}};
+  p.colliders = {Collider::sphere({0, 0.2, 0.2}, 0.3)};
+  for (Integrator integ : {Integrator::semi_implicit_euler, Integrator::rk4}) {
+    p.integrator = integ;
+    auto one = CpuSolver<float>::create(cloth(d), p, {1});
+    auto two = CpuSolver<float>::create(cloth(d), p, {2});
+    REQUIRE(one.ok());
+    REQUIRE(two.ok());
+    CHECK(one->threads() == 1);
+    CHECK(two->threads() == 2);
+    REQUIRE(one->run(50).ok());
+    REQUIRE(two->run(50).ok());
+    std::size_t differ = 0;
+    for (std::size_t k = 0; k < one->positions().size(); ++k)
+      differ += one->positions()[k] != two->positions()[k] || one->velocities()[k] != two->velocities()[k];
+    CHECK(differ == 0);
+  }
+}

@@ -13,6 +13,7 @@
 //   6. check     NaN/inf or |p| > divergence_limit -> Error{diverged} naming the step and time
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -26,12 +27,30 @@
 
 namespace vkcloth {
 
+namespace detail {
+class ThreadPool;
+}
+
+struct CpuSolverOptions {
+  /// Threads that share a step (including the caller's); 0 = the host's hardware threads.
+  /// Small systems use fewer (one per ~1000 particles).
+  /// Every particle's arithmetic is independent of the others', so results are bit-identical
+  /// for any thread count.
+  unsigned threads = 0;
+};
+
 template <typename Real> class CpuSolver {
 public:
   using Vec3 = glm::vec<3, Real, glm::defaultp>;
 
   /// Validates `params` against `system` and copies the initial state.
-  static Result<CpuSolver> create(const ParticleSystem& system, SimParams params);
+  static Result<CpuSolver> create(const ParticleSystem& system, SimParams params, CpuSolverOptions options = {});
+
+  CpuSolver(CpuSolver&&) noexcept;
+  CpuSolver& operator=(CpuSolver&&) noexcept;
+  ~CpuSolver();
+
+  unsigned threads() const;
 
   /// Advances one time step. On a blow-up the state is left as it was after the bad step.
   Result<void> step();
@@ -64,11 +83,14 @@ public:
   Energy energy() const;
 
 private:
-  CpuSolver() = default;
+  CpuSolver();
+  // Per-particle kernels: each reads shared inputs and writes only particle p's outputs.
+  Vec3 normal_at(std::span<const Vec3> pos, std::size_t p) const;
+  Vec3 force_at(std::span<const Vec3> pos, std::span<const Vec3> vel, std::size_t p) const;
+  void contact_at(Vec3 pos, Vec3& vel, Vec3& force) const;
+  void project_at(Vec3& pos, Vec3& vel) const;
   void compute_normals(std::span<const Vec3> pos);
-  void compute_forces(std::span<const Vec3> pos, std::span<const Vec3> vel, std::vector<Vec3>& out);
-  void apply_contacts(std::span<const Vec3> pos, std::vector<Vec3>& vel, std::vector<Vec3>& force) const;
-  void project(std::vector<Vec3>& pos, std::vector<Vec3>& vel) const;
+  template <typename F> void for_particles(F&& body);
   Result<void> check_finite() const;
 
   struct Edge {
@@ -84,8 +106,11 @@ private:
   std::vector<Real> mass_;
   std::vector<std::uint8_t> pinned_;
   std::vector<Vec3> pos_, vel_, force_, normal_;
-  std::vector<Vec3> k_pos_[4], k_vel_[4], stage_pos_, stage_vel_; // RK4 scratch
+  std::vector<Vec3> pos_next_; // integration writes here while forces still read pos_
+  std::array<std::vector<Vec3>, 4> k_pos_, k_vel_; // RK4 stage derivatives
+  std::vector<Vec3> stage_pos_, stage_vel_;
   std::uint64_t step_ = 0;
+  std::unique_ptr<detail::ThreadPool> pool_;
 };
 
 extern template class CpuSolver<float>;

@@ -1,9 +1,13 @@
 #include "vkcloth/cpu_solver.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <thread>
 
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
+
+#include "thread_pool.hpp"
 
 // Floating-point expressions below are written in the exact order the GLSL passes use
 // (shaders/force.comp, shaders/integrate.comp); the engine is built with -ffp-contract=off so the
@@ -34,7 +38,14 @@ template <typename Real> Contact<Real> collider_contact(const Collider& c, glm::
 
 } // namespace
 
-template <typename Real> Result<CpuSolver<Real>> CpuSolver<Real>::create(const ParticleSystem& system, SimParams params) {
+template <typename Real> CpuSolver<Real>::CpuSolver() = default;
+template <typename Real> CpuSolver<Real>::CpuSolver(CpuSolver&&) noexcept = default;
+template <typename Real> CpuSolver<Real>& CpuSolver<Real>::operator=(CpuSolver&&) noexcept = default;
+template <typename Real> CpuSolver<Real>::~CpuSolver() = default;
+template <typename Real> unsigned CpuSolver<Real>::threads() const { return pool_->size(); }
+
+template <typename Real>
+Result<CpuSolver<Real>> CpuSolver<Real>::create(const ParticleSystem& system, SimParams params, CpuSolverOptions options) {
   VKCLOTH_TRY(params.validate());
   const std::size_t n = system.size();
   if (n == 0) return make_error(ErrorCode::invalid_argument, "the particle system is empty");
@@ -70,6 +81,13 @@ template <typename Real> Result<CpuSolver<Real>> CpuSolver<Real>::create(const P
   }
   s.force_.assign(n, Vec3(0));
   s.normal_.assign(n, Vec3(0));
+  s.pos_next_ = s.pos_;
+  if (options.threads > 256)
+    return make_error(ErrorCode::invalid_argument, fmt::format("threads must be at most 256, got {}", options.threads));
+  // Below ~1000 particles per thread the fork-join costs more than it saves.
+  const unsigned wanted = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+  const auto useful = static_cast<unsigned>(std::max<std::size_t>(1, n / 1024));
+  s.pool_ = std::make_unique<detail::ThreadPool>(std::min(wanted, useful));
   return s;
 }
 
@@ -85,91 +103,85 @@ template <typename Real> void CpuSolver<Real>::set_particle(std::uint32_t index,
   vel_[index] = pinned_[index] ? Vec3(0) : velocity;
 }
 
+template <typename Real>
+typename CpuSolver<Real>::Vec3 CpuSolver<Real>::normal_at(std::span<const Vec3> pos, std::size_t index) const {
+  const std::int64_t nx = system_->grid->nx, ny = system_->grid->ny;
+  const std::int64_t i = std::int64_t(index) % nx, j = std::int64_t(index) / nx;
+  const Vec3 p = pos[index];
+  // Fan around p: right, up, left, down. Each present pair adds one triangle's
+  // cross product (twice its area times its normal): an area-weighted vertex normal.
+  const bool has[4] = {i + 1 < nx, j + 1 < ny, i > 0, j > 0};
+  Vec3 e[4] = {};
+  if (has[0]) e[0] = pos[index + 1] - p;
+  if (has[1]) e[1] = pos[index + nx] - p;
+  if (has[2]) e[2] = pos[index - 1] - p;
+  if (has[3]) e[3] = pos[index - nx] - p;
+  Vec3 sum(0);
+  for (int k = 0; k < 4; ++k)
+    if (has[k] && has[(k + 1) & 3]) sum += glm::cross(e[k], e[(k + 1) & 3]);
+  const Real len = std::sqrt(dot3(sum, sum));
+  return len > Real(0) ? sum / len : Vec3(0);
+}
+
 template <typename Real> void CpuSolver<Real>::compute_normals(std::span<const Vec3> pos) {
   if (!system_->grid) return;
-  const std::int64_t nx = system_->grid->nx, ny = system_->grid->ny;
-  for (std::int64_t j = 0; j < ny; ++j)
-    for (std::int64_t i = 0; i < nx; ++i) {
-      const Vec3 p = pos[j * nx + i];
-      // Fan around p: right, up, left, down. Each present pair adds one triangle's
-      // cross product (twice its area times its normal): an area-weighted vertex normal.
-      const bool has[4] = {i + 1 < nx, j + 1 < ny, i > 0, j > 0};
-      Vec3 e[4] = {};
-      if (has[0]) e[0] = pos[j * nx + i + 1] - p;
-      if (has[1]) e[1] = pos[(j + 1) * nx + i] - p;
-      if (has[2]) e[2] = pos[j * nx + i - 1] - p;
-      if (has[3]) e[3] = pos[(j - 1) * nx + i] - p;
-      Vec3 sum(0);
-      for (int k = 0; k < 4; ++k)
-        if (has[k] && has[(k + 1) & 3]) sum += glm::cross(e[k], e[(k + 1) & 3]);
-      const Real len = std::sqrt(dot3(sum, sum));
-      normal_[j * nx + i] = len > Real(0) ? sum / len : Vec3(0);
-    }
+  for_particles([&](std::size_t p) { normal_[p] = normal_at(pos, p); });
 }
 
 template <typename Real>
-void CpuSolver<Real>::compute_forces(std::span<const Vec3> pos, std::span<const Vec3> vel, std::vector<Vec3>& out) {
-  compute_normals(pos);
-  const Vec3 g{params_.gravity};
-  const Real mu = Real(params_.damping);
+typename CpuSolver<Real>::Vec3 CpuSolver<Real>::force_at(std::span<const Vec3> pos, std::span<const Vec3> vel,
+                                                         std::size_t p) const {
+  const Vec3 x = pos[p];
+  Vec3 f(0);
+  for (std::uint32_t e = edge_offsets_[p]; e < edge_offsets_[p + 1]; ++e) {
+    const Edge& s = edges_[e];
+    const Vec3 u = pos[s.other] - x;
+    const Real len = std::sqrt(dot3(u, u));
+    if (len > Real(0)) f += u * (s.stiffness * (len - s.rest_length) / len); // report eq. 2
+  }
+  const Real m = mass_[p];
+  f += Vec3{params_.gravity} * m;
+  f -= vel[p] * (Real(params_.damping) * m);
   const Real kw = Real(params_.wind.strength);
-  const Vec3 uw{params_.wind.direction};
-  const std::size_t n = pos.size();
-  for (std::size_t p = 0; p < n; ++p) {
-    const Vec3 x = pos[p];
-    Vec3 f(0);
-    for (std::uint32_t e = edge_offsets_[p]; e < edge_offsets_[p + 1]; ++e) {
-      const Edge& s = edges_[e];
-      const Vec3 u = pos[s.other] - x;
-      const Real len = std::sqrt(dot3(u, u));
-      if (len > Real(0)) f += u * (s.stiffness * (len - s.rest_length) / len); // report eq. 2
-    }
-    const Real m = mass_[p];
-    f += g * m;
-    f -= vel[p] * (mu * m);
-    if (kw != Real(0)) {
-      const Vec3 nrm = normal_[p];
-      f += nrm * (kw * dot3(nrm, uw));
-    }
-    out[p] = f;
+  if (kw != Real(0)) {
+    const Vec3 nrm = normal_[p];
+    f += nrm * (kw * dot3(nrm, Vec3{params_.wind.direction}));
   }
+  return f;
 }
 
-template <typename Real>
-void CpuSolver<Real>::apply_contacts(std::span<const Vec3> pos, std::vector<Vec3>& vel, std::vector<Vec3>& force) const {
-  if (params_.colliders.empty()) return;
+template <typename Real> void CpuSolver<Real>::contact_at(Vec3 pos, Vec3& vel, Vec3& force) const {
   const Real band = Real(2) * Real(params_.contact_epsilon);
-  for (std::size_t p = 0; p < pos.size(); ++p) {
-    if (pinned_[p]) continue;
-    for (const Collider& c : params_.colliders) {
-      const Contact<Real> ct = collider_contact<Real>(c, pos[p]);
-      if (!(ct.distance < band)) continue;
-      // Only the part pointing INTO the collider is removed: a hand lifting the cloth keeps
-      // its outward pull (report §4, Figure 12).
-      const Real vn = dot3(vel[p], ct.normal);
-      if (vn < Real(0)) vel[p] -= ct.normal * vn;
-      const Real fn = dot3(force[p], ct.normal);
-      if (fn < Real(0)) force[p] -= ct.normal * fn;
-    }
+  for (const Collider& c : params_.colliders) {
+    const Contact<Real> ct = collider_contact<Real>(c, pos);
+    if (!(ct.distance < band)) continue;
+    // Only the part pointing INTO the collider is removed: a hand lifting the cloth keeps
+    // its outward pull (report §4, Figure 12).
+    const Real vn = dot3(vel, ct.normal);
+    if (vn < Real(0)) vel -= ct.normal * vn;
+    const Real fn = dot3(force, ct.normal);
+    if (fn < Real(0)) force -= ct.normal * fn;
   }
 }
 
-template <typename Real> void CpuSolver<Real>::project(std::vector<Vec3>& pos, std::vector<Vec3>& vel) const {
-  if (params_.colliders.empty()) return;
+template <typename Real> void CpuSolver<Real>::project_at(Vec3& pos, Vec3& vel) const {
   const Real eps = Real(params_.contact_epsilon);
-  for (std::size_t p = 0; p < pos.size(); ++p) {
-    if (pinned_[p]) continue;
-    for (const Collider& c : params_.colliders) {
-      const Contact<Real> ct = collider_contact<Real>(c, pos[p]);
-      if (!(ct.distance < Real(0))) continue;
-      if (c.type == Collider::Type::plane)
-        pos[p] += ct.normal * (eps - ct.distance); // report eq. 5: back to z_s + eps
-      else
-        pos[p] = Vec3{c.center} + ct.normal * (Real(c.radius) + eps); // report eq. 6
-      const Real vn = dot3(vel[p], ct.normal);
-      if (vn < Real(0)) vel[p] -= ct.normal * vn;
-    }
+  for (const Collider& c : params_.colliders) {
+    const Contact<Real> ct = collider_contact<Real>(c, pos);
+    if (!(ct.distance < Real(0))) continue;
+    if (c.type == Collider::Type::plane)
+      pos += ct.normal * (eps - ct.distance); // report eq. 5: back to z_s + eps
+    else
+      pos = Vec3{c.center} + ct.normal * (Real(c.radius) + eps); // report eq. 6
+    const Real vn = dot3(vel, ct.normal);
+    if (vn < Real(0)) vel -= ct.normal * vn;
   }
+}
+
+template <typename Real> template <typename F> void CpuSolver<Real>::for_particles(F&& body) {
+  pool_->parallel_for(pos_.size(), [&](std::size_t begin, std::size_t end) {
+    for (std::size_t p = begin; p < end; ++p) body(p);
+  });
 }
 
 template <typename Real> Result<void> CpuSolver<Real>::check_finite() const {
@@ -190,29 +202,41 @@ template <typename Real> Result<void> CpuSolver<Real>::check_finite() const {
 }
 
 template <typename Real> Result<void> CpuSolver<Real>::step() {
-  const std::size_t n = pos_.size();
   const Real dt = Real(params_.dt);
   switch (params_.integrator) {
   case Integrator::explicit_euler:
   case Integrator::semi_implicit_euler: {
-    compute_forces(pos_, vel_, force_);
-    apply_contacts(pos_, vel_, force_);
+    compute_normals(pos_);
     const bool semi = params_.integrator == Integrator::semi_implicit_euler;
-    for (std::size_t p = 0; p < n; ++p) {
-      if (pinned_[p]) continue;
-      const Vec3 a = force_[p] / mass_[p];
-      if (semi) {
-        vel_[p] += a * dt;
-        pos_[p] += vel_[p] * dt;
-      } else {
-        pos_[p] += vel_[p] * dt;
-        vel_[p] += a * dt;
+    for_particles([&](std::size_t p) {
+      Vec3 f = force_at(pos_, vel_, p);
+      if (pinned_[p]) {
+        force_[p] = f;
+        pos_next_[p] = pos_[p];
+        return;
       }
-    }
+      Vec3 v = vel_[p];
+      contact_at(pos_[p], v, f);
+      force_[p] = f;
+      const Vec3 a = f / mass_[p];
+      Vec3 x = pos_[p];
+      if (semi) {
+        v += a * dt;
+        x += v * dt;
+      } else {
+        x += v * dt;
+        v += a * dt;
+      }
+      project_at(x, v);
+      pos_next_[p] = x;
+      vel_[p] = v; // only particle p reads its own velocity: updating in place is safe
+    });
+    std::swap(pos_, pos_next_);
     break;
   }
   case Integrator::rk4: {
-    // Stage k evaluates (v, F/m) at y_k = y0 + c_k dt k_{k-1}; contacts filter each stage.
+    // Stage s evaluates (v, F/m) at y_s = y0 + c_s dt k_{s-1}; contacts filter each stage.
+    const std::size_t n = pos_.size();
     if (stage_pos_.size() != n) {
       for (auto& k : k_pos_) k.resize(n);
       for (auto& k : k_vel_) k.resize(n);
@@ -225,22 +249,23 @@ template <typename Real> Result<void> CpuSolver<Real>::step() {
         stage_pos_ = pos_;
         stage_vel_ = vel_;
       } else {
-        for (std::size_t p = 0; p < n; ++p) {
+        for_particles([&](std::size_t p) {
           stage_pos_[p] = pos_[p] + k_pos_[s - 1][p] * c[s];
           stage_vel_[p] = vel_[p] + k_vel_[s - 1][p] * c[s];
-        }
+        });
       }
-      std::vector<Vec3>& f = s == 0 ? force_ : k_vel_[s];
-      compute_forces(stage_pos_, stage_vel_, f);
-      apply_contacts(stage_pos_, stage_vel_, f);
-      for (std::size_t p = 0; p < n; ++p) {
+      compute_normals(stage_pos_);
+      for_particles([&](std::size_t p) {
+        Vec3 f = force_at(stage_pos_, stage_vel_, p);
+        if (!pinned_[p]) contact_at(stage_pos_[p], stage_vel_[p], f);
+        if (s == 0) force_[p] = f;
         k_pos_[s][p] = pinned_[p] ? Vec3(0) : stage_vel_[p];
-        k_vel_[s][p] = pinned_[p] ? Vec3(0) : f[p] / mass_[p];
-      }
+        k_vel_[s][p] = pinned_[p] ? Vec3(0) : f / mass_[p];
+      });
     }
     const Real w = dt / Real(6);
-    for (std::size_t p = 0; p < n; ++p) {
-      if (pinned_[p]) continue;
+    for_particles([&](std::size_t p) {
+      if (pinned_[p]) return;
       Vec3 dp = k_pos_[0][p] + k_pos_[1][p] * Real(2);
       dp += k_pos_[2][p] * Real(2);
       dp += k_pos_[3][p];
@@ -249,11 +274,11 @@ template <typename Real> Result<void> CpuSolver<Real>::step() {
       dv += k_vel_[3][p];
       pos_[p] += dp * w;
       vel_[p] += dv * w;
-    }
+      project_at(pos_[p], vel_[p]);
+    });
     break;
   }
   }
-  project(pos_, vel_);
   ++step_;
   return check_finite();
 }
