@@ -1,0 +1,185 @@
+// The vkcloth command line, run as a separate process: exit codes, messages, CSV outputs.
+#include <doctest/doctest.h>
+
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Outcome {
+  int code = -1;
+  std::string out, err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+fs::path tmp_dir() {
+  fs::path d(VKCLOTH_TEST_TMP);
+  fs::create_directories(d);
+  return d;
+}
+
+/// Runs `vkcloth <args>`; `tag` keeps the captured output of concurrent tests apart.
+Outcome vkcloth(const std::string& tag, const std::string& args) {
+  const fs::path out = tmp_dir() / (tag + ".stdout"), err = tmp_dir() / (tag + ".stderr");
+  const std::string cmd = std::string("'") + VKCLOTH_CLI_PATH + "' " + args + " >'" + out.string() + "' 2>'" +
+                          err.string() + "' </dev/null";
+  const int status = std::system(cmd.c_str());
+  Outcome o;
+  o.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  o.out = slurp(out);
+  o.err = slurp(err);
+  return o;
+}
+
+/// Single-quoted for the shell. (Appending avoids a g++ 12 -Wrestrict false positive on "'" + s.)
+std::string quote(const std::string& s) {
+  std::string q;
+  q.reserve(s.size() + 2);
+  q.append(1, '\'').append(s).append(1, '\'');
+  return q;
+}
+
+std::string write_scene(const std::string& name, const std::string& text) {
+  const fs::path p = tmp_dir() / name;
+  std::ofstream(p) << text;
+  return quote(p.string());
+}
+
+std::string sample(const std::string& name) { return quote(std::string(VKCLOTH_SCENES_DIR) + "/" + name); }
+
+std::vector<std::vector<std::string>> read_csv(const fs::path& p) {
+  std::vector<std::vector<std::string>> rows;
+  std::ifstream in(p);
+  for (std::string line; std::getline(in, line);) {
+    std::vector<std::string> cells;
+    std::stringstream s(line);
+    for (std::string c; std::getline(s, c, ',');) cells.push_back(c);
+    rows.push_back(cells);
+  }
+  return rows;
+}
+
+} // namespace
+
+TEST_CASE("cli: bad scene files exit 2 and stderr names the key") {
+  struct Bad {
+    const char* name;
+    const char* text;
+    const char* needle;
+  };
+  const Bad cases[] = {
+      {"typo.json", R"({"system": "cloth", "cloth": {"stifness": {"bend": 1}}})", "cloth.stifness"},
+      {"type.json", R"({"system": "chain", "integrator": {"dt": "fast"}})", "integrator.dt"},
+      {"range.json", R"({"system": "chain", "physics": {"damping": -1}})", "physics.damping"},
+      {"grid.json", R"({"system": "cloth", "cloth": {"resolution": [100000, 100000]}})", "cloth.resolution"},
+      {"inf.json", R"({"system": "chain", "integrator": {"dt": 1e999}})", "integrator.dt"},
+      {"nosystem.json", R"({"integrator": {"dt": 0.02}})", "system"},
+      {"syntax.json", "{\"system\": \"chain\",\n}", "syntax.json:2:"},
+  };
+  for (const Bad& b : cases) {
+    CAPTURE(b.name);
+    const Outcome o = vkcloth(std::string("bad_") + b.name, "run " + write_scene(b.name, b.text));
+    CHECK(o.code == 2);
+    CHECK_MESSAGE(o.err.find(b.needle) != std::string::npos, o.err);
+    CHECK(o.out.empty());
+  }
+  const Outcome missing = vkcloth("missing", "run /nonexistent/scene.json");
+  CHECK(missing.code == 2);
+  CHECK(missing.err.find("/nonexistent/scene.json") != std::string::npos);
+  const Outcome bad_set = vkcloth("bad_set", "run " + sample("spring.json") + " --set integrator.dt.x=1");
+  CHECK(bad_set.code == 2);
+  CHECK(bad_set.err.find("integrator.dt.x") != std::string::npos);
+}
+
+TEST_CASE("cli: the single spring settles at the static sag L0 + mg/K below the anchor") {
+  const fs::path pos = tmp_dir() / "spring_positions.csv";
+  const Outcome o = vkcloth("sag", "run " + sample("spring.json") + " --steps 3000 --positions '" + pos.string() + "'");
+  REQUIRE(o.code == 0);
+  CHECK(o.out.find("spring") != std::string::npos);
+  CHECK(o.out.find("3000 steps") != std::string::npos);
+  const auto rows = read_csv(pos);
+  REQUIRE(rows.size() == 3);
+  CHECK(rows[0] == std::vector<std::string>{"particle", "x", "y", "z"});
+  REQUIRE(rows[2].size() == 4);
+  CHECK(rows[2][0] == "1");
+  CHECK(std::abs(std::stod(rows[2][3]) - (-0.4 - 0.4905)) < 1e-3);
+}
+
+TEST_CASE("cli: --trace writes step 0 and every K-th step for every particle") {
+  const fs::path trace = tmp_dir() / "trace.csv";
+  const Outcome o = vkcloth("trace", "run " + sample("double_spring.json") + " --steps 10 --trace-every 3 --trace '" +
+                                         trace.string() + "' --precision double");
+  REQUIRE(o.code == 0);
+  const auto rows = read_csv(trace);
+  // Steps 0, 3, 6, 9 for 3 particles (anchor included), plus the header.
+  REQUIRE(rows.size() == 1 + 4 * 3);
+  CHECK(rows[0] == std::vector<std::string>{"step", "time", "particle", "x", "y", "z", "vx", "vy", "vz"});
+  CHECK(rows[1][0] == "0");
+  CHECK(rows[1][2] == "0");
+  CHECK(rows[2][3] == "0.3"); // particle 1 starts at x = 0.3
+  CHECK(rows.back()[0] == "9");
+  CHECK(std::stod(rows.back()[1]) == doctest::Approx(0.18));
+  CHECK(rows.back()[2] == "2");
+  for (const auto& r : rows) CHECK(r.size() == 9);
+
+  const Outcome every = vkcloth("trace1", "run " + sample("spring.json") + " --steps 4 --trace '" + trace.string() + "'");
+  REQUIRE(every.code == 0);
+  CHECK(read_csv(trace).size() == 1 + 5 * 2);
+}
+
+TEST_CASE("cli: a diverging run exits 3, names the step, and keeps the trace rows before it") {
+  const fs::path trace = tmp_dir() / "diverge.csv";
+  const Outcome o =
+      vkcloth("diverge", "run " + sample("spring.json") + " --dt 0.45 --steps 200 --trace '" + trace.string() + "'");
+  CHECK(o.code == 3);
+  CHECK(o.err.find("diverged") != std::string::npos);
+  CHECK(o.err.find("step") != std::string::npos);
+  const auto rows = read_csv(trace);
+  CHECK(rows.size() > 3);           // some steps ran before the blow-up...
+  CHECK(rows.size() < 1 + 201 * 2); // ...but not all of them
+}
+
+TEST_CASE("cli: usage errors exit 2, --help exits 0 and documents the exit codes") {
+  CHECK(vkcloth("nosuch", "run " + sample("spring.json") + " --backend nosuch").code == 2);
+  const Outcome vk = vkcloth("vulkan", "run " + sample("spring.json") + " --backend vulkan");
+  CHECK((vk.code == 4 || vk.code == 0)); // 0 once a Vulkan backend is built in and finds a device
+  if (vk.code == 4) CHECK(vk.err.find("vulkan") != std::string::npos);
+  CHECK(vkcloth("noargs", "").code == 2);
+  CHECK(vkcloth("noscene", "run").code == 2);
+  CHECK(vkcloth("badflag", "run " + sample("spring.json") + " --bogus").code == 2);
+  CHECK(vkcloth("badsteps", "run " + sample("spring.json") + " --steps -3").code == 2);
+  CHECK(vkcloth("badprec", "run " + sample("spring.json") + " --precision half").code == 2);
+  CHECK(vkcloth("badinteg", "run " + sample("spring.json") + " --integrator leapfrog").code == 2);
+  const Outcome help = vkcloth("help", "--help");
+  CHECK(help.code == 0);
+  CHECK(help.out.find("Exit codes") != std::string::npos);
+  CHECK(help.out.find("run") != std::string::npos);
+  CHECK(help.out.find("info") != std::string::npos);
+  const Outcome run_help = vkcloth("run_help", "run --help");
+  CHECK(run_help.code == 0);
+  CHECK(run_help.out.find("--trace-every") != std::string::npos);
+  CHECK(run_help.out.find("Exit codes") != std::string::npos);
+}
+
+TEST_CASE("cli: info prints the parsed scene") {
+  const Outcome o = vkcloth("info", "info " + sample("cloth_hanging.json") + " --set cloth.stiffness.shear=0");
+  REQUIRE(o.code == 0);
+  CHECK(o.out.find("100 (2 pinned") != std::string::npos);
+  CHECK(o.out.find("structural") != std::string::npos);
+  CHECK(o.out.find("shear") == std::string::npos); // switched off by the override
+  CHECK(o.out.find("semi_implicit_euler") != std::string::npos);
+}

@@ -1,0 +1,209 @@
+// Scene files that load: the samples, defaults for omitted keys, overrides.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "vkcloth/vkcloth.hpp"
+
+using namespace vkcloth;
+
+namespace {
+
+Scene load_ok(const std::string& text, std::vector<std::string> overrides = {}) {
+  auto s = parse_scene(text, "test.json", overrides);
+  if (!s) FAIL("unexpected error: " << s.error().message);
+  return std::move(*s);
+}
+
+std::size_t count_pinned(const ParticleSystem& sys) {
+  return static_cast<std::size_t>(
+      std::count_if(sys.particles.begin(), sys.particles.end(), [](const Particle& p) { return p.pinned; }));
+}
+
+std::size_t count_kind(const ParticleSystem& sys, SpringKind kind) {
+  return static_cast<std::size_t>(
+      std::count_if(sys.springs.begin(), sys.springs.end(), [&](const Spring& s) { return s.kind == kind; }));
+}
+
+} // namespace
+
+TEST_CASE("every sample scene loads and runs its steps on the CPU solver without diverging") {
+  std::size_t n = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(VKCLOTH_SCENES_DIR)) {
+    if (entry.path().extension() != ".json") continue;
+    CAPTURE(entry.path().string());
+    auto scene = load_scene_file(entry.path());
+    REQUIRE_MESSAGE(scene.ok(), (scene.ok() ? "" : scene.error().message));
+    CHECK(scene->name == entry.path().stem().string());
+    auto solver = CpuSolver<float>::create(scene->system, scene->params);
+    REQUIRE(solver.ok());
+    auto run = solver->run(scene->steps);
+    CHECK_MESSAGE(run.ok(), (run.ok() ? "" : run.error().message));
+    ++n;
+  }
+  CHECK(n >= 6);
+}
+
+TEST_CASE("spring.json is the report's single spring (section 2.1)") {
+  auto s = load_scene_file(std::filesystem::path(VKCLOTH_SCENES_DIR) / "spring.json");
+  REQUIRE(s.ok());
+  CHECK(s->system_kind == "chain");
+  REQUIRE(s->system.size() == 2);
+  REQUIRE(s->system.springs.size() == 1);
+  CHECK(s->system.particles[0].pinned);
+  CHECK(s->system.particles[1].mass == 1.0);
+  CHECK(s->system.particles[1].position.z == doctest::Approx(-0.4));
+  CHECK(s->system.springs[0].stiffness == 20.0);
+  CHECK(s->system.springs[0].rest_length == 0.4);
+  CHECK(s->params.dt == 0.02);
+  CHECK(s->params.damping == 0.5);
+  CHECK(s->params.gravity.z == doctest::Approx(-9.81));
+  CHECK(s->params.integrator == Integrator::semi_implicit_euler);
+  CHECK(s->steps == 500);
+}
+
+TEST_CASE("the cloth samples have the documented shape") {
+  const std::filesystem::path dir(VKCLOTH_SCENES_DIR);
+  auto hanging = load_scene_file(dir / "cloth_hanging.json");
+  REQUIRE(hanging.ok());
+  REQUIRE(hanging->system.grid.has_value());
+  CHECK(hanging->system.grid->nx == 10);
+  CHECK(hanging->system.grid->ny == 10);
+  CHECK(count_pinned(hanging->system) == 2);
+  CHECK(hanging->system.particles[9 * 10 + 0].pinned);
+  CHECK(hanging->system.particles[9 * 10 + 9].pinned);
+  CHECK(hanging->system.particles[0].position.x == doctest::Approx(-0.5));
+  CHECK(hanging->system.particles[0].position.z == doctest::Approx(0.5));
+  CHECK(hanging->system.particles[99].position.z == doctest::Approx(1.5)); // vertical: j goes up z
+
+  auto plane = load_scene_file(dir / "cloth_on_plane.json");
+  REQUIRE(plane.ok());
+  CHECK(count_pinned(plane->system) == 0);
+  REQUIRE(plane->params.colliders.size() == 1);
+  CHECK(plane->params.colliders[0].type == Collider::Type::plane);
+
+  auto sphere = load_scene_file(dir / "cloth_on_sphere.json");
+  REQUIRE(sphere.ok());
+  CHECK(count_pinned(sphere->system) == 0);
+  REQUIRE(!sphere->params.colliders.empty());
+  CHECK(sphere->params.colliders[0].type == Collider::Type::sphere);
+  CHECK(sphere->params.colliders[0].radius > 0.0);
+
+  auto wind = load_scene_file(dir / "cloth_wind.json");
+  REQUIRE(wind.ok());
+  CHECK(wind->params.wind.strength > 0.0);
+
+  auto dbl = load_scene_file(dir / "double_spring.json");
+  REQUIRE(dbl.ok());
+  CHECK(dbl->system.size() == 3);
+  CHECK(dbl->system.springs.size() == 2);
+  CHECK(dbl->system.particles[1].position.x != 0.0); // started off-axis: it swings
+}
+
+TEST_CASE("omitted keys take the report's defaults") {
+  const Scene chain = load_ok(R"({"system": "chain"})");
+  const SimParams def;
+  CHECK(chain.params.dt == def.dt);
+  CHECK(chain.params.damping == def.damping);
+  CHECK(chain.params.gravity == def.gravity);
+  CHECK(chain.params.integrator == Integrator::semi_implicit_euler);
+  CHECK(chain.params.contact_epsilon == def.contact_epsilon);
+  CHECK(chain.params.divergence_limit == def.divergence_limit);
+  CHECK(chain.params.wind.strength == 0.0);
+  CHECK(chain.params.colliders.empty());
+  CHECK(chain.steps == 500);
+  CHECK(chain.name == "test");
+  REQUIRE(chain.system.size() == 2);
+  CHECK(chain.system.springs[0].stiffness == 20.0);
+  CHECK(chain.system.particles[1].position.z == doctest::Approx(-0.4));
+
+  const Scene cloth = load_ok(R"({"system": "cloth", "name": "c"})");
+  CHECK(cloth.name == "c");
+  REQUIRE(cloth.system.grid.has_value());
+  CHECK(cloth.system.grid->nx == 10);
+  CHECK(cloth.system.particles[0].mass == 0.05);
+  CHECK(count_pinned(cloth.system) == 2); // absent "pins": the two top corners
+  CHECK(count_kind(cloth.system, SpringKind::structural) == 180);
+  CHECK(cloth.system.springs[0].stiffness == 40.0);
+  const Spring* shear = nullptr;
+  for (const Spring& s : cloth.system.springs)
+    if (s.kind == SpringKind::shear) shear = &s;
+  REQUIRE(shear != nullptr);
+  CHECK(shear->stiffness == 8.0);
+}
+
+TEST_CASE("chain: anchor without positions hangs the masses below it at rest length") {
+  const Scene s = load_ok(R"({"system": "chain", "chain": {"anchor": [1, 2, 3], "masses": [1, 2],
+                                "stiffness": 20, "rest_lengths": [0.4, 0.5]}})");
+  REQUIRE(s.system.size() == 3);
+  CHECK(s.system.particles[1].position == glm::dvec3(1, 2, 2.6));
+  CHECK(s.system.particles[2].position.z == doctest::Approx(2.1));
+  CHECK(s.system.particles[2].mass == 2.0);
+  CHECK(s.system.springs[1].stiffness == 20.0); // one stiffness for every spring
+}
+
+TEST_CASE("cloth: pins absent, empty and explicit") {
+  CHECK(count_pinned(load_ok(R"({"system": "cloth", "cloth": {}})").system) == 2);
+  CHECK(count_pinned(load_ok(R"({"system": "cloth", "cloth": {"pins": []}})").system) == 0);
+  const Scene s = load_ok(R"({"system": "cloth", "cloth": {"resolution": [4, 3], "pins": [[1, 2]]}})");
+  CHECK(count_pinned(s.system) == 1);
+  CHECK(s.system.particles[2 * 4 + 1].pinned); // index j*nx+i
+}
+
+TEST_CASE("cloth: every key is read") {
+  const Scene s = load_ok(R"({"system": "cloth", "cloth": {"resolution": [5, 4], "size": [2, 3],
+    "origin": [1, 1, 1], "orientation": "horizontal", "particle_mass": 0.2,
+    "stiffness": {"structural": 30, "shear": 0, "bend": 2}},
+    "integrator": {"method": "rk4", "dt": 0.005, "steps": 1e3},
+    "physics": {"gravity": [0, 0, -1], "damping": 0.1},
+    "wind": {"strength": 0.02, "direction": [0, 2, 0]},
+    "colliders": [{"type": "plane", "normal": [0, 0, 2], "offset": -1},
+                  {"type": "sphere", "center": [0, 0, -5], "radius": 0.5}],
+    "contact_epsilon": 0.002, "divergence_limit": 100})");
+  CHECK(s.system.grid->nx == 5);
+  CHECK(s.system.grid->ny == 4);
+  CHECK(s.system.particles[19].position == glm::dvec3(3, 4, 1)); // horizontal: j goes along y
+  CHECK(s.system.particles[0].mass == 0.2);
+  CHECK(count_kind(s.system, SpringKind::shear) == 0);
+  CHECK(count_kind(s.system, SpringKind::bend) > 0);
+  CHECK(s.params.integrator == Integrator::rk4);
+  CHECK(s.params.dt == 0.005);
+  CHECK(s.steps == 1000);
+  CHECK(s.params.damping == 0.1);
+  CHECK(s.params.wind.direction == glm::dvec3(0, 1, 0)); // normalised
+  REQUIRE(s.params.colliders.size() == 2);
+  CHECK(s.params.colliders[0].normal == glm::dvec3(0, 0, 1));
+  CHECK(s.params.colliders[0].offset == -1.0);
+  CHECK(s.params.colliders[1].radius == 0.5);
+  CHECK(s.params.contact_epsilon == 0.002);
+  CHECK(s.params.divergence_limit == 100.0);
+}
+
+TEST_CASE("overrides set values before validation") {
+  const std::string base = R"({"system": "cloth", "colliders": [{"type": "sphere", "center": [0, 0, 0], "radius": 1}]})";
+  const Scene s = load_ok(base, {"cloth.stiffness.bend=15", "integrator.dt=0.01", "wind.direction=[0,1,0]",
+                                 "wind.strength=0.05", "colliders.0.radius=0.3", "integrator.method=rk4",
+                                 "integrator.steps=7", "name=renamed", "cloth.pins=[]"});
+  CHECK(s.params.dt == 0.01);
+  CHECK(s.params.wind.direction == glm::dvec3(0, 1, 0));
+  CHECK(s.params.colliders[0].radius == 0.3);
+  CHECK(s.params.integrator == Integrator::rk4);
+  CHECK(s.steps == 7);
+  CHECK(s.name == "renamed");
+  CHECK(count_pinned(s.system) == 0);
+  bool bend15 = false;
+  for (const Spring& sp : s.system.springs) bend15 = bend15 || (sp.kind == SpringKind::bend && sp.stiffness == 15.0);
+  CHECK(bend15);
+
+  // Bracket indices, and appending a collider at index == size.
+  const Scene t = load_ok(base, {"colliders[0].radius=2", R"(colliders.1={"type":"plane"})"});
+  CHECK(t.params.colliders[0].radius == 2.0);
+  REQUIRE(t.params.colliders.size() == 2);
+  CHECK(t.params.colliders[1].type == Collider::Type::plane);
+
+  // Later overrides win.
+  CHECK(load_ok(R"({"system": "chain"})", {"integrator.dt=0.1", "integrator.dt=0.2"}).params.dt == 0.2);
+}
