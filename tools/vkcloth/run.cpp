@@ -1,7 +1,9 @@
 // `vkcloth run`: load, simulate, write CSVs, summarise.
 #include <algorithm>
 #include <chrono>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <cstdio>
 #include <memory>
 
@@ -23,7 +25,8 @@ using File = std::unique_ptr<std::FILE, FileCloser>;
 
 Result<File> open_output(const std::string& path, const char* what) {
   File f{std::fopen(path.c_str(), "w")};
-  if (!f) return make_error(ErrorCode::io, fmt::format("cannot write the {} file {}", what, path));
+  if (!f)
+    return make_error(ErrorCode::io, fmt::format("cannot write the {} file {}: {}", what, path, std::strerror(errno)));
   return f;
 }
 
@@ -94,8 +97,9 @@ int run_command(const RunOptions& opt) {
   const auto read = [&] { return backend.read_state(pos, vel); };
   const std::uint64_t total = scene->steps;
   const std::uint64_t every = std::max<std::uint64_t>(opt.trace_every, 1);
+  if (auto r = read(); !r) return report(r.error());
+  const std::vector<glm::dvec3> initial = pos; // in the solver's precision, for the displacement
   if (trace) {
-    if (auto r = read(); !r) return report(r.error());
     write_trace_rows(trace.get(), 0, backend.time(), pos, vel);
   }
 
@@ -134,7 +138,7 @@ int run_command(const RunOptions& opt) {
 
   double max_disp = 0.0;
   for (std::size_t k = 0; k < pos.size(); ++k)
-    max_disp = std::max(max_disp, glm::length(pos[k] - scene->system.particles[k].position));
+    max_disp = std::max(max_disp, glm::length(pos[k] - initial[k]));
   fmt::print("{}: {} particles, {} springs, {} steps of {:g} s ({}, {} {}): simulated {:.6g} s in {:.3f} s wall, "
              "max displacement {:.6g} m\n",
              scene->name, scene->system.size(), scene->system.springs.size(), backend.step_index(), scene->params.dt,
