@@ -59,7 +59,9 @@ std::string write_scene(const std::string& name, const std::string& text) {
   return quote(p.string());
 }
 
-std::string sample(const std::string& name) { return quote(std::string(VKCLOTH_SCENES_DIR) + "/" + name); }
+std::string sample(const std::string& name) {
+  return quote(std::string(VKCLOTH_SCENES_DIR) + "/" + name);
+}
 
 std::vector<std::vector<std::string>> read_csv(const fs::path& p) {
   std::vector<std::vector<std::string>> rows;
@@ -67,7 +69,8 @@ std::vector<std::vector<std::string>> read_csv(const fs::path& p) {
   for (std::string line; std::getline(in, line);) {
     std::vector<std::string> cells;
     std::stringstream s(line);
-    for (std::string c; std::getline(s, c, ',');) cells.push_back(c);
+    for (std::string c; std::getline(s, c, ',');)
+      cells.push_back(c);
     rows.push_back(cells);
   }
   return rows;
@@ -107,7 +110,8 @@ TEST_CASE("cli: bad scene files exit 2 and stderr names the key") {
 
 TEST_CASE("cli: the single spring settles at the static sag L0 + mg/K below the anchor") {
   const fs::path pos = tmp_dir() / "spring_positions.csv";
-  const Outcome o = vkcloth("sag", "run " + sample("spring.json") + " --steps 3000 --positions '" + pos.string() + "'");
+  const Outcome o =
+      vkcloth("sag", "run " + sample("spring.json") + " --steps 3000 --positions '" + pos.string() + "'");
   REQUIRE(o.code == 0);
   CHECK(o.out.find("spring") != std::string::npos);
   CHECK(o.out.find("3000 steps") != std::string::npos);
@@ -121,8 +125,9 @@ TEST_CASE("cli: the single spring settles at the static sag L0 + mg/K below the 
 
 TEST_CASE("cli: --trace writes step 0 and every K-th step for every particle") {
   const fs::path trace = tmp_dir() / "trace.csv";
-  const Outcome o = vkcloth("trace", "run " + sample("double_spring.json") + " --steps 10 --trace-every 3 --trace '" +
-                                         trace.string() + "' --precision double");
+  const Outcome o =
+      vkcloth("trace", "run " + sample("double_spring.json") + " --steps 10 --trace-every 3 --trace '" +
+                           trace.string() + "' --precision double");
   REQUIRE(o.code == 0);
   const auto rows = read_csv(trace);
   // Steps 0, 3, 6, 9 for 3 particles (anchor included), plus the header.
@@ -134,17 +139,19 @@ TEST_CASE("cli: --trace writes step 0 and every K-th step for every particle") {
   CHECK(rows.back()[0] == "9");
   CHECK(std::stod(rows.back()[1]) == doctest::Approx(0.18));
   CHECK(rows.back()[2] == "2");
-  for (const auto& r : rows) CHECK(r.size() == 9);
+  for (const auto& r : rows)
+    CHECK(r.size() == 9);
 
-  const Outcome every = vkcloth("trace1", "run " + sample("spring.json") + " --steps 4 --trace '" + trace.string() + "'");
+  const Outcome every =
+      vkcloth("trace1", "run " + sample("spring.json") + " --steps 4 --trace '" + trace.string() + "'");
   REQUIRE(every.code == 0);
   CHECK(read_csv(trace).size() == 1 + 5 * 2);
 }
 
 TEST_CASE("cli: a diverging run exits 3, names the step, and keeps the trace rows before it") {
   const fs::path trace = tmp_dir() / "diverge.csv";
-  const Outcome o =
-      vkcloth("diverge", "run " + sample("spring.json") + " --dt 0.45 --steps 200 --trace '" + trace.string() + "'");
+  const Outcome o = vkcloth("diverge", "run " + sample("spring.json") + " --dt 0.45 --steps 200 --trace '" +
+                                           trace.string() + "'");
   CHECK(o.code == 3);
   CHECK(o.err.find("diverged") != std::string::npos);
   CHECK(o.err.find("step") != std::string::npos);
@@ -157,7 +164,8 @@ TEST_CASE("cli: usage errors exit 2, --help exits 0 and documents the exit codes
   CHECK(vkcloth("nosuch", "run " + sample("spring.json") + " --backend nosuch").code == 2);
   const Outcome vk = vkcloth("vulkan", "run " + sample("spring.json") + " --backend vulkan");
   CHECK((vk.code == 4 || vk.code == 0)); // 0 once a Vulkan backend is built in and finds a device
-  if (vk.code == 4) CHECK(vk.err.find("vulkan") != std::string::npos);
+  if (vk.code == 4)
+    CHECK(vk.err.find("vulkan") != std::string::npos);
   CHECK(vkcloth("noargs", "").code == 2);
   CHECK(vkcloth("noscene", "run").code == 2);
   CHECK(vkcloth("badflag", "run " + sample("spring.json") + " --bogus").code == 2);
@@ -176,7 +184,8 @@ TEST_CASE("cli: usage errors exit 2, --help exits 0 and documents the exit codes
 }
 
 TEST_CASE("cli: info prints the parsed scene") {
-  const Outcome o = vkcloth("info", "info " + sample("cloth_hanging.json") + " --set cloth.stiffness.shear=0");
+  const Outcome o =
+      vkcloth("info", "info " + sample("cloth_hanging.json") + " --set cloth.stiffness.shear=0");
   REQUIRE(o.code == 0);
   CHECK(o.out.find("100 (2 pinned") != std::string::npos);
   CHECK(o.out.find("structural") != std::string::npos);

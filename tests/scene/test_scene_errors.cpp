@@ -17,17 +17,21 @@ Error expect_error(const std::string& text, std::initializer_list<std::string> n
   auto s = parse_scene(text, "bad.json", overrides);
   REQUIRE_MESSAGE(!s.ok(), "expected an error for: " << text);
   const std::string& msg = s.error().message;
-  for (const std::string& n : needles) CHECK_MESSAGE(msg.find(n) != std::string::npos, "'" << n << "' not in: " << msg);
+  for (const std::string& n : needles)
+    CHECK_MESSAGE(msg.find(n) != std::string::npos, "'" << n << "' not in: " << msg);
   CHECK(msg.find("bad.json") != std::string::npos); // every message names the file
   return s.error();
 }
 
-std::string cloth(const std::string& body) { return R"({"system": "cloth", "cloth": )" + body + "}"; }
+std::string cloth(const std::string& body) {
+  return R"({"system": "cloth", "cloth": )" + body + "}";
+}
 
 } // namespace
 
 TEST_CASE("malformed JSON: parse error with line and column") {
-  const Error e = expect_error("{\"system\": \"chain\",\n  \"physics\": {\"damping\": 0.5,}\n}", {"bad.json:2:", "invalid JSON"});
+  const Error e = expect_error("{\"system\": \"chain\",\n  \"physics\": {\"damping\": 0.5,}\n}",
+                               {"bad.json:2:", "invalid JSON"});
   CHECK(e.code == ErrorCode::parse);
   expect_error("", {"bad.json:1:1", "invalid JSON"});
   expect_error("[1, 2]", {"JSON object"});
@@ -37,21 +41,26 @@ TEST_CASE("unknown keys are refused at every level, naming the full path") {
   expect_error(R"({"system": "chain", "dampin": 1})", {"unknown key dampin"});
   expect_error(cloth(R"({"stifness": {"bend": 1}})"), {"unknown key cloth.stifness"});
   expect_error(cloth(R"({"stiffness": {"bent": 1}})"), {"unknown key cloth.stiffness.bent"});
-  expect_error(R"({"system": "chain", "integrator": {"dt": 0.02, "step": 5}})", {"unknown key integrator.step"});
+  expect_error(R"({"system": "chain", "integrator": {"dt": 0.02, "step": 5}})",
+               {"unknown key integrator.step"});
   expect_error(R"({"system": "chain", "physics": {"g": 1}})", {"unknown key physics.g"});
   expect_error(R"({"system": "chain", "wind": {"speed": 1}})", {"unknown key wind.speed"});
   expect_error(R"({"system": "chain", "chain": {"mass": [1]}})", {"unknown key chain.mass"});
-  expect_error(R"({"system": "chain", "colliders": [{"type": "sphere", "center": [0,0,0], "radius": 1, "r": 2}]})",
-               {"unknown key colliders[0].r"});
-  expect_error(R"({"system": "chain", "colliders": [{"type": "plane", "radius": 2}]})", {"unknown key colliders[0].radius"});
+  expect_error(
+      R"({"system": "chain", "colliders": [{"type": "sphere", "center": [0,0,0], "radius": 1, "r": 2}]})",
+      {"unknown key colliders[0].r"});
+  expect_error(R"({"system": "chain", "colliders": [{"type": "plane", "radius": 2}]})",
+               {"unknown key colliders[0].radius"});
 }
 
 TEST_CASE("wrong types name the key, the expected type and the value") {
   const Error e = expect_error(R"({"system": "chain", "integrator": {"dt": "fast"}})",
                                {"integrator.dt", "must be a number", "\"fast\""});
   CHECK(e.code == ErrorCode::parse);
-  expect_error(R"({"system": "chain", "physics": {"gravity": [0, -9.81]}})", {"physics.gravity", "3 numbers", "[0,-9.81]"});
-  expect_error(R"({"system": "chain", "physics": {"gravity": [0, 0, "down"]}})", {"physics.gravity[2]", "\"down\""});
+  expect_error(R"({"system": "chain", "physics": {"gravity": [0, -9.81]}})",
+               {"physics.gravity", "3 numbers", "[0,-9.81]"});
+  expect_error(R"({"system": "chain", "physics": {"gravity": [0, 0, "down"]}})",
+               {"physics.gravity[2]", "\"down\""});
   expect_error(R"({"system": "chain", "physics": 3})", {"physics", "an object", "3"});
   expect_error(cloth(R"({"resolution": [10.5, 10]})"), {"cloth.resolution[0]", "integer", "10.5"});
   expect_error(cloth(R"({"resolution": 10})"), {"cloth.resolution", "2 integers", "10"});
@@ -59,7 +68,8 @@ TEST_CASE("wrong types name the key, the expected type and the value") {
   expect_error(cloth(R"({"pins": [[1]]})"), {"cloth.pins[0]", "[1]"});
   expect_error(R"({"system": "chain", "integrator": {"steps": -5}})", {"integrator.steps", "-5"});
   expect_error(R"({"system": "chain", "integrator": {"steps": 2e9}})", {"integrator.steps", "1000000000"});
-  expect_error(R"({"system": "chain", "chain": {"positions": [[0, 0]]}})", {"chain.positions[0]", "3 numbers"});
+  expect_error(R"({"system": "chain", "chain": {"positions": [[0, 0]]}})",
+               {"chain.positions[0]", "3 numbers"});
   expect_error(R"({"system": "chain", "colliders": {"type": "plane"}})", {"colliders", "an array"});
   expect_error(R"({"system": "chain", "colliders": [{"type": "cube"}]})", {"colliders[0].type", "cube"});
   expect_error(R"({"system": "chain", "colliders": [{"type": "sphere", "center": [0, 0, 0]}]})",
@@ -76,7 +86,8 @@ TEST_CASE("values out of range name the key and the value") {
   expect_error(cloth(R"({"particle_mass": 0})"), {"cloth.particle_mass", "got 0"});
   expect_error(cloth(R"({"resolution": [0, 5]})"), {"cloth.resolution", "[0, 5]"});
   // Refused before anything is allocated (10^10 particles would not fit).
-  const Error big = expect_error(cloth(R"({"resolution": [100000, 100000]})"), {"cloth.resolution", "[100000, 100000]"});
+  const Error big =
+      expect_error(cloth(R"({"resolution": [100000, 100000]})"), {"cloth.resolution", "[100000, 100000]"});
   CHECK(big.code == ErrorCode::invalid_argument);
   expect_error(cloth(R"({"resolution": [8000, 8000]})"), {"cloth.resolution", "particles"});
   expect_error(cloth(R"({"resolution": [1e12, 5]})"), {"cloth.resolution[0]", "integer"});
@@ -85,13 +96,15 @@ TEST_CASE("values out of range name the key and the value") {
   expect_error(cloth(R"({"size": [0, 1]})"), {"cloth.size", "[0, 1]"});
   expect_error(R"({"system": "chain", "chain": {"masses": [1, 1], "stiffness": [20, 20, 20]}})",
                {"chain.stiffness", "3"});
-  expect_error(R"({"system": "chain", "chain": {"masses": [1, 1], "positions": [[0, 0, -1]]}})", {"chain.positions"});
+  expect_error(R"({"system": "chain", "chain": {"masses": [1, 1], "positions": [[0, 0, -1]]}})",
+               {"chain.positions"});
   expect_error(R"({"system": "chain", "chain": {"masses": [1, -1]}})", {"chain.masses[1]", "-1"});
   expect_error(R"({"system": "chain", "chain": {"masses": []}})", {"chain.masses"});
 }
 
 TEST_CASE("numbers that overflow a double (1e999) are refused, naming the key") {
-  const Error e = expect_error(R"({"system": "chain", "physics": {"damping": 1e999}})", {"physics.damping", "1e999"});
+  const Error e =
+      expect_error(R"({"system": "chain", "physics": {"damping": 1e999}})", {"physics.damping", "1e999"});
   CHECK(e.code == ErrorCode::parse);
   expect_error(cloth(R"({"pins": [[0, 1], [2, 1e999]]})"), {"cloth.pins[1][1]", "1e999"});
   expect_error(R"({"system": "chain"})", {"integrator.dt", "1e999"}, {"integrator.dt=1e999"});

@@ -14,7 +14,8 @@ namespace {
 
 Scene load_ok(const std::string& text, std::vector<std::string> overrides = {}) {
   auto s = parse_scene(text, "test.json", overrides);
-  if (!s) FAIL("unexpected error: " << s.error().message);
+  if (!s)
+    FAIL("unexpected error: " << s.error().message);
   return std::move(*s);
 }
 
@@ -33,7 +34,8 @@ std::size_t count_kind(const ParticleSystem& sys, SpringKind kind) {
 TEST_CASE("every sample scene loads and runs its steps on the CPU solver without diverging") {
   std::size_t n = 0;
   for (const auto& entry : std::filesystem::directory_iterator(VKCLOTH_SCENES_DIR)) {
-    if (entry.path().extension() != ".json") continue;
+    if (entry.path().extension() != ".json")
+      continue;
     CAPTURE(entry.path().string());
     auto scene = load_scene_file(entry.path());
     REQUIRE_MESSAGE(scene.ok(), (scene.ok() ? "" : scene.error().message));
@@ -130,7 +132,8 @@ TEST_CASE("omitted keys take the report's defaults") {
   CHECK(cloth.system.springs[0].stiffness == 40.0);
   const Spring* shear = nullptr;
   for (const Spring& s : cloth.system.springs)
-    if (s.kind == SpringKind::shear) shear = &s;
+    if (s.kind == SpringKind::shear)
+      shear = &s;
   REQUIRE(shear != nullptr);
   CHECK(shear->stiffness == 8.0);
 }
@@ -183,7 +186,8 @@ TEST_CASE("cloth: every key is read") {
 }
 
 TEST_CASE("overrides set values before validation") {
-  const std::string base = R"({"system": "cloth", "colliders": [{"type": "sphere", "center": [0, 0, 0], "radius": 1}]})";
+  const std::string base =
+      R"({"system": "cloth", "colliders": [{"type": "sphere", "center": [0, 0, 0], "radius": 1}]})";
   const Scene s = load_ok(base, {"cloth.stiffness.bend=15", "integrator.dt=0.01", "wind.direction=[0,1,0]",
                                  "wind.strength=0.05", "colliders.0.radius=0.3", "integrator.method=rk4",
                                  "integrator.steps=7", "name=renamed", "cloth.pins=[]"});
@@ -195,7 +199,8 @@ TEST_CASE("overrides set values before validation") {
   CHECK(s.name == "renamed");
   CHECK(count_pinned(s.system) == 0);
   bool bend15 = false;
-  for (const Spring& sp : s.system.springs) bend15 = bend15 || (sp.kind == SpringKind::bend && sp.stiffness == 15.0);
+  for (const Spring& sp : s.system.springs)
+    bend15 = bend15 || (sp.kind == SpringKind::bend && sp.stiffness == 15.0);
   CHECK(bend15);
 
   // Bracket indices, and appending a collider at index == size.

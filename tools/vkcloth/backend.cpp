@@ -30,22 +30,29 @@ private:
 
 template <typename Real> Result<std::unique_ptr<SimBackend>> make_cpu(const Scene& scene) {
   auto solver = CpuSolver<Real>::create(scene.system, scene.params);
-  if (!solver) return solver.error();
+  if (!solver)
+    return solver.error();
   return std::unique_ptr<SimBackend>(std::make_unique<CpuBackend<Real>>(std::move(*solver)));
 }
 
 } // namespace
 
 std::optional<Precision> parse_precision(std::string_view name) {
-  if (name == "float") return Precision::float32;
-  if (name == "double") return Precision::float64;
+  if (name == "float")
+    return Precision::float32;
+  if (name == "double")
+    return Precision::float64;
   return std::nullopt;
 }
 
-const char* to_string(Precision p) { return p == Precision::float32 ? "float" : "double"; }
+const char* to_string(Precision p) {
+  return p == Precision::float32 ? "float" : "double";
+}
 
-Result<std::unique_ptr<SimBackend>> make_backend(std::string_view name, const Scene& scene, Precision precision) {
-  if (name == "cpu") return precision == Precision::float32 ? make_cpu<float>(scene) : make_cpu<double>(scene);
+Result<std::unique_ptr<SimBackend>> make_backend(std::string_view name, const Scene& scene,
+                                                 Precision precision) {
+  if (name == "cpu")
+    return precision == Precision::float32 ? make_cpu<float>(scene) : make_cpu<double>(scene);
   if (name == "vulkan") {
 #if defined(VKCLOTH_CLI_HAS_VULKAN)
     return make_vulkan_backend(scene, precision);
@@ -53,7 +60,8 @@ Result<std::unique_ptr<SimBackend>> make_backend(std::string_view name, const Sc
     return make_error(ErrorCode::no_device, "the vulkan backend is not available in this build");
 #endif
   }
-  return make_error(ErrorCode::invalid_argument, fmt::format("unknown backend \"{}\" (known: cpu, vulkan)", name));
+  return make_error(ErrorCode::invalid_argument,
+                    fmt::format("unknown backend \"{}\" (known: cpu, vulkan)", name));
 }
 
 } // namespace vkcloth::cli

@@ -19,7 +19,7 @@ namespace vkcloth::cli {
 /// Arithmetic the solver runs in (`--precision float|double`).
 enum class Precision { float32, float64 };
 std::optional<Precision> parse_precision(std::string_view name); ///< "float" | "double"
-const char* to_string(Precision p);                               ///< "float" | "double"
+const char* to_string(Precision p);                              ///< "float" | "double"
 
 class SimBackend {
 public:
@@ -28,7 +28,8 @@ public:
   /// message naming the step and the time.
   virtual Result<void> step(std::uint64_t n) = 0;
   /// Copies the current state out (the vectors are resized to the particle count).
-  virtual Result<void> read_state(std::vector<glm::dvec3>& positions, std::vector<glm::dvec3>& velocities) = 0;
+  virtual Result<void> read_state(std::vector<glm::dvec3>& positions,
+                                  std::vector<glm::dvec3>& velocities) = 0;
   /// Steps taken so far, and the simulated time step_index() * dt.
   virtual std::uint64_t step_index() const = 0;
   virtual double time() const = 0;
@@ -36,7 +37,8 @@ public:
 
 /// "cpu" (or "vulkan" where built in). Unknown name: ErrorCode::invalid_argument; a backend that is
 /// not built in or finds no device: ErrorCode::no_device.
-Result<std::unique_ptr<SimBackend>> make_backend(std::string_view name, const Scene& scene, Precision precision);
+Result<std::unique_ptr<SimBackend>> make_backend(std::string_view name, const Scene& scene,
+                                                 Precision precision);
 
 /// Defined in backend_vulkan.cpp when that file exists (tools/CMakeLists.txt sets VKCLOTH_CLI_HAS_VULKAN).
 Result<std::unique_ptr<SimBackend>> make_vulkan_backend(const Scene& scene, Precision precision);

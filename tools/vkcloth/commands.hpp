@@ -28,7 +28,7 @@ struct RunOptions {
   std::vector<std::string> overrides; ///< --set, then --steps/--dt/--integrator
   std::string trace;                  ///< empty: no trace
   std::uint64_t trace_every = 1;
-  std::string positions;              ///< empty: no final positions file
+  std::string positions; ///< empty: no final positions file
   std::string backend = "cpu";
   std::string precision = "float";
 };

@@ -9,13 +9,16 @@
 namespace vkcloth::cli {
 namespace {
 
-std::string vec(glm::dvec3 v) { return fmt::format("[{:g}, {:g}, {:g}]", v.x, v.y, v.z); }
+std::string vec(glm::dvec3 v) {
+  return fmt::format("[{:g}, {:g}, {:g}]", v.x, v.y, v.z);
+}
 
 } // namespace
 
 int info_command(const InfoOptions& opt) {
   auto scene_r = load_scene_file(opt.scene, opt.overrides);
-  if (!scene_r) return report(scene_r.error());
+  if (!scene_r)
+    return report(scene_r.error());
   const Scene& s = *scene_r;
   const SimParams& p = s.params;
 
@@ -26,15 +29,18 @@ int info_command(const InfoOptions& opt) {
     mass += q.pinned ? 0.0 : q.mass;
   }
   std::array<std::size_t, 4> per_kind{};
-  for (const Spring& sp : s.system.springs) ++per_kind[static_cast<std::size_t>(sp.kind)];
+  for (const Spring& sp : s.system.springs)
+    ++per_kind[static_cast<std::size_t>(sp.kind)];
 
   fmt::print("scene       {}\n", s.name);
   fmt::print("system      {}", s.system_kind);
-  if (s.system.grid) fmt::print(" ({} x {} grid, index j*nx+i)", s.system.grid->nx, s.system.grid->ny);
+  if (s.system.grid)
+    fmt::print(" ({} x {} grid, index j*nx+i)", s.system.grid->nx, s.system.grid->ny);
   fmt::print("\nparticles   {} ({} pinned, free mass {:g} kg)\n", s.system.size(), pinned, mass);
   fmt::print("springs     {}", s.system.springs.size());
   for (SpringKind k : {SpringKind::plain, SpringKind::structural, SpringKind::shear, SpringKind::bend})
-    if (const auto n = per_kind[static_cast<std::size_t>(k)]) fmt::print(", {} {}", n, to_string(k));
+    if (const auto n = per_kind[static_cast<std::size_t>(k)])
+      fmt::print(", {} {}", n, to_string(k));
   fmt::print("\nintegrator  {}, dt {:g} s, {} steps ({:g} s)\n", to_string(p.integrator), p.dt, s.steps,
              p.dt * static_cast<double>(s.steps));
   fmt::print("gravity     {} m/s^2\ndamping     {:g} 1/s\n", vec(p.gravity), p.damping);

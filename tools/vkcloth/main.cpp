@@ -11,12 +11,16 @@ int exit_code(const Error& e) {
   switch (e.code) {
   case ErrorCode::invalid_argument:
   case ErrorCode::io:
-  case ErrorCode::parse: return exit_bad_input;
-  case ErrorCode::diverged: return exit_diverged;
+  case ErrorCode::parse:
+    return exit_bad_input;
+  case ErrorCode::diverged:
+    return exit_diverged;
   case ErrorCode::no_device:
-  case ErrorCode::unsupported: return exit_no_device;
+  case ErrorCode::unsupported:
+    return exit_no_device;
   case ErrorCode::vulkan:
-  case ErrorCode::out_of_memory: return exit_failure;
+  case ErrorCode::out_of_memory:
+    return exit_failure;
   }
   return exit_failure;
 }
@@ -66,19 +70,22 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--integrator", integrator,
                       "explicit_euler | semi_implicit_euler | rk4 (sugar for --set integrator.method=NAME)");
   add_override_options(*run_cmd, run.overrides);
-  auto* trace = run_cmd->add_option("--trace", run.trace,
-                                    "Write every particle's state to a CSV file: step,time,particle,x,y,z,vx,vy,vz "
-                                    "(step 0 then every K steps)");
+  auto* trace =
+      run_cmd->add_option("--trace", run.trace,
+                          "Write every particle's state to a CSV file: step,time,particle,x,y,z,vx,vy,vz "
+                          "(step 0 then every K steps)");
   run_cmd->add_option("--trace-every", run.trace_every, "K for --trace (default 1)")
       ->check(CLI::PositiveNumber)
       ->needs(trace);
-  run_cmd->add_option("--positions", run.positions, "Write the final positions to a CSV file: particle,x,y,z");
+  run_cmd->add_option("--positions", run.positions,
+                      "Write the final positions to a CSV file: particle,x,y,z");
   run_cmd->add_option("--backend", run.backend, "Solver backend: cpu | vulkan (default cpu)");
   run_cmd->add_option("--precision", run.precision, "Solver arithmetic: float | double (default float)")
       ->check(CLI::IsMember({"float", "double"}));
 
   InfoOptions info;
-  CLI::App* info_cmd = app.add_subcommand("info", "Print a parsed scene: particles, springs per kind, parameters");
+  CLI::App* info_cmd =
+      app.add_subcommand("info", "Print a parsed scene: particles, springs per kind, parameters");
   info_cmd->footer(exit_codes_footer);
   info_cmd->add_option("scene", info.scene, "Scene file (JSON)")->required();
   add_override_options(*info_cmd, info.overrides);
@@ -97,9 +104,12 @@ int main(int argc, char** argv) {
   try {
     if (*run_cmd) {
       // The sugar flags come after --set, so they win over a --set of the same key.
-      if (steps) run.overrides.push_back(fmt::format("integrator.steps={}", *steps));
-      if (dt) run.overrides.push_back(fmt::format("integrator.dt={:.17g}", *dt));
-      if (integrator) run.overrides.push_back(fmt::format("integrator.method={}", *integrator));
+      if (steps)
+        run.overrides.push_back(fmt::format("integrator.steps={}", *steps));
+      if (dt)
+        run.overrides.push_back(fmt::format("integrator.dt={:.17g}", *dt));
+      if (integrator)
+        run.overrides.push_back(fmt::format("integrator.method={}", *integrator));
       return run_command(run);
     }
     return info_command(info);

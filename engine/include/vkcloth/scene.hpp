@@ -16,9 +16,9 @@ namespace vkcloth {
 
 /// A loaded, validated scene: ready to hand to a solver.
 struct Scene {
-  std::string name;        ///< "name" key, else the file stem (or the source name)
-  ParticleSystem system;   ///< finalized
-  SimParams params;        ///< validated (directions normalised)
+  std::string name;      ///< "name" key, else the file stem (or the source name)
+  ParticleSystem system; ///< finalized
+  SimParams params;      ///< validated (directions normalised)
   std::uint64_t steps = 500;
   std::string system_kind; ///< "chain" | "cloth"
 };

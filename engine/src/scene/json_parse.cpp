@@ -18,28 +18,37 @@ public:
   bool boolean(bool v) { return value(), dom_.boolean(v); }
   bool number_integer(json::number_integer_t v) { return value(), dom_.number_integer(v); }
   bool number_unsigned(json::number_unsigned_t v) { return value(), dom_.number_unsigned(v); }
-  bool number_float(json::number_float_t v, const json::string_t& s) { return value(), dom_.number_float(v, s); }
+  bool number_float(json::number_float_t v, const json::string_t& s) {
+    return value(), dom_.number_float(v, s);
+  }
   bool string(json::string_t& v) { return value(), dom_.string(v); }
   bool binary(json::binary_t& v) { return value(), dom_.binary(v); }
-  bool start_object(std::size_t n) { return value(), frames_.push_back({false, 0, {}}), dom_.start_object(n); }
+  bool start_object(std::size_t n) {
+    return value(), frames_.push_back({false, 0, {}}), dom_.start_object(n);
+  }
   bool key(json::string_t& k) { return frames_.back().key = k, dom_.key(k); }
   bool end_object() { return frames_.pop_back(), dom_.end_object(); }
   bool start_array(std::size_t n) { return value(), frames_.push_back({true, 0, {}}), dom_.start_array(n); }
   bool end_array() { return frames_.pop_back(), dom_.end_array(); }
 
-  bool parse_error(std::size_t position, const std::string& /*last_token*/, const nlohmann::detail::exception& ex) {
+  bool parse_error(std::size_t position, const std::string& /*last_token*/,
+                   const nlohmann::detail::exception& ex) {
     failure.byte = position > 0 ? position - 1 : 0; // nlohmann counts the character just read
     failure.overflow = ex.id == 406;
     failure.message = ex.what();
     // Drop "[json.exception.parse_error.101] parse error at line 1, column 2: " style prefixes.
-    if (auto at = failure.message.find("] "); at != std::string::npos) failure.message.erase(0, at + 2);
+    if (auto at = failure.message.find("] "); at != std::string::npos)
+      failure.message.erase(0, at + 2);
     if (auto col = failure.message.find("column "); col != std::string::npos)
-      if (auto at = failure.message.find(": ", col); at != std::string::npos) failure.message.erase(0, at + 2);
+      if (auto at = failure.message.find(": ", col); at != std::string::npos)
+        failure.message.erase(0, at + 2);
     // The failing value was not started: the innermost array's index is its element count.
     for (std::size_t k = 0; k < frames_.size(); ++k) {
       const Frame& f = frames_[k];
-      if (f.array) failure.path += fmt::format("[{}]", k + 1 == frames_.size() ? f.count : f.count - 1);
-      else failure.path += (failure.path.empty() ? "" : ".") + f.key;
+      if (f.array)
+        failure.path += fmt::format("[{}]", k + 1 == frames_.size() ? f.count : f.count - 1);
+      else
+        failure.path += (failure.path.empty() ? "" : ".") + f.key;
     }
     return false;
   }
@@ -53,7 +62,8 @@ private:
     std::string key;
   };
   void value() {
-    if (!frames_.empty() && frames_.back().array) ++frames_.back().count;
+    if (!frames_.empty() && frames_.back().array)
+      ++frames_.back().count;
   }
   nlohmann::detail::json_sax_dom_parser<json> dom_;
   std::vector<Frame> frames_;
@@ -63,7 +73,8 @@ private:
 
 bool parse_json(std::string_view text, json& out, JsonParseFailure& failure) {
   PathTrackingSax sax(out);
-  if (json::sax_parse(text, &sax)) return true;
+  if (json::sax_parse(text, &sax))
+    return true;
   failure = std::move(sax.failure);
   out = json();
   return false;
@@ -72,8 +83,10 @@ bool parse_json(std::string_view text, json& out, JsonParseFailure& failure) {
 std::pair<std::size_t, std::size_t> line_col(std::string_view text, std::size_t byte) {
   std::size_t line = 1, col = 1;
   for (std::size_t k = 0; k < byte && k < text.size(); ++k) {
-    if (text[k] == '\n') ++line, col = 1;
-    else ++col;
+    if (text[k] == '\n')
+      ++line, col = 1;
+    else
+      ++col;
   }
   return {line, col};
 }

@@ -11,10 +11,10 @@
 namespace vkcloth::scene_detail {
 
 struct JsonParseFailure {
-  std::size_t byte = 0;   ///< 0-based offset of the offending character
-  std::string path;       ///< key path of the value being read ("" at top level)
-  std::string message;    ///< what nlohmann reported, without its prefix
-  bool overflow = false;  ///< a number out of the double range
+  std::size_t byte = 0;  ///< 0-based offset of the offending character
+  std::string path;      ///< key path of the value being read ("" at top level)
+  std::string message;   ///< what nlohmann reported, without its prefix
+  bool overflow = false; ///< a number out of the double range
 };
 
 /// Parses `text`; on failure fills `failure` and returns false. Never throws (except bad_alloc).

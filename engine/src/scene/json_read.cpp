@@ -7,19 +7,24 @@
 namespace vkcloth::scene_detail {
 
 std::string join(std::string_view path, std::string_view key) {
-  if (path.empty()) return std::string(key);
+  if (path.empty())
+    return std::string(key);
   return fmt::format("{}.{}", path, key);
 }
 
 std::string show(const json& v) {
   // dump() would print inf as null; say what the parser really produced.
-  if (v.is_number_float() && !std::isfinite(v.get<double>())) return fmt::format("{}", v.get<double>());
+  if (v.is_number_float() && !std::isfinite(v.get<double>()))
+    return fmt::format("{}", v.get<double>());
   std::string s = v.dump();
-  if (s.size() > 60) s = s.substr(0, 57) + "...";
+  if (s.size() > 60)
+    s = s.substr(0, 57) + "...";
   return s;
 }
 
-Error shape_error(std::string message) { return make_error(ErrorCode::parse, std::move(message)); }
+Error shape_error(std::string message) {
+  return make_error(ErrorCode::parse, std::move(message));
+}
 
 namespace {
 
@@ -29,16 +34,19 @@ Error type_error(std::string_view path, std::string_view expected, const json& v
 
 std::string list(std::initializer_list<std::string_view> keys) {
   std::string s;
-  for (std::string_view k : keys) s += (s.empty() ? "" : ", ") + std::string(k);
+  for (std::string_view k : keys)
+    s += (s.empty() ? "" : ", ") + std::string(k);
   return s;
 }
 
 } // namespace
 
-Result<void> check_keys(const json& obj, std::string_view path, std::initializer_list<std::string_view> allowed) {
+Result<void> check_keys(const json& obj, std::string_view path,
+                        std::initializer_list<std::string_view> allowed) {
   for (auto it = obj.begin(); it != obj.end(); ++it) {
     bool known = false;
-    for (std::string_view a : allowed) known = known || it.key() == a;
+    for (std::string_view a : allowed)
+      known = known || it.key() == a;
     if (!known)
       return shape_error(fmt::format("unknown key {} (known keys{}: {})", join(path, it.key()),
                                      path.empty() ? "" : fmt::format(" in {}", path), list(allowed)));
@@ -48,48 +56,61 @@ Result<void> check_keys(const json& obj, std::string_view path, std::initializer
 
 Result<const json*> read_object(const json& obj, std::string_view path, const char* key) {
   auto it = obj.find(key);
-  if (it == obj.end()) return static_cast<const json*>(nullptr);
-  if (!it->is_object()) return type_error(join(path, key), "an object", *it);
+  if (it == obj.end())
+    return static_cast<const json*>(nullptr);
+  if (!it->is_object())
+    return type_error(join(path, key), "an object", *it);
   return &*it;
 }
 
 Result<const json*> read_array(const json& obj, std::string_view path, const char* key) {
   auto it = obj.find(key);
-  if (it == obj.end()) return static_cast<const json*>(nullptr);
-  if (!it->is_array()) return type_error(join(path, key), "an array", *it);
+  if (it == obj.end())
+    return static_cast<const json*>(nullptr);
+  if (!it->is_array())
+    return type_error(join(path, key), "an array", *it);
   return &*it;
 }
 
 Result<double> as_number(const json& v, std::string_view path) {
-  if (!v.is_number()) return type_error(path, "a number", v);
+  if (!v.is_number())
+    return type_error(path, "a number", v);
   const double d = v.get<double>();
-  if (!std::isfinite(d)) return shape_error(fmt::format("{} must be a finite number, got {} (out of the double range)", path, d));
+  if (!std::isfinite(d))
+    return shape_error(fmt::format("{} must be a finite number, got {} (out of the double range)", path, d));
   return d;
 }
 
 Result<std::uint64_t> as_integer(const json& v, std::string_view path, std::uint64_t max) {
-  const auto range = [&] { return shape_error(fmt::format("{} must be an integer in 0..{}, got {}", path, max, show(v))); };
+  const auto range = [&] {
+    return shape_error(fmt::format("{} must be an integer in 0..{}, got {}", path, max, show(v)));
+  };
   if (v.is_number_unsigned()) {
     const auto u = v.get<std::uint64_t>();
-    if (u > max) return range();
+    if (u > max)
+      return range();
     return u;
   }
-  if (v.is_number_integer()) return range(); // negative
+  if (v.is_number_integer())
+    return range(); // negative
   if (v.is_number_float()) {
     const double d = v.get<double>();
     // 1e3 is a JSON float; accept it when it is a whole number.
-    if (!std::isfinite(d) || d < 0.0 || d != std::floor(d) || d > static_cast<double>(max)) return range();
+    if (!std::isfinite(d) || d < 0.0 || d != std::floor(d) || d > static_cast<double>(max))
+      return range();
     return static_cast<std::uint64_t>(d);
   }
   return type_error(path, "an integer", v);
 }
 
 Result<glm::dvec3> as_vec3(const json& v, std::string_view path) {
-  if (!v.is_array() || v.size() != 3) return type_error(path, "an array of 3 numbers", v);
+  if (!v.is_array() || v.size() != 3)
+    return type_error(path, "an array of 3 numbers", v);
   glm::dvec3 out{0.0};
   for (int k = 0; k < 3; ++k) {
     auto x = as_number(v[k], fmt::format("{}[{}]", path, k));
-    if (!x) return x.error();
+    if (!x)
+      return x.error();
     out[k] = *x;
   }
   return out;
@@ -97,38 +118,47 @@ Result<glm::dvec3> as_vec3(const json& v, std::string_view path) {
 
 Result<void> read(const json& obj, std::string_view path, const char* key, double& out) {
   auto it = obj.find(key);
-  if (it == obj.end()) return {};
+  if (it == obj.end())
+    return {};
   auto x = as_number(*it, join(path, key));
-  if (!x) return x.error();
+  if (!x)
+    return x.error();
   out = *x;
   return {};
 }
 
 Result<void> read(const json& obj, std::string_view path, const char* key, std::string& out) {
   auto it = obj.find(key);
-  if (it == obj.end()) return {};
-  if (!it->is_string()) return type_error(join(path, key), "a string", *it);
+  if (it == obj.end())
+    return {};
+  if (!it->is_string())
+    return type_error(join(path, key), "a string", *it);
   out = it->get<std::string>();
   return {};
 }
 
 Result<void> read(const json& obj, std::string_view path, const char* key, glm::dvec3& out) {
   auto it = obj.find(key);
-  if (it == obj.end()) return {};
+  if (it == obj.end())
+    return {};
   auto v = as_vec3(*it, join(path, key));
-  if (!v) return v.error();
+  if (!v)
+    return v.error();
   out = *v;
   return {};
 }
 
 Result<void> read(const json& obj, std::string_view path, const char* key, glm::dvec2& out) {
   auto it = obj.find(key);
-  if (it == obj.end()) return {};
+  if (it == obj.end())
+    return {};
   const std::string p = join(path, key);
-  if (!it->is_array() || it->size() != 2) return type_error(p, "an array of 2 numbers", *it);
+  if (!it->is_array() || it->size() != 2)
+    return type_error(p, "an array of 2 numbers", *it);
   for (int k = 0; k < 2; ++k) {
     auto x = as_number((*it)[k], fmt::format("{}[{}]", p, k));
-    if (!x) return x.error();
+    if (!x)
+      return x.error();
     out[k] = *x;
   }
   return {};
@@ -136,20 +166,24 @@ Result<void> read(const json& obj, std::string_view path, const char* key, glm::
 
 Result<void> read(const json& obj, std::string_view path, const char* key, std::vector<double>& out) {
   auto it = obj.find(key);
-  if (it == obj.end()) return {};
+  if (it == obj.end())
+    return {};
   const std::string p = join(path, key);
   if (it->is_number()) {
     auto x = as_number(*it, p);
-    if (!x) return x.error();
+    if (!x)
+      return x.error();
     out.assign(1, *x);
     return {};
   }
-  if (!it->is_array()) return type_error(p, "a number or an array of numbers", *it);
+  if (!it->is_array())
+    return type_error(p, "a number or an array of numbers", *it);
   out.clear();
   out.reserve(it->size());
   for (std::size_t k = 0; k < it->size(); ++k) {
     auto x = as_number((*it)[k], fmt::format("{}[{}]", p, k));
-    if (!x) return x.error();
+    if (!x)
+      return x.error();
     out.push_back(*x);
   }
   return {};

@@ -26,7 +26,8 @@ std::string show(const json& v);
 Error shape_error(std::string message);
 
 /// Errors on the first key of `obj` not in `allowed`, naming its full path.
-Result<void> check_keys(const json& obj, std::string_view path, std::initializer_list<std::string_view> allowed);
+Result<void> check_keys(const json& obj, std::string_view path,
+                        std::initializer_list<std::string_view> allowed);
 
 /// Readers: absent key -> `out` keeps its default. Wrong type or non-finite -> error.
 /// `obj` must be an object.

@@ -20,14 +20,16 @@ using sd::json;
 
 namespace {
 
-#define SCENE_TRY_ASSIGN(var, expr)                                                                                    \
-  auto var##_r = (expr);                                                                                               \
-  if (!var##_r) return var##_r.error();                                                                                \
+#define SCENE_TRY_ASSIGN(var, expr)                                                                          \
+  auto var##_r = (expr);                                                                                     \
+  if (!var##_r)                                                                                              \
+    return var##_r.error();                                                                                  \
   auto& var = *var##_r
 
 Result<void> read_integrator(const json& doc, SimParams& params, std::uint64_t& steps) {
   SCENE_TRY_ASSIGN(obj, sd::read_object(doc, "", "integrator"));
-  if (!obj) return {};
+  if (!obj)
+    return {};
   VKCLOTH_TRY(sd::check_keys(*obj, "integrator", {"method", "dt", "steps"}));
   std::string method = to_string(params.integrator);
   VKCLOTH_TRY(sd::read(*obj, "integrator", "method", method));
@@ -35,7 +37,8 @@ Result<void> read_integrator(const json& doc, SimParams& params, std::uint64_t& 
   if (!integ)
     return make_error(ErrorCode::invalid_argument,
                       fmt::format("integrator.method: unknown integrator \"{}\" (known: explicit_euler, "
-                                  "semi_implicit_euler, rk4)", method));
+                                  "semi_implicit_euler, rk4)",
+                                  method));
   params.integrator = *integ;
   VKCLOTH_TRY(sd::read(*obj, "integrator", "dt", params.dt));
   if (auto it = obj->find("steps"); it != obj->end()) {
@@ -47,7 +50,8 @@ Result<void> read_integrator(const json& doc, SimParams& params, std::uint64_t& 
 
 Result<void> read_physics(const json& doc, SimParams& params) {
   SCENE_TRY_ASSIGN(obj, sd::read_object(doc, "", "physics"));
-  if (!obj) return {};
+  if (!obj)
+    return {};
   VKCLOTH_TRY(sd::check_keys(*obj, "physics", {"gravity", "damping"}));
   VKCLOTH_TRY(sd::read(*obj, "physics", "gravity", params.gravity));
   return sd::read(*obj, "physics", "damping", params.damping);
@@ -55,7 +59,8 @@ Result<void> read_physics(const json& doc, SimParams& params) {
 
 Result<void> read_wind(const json& doc, SimParams& params) {
   SCENE_TRY_ASSIGN(obj, sd::read_object(doc, "", "wind"));
-  if (!obj) return {};
+  if (!obj)
+    return {};
   VKCLOTH_TRY(sd::check_keys(*obj, "wind", {"strength", "direction"}));
   VKCLOTH_TRY(sd::read(*obj, "wind", "strength", params.wind.strength));
   return sd::read(*obj, "wind", "direction", params.wind.direction);
@@ -63,11 +68,13 @@ Result<void> read_wind(const json& doc, SimParams& params) {
 
 Result<void> read_colliders(const json& doc, SimParams& params) {
   SCENE_TRY_ASSIGN(arr, sd::read_array(doc, "", "colliders"));
-  if (!arr) return {};
+  if (!arr)
+    return {};
   for (std::size_t k = 0; k < arr->size(); ++k) {
     const json& c = (*arr)[k];
     const std::string path = fmt::format("colliders[{}]", k);
-    if (!c.is_object()) return sd::shape_error(fmt::format("{} must be an object, got {}", path, sd::show(c)));
+    if (!c.is_object())
+      return sd::shape_error(fmt::format("{} must be an object, got {}", path, sd::show(c)));
     if (!c.contains("type"))
       return sd::shape_error(fmt::format("{}.type is required (\"plane\" or \"sphere\")", path));
     std::string type;
@@ -81,12 +88,14 @@ Result<void> read_colliders(const json& doc, SimParams& params) {
     } else if (type == "sphere") {
       VKCLOTH_TRY(sd::check_keys(c, path, {"type", "center", "radius"}));
       for (const char* key : {"center", "radius"})
-        if (!c.contains(key)) return sd::shape_error(fmt::format("{}.{} is required for a sphere", path, key));
+        if (!c.contains(key))
+          return sd::shape_error(fmt::format("{}.{} is required for a sphere", path, key));
       col = Collider::sphere({}, 0.0);
       VKCLOTH_TRY(sd::read(c, path, "center", col.center));
       VKCLOTH_TRY(sd::read(c, path, "radius", col.radius));
     } else {
-      return sd::shape_error(fmt::format("{}.type must be \"plane\" or \"sphere\", got {}", path, sd::show(c["type"])));
+      return sd::shape_error(
+          fmt::format("{}.type must be \"plane\" or \"sphere\", got {}", path, sd::show(c["type"])));
     }
     params.colliders.push_back(col);
   }
@@ -97,7 +106,8 @@ Result<ParticleSystem> read_chain(const json& doc) {
   ChainDesc d;
   SCENE_TRY_ASSIGN(obj, sd::read_object(doc, "", "chain"));
   if (obj) {
-    VKCLOTH_TRY(sd::check_keys(*obj, "chain", {"anchor", "masses", "stiffness", "rest_lengths", "positions"}));
+    VKCLOTH_TRY(
+        sd::check_keys(*obj, "chain", {"anchor", "masses", "stiffness", "rest_lengths", "positions"}));
     VKCLOTH_TRY(sd::read(*obj, "chain", "anchor", d.anchor));
     VKCLOTH_TRY(sd::read(*obj, "chain", "masses", d.masses));
     VKCLOTH_TRY(sd::read(*obj, "chain", "stiffness", d.stiffness));
@@ -120,14 +130,18 @@ Result<ParticleSystem> read_cloth(const json& doc) {
   ClothDesc d;
   SCENE_TRY_ASSIGN(obj, sd::read_object(doc, "", "cloth"));
   if (obj) {
-    VKCLOTH_TRY(sd::check_keys(*obj, "cloth",
-                               {"resolution", "size", "origin", "orientation", "particle_mass", "stiffness", "pins"}));
+    VKCLOTH_TRY(sd::check_keys(
+        *obj, "cloth",
+        {"resolution", "size", "origin", "orientation", "particle_mass", "stiffness", "pins"}));
     if (auto it = obj->find("resolution"); it != obj->end()) {
       if (!it->is_array() || it->size() != 2)
-        return sd::shape_error(fmt::format("cloth.resolution must be an array of 2 integers [nx, ny], got {}", sd::show(*it)));
+        return sd::shape_error(
+            fmt::format("cloth.resolution must be an array of 2 integers [nx, ny], got {}", sd::show(*it)));
       // Sizes beyond uint32 are refused here; make_cloth() checks the real limits before allocating.
-      SCENE_TRY_ASSIGN(nx, sd::as_integer((*it)[0], "cloth.resolution[0]", std::numeric_limits<std::uint32_t>::max()));
-      SCENE_TRY_ASSIGN(ny, sd::as_integer((*it)[1], "cloth.resolution[1]", std::numeric_limits<std::uint32_t>::max()));
+      SCENE_TRY_ASSIGN(
+          nx, sd::as_integer((*it)[0], "cloth.resolution[0]", std::numeric_limits<std::uint32_t>::max()));
+      SCENE_TRY_ASSIGN(
+          ny, sd::as_integer((*it)[1], "cloth.resolution[1]", std::numeric_limits<std::uint32_t>::max()));
       d.nx = static_cast<std::uint32_t>(nx);
       d.ny = static_cast<std::uint32_t>(ny);
     }
@@ -135,8 +149,10 @@ Result<ParticleSystem> read_cloth(const json& doc) {
     VKCLOTH_TRY(sd::read(*obj, "cloth", "origin", d.origin));
     std::string orientation = "vertical";
     VKCLOTH_TRY(sd::read(*obj, "cloth", "orientation", orientation));
-    if (orientation == "vertical") d.orientation = ClothOrientation::vertical;
-    else if (orientation == "horizontal") d.orientation = ClothOrientation::horizontal;
+    if (orientation == "vertical")
+      d.orientation = ClothOrientation::vertical;
+    else if (orientation == "horizontal")
+      d.orientation = ClothOrientation::horizontal;
     else
       return sd::shape_error(
           fmt::format("cloth.orientation must be \"vertical\" or \"horizontal\", got \"{}\"", orientation));
@@ -155,7 +171,8 @@ Result<ParticleSystem> read_cloth(const json& doc) {
         const json& p = (*pins)[n];
         const std::string path = fmt::format("cloth.pins[{}]", n);
         if (!p.is_array() || p.size() != 2)
-          return sd::shape_error(fmt::format("{} must be an array of 2 integers [i, j], got {}", path, sd::show(p)));
+          return sd::shape_error(
+              fmt::format("{} must be an array of 2 integers [i, j], got {}", path, sd::show(p)));
         const auto lim = std::numeric_limits<std::uint32_t>::max();
         SCENE_TRY_ASSIGN(i, sd::as_integer(p[0], path + "[0]", lim));
         SCENE_TRY_ASSIGN(j, sd::as_integer(p[1], path + "[1]", lim));
@@ -167,19 +184,22 @@ Result<ParticleSystem> read_cloth(const json& doc) {
 }
 
 Result<Scene> build_scene(const json& doc, std::string_view source_name) {
-  if (!doc.is_object()) return sd::shape_error(fmt::format("the scene must be a JSON object, got {}", doc.type_name()));
+  if (!doc.is_object())
+    return sd::shape_error(fmt::format("the scene must be a JSON object, got {}", doc.type_name()));
   VKCLOTH_TRY(sd::check_keys(doc, "",
-                             {"name", "system", "integrator", "physics", "chain", "cloth", "wind", "colliders",
-                              "contact_epsilon", "divergence_limit"}));
+                             {"name", "system", "integrator", "physics", "chain", "cloth", "wind",
+                              "colliders", "contact_epsilon", "divergence_limit"}));
   Scene scene;
-  if (!doc.contains("system")) return sd::shape_error("missing required key system (\"chain\" or \"cloth\")");
+  if (!doc.contains("system"))
+    return sd::shape_error("missing required key system (\"chain\" or \"cloth\")");
   VKCLOTH_TRY(sd::read(doc, "", "system", scene.system_kind));
   if (scene.system_kind != "chain" && scene.system_kind != "cloth")
-    return sd::shape_error(fmt::format("system must be \"chain\" or \"cloth\", got \"{}\"", scene.system_kind));
+    return sd::shape_error(
+        fmt::format("system must be \"chain\" or \"cloth\", got \"{}\"", scene.system_kind));
   const char* other = scene.system_kind == "chain" ? "cloth" : "chain";
   if (doc.contains(other))
-    return sd::shape_error(fmt::format("a \"{}\" section is not allowed in a scene whose system is \"{}\"", other,
-                                       scene.system_kind));
+    return sd::shape_error(fmt::format("a \"{}\" section is not allowed in a scene whose system is \"{}\"",
+                                       other, scene.system_kind));
 
   scene.name = std::filesystem::path(source_name).stem().string();
   VKCLOTH_TRY(sd::read(doc, "", "name", scene.name));
@@ -192,7 +212,8 @@ Result<Scene> build_scene(const json& doc, std::string_view source_name) {
   VKCLOTH_TRY(scene.params.validate()); // ranges, before any large allocation below
 
   auto system = scene.system_kind == "chain" ? read_chain(doc) : read_cloth(doc);
-  if (!system) return system.error();
+  if (!system)
+    return system.error();
   scene.system = std::move(*system);
   return scene;
 }
@@ -211,19 +232,23 @@ Result<Scene> parse_scene(std::string_view json_text, std::string_view source_na
     if (sd::JsonParseFailure f; !sd::parse_json(json_text, doc, f)) {
       const auto [line, col] = sd::line_col(json_text, f.byte);
       const std::string where = f.path.empty() ? "" : fmt::format(" at {}", f.path);
-      return make_error(ErrorCode::parse, fmt::format("{}:{}:{}: invalid JSON{} (byte {}): {}", source_name, line, col,
-                                                      where, f.byte, f.message));
+      return make_error(ErrorCode::parse, fmt::format("{}:{}:{}: invalid JSON{} (byte {}): {}", source_name,
+                                                      line, col, where, f.byte, f.message));
     }
     if (!doc.is_object())
-      return with_source(sd::shape_error(fmt::format("the scene must be a JSON object, got {}", doc.type_name())),
-                         source_name);
+      return with_source(
+          sd::shape_error(fmt::format("the scene must be a JSON object, got {}", doc.type_name())),
+          source_name);
     for (const std::string& o : overrides)
-      if (auto r = sd::apply_override(doc, o); !r) return with_source(r.error(), source_name);
+      if (auto r = sd::apply_override(doc, o); !r)
+        return with_source(r.error(), source_name);
     auto scene = build_scene(doc, source_name);
-    if (!scene) return with_source(scene.error(), source_name);
+    if (!scene)
+      return with_source(scene.error(), source_name);
     return scene;
   } catch (const std::bad_alloc&) {
-    return make_error(ErrorCode::out_of_memory, fmt::format("{}: out of memory while loading the scene", source_name));
+    return make_error(ErrorCode::out_of_memory,
+                      fmt::format("{}: out of memory while loading the scene", source_name));
   } catch (const std::exception& e) {
     return make_error(ErrorCode::parse, fmt::format("{}: {}", source_name, e.what()));
   }
@@ -235,10 +260,12 @@ Result<Scene> load_scene_file(const std::filesystem::path& path, std::span<const
     if (std::filesystem::is_directory(path, ec))
       return make_error(ErrorCode::io, fmt::format("{}: is a directory, not a scene file", path.string()));
     std::ifstream in(path, std::ios::binary);
-    if (!in) return make_error(ErrorCode::io, fmt::format("{}: cannot open the scene file", path.string()));
+    if (!in)
+      return make_error(ErrorCode::io, fmt::format("{}: cannot open the scene file", path.string()));
     std::ostringstream text;
     text << in.rdbuf();
-    if (in.bad()) return make_error(ErrorCode::io, fmt::format("{}: read error", path.string()));
+    if (in.bad())
+      return make_error(ErrorCode::io, fmt::format("{}: read error", path.string()));
     return parse_scene(text.str(), path.string(), overrides);
   } catch (const std::exception& e) {
     return make_error(ErrorCode::io, fmt::format("{}: {}", path.string(), e.what()));
