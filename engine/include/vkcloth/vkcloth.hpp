@@ -7,3 +7,4 @@
 #include "vkcloth/result.hpp"
 #include "vkcloth/system.hpp"
 #include "vkcloth/scene.hpp"
+#include "vkcloth/gpu/gpu_solver.hpp"

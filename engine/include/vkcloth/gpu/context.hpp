@@ -1,0 +1,102 @@
+// Vulkan context for the compute solver: either a headless instance + device of its own (tools,
+// samples, tests) or a host's existing handles (an engine embedding vkcloth). The solver only
+// ever borrows a Context; a Context destroys only the handles it created.
+//
+// Thread safety: a Context may be shared by several solvers, but submissions to its queue must be
+// externally synchronised (Vulkan's rule for VkQueue): do not call GpuSolver::simulate() or the
+// readbacks of solvers sharing a Context from several threads at once.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <vulkan/vulkan_core.h>
+
+#include "vkcloth/result.hpp"
+
+namespace vkcloth::gpu {
+
+/// Options for a Context that creates its own instance and device.
+struct ContextOptions {
+  /// Device choice: a decimal index into the device list, or a case-insensitive substring of the
+  /// device name. Empty: the environment variable VKCLOTH_DEVICE, else the first discrete GPU,
+  /// else integrated, virtual, other, CPU (lavapipe), in that order.
+  std::string device_filter;
+  /// Enables VK_LAYER_KHRONOS_validation with synchronization validation and a debug messenger
+  /// that counts (and prints) warnings and errors. Unset: VKCLOTH_VALIDATION=1 in the environment.
+  std::optional<bool> validation;
+  /// Print each validation message to stderr (they are counted either way).
+  bool print_validation_messages = true;
+};
+
+/// A host's Vulkan handles, adopted as they are (nothing is created or destroyed but the
+/// solver's own objects). The device needs one queue of `queue_family` with compute support;
+/// no extension or feature beyond Vulkan 1.2 core is required.
+struct HostHandles {
+  VkInstance instance = VK_NULL_HANDLE;
+  VkPhysicalDevice physical_device = VK_NULL_HANDLE;
+  VkDevice device = VK_NULL_HANDLE;
+  std::uint32_t queue_family = 0;
+  VkQueue queue = VK_NULL_HANDLE;
+  PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr;
+  /// The API version the instance and device were created for; the shaders need 1.2.
+  std::uint32_t api_version = VK_API_VERSION_1_2;
+};
+
+/// One physical device as listed by Context::list_devices().
+struct DeviceInfo {
+  std::uint32_t index = 0;
+  std::string name;
+  VkPhysicalDeviceType type = VK_PHYSICAL_DEVICE_TYPE_OTHER;
+  std::uint32_t api_version = 0;
+  bool usable = false; ///< Vulkan >= 1.2 and a compute queue
+};
+
+/// A Vulkan instance, physical device, device and compute queue. Movable, not copyable; solvers
+/// created from it keep its internals alive, so it may be destroyed before them.
+class Context {
+public:
+  /// Creates a headless instance and device. ErrorCode::no_device when no Vulkan driver or
+  /// device is found or nothing matches the filter; ErrorCode::unsupported when validation was
+  /// requested and the layer is missing; ErrorCode::vulkan for other failures.
+  static Result<Context> create(const ContextOptions& options = {});
+  /// Adopts a host's handles; destroys none of them.
+  static Result<Context> adopt(const HostHandles& handles);
+  /// The devices the Vulkan loader reports (for `--list-devices`); no device is created.
+  static Result<std::vector<DeviceInfo>> list_devices();
+
+  Context(Context&&) noexcept;
+  Context& operator=(Context&&) noexcept;
+  Context(const Context&) = delete;
+  Context& operator=(const Context&) = delete;
+  ~Context();
+
+  /// The handles in use (adoptable by another Context or by a renderer).
+  HostHandles handles() const;
+  /// vkGetDeviceProcAddr for this device, to load further device functions.
+  PFN_vkGetDeviceProcAddr device_proc_addr() const;
+  const std::string& device_name() const;
+  VkPhysicalDeviceType device_type() const;
+  const VkPhysicalDeviceLimits& limits() const;
+  /// True when this Context created (and will destroy) the instance and device.
+  bool owns_device() const;
+
+  bool validation_enabled() const;
+  /// Validation warnings and errors reported so far (0 when validation is off).
+  std::uint64_t validation_message_count() const;
+
+  /// vkDeviceWaitIdle.
+  Result<void> wait_idle() const;
+
+  struct Impl; ///< internal (engine/src/vulkan)
+  const std::shared_ptr<Impl>& impl() const { return impl_; }
+
+private:
+  explicit Context(std::shared_ptr<Impl> impl);
+  std::shared_ptr<Impl> impl_;
+};
+
+} // namespace vkcloth::gpu

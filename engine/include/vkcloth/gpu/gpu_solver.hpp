@@ -1,0 +1,116 @@
+// The Vulkan compute solver: the CPU reference's step (cpu_solver.hpp) as two compute passes per
+// particle, force.comp and integrate.comp, with the same float expression order, so on a driver
+// without FMA contraction it reproduces CpuSolver<float> (lavapipe: bit for bit).
+//
+// Per step (Euler):      force(positions[read]) -> integrate(-> positions[write]) -> swap
+// Per step (RK4):        4 x (force(stage input) -> integrate(stage k)); the last writes positions[write]
+//
+// Buffers (device-local storage buffers, vec4 per particle, w unused; positions have w = 1):
+// positions[2] (ping-pong), velocities, forces, normals (unit, rebuilt every force pass, zero for
+// chains), uvs (i/(nx-1), j/(ny-1) for grids, zero for chains), plus internal scratch.
+//
+// Thread safety: none; one thread drives a solver. Known limitations: the step counter of the
+// divergence flags is 32-bit (about 4e9 steps per solver); set_params() must not be called while
+// recorded steps of this solver are still pending on the GPU.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+#include <vulkan/vulkan_core.h>
+
+#include "vkcloth/gpu/context.hpp"
+#include "vkcloth/params.hpp"
+#include "vkcloth/result.hpp"
+#include "vkcloth/system.hpp"
+
+namespace vkcloth::gpu {
+
+struct GpuSolverOptions {
+  /// Keep every bulk buffer in device-local memory and go through staging buffers for uploads
+  /// and readbacks even when the device-local memory is host-visible (as on lavapipe or UMA).
+  bool force_staging = false;
+  /// Lower the per-buffer size limit below the device's maxStorageBufferRange (0: the device's).
+  std::uint64_t max_storage_buffer_bytes = 0;
+};
+
+class GpuSolver {
+public:
+  /// Validates `params` and `system` as CpuSolver::create does, checks the device limits BEFORE
+  /// allocating (ErrorCode::unsupported naming the buffer and the limit), uploads the state.
+  static Result<GpuSolver> create(Context& context, const ParticleSystem& system, SimParams params,
+                                  const GpuSolverOptions& options = {});
+
+  GpuSolver(GpuSolver&&) noexcept;
+  GpuSolver& operator=(GpuSolver&&) noexcept;
+  GpuSolver(const GpuSolver&) = delete;
+  GpuSolver& operator=(const GpuSolver&) = delete;
+  ~GpuSolver(); ///< waits for the solver's own submissions, then frees its objects
+
+  /// Replaces the parameters (validated). No recorded work of this solver may be pending.
+  Result<void> set_params(SimParams params);
+  const SimParams& params() const;
+
+  /// Records `steps` steps into the caller's command buffer (recording state, compute-capable
+  /// queue family of the Context). Host-side counters (step_index, current_position_index)
+  /// advance now: submit the command buffer exactly once, in recording order.
+  /// Synchronisation: the recording starts with one barrier ordering all earlier commands and
+  /// their memory writes before the first dispatch. It ends right after the last dispatch: the
+  /// buffers are left as compute-shader writes NOT yet visible to any later stage. Before reading
+  /// them (drawing the current positions and normals, copying), record the caller's barrier or
+  /// call record_barrier_to(cmd, dst_stage, dst_access).
+  void record_steps(VkCommandBuffer cmd, std::uint32_t steps);
+  /// Records the barrier that makes the last record_steps() writes visible to `dst_stage` /
+  /// `dst_access` (e.g. VK_PIPELINE_STAGE_VERTEX_INPUT_BIT / VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT).
+  void record_barrier_to(VkCommandBuffer cmd, VkPipelineStageFlags dst_stage, VkAccessFlags dst_access) const;
+
+  /// Records, submits and waits for `steps` steps, `steps_per_submit` per command buffer; sums the
+  /// GPU time of the submissions (last_gpu_ms). Checks the divergence flags after each submission:
+  /// ErrorCode::diverged names the exact first bad step; the state is left as after that step
+  /// (later steps of the batch leave it unchanged), and step_index() is that step.
+  Result<void> simulate(std::uint64_t steps, std::uint32_t steps_per_submit = 64);
+  /// Reads the divergence flags after the caller's own submissions of record_steps() completed.
+  Result<void> check_divergence();
+
+  /// Readbacks (submit, wait, copy). Values are those of the last completed step.
+  Result<std::vector<glm::vec3>> positions();
+  Result<std::vector<glm::vec3>> velocities();
+  /// Unit normals of the last force evaluation (zero for chains and degenerate fans).
+  Result<std::vector<glm::vec3>> normals();
+  /// Forces of the last evaluation after contacts (for RK4 the first stage's), as on the CPU.
+  Result<std::vector<glm::vec3>> forces();
+  /// Texture coordinates as uploaded.
+  const std::vector<glm::vec2>& uvs() const;
+
+  std::uint64_t step_index() const;
+  double time() const;
+  std::uint32_t particle_count() const;
+
+  /// Index (0 or 1) of the positions buffer holding the current positions: 0 at creation,
+  /// flipped by every recorded step (so step_index() % 2, unless a step diverged).
+  std::uint32_t current_position_index() const;
+  VkBuffer position_buffer(std::uint32_t index) const;
+  VkBuffer current_position_buffer() const;
+  VkBuffer velocity_buffer() const;
+  VkBuffer normal_buffer() const;
+  VkBuffer uv_buffer() const;
+  /// Byte stride of every per-particle buffer above (vec4).
+  static constexpr VkDeviceSize stride = 16;
+
+  /// GPU time of the last simulate() (sum over its submissions, timestamps), in milliseconds;
+  /// negative when the queue has no timestamp support.
+  double last_gpu_ms() const;
+  /// True when bulk buffers go through staging (not host-visible or force_staging).
+  bool uses_staging() const;
+
+  struct Impl; ///< internal (engine/src/vulkan)
+
+private:
+  explicit GpuSolver(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+} // namespace vkcloth::gpu

@@ -1,0 +1,71 @@
+#include "vk_internal.hpp"
+
+#include <fmt/format.h>
+
+namespace vkcloth::gpu {
+
+Result<Buffer> create_buffer(Context::Impl& ctx, VkDeviceSize size, VkBufferUsageFlags usage, MemoryUse use, bool allow_map,
+                             const char* what) {
+  const auto& vk = ctx.vk;
+  Buffer b;
+  b.size = size;
+  VkBufferCreateInfo bi{};
+  bi.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
+  bi.size = size;
+  bi.usage = usage;
+  bi.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  VKCLOTH_VK_TRY(vk.vkCreateBuffer(ctx.device, &bi, nullptr, &b.buffer), fmt::format("vkCreateBuffer ({}, {} bytes)", what, size));
+  VkMemoryRequirements req;
+  vk.vkGetBufferMemoryRequirements(ctx.device, b.buffer, &req);
+
+  constexpr VkMemoryPropertyFlags mappable = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+  int type = -1;
+  bool map = false;
+  switch (use) {
+  case MemoryUse::device:
+    if (allow_map) type = ctx.find_memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT | mappable, 0);
+    map = type >= 0;
+    if (type < 0) type = ctx.find_memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0);
+    if (type < 0) type = ctx.find_memory_type(req.memoryTypeBits, 0, 0);
+    break;
+  case MemoryUse::host_upload:
+    type = ctx.find_memory_type(req.memoryTypeBits, mappable, 0);
+    map = true;
+    break;
+  case MemoryUse::host_readback:
+    type = ctx.find_memory_type(req.memoryTypeBits, mappable, VK_MEMORY_PROPERTY_HOST_CACHED_BIT);
+    map = true;
+    break;
+  }
+  if (type < 0) {
+    destroy_buffer(ctx, b);
+    return make_error(ErrorCode::unsupported, fmt::format("no suitable memory type for the {} buffer", what));
+  }
+  VkMemoryAllocateInfo ai{};
+  ai.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+  ai.allocationSize = req.size;
+  ai.memoryTypeIndex = static_cast<std::uint32_t>(type);
+  if (const VkResult r = vk.vkAllocateMemory(ctx.device, &ai, nullptr, &b.memory); r != VK_SUCCESS) {
+    destroy_buffer(ctx, b);
+    return vk_error(r, fmt::format("vkAllocateMemory ({}, {} bytes)", what, req.size));
+  }
+  if (const VkResult r = vk.vkBindBufferMemory(ctx.device, b.buffer, b.memory, 0); r != VK_SUCCESS) {
+    destroy_buffer(ctx, b);
+    return vk_error(r, fmt::format("vkBindBufferMemory ({})", what));
+  }
+  if (map) {
+    if (const VkResult r = vk.vkMapMemory(ctx.device, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped); r != VK_SUCCESS) {
+      destroy_buffer(ctx, b);
+      return vk_error(r, fmt::format("vkMapMemory ({})", what));
+    }
+  }
+  return b;
+}
+
+void destroy_buffer(Context::Impl& ctx, Buffer& b) {
+  if (b.buffer) ctx.vk.vkDestroyBuffer(ctx.device, b.buffer, nullptr);
+  if (b.memory) ctx.vk.vkFreeMemory(ctx.device, b.memory, nullptr); // unmaps implicitly
+  b = Buffer{};
+}
+
+} // namespace vkcloth::gpu

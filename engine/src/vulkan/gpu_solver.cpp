@@ -1,0 +1,635 @@
+#include "vk_internal.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <optional>
+
+#include <fmt/format.h>
+
+#include "barriers.hpp"
+#include "vkcloth/gpu/gpu_solver.hpp"
+#include "vkcloth/shaders/force_comp_spv.hpp"
+#include "vkcloth/shaders/integrate_comp_spv.hpp"
+#include "vkcloth_shared.h"
+
+namespace vkcloth::gpu {
+
+namespace sh = shared;
+
+struct GpuSolver::Impl {
+  std::shared_ptr<Context::Impl> ctx;
+  SimParams params;
+  GpuSolverOptions options;
+  std::uint32_t count = 0;
+  std::uint32_t nx = 0, ny = 0;
+  bool staging = false;
+
+  // Per-particle vec4 buffers, then the constant topology, then the small host-visible ones.
+  Buffer pos[2], vel, force, force_stage, vel_filt, normal, uv, stage_pos, stage_vel, acc_pos, acc_vel;
+  Buffer particle, offsets, edges;
+  Buffer colliders, flags; // host-visible (small; written / read by the host)
+  std::uint32_t collider_capacity = 0;
+
+  VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
+  VkDescriptorPool pool = VK_NULL_HANDLE;
+  VkDescriptorSet sets[2][2] = {}; // [positions read index][0: state input, 1: RK4 stage input]
+  VkPipelineLayout layout = VK_NULL_HANDLE;
+  VkPipeline force_pipeline = VK_NULL_HANDLE, integrate_pipeline = VK_NULL_HANDLE;
+  VkCommandPool cmd_pool = VK_NULL_HANDLE;
+  VkCommandBuffer cmd = VK_NULL_HANDLE;
+  VkFence fence = VK_NULL_HANDLE;
+  VkQueryPool queries = VK_NULL_HANDLE;
+  std::uint32_t groups_x = 1, groups_y = 1;
+
+  sh::PushConstants pc{};
+  std::uint64_t step = 0;     // completed steps (the bad one when diverged)
+  std::uint64_t recorded = 0; // recorded steps: parity of the current positions, flag step numbers
+  std::vector<glm::vec2> uvs;
+  double last_ms = -1.0;
+  std::optional<Error> diverged;
+
+  Impl() = default;
+  Impl(const Impl&) = delete;
+  Impl& operator=(const Impl&) = delete;
+  ~Impl();
+
+  const VolkDeviceTable& vk() const { return ctx->vk; }
+  std::uint32_t current() const { return static_cast<std::uint32_t>(recorded & 1u); }
+
+  Result<void> init_pipelines();
+  Result<void> write_sets();
+  Result<void> upload_colliders();
+  void set_push_constants();
+  template <typename F> Result<void> submit_and_wait(F&& record);
+  Result<std::vector<glm::vec3>> read_vec3(const Buffer& b);
+  Result<void> check_flags();
+  void record(VkCommandBuffer cmd, std::uint32_t steps);
+};
+
+GpuSolver::Impl::~Impl() {
+  if (!ctx || !ctx->device) return;
+  const auto& v = ctx->vk;
+  const VkDevice d = ctx->device;
+  if (fence) {
+    v.vkWaitForFences(d, 1, &fence, VK_TRUE, UINT64_MAX); // our own submissions (always waited already)
+    v.vkDestroyFence(d, fence, nullptr);
+  }
+  if (queries) v.vkDestroyQueryPool(d, queries, nullptr);
+  if (cmd_pool) v.vkDestroyCommandPool(d, cmd_pool, nullptr);
+  if (force_pipeline) v.vkDestroyPipeline(d, force_pipeline, nullptr);
+  if (integrate_pipeline) v.vkDestroyPipeline(d, integrate_pipeline, nullptr);
+  if (layout) v.vkDestroyPipelineLayout(d, layout, nullptr);
+  if (pool) v.vkDestroyDescriptorPool(d, pool, nullptr);
+  if (set_layout) v.vkDestroyDescriptorSetLayout(d, set_layout, nullptr);
+  for (Buffer* b : {&pos[0], &pos[1], &vel, &force, &force_stage, &vel_filt, &normal, &uv, &stage_pos, &stage_vel, &acc_pos,
+                    &acc_vel, &particle, &offsets, &edges, &colliders, &flags})
+    destroy_buffer(*ctx, *b);
+}
+
+namespace {
+
+template <std::size_t N> Result<VkShaderModule> make_module(const VolkDeviceTable& vk, VkDevice d, const std::uint32_t (&code)[N],
+                                                            const char* name) {
+  VkShaderModuleCreateInfo ci{};
+  ci.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
+  ci.codeSize = N * sizeof(std::uint32_t);
+  ci.pCode = code;
+  VkShaderModule m = VK_NULL_HANDLE;
+  VKCLOTH_VK_TRY(vk.vkCreateShaderModule(d, &ci, nullptr, &m), fmt::format("vkCreateShaderModule ({})", name));
+  return m;
+}
+
+std::string vec_str(glm::vec3 v) { return fmt::format("({:.4g}, {:.4g}, {:.4g})", double(v.x), double(v.y), double(v.z)); }
+
+} // namespace
+
+Result<void> GpuSolver::Impl::init_pipelines() {
+  const auto& v = vk();
+  const VkDevice d = ctx->device;
+  std::array<VkDescriptorSetLayoutBinding, VKCLOTH_BINDING_COUNT> bindings{};
+  for (std::uint32_t i = 0; i < bindings.size(); ++i)
+    bindings[i] = VkDescriptorSetLayoutBinding{i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+  VkDescriptorSetLayoutCreateInfo li{};
+  li.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
+  li.bindingCount = static_cast<std::uint32_t>(bindings.size());
+  li.pBindings = bindings.data();
+  VKCLOTH_VK_TRY(v.vkCreateDescriptorSetLayout(d, &li, nullptr, &set_layout), "vkCreateDescriptorSetLayout");
+
+  const VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(sh::PushConstants)};
+  VkPipelineLayoutCreateInfo pi{};
+  pi.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
+  pi.setLayoutCount = 1;
+  pi.pSetLayouts = &set_layout;
+  pi.pushConstantRangeCount = 1;
+  pi.pPushConstantRanges = &range;
+  VKCLOTH_VK_TRY(v.vkCreatePipelineLayout(d, &pi, nullptr, &layout), "vkCreatePipelineLayout");
+
+  const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 4 * VKCLOTH_BINDING_COUNT};
+  VkDescriptorPoolCreateInfo dp{};
+  dp.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
+  dp.maxSets = 4;
+  dp.poolSizeCount = 1;
+  dp.pPoolSizes = &size;
+  VKCLOTH_VK_TRY(v.vkCreateDescriptorPool(d, &dp, nullptr, &pool), "vkCreateDescriptorPool");
+  const VkDescriptorSetLayout layouts[4] = {set_layout, set_layout, set_layout, set_layout};
+  VkDescriptorSetAllocateInfo ai{};
+  ai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
+  ai.descriptorPool = pool;
+  ai.descriptorSetCount = 4;
+  ai.pSetLayouts = layouts;
+  VKCLOTH_VK_TRY(v.vkAllocateDescriptorSets(d, &ai, &sets[0][0]), "vkAllocateDescriptorSets");
+
+  auto fm = make_module(v, d, spirv::force_comp_spv, "force.comp");
+  if (!fm) return fm.error();
+  auto im = make_module(v, d, spirv::integrate_comp_spv, "integrate.comp");
+  if (!im) {
+    v.vkDestroyShaderModule(d, *fm, nullptr);
+    return im.error();
+  }
+  VkComputePipelineCreateInfo ci[2]{};
+  const VkShaderModule modules[2] = {*fm, *im};
+  for (int k = 0; k < 2; ++k) {
+    ci[k].sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
+    ci[k].stage = VkPipelineShaderStageCreateInfo{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0,
+                                                  VK_SHADER_STAGE_COMPUTE_BIT, modules[k], "main", nullptr};
+    ci[k].layout = layout;
+  }
+  VkPipeline pipes[2] = {};
+  const VkResult r = v.vkCreateComputePipelines(d, VK_NULL_HANDLE, 2, ci, nullptr, pipes);
+  v.vkDestroyShaderModule(d, *fm, nullptr);
+  v.vkDestroyShaderModule(d, *im, nullptr);
+  if (r != VK_SUCCESS) return vk_error(r, "vkCreateComputePipelines (force.comp, integrate.comp)");
+  force_pipeline = pipes[0];
+  integrate_pipeline = pipes[1];
+  return {};
+}
+
+Result<void> GpuSolver::Impl::write_sets() {
+  std::array<VkDescriptorBufferInfo, 4 * VKCLOTH_BINDING_COUNT> infos{};
+  std::array<VkWriteDescriptorSet, 4 * VKCLOTH_BINDING_COUNT> writes{};
+  std::size_t k = 0;
+  for (std::uint32_t read = 0; read < 2; ++read)
+    for (std::uint32_t src = 0; src < 2; ++src) {
+      const Buffer* by_binding[VKCLOTH_BINDING_COUNT] = {};
+      by_binding[VKCLOTH_BINDING_POS_IN] = src ? &stage_pos : &pos[read];
+      by_binding[VKCLOTH_BINDING_VEL_IN] = src ? &stage_vel : &vel;
+      by_binding[VKCLOTH_BINDING_FORCE_OUT] = src ? &force_stage : &force;
+      by_binding[VKCLOTH_BINDING_VEL_FILT] = &vel_filt;
+      by_binding[VKCLOTH_BINDING_NORMAL] = &normal;
+      by_binding[VKCLOTH_BINDING_POS_BASE] = &pos[read];
+      by_binding[VKCLOTH_BINDING_POS_OUT] = &pos[read ^ 1u];
+      by_binding[VKCLOTH_BINDING_VEL] = &vel;
+      by_binding[VKCLOTH_BINDING_STAGE_POS] = &stage_pos;
+      by_binding[VKCLOTH_BINDING_STAGE_VEL] = &stage_vel;
+      by_binding[VKCLOTH_BINDING_ACC_POS] = &acc_pos;
+      by_binding[VKCLOTH_BINDING_ACC_VEL] = &acc_vel;
+      by_binding[VKCLOTH_BINDING_PARTICLE] = &particle;
+      by_binding[VKCLOTH_BINDING_OFFSETS] = &offsets;
+      by_binding[VKCLOTH_BINDING_EDGES] = &edges;
+      by_binding[VKCLOTH_BINDING_COLLIDERS] = &colliders;
+      by_binding[VKCLOTH_BINDING_FLAGS] = &flags;
+      for (std::uint32_t b = 0; b < VKCLOTH_BINDING_COUNT; ++b, ++k) {
+        infos[k] = VkDescriptorBufferInfo{by_binding[b]->buffer, 0, VK_WHOLE_SIZE};
+        writes[k] = VkWriteDescriptorSet{};
+        writes[k].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+        writes[k].dstSet = sets[read][src];
+        writes[k].dstBinding = b;
+        writes[k].descriptorCount = 1;
+        writes[k].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        writes[k].pBufferInfo = &infos[k];
+      }
+    }
+  vk().vkUpdateDescriptorSets(ctx->device, static_cast<std::uint32_t>(writes.size()), writes.data(), 0, nullptr);
+  return {};
+}
+
+Result<void> GpuSolver::Impl::upload_colliders() {
+  const std::uint32_t n = static_cast<std::uint32_t>(params.colliders.size());
+  if (n > collider_capacity || !colliders.buffer) {
+    const std::uint32_t cap = std::max<std::uint32_t>(n, 4);
+    auto b = create_buffer(*ctx, cap * sizeof(sh::Collider), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::host_upload, true,
+                           "colliders");
+    if (!b) return b.error();
+    destroy_buffer(*ctx, colliders);
+    colliders = *b;
+    collider_capacity = cap;
+    if (sets[0][0]) VKCLOTH_TRY(write_sets());
+  }
+  auto* out = static_cast<sh::Collider*>(colliders.mapped);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const Collider& c = params.colliders[i];
+    sh::Collider g{};
+    g.type = static_cast<std::uint32_t>(c.type);
+    if (c.type == Collider::Type::plane)
+      g.shape = {float(c.normal.x), float(c.normal.y), float(c.normal.z), float(c.offset)};
+    else
+      g.shape = {float(c.center.x), float(c.center.y), float(c.center.z), float(c.radius)};
+    out[i] = g;
+  }
+  return {};
+}
+
+void GpuSolver::Impl::set_push_constants() {
+  // Conversions exactly as CpuSolver<float>: each double field cast to float, then float math.
+  const float dt = float(params.dt);
+  pc.count = count;
+  pc.nx = nx;
+  pc.ny = ny;
+  pc.flags = (nx ? VKCLOTH_FLAG_HAS_GRID : 0u) | (float(params.wind.strength) != 0.0f ? VKCLOTH_FLAG_WIND : 0u);
+  pc.integrator = static_cast<std::uint32_t>(params.integrator);
+  pc.collider_count = static_cast<std::uint32_t>(params.colliders.size());
+  pc.gravity_damping = {float(params.gravity.x), float(params.gravity.y), float(params.gravity.z), float(params.damping)};
+  pc.wind = {float(params.wind.direction.x), float(params.wind.direction.y), float(params.wind.direction.z),
+             float(params.wind.strength)};
+  pc.dt = dt;
+  pc.w6 = dt / 6.0f;
+  pc.eps = float(params.contact_epsilon);
+  pc.band = 2.0f * pc.eps;
+  pc.limit = float(params.divergence_limit);
+}
+
+template <typename F> Result<void> GpuSolver::Impl::submit_and_wait(F&& record_fn) {
+  const auto& v = vk();
+  VKCLOTH_VK_TRY(v.vkResetCommandBuffer(cmd, 0), "vkResetCommandBuffer");
+  VkCommandBufferBeginInfo bi{};
+  bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+  bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  VKCLOTH_VK_TRY(v.vkBeginCommandBuffer(cmd, &bi), "vkBeginCommandBuffer");
+  record_fn(cmd);
+  VKCLOTH_VK_TRY(v.vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
+  VkSubmitInfo si{};
+  si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
+  si.commandBufferCount = 1;
+  si.pCommandBuffers = &cmd;
+  VKCLOTH_VK_TRY(v.vkResetFences(ctx->device, 1, &fence), "vkResetFences");
+  VKCLOTH_VK_TRY(v.vkQueueSubmit(ctx->queue, 1, &si, fence), "vkQueueSubmit");
+  VKCLOTH_VK_TRY(v.vkWaitForFences(ctx->device, 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+  return {};
+}
+
+Result<std::vector<glm::vec3>> GpuSolver::Impl::read_vec3(const Buffer& b) {
+  std::optional<Buffer> tmp;
+  if (!b.mapped) {
+    auto s = create_buffer(*ctx, b.size, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUse::host_readback, true, "readback staging");
+    if (!s) return s.error();
+    tmp = *s;
+  }
+  auto r = submit_and_wait([&](VkCommandBuffer c) {
+    barriers::before_readback(vk(), c);
+    if (tmp) {
+      const VkBufferCopy region{0, 0, b.size};
+      vk().vkCmdCopyBuffer(c, b.buffer, tmp->buffer, 1, &region);
+      barriers::transfer_to_host(vk(), c);
+    }
+  });
+  std::vector<glm::vec3> out;
+  if (r) {
+    const auto* src = static_cast<const sh::vec4*>(tmp ? tmp->mapped : b.mapped);
+    out.resize(count);
+    for (std::uint32_t i = 0; i < count; ++i) out[i] = glm::vec3(src[i].x, src[i].y, src[i].z);
+  }
+  if (tmp) destroy_buffer(*ctx, *tmp);
+  if (!r) return r.error();
+  return out;
+}
+
+Result<void> GpuSolver::Impl::check_flags() {
+  if (diverged) return *diverged;
+  const auto* f = static_cast<const sh::Flags*>(flags.mapped);
+  if (!f->diverged) return {};
+  step = f->first_bad_step; // the flag epoch is creation (step 0), so relative == absolute
+  const std::uint32_t p = std::min(f->bad_particle, count - 1);
+  std::string where;
+  auto x = read_vec3(pos[current()]);
+  auto v = read_vec3(vel);
+  if (x && v) where = fmt::format(": particle {} is at {} with velocity {}", p, vec_str((*x)[p]), vec_str((*v)[p]));
+  diverged = make_error(ErrorCode::diverged,
+                        fmt::format("simulation diverged at step {} (t = {:.4g} s) on the GPU{} (limit {:g}); the state "
+                                    "is left as after that step; try a smaller integrator.dt, lower stiffness or more "
+                                    "damping",
+                                    step, double(step) * params.dt, where, params.divergence_limit));
+  return *diverged;
+}
+
+void GpuSolver::Impl::record(VkCommandBuffer c, std::uint32_t steps) {
+  if (steps == 0) return;
+  const auto& v = vk();
+  barriers::before_steps(v, c);
+  const bool rk4 = params.integrator == Integrator::rk4;
+  const std::uint32_t stages = rk4 ? 4 : 1;
+  const float half = pc.dt / 2.0f; // CPU: c = {0, dt/2, dt/2, dt}
+  const float c_next[4] = {half, half, pc.dt, 0.0f};
+  VkDescriptorSet bound = VK_NULL_HANDLE;
+  bool first = true;
+  for (std::uint32_t s = 0; s < steps; ++s) {
+    const std::uint32_t read = current();
+    pc.step = static_cast<std::uint32_t>(recorded + 1); // 1-based number of the step being computed
+    for (std::uint32_t k = 0; k < stages; ++k) {
+      pc.stage = k;
+      pc.c_next = c_next[k];
+      const VkDescriptorSet set = sets[read][k == 0 ? 0 : 1];
+      if (set != bound) {
+        v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &set, 0, nullptr);
+        bound = set;
+      }
+      v.vkCmdPushConstants(c, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
+      if (!first) barriers::dispatch_to_dispatch(v, c); // integrate (previous stage/step) -> force
+      first = false;
+      v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, force_pipeline);
+      v.vkCmdDispatch(c, groups_x, groups_y, 1);
+      barriers::dispatch_to_dispatch(v, c); // force -> integrate
+      v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, integrate_pipeline);
+      v.vkCmdDispatch(c, groups_x, groups_y, 1);
+    }
+    ++recorded; // positions[read ^ 1] now holds the new state
+    if (!diverged) ++step;
+  }
+}
+
+Result<GpuSolver> GpuSolver::create(Context& context, const ParticleSystem& system, SimParams params,
+                                    const GpuSolverOptions& options) {
+  VKCLOTH_TRY(params.validate());
+  const std::size_t n = system.size();
+  if (n == 0) return make_error(ErrorCode::invalid_argument, "the particle system is empty");
+  if (system.adjacency.offsets.size() != n + 1 || system.adjacency.refs.size() != system.adjacency.offsets[n])
+    return make_error(ErrorCode::invalid_argument, "the particle system was not finalized (call finalize())");
+  if (system.grid && std::uint64_t(system.grid->nx) * system.grid->ny != n)
+    return make_error(ErrorCode::invalid_argument,
+                      fmt::format("grid {} x {} does not match the {} particles", system.grid->nx, system.grid->ny, n));
+  for (std::size_t p = 0; p < n; ++p)
+    if (!system.particles[p].pinned && !(system.particles[p].mass > 0.0))
+      return make_error(ErrorCode::invalid_argument,
+                        fmt::format("particle {} has mass {}; free particles need a mass > 0", p, system.particles[p].mass));
+  for (const SpringRef& r : system.adjacency.refs)
+    if (r.other >= n || r.spring >= system.springs.size())
+      return make_error(ErrorCode::invalid_argument, "the particle system's adjacency refers to a missing particle or spring");
+
+  // Device limits, checked before any allocation.
+  const std::shared_ptr<Context::Impl>& ctx = context.impl();
+  const VkPhysicalDeviceLimits& lim = ctx->properties.limits;
+  std::uint64_t max_bytes = lim.maxStorageBufferRange;
+  const bool overridden = options.max_storage_buffer_bytes && options.max_storage_buffer_bytes < max_bytes;
+  if (overridden) max_bytes = options.max_storage_buffer_bytes;
+  const std::uint64_t edges_n = system.adjacency.refs.size();
+  const struct {
+    const char* what;
+    std::uint64_t bytes;
+    std::uint64_t per;
+    std::uint64_t items;
+  } needs[] = {{"per-particle (vec4)", std::uint64_t(n) * 16, 16, n},
+               {"spring adjacency", edges_n * sizeof(sh::Edge), sizeof(sh::Edge), edges_n},
+               {"particle constants", std::uint64_t(n) * sizeof(sh::ParticleInfo), sizeof(sh::ParticleInfo), n}};
+  for (const auto& need : needs)
+    if (need.bytes > max_bytes)
+      return make_error(ErrorCode::unsupported,
+                        fmt::format("the system is too large for device '{}': its {} buffer needs {} bytes ({} x {} "
+                                    "bytes) but a storage buffer may hold at most {} bytes ({}); use fewer particles",
+                                    ctx->name, need.what, need.bytes, need.items, need.per, max_bytes,
+                                    overridden ? "GpuSolverOptions::max_storage_buffer_bytes"
+                                               : "maxStorageBufferRange"));
+  const std::uint64_t groups = (std::uint64_t(n) + VKCLOTH_WORKGROUP_SIZE - 1) / VKCLOTH_WORKGROUP_SIZE;
+  const std::uint64_t gx = std::min<std::uint64_t>(groups, lim.maxComputeWorkGroupCount[0]);
+  const std::uint64_t gy = (groups + gx - 1) / gx;
+  if (gy > lim.maxComputeWorkGroupCount[1] || n >= std::numeric_limits<std::uint32_t>::max())
+    return make_error(ErrorCode::unsupported,
+                      fmt::format("the system is too large for device '{}': {} particles need {} workgroups of {} but "
+                                  "the device dispatches at most {} x {}",
+                                  ctx->name, n, groups, VKCLOTH_WORKGROUP_SIZE, lim.maxComputeWorkGroupCount[0],
+                                  lim.maxComputeWorkGroupCount[1]));
+
+  auto impl = std::make_unique<Impl>();
+  Impl& s = *impl;
+  s.ctx = ctx;
+  s.params = std::move(params);
+  s.options = options;
+  s.count = static_cast<std::uint32_t>(n);
+  s.groups_x = static_cast<std::uint32_t>(gx);
+  s.groups_y = static_cast<std::uint32_t>(gy);
+  if (system.grid) {
+    s.nx = system.grid->nx;
+    s.ny = system.grid->ny;
+  }
+  const auto& v = ctx->vk;
+  const VkDevice d = ctx->device;
+
+  // Buffers. Bulk ones prefer device-local + host-visible (mapped) unless staging is forced.
+  const VkBufferUsageFlags usage =
+      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  const VkDeviceSize vec4_bytes = VkDeviceSize(n) * 16;
+  const bool allow_map = !options.force_staging;
+  const std::pair<Buffer*, const char*> vec4_buffers[] = {
+      {&s.pos[0], "positions[0]"}, {&s.pos[1], "positions[1]"}, {&s.vel, "velocities"},     {&s.force, "forces"},
+      {&s.force_stage, "stage forces"}, {&s.vel_filt, "contact velocities"}, {&s.normal, "normals"}, {&s.uv, "uvs"},
+      {&s.stage_pos, "stage positions"}, {&s.stage_vel, "stage velocities"}, {&s.acc_pos, "rk4 sums (positions)"},
+      {&s.acc_vel, "rk4 sums (velocities)"}};
+  for (auto [b, what] : vec4_buffers) {
+    auto r = create_buffer(*ctx, vec4_bytes, usage, MemoryUse::device, allow_map, what);
+    if (!r) return r.error();
+    *b = *r;
+  }
+  const std::tuple<Buffer*, VkDeviceSize, const char*> const_buffers[] = {
+      {&s.particle, std::max<VkDeviceSize>(n * sizeof(sh::ParticleInfo), 16), "particle constants"},
+      {&s.offsets, std::max<VkDeviceSize>((n + 1) * sizeof(std::uint32_t), 16), "adjacency offsets"},
+      {&s.edges, std::max<VkDeviceSize>(edges_n * sizeof(sh::Edge), 16), "adjacency"}};
+  for (auto [b, bytes, what] : const_buffers) {
+    auto r = create_buffer(*ctx, bytes, usage, MemoryUse::device, allow_map, what);
+    if (!r) return r.error();
+    *b = *r;
+  }
+  s.staging = s.pos[0].mapped == nullptr;
+  {
+    auto r = create_buffer(*ctx, sizeof(sh::Flags), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::host_readback, true, "flags");
+    if (!r) return r.error();
+    s.flags = *r;
+    *static_cast<sh::Flags*>(s.flags.mapped) = sh::Flags{0, VKCLOTH_NO_BAD_STEP, VKCLOTH_NO_BAD_STEP, 0};
+  }
+  VKCLOTH_TRY(s.upload_colliders());
+
+  // Command pool, command buffer, fence, timestamps.
+  VkCommandPoolCreateInfo cp{};
+  cp.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
+  cp.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+  cp.queueFamilyIndex = ctx->queue_family;
+  VKCLOTH_VK_TRY(v.vkCreateCommandPool(d, &cp, nullptr, &s.cmd_pool), "vkCreateCommandPool");
+  VkCommandBufferAllocateInfo ca{};
+  ca.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
+  ca.commandPool = s.cmd_pool;
+  ca.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  ca.commandBufferCount = 1;
+  VKCLOTH_VK_TRY(v.vkAllocateCommandBuffers(d, &ca, &s.cmd), "vkAllocateCommandBuffers");
+  VkFenceCreateInfo fi{};
+  fi.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
+  fi.flags = VK_FENCE_CREATE_SIGNALED_BIT;
+  VKCLOTH_VK_TRY(v.vkCreateFence(d, &fi, nullptr, &s.fence), "vkCreateFence");
+  if (ctx->timestamp_valid_bits > 0) {
+    VkQueryPoolCreateInfo qi{};
+    qi.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
+    qi.queryType = VK_QUERY_TYPE_TIMESTAMP;
+    qi.queryCount = 2;
+    VKCLOTH_VK_TRY(v.vkCreateQueryPool(d, &qi, nullptr, &s.queries), "vkCreateQueryPool");
+  }
+  VKCLOTH_TRY(s.init_pipelines());
+  VKCLOTH_TRY(s.write_sets());
+  s.set_push_constants();
+
+  // Initial state, converted as CpuSolver<float>::create converts it.
+  std::vector<sh::vec4> pos(n), vel(n), uv(n);
+  std::vector<sh::ParticleInfo> info(n);
+  s.uvs.assign(n, glm::vec2(0.0f));
+  for (std::size_t p = 0; p < n; ++p) {
+    const Particle& q = system.particles[p];
+    pos[p] = {float(q.position.x), float(q.position.y), float(q.position.z), 1.0f};
+    vel[p] = q.pinned ? sh::vec4{0, 0, 0, 0} : sh::vec4{float(q.velocity.x), float(q.velocity.y), float(q.velocity.z), 0.0f};
+    info[p] = {float(q.mass), q.pinned ? 1u : 0u};
+  }
+  if (system.grid) {
+    for (std::uint32_t j = 0; j < s.ny; ++j)
+      for (std::uint32_t i = 0; i < s.nx; ++i) {
+        const glm::vec2 t(s.nx > 1 ? float(i) / float(s.nx - 1) : 0.0f, s.ny > 1 ? float(j) / float(s.ny - 1) : 0.0f);
+        s.uvs[std::size_t(j) * s.nx + i] = t;
+        uv[std::size_t(j) * s.nx + i] = {t.x, t.y, 0.0f, 0.0f};
+      }
+  }
+  std::vector<sh::Edge> edges(edges_n);
+  for (std::size_t e = 0; e < edges_n; ++e) {
+    const SpringRef& r = system.adjacency.refs[e];
+    const Spring& sp = system.springs[r.spring];
+    edges[e] = {r.other, float(sp.rest_length), float(sp.stiffness)};
+  }
+  struct Upload {
+    Buffer* dst;
+    const void* data; // null: zero fill
+    VkDeviceSize bytes;
+  };
+  const Upload uploads[] = {{&s.pos[0], pos.data(), vec4_bytes},
+                            {&s.pos[1], pos.data(), vec4_bytes},
+                            {&s.vel, vel.data(), vec4_bytes},
+                            {&s.uv, uv.data(), vec4_bytes},
+                            {&s.particle, info.data(), n * sizeof(sh::ParticleInfo)},
+                            {&s.offsets, system.adjacency.offsets.data(), (n + 1) * sizeof(std::uint32_t)},
+                            {&s.edges, edges.data(), edges_n * sizeof(sh::Edge)},
+                            {&s.force, nullptr, 0},
+                            {&s.force_stage, nullptr, 0},
+                            {&s.vel_filt, nullptr, 0},
+                            {&s.normal, nullptr, 0},
+                            {&s.stage_pos, nullptr, 0},
+                            {&s.stage_vel, nullptr, 0},
+                            {&s.acc_pos, nullptr, 0},
+                            {&s.acc_vel, nullptr, 0}};
+  if (!s.staging) {
+    for (const Upload& u : uploads) {
+      if (u.data)
+        std::memcpy(u.dst->mapped, u.data, u.bytes);
+      else
+        std::memset(u.dst->mapped, 0, u.dst->size);
+    }
+  } else {
+    VkDeviceSize total = 0;
+    for (const Upload& u : uploads) total += u.data ? u.bytes : 0;
+    auto st = create_buffer(*ctx, std::max<VkDeviceSize>(total, 16), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryUse::host_upload,
+                            true, "upload staging");
+    if (!st) return st.error();
+    Buffer staging = *st;
+    VkDeviceSize at = 0;
+    auto r = s.submit_and_wait([&](VkCommandBuffer c) {
+      for (const Upload& u : uploads) {
+        if (!u.data) {
+          v.vkCmdFillBuffer(c, u.dst->buffer, 0, VK_WHOLE_SIZE, 0);
+          continue;
+        }
+        if (u.bytes == 0) continue;
+        std::memcpy(static_cast<char*>(staging.mapped) + at, u.data, u.bytes);
+        const VkBufferCopy region{at, 0, u.bytes};
+        v.vkCmdCopyBuffer(c, staging.buffer, u.dst->buffer, 1, &region);
+        at += u.bytes;
+      }
+      barriers::transfer_to_compute(v, c);
+    });
+    destroy_buffer(*ctx, staging);
+    VKCLOTH_TRY(r);
+  }
+  return GpuSolver(std::move(impl));
+}
+
+GpuSolver::GpuSolver(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+GpuSolver::GpuSolver(GpuSolver&&) noexcept = default;
+GpuSolver& GpuSolver::operator=(GpuSolver&&) noexcept = default;
+GpuSolver::~GpuSolver() = default;
+
+Result<void> GpuSolver::set_params(SimParams params) {
+  VKCLOTH_TRY(params.validate());
+  impl_->params = std::move(params);
+  VKCLOTH_TRY(impl_->upload_colliders());
+  impl_->set_push_constants();
+  return {};
+}
+const SimParams& GpuSolver::params() const { return impl_->params; }
+
+void GpuSolver::record_steps(VkCommandBuffer cmd, std::uint32_t steps) { impl_->record(cmd, steps); }
+
+void GpuSolver::record_barrier_to(VkCommandBuffer cmd, VkPipelineStageFlags dst_stage, VkAccessFlags dst_access) const {
+  barriers::after_steps(impl_->vk(), cmd, dst_stage, dst_access);
+}
+
+Result<void> GpuSolver::simulate(std::uint64_t steps, std::uint32_t steps_per_submit) {
+  Impl& s = *impl_;
+  if (s.diverged) return *s.diverged;
+  if (steps_per_submit == 0) return make_error(ErrorCode::invalid_argument, "steps_per_submit must be > 0");
+  const auto& v = s.vk();
+  s.last_ms = s.queries ? 0.0 : -1.0;
+  for (std::uint64_t done = 0; done < steps;) {
+    const auto k = static_cast<std::uint32_t>(std::min<std::uint64_t>(steps - done, steps_per_submit));
+    VKCLOTH_TRY(s.submit_and_wait([&](VkCommandBuffer c) {
+      if (s.queries) {
+        v.vkCmdResetQueryPool(c, s.queries, 0, 2);
+        v.vkCmdWriteTimestamp(c, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, s.queries, 0);
+      }
+      s.record(c, k);
+      if (s.queries) v.vkCmdWriteTimestamp(c, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, s.queries, 1);
+      barriers::after_steps(v, c, VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT); // flags read by the host
+    }));
+    if (s.queries) {
+      std::uint64_t ts[2] = {};
+      VKCLOTH_VK_TRY(v.vkGetQueryPoolResults(s.ctx->device, s.queries, 0, 2, sizeof(ts), ts, sizeof(std::uint64_t),
+                                             VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+                     "vkGetQueryPoolResults");
+      const std::uint32_t bits = s.ctx->timestamp_valid_bits;
+      const std::uint64_t mask = bits >= 64 ? ~0ull : ((1ull << bits) - 1);
+      const std::uint64_t ticks = ((ts[1] & mask) - (ts[0] & mask)) & mask;
+      s.last_ms += double(ticks) * double(s.ctx->properties.limits.timestampPeriod) * 1e-6;
+    }
+    done += k;
+    VKCLOTH_TRY(s.check_flags());
+  }
+  return {};
+}
+
+Result<void> GpuSolver::check_divergence() {
+  Impl& s = *impl_;
+  if (s.diverged) return *s.diverged;
+  VKCLOTH_TRY(s.submit_and_wait([&](VkCommandBuffer c) { barriers::before_readback(s.vk(), c); }));
+  return s.check_flags();
+}
+
+Result<std::vector<glm::vec3>> GpuSolver::positions() { return impl_->read_vec3(impl_->pos[impl_->current()]); }
+Result<std::vector<glm::vec3>> GpuSolver::velocities() { return impl_->read_vec3(impl_->vel); }
+Result<std::vector<glm::vec3>> GpuSolver::normals() { return impl_->read_vec3(impl_->normal); }
+Result<std::vector<glm::vec3>> GpuSolver::forces() { return impl_->read_vec3(impl_->force); }
+const std::vector<glm::vec2>& GpuSolver::uvs() const { return impl_->uvs; }
+
+std::uint64_t GpuSolver::step_index() const { return impl_->step; }
+double GpuSolver::time() const { return static_cast<double>(impl_->step) * impl_->params.dt; }
+std::uint32_t GpuSolver::particle_count() const { return impl_->count; }
+std::uint32_t GpuSolver::current_position_index() const { return impl_->current(); }
+VkBuffer GpuSolver::position_buffer(std::uint32_t index) const { return impl_->pos[index & 1u].buffer; }
+VkBuffer GpuSolver::current_position_buffer() const { return impl_->pos[impl_->current()].buffer; }
+VkBuffer GpuSolver::velocity_buffer() const { return impl_->vel.buffer; }
+VkBuffer GpuSolver::normal_buffer() const { return impl_->normal.buffer; }
+VkBuffer GpuSolver::uv_buffer() const { return impl_->uv.buffer; }
+double GpuSolver::last_gpu_ms() const { return impl_->last_ms; }
+bool GpuSolver::uses_staging() const { return impl_->staging; }
+
+} // namespace vkcloth::gpu

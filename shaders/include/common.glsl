@@ -1,0 +1,56 @@
+// Helpers shared by force.comp and integrate.comp. Every float expression is written in the
+// order engine/src/core/cpu_solver.cpp uses, and `precise` keeps the compiler from fusing or
+// reassociating it (no FMA contraction), so lavapipe reproduces the CPU bit for bit.
+#ifndef VKCLOTH_COMMON_GLSL
+#define VKCLOTH_COMMON_GLSL
+
+layout(local_size_x = VKCLOTH_WORKGROUP_SIZE) in;
+
+layout(push_constant) uniform PushBlock { PushConstants pc; };
+
+layout(std430, set = 0, binding = VKCLOTH_BINDING_PARTICLE) readonly buffer ParticleBuf { ParticleInfo particle[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_COLLIDERS) readonly buffer ColliderBuf { Collider colliders[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_FLAGS) buffer FlagBuf { Flags flags; };
+
+// Particle index: 1-D, with a second grid dimension when one row of workgroups is not enough.
+uint particle_index() {
+  return gl_WorkGroupID.y * gl_NumWorkGroups.x * uint(VKCLOTH_WORKGROUP_SIZE) + gl_GlobalInvocationID.x;
+}
+
+// A step after the first diverged one leaves the state as it was after the bad step (like the
+// CPU, which stops there). Stable within a dispatch: first_bad_step only takes this step's value.
+bool frozen() { return flags.first_bad_step < pc.step; }
+
+// dot3(a, b) = a.x*b.x + a.y*b.y + a.z*b.z, left to right (CPU dot3).
+precise float dot3(vec3 a, vec3 b) {
+  precise float r = a.x * b.x + a.y * b.y;
+  r = r + a.z * b.z;
+  return r;
+}
+
+// glm::cross order.
+precise vec3 cross3(vec3 x, vec3 y) {
+  precise float cx = x.y * y.z - y.y * x.z;
+  precise float cy = x.z * y.x - y.z * x.x;
+  precise float cz = x.x * y.y - y.x * x.y;
+  return vec3(cx, cy, cz);
+}
+
+// Signed distance to collider c and its outward unit normal (CPU collider_contact).
+void collider_contact(uint c, vec3 p, out float distance, out vec3 normal) {
+  const vec4 shape = colliders[c].shape;
+  if (colliders[c].type == VKCLOTH_COLLIDER_PLANE) {
+    normal = shape.xyz;
+    precise float d = dot3(shape.xyz, p) - shape.w;
+    distance = d;
+    return;
+  }
+  precise vec3 r = p - shape.xyz;
+  precise float len = sqrt(dot3(r, r));
+  precise vec3 n = len > 0.0 ? r / len : vec3(0.0, 0.0, 1.0); // at the exact centre, push up
+  precise float d = len - shape.w;
+  normal = n;
+  distance = d;
+}
+
+#endif

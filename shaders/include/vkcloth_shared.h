@@ -1,0 +1,126 @@
+// Declarations shared by the GLSL compute shaders and the C++ Vulkan solver: workgroup size,
+// descriptor binding indices, push constants and the storage-buffer element layouts.
+// Declared ONCE here; C++ static_asserts at the bottom pin the std430 layout.
+#ifndef VKCLOTH_SHARED_H
+#define VKCLOTH_SHARED_H
+
+#ifdef __cplusplus
+#include <cstddef>
+#include <cstdint>
+namespace vkcloth::gpu::shared {
+using uint = std::uint32_t;
+struct vec4 {
+  float x, y, z, w;
+};
+#endif
+
+// Invocations per workgroup (1-D). Dispatches round up and every shader guards `p < count`.
+#define VKCLOTH_WORKGROUP_SIZE 64
+
+// Descriptor bindings (set 0). One layout serves both pipelines; each shader declares the
+// bindings it uses. Four descriptor sets differ only in which buffers sit behind the
+// *_IN / *_BASE / *_OUT / FORCE_OUT bindings (position parity x state-or-RK4-stage input).
+#define VKCLOTH_BINDING_POS_IN 0     // positions the force pass reads (state or RK4 stage)
+#define VKCLOTH_BINDING_VEL_IN 1     // velocities the force pass reads (state or RK4 stage)
+#define VKCLOTH_BINDING_FORCE_OUT 2  // force after contacts (state force, or RK4 stage scratch)
+#define VKCLOTH_BINDING_VEL_FILT 3   // velocity after contact filtering (force -> integrate)
+#define VKCLOTH_BINDING_NORMAL 4     // unit vertex normals (cloth), written every force pass
+#define VKCLOTH_BINDING_POS_BASE 5   // positions at the start of the step (= positions[read])
+#define VKCLOTH_BINDING_POS_OUT 6    // positions at the end of the step (= positions[write])
+#define VKCLOTH_BINDING_VEL 7        // state velocities (read and written by integrate)
+#define VKCLOTH_BINDING_STAGE_POS 8  // RK4 stage positions y_k
+#define VKCLOTH_BINDING_STAGE_VEL 9  // RK4 stage velocities
+#define VKCLOTH_BINDING_ACC_POS 10   // RK4 running sum k1 + 2 k2 + 2 k3 + k4 (positions)
+#define VKCLOTH_BINDING_ACC_VEL 11   // RK4 running sum (velocities)
+#define VKCLOTH_BINDING_PARTICLE 12  // ParticleInfo per particle
+#define VKCLOTH_BINDING_OFFSETS 13   // CSR offsets, count + 1 entries (SpringAdjacency::offsets)
+#define VKCLOTH_BINDING_EDGES 14     // CSR entries in gather order (Edge)
+#define VKCLOTH_BINDING_COLLIDERS 15 // Collider array (collider_count entries, at least one slot)
+#define VKCLOTH_BINDING_FLAGS 16     // Flags (divergence detection)
+#define VKCLOTH_BINDING_COUNT 17
+
+// PushConstants::flags bits.
+#define VKCLOTH_FLAG_HAS_GRID 1u // the system is a cloth grid: rebuild normals
+#define VKCLOTH_FLAG_WIND 2u     // wind strength != 0
+
+// PushConstants::integrator (same values as vkcloth::Integrator).
+#define VKCLOTH_INTEGRATOR_EXPLICIT_EULER 0u
+#define VKCLOTH_INTEGRATOR_SEMI_IMPLICIT_EULER 1u
+#define VKCLOTH_INTEGRATOR_RK4 2u
+
+// Collider::type (same values as vkcloth::Collider::Type).
+#define VKCLOTH_COLLIDER_PLANE 0u
+#define VKCLOTH_COLLIDER_SPHERE 1u
+
+// Flags::first_bad_step before anything diverged.
+#define VKCLOTH_NO_BAD_STEP 0xffffffffu
+
+/// Per-dispatch parameters (96 bytes; Vulkan guarantees 128). Floats are converted from the
+/// double SimParams on the host exactly as CpuSolver<float> converts them.
+struct PushConstants {
+  uint count;          // particles
+  uint nx;             // grid width (0 for chains)
+  uint ny;             // grid height
+  uint flags;          // VKCLOTH_FLAG_*
+  uint integrator;     // VKCLOTH_INTEGRATOR_*
+  uint stage;          // RK4 stage 0..3 (0 for Euler)
+  uint step;           // 1-based step number since the flag epoch (the step being computed)
+  uint collider_count; // entries used in the collider array
+  vec4 gravity_damping; // xyz: gravity, w: damping mu
+  vec4 wind;            // xyz: unit wind direction, w: strength Kw
+  float dt;             // time step
+  float c_next;         // RK4: c[stage + 1] (dt/2, dt/2, dt), the next stage's offset
+  float w6;             // RK4: dt / 6
+  float band;           // contact band 2 eps
+  float eps;            // projection distance eps
+  float limit;          // divergence limit
+  uint pad0;
+  uint pad1;
+};
+
+/// Per-particle constants (std430: 8 bytes).
+struct ParticleInfo {
+  float mass;
+  uint pinned; // 1 when pinned
+};
+
+/// One gather-list entry (std430: 12 bytes, stride 12).
+struct Edge {
+  uint other;
+  float rest_length;
+  float stiffness;
+};
+
+/// A plane {n.p = offset} (shape = (n, offset)) or a sphere (shape = (centre, radius)).
+struct Collider {
+  vec4 shape;
+  uint type;
+  uint pad0;
+  uint pad1;
+  uint pad2;
+};
+
+/// Divergence flags, written with integer atomics by integrate.comp.
+struct Flags {
+  uint diverged;       // non-zero once any particle went non-finite or past the limit
+  uint first_bad_step; // smallest PushConstants::step that diverged (VKCLOTH_NO_BAD_STEP if none)
+  uint bad_particle;   // smallest particle index that diverged at that step
+  uint pad;
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(PushConstants) == 96);
+static_assert(offsetof(PushConstants, gravity_damping) == 32);
+static_assert(offsetof(PushConstants, wind) == 48);
+static_assert(offsetof(PushConstants, dt) == 64);
+static_assert(offsetof(PushConstants, limit) == 84);
+static_assert(sizeof(ParticleInfo) == 8);
+static_assert(sizeof(Edge) == 12);
+static_assert(sizeof(Collider) == 32);
+static_assert(offsetof(Collider, type) == 16);
+static_assert(sizeof(Flags) == 16);
+static_assert(sizeof(vec4) == 16);
+} // namespace vkcloth::gpu::shared
+#endif
+
+#endif // VKCLOTH_SHARED_H

@@ -1,0 +1,118 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// Integration pass, one invocation per particle (CpuSolver::step after the forces, then
+// CpuSolver::project and check_finite). Euler: one pass per step. RK4: one pass per stage;
+// stages 0..2 write the next stage's (STAGE_POS, STAGE_VEL) and the running sums, stage 3
+// writes the new state. Reads FORCE_OUT, VEL_FILT (own), POS_BASE, VEL; writes POS_OUT, VEL.
+#include "vkcloth_shared.h"
+#include "common.glsl"
+
+layout(std430, set = 0, binding = VKCLOTH_BINDING_FORCE_OUT) readonly buffer ForceIn { vec4 force_in[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_VEL_FILT) readonly buffer VelFilt { vec4 vel_filt[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_POS_BASE) readonly buffer PosBase { vec4 pos_base[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_POS_OUT) writeonly buffer PosOut { vec4 pos_out[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_VEL) buffer VelBuf { vec4 vel[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_STAGE_POS) writeonly buffer StagePos { vec4 stage_pos[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_STAGE_VEL) writeonly buffer StageVel { vec4 stage_vel[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_ACC_POS) buffer AccPos { vec4 acc_pos[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_ACC_VEL) buffer AccVel { vec4 acc_vel[]; };
+
+bool is_finite(vec3 v) {
+  const uvec3 bits = floatBitsToUint(v) & 0x7f800000u; // exponent all ones: inf or NaN
+  return all(notEqual(bits, uvec3(0x7f800000u)));
+}
+
+// CpuSolver::project for one particle, then check_finite; writes the new state.
+void finish(uint p, bool pinned, vec3 x_in, vec3 v_in) {
+  precise vec3 x = x_in;
+  precise vec3 v = v_in;
+  if (!pinned) {
+    for (uint c = 0u; c < pc.collider_count; ++c) {
+      float dist;
+      vec3 n;
+      collider_contact(c, x, dist, n);
+      if (!(dist < 0.0)) continue;
+      if (colliders[c].type == VKCLOTH_COLLIDER_PLANE) {
+        precise float back = pc.eps - dist;
+        x = x + n * back; // report eq. 5: back to z_s + eps
+      } else {
+        precise float r = colliders[c].shape.w + pc.eps;
+        x = colliders[c].shape.xyz + n * r; // report eq. 6
+      }
+      precise float vn = dot3(v, n);
+      if (vn < 0.0) v = v - n * vn;
+    }
+  }
+  pos_out[p] = vec4(x, 1.0);
+  vel[p] = vec4(v, 0.0);
+  const vec3 ax = abs(x);
+  if (!is_finite(x) || !is_finite(v) || ax.x > pc.limit || ax.y > pc.limit || ax.z > pc.limit) {
+    atomicOr(flags.diverged, 1u);
+    atomicMin(flags.first_bad_step, pc.step);
+    atomicMin(flags.bad_particle, p);
+  }
+}
+
+void main() {
+  const uint p = particle_index();
+  if (p >= pc.count) return;
+  const bool last = pc.integrator != VKCLOTH_INTEGRATOR_RK4 || pc.stage == 3u;
+  if (frozen()) {
+    if (last) pos_out[p] = pos_base[p]; // keep the frozen state in the buffer that becomes current
+    return;
+  }
+  const bool pinned = particle[p].pinned != 0u;
+  const float m = particle[p].mass;
+  const vec3 base = pos_base[p].xyz;
+  const vec3 f = force_in[p].xyz;
+  const vec3 vf = vel_filt[p].xyz;
+
+  if (pc.integrator != VKCLOTH_INTEGRATOR_RK4) {
+    precise vec3 x = base;
+    precise vec3 v = vf;
+    if (!pinned) {
+      precise vec3 a = f / m;
+      if (pc.integrator == VKCLOTH_INTEGRATOR_SEMI_IMPLICIT_EULER) {
+        v = v + a * pc.dt;
+        x = x + v * pc.dt;
+      } else {
+        x = x + v * pc.dt;
+        v = v + a * pc.dt;
+      }
+    }
+    finish(p, pinned, x, v);
+    return;
+  }
+
+  // RK4 stage k: k_pos = stage velocity (after contacts), k_vel = F / m; zero when pinned.
+  precise vec3 kp = pinned ? vec3(0.0) : vf;
+  precise vec3 kv = pinned ? vec3(0.0) : f / m;
+  precise vec3 sp, sv;
+  if (pc.stage == 0u) {
+    sp = kp;
+    sv = kv;
+  } else if (pc.stage < 3u) {
+    sp = acc_pos[p].xyz + kp * 2.0; // CPU: dp = k0 + k1 * 2; dp += k2 * 2
+    sv = acc_vel[p].xyz + kv * 2.0;
+  } else {
+    sp = acc_pos[p].xyz + kp; // dp += k3
+    sv = acc_vel[p].xyz + kv;
+  }
+  const vec3 v0 = vel[p].xyz;
+  if (pc.stage < 3u) {
+    acc_pos[p] = vec4(sp, 0.0);
+    acc_vel[p] = vec4(sv, 0.0);
+    precise vec3 y = base + kp * pc.c_next; // y_{k+1} = y0 + c_{k+1} k_k
+    precise vec3 w = v0 + kv * pc.c_next;
+    stage_pos[p] = vec4(y, 1.0);
+    stage_vel[p] = vec4(w, 0.0);
+    return;
+  }
+  precise vec3 x = base;
+  precise vec3 v = v0;
+  if (!pinned) {
+    x = x + sp * pc.w6;
+    v = v + sv * pc.w6;
+  }
+  finish(p, pinned, x, v);
+}

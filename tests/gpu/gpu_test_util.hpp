@@ -1,0 +1,84 @@
+// Shared helpers of the GPU tests: one validated Context per process, the CI/skip rule, the
+// per-test-case validation check, CPU-vs-GPU comparison.
+#pragma once
+
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "vkcloth/vkcloth.hpp"
+
+namespace vkcloth::gpu::test {
+
+inline bool on_ci() {
+  const char* v = std::getenv("CI");
+  return v && (std::strcmp(v, "true") == 0 || std::strcmp(v, "1") == 0);
+}
+
+struct SharedContext {
+  std::optional<Context> context;
+  std::string error;
+};
+
+/// One Context for the whole run, created with validation and synchronization validation.
+inline SharedContext& shared_context() {
+  static SharedContext s = [] {
+    SharedContext r;
+    ContextOptions o;
+    o.validation = true;
+    auto c = Context::create(o);
+    if (c)
+      r.context.emplace(std::move(c.value()));
+    else
+      r.error = std::string(to_string(c.error().code)) + ": " + c.error().message;
+    return r;
+  }();
+  return s;
+}
+
+/// Fails every validation message emitted during one test case.
+struct ValidationGuard {
+  const Context& context;
+  std::uint64_t start = context.validation_message_count();
+  ~ValidationGuard() {
+    CHECK_MESSAGE(context.validation_message_count() == start, "Vulkan validation reported messages (see stderr)");
+  }
+};
+
+/// Max |a - b| over all components; `bitwise` when every float is identical.
+struct Diff {
+  double max_abs = 0.0;
+  bool bitwise = true;
+};
+inline Diff diff(std::span<const glm::vec3> a, std::span<const glm::vec3> b) {
+  Diff d;
+  REQUIRE(a.size() == b.size());
+  for (std::size_t i = 0; i < a.size(); ++i)
+    for (int k = 0; k < 3; ++k) {
+      const double e = std::abs(double(a[i][k]) - double(b[i][k]));
+      d.max_abs = std::isnan(e) ? INFINITY : std::max(d.max_abs, e);
+      if (std::memcmp(&a[i][k], &b[i][k], sizeof(float)) != 0) d.bitwise = false;
+    }
+  return d;
+}
+
+} // namespace vkcloth::gpu::test
+
+/// Starts a GPU test case: binds `ctx` to the shared validated Context and checks validation at
+/// the end; without a device skips (or fails on CI).
+#define VKCLOTH_GPU_TEST_BEGIN(ctx)                                                                       \
+  auto& vkcloth_shared_ = ::vkcloth::gpu::test::shared_context();                                         \
+  if (!vkcloth_shared_.context) {                                                                         \
+    if (::vkcloth::gpu::test::on_ci()) FAIL("CI=true but no Vulkan device: " << vkcloth_shared_.error);  \
+    MESSAGE("skipped, no Vulkan device: " << vkcloth_shared_.error);                                      \
+    return;                                                                                               \
+  }                                                                                                       \
+  ::vkcloth::gpu::Context& ctx = *vkcloth_shared_.context;                                                \
+  REQUIRE(ctx.validation_enabled());                                                                      \
+  ::vkcloth::gpu::test::ValidationGuard vkcloth_guard_{ctx}

@@ -1,0 +1,142 @@
+// Context and error paths: device filters, adopting a host's handles, size limits, bad input.
+#include "gpu_test_util.hpp"
+
+using namespace vkcloth;
+using namespace vkcloth::gpu;
+using namespace vkcloth::gpu::test;
+
+TEST_CASE("Context: a device filter that matches nothing is ErrorCode::no_device") {
+  ContextOptions o;
+  o.device_filter = "no-such-device-1f2e3d";
+  o.validation = false;
+  auto c = Context::create(o);
+  REQUIRE(!c.ok());
+  CHECK(c.error().code == ErrorCode::no_device);
+  MESSAGE(c.error().message);
+  if (shared_context().context) CHECK(c.error().message.find("no-such-device-1f2e3d") != std::string::npos);
+  o.device_filter = "4096"; // an index past the end
+  auto c2 = Context::create(o);
+  REQUIRE(!c2.ok());
+  CHECK(c2.error().code == ErrorCode::no_device);
+}
+
+TEST_CASE("Context: picks a device, lists devices, selects by index and name") {
+  VKCLOTH_GPU_TEST_BEGIN(ctx);
+  CHECK(ctx.owns_device());
+  CHECK(!ctx.device_name().empty());
+  auto list = Context::list_devices();
+  REQUIRE(list.ok());
+  REQUIRE(!list->empty());
+  const auto usable = std::find_if(list->begin(), list->end(), [](const DeviceInfo& d) { return d.usable; });
+  REQUIRE(usable != list->end());
+  ContextOptions by_index;
+  by_index.device_filter = std::to_string(usable->index);
+  by_index.validation = true;
+  auto c = Context::create(by_index);
+  REQUIRE(c.ok());
+  CHECK(c->device_name() == usable->name);
+  ContextOptions by_name;
+  by_name.device_filter = usable->name.substr(0, 4);
+  by_name.validation = true;
+  auto c2 = Context::create(by_name);
+  REQUIRE(c2.ok());
+  CHECK(c->validation_message_count() == 0);
+  CHECK(c2->validation_message_count() == 0);
+}
+
+TEST_CASE("Context: adopting a host's handles destroys none of them") {
+  VKCLOTH_GPU_TEST_BEGIN(ctx);
+  auto cloth = make_cloth(ClothDesc{});
+  REQUIRE(cloth.ok());
+  {
+    auto adopted = Context::adopt(ctx.handles());
+    REQUIRE(adopted.ok());
+    CHECK(!adopted->owns_device());
+    CHECK(adopted->device_name() == ctx.device_name());
+    auto gpu = GpuSolver::create(*adopted, *cloth, SimParams{});
+    REQUIRE(gpu.ok());
+    REQUIRE(gpu->simulate(10).ok());
+  } // adopted Context and its solver gone; the host's device must still work
+  auto gpu = GpuSolver::create(ctx, *cloth, SimParams{});
+  REQUIRE(gpu.ok());
+  REQUIRE(gpu->simulate(10).ok());
+  CHECK(ctx.wait_idle().ok());
+  HostHandles incomplete = ctx.handles();
+  incomplete.queue = VK_NULL_HANDLE;
+  CHECK(Context::adopt(incomplete).error().code == ErrorCode::invalid_argument);
+}
+
+TEST_CASE("GpuSolver: a system too large for the device is refused before allocation") {
+  VKCLOTH_GPU_TEST_BEGIN(ctx);
+  auto cloth = make_cloth(ClothDesc{});
+  REQUIRE(cloth.ok());
+  GpuSolverOptions o;
+  o.max_storage_buffer_bytes = 1024; // 100 particles x 16 bytes = 1600 > 1024
+  auto gpu = GpuSolver::create(ctx, *cloth, SimParams{}, o);
+  REQUIRE(!gpu.ok());
+  CHECK(gpu.error().code == ErrorCode::unsupported);
+  CHECK(gpu.error().message.find("too large") != std::string::npos);
+  CHECK(gpu.error().message.find("1600") != std::string::npos);
+  CHECK(gpu.error().message.find("1024") != std::string::npos);
+  MESSAGE(gpu.error().message);
+  // Past the device's real limit (maxStorageBufferRange): a description is enough, no allocation
+  // happens; only the particle list is built (~40 B per particle on the host).
+  const std::uint64_t limit = ctx.limits().maxStorageBufferRange;
+  if (limit / 16 + 1 <= 20'000'000) {
+    ParticleSystem big;
+    big.particles.resize(limit / 16 + 1);
+    big.finalize();
+    auto g2 = GpuSolver::create(ctx, big, SimParams{});
+    REQUIRE(!g2.ok());
+    CHECK(g2.error().code == ErrorCode::unsupported);
+    CHECK(g2.error().message.find("maxStorageBufferRange") != std::string::npos);
+  }
+}
+
+TEST_CASE("GpuSolver: invalid input is ErrorCode::invalid_argument") {
+  VKCLOTH_GPU_TEST_BEGIN(ctx);
+  ParticleSystem empty;
+  empty.finalize();
+  CHECK(GpuSolver::create(ctx, empty, SimParams{}).error().code == ErrorCode::invalid_argument);
+  auto cloth = make_cloth(ClothDesc{});
+  REQUIRE(cloth.ok());
+  SimParams p;
+  p.dt = 0;
+  CHECK(GpuSolver::create(ctx, *cloth, p).error().code == ErrorCode::invalid_argument);
+  ParticleSystem unfinalized = *cloth;
+  unfinalized.adjacency = {};
+  CHECK(GpuSolver::create(ctx, unfinalized, SimParams{}).error().code == ErrorCode::invalid_argument);
+}
+
+TEST_CASE("GpuSolver: uvs and buffers of a grid") {
+  VKCLOTH_GPU_TEST_BEGIN(ctx);
+  ClothDesc d;
+  d.nx = 37;
+  d.ny = 23;
+  auto cloth = make_cloth(d);
+  REQUIRE(cloth.ok());
+  auto gpu = GpuSolver::create(ctx, *cloth, SimParams{});
+  REQUIRE(gpu.ok());
+  CHECK(gpu->particle_count() == 37 * 23);
+  const auto& uv = gpu->uvs();
+  REQUIRE(uv.size() == 37 * 23);
+  CHECK(uv[0] == glm::vec2(0, 0));
+  CHECK(uv[36] == glm::vec2(1, 0));
+  CHECK(uv[22 * 37] == glm::vec2(0, 1));
+  CHECK(uv[22 * 37 + 18] == glm::vec2(0.5f, 1));
+  CHECK(gpu->normal_buffer() != VK_NULL_HANDLE);
+  CHECK(gpu->uv_buffer() != VK_NULL_HANDLE);
+  CHECK(gpu->velocity_buffer() != VK_NULL_HANDLE);
+  // Before any step the normals are zero (as on the CPU) and the forces too.
+  auto n = gpu->normals();
+  REQUIRE(n.ok());
+  CHECK((*n)[5] == glm::vec3(0));
+  // After one step the normals of a flat vertical (x-z) cloth point along -y or +y.
+  REQUIRE(gpu->simulate(1).ok());
+  n = gpu->normals();
+  REQUIRE(n.ok());
+  CHECK(std::abs(std::abs((*n)[400].y) - 1.0f) < 1e-6f);
+  auto f = gpu->forces();
+  REQUIRE(f.ok());
+  CHECK((*f)[400].z < 0.0f); // gravity on a free particle at rest
+}
