@@ -140,3 +140,63 @@ TEST_CASE("GpuSolver: uvs and buffers of a grid") {
   REQUIRE(f.ok());
   CHECK((*f)[400].z < 0.0f); // gravity on a free particle at rest
 }
+
+TEST_CASE("Context: the validation messenger counts real errors, sync validation included") {
+  VKCLOTH_GPU_TEST_BEGIN(shared_ctx);
+  // A Context of its own, so the deliberate errors below do not touch the shared count.
+  ContextOptions o;
+  o.validation = true;
+  o.print_validation_messages = false;
+  auto c = Context::create(o);
+  REQUIRE(c.ok());
+  Context& ctx = *c;
+  const HostHandles h = ctx.handles();
+  const auto gdpa = ctx.device_proc_addr();
+#define LOAD(name) const auto name = reinterpret_cast<PFN_##name>(gdpa(h.device, #name)); REQUIRE((name != nullptr ? true : false))
+  LOAD(vkCreateCommandPool);
+  LOAD(vkDestroyCommandPool);
+  LOAD(vkAllocateCommandBuffers);
+  LOAD(vkBeginCommandBuffer);
+  LOAD(vkEndCommandBuffer);
+  LOAD(vkCmdCopyBuffer);
+  LOAD(vkQueueSubmit);
+  LOAD(vkQueueWaitIdle);
+#undef LOAD
+  auto cloth = make_cloth(ClothDesc{});
+  REQUIRE(cloth.ok());
+  auto gpu = GpuSolver::create(ctx, *cloth, SimParams{});
+  REQUIRE(gpu.ok());
+  CHECK(ctx.validation_message_count() == 0);
+
+  VkCommandPoolCreateInfo pi{};
+  pi.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
+  pi.queueFamilyIndex = h.queue_family;
+  VkCommandPool pool = VK_NULL_HANDLE;
+  REQUIRE(vkCreateCommandPool(h.device, &pi, nullptr, &pool) == VK_SUCCESS);
+  VkCommandBufferAllocateInfo ai{};
+  ai.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
+  ai.commandPool = pool;
+  ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  ai.commandBufferCount = 1;
+  VkCommandBuffer cb = VK_NULL_HANDLE;
+  REQUIRE(vkAllocateCommandBuffers(h.device, &ai, &cb) == VK_SUCCESS);
+  VkCommandBufferBeginInfo bi{};
+  bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+  REQUIRE(vkBeginCommandBuffer(cb, &bi) == VK_SUCCESS);
+  gpu->record_steps(cb, 1);
+  // Deliberate hazard: copy the positions just written by the last dispatch WITHOUT the barrier
+  // record_barrier_to() would add (read-after-write for synchronization validation).
+  const VkBufferCopy region{0, 0, 16};
+  vkCmdCopyBuffer(cb, gpu->current_position_buffer(), gpu->position_buffer(gpu->current_position_index() ^ 1u), 1, &region);
+  REQUIRE(vkEndCommandBuffer(cb) == VK_SUCCESS);
+  const std::uint64_t before_submit = ctx.validation_message_count();
+  CHECK(before_submit >= 1); // the hazard is reported at record time
+  VkSubmitInfo si{};
+  si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
+  si.commandBufferCount = 1;
+  si.pCommandBuffers = &cb;
+  REQUIRE(vkQueueSubmit(h.queue, 1, &si, VK_NULL_HANDLE) == VK_SUCCESS);
+  REQUIRE(vkQueueWaitIdle(h.queue) == VK_SUCCESS);
+  vkDestroyCommandPool(h.device, pool, nullptr);
+  MESSAGE("deliberate hazard: " << ctx.validation_message_count() << " validation message(s)");
+}

@@ -168,6 +168,15 @@ TEST_CASE("GPU staging path (forced) matches CPU") {
   check_against_cpu(ctx, "cloth 13x7 + wind (staging)", std::move(w), 40, o);
 }
 
+TEST_CASE("GPU two-dimensional dispatch (rows of workgroups) matches CPU") {
+  VKCLOTH_GPU_TEST_BEGIN(ctx);
+  GpuSolverOptions o;
+  o.max_workgroups_x = 3; // 851 particles = 14 groups of 64 -> 3 x 5 groups, the last row partly idle
+  TestScene w = cloth(37, 23);
+  w.params.wind.strength = 0.8;
+  check_against_cpu(ctx, "cloth 37x23 + wind (3x5 groups)", std::move(w), 50, o);
+}
+
 TEST_CASE("GPU runs are deterministic (bit-identical)") {
   VKCLOTH_GPU_TEST_BEGIN(ctx);
   TestScene s = cloth(37, 23);

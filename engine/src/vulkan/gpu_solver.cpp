@@ -391,7 +391,9 @@ Result<GpuSolver> GpuSolver::create(Context& context, const ParticleSystem& syst
                                     overridden ? "GpuSolverOptions::max_storage_buffer_bytes"
                                                : "maxStorageBufferRange"));
   const std::uint64_t groups = (std::uint64_t(n) + VKCLOTH_WORKGROUP_SIZE - 1) / VKCLOTH_WORKGROUP_SIZE;
-  const std::uint64_t gx = std::min<std::uint64_t>(groups, lim.maxComputeWorkGroupCount[0]);
+  std::uint64_t row = lim.maxComputeWorkGroupCount[0];
+  if (options.max_workgroups_x) row = std::min<std::uint64_t>(row, options.max_workgroups_x);
+  const std::uint64_t gx = std::min<std::uint64_t>(groups, row);
   const std::uint64_t gy = (groups + gx - 1) / gx;
   if (gy > lim.maxComputeWorkGroupCount[1] || n >= std::numeric_limits<std::uint32_t>::max())
     return make_error(ErrorCode::unsupported,

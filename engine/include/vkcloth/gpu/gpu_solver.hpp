@@ -35,6 +35,9 @@ struct GpuSolverOptions {
   bool force_staging = false;
   /// Lower the per-buffer size limit below the device's maxStorageBufferRange (0: the device's).
   std::uint64_t max_storage_buffer_bytes = 0;
+  /// Lower the workgroups per dispatch row below maxComputeWorkGroupCount[0] (0: the device's);
+  /// larger systems then dispatch a second grid dimension (tests use it to exercise that path).
+  std::uint32_t max_workgroups_x = 0;
 };
 
 class GpuSolver {
@@ -48,7 +51,9 @@ public:
   GpuSolver& operator=(GpuSolver&&) noexcept;
   GpuSolver(const GpuSolver&) = delete;
   GpuSolver& operator=(const GpuSolver&) = delete;
-  ~GpuSolver(); ///< waits for the solver's own submissions, then frees its objects
+  /// Frees the solver's objects. Its own submissions are always complete; command buffers the
+  /// caller recorded with record_steps() must have finished executing (or never be submitted).
+  ~GpuSolver();
 
   /// Replaces the parameters (validated). No recorded work of this solver may be pending.
   Result<void> set_params(SimParams params);
