@@ -53,13 +53,8 @@ Result<std::unique_ptr<SimBackend>> make_backend(std::string_view name, const Sc
                                                  Precision precision) {
   if (name == "cpu")
     return precision == Precision::float32 ? make_cpu<float>(scene) : make_cpu<double>(scene);
-  if (name == "vulkan") {
-#if defined(VKCLOTH_CLI_HAS_VULKAN)
+  if (name == "vulkan")
     return make_vulkan_backend(scene, precision);
-#else
-    return make_error(ErrorCode::no_device, "the vulkan backend is not available in this build");
-#endif
-  }
   return make_error(ErrorCode::invalid_argument,
                     fmt::format("unknown backend \"{}\" (known: cpu, vulkan)", name));
 }

@@ -1,6 +1,5 @@
-// The solver behind `vkcloth run`, behind a small interface so that backends (CPU today, Vulkan
-// later) live in their own files. To add one: implement SimBackend in backend_<name>.cpp, give it a
-// factory, and dispatch to it from make_backend() (backend.cpp).
+// The solver behind `vkcloth run` and `compare`, behind a small interface so that each backend
+// (backend.cpp: CPU, backend_vulkan.cpp: Vulkan) lives in its own file.
 #pragma once
 
 #include <cstdint>
@@ -35,12 +34,11 @@ public:
   virtual double time() const = 0;
 };
 
-/// "cpu" (or "vulkan" where built in). Unknown name: ErrorCode::invalid_argument; a backend that is
-/// not built in or finds no device: ErrorCode::no_device.
+/// "cpu" or "vulkan". Unknown name: ErrorCode::invalid_argument; no Vulkan device: ErrorCode::no_device.
 Result<std::unique_ptr<SimBackend>> make_backend(std::string_view name, const Scene& scene,
                                                  Precision precision);
 
-/// Defined in backend_vulkan.cpp when that file exists (tools/CMakeLists.txt sets VKCLOTH_CLI_HAS_VULKAN).
+/// The GpuSolver on a Context of its own (backend_vulkan.cpp).
 Result<std::unique_ptr<SimBackend>> make_vulkan_backend(const Scene& scene, Precision precision);
 
 } // namespace vkcloth::cli

@@ -39,7 +39,8 @@ constexpr const char* exit_codes_footer = R"(Exit codes:
   1  unexpected runtime failure (Vulkan error, out of memory)
   2  bad input or usage: command line, scene file (the message names the key), output file
   3  the simulation diverged (the message names the step and time; --trace keeps the rows before it)
-  4  no usable Vulkan device, or the backend is not built in
+  4  no usable Vulkan device
+  5  compare: the backends differ by more than the tolerance
 Scene format and CSV outputs: docs/scene-format.md)";
 
 void add_override_options(CLI::App& cmd, std::vector<std::string>& overrides) {
@@ -54,7 +55,7 @@ void add_override_options(CLI::App& cmd, std::vector<std::string>& overrides) {
 
 int main(int argc, char** argv) {
   using namespace vkcloth::cli;
-  CLI::App app{"vkcloth: mass-spring cloth simulation (CPU reference solver; Vulkan compute)", "vkcloth"};
+  CLI::App app{"vkcloth: mass-spring cloth simulation on the CPU reference solver and on Vulkan compute", "vkcloth"};
   app.footer(exit_codes_footer);
   app.require_subcommand(1);
 
@@ -83,6 +84,28 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--precision", run.precision, "Solver arithmetic: float | double (default float)")
       ->check(CLI::IsMember({"float", "double"}));
 
+  CompareOptions compare;
+  std::optional<std::uint64_t> cmp_steps;
+  std::optional<double> cmp_dt;
+  std::optional<std::string> cmp_integrator;
+  CLI::App* compare_cmd = app.add_subcommand(
+      "compare", "Run a scene on the CPU reference and on Vulkan; print the max and RMS position difference "
+                 "per window of steps; exit 5 above the tolerance");
+  compare_cmd->footer(exit_codes_footer);
+  compare_cmd->add_option("scene", compare.scene, "Scene file (JSON)")->required();
+  compare_cmd->add_option("--steps", cmp_steps, "Number of steps (sugar for --set integrator.steps=N)");
+  compare_cmd->add_option("--dt", cmp_dt, "Time step in seconds (sugar for --set integrator.dt=X)");
+  compare_cmd->add_option("--integrator", cmp_integrator, "explicit_euler | semi_implicit_euler | rk4");
+  add_override_options(*compare_cmd, compare.overrides);
+  compare_cmd->add_option("--window", compare.window, "Steps per report row (default: a tenth of the run)")
+      ->check(CLI::PositiveNumber);
+  compare_cmd->add_option("--tolerance", compare.tolerance,
+                          "Largest max position difference that passes, in scene units (default 1e-5)");
+
+  CLI::App* devices_cmd =
+      app.add_subcommand("devices", "List the Vulkan devices and the one a solver would use (exit 4 if none)");
+  devices_cmd->footer(exit_codes_footer);
+
   InfoOptions info;
   CLI::App* info_cmd =
       app.add_subcommand("info", "Print a parsed scene: particles, springs per kind, parameters");
@@ -102,16 +125,26 @@ int main(int argc, char** argv) {
   }
 
   try {
+    // The sugar flags come after --set, so they win over a --set of the same key.
+    const auto add_sugar = [](std::vector<std::string>& overrides, const std::optional<std::uint64_t>& n,
+                              const std::optional<double>& h, const std::optional<std::string>& method) {
+      if (n)
+        overrides.push_back(fmt::format("integrator.steps={}", *n));
+      if (h)
+        overrides.push_back(fmt::format("integrator.dt={:.17g}", *h));
+      if (method)
+        overrides.push_back(fmt::format("integrator.method={}", *method));
+    };
     if (*run_cmd) {
-      // The sugar flags come after --set, so they win over a --set of the same key.
-      if (steps)
-        run.overrides.push_back(fmt::format("integrator.steps={}", *steps));
-      if (dt)
-        run.overrides.push_back(fmt::format("integrator.dt={:.17g}", *dt));
-      if (integrator)
-        run.overrides.push_back(fmt::format("integrator.method={}", *integrator));
+      add_sugar(run.overrides, steps, dt, integrator);
       return run_command(run);
     }
+    if (*compare_cmd) {
+      add_sugar(compare.overrides, cmp_steps, cmp_dt, cmp_integrator);
+      return compare_command(compare);
+    }
+    if (*devices_cmd)
+      return devices_command();
     return info_command(info);
   } catch (const std::exception& e) {
     fmt::print(stderr, "vkcloth: unexpected error: {}\n", e.what());

@@ -1,0 +1,41 @@
+// `vkcloth devices`: the Vulkan devices the loader reports, and which one a solver would take.
+#include <fmt/format.h>
+
+#include "commands.hpp"
+#include "vkcloth/gpu/context.hpp"
+
+namespace vkcloth::cli {
+namespace {
+
+const char* type_name(VkPhysicalDeviceType t) {
+  switch (t) {
+  case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return "discrete";
+  case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return "integrated";
+  case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return "virtual";
+  case VK_PHYSICAL_DEVICE_TYPE_CPU: return "cpu";
+  default: return "other";
+  }
+}
+
+} // namespace
+
+int devices_command() {
+  auto list = gpu::Context::list_devices();
+  if (!list)
+    return report(list.error());
+  int usable = 0;
+  for (const gpu::DeviceInfo& d : *list) {
+    fmt::print("{}: {} ({}, Vulkan {}.{}){}\n", d.index, d.name, type_name(d.type), VK_API_VERSION_MAJOR(d.api_version),
+               VK_API_VERSION_MINOR(d.api_version), d.usable ? "" : " - not usable (needs Vulkan 1.2 and compute)");
+    usable += d.usable;
+  }
+  if (usable == 0)
+    return report(make_error(ErrorCode::no_device, "no usable Vulkan device (install mesa-vulkan-drivers for lavapipe)"));
+  auto context = gpu::Context::create(gpu::ContextOptions{{}, false, true});
+  if (!context)
+    return report(context.error());
+  fmt::print("selected: {} (set VKCLOTH_DEVICE to a name or an index to choose)\n", context->device_name());
+  return exit_ok;
+}
+
+} // namespace vkcloth::cli
