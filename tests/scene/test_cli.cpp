@@ -32,10 +32,10 @@ fs::path tmp_dir() {
   return d;
 }
 
-/// Runs `vkcloth <args>`; `tag` keeps the captured output of concurrent tests apart.
-Outcome vkcloth(const std::string& tag, const std::string& args) {
+/// Runs `[env] vkcloth <args>`; `tag` keeps the captured output of concurrent tests apart.
+Outcome vkcloth(const std::string& tag, const std::string& args, const std::string& env = "") {
   const fs::path out = tmp_dir() / (tag + ".stdout"), err = tmp_dir() / (tag + ".stderr");
-  const std::string cmd = std::string("'") + VKCLOTH_CLI_PATH + "' " + args + " >'" + out.string() + "' 2>'" +
+  const std::string cmd = env + " '" + VKCLOTH_CLI_PATH + "' " + args + " >'" + out.string() + "' 2>'" +
                           err.string() + "' </dev/null";
   const int status = std::system(cmd.c_str());
   Outcome o;
@@ -162,10 +162,6 @@ TEST_CASE("cli: a diverging run exits 3, names the step, and keeps the trace row
 
 TEST_CASE("cli: usage errors exit 2, --help exits 0 and documents the exit codes") {
   CHECK(vkcloth("nosuch", "run " + sample("spring.json") + " --backend nosuch").code == 2);
-  const Outcome vk = vkcloth("vulkan", "run " + sample("spring.json") + " --backend vulkan");
-  CHECK((vk.code == 4 || vk.code == 0)); // 0 once a Vulkan backend is built in and finds a device
-  if (vk.code == 4)
-    CHECK(vk.err.find("vulkan") != std::string::npos);
   CHECK(vkcloth("noargs", "").code == 2);
   CHECK(vkcloth("noscene", "run").code == 2);
   CHECK(vkcloth("badflag", "run " + sample("spring.json") + " --bogus").code == 2);
@@ -191,4 +187,75 @@ TEST_CASE("cli: info prints the parsed scene") {
   CHECK(o.out.find("structural") != std::string::npos);
   CHECK(o.out.find("shear") == std::string::npos); // switched off by the override
   CHECK(o.out.find("semi_implicit_euler") != std::string::npos);
+}
+
+// ---- The Vulkan backend through the CLI (lavapipe in CI, with the validation layer on) ----
+
+namespace {
+
+/// True when a Vulkan device is there. On CI (CI=true) its absence fails the calling test.
+bool have_vulkan_device() {
+  const Outcome o = vkcloth("devices", "devices");
+  if (o.code == 0)
+    return true;
+  const char* ci = std::getenv("CI");
+  if (ci && std::string(ci) == "true")
+    FAIL("CI=true but `vkcloth devices` found no usable Vulkan device (exit ", o.code, "): ", o.err);
+  MESSAGE("skipped: no Vulkan device (", o.err, ")");
+  return false;
+}
+
+const std::string validate = "VKCLOTH_VALIDATION=1";
+
+} // namespace
+
+TEST_CASE("vkcloth compare passes on every sample scene, with zero validation messages") {
+  if (!have_vulkan_device())
+    return;
+  for (const auto& entry : fs::directory_iterator(VKCLOTH_SCENES_DIR)) {
+    const std::string name = entry.path().filename().string();
+    CAPTURE(name);
+    const Outcome o = vkcloth("compare_" + name, "compare " + sample(name) + " --steps 100", validate);
+    CHECK(o.code == 0);
+    CHECK(o.out.find("PASS: max position difference") != std::string::npos);
+    CHECK(o.out.find("> tolerance") == std::string::npos);
+    CHECK(o.err.find("validation") == std::string::npos);
+  }
+}
+
+TEST_CASE("vkcloth run --backend vulkan writes the positions the CPU writes (within 1e-5)") {
+  if (!have_vulkan_device())
+    return;
+  const fs::path cpu_csv = tmp_dir() / "wind_cpu.csv", gpu_csv = tmp_dir() / "wind_gpu.csv";
+  const std::string scene = sample("cloth_wind.json") + " --steps 100 --integrator rk4";
+  REQUIRE(vkcloth("wind_cpu", "run " + scene + " --positions " + quote(cpu_csv.string())).code == 0);
+  const Outcome g = vkcloth("wind_gpu", "run " + scene + " --backend vulkan --positions " + quote(gpu_csv.string()),
+                            validate);
+  REQUIRE(g.code == 0);
+  CHECK(g.err.find("validation") == std::string::npos);
+  const auto a = read_csv(cpu_csv), b = read_csv(gpu_csv);
+  REQUIRE(a.size() == 101); // header + 100 particles
+  REQUIRE(b.size() == a.size());
+  for (std::size_t r = 1; r < a.size(); ++r)
+    for (std::size_t c = 1; c < 4; ++c)
+      CHECK(std::abs(std::stod(a[r][c]) - std::stod(b[r][c])) <= 1e-5);
+}
+
+TEST_CASE("vkcloth on Vulkan: divergence exits 3, no device exits 4, bad compare flags exit 2") {
+  if (!have_vulkan_device())
+    return;
+  const Outcome div = vkcloth("gpu_div", "run " + sample("spring.json") + " --dt 0.45 --steps 200 --backend vulkan");
+  CHECK(div.code == 3);
+  CHECK(div.err.find("diverged") != std::string::npos);
+
+  const Outcome none = vkcloth("gpu_none", "run " + sample("spring.json") + " --backend vulkan",
+                               "VKCLOTH_DEVICE=no-such-device");
+  CHECK(none.code == 4);
+  CHECK(none.err.find("no-such-device") != std::string::npos);
+  CHECK(vkcloth("gpu_noicd", "devices", "VK_ICD_FILENAMES=/nonexistent.json VK_DRIVER_FILES=/nonexistent.json").code == 4);
+
+  const Outcome tol = vkcloth("cmp_tol", "compare " + sample("spring.json") + " --tolerance -1");
+  CHECK(tol.code == 2);
+  CHECK(tol.err.find("--tolerance") != std::string::npos);
+  CHECK(vkcloth("gpu_double", "run " + sample("spring.json") + " --backend vulkan --precision double").code == 2);
 }
