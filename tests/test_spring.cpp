@@ -1,13 +1,17 @@
 // Single and coupled springs (report §2) against closed forms and the integrators' stability theory.
+// The observations of the report run on every backend; the convergence-order and energy studies
+// need double precision and run on the CPU double solver.
 #include <doctest/doctest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <vector>
 
+#include "sim_backends.hpp"
 #include "vkcloth/vkcloth.hpp"
 
 using namespace vkcloth;
+using namespace vkcloth::test;
 
 namespace {
 
@@ -29,13 +33,18 @@ double closed_form_z(double t, double damping = mu) {
   return z_eq + std::exp(-gam * t) * (x0 * std::cos(wd * t) + gam * x0 / wd * std::sin(wd * t));
 }
 
-template <typename Real> double run_z(Integrator integ, double dt, double t_end) {
+double run_z(Backend b, Integrator integ, double dt, double t_end) {
   auto sys = make_chain({});
-  auto s = CpuSolver<Real>::create(*sys, spring_params(integ, dt));
-  REQUIRE(s.ok());
+  auto s = make_sim(b, *sys, spring_params(integ, dt));
   const auto steps = static_cast<std::uint64_t>(std::llround(t_end / dt));
   REQUIRE(s->run(steps).ok());
-  return double(s->positions()[1].z);
+  return s->position(1).z;
+}
+
+/// Runs the single spring until it diverges or `steps` pass; returns the error (if any).
+Result<void> run_spring(Backend b, Integrator integ, double dt, std::uint64_t steps) {
+  auto sys = make_chain({});
+  return make_sim(b, *sys, spring_params(integ, dt))->run(steps);
 }
 
 } // namespace
@@ -75,9 +84,9 @@ TEST_CASE("convergence order: the Euler schemes are first order in dt, RK4 fourt
     CAPTURE(to_string(integ));
     const bool rk = integ == Integrator::rk4;
     const double dt0 = rk ? 0.02 : 0.002; // explicit Euler needs dt < mu/K = 0.025 to be stable
-    const double e1 = std::abs(run_z<double>(integ, dt0, t) - exact);
-    const double e2 = std::abs(run_z<double>(integ, dt0 / 2, t) - exact);
-    const double e4 = std::abs(run_z<double>(integ, dt0 / 4, t) - exact);
+    const double e1 = std::abs(run_z(Backend::cpu_double, integ, dt0, t) - exact);
+    const double e2 = std::abs(run_z(Backend::cpu_double, integ, dt0 / 2, t) - exact);
+    const double e4 = std::abs(run_z(Backend::cpu_double, integ, dt0 / 4, t) - exact);
     const double order1 = std::log2(e1 / e2), order2 = std::log2(e2 / e4);
     MESSAGE(to_string(integ), ": errors ", e1, " ", e2, " ", e4, ", observed orders ", order1, " ", order2);
     CHECK(order2 == doctest::Approx(rk ? 4.0 : 1.0).epsilon(0.1));
@@ -87,65 +96,85 @@ TEST_CASE("convergence order: the Euler schemes are first order in dt, RK4 fourt
 
 /// |z - z_eq| after `steps` steps started `offset` from equilibrium (the linear regime);
 /// infinity when the run diverged.
-double excursion_after(Integrator integ, double dt, double offset, int steps) {
+double excursion_after(Backend b, Integrator integ, double dt, double offset, int steps) {
   ChainDesc d;
   d.positions = {{0.0, 0.0, z_eq + offset}};
   auto sys = make_chain(d);
-  auto s = CpuSolver<double>::create(*sys, spring_params(integ, dt));
-  REQUIRE(s.ok());
+  auto s = make_sim(b, *sys, spring_params(integ, dt));
   if (!s->run(std::uint64_t(steps)).ok()) return INFINITY;
-  return std::abs(s->positions()[1].z - z_eq);
+  return std::abs(s->position(1).z - z_eq);
 }
 
 TEST_CASE("report §2.2 stability (K = 20, mu = 0.5, m = 1) with semi-implicit Euler: 0.02 and 0.2 settle, 0.45 diverges") {
-  for (double dt : {0.02, 0.2}) {
-    CAPTURE(dt);
-    CHECK(run_z<double>(Integrator::semi_implicit_euler, dt, 200.0) == doctest::Approx(z_eq).epsilon(1e-6));
+  ValidationScope validation;
+  for (Backend b : backends()) {
+    CAPTURE(to_string(b));
+    const double tol = is_float(b) ? 1e-6 : 1e-9; // float: the rest position itself rounds
+    for (double dt : {0.02, 0.2}) {
+      CAPTURE(dt);
+      CHECK(std::abs(run_z(b, Integrator::semi_implicit_euler, dt, 200.0) - z_eq) < tol);
+    }
+    auto r = run_spring(b, Integrator::semi_implicit_euler, 0.45, 5000);
+    REQUIRE_FALSE(r.ok());
+    CHECK(r.error().code == ErrorCode::diverged);
+    CHECK(r.error().message.find("diverged at step") != std::string::npos);
   }
-  auto sys = make_chain({});
-  auto s = CpuSolver<double>::create(*sys, spring_params(Integrator::semi_implicit_euler, 0.45));
-  auto r = s->run(5000);
-  REQUIRE_FALSE(r.ok());
-  CHECK(r.error().code == ErrorCode::diverged);
-  CHECK(r.error().message.find("diverged at step") != std::string::npos);
 }
 
 TEST_CASE("semi-implicit Euler is unstable exactly where theory says: (K/m) dt^2 + 2 (mu/m) dt > 4, dt > 0.4234") {
   // Started 1e-4 from equilibrium the motion is linear until it grows; far from it the spring can
   // fold through its anchor, where the force is discontinuous and the motion bounded but chaotic.
-  CHECK(excursion_after(Integrator::semi_implicit_euler, 0.41, 1e-4, 200) < 1e-6);
-  CHECK(excursion_after(Integrator::semi_implicit_euler, 0.42, 1e-4, 200) < 1e-6);
-  CHECK(excursion_after(Integrator::semi_implicit_euler, 0.43, 1e-4, 200) > 1e-2);
-  CHECK(excursion_after(Integrator::semi_implicit_euler, 0.44, 1e-4, 200) > 1e-2);
+  ValidationScope validation;
+  for (Backend b : backends()) {
+    CAPTURE(to_string(b));
+    CHECK(excursion_after(b, Integrator::semi_implicit_euler, 0.41, 1e-4, 200) < 1e-6);
+    CHECK(excursion_after(b, Integrator::semi_implicit_euler, 0.42, 1e-4, 200) < 1e-6);
+    CHECK(excursion_after(b, Integrator::semi_implicit_euler, 0.43, 1e-4, 200) > 1e-2);
+    CHECK(excursion_after(b, Integrator::semi_implicit_euler, 0.44, 1e-4, 200) > 1e-2);
+  }
 }
 
 TEST_CASE("explicit Euler (eq. 3 as written) is stable only while dt < mu/K = 0.025, so already unstable at 0.2") {
-  CHECK(run_z<double>(Integrator::explicit_euler, 0.02, 400.0) == doctest::Approx(z_eq).epsilon(1e-6));
-  CHECK(excursion_after(Integrator::explicit_euler, 0.02, 1e-4, 10000) < 1e-6);
-  CHECK(excursion_after(Integrator::explicit_euler, 0.04, 1e-4, 2000) > 1e-2);
-  auto sys = make_chain({});
-  auto s = CpuSolver<double>::create(*sys, spring_params(Integrator::explicit_euler, 0.2));
-  auto r = s->run(5000);
-  REQUIRE_FALSE(r.ok());
-  CHECK(r.error().code == ErrorCode::diverged);
+  ValidationScope validation;
+  for (Backend b : backends()) {
+    CAPTURE(to_string(b));
+    CHECK(std::abs(run_z(b, Integrator::explicit_euler, 0.02, 400.0) - z_eq) < (is_float(b) ? 1e-6 : 1e-9));
+    CHECK(excursion_after(b, Integrator::explicit_euler, 0.02, 1e-4, 10000) < 1e-6);
+    CHECK(excursion_after(b, Integrator::explicit_euler, 0.04, 1e-4, 2000) > 1e-2);
+    auto r = run_spring(b, Integrator::explicit_euler, 0.2, 5000);
+    REQUIRE_FALSE(r.ok());
+    CHECK(r.error().code == ErrorCode::diverged);
+  }
 }
 
 TEST_CASE("mu = 100 at dt = 0.02: the integrator, not physics, makes the mass oscillate (report §2.2)") {
   // Physically the motion is overdamped (mu/2 > sqrt(K/m)) and never crosses equilibrium. With
   // semi-implicit Euler the velocity factor (1 - dt mu) is -1: the velocity flips sign every step.
-  auto sys = make_chain({});
-  auto s = CpuSolver<double>::create(*sys, spring_params(Integrator::semi_implicit_euler, 0.02, 100.0));
-  REQUIRE(s.ok());
-  REQUIRE(s->run(10).ok());
-  int flips = 0;
-  double last_v = s->velocities()[1].z;
-  for (int k = 0; k < 20; ++k) {
-    REQUIRE(s->step().ok());
-    const double v = s->velocities()[1].z;
-    flips += (v * last_v < 0);
-    last_v = v;
+  ValidationScope validation;
+  for (Backend b : backends()) {
+    CAPTURE(to_string(b));
+    auto sys = make_chain({});
+    auto s = make_sim(b, *sys, spring_params(Integrator::semi_implicit_euler, 0.02, 100.0));
+    REQUIRE(s->run(10).ok());
+    int flips = 0;
+    double last_v = s->velocity(1).z;
+    for (int k = 0; k < 20; ++k) {
+      REQUIRE(s->step().ok());
+      const double v = s->velocity(1).z;
+      flips += (v * last_v < 0);
+      last_v = v;
+    }
+    CHECK(flips == 20);
   }
-  CHECK(flips == 20);
+}
+
+TEST_CASE("every backend follows the closed-form damped oscillator (RK4, dt = 0.01, 2 s)") {
+  ValidationScope validation;
+  for (Backend b : backends()) {
+    CAPTURE(to_string(b));
+    // RK4's own error here is ~3e-8; float rounding over 200 steps adds a few 1e-7.
+    CHECK(std::abs(run_z(b, Integrator::rk4, 0.01, 2.0) - closed_form_z(2.0)) < (is_float(b) ? 2e-6 : 1e-7));
+  }
 }
 
 TEST_CASE("coupled springs (report §2.3): static equilibrium and energy conservation without damping") {
@@ -175,7 +204,7 @@ TEST_CASE("coupled springs (report §2.3): static equilibrium and energy conserv
 }
 
 TEST_CASE("float and double solvers agree on the single spring to float precision") {
-  const double zf = run_z<float>(Integrator::semi_implicit_euler, 0.02, 5.0);
-  const double zd = run_z<double>(Integrator::semi_implicit_euler, 0.02, 5.0);
+  const double zf = run_z(Backend::cpu_float, Integrator::semi_implicit_euler, 0.02, 5.0);
+  const double zd = run_z(Backend::cpu_double, Integrator::semi_implicit_euler, 0.02, 5.0);
   CHECK(zf == doctest::Approx(zd).epsilon(1e-5));
 }

@@ -1,0 +1,121 @@
+// The physics tests run against every backend: CPU float, CPU double and Vulkan (float, on the
+// shared validated Context of the GPU tests). On CI (CI=true) a missing Vulkan device fails;
+// elsewhere the Vulkan backend is left out with a message.
+#pragma once
+
+#include <doctest/doctest.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "gpu/gpu_test_util.hpp"
+#include "vkcloth/vkcloth.hpp"
+
+namespace vkcloth::test {
+
+enum class Backend { cpu_float, cpu_double, vulkan };
+
+inline const char* to_string(Backend b) {
+  return b == Backend::cpu_float ? "cpu float" : b == Backend::cpu_double ? "cpu double" : "vulkan";
+}
+inline bool is_float(Backend b) { return b != Backend::cpu_double; }
+
+/// One solver behind a common face; state comes back in double whatever the backend computes in.
+class Sim {
+public:
+  virtual ~Sim() = default;
+  virtual Result<void> run(std::uint64_t steps) = 0;
+  virtual std::vector<glm::dvec3> positions() = 0;
+  virtual std::vector<glm::dvec3> velocities() = 0;
+  virtual std::vector<glm::dvec3> forces() = 0;
+  virtual std::vector<glm::dvec3> normals() = 0;
+  Result<void> step() { return run(1); }
+  glm::dvec3 position(std::size_t i) { return positions().at(i); }
+  glm::dvec3 velocity(std::size_t i) { return velocities().at(i); }
+};
+
+template <typename V> std::vector<glm::dvec3> widen(const V& v) { return std::vector<glm::dvec3>(v.begin(), v.end()); }
+
+template <typename Real> class CpuSim final : public Sim {
+public:
+  explicit CpuSim(CpuSolver<Real> s) : s_(std::move(s)) {}
+  Result<void> run(std::uint64_t steps) override { return s_.run(steps); }
+  std::vector<glm::dvec3> positions() override { return widen(s_.positions()); }
+  std::vector<glm::dvec3> velocities() override { return widen(s_.velocities()); }
+  std::vector<glm::dvec3> forces() override { return widen(s_.forces()); }
+  std::vector<glm::dvec3> normals() override { return widen(s_.normals()); }
+
+private:
+  CpuSolver<Real> s_;
+};
+
+class GpuSim final : public Sim {
+public:
+  explicit GpuSim(gpu::GpuSolver s) : s_(std::move(s)) {}
+  Result<void> run(std::uint64_t steps) override { return s_.simulate(steps); }
+  std::vector<glm::dvec3> positions() override { return read(s_.positions()); }
+  std::vector<glm::dvec3> velocities() override { return read(s_.velocities()); }
+  std::vector<glm::dvec3> forces() override { return read(s_.forces()); }
+  std::vector<glm::dvec3> normals() override { return read(s_.normals()); }
+
+private:
+  static std::vector<glm::dvec3> read(const Result<std::vector<glm::vec3>>& r) {
+    REQUIRE_MESSAGE(r.ok(), (r.ok() ? "" : r.error().message));
+    return widen(*r);
+  }
+  gpu::GpuSolver s_;
+};
+
+/// The backends to test here: both CPU precisions, and Vulkan when a device is there.
+inline std::vector<Backend> backends() {
+  auto& shared = gpu::test::shared_context();
+  if (shared.context) return {Backend::cpu_float, Backend::cpu_double, Backend::vulkan};
+  if (gpu::test::on_ci()) FAIL("CI=true but no Vulkan device: " << shared.error);
+  MESSAGE("Vulkan backend left out, no device: " << shared.error);
+  return {Backend::cpu_float, Backend::cpu_double};
+}
+
+/// Float-only backends (CPU float and Vulkan), for checks stated at float precision.
+inline std::vector<Backend> float_backends() {
+  std::vector<Backend> r;
+  for (Backend b : backends())
+    if (is_float(b)) r.push_back(b);
+  return r;
+}
+
+/// Creates a solver; the test fails (REQUIRE) when creation fails.
+inline std::unique_ptr<Sim> make_sim(Backend b, const ParticleSystem& system, const SimParams& params) {
+  switch (b) {
+  case Backend::cpu_float: {
+    auto s = CpuSolver<float>::create(system, params);
+    REQUIRE_MESSAGE(s.ok(), (s.ok() ? "" : s.error().message));
+    return std::make_unique<CpuSim<float>>(std::move(*s));
+  }
+  case Backend::cpu_double: {
+    auto s = CpuSolver<double>::create(system, params);
+    REQUIRE_MESSAGE(s.ok(), (s.ok() ? "" : s.error().message));
+    return std::make_unique<CpuSim<double>>(std::move(*s));
+  }
+  case Backend::vulkan: {
+    auto s = gpu::GpuSolver::create(*gpu::test::shared_context().context, system, params);
+    REQUIRE_MESSAGE(s.ok(), (s.ok() ? "" : s.error().message));
+    return std::make_unique<GpuSim>(std::move(*s));
+  }
+  }
+  return nullptr;
+}
+
+/// Fails the test case if the shared Vulkan context reported validation messages during it.
+struct ValidationScope {
+  std::uint64_t start = count();
+  static std::uint64_t count() {
+    auto& shared = gpu::test::shared_context();
+    return shared.context ? shared.context->validation_message_count() : 0;
+  }
+  ~ValidationScope() { CHECK_MESSAGE(count() == start, "Vulkan validation reported messages (see stderr)"); }
+};
+
+} // namespace vkcloth::test
