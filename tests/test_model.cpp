@@ -184,3 +184,21 @@ TEST_CASE("SimParams::validate names the field, rejects non-finite values and no
   CHECK(parse_integrator("rk4") == Integrator::rk4);
   CHECK_FALSE(parse_integrator("verlet").has_value());
 }
+
+TEST_CASE("ParticleSystem::validate refuses what no solver can run, naming the problem") {
+  auto sys = make_cloth({});
+  REQUIRE(sys.ok());
+  CHECK(sys->validate().ok());
+  ParticleSystem empty;
+  CHECK(empty.validate().error().message.find("empty") != std::string::npos);
+  ParticleSystem edited = *sys;
+  edited.springs.push_back(Spring{0, 100, 1.0, 1.0, SpringKind::plain});
+  CHECK(edited.validate().error().message.find("not finalized") != std::string::npos);
+  edited.finalize(); // leaves the bad spring out of the gather lists; validate() names it
+  CHECK(edited.validate().error().message.find("joins particles 0 and 100, but there are 100") != std::string::npos);
+  ParticleSystem massless = *sys;
+  massless.particles[0].mass = 0.0;
+  CHECK(massless.validate().error().message.find("particle 0 has mass 0") != std::string::npos);
+  // Every solver refuses it the same way.
+  CHECK_FALSE(CpuSolver<float>::create(massless, SimParams{}).ok());
+}

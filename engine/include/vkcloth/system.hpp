@@ -9,6 +9,8 @@
 
 #include <glm/vec3.hpp>
 
+#include "vkcloth/result.hpp"
+
 namespace vkcloth {
 
 /// The report's spring families (Figure 4); `plain` is a chain spring (§2).
@@ -64,6 +66,10 @@ struct ParticleSystem {
 
   /// Builds `adjacency` from `springs`. Builders call it; call it again after editing springs.
   void finalize();
+
+  /// What every solver checks before it starts: not empty, finalized, grid size = particle
+  /// count, springs and gather lists within range, free particles with a mass > 0.
+  Result<void> validate() const;
 };
 
 } // namespace vkcloth

@@ -47,17 +47,8 @@ template <typename Real> unsigned CpuSolver<Real>::threads() const { return pool
 template <typename Real>
 Result<CpuSolver<Real>> CpuSolver<Real>::create(const ParticleSystem& system, SimParams params, CpuSolverOptions options) {
   VKCLOTH_TRY(params.validate());
+  VKCLOTH_TRY(system.validate());
   const std::size_t n = system.size();
-  if (n == 0) return make_error(ErrorCode::invalid_argument, "the particle system is empty");
-  if (system.adjacency.offsets.size() != n + 1)
-    return make_error(ErrorCode::invalid_argument, "the particle system was not finalized (call finalize())");
-  if (system.grid && std::uint64_t(system.grid->nx) * system.grid->ny != n)
-    return make_error(ErrorCode::invalid_argument,
-                      fmt::format("grid {} x {} does not match the {} particles", system.grid->nx, system.grid->ny, n));
-  for (std::size_t p = 0; p < n; ++p)
-    if (!system.particles[p].pinned && !(system.particles[p].mass > 0.0))
-      return make_error(ErrorCode::invalid_argument,
-                        fmt::format("particle {} has mass {}; free particles need a mass > 0", p, system.particles[p].mass));
 
   CpuSolver s;
   s.system_ = std::make_shared<const ParticleSystem>(system);

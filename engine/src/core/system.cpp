@@ -1,5 +1,7 @@
 #include "vkcloth/system.hpp"
 
+#include <fmt/format.h>
+
 namespace vkcloth {
 
 const char* to_string(SpringKind kind) {
@@ -17,7 +19,10 @@ void ParticleSystem::finalize() {
   // index, which fixes the force summation order for every solver.
   const std::size_t n = particles.size();
   adjacency.offsets.assign(n + 1, 0);
+  // A spring with an end out of range is left out here; validate() reports it.
+  const auto valid = [n](const Spring& s) { return s.a < n && s.b < n; };
   for (const Spring& s : springs) {
+    if (!valid(s)) continue;
     ++adjacency.offsets[s.a + 1];
     ++adjacency.offsets[s.b + 1];
   }
@@ -26,9 +31,30 @@ void ParticleSystem::finalize() {
   std::vector<std::uint32_t> fill(adjacency.offsets.begin(), adjacency.offsets.end() - 1);
   for (std::uint32_t k = 0; k < springs.size(); ++k) {
     const Spring& s = springs[k];
+    if (!valid(s)) continue;
     adjacency.refs[fill[s.a]++] = SpringRef{s.b, k};
     adjacency.refs[fill[s.b]++] = SpringRef{s.a, k};
   }
+}
+
+Result<void> ParticleSystem::validate() const {
+  const std::size_t n = particles.size();
+  auto bad = [](std::string m) { return make_error(ErrorCode::invalid_argument, std::move(m)); };
+  if (n == 0) return bad("the particle system is empty");
+  if (adjacency.offsets.size() != n + 1 || adjacency.refs.size() != adjacency.offsets[n])
+    return bad("the particle system was not finalized (call finalize())");
+  if (grid && std::uint64_t(grid->nx) * grid->ny != n)
+    return bad(fmt::format("grid {} x {} does not match the {} particles", grid->nx, grid->ny, n));
+  for (std::size_t k = 0; k < springs.size(); ++k)
+    if (springs[k].a >= n || springs[k].b >= n)
+      return bad(fmt::format("spring {} joins particles {} and {}, but there are {}", k, springs[k].a, springs[k].b, n));
+  for (const SpringRef& r : adjacency.refs)
+    if (r.other >= n || r.spring >= springs.size())
+      return bad("the particle system's adjacency refers to a missing particle or spring (call finalize())");
+  for (std::size_t p = 0; p < n; ++p)
+    if (!particles[p].pinned && !(particles[p].mass > 0.0))
+      return bad(fmt::format("particle {} has mass {}; free particles need a mass > 0", p, particles[p].mass));
+  return {};
 }
 
 } // namespace vkcloth

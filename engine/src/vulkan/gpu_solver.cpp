@@ -352,20 +352,8 @@ void GpuSolver::Impl::record(VkCommandBuffer c, std::uint32_t steps) {
 Result<GpuSolver> GpuSolver::create(Context& context, const ParticleSystem& system, SimParams params,
                                     const GpuSolverOptions& options) {
   VKCLOTH_TRY(params.validate());
+  VKCLOTH_TRY(system.validate());
   const std::size_t n = system.size();
-  if (n == 0) return make_error(ErrorCode::invalid_argument, "the particle system is empty");
-  if (system.adjacency.offsets.size() != n + 1 || system.adjacency.refs.size() != system.adjacency.offsets[n])
-    return make_error(ErrorCode::invalid_argument, "the particle system was not finalized (call finalize())");
-  if (system.grid && std::uint64_t(system.grid->nx) * system.grid->ny != n)
-    return make_error(ErrorCode::invalid_argument,
-                      fmt::format("grid {} x {} does not match the {} particles", system.grid->nx, system.grid->ny, n));
-  for (std::size_t p = 0; p < n; ++p)
-    if (!system.particles[p].pinned && !(system.particles[p].mass > 0.0))
-      return make_error(ErrorCode::invalid_argument,
-                        fmt::format("particle {} has mass {}; free particles need a mass > 0", p, system.particles[p].mass));
-  for (const SpringRef& r : system.adjacency.refs)
-    if (r.other >= n || r.spring >= system.springs.size())
-      return make_error(ErrorCode::invalid_argument, "the particle system's adjacency refers to a missing particle or spring");
 
   // Device limits, checked before any allocation.
   const std::shared_ptr<Context::Impl>& ctx = context.impl();
