@@ -191,9 +191,11 @@ TEST_CASE("ParticleSystem::validate refuses what no solver can run, naming the p
   CHECK(sys->validate().ok());
   ParticleSystem empty;
   CHECK(empty.validate().error().message.find("empty") != std::string::npos);
+  ParticleSystem raw;
+  raw.particles.resize(2);
+  CHECK(raw.validate().error().message.find("not finalized") != std::string::npos);
   ParticleSystem edited = *sys;
   edited.springs.push_back(Spring{0, 100, 1.0, 1.0, SpringKind::plain});
-  CHECK(edited.validate().error().message.find("not finalized") != std::string::npos);
   edited.finalize(); // leaves the bad spring out of the gather lists; validate() names it
   CHECK(edited.validate().error().message.find("joins particles 0 and 100, but there are 100") != std::string::npos);
   ParticleSystem massless = *sys;
