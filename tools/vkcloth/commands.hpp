@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
+
 #include "vkcloth/result.hpp"
 
 namespace vkcloth::cli {
@@ -24,31 +26,29 @@ int exit_code(const Error& e);
 /// Prints "vkcloth: <message>" on stderr and returns exit_code(e).
 int report(const Error& e);
 
-struct RunOptions {
+/// The scene arguments shared by the commands that load a scene: the file, --set overrides and
+/// the --steps / --dt / --integrator sugar (applied after --set, so they win).
+struct SceneArgs {
   std::string scene;
-  std::vector<std::string> overrides; ///< --set, then --steps/--dt/--integrator
-  std::string trace;                  ///< empty: no trace
-  std::uint64_t trace_every = 1;
-  std::string positions; ///< empty: no final positions file
-  std::string backend = "cpu";
-  std::string precision = "float";
+  std::vector<std::string> sets;
+  std::optional<std::uint64_t> steps;
+  std::optional<double> dt;
+  std::optional<std::string> integrator;
+  /// --set values followed by the sugar flags, as key.path=value strings.
+  std::vector<std::string> overrides() const;
 };
 
-struct InfoOptions {
-  std::string scene;
-  std::vector<std::string> overrides;
-};
+/// The exit-code table, shown under every command's --help.
+extern const char* const exit_codes_footer;
 
-struct CompareOptions {
-  std::string scene;
-  std::vector<std::string> overrides; ///< --set, then --steps/--dt/--integrator
-  std::uint64_t window = 0;           ///< steps per report row; 0: a tenth of the run
-  double tolerance = 1e-5;            ///< max position difference (scene units) that passes
-};
+/// Registers SCENE, --set, --steps, --dt and --integrator on `cmd`.
+void add_scene_options(CLI::App& cmd, SceneArgs& args, bool sugar = true);
 
-int run_command(const RunOptions& opt);
-int info_command(const InfoOptions& opt);
-int compare_command(const CompareOptions& opt);
-int devices_command();
+// Each command registers itself on the app; when chosen, its callback stores its exit code in
+// *exit. One line per command in main.cpp.
+void add_run_command(CLI::App& app, int* exit);
+void add_info_command(CLI::App& app, int* exit);
+void add_compare_command(CLI::App& app, int* exit);
+void add_devices_command(CLI::App& app, int* exit);
 
 } // namespace vkcloth::cli

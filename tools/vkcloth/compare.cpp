@@ -10,9 +10,16 @@
 #include "commands.hpp"
 
 namespace vkcloth::cli {
+namespace {
+
+struct CompareOptions {
+  SceneArgs args;
+  std::uint64_t window = 0; ///< steps per report row; 0: a tenth of the run
+  double tolerance = 1e-5;  ///< max position difference (scene units) that passes
+};
 
 int compare_command(const CompareOptions& opt) {
-  auto scene = load_scene_file(opt.scene, opt.overrides);
+  auto scene = load_scene_file(opt.args.scene, opt.args.overrides());
   if (!scene)
     return report(scene.error());
   if (!std::isfinite(opt.tolerance) || opt.tolerance < 0.0)
@@ -72,6 +79,22 @@ int compare_command(const CompareOptions& opt) {
   }
   fmt::print("PASS: max position difference {:.3e} <= {:g}\n", worst, opt.tolerance);
   return exit_ok;
+}
+
+} // namespace
+
+void add_compare_command(CLI::App& app, int* exit) {
+  auto opt = std::make_shared<CompareOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "compare", "Run a scene on the CPU reference and on Vulkan; print the max and RMS position difference per "
+                 "window of steps; exit 5 above the tolerance");
+  cmd->footer(exit_codes_footer);
+  add_scene_options(*cmd, opt->args);
+  cmd->add_option("--window", opt->window, "Steps per report row (default: a tenth of the run)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--tolerance", opt->tolerance,
+                  "Largest max position difference that passes, in scene units (default 1e-5)");
+  cmd->callback([opt, exit] { *exit = compare_command(*opt); });
 }
 
 } // namespace vkcloth::cli

@@ -17,8 +17,6 @@ const char* type_name(VkPhysicalDeviceType t) {
   }
 }
 
-} // namespace
-
 int devices_command() {
   auto list = gpu::Context::list_devices();
   if (!list)
@@ -36,6 +34,14 @@ int devices_command() {
     return report(context.error());
   fmt::print("selected: {} (set VKCLOTH_DEVICE to a name or an index to choose)\n", context->device_name());
   return exit_ok;
+}
+
+} // namespace
+
+void add_devices_command(CLI::App& app, int* exit) {
+  CLI::App* cmd = app.add_subcommand("devices", "List the Vulkan devices and the one a solver would use (exit 4 if none)");
+  cmd->footer(exit_codes_footer);
+  cmd->callback([exit] { *exit = devices_command(); });
 }
 
 } // namespace vkcloth::cli

@@ -13,10 +13,8 @@ std::string vec(glm::dvec3 v) {
   return fmt::format("[{:g}, {:g}, {:g}]", v.x, v.y, v.z);
 }
 
-} // namespace
-
-int info_command(const InfoOptions& opt) {
-  auto scene_r = load_scene_file(opt.scene, opt.overrides);
+int info_command(const SceneArgs& opt) {
+  auto scene_r = load_scene_file(opt.scene, opt.overrides());
   if (!scene_r)
     return report(scene_r.error());
   const Scene& s = *scene_r;
@@ -55,6 +53,16 @@ int info_command(const InfoOptions& opt) {
   }
   fmt::print("contact_epsilon {:g} m, divergence_limit {:g} m\n", p.contact_epsilon, p.divergence_limit);
   return exit_ok;
+}
+
+} // namespace
+
+void add_info_command(CLI::App& app, int* exit) {
+  auto args = std::make_shared<SceneArgs>();
+  CLI::App* cmd = app.add_subcommand("info", "Print a parsed scene: particles, springs per kind, parameters");
+  cmd->footer(exit_codes_footer);
+  add_scene_options(*cmd, *args, false);
+  cmd->callback([args, exit] { *exit = info_command(*args); });
 }
 
 } // namespace vkcloth::cli

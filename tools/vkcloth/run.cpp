@@ -73,13 +73,20 @@ void write_trace_rows(std::FILE* f, std::uint64_t step, double time, const std::
                p[k].z, v[k].x, v[k].y, v[k].z);
 }
 
-} // namespace
+struct RunOptions {
+  SceneArgs args;
+  std::string trace; ///< empty: no trace
+  std::uint64_t trace_every = 1;
+  std::string positions; ///< empty: no final positions file
+  std::string backend = "cpu";
+  std::string precision = "float";
+};
 
 int run_command(const RunOptions& opt) {
   const auto precision = parse_precision(opt.precision);
   if (!precision)
     return report(make_error(ErrorCode::invalid_argument, "--precision must be float or double"));
-  auto scene = load_scene_file(opt.scene, opt.overrides);
+  auto scene = load_scene_file(opt.args.scene, opt.args.overrides());
   if (!scene)
     return report(scene.error());
   auto backend_r = make_backend(opt.backend, *scene, *precision);
@@ -160,6 +167,26 @@ int run_command(const RunOptions& opt) {
       scene->name, scene->system.size(), scene->system.springs.size(), backend.step_index(), scene->params.dt,
       to_string(scene->params.integrator), opt.backend, opt.precision, backend.time(), wall, max_disp);
   return exit_ok;
+}
+
+} // namespace
+
+void add_run_command(CLI::App& app, int* exit) {
+  auto opt = std::make_shared<RunOptions>();
+  CLI::App* cmd = app.add_subcommand("run", "Simulate a scene and optionally write CSV traces");
+  cmd->footer(exit_codes_footer);
+  add_scene_options(*cmd, opt->args);
+  auto* trace = cmd->add_option("--trace", opt->trace,
+                                "Write every particle's state to a CSV file: step,time,particle,x,y,z,vx,vy,vz "
+                                "(step 0 then every K steps)");
+  cmd->add_option("--trace-every", opt->trace_every, "K for --trace (default 1)")
+      ->check(CLI::PositiveNumber)
+      ->needs(trace);
+  cmd->add_option("--positions", opt->positions, "Write the final positions to a CSV file: particle,x,y,z");
+  cmd->add_option("--backend", opt->backend, "Solver backend: cpu | vulkan (default cpu)");
+  cmd->add_option("--precision", opt->precision, "Solver arithmetic: float | double (default float; vulkan: float)")
+      ->check(CLI::IsMember({"float", "double"}));
+  cmd->callback([opt, exit] { *exit = run_command(*opt); });
 }
 
 } // namespace vkcloth::cli
