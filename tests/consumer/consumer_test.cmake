@@ -1,0 +1,24 @@
+# ctest driver: install vkcloth from BUILD_DIR into a prefix, MOVE the prefix (the package must be
+# relocatable), then configure, build and run the consumer against it; or, with MODE=subdir,
+# build the consumer with add_subdirectory(SOURCE_DIR).
+set(work ${WORK_DIR}/${MODE})
+file(REMOVE_RECURSE ${work})
+file(MAKE_DIRECTORY ${work})
+function(run)
+  execute_process(COMMAND ${ARGV} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "failed (${rc}): ${ARGV}\n${out}\n${err}")
+  endif()
+  message(STATUS "${out}")
+endfunction()
+if(MODE STREQUAL "installed")
+  run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${work}/staged)
+  file(RENAME ${work}/staged ${work}/moved)
+  run(${CMAKE_COMMAND} -S ${SOURCE_DIR}/tests/consumer -B ${work}/build -G Ninja -DCMAKE_BUILD_TYPE=Release
+      -DCMAKE_PREFIX_PATH=${work}/moved)
+else()
+  run(${CMAKE_COMMAND} -S ${SOURCE_DIR}/tests/consumer -B ${work}/build -G Ninja -DCMAKE_BUILD_TYPE=Release
+      -DVKCLOTH_SOURCE_DIR=${SOURCE_DIR})
+endif()
+run(${CMAKE_COMMAND} --build ${work}/build)
+run(${work}/build/consumer)
