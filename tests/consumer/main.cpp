@@ -1,5 +1,12 @@
 // Consumer smoke test: builds a cloth through the public API only, steps it on the CPU and, when a
-// Vulkan device is there, on the GPU, and checks both agree. Exit 0 on success.
+// Vulkan device is there, on the GPU, and checks both agree. Exit 0 on success. The host also
+// calls Vulkan its own way (its own volk, or the loader directly), next to vkcloth.
+#if defined(HOST_USES_VOLK)
+#include <volk.h> // before any other Vulkan header, as volk requires
+#else
+#include <vulkan/vulkan.h>
+#endif
+
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -8,6 +15,16 @@
 #include <vkcloth/vkcloth.hpp>
 
 int main() {
+  std::uint32_t host_version = 0;
+#if defined(HOST_USES_VOLK)
+  if (volkInitialize() == VK_SUCCESS) host_version = volkGetInstanceVersion();
+  std::printf("host: its own volk, instance version %u.%u\n", VK_API_VERSION_MAJOR(host_version),
+              VK_API_VERSION_MINOR(host_version));
+#else
+  if (vkEnumerateInstanceVersion(&host_version) != VK_SUCCESS) return 1;
+  std::printf("host: loader linked directly, instance version %u.%u\n", VK_API_VERSION_MAJOR(host_version),
+              VK_API_VERSION_MINOR(host_version));
+#endif
   vkcloth::ClothDesc desc;
   desc.nx = 17;
   desc.ny = 11;

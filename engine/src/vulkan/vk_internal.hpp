@@ -2,6 +2,9 @@
 // Include this FIRST in every .cpp here: volk.h must precede any other Vulkan header.
 #pragma once
 
+// volk's symbols are renamed vkcloth_* (see engine/src/vulkan/CMakeLists.txt): no clash with a
+// host's own volk or Vulkan loader.
+#include "vkcloth_volk_prefix.h"
 #include <volk.h>
 
 #include <atomic>
