@@ -1,6 +1,8 @@
 // The vkcloth command line, run as a separate process: exit codes, messages, CSV outputs.
 #include <doctest/doctest.h>
 
+#include "cli_util.hpp"
+
 #include <sys/wait.h>
 
 #include <cstdlib>
@@ -10,73 +12,7 @@
 #include <string>
 #include <vector>
 
-namespace fs = std::filesystem;
-
-namespace {
-
-struct Outcome {
-  int code = -1;
-  std::string out, err;
-};
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-fs::path tmp_dir() {
-  fs::path d(VKCLOTH_TEST_TMP);
-  fs::create_directories(d);
-  return d;
-}
-
-/// Runs `[env] vkcloth <args>`; `tag` keeps the captured output of concurrent tests apart.
-Outcome vkcloth(const std::string& tag, const std::string& args, const std::string& env = "") {
-  const fs::path out = tmp_dir() / (tag + ".stdout"), err = tmp_dir() / (tag + ".stderr");
-  const std::string cmd = env + " '" + VKCLOTH_CLI_PATH + "' " + args + " >'" + out.string() + "' 2>'" +
-                          err.string() + "' </dev/null";
-  const int status = std::system(cmd.c_str());
-  Outcome o;
-  o.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  o.out = slurp(out);
-  o.err = slurp(err);
-  return o;
-}
-
-/// Single-quoted for the shell. (Appending avoids a g++ 12 -Wrestrict false positive on "'" + s.)
-std::string quote(const std::string& s) {
-  std::string q;
-  q.reserve(s.size() + 2);
-  q.append(1, '\'').append(s).append(1, '\'');
-  return q;
-}
-
-std::string write_scene(const std::string& name, const std::string& text) {
-  const fs::path p = tmp_dir() / name;
-  std::ofstream(p) << text;
-  return quote(p.string());
-}
-
-std::string sample(const std::string& name) {
-  return quote(std::string(VKCLOTH_SCENES_DIR) + "/" + name);
-}
-
-std::vector<std::vector<std::string>> read_csv(const fs::path& p) {
-  std::vector<std::vector<std::string>> rows;
-  std::ifstream in(p);
-  for (std::string line; std::getline(in, line);) {
-    std::vector<std::string> cells;
-    std::stringstream s(line);
-    for (std::string c; std::getline(s, c, ',');)
-      cells.push_back(c);
-    rows.push_back(cells);
-  }
-  return rows;
-}
-
-} // namespace
+using namespace vkcloth::test;
 
 TEST_CASE("cli: bad scene files exit 2 and stderr names the key") {
   struct Bad {
@@ -95,15 +31,15 @@ TEST_CASE("cli: bad scene files exit 2 and stderr names the key") {
   };
   for (const Bad& b : cases) {
     CAPTURE(b.name);
-    const Outcome o = vkcloth(std::string("bad_") + b.name, "run " + write_scene(b.name, b.text));
+    const Outcome o = run_cli(std::string("bad_") + b.name, "run " + write_scene(b.name, b.text));
     CHECK(o.code == 2);
     CHECK_MESSAGE(o.err.find(b.needle) != std::string::npos, o.err);
     CHECK(o.out.empty());
   }
-  const Outcome missing = vkcloth("missing", "run /nonexistent/scene.json");
+  const Outcome missing = run_cli("missing", "run /nonexistent/scene.json");
   CHECK(missing.code == 2);
   CHECK(missing.err.find("/nonexistent/scene.json") != std::string::npos);
-  const Outcome bad_set = vkcloth("bad_set", "run " + sample("spring.json") + " --set integrator.dt.x=1");
+  const Outcome bad_set = run_cli("bad_set", "run " + sample("spring.json") + " --set integrator.dt.x=1");
   CHECK(bad_set.code == 2);
   CHECK(bad_set.err.find("integrator.dt.x") != std::string::npos);
 }
@@ -111,7 +47,7 @@ TEST_CASE("cli: bad scene files exit 2 and stderr names the key") {
 TEST_CASE("cli: the single spring settles at the static sag L0 + mg/K below the anchor") {
   const fs::path pos = tmp_dir() / "spring_positions.csv";
   const Outcome o =
-      vkcloth("sag", "run " + sample("spring.json") + " --steps 3000 --positions '" + pos.string() + "'");
+      run_cli("sag", "run " + sample("spring.json") + " --steps 3000 --positions '" + pos.string() + "'");
   REQUIRE(o.code == 0);
   CHECK(o.out.find("spring") != std::string::npos);
   CHECK(o.out.find("3000 steps") != std::string::npos);
@@ -126,7 +62,7 @@ TEST_CASE("cli: the single spring settles at the static sag L0 + mg/K below the 
 TEST_CASE("cli: --trace writes step 0 and every K-th step for every particle") {
   const fs::path trace = tmp_dir() / "trace.csv";
   const Outcome o =
-      vkcloth("trace", "run " + sample("double_spring.json") + " --steps 10 --trace-every 3 --trace '" +
+      run_cli("trace", "run " + sample("double_spring.json") + " --steps 10 --trace-every 3 --trace '" +
                            trace.string() + "' --precision double");
   REQUIRE(o.code == 0);
   const auto rows = read_csv(trace);
@@ -143,14 +79,14 @@ TEST_CASE("cli: --trace writes step 0 and every K-th step for every particle") {
     CHECK(r.size() == 9);
 
   const Outcome every =
-      vkcloth("trace1", "run " + sample("spring.json") + " --steps 4 --trace '" + trace.string() + "'");
+      run_cli("trace1", "run " + sample("spring.json") + " --steps 4 --trace '" + trace.string() + "'");
   REQUIRE(every.code == 0);
   CHECK(read_csv(trace).size() == 1 + 5 * 2);
 }
 
 TEST_CASE("cli: a diverging run exits 3, names the step, and keeps the trace rows before it") {
   const fs::path trace = tmp_dir() / "diverge.csv";
-  const Outcome o = vkcloth("diverge", "run " + sample("spring.json") + " --dt 0.45 --steps 200 --trace '" +
+  const Outcome o = run_cli("diverge", "run " + sample("spring.json") + " --dt 0.45 --steps 200 --trace '" +
                                            trace.string() + "'");
   CHECK(o.code == 3);
   CHECK(o.err.find("diverged") != std::string::npos);
@@ -161,19 +97,19 @@ TEST_CASE("cli: a diverging run exits 3, names the step, and keeps the trace row
 }
 
 TEST_CASE("cli: usage errors exit 2, --help exits 0 and documents the exit codes") {
-  CHECK(vkcloth("nosuch", "run " + sample("spring.json") + " --backend nosuch").code == 2);
-  CHECK(vkcloth("noargs", "").code == 2);
-  CHECK(vkcloth("noscene", "run").code == 2);
-  CHECK(vkcloth("badflag", "run " + sample("spring.json") + " --bogus").code == 2);
-  CHECK(vkcloth("badsteps", "run " + sample("spring.json") + " --steps -3").code == 2);
-  CHECK(vkcloth("badprec", "run " + sample("spring.json") + " --precision half").code == 2);
-  CHECK(vkcloth("badinteg", "run " + sample("spring.json") + " --integrator leapfrog").code == 2);
-  const Outcome help = vkcloth("help", "--help");
+  CHECK(run_cli("nosuch", "run " + sample("spring.json") + " --backend nosuch").code == 2);
+  CHECK(run_cli("noargs", "").code == 2);
+  CHECK(run_cli("noscene", "run").code == 2);
+  CHECK(run_cli("badflag", "run " + sample("spring.json") + " --bogus").code == 2);
+  CHECK(run_cli("badsteps", "run " + sample("spring.json") + " --steps -3").code == 2);
+  CHECK(run_cli("badprec", "run " + sample("spring.json") + " --precision half").code == 2);
+  CHECK(run_cli("badinteg", "run " + sample("spring.json") + " --integrator leapfrog").code == 2);
+  const Outcome help = run_cli("help", "--help");
   CHECK(help.code == 0);
   CHECK(help.out.find("Exit codes") != std::string::npos);
   CHECK(help.out.find("run") != std::string::npos);
   CHECK(help.out.find("info") != std::string::npos);
-  const Outcome run_help = vkcloth("run_help", "run --help");
+  const Outcome run_help = run_cli("run_help", "run --help");
   CHECK(run_help.code == 0);
   CHECK(run_help.out.find("--trace-every") != std::string::npos);
   CHECK(run_help.out.find("Exit codes") != std::string::npos);
@@ -181,7 +117,7 @@ TEST_CASE("cli: usage errors exit 2, --help exits 0 and documents the exit codes
 
 TEST_CASE("cli: info prints the parsed scene") {
   const Outcome o =
-      vkcloth("info", "info " + sample("cloth_hanging.json") + " --set cloth.stiffness.shear=0");
+      run_cli("info", "info " + sample("cloth_hanging.json") + " --set cloth.stiffness.shear=0");
   REQUIRE(o.code == 0);
   CHECK(o.out.find("100 (2 pinned") != std::string::npos);
   CHECK(o.out.find("structural") != std::string::npos);
@@ -191,23 +127,6 @@ TEST_CASE("cli: info prints the parsed scene") {
 
 // ---- The Vulkan backend through the CLI (lavapipe in CI, with the validation layer on) ----
 
-namespace {
-
-/// True when a Vulkan device is there. On CI (CI=true) its absence fails the calling test.
-bool have_vulkan_device() {
-  const Outcome o = vkcloth("devices", "devices");
-  if (o.code == 0)
-    return true;
-  const char* ci = std::getenv("CI");
-  if (ci && std::string(ci) == "true")
-    FAIL("CI=true but `vkcloth devices` found no usable Vulkan device (exit ", o.code, "): ", o.err);
-  MESSAGE("skipped: no Vulkan device (", o.err, ")");
-  return false;
-}
-
-const std::string validate = "VKCLOTH_VALIDATION=1";
-
-} // namespace
 
 TEST_CASE("vkcloth compare passes on every sample scene, with zero validation messages") {
   if (!have_vulkan_device())
@@ -215,7 +134,7 @@ TEST_CASE("vkcloth compare passes on every sample scene, with zero validation me
   for (const auto& entry : fs::directory_iterator(VKCLOTH_SCENES_DIR)) {
     const std::string name = entry.path().filename().string();
     CAPTURE(name);
-    const Outcome o = vkcloth("compare_" + name, "compare " + sample(name) + " --steps 100", validate);
+    const Outcome o = run_cli("compare_" + name, "compare " + sample(name) + " --steps 100", validate);
     CHECK(o.code == 0);
     CHECK(o.out.find("PASS: max position difference") != std::string::npos);
     CHECK(o.out.find("> tolerance") == std::string::npos);
@@ -228,8 +147,8 @@ TEST_CASE("vkcloth run --backend vulkan writes the positions the CPU writes (wit
     return;
   const fs::path cpu_csv = tmp_dir() / "wind_cpu.csv", gpu_csv = tmp_dir() / "wind_gpu.csv";
   const std::string scene = sample("cloth_wind.json") + " --steps 100 --integrator rk4";
-  REQUIRE(vkcloth("wind_cpu", "run " + scene + " --positions " + quote(cpu_csv.string())).code == 0);
-  const Outcome g = vkcloth("wind_gpu", "run " + scene + " --backend vulkan --positions " + quote(gpu_csv.string()),
+  REQUIRE(run_cli("wind_cpu", "run " + scene + " --positions " + quote(cpu_csv.string())).code == 0);
+  const Outcome g = run_cli("wind_gpu", "run " + scene + " --backend vulkan --positions " + quote(gpu_csv.string()),
                             validate);
   REQUIRE(g.code == 0);
   CHECK(g.err.find("validation") == std::string::npos);
@@ -244,18 +163,18 @@ TEST_CASE("vkcloth run --backend vulkan writes the positions the CPU writes (wit
 TEST_CASE("vkcloth on Vulkan: divergence exits 3, no device exits 4, bad compare flags exit 2") {
   if (!have_vulkan_device())
     return;
-  const Outcome div = vkcloth("gpu_div", "run " + sample("spring.json") + " --dt 0.45 --steps 200 --backend vulkan");
+  const Outcome div = run_cli("gpu_div", "run " + sample("spring.json") + " --dt 0.45 --steps 200 --backend vulkan");
   CHECK(div.code == 3);
   CHECK(div.err.find("diverged") != std::string::npos);
 
-  const Outcome none = vkcloth("gpu_none", "run " + sample("spring.json") + " --backend vulkan",
+  const Outcome none = run_cli("gpu_none", "run " + sample("spring.json") + " --backend vulkan",
                                "VKCLOTH_DEVICE=no-such-device");
   CHECK(none.code == 4);
   CHECK(none.err.find("no-such-device") != std::string::npos);
-  CHECK(vkcloth("gpu_noicd", "devices", "VK_ICD_FILENAMES=/nonexistent.json VK_DRIVER_FILES=/nonexistent.json").code == 4);
+  CHECK(run_cli("gpu_noicd", "devices", "VK_ICD_FILENAMES=/nonexistent.json VK_DRIVER_FILES=/nonexistent.json").code == 4);
 
-  const Outcome tol = vkcloth("cmp_tol", "compare " + sample("spring.json") + " --tolerance -1");
+  const Outcome tol = run_cli("cmp_tol", "compare " + sample("spring.json") + " --tolerance -1");
   CHECK(tol.code == 2);
   CHECK(tol.err.find("--tolerance") != std::string::npos);
-  CHECK(vkcloth("gpu_double", "run " + sample("spring.json") + " --backend vulkan --precision double").code == 2);
+  CHECK(run_cli("gpu_double", "run " + sample("spring.json") + " --backend vulkan --precision double").code == 2);
 }

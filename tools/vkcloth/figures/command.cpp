@@ -1,0 +1,45 @@
+// Registers `vkcloth figures`.
+#include <filesystem>
+
+#include <fmt/format.h>
+
+#include "../commands.hpp"
+#include "figures.hpp"
+
+namespace vkcloth::cli {
+namespace {
+
+struct FiguresOptions {
+  std::string out = "out/figures";
+  std::string backend = "cpu";
+};
+
+int figures_command(const FiguresOptions& opt) {
+  if (opt.backend != "cpu" && opt.backend != "vulkan")
+    return report(make_error(ErrorCode::invalid_argument, fmt::format("unknown backend \"{}\" (known: cpu, vulkan)", opt.backend)));
+  std::error_code ec;
+  std::filesystem::create_directories(opt.out, ec);
+  if (ec)
+    return report(make_error(ErrorCode::io, fmt::format("cannot create the output directory {}: {}", opt.out, ec.message())));
+  figures::Gallery gallery{opt.out, opt.backend, {}, nlohmann::json::object()};
+  fmt::print(stderr, "figures: springs...\n");
+  if (auto r = figures::spring_figures(gallery); !r)
+    return report(r.error());
+  if (auto r = gallery.write_index(); !r)
+    return report(r.error());
+  fmt::print("{} figures in {}/index.html\n", gallery.figures.size(), opt.out);
+  return exit_ok;
+}
+
+} // namespace
+
+void add_figures_command(CLI::App& app, int* exit) {
+  auto opt = std::make_shared<FiguresOptions>();
+  CLI::App* cmd = app.add_subcommand("figures", "Regenerate the report's figures (SVG plots, images) and an index.html gallery");
+  cmd->footer(exit_codes_footer);
+  cmd->add_option("--out", opt->out, "Output directory (default out/figures)");
+  cmd->add_option("--backend", opt->backend, "Solver backend: cpu | vulkan (default cpu)");
+  cmd->callback([opt, exit] { *exit = figures_command(*opt); });
+}
+
+} // namespace vkcloth::cli

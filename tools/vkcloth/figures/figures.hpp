@@ -1,0 +1,48 @@
+// `vkcloth figures`: the report's figures, regenerated as SVG plots and image grids, with an
+// index.html gallery and a figures.json of the numbers behind them (checked by the tests).
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "../backend.hpp"
+#include "vkcloth/builders.hpp"
+
+namespace vkcloth::figures {
+
+/// One picture of the gallery.
+struct Figure {
+  std::string file;    ///< relative to the output directory
+  std::string section; ///< "Single spring (§2.2)", ...
+  std::string title;
+  std::string caption; ///< the parameters, in words
+};
+
+struct Gallery {
+  std::filesystem::path dir;
+  std::string backend; ///< "cpu" | "vulkan"
+  std::vector<Figure> figures;
+  nlohmann::json metrics = nlohmann::json::object(); ///< the numbers behind the pictures
+
+  Result<void> write_text(const std::string& file, const std::string& text) const;
+  Result<void> write_index() const; ///< index.html and figures.json
+};
+
+/// A run of one backend: state after each recorded step (every `every` steps).
+struct Trace {
+  std::vector<double> t;
+  std::vector<std::vector<glm::dvec3>> positions, velocities;
+  std::string diverged; ///< the error message when the run blew up
+  double diverged_at = -1.0;
+};
+Result<Trace> simulate(const Scene& scene, const std::string& backend, std::uint64_t steps, std::uint64_t every);
+
+/// Kinetic + gravitational + spring energy of a state of `scene`'s system.
+double total_energy(const Scene& scene, const std::vector<glm::dvec3>& pos, const std::vector<glm::dvec3>& vel);
+
+Result<void> spring_figures(Gallery& gallery);
+
+} // namespace vkcloth::figures
