@@ -9,20 +9,24 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_POS_IN) readonly buffer PosIn 
 layout(std430, set = 0, binding = VKCLOTH_BINDING_OFFSETS) readonly buffer OffsetBuf { uint offsets[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_EDGES) readonly buffer EdgeBuf { Edge edges[]; };
 
-// CpuSolver::compute_normals for particle (i, j): fan right, up, left, down; area-weighted sum.
+// CpuSolver::normal_at for particle (i, j): fan right, up, left, down; area-weighted sum of the
+// cross products of consecutive present edges, k = 0..3 in that order (the CPU's loop, unrolled:
+// no local arrays, which llvmpipe would keep in memory with per-lane gathers).
 vec3 grid_normal(uint p) {
-  const int nx = int(pc.nx), ny = int(pc.ny);
-  const int i = int(p % pc.nx), j = int(p / pc.nx);
+  const uint nx = pc.nx;
+  const uint i = p % nx, j = p / nx;
   const vec3 x = pos_in[p].xyz;
-  bool has[4] = bool[4](i + 1 < nx, j + 1 < ny, i > 0, j > 0);
-  precise vec3 e[4] = vec3[4](vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0));
-  if (has[0]) e[0] = pos_in[j * nx + i + 1].xyz - x;
-  if (has[1]) e[1] = pos_in[(j + 1) * nx + i].xyz - x;
-  if (has[2]) e[2] = pos_in[j * nx + i - 1].xyz - x;
-  if (has[3]) e[3] = pos_in[(j - 1) * nx + i].xyz - x;
+  const bool h0 = i + 1u < nx, h1 = j + 1u < pc.ny, h2 = i > 0u, h3 = j > 0u;
+  precise vec3 e0 = vec3(0.0), e1 = vec3(0.0), e2 = vec3(0.0), e3 = vec3(0.0);
+  if (h0) e0 = pos_in[p + 1u].xyz - x;
+  if (h1) e1 = pos_in[p + nx].xyz - x;
+  if (h2) e2 = pos_in[p - 1u].xyz - x;
+  if (h3) e3 = pos_in[p - nx].xyz - x;
   precise vec3 sum = vec3(0.0);
-  for (int k = 0; k < 4; ++k)
-    if (has[k] && has[(k + 1) & 3]) sum = sum + cross3(e[k], e[(k + 1) & 3]);
+  if (h0 && h1) sum = sum + cross3(e0, e1);
+  if (h1 && h2) sum = sum + cross3(e1, e2);
+  if (h2 && h3) sum = sum + cross3(e2, e3);
+  if (h3 && h0) sum = sum + cross3(e3, e0);
   precise float len = sqrt(dot3(sum, sum));
   precise vec3 n = len > 0.0 ? sum / len : vec3(0.0);
   return n;
