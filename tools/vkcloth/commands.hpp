@@ -51,5 +51,6 @@ void add_info_command(CLI::App& app, int* exit);
 void add_compare_command(CLI::App& app, int* exit);
 void add_devices_command(CLI::App& app, int* exit);
 void add_figures_command(CLI::App& app, int* exit);
+void add_bench_command(CLI::App& app, int* exit);
 
 } // namespace vkcloth::cli

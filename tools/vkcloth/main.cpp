@@ -80,6 +80,7 @@ int main(int argc, char** argv) {
   add_info_command(app, &exit);
   add_devices_command(app, &exit);
   add_figures_command(app, &exit);
+  add_bench_command(app, &exit);
 
   try {
     app.parse(argc, argv);

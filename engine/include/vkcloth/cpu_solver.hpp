@@ -87,9 +87,11 @@ private:
   // Per-particle kernels: each reads shared inputs and writes only particle p's outputs.
   Vec3 normal_at(std::span<const Vec3> pos, std::size_t p) const;
   Vec3 force_at(std::span<const Vec3> pos, std::span<const Vec3> vel, std::size_t p) const;
+  /// normal_at + force_at for particle p: writes normal_[p] (cloth), returns the force.
+  Vec3 normal_force_at(std::span<const Vec3> pos, std::span<const Vec3> vel, std::size_t p);
+  void detect_stencil();
   void contact_at(Vec3 pos, Vec3& vel, Vec3& force) const;
   void project_at(Vec3& pos, Vec3& vel) const;
-  void compute_normals(std::span<const Vec3> pos);
   template <typename F> void for_particles(F&& body);
   Result<void> check_finite() const;
 
@@ -109,6 +111,13 @@ private:
   std::vector<Vec3> pos_next_; // integration writes here while forces still read pos_
   std::array<std::vector<Vec3>, 4> k_pos_, k_vel_; // RK4 stage derivatives
   std::vector<Vec3> stage_pos_, stage_vel_;
+  // Grid stencil: when every interior particle of a cloth (2 <= i < nx-2, 2 <= j < ny-2) has the
+  // same gather list up to translation (same relative neighbour offsets and spring constants, in
+  // the same order), force_at reads the constants from here instead of the CSR lists: same
+  // expressions, same summation order, so the same bits.
+  bool stencil_ = false;
+  std::array<std::int64_t, 12> stencil_offset_{};
+  std::array<Edge, 12> stencil_edge_{};
   std::uint64_t step_ = 0;
   std::unique_ptr<detail::ThreadPool> pool_;
 };

@@ -79,6 +79,7 @@ Result<CpuSolver<Real>> CpuSolver<Real>::create(const ParticleSystem& system, Si
   const unsigned wanted = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
   const auto useful = static_cast<unsigned>(std::max<std::size_t>(1, n / 1024));
   s.pool_ = std::make_unique<detail::ThreadPool>(std::min(wanted, useful));
+  s.detect_stencil();
   return s;
 }
 
@@ -114,9 +115,37 @@ typename CpuSolver<Real>::Vec3 CpuSolver<Real>::normal_at(std::span<const Vec3> 
   return len > Real(0) ? sum / len : Vec3(0);
 }
 
-template <typename Real> void CpuSolver<Real>::compute_normals(std::span<const Vec3> pos) {
+template <typename Real> void CpuSolver<Real>::detect_stencil() {
+  stencil_ = false;
   if (!system_->grid) return;
-  for_particles([&](std::size_t p) { normal_[p] = normal_at(pos, p); });
+  const std::int64_t nx = system_->grid->nx, ny = system_->grid->ny;
+  if (nx < 5 || ny < 5) return;
+  const std::int64_t first = 2 * nx + 2;
+  if (edge_offsets_[first + 1] - edge_offsets_[first] != 12) return;
+  for (int k = 0; k < 12; ++k) {
+    const Edge& e = edges_[edge_offsets_[first] + k];
+    stencil_offset_[k] = std::int64_t(e.other) - first;
+    stencil_edge_[k] = e;
+  }
+  for (std::int64_t j = 2; j < ny - 2; ++j)
+    for (std::int64_t i = 2; i < nx - 2; ++i) {
+      const std::int64_t p = j * nx + i;
+      if (edge_offsets_[p + 1] - edge_offsets_[p] != 12) return;
+      for (int k = 0; k < 12; ++k) {
+        const Edge& e = edges_[edge_offsets_[p] + k];
+        if (std::int64_t(e.other) - p != stencil_offset_[k] || e.rest_length != stencil_edge_[k].rest_length ||
+            e.stiffness != stencil_edge_[k].stiffness)
+          return;
+      }
+    }
+  stencil_ = true;
+}
+
+template <typename Real>
+typename CpuSolver<Real>::Vec3 CpuSolver<Real>::normal_force_at(std::span<const Vec3> pos, std::span<const Vec3> vel,
+                                                                std::size_t p) {
+  if (system_->grid) normal_[p] = normal_at(pos, p);
+  return force_at(pos, vel, p);
 }
 
 template <typename Real>
@@ -124,11 +153,27 @@ typename CpuSolver<Real>::Vec3 CpuSolver<Real>::force_at(std::span<const Vec3> p
                                                          std::size_t p) const {
   const Vec3 x = pos[p];
   Vec3 f(0);
-  for (std::uint32_t e = edge_offsets_[p]; e < edge_offsets_[p + 1]; ++e) {
-    const Edge& s = edges_[e];
-    const Vec3 u = pos[s.other] - x;
-    const Real len = std::sqrt(dot3(u, u));
-    if (len > Real(0)) f += u * (s.stiffness * (len - s.rest_length) / len); // report eq. 2
+  bool interior = false;
+  if (stencil_) {
+    const std::size_t nx = system_->grid->nx, ny = system_->grid->ny;
+    const std::size_t i = p % nx, j = p / nx;
+    interior = i >= 2 && i + 2 < nx && j >= 2 && j + 2 < ny;
+  }
+  if (interior) {
+    // Same terms, same order as the CSR loop below (detect_stencil checked it).
+    for (int k = 0; k < 12; ++k) {
+      const Edge& s = stencil_edge_[k];
+      const Vec3 u = pos[std::size_t(std::int64_t(p) + stencil_offset_[k])] - x;
+      const Real len = std::sqrt(dot3(u, u));
+      if (len > Real(0)) f += u * (s.stiffness * (len - s.rest_length) / len); // report eq. 2
+    }
+  } else {
+    for (std::uint32_t e = edge_offsets_[p]; e < edge_offsets_[p + 1]; ++e) {
+      const Edge& s = edges_[e];
+      const Vec3 u = pos[s.other] - x;
+      const Real len = std::sqrt(dot3(u, u));
+      if (len > Real(0)) f += u * (s.stiffness * (len - s.rest_length) / len); // report eq. 2
+    }
   }
   const Real m = mass_[p];
   f += Vec3{params_.gravity} * m;
@@ -197,10 +242,10 @@ template <typename Real> Result<void> CpuSolver<Real>::step() {
   switch (params_.integrator) {
   case Integrator::explicit_euler:
   case Integrator::semi_implicit_euler: {
-    compute_normals(pos_);
     const bool semi = params_.integrator == Integrator::semi_implicit_euler;
+    // One sweep: p's normal needs only positions (read-only here), and force_at reads p's own.
     for_particles([&](std::size_t p) {
-      Vec3 f = force_at(pos_, vel_, p);
+      Vec3 f = normal_force_at(pos_, vel_, p);
       if (pinned_[p]) {
         force_[p] = f;
         pos_next_[p] = pos_[p];
@@ -245,9 +290,8 @@ template <typename Real> Result<void> CpuSolver<Real>::step() {
           stage_vel_[p] = vel_[p] + k_vel_[s - 1][p] * c[s];
         });
       }
-      compute_normals(stage_pos_);
       for_particles([&](std::size_t p) {
-        Vec3 f = force_at(stage_pos_, stage_vel_, p);
+        Vec3 f = normal_force_at(stage_pos_, stage_vel_, p);
         if (!pinned_[p]) contact_at(stage_pos_[p], stage_vel_[p], f);
         if (s == 0) force_[p] = f;
         k_pos_[s][p] = pinned_[p] ? Vec3(0) : stage_vel_[p];

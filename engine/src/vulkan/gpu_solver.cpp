@@ -13,6 +13,7 @@
 #include "vkcloth/gpu/gpu_solver.hpp"
 #include "vkcloth/shaders/force_comp_spv.hpp"
 #include "vkcloth/shaders/integrate_comp_spv.hpp"
+#include "vkcloth/shaders/fused_comp_spv.hpp"
 #include "vkcloth_shared.h"
 
 namespace vkcloth::gpu {
@@ -37,7 +38,7 @@ struct GpuSolver::Impl {
   VkDescriptorPool pool = VK_NULL_HANDLE;
   VkDescriptorSet sets[2][2] = {}; // [positions read index][0: state input, 1: RK4 stage input]
   VkPipelineLayout layout = VK_NULL_HANDLE;
-  VkPipeline force_pipeline = VK_NULL_HANDLE, integrate_pipeline = VK_NULL_HANDLE;
+  VkPipeline force_pipeline = VK_NULL_HANDLE, integrate_pipeline = VK_NULL_HANDLE, fused_pipeline = VK_NULL_HANDLE;
   VkCommandPool cmd_pool = VK_NULL_HANDLE;
   VkCommandBuffer cmd = VK_NULL_HANDLE;
   VkFence fence = VK_NULL_HANDLE;
@@ -81,6 +82,7 @@ GpuSolver::Impl::~Impl() {
   if (cmd_pool) v.vkDestroyCommandPool(d, cmd_pool, nullptr);
   if (force_pipeline) v.vkDestroyPipeline(d, force_pipeline, nullptr);
   if (integrate_pipeline) v.vkDestroyPipeline(d, integrate_pipeline, nullptr);
+  if (fused_pipeline) v.vkDestroyPipeline(d, fused_pipeline, nullptr);
   if (layout) v.vkDestroyPipelineLayout(d, layout, nullptr);
   if (pool) v.vkDestroyDescriptorPool(d, pool, nullptr);
   if (set_layout) v.vkDestroyDescriptorSetLayout(d, set_layout, nullptr);
@@ -142,28 +144,42 @@ Result<void> GpuSolver::Impl::init_pipelines() {
   ai.pSetLayouts = layouts;
   VKCLOTH_VK_TRY(v.vkAllocateDescriptorSets(d, &ai, &sets[0][0]), "vkAllocateDescriptorSets");
 
-  auto fm = make_module(v, d, spirv::force_comp_spv, "force.comp");
-  if (!fm) return fm.error();
-  auto im = make_module(v, d, spirv::integrate_comp_spv, "integrate.comp");
-  if (!im) {
-    v.vkDestroyShaderModule(d, *fm, nullptr);
-    return im.error();
+  VkShaderModule modules[3] = {};
+  auto destroy_modules = [&] {
+    for (VkShaderModule m : modules)
+      if (m) v.vkDestroyShaderModule(d, m, nullptr);
+  };
+  {
+    auto fm = make_module(v, d, spirv::force_comp_spv, "force.comp");
+    if (!fm) return fm.error();
+    modules[0] = *fm;
+    auto im = make_module(v, d, spirv::integrate_comp_spv, "integrate.comp");
+    if (!im) {
+      destroy_modules();
+      return im.error();
+    }
+    modules[1] = *im;
+    auto um = make_module(v, d, spirv::fused_comp_spv, "fused.comp");
+    if (!um) {
+      destroy_modules();
+      return um.error();
+    }
+    modules[2] = *um;
   }
-  VkComputePipelineCreateInfo ci[2]{};
-  const VkShaderModule modules[2] = {*fm, *im};
-  for (int k = 0; k < 2; ++k) {
+  VkComputePipelineCreateInfo ci[3]{};
+  for (int k = 0; k < 3; ++k) {
     ci[k].sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
     ci[k].stage = VkPipelineShaderStageCreateInfo{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0,
                                                   VK_SHADER_STAGE_COMPUTE_BIT, modules[k], "main", nullptr};
     ci[k].layout = layout;
   }
-  VkPipeline pipes[2] = {};
-  const VkResult r = v.vkCreateComputePipelines(d, VK_NULL_HANDLE, 2, ci, nullptr, pipes);
-  v.vkDestroyShaderModule(d, *fm, nullptr);
-  v.vkDestroyShaderModule(d, *im, nullptr);
-  if (r != VK_SUCCESS) return vk_error(r, "vkCreateComputePipelines (force.comp, integrate.comp)");
+  VkPipeline pipes[3] = {};
+  const VkResult r = v.vkCreateComputePipelines(d, VK_NULL_HANDLE, 3, ci, nullptr, pipes);
+  destroy_modules();
+  if (r != VK_SUCCESS) return vk_error(r, "vkCreateComputePipelines (force.comp, integrate.comp, fused.comp)");
   force_pipeline = pipes[0];
   integrate_pipeline = pipes[1];
+  fused_pipeline = pipes[2];
   return {};
 }
 
@@ -324,6 +340,25 @@ void GpuSolver::Impl::record(VkCommandBuffer c, std::uint32_t steps) {
   const float c_next[4] = {half, half, pc.dt, 0.0f};
   VkDescriptorSet bound = VK_NULL_HANDLE;
   bool first = true;
+  if (options.fused && !rk4) {
+    // One dispatch per step (fused.comp): the pipeline is bound once, the descriptor set
+    // alternates with the position parity, one barrier between consecutive steps.
+    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, fused_pipeline);
+    pc.stage = 0;
+    pc.c_next = c_next[0];
+    for (std::uint32_t s = 0; s < steps; ++s) {
+      pc.step = static_cast<std::uint32_t>(recorded + 1);
+      const VkDescriptorSet set = sets[current()][0];
+      v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &set, 0, nullptr);
+      v.vkCmdPushConstants(c, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
+      if (!first) barriers::dispatch_to_dispatch(v, c); // previous step -> this step
+      first = false;
+      v.vkCmdDispatch(c, groups_x, groups_y, 1);
+      ++recorded;
+      if (!diverged) ++step;
+    }
+    return;
+  }
   for (std::uint32_t s = 0; s < steps; ++s) {
     const std::uint32_t read = current();
     pc.step = static_cast<std::uint32_t>(recorded + 1); // 1-based number of the step being computed

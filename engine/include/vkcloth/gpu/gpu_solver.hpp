@@ -2,7 +2,8 @@
 // particle, force.comp and integrate.comp, with the same float expression order, so on a driver
 // without FMA contraction it reproduces CpuSolver<float> (lavapipe: bit for bit).
 //
-// Per step (Euler):      force(positions[read]) -> integrate(-> positions[write]) -> swap
+// Per step (Euler):      fused(positions[read] -> positions[write]) -> swap   (GpuSolverOptions::fused)
+//                   or   force(positions[read]) -> integrate(-> positions[write]) -> swap
 // Per step (RK4):        4 x (force(stage input) -> integrate(stage k)); the last writes positions[write]
 //
 // Buffers (device-local storage buffers, vec4 per particle, w unused; positions have w = 1):
@@ -30,6 +31,12 @@
 namespace vkcloth::gpu {
 
 struct GpuSolverOptions {
+  /// Euler integrators: one fused dispatch per step (fused.comp: normal, spring gather, contacts,
+  /// integration and projection in one invocation) instead of force.comp + integrate.comp. Same
+  /// arithmetic in the same order, so the results are identical; fewer bytes moved and one barrier
+  /// per step instead of two. RK4 always uses the two-pass layout (its stages need every
+  /// particle's stage state before the next force evaluation).
+  bool fused = true;
   /// Keep every bulk buffer in device-local memory and go through staging buffers for uploads
   /// and readbacks even when the device-local memory is host-visible (as on lavapipe or UMA).
   bool force_staging = false;

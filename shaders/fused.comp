@@ -1,0 +1,50 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// Fused Euler step, one invocation per particle, one dispatch per step (GpuSolverOptions::fused):
+// the force pass (force_body.glsl: normal rebuilt from the neighbours' POS_IN, spring gather,
+// contacts) followed by the Euler update and projection (finish.glsl) in registers. Valid in one
+// dispatch because positions are ping-ponged (every invocation reads POS_IN = positions[read] and
+// writes only its own POS_OUT = positions[write]) and the velocity is read and written only by its
+// own invocation. Removes the force / filtered-velocity round trip through memory and one barrier
+// per step. Same float expressions, in the same order, as force.comp + integrate.comp.
+// Reads POS_IN (all), VEL (own); writes POS_OUT, VEL, FORCE_OUT, NORMAL (own).
+#include "vkcloth_shared.h"
+#include "common.glsl"
+#include "force_body.glsl"
+
+layout(std430, set = 0, binding = VKCLOTH_BINDING_FORCE_OUT) writeonly buffer ForceOut { vec4 force_out[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_NORMAL) writeonly buffer NormalOut { vec4 normal_out[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_POS_OUT) writeonly buffer PosOut { vec4 pos_out[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_VEL) buffer VelBuf { vec4 vel[]; };
+
+#include "finish.glsl"
+
+void main() {
+  const uint p = particle_index();
+  if (p >= pc.count) return;
+  if (frozen()) {
+    pos_out[p] = pos_in[p]; // keep the frozen state in the buffer that becomes current
+    return;
+  }
+  vec3 vf = vel[p].xyz;
+  vec3 f, nrm;
+  particle_force(p, vf, f, nrm);
+  force_out[p] = vec4(f, 0.0);
+  normal_out[p] = vec4(nrm, 0.0);
+
+  const bool pinned = particle[p].pinned != 0u;
+  const float m = particle[p].mass;
+  precise vec3 x = pos_in[p].xyz;
+  precise vec3 v = vf;
+  if (!pinned) {
+    precise vec3 a = f / m;
+    if (pc.integrator == VKCLOTH_INTEGRATOR_SEMI_IMPLICIT_EULER) {
+      v = v + a * pc.dt;
+      x = x + v * pc.dt;
+    } else {
+      x = x + v * pc.dt;
+      v = v + a * pc.dt;
+    }
+  }
+  finish(p, pinned, x, v);
+}

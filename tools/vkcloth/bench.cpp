@@ -1,0 +1,336 @@
+// `vkcloth bench`: throughput of the solvers on the report's hanging cloth (structural, shear and
+// bend springs, two pinned corners, wind) at several grid sizes, against this machine's memory
+// and compute ceilings. Bytes and flops per particle-step are counted from the kernels (the
+// counting is documented in docs/performance.md). A table for people, --json for tools.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <optional>
+#include <sstream>
+#include <thread>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "vkcloth/builders.hpp"
+#include "vkcloth/cpu_solver.hpp"
+#include "vkcloth/gpu/gpu_solver.hpp"
+
+namespace vkcloth::cli {
+namespace {
+
+struct BenchOptions {
+  std::string backend = "all";
+  std::string sizes = "64,128,256,512,1024";
+  std::uint64_t steps = 200;
+  std::uint64_t warmup = 20;
+  unsigned reps = 3;
+  std::string integrator = "semi_implicit_euler";
+  unsigned threads = 0;
+  std::uint32_t steps_per_submit = 100;
+  std::optional<double> dt;
+  double memory_gbps = 39.0;
+  double compute_gflops = 192.0;
+  std::string json;
+};
+
+/// The benchmark scene at n x n: a 1 m x 1 m vertical cloth hanging from its two top corners, in
+/// the wind. The total mass stays that of the report's 64 x 64-ish cloth scaled to the grid
+/// (m = 0.05 kg * 4096 / n^2, the particle mass 0.05 kg of the report at 64 x 64), and the wind
+/// force scales with m, so the accelerations are the same at every size; dt = 5e-4 s keeps the
+/// stiffest size (1024: sqrt(k/m) ~ 450 1/s per spring) well inside the Euler stability limit.
+struct BenchScene {
+  ParticleSystem system;
+  SimParams params;
+};
+
+Result<BenchScene> bench_scene(std::uint32_t n, Integrator integrator, double dt) {
+  ClothDesc d;
+  d.nx = n;
+  d.ny = n;
+  d.size = {1.0, 1.0};
+  d.particle_mass = 0.05 * 4096.0 / (double(n) * double(n));
+  auto sys = make_cloth(d);
+  if (!sys) return sys.error();
+  SimParams p;
+  p.integrator = integrator;
+  p.dt = dt;
+  p.wind.strength = 2.0 * d.particle_mass; // ~2 m/s^2 on a cloth facing the wind
+  p.wind.direction = {0.3, 1.0, 0.1};
+  VKCLOTH_TRY(p.validate());
+  return BenchScene{std::move(*sys), p};
+}
+
+/// Bytes and flops per particle-step counted from the kernels (docs/performance.md, "Counting").
+/// `s` is the mean number of springs per particle (gather-list entries / particles).
+struct Cost {
+  double bytes = 0, flops = 0;
+};
+
+double kernel_flops(double s, bool grid, bool wind) {
+  const double normal = grid ? 69.0 : 0.0; // 4 edges 12, 4 crosses 36, sum 12, length 5 + sqrt 1, divide 3
+  const double springs = 18.0 * s;         // u 3, dot 5, sqrt 1, (len - L) 1, k * 1, / len 1, u * 3, += 3
+  const double external = 6.0 + 7.0 + (wind ? 12.0 : 0.0); // gravity, damping, wind
+  return normal + springs + external;
+}
+
+Cost cost_of(const std::string& variant, Integrator integrator, double s, bool grid, bool wind) {
+  Cost c;
+  const double eval = kernel_flops(s, grid, wind);
+  const bool rk4 = integrator == Integrator::rk4;
+  // Euler update: a = f/m 3, two axpys 12. RK4: 4 stages (eval + k sums 6 + next stage 12), final 12.
+  c.flops = rk4 ? 4.0 * (eval + 18.0) + 12.0 : eval + 15.0;
+  const double csr = 4.0 + 12.0 * s; // offsets + 12-byte edges
+  if (variant == "cpu") {
+    // float vec3 (12 B): read pos, vel; write pos_next, vel, force, normal; mass 4 + pinned 1.
+    const double euler = 6 * 12.0 + 5.0 + csr;
+    c.bytes = rk4 ? 4.0 * (4 * 12.0 + 5.0 + csr + 6 * 12.0) + 4 * 12.0 : euler;
+  } else if (variant == "fused") {
+    // vec4 (16 B): read pos, vel, particle 8; write pos, vel, force, normal.
+    c.bytes = 16.0 * 2 + 8.0 + csr + 16.0 * 4;
+  } else {
+    // two-pass: force reads pos, vel, particle, CSR; writes force, vel_filt, normal.
+    //           integrate reads particle, force, vel_filt, pos; writes pos, vel.
+    const double force = 16.0 * 2 + 8.0 + csr + 16.0 * 3;
+    const double integ = 8.0 + 16.0 * 3 + 16.0 * 2;
+    // RK4 stages also read and write the running sums and write the stage state (4 x 16 B more).
+    c.bytes = rk4 ? 4.0 * (force + integ + 64.0) : force + integ;
+  }
+  return c;
+}
+
+struct Row {
+  std::string backend, variant;
+  std::uint32_t size = 0;
+  std::size_t particles = 0, springs = 0;
+  unsigned threads = 0;
+  std::uint64_t steps = 0;
+  unsigned reps = 0;
+  double wall_ms = 0;          // median over reps of the wall time of `steps` steps
+  double gpu_ms = -1;          // median GPU (timestamp) time of `steps` steps; -1 for the CPU
+  Cost cost;
+};
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+Result<Row> bench_cpu(const BenchScene& sc, std::uint32_t n, const BenchOptions& o) {
+  CpuSolverOptions co;
+  co.threads = o.threads;
+  auto s = CpuSolver<float>::create(sc.system, sc.params, co);
+  if (!s) return s.error();
+  VKCLOTH_TRY(s->run(o.warmup));
+  std::vector<double> wall;
+  for (unsigned r = 0; r < o.reps; ++r) {
+    const auto t0 = Clock::now();
+    VKCLOTH_TRY(s->run(o.steps));
+    wall.push_back(ms_since(t0));
+  }
+  Row row;
+  row.backend = "cpu";
+  row.variant = "cpu";
+  row.threads = s->threads();
+  row.size = n;
+  row.wall_ms = median(wall);
+  return row;
+}
+
+Result<Row> bench_vulkan(gpu::Context& ctx, const BenchScene& sc, std::uint32_t n, bool fused, const BenchOptions& o) {
+  gpu::GpuSolverOptions go;
+  go.fused = fused;
+  auto s = gpu::GpuSolver::create(ctx, sc.system, sc.params, go);
+  if (!s) return s.error();
+  VKCLOTH_TRY(s->simulate(o.warmup, o.steps_per_submit));
+  std::vector<double> wall, gpu_ms;
+  for (unsigned r = 0; r < o.reps; ++r) {
+    const auto t0 = Clock::now();
+    VKCLOTH_TRY(s->simulate(o.steps, o.steps_per_submit));
+    wall.push_back(ms_since(t0));
+    gpu_ms.push_back(s->last_gpu_ms());
+  }
+  Row row;
+  row.backend = "vulkan";
+  row.variant = fused && sc.params.integrator != Integrator::rk4 ? "fused" : "two_pass";
+  row.size = n;
+  row.wall_ms = median(wall);
+  row.gpu_ms = median(gpu_ms);
+  return row;
+}
+
+Result<std::vector<std::uint32_t>> parse_sizes(const std::string& text) {
+  std::vector<std::uint32_t> out;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    std::size_t used = 0;
+    unsigned long v = 0;
+    try {
+      v = std::stoul(item, &used);
+    } catch (...) {
+      used = 0;
+    }
+    if (used != item.size() || v < 2 || v > max_cloth_side)
+      return make_error(ErrorCode::invalid_argument,
+                        fmt::format("--sizes: '{}' is not a grid side in 2..{}", item, max_cloth_side));
+    out.push_back(static_cast<std::uint32_t>(v));
+  }
+  if (out.empty()) return make_error(ErrorCode::invalid_argument, "--sizes: give at least one size, e.g. 64,256");
+  return out;
+}
+
+int bench_command(const BenchOptions& o) {
+  if (o.backend != "cpu" && o.backend != "vulkan" && o.backend != "all")
+    return report(make_error(ErrorCode::invalid_argument,
+                             fmt::format("--backend must be cpu, vulkan or all, got '{}'", o.backend)));
+  const auto integrator = parse_integrator(o.integrator);
+  if (!integrator)
+    return report(make_error(ErrorCode::invalid_argument,
+                             fmt::format("--integrator must be explicit_euler, semi_implicit_euler or rk4, got '{}'",
+                                         o.integrator)));
+  auto sizes = parse_sizes(o.sizes);
+  if (!sizes) return report(sizes.error());
+  if (o.steps == 0 || o.reps == 0 || o.steps_per_submit == 0)
+    return report(make_error(ErrorCode::invalid_argument, "--steps, --reps and --steps-per-submit must be > 0"));
+  if (!(o.memory_gbps > 0) || !(o.compute_gflops > 0))
+    return report(make_error(ErrorCode::invalid_argument, "--memory-gbps and --compute-gflops must be > 0"));
+  const double dt = o.dt.value_or(5e-4);
+
+  std::optional<gpu::Context> ctx;
+  std::string vulkan_note;
+  if (o.backend != "cpu") {
+    auto c = gpu::Context::create();
+    if (c) ctx.emplace(std::move(*c));
+    else if (o.backend == "vulkan") return report(c.error());
+    else vulkan_note = c.error().message;
+  }
+
+  std::vector<Row> rows;
+  for (std::uint32_t n : *sizes) {
+    auto sc = bench_scene(n, *integrator, dt);
+    if (!sc) return report(sc.error());
+    const double s = double(sc->system.adjacency.refs.size()) / double(sc->system.size());
+    auto add = [&](Result<Row> r) -> int {
+      if (!r && r.error().code == ErrorCode::unsupported) { // too large for this device: note it, go on
+        fmt::print("note: n = {}: {}\n", n, r.error().message);
+        return exit_ok;
+      }
+      if (!r) return report(r.error());
+      r->particles = sc->system.size();
+      r->springs = sc->system.springs.size();
+      r->steps = o.steps;
+      r->reps = o.reps;
+      r->cost = cost_of(r->variant, *integrator, s, true, true);
+      rows.push_back(*r);
+      return exit_ok;
+    };
+    if (o.backend != "vulkan")
+      if (int e = add(bench_cpu(*sc, n, o))) return e;
+    if (ctx) {
+      if (int e = add(bench_vulkan(*ctx, *sc, n, true, o))) return e;
+      if (*integrator != Integrator::rk4)
+        if (int e = add(bench_vulkan(*ctx, *sc, n, false, o))) return e;
+    }
+  }
+
+  // Table for people.
+  fmt::print("vkcloth bench: hanging cloth n x n (3 spring kinds, 2 pins, wind), {}, dt {:g} s, {} steps x {} reps "
+             "(median), warm-up {}\n",
+             o.integrator, dt, o.steps, o.reps, o.warmup);
+  fmt::print("ceilings: memory {:g} GB/s, compute {:g} GFLOP/s (--memory-gbps, --compute-gflops)\n", o.memory_gbps,
+             o.compute_gflops);
+  if (ctx) fmt::print("vulkan device: {}\n", ctx->device_name());
+  if (!vulkan_note.empty()) fmt::print("vulkan: skipped ({})\n", vulkan_note);
+  fmt::print("{:<7} {:<9} {:>5} {:>8} {:>3} {:>9} {:>9} {:>9} {:>6} {:>7} {:>5} {:>6} {:>8} {:>5}\n", "backend", "variant",
+             "n", "particles", "thr", "ms/step", "gpu ms", "M p-st/s", "B/p-st", "GB/s", "%mem", "fl/pst", "GFLOP/s",
+             "%cmp");
+  nlohmann::json results = nlohmann::json::array();
+  for (const Row& r : rows) {
+    const double ms_step = r.wall_ms / double(r.steps);
+    const double rate = double(r.particles) * double(r.steps) / (r.wall_ms * 1e-3);
+    const double gbps = rate * r.cost.bytes * 1e-9;
+    const double gflops = rate * r.cost.flops * 1e-9;
+    const double gpu_step = r.gpu_ms >= 0 ? r.gpu_ms / double(r.steps) : -1.0;
+    fmt::print("{:<7} {:<9} {:>5} {:>8} {:>3} {:>9.4f} {:>9} {:>9.1f} {:>6.0f} {:>7.2f} {:>4.0f}% {:>6.0f} {:>8.2f} "
+               "{:>4.1f}%\n",
+               r.backend, r.variant, r.size, r.particles, r.backend == "cpu" ? fmt::format("{}", r.threads) : "-",
+               ms_step, gpu_step >= 0 ? fmt::format("{:.4f}", gpu_step) : "-", rate * 1e-6, r.cost.bytes, gbps,
+               100.0 * gbps / o.memory_gbps, r.cost.flops, gflops, 100.0 * gflops / o.compute_gflops);
+    nlohmann::json j;
+    j["backend"] = r.backend;
+    j["variant"] = r.variant;
+    j["size"] = r.size;
+    j["particles"] = r.particles;
+    j["springs"] = r.springs;
+    j["threads"] = r.backend == "cpu" ? nlohmann::json(r.threads) : nlohmann::json(nullptr);
+    j["steps"] = r.steps;
+    j["reps"] = r.reps;
+    j["wall_ms"] = r.wall_ms;
+    j["gpu_ms"] = r.gpu_ms >= 0 ? nlohmann::json(r.gpu_ms) : nlohmann::json(nullptr);
+    j["ms_per_step"] = ms_step;
+    j["gpu_ms_per_step"] = gpu_step >= 0 ? nlohmann::json(gpu_step) : nlohmann::json(nullptr);
+    j["particle_steps_per_s"] = rate;
+    j["bytes_per_particle_step"] = r.cost.bytes;
+    j["flops_per_particle_step"] = r.cost.flops;
+    j["achieved_gbps"] = gbps;
+    j["memory_fraction"] = gbps / o.memory_gbps;
+    j["achieved_gflops"] = gflops;
+    j["compute_fraction"] = gflops / o.compute_gflops;
+    results.push_back(std::move(j));
+  }
+  if (!o.json.empty()) {
+    nlohmann::json doc;
+    doc["schema"] = "vkcloth-bench/1";
+    doc["scene"] = "hanging_cloth";
+    doc["integrator"] = o.integrator;
+    doc["dt"] = dt;
+    doc["steps"] = o.steps;
+    doc["warmup"] = o.warmup;
+    doc["reps"] = o.reps;
+    doc["steps_per_submit"] = o.steps_per_submit;
+    doc["ceilings"] = {{"memory_gbps", o.memory_gbps}, {"compute_gflops", o.compute_gflops}};
+    doc["host_threads"] = std::thread::hardware_concurrency();
+    doc["vulkan_device"] = ctx ? nlohmann::json(ctx->device_name()) : nlohmann::json(nullptr);
+    doc["vulkan_skipped"] = vulkan_note.empty() ? nlohmann::json(nullptr) : nlohmann::json(vulkan_note);
+    doc["results"] = std::move(results);
+    std::ofstream f(o.json);
+    f << doc.dump(2) << "\n";
+    if (!f)
+      return report(make_error(ErrorCode::io, fmt::format("--json: cannot write '{}'", o.json)));
+  }
+  return exit_ok;
+}
+
+} // namespace
+
+void add_bench_command(CLI::App& app, int* exit) {
+  auto opt = std::make_shared<BenchOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "bench", "Throughput of the solvers on the hanging cloth at several sizes, against the memory and compute "
+               "ceilings (docs/performance.md)");
+  cmd->add_option("--backend", opt->backend, "cpu | vulkan | all (all: Vulkan is skipped with a note if no device)")
+      ->capture_default_str();
+  cmd->add_option("--sizes", opt->sizes, "Comma-separated grid sides n (n x n particles)")->capture_default_str();
+  cmd->add_option("--steps", opt->steps, "Timed steps per repetition")->capture_default_str();
+  cmd->add_option("--warmup", opt->warmup, "Untimed steps before the first repetition")->capture_default_str();
+  cmd->add_option("--reps", opt->reps, "Repetitions; the median is reported")->capture_default_str();
+  cmd->add_option("--integrator", opt->integrator, "explicit_euler | semi_implicit_euler | rk4")->capture_default_str();
+  cmd->add_option("--threads", opt->threads, "CPU solver threads (0: the host's hardware threads)")->capture_default_str();
+  cmd->add_option("--steps-per-submit", opt->steps_per_submit, "Vulkan: steps recorded per command buffer")
+      ->capture_default_str();
+  cmd->add_option("--dt", opt->dt, "Time step in seconds (default 5e-4, stable at every size)");
+  cmd->add_option("--memory-gbps", opt->memory_gbps, "Memory bandwidth ceiling in GB/s")->capture_default_str();
+  cmd->add_option("--compute-gflops", opt->compute_gflops, "Compute ceiling in GFLOP/s")->capture_default_str();
+  cmd->add_option("--json", opt->json, "Also write the results as JSON to FILE (keys: docs/performance.md)");
+  cmd->footer(exit_codes_footer);
+  cmd->callback([opt, exit] { *exit = bench_command(*opt); });
+}
+
+} // namespace vkcloth::cli
