@@ -79,6 +79,8 @@ int main(int argc, char** argv) {
   add_compare_command(app, &exit);
   add_info_command(app, &exit);
   add_devices_command(app, &exit);
+  add_render_command(app, &exit);
+  add_view_command(app, &exit);
 
   try {
     app.parse(argc, argv);
