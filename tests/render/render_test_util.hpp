@@ -16,6 +16,7 @@
 #include "vkcloth/render/camera.hpp"
 #include "vkcloth/render/cloth_renderer.hpp"
 #include "vkcloth/render/image.hpp"
+#include "vkcloth/render/interaction.hpp"
 #include "vkcloth/render/offscreen.hpp"
 #include "vkcloth/scene.hpp"
 

@@ -205,3 +205,31 @@ TEST_CASE("image: load_image errors name the file") {
   CHECK(ok->width == 64);
   CHECK(ok->height == 2);
 }
+
+TEST_CASE("interaction: record_hold_particle moves one particle and zeroes its velocity") {
+  VKCLOTH_RENDER_TEST_BEGIN(ctx);
+  auto rig = make_rig(ctx, load("cloth_on_sphere.json"), 64, 48);
+  REQUIRE(rig->solver.simulate(5));
+  const std::uint32_t held = 37;
+  const glm::vec3 where(0.2f, -0.1f, 1.5f);
+  // Held, then 0 steps: the drawn frame and the readback see exactly the written position.
+  auto img = rig->target.render(rig->solver, rig->renderer, rig->camera, 0,
+                                [&](VkCommandBuffer cmd) { record_hold_particle(ctx, cmd, rig->solver, held, where); });
+  REQUIRE(img);
+  auto p = rig->solver.positions();
+  auto v = rig->solver.velocities();
+  REQUIRE(p);
+  REQUIRE(v);
+  const glm::vec3 before = (*p)[held + 1] + glm::vec3(-0.1f, 0.0f, 0.0f); // its old place, about
+  CHECK((*p)[held] == where);
+  CHECK((*v)[held] == glm::vec3(0.0f));
+  CHECK((*p)[held + 1].z < 0.9f); // the others are untouched
+  // Held before 3 steps: the particle starts the steps from there; its stretched springs pull it
+  // back towards the cloth, but it stays much nearer the hand than its old place.
+  auto img2 = rig->target.render(rig->solver, rig->renderer, rig->camera, 3,
+                                 [&](VkCommandBuffer cmd) { record_hold_particle(ctx, cmd, rig->solver, held, where); });
+  REQUIRE(img2);
+  p = rig->solver.positions();
+  REQUIRE(p);
+  CHECK(glm::length((*p)[held] - where) < 0.5f * glm::length(before - where));
+}

@@ -163,7 +163,7 @@ std::uint32_t OffscreenTarget::width() const { return impl_->width; }
 std::uint32_t OffscreenTarget::height() const { return impl_->height; }
 
 Result<Image> OffscreenTarget::render(gpu::GpuSolver& solver, const ClothRenderer& renderer, const Camera& camera,
-                                      std::uint32_t steps) {
+                                      std::uint32_t steps, const std::function<void(VkCommandBuffer)>& before_steps) {
   Impl& s = *impl_;
   const auto& v = s.ctx->vk;
   VKCLOTH_VK_TRY(v.vkResetCommandBuffer(s.cmd, 0), "vkResetCommandBuffer (offscreen)");
@@ -171,6 +171,7 @@ Result<Image> OffscreenTarget::render(gpu::GpuSolver& solver, const ClothRendere
   bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
   bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   VKCLOTH_VK_TRY(v.vkBeginCommandBuffer(s.cmd, &bi), "vkBeginCommandBuffer (offscreen)");
+  if (before_steps) before_steps(s.cmd);
   solver.record_steps(s.cmd, steps);
   // THE compute -> graphics barrier: the steps' shader writes of positions[current] and normals
   // become visible to the vertex fetch of the draws below (VERTEX_INPUT / VERTEX_ATTRIBUTE_READ).

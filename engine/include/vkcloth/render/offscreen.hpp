@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 
 #include "vkcloth/gpu/context.hpp"
@@ -33,8 +34,9 @@ public:
   /// Records `steps` solver steps, the one compute -> vertex barrier, the render pass (cleared to
   /// the renderer's background) with the draws, and the copy to the readback buffer; submits,
   /// waits, checks the solver's divergence flags (ErrorCode::diverged), returns the frame.
+  /// `before_steps`, when set, records the caller's own commands first (e.g. record_hold_particle).
   Result<Image> render(gpu::GpuSolver& solver, const ClothRenderer& renderer, const Camera& camera,
-                       std::uint32_t steps = 0);
+                       std::uint32_t steps = 0, const std::function<void(VkCommandBuffer)>& before_steps = {});
 
   struct Impl; ///< internal (engine/src/render)
 
