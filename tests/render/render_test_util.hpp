@@ -54,7 +54,8 @@ struct Rig {
   Camera camera;
 };
 
-inline std::optional<Rig> make_rig(gpu::Context& ctx, Scene scene, std::uint32_t w, std::uint32_t h, Image texture = {}) {
+inline std::optional<Rig> make_rig(gpu::Context& ctx, Scene scene, std::uint32_t w, std::uint32_t h,
+                                   Image texture = {}) {
   auto solver = gpu::GpuSolver::create(ctx, scene.system, scene.params);
   REQUIRE_MESSAGE(solver, (solver ? "" : solver.error().message));
   auto target = OffscreenTarget::create(ctx, w, h);
@@ -79,7 +80,9 @@ inline glm::vec3 rgb(const Image& img, std::uint32_t x, std::uint32_t y) {
   return {float(p[0]), float(p[1]), float(p[2])};
 }
 
-inline glm::vec3 rgb255(glm::vec3 linear01) { return linear01 * 255.0f; }
+inline glm::vec3 rgb255(glm::vec3 linear01) {
+  return linear01 * 255.0f;
+}
 
 inline float max_abs(glm::vec3 a, glm::vec3 b) {
   const glm::vec3 d = glm::abs(a - b);
@@ -98,20 +101,23 @@ struct Comparison {
 
 inline Comparison compare(const Image& actual, const Image& golden) {
   Comparison c;
-  if (actual.width != golden.width || actual.height != golden.height) return c;
+  if (actual.width != golden.width || actual.height != golden.height)
+    return c;
   c.diff = golden;
   std::size_t bad = 0;
   for (std::uint32_t y = 0; y < actual.height; ++y)
     for (std::uint32_t x = 0; x < actual.width; ++x) {
       const std::uint8_t *a = actual.pixel(x, y), *g = golden.pixel(x, y);
       int m = 0;
-      for (int k = 0; k < 3; ++k) m = std::max(m, std::abs(int(a[k]) - int(g[k])));
+      for (int k = 0; k < 3; ++k)
+        m = std::max(m, std::abs(int(a[k]) - int(g[k])));
       std::uint8_t* d = c.diff.pixel(x, y);
       if (m > golden_channel_tolerance) {
         ++bad;
         d[0] = 255, d[1] = 0, d[2] = 0;
       } else {
-        for (int k = 0; k < 3; ++k) d[k] = std::uint8_t(128 + g[k] / 4);
+        for (int k = 0; k < 3; ++k)
+          d[k] = std::uint8_t(128 + g[k] / 4);
       }
       d[3] = 255;
     }
@@ -134,30 +140,36 @@ inline void check_golden(const std::string& name, const Image& actual) {
   const std::filesystem::path actual_path = out_dir() / (name + ".actual.png");
   if (!golden) {
     REQUIRE(write_png(actual_path, actual));
-    FAIL("no golden image " << golden_path.string() << " (" << golden.error().message << "); the actual frame is "
-                            << actual_path.string() << "; run with VKCLOTH_UPDATE_GOLDEN=1 to create it");
+    FAIL("no golden image " << golden_path.string() << " (" << golden.error().message
+                            << "); the actual frame is " << actual_path.string()
+                            << "; run with VKCLOTH_UPDATE_GOLDEN=1 to create it");
   }
   const Comparison c = compare(actual, *golden);
   if (c.fraction >= golden_max_fraction) {
     REQUIRE(write_png(actual_path, actual));
-    if (!c.diff.rgba.empty()) REQUIRE(write_png(out_dir() / (name + ".diff.png"), c.diff));
+    if (!c.diff.rgba.empty())
+      REQUIRE(write_png(out_dir() / (name + ".diff.png"), c.diff));
   }
   CHECK_MESSAGE(c.fraction < golden_max_fraction,
-                name << ": " << c.fraction * 100.0 << "% of the pixels differ by more than " << golden_channel_tolerance
-                     << " (limit " << golden_max_fraction * 100.0 << "%); actual and diff images in " << out_dir().string());
+                name << ": " << c.fraction * 100.0 << "% of the pixels differ by more than "
+                     << golden_channel_tolerance << " (limit " << golden_max_fraction * 100.0
+                     << "%); actual and diff images in " << out_dir().string());
 }
 
 } // namespace vkcloth::render::test
 
 /// Starts a render test case: binds `ctx` to the shared validated graphics Context and checks
 /// validation at the end; without a device skips (or fails on CI).
-#define VKCLOTH_RENDER_TEST_BEGIN(ctx)                                                                    \
-  auto& vkcloth_shared_ = ::vkcloth::render::test::render_context();                                      \
-  if (!vkcloth_shared_.context) {                                                                         \
-    if (::vkcloth::gpu::test::on_ci()) FAIL("CI=true but no Vulkan device: " << vkcloth_shared_.error);  \
-    MESSAGE("skipped, no Vulkan device: " << vkcloth_shared_.error);                                      \
-    return;                                                                                               \
-  }                                                                                                       \
-  ::vkcloth::gpu::Context& ctx = *vkcloth_shared_.context;                                                \
-  REQUIRE(ctx.validation_enabled());                                                                      \
-  ::vkcloth::gpu::test::ValidationGuard vkcloth_guard_{ctx}
+#define VKCLOTH_RENDER_TEST_BEGIN(ctx)                                                                       \
+  auto& vkcloth_shared_ = ::vkcloth::render::test::render_context();                                         \
+  if (!vkcloth_shared_.context) {                                                                            \
+    if (::vkcloth::gpu::test::on_ci())                                                                       \
+      FAIL("CI=true but no Vulkan device: " << vkcloth_shared_.error);                                       \
+    MESSAGE("skipped, no Vulkan device: " << vkcloth_shared_.error);                                         \
+    return;                                                                                                  \
+  }                                                                                                          \
+  ::vkcloth::gpu::Context& ctx = *vkcloth_shared_.context;                                                   \
+  REQUIRE(ctx.validation_enabled());                                                                         \
+  ::vkcloth::gpu::test::ValidationGuard vkcloth_guard_ {                                                     \
+    ctx                                                                                                      \
+  }

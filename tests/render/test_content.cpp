@@ -27,7 +27,8 @@ std::pair<std::uint32_t, std::uint32_t> pixel_of(const Camera& cam, glm::vec3 p)
 
 /// Where the segment eye -> p crosses the flat initial cloth (z = 0.8, |x|,|y| <= 0.5).
 bool hidden_by_flat_cloth(glm::vec3 eye, glm::vec3 p) {
-  if ((eye.z - 0.8f) * (p.z - 0.8f) >= 0.0f) return false;
+  if ((eye.z - 0.8f) * (p.z - 0.8f) >= 0.0f)
+    return false;
   const float t = (0.8f - eye.z) / (p.z - eye.z);
   const glm::vec3 x = eye + t * (p - eye);
   return std::abs(x.x) <= 0.55f && std::abs(x.y) <= 0.55f;
@@ -48,13 +49,15 @@ std::vector<float> cloth_samples(const Image& img, const Camera& cam, float z0) 
 
 float mean(const std::vector<float>& v) {
   float s = 0;
-  for (float x : v) s += x;
+  for (float x : v)
+    s += x;
   return s / float(v.size());
 }
 float stddev(const std::vector<float>& v) {
   const float m = mean(v);
   float s = 0;
-  for (float x : v) s += (x - m) * (x - m);
+  for (float x : v)
+    s += (x - m) * (x - m);
   return std::sqrt(s / float(v.size()));
 }
 
@@ -106,7 +109,8 @@ TEST_CASE("content: background, cloth, sphere and floor where the camera must se
     for (float d = 0.35f; d <= 1.5f; d += 0.05f) {
       const glm::vec3 p = d * dir;
       auto q = cam.project(p, W, H);
-      if (!q || q->x < 2 || q->y < 2 || q->x >= W - 2 || q->y >= H - 2 || hidden_by_flat_cloth(cam.eye, p)) continue;
+      if (!q || q->x < 2 || q->y < 2 || q->x >= W - 2 || q->y >= H - 2 || hidden_by_flat_cloth(cam.eye, p))
+        continue;
       ++seen;
       const glm::vec3 c = rgb(*img, std::uint32_t(q->x), std::uint32_t(q->y));
       INFO("floor pixel at distance " << d << ": " << c.r << ", " << c.g << ", " << c.b);
@@ -213,8 +217,9 @@ TEST_CASE("interaction: record_hold_particle moves one particle and zeroes its v
   const std::uint32_t held = 37;
   const glm::vec3 where(0.2f, -0.1f, 1.5f);
   // Held, then 0 steps: the drawn frame and the readback see exactly the written position.
-  auto img = rig->target.render(rig->solver, rig->renderer, rig->camera, 0,
-                                [&](VkCommandBuffer cmd) { record_hold_particle(ctx, cmd, rig->solver, held, where); });
+  auto img = rig->target.render(rig->solver, rig->renderer, rig->camera, 0, [&](VkCommandBuffer cmd) {
+    record_hold_particle(ctx, cmd, rig->solver, held, where);
+  });
   REQUIRE(img);
   auto p = rig->solver.positions();
   auto v = rig->solver.velocities();
@@ -226,8 +231,9 @@ TEST_CASE("interaction: record_hold_particle moves one particle and zeroes its v
   CHECK((*p)[held + 1].z < 0.9f); // the others are untouched
   // Held before 3 steps: the particle starts the steps from there; its stretched springs pull it
   // back towards the cloth, but it stays much nearer the hand than its old place.
-  auto img2 = rig->target.render(rig->solver, rig->renderer, rig->camera, 3,
-                                 [&](VkCommandBuffer cmd) { record_hold_particle(ctx, cmd, rig->solver, held, where); });
+  auto img2 = rig->target.render(rig->solver, rig->renderer, rig->camera, 3, [&](VkCommandBuffer cmd) {
+    record_hold_particle(ctx, cmd, rig->solver, held, where);
+  });
   REQUIRE(img2);
   p = rig->solver.positions();
   REQUIRE(p);

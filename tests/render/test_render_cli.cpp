@@ -36,8 +36,8 @@ fs::path tmp_dir() {
 
 Outcome vkcloth(const std::string& tag, const std::string& args, const std::string& env = "") {
   const fs::path out = tmp_dir() / (tag + ".stdout"), err = tmp_dir() / (tag + ".stderr");
-  const std::string cmd = env + " '" + VKCLOTH_CLI_PATH + "' " + args + " >'" + out.string() + "' 2>'" + err.string() +
-                          "' </dev/null";
+  const std::string cmd = env + " '" + VKCLOTH_CLI_PATH + "' " + args + " >'" + out.string() + "' 2>'" +
+                          err.string() + "' </dev/null";
   const int status = std::system(cmd.c_str());
   Outcome o;
   o.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -53,8 +53,10 @@ bool on_ci() {
 
 /// Exit 4 (no device) skips the check off CI.
 bool device_missing(const Outcome& o) {
-  if (o.code != 4) return false;
-  if (on_ci()) FAIL("CI=true but no Vulkan device: " << o.err);
+  if (o.code != 4)
+    return false;
+  if (on_ci())
+    FAIL("CI=true but no Vulkan device: " << o.err);
   MESSAGE("skipped, no Vulkan device: " << o.err);
   return true;
 }
@@ -83,7 +85,8 @@ TEST_CASE("render: a corrupt texture file is exit 2 naming the file") {
 
 TEST_CASE("render: --video without ffmpeg is exit 2 with a clear message") {
   const Outcome o = vkcloth("video_no_ffmpeg",
-                            "render " + scenes + "/cloth_on_sphere.json --steps 2 --video " + (tmp_dir() / "v.mp4").string(),
+                            "render " + scenes + "/cloth_on_sphere.json --steps 2 --video " +
+                                (tmp_dir() / "v.mp4").string(),
                             "PATH=/nonexistent");
   CHECK(o.code == 2);
   CHECK(o.err.find("needs ffmpeg") != std::string::npos);
@@ -94,9 +97,11 @@ TEST_CASE("render: --out and --frames write PNGs, a chain renders too") {
   fs::remove_all(frames);
   const fs::path out = tmp_dir() / "final.png";
   fs::remove(out);
-  const Outcome o = vkcloth("frames", "render " + scenes + "/cloth_on_sphere.json --steps 6 --every 3 --size 64x48 --frames " +
+  const Outcome o = vkcloth("frames", "render " + scenes +
+                                          "/cloth_on_sphere.json --steps 6 --every 3 --size 64x48 --frames " +
                                           frames.string() + " --out " + out.string());
-  if (device_missing(o)) return;
+  if (device_missing(o))
+    return;
   REQUIRE_MESSAGE(o.code == 0, o.err);
   CHECK(fs::file_size(frames / "frame_00000.png") > 0);
   CHECK(fs::file_size(frames / "frame_00002.png") > 0);

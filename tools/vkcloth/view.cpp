@@ -59,7 +59,8 @@ struct Orbit {
   render::Camera camera() const {
     render::Camera c;
     c.target = target;
-    c.eye = target + distance * glm::vec3(std::cos(pitch) * std::cos(yaw), std::cos(pitch) * std::sin(yaw), std::sin(pitch));
+    c.eye = target + distance * glm::vec3(std::cos(pitch) * std::cos(yaw), std::cos(pitch) * std::sin(yaw),
+                                          std::sin(pitch));
     c.fov_y_degrees = fov;
     c.near_plane = std::max(distance * 0.01f, distance - 4.0f * scene_radius);
     c.far_plane = distance + 30.0f * scene_radius + 10.0f;
@@ -133,27 +134,35 @@ private:
 };
 
 void Viewer::shutdown() {
-  if (device_) vkDeviceWaitIdle(device_);
+  if (device_)
+    vkDeviceWaitIdle(device_);
   renderer_.reset();
   solver_.reset();
   if (device_) {
     destroy_swapchain();
-    if (sc_.handle) vkDestroySwapchainKHR(device_, sc_.handle, nullptr);
+    if (sc_.handle)
+      vkDestroySwapchainKHR(device_, sc_.handle, nullptr);
     sc_.handle = VK_NULL_HANDLE;
-    if (render_pass_) vkDestroyRenderPass(device_, render_pass_, nullptr);
-    if (pool_) vkDestroyCommandPool(device_, pool_, nullptr);
-    if (in_flight_) vkDestroyFence(device_, in_flight_, nullptr);
-    if (acquired_) vkDestroySemaphore(device_, acquired_, nullptr);
+    if (render_pass_)
+      vkDestroyRenderPass(device_, render_pass_, nullptr);
+    if (pool_)
+      vkDestroyCommandPool(device_, pool_, nullptr);
+    if (in_flight_)
+      vkDestroyFence(device_, in_flight_, nullptr);
+    if (acquired_)
+      vkDestroySemaphore(device_, acquired_, nullptr);
     render_pass_ = VK_NULL_HANDLE;
     pool_ = VK_NULL_HANDLE;
     in_flight_ = VK_NULL_HANDLE;
     acquired_ = VK_NULL_HANDLE;
   }
-  if (surface_ && context_) vkDestroySurfaceKHR(context_->handles().instance, surface_, nullptr);
+  if (surface_ && context_)
+    vkDestroySurfaceKHR(context_->handles().instance, surface_, nullptr);
   surface_ = VK_NULL_HANDLE;
   context_.reset(); // destroys the device and instance
   device_ = VK_NULL_HANDLE;
-  if (window_) glfwDestroyWindow(window_);
+  if (window_)
+    glfwDestroyWindow(window_);
   window_ = nullptr;
   glfwTerminate();
 }
@@ -184,9 +193,11 @@ Result<void> Viewer::create_render_pass() {
   // transition and clear wait for it; the previous frame's depth writes finish before this clear.
   dep[0].srcSubpass = VK_SUBPASS_EXTERNAL;
   dep[0].dstSubpass = 0;
-  dep[0].srcStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT;
+  dep[0].srcStageMask =
+      VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT;
   dep[0].srcAccessMask = VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
-  dep[0].dstStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT | VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT |
+  dep[0].dstStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT |
+                        VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT |
                         VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT;
   dep[0].dstAccessMask = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
                          VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
@@ -211,12 +222,18 @@ Result<void> Viewer::create_render_pass() {
 }
 
 void Viewer::destroy_swapchain() {
-  for (VkFramebuffer f : sc_.framebuffers) vkDestroyFramebuffer(device_, f, nullptr);
-  for (VkImageView v : sc_.views) vkDestroyImageView(device_, v, nullptr);
-  for (VkSemaphore s : sc_.render_done) vkDestroySemaphore(device_, s, nullptr);
-  if (sc_.depth_view) vkDestroyImageView(device_, sc_.depth_view, nullptr);
-  if (sc_.depth) vkDestroyImage(device_, sc_.depth, nullptr);
-  if (sc_.depth_memory) vkFreeMemory(device_, sc_.depth_memory, nullptr);
+  for (VkFramebuffer f : sc_.framebuffers)
+    vkDestroyFramebuffer(device_, f, nullptr);
+  for (VkImageView v : sc_.views)
+    vkDestroyImageView(device_, v, nullptr);
+  for (VkSemaphore s : sc_.render_done)
+    vkDestroySemaphore(device_, s, nullptr);
+  if (sc_.depth_view)
+    vkDestroyImageView(device_, sc_.depth_view, nullptr);
+  if (sc_.depth)
+    vkDestroyImage(device_, sc_.depth, nullptr);
+  if (sc_.depth_memory)
+    vkFreeMemory(device_, sc_.depth_memory, nullptr);
   VkSwapchainKHR old = sc_.handle;
   sc_ = Swapchain{};
   sc_.handle = old; // kept for oldSwapchain; destroyed by the caller
@@ -230,11 +247,14 @@ Result<void> Viewer::create_swapchain() {
   glfwGetFramebufferSize(window_, &fw, &fh);
   VkExtent2D extent = caps.currentExtent;
   if (extent.width == UINT32_MAX)
-    extent = {std::clamp<std::uint32_t>(std::uint32_t(fw), caps.minImageExtent.width, caps.maxImageExtent.width),
-              std::clamp<std::uint32_t>(std::uint32_t(fh), caps.minImageExtent.height, caps.maxImageExtent.height)};
-  if (extent.width == 0 || extent.height == 0) return {}; // minimised: no swapchain until restored
+    extent = {
+        std::clamp<std::uint32_t>(std::uint32_t(fw), caps.minImageExtent.width, caps.maxImageExtent.width),
+        std::clamp<std::uint32_t>(std::uint32_t(fh), caps.minImageExtent.height, caps.maxImageExtent.height)};
+  if (extent.width == 0 || extent.height == 0)
+    return {}; // minimised: no swapchain until restored
   std::uint32_t count = std::max(caps.minImageCount, 2u);
-  if (caps.maxImageCount) count = std::min(count, caps.maxImageCount);
+  if (caps.maxImageCount)
+    count = std::min(count, caps.maxImageCount);
   VkSwapchainCreateInfoKHR ci{};
   ci.sType = VK_STRUCTURE_TYPE_SWAPCHAIN_CREATE_INFO_KHR;
   ci.surface = surface_;
@@ -246,16 +266,19 @@ Result<void> Viewer::create_swapchain() {
   ci.imageUsage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT;
   ci.imageSharingMode = VK_SHARING_MODE_EXCLUSIVE;
   ci.preTransform = caps.currentTransform;
-  ci.compositeAlpha = (caps.supportedCompositeAlpha & VK_COMPOSITE_ALPHA_OPAQUE_BIT_KHR) ? VK_COMPOSITE_ALPHA_OPAQUE_BIT_KHR
-                                                                                           : VK_COMPOSITE_ALPHA_INHERIT_BIT_KHR;
+  ci.compositeAlpha = (caps.supportedCompositeAlpha & VK_COMPOSITE_ALPHA_OPAQUE_BIT_KHR)
+                          ? VK_COMPOSITE_ALPHA_OPAQUE_BIT_KHR
+                          : VK_COMPOSITE_ALPHA_INHERIT_BIT_KHR;
   ci.presentMode = VK_PRESENT_MODE_FIFO_KHR; // always supported
   ci.clipped = VK_TRUE;
   ci.oldSwapchain = sc_.handle;
   VkSwapchainKHR handle = VK_NULL_HANDLE;
   const VkResult cr = vkCreateSwapchainKHR(device_, &ci, nullptr, &handle);
-  if (sc_.handle) vkDestroySwapchainKHR(device_, sc_.handle, nullptr);
+  if (sc_.handle)
+    vkDestroySwapchainKHR(device_, sc_.handle, nullptr);
   sc_.handle = VK_NULL_HANDLE;
-  if (cr != VK_SUCCESS) return vk_fail(cr, "vkCreateSwapchainKHR");
+  if (cr != VK_SUCCESS)
+    return vk_fail(cr, "vkCreateSwapchainKHR");
   sc_.handle = handle;
   sc_.extent = extent;
   std::uint32_t n = 0;
@@ -273,16 +296,20 @@ Result<void> Viewer::create_swapchain() {
   ii.samples = VK_SAMPLE_COUNT_1_BIT;
   ii.tiling = VK_IMAGE_TILING_OPTIMAL;
   ii.usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT;
-  if (VkResult r = vkCreateImage(device_, &ii, nullptr, &sc_.depth); r != VK_SUCCESS) return vk_fail(r, "vkCreateImage (depth)");
+  if (VkResult r = vkCreateImage(device_, &ii, nullptr, &sc_.depth); r != VK_SUCCESS)
+    return vk_fail(r, "vkCreateImage (depth)");
   VkMemoryRequirements req;
   vkGetImageMemoryRequirements(device_, sc_.depth, &req);
   VkPhysicalDeviceMemoryProperties mp;
   vkGetPhysicalDeviceMemoryProperties(physical_, &mp);
   std::uint32_t type = UINT32_MAX;
   for (std::uint32_t i = 0; i < mp.memoryTypeCount && type == UINT32_MAX; ++i)
-    if ((req.memoryTypeBits & (1u << i)) && (mp.memoryTypes[i].propertyFlags & VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT)) type = i;
+    if ((req.memoryTypeBits & (1u << i)) &&
+        (mp.memoryTypes[i].propertyFlags & VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT))
+      type = i;
   for (std::uint32_t i = 0; i < mp.memoryTypeCount && type == UINT32_MAX; ++i)
-    if (req.memoryTypeBits & (1u << i)) type = i;
+    if (req.memoryTypeBits & (1u << i))
+      type = i;
   VkMemoryAllocateInfo ai{};
   ai.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
   ai.allocationSize = req.size;
@@ -317,24 +344,28 @@ Result<void> Viewer::create_swapchain() {
     fb.height = extent.height;
     fb.layers = 1;
     VkFramebuffer f = VK_NULL_HANDLE;
-    if (VkResult r = vkCreateFramebuffer(device_, &fb, nullptr, &f); r != VK_SUCCESS) return vk_fail(r, "vkCreateFramebuffer");
+    if (VkResult r = vkCreateFramebuffer(device_, &fb, nullptr, &f); r != VK_SUCCESS)
+      return vk_fail(r, "vkCreateFramebuffer");
     sc_.framebuffers.push_back(f);
     VkSemaphoreCreateInfo si{};
     si.sType = VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO;
     VkSemaphore s = VK_NULL_HANDLE;
-    if (VkResult r = vkCreateSemaphore(device_, &si, nullptr, &s); r != VK_SUCCESS) return vk_fail(r, "vkCreateSemaphore");
+    if (VkResult r = vkCreateSemaphore(device_, &si, nullptr, &s); r != VK_SUCCESS)
+      return vk_fail(r, "vkCreateSemaphore");
     sc_.render_done.push_back(s);
   }
   return {};
 }
 
 Result<void> Viewer::reset_solver() {
-  if (device_) vkDeviceWaitIdle(device_);
+  if (device_)
+    vkDeviceWaitIdle(device_);
   solver_.reset();
   SimParams p = scene_->params;
   p.wind = wind_on_ ? base_wind_ : Wind{0.0, base_wind_.direction};
   auto s = gpu::GpuSolver::create(*context_, scene_->system, p);
-  if (!s) return s.error();
+  if (!s)
+    return s.error();
   solver_.emplace(std::move(*s));
   held_.reset();
   return {};
@@ -344,7 +375,8 @@ void Viewer::handle_input() {
   const render::Camera cam = orbit_.camera();
   if (input_.scroll != 0.0) {
     orbit_.distance *= std::pow(0.9f, float(input_.scroll));
-    orbit_.distance = std::clamp(orbit_.distance, 0.05f * orbit_.scene_radius, 50.0f * orbit_.scene_radius + 1.0f);
+    orbit_.distance =
+        std::clamp(orbit_.distance, 0.05f * orbit_.scene_radius, 50.0f * orbit_.scene_radius + 1.0f);
     input_.scroll = 0.0;
   }
   if (input_.left_pressed && sc_.extent.width) {
@@ -357,7 +389,8 @@ void Viewer::handle_input() {
       for (std::uint32_t i = 0; i < pos->size(); ++i) {
         const glm::vec3 d = (*pos)[i] - ray.origin;
         const float along = glm::dot(d, ray.dir);
-        if (along <= 0.0f) continue;
+        if (along <= 0.0f)
+          continue;
         const float off = glm::length(d - along * ray.dir);
         if (off < best) {
           best = off;
@@ -381,7 +414,8 @@ void Viewer::handle_input() {
     const float denom = glm::dot(ray.dir, drag_normal_);
     if (std::abs(denom) > 1e-6f) {
       const float t = glm::dot(held_pos_ - ray.origin, drag_normal_) / denom;
-      if (t > 0.0f) held_pos_ = ray.origin + t * ray.dir;
+      if (t > 0.0f)
+        held_pos_ = ray.origin + t * ray.dir;
     }
   } else if (input_.left_down) {
     orbit_.yaw -= float(dx) * 0.008f;
@@ -409,7 +443,8 @@ Result<void> Viewer::draw_frame() {
     vkDeviceWaitIdle(device_);
     destroy_swapchain();
     VKCLOTH_TRY(create_swapchain());
-    if (sc_.images.empty()) return {}; // minimised
+    if (sc_.images.empty())
+      return {}; // minimised
   }
   std::uint32_t index = 0;
   VkResult r = vkAcquireNextImageKHR(device_, sc_.handle, UINT64_MAX, acquired_, VK_NULL_HANDLE, &index);
@@ -417,14 +452,16 @@ Result<void> Viewer::draw_frame() {
     input_.resized = true;
     return {};
   }
-  if (r != VK_SUCCESS && r != VK_SUBOPTIMAL_KHR) return vk_fail(r, "vkAcquireNextImageKHR");
+  if (r != VK_SUCCESS && r != VK_SUBOPTIMAL_KHR)
+    return vk_fail(r, "vkAcquireNextImageKHR");
   vkResetFences(device_, 1, &in_flight_);
   vkResetCommandBuffer(cmd_, 0);
   VkCommandBufferBeginInfo bi{};
   bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
   bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   vkBeginCommandBuffer(cmd_, &bi);
-  if (held_) render::record_hold_particle(*context_, cmd_, *solver_, *held_, held_pos_);
+  if (held_)
+    render::record_hold_particle(*context_, cmd_, *solver_, *held_, held_pos_);
   if (!input_.paused) {
     solver_->record_steps(cmd_, steps_per_frame_);
   } else if (input_.step_once) {
@@ -448,7 +485,8 @@ Result<void> Viewer::draw_frame() {
   vkCmdBeginRenderPass(cmd_, &rb, VK_SUBPASS_CONTENTS_INLINE);
   renderer_->record_draw(cmd_, *solver_, orbit_.camera(), sc_.extent);
   vkCmdEndRenderPass(cmd_);
-  if (VkResult e = vkEndCommandBuffer(cmd_); e != VK_SUCCESS) return vk_fail(e, "vkEndCommandBuffer");
+  if (VkResult e = vkEndCommandBuffer(cmd_); e != VK_SUCCESS)
+    return vk_fail(e, "vkEndCommandBuffer");
   const VkPipelineStageFlags wait_stage = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
   VkSubmitInfo si{};
   si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
@@ -459,7 +497,8 @@ Result<void> Viewer::draw_frame() {
   si.pCommandBuffers = &cmd_;
   si.signalSemaphoreCount = 1;
   si.pSignalSemaphores = &sc_.render_done[index];
-  if (VkResult e = vkQueueSubmit(queue_, 1, &si, in_flight_); e != VK_SUCCESS) return vk_fail(e, "vkQueueSubmit");
+  if (VkResult e = vkQueueSubmit(queue_, 1, &si, in_flight_); e != VK_SUCCESS)
+    return vk_fail(e, "vkQueueSubmit");
   VkPresentInfoKHR pi{};
   pi.sType = VK_STRUCTURE_TYPE_PRESENT_INFO_KHR;
   pi.waitSemaphoreCount = 1;
@@ -468,51 +507,69 @@ Result<void> Viewer::draw_frame() {
   pi.pSwapchains = &sc_.handle;
   pi.pImageIndices = &index;
   r = vkQueuePresentKHR(queue_, &pi);
-  if (r == VK_ERROR_OUT_OF_DATE_KHR || r == VK_SUBOPTIMAL_KHR) input_.resized = true;
-  else if (r != VK_SUCCESS) return vk_fail(r, "vkQueuePresentKHR");
+  if (r == VK_ERROR_OUT_OF_DATE_KHR || r == VK_SUBOPTIMAL_KHR)
+    input_.resized = true;
+  else if (r != VK_SUCCESS)
+    return vk_fail(r, "vkQueuePresentKHR");
   return {};
 }
 
 int Viewer::run(const ViewOptions& opt) {
   auto size = parse_size(opt.size);
-  if (!size) return report(size.error());
+  if (!size)
+    return report(size.error());
   auto scene = load_scene_file(opt.args.scene, opt.args.overrides());
-  if (!scene) return report(scene.error());
+  if (!scene)
+    return report(scene.error());
   scene_.emplace(std::move(*scene));
   if (!opt.texture.empty()) {
     auto tex = render::load_image(opt.texture);
-    if (!tex) return report(tex.error());
+    if (!tex)
+      return report(tex.error());
     texture_ = std::move(*tex);
   }
   if (!glfwInit())
-    return report(make_error(ErrorCode::no_device, "cannot open a window: GLFW found no display (set DISPLAY, or run "
-                                                   "under xvfb-run; `vkcloth render` needs no display)"));
+    return report(make_error(ErrorCode::no_device,
+                             "cannot open a window: GLFW found no display (set DISPLAY, or run "
+                             "under xvfb-run; `vkcloth render` needs no display)"));
   if (!glfwVulkanSupported())
     return report(make_error(ErrorCode::no_device, "GLFW found no Vulkan loader with window-system support"));
   glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);
-  window_ = glfwCreateWindow(int(size->first), int(size->second), fmt::format("vkcloth: {}", scene_->name).c_str(), nullptr,
-                             nullptr);
-  if (!window_) return report(make_error(ErrorCode::no_device, "glfwCreateWindow failed"));
+  window_ = glfwCreateWindow(int(size->first), int(size->second),
+                             fmt::format("vkcloth: {}", scene_->name).c_str(), nullptr, nullptr);
+  if (!window_)
+    return report(make_error(ErrorCode::no_device, "glfwCreateWindow failed"));
   glfwSetWindowUserPointer(window_, &input_);
   glfwSetKeyCallback(window_, [](GLFWwindow* w, int key, int, int action, int) {
     auto* in = static_cast<Input*>(glfwGetWindowUserPointer(w));
-    if (action != GLFW_PRESS && !(action == GLFW_REPEAT && (key == GLFW_KEY_S || key == GLFW_KEY_RIGHT))) return;
+    if (action != GLFW_PRESS && !(action == GLFW_REPEAT && (key == GLFW_KEY_S || key == GLFW_KEY_RIGHT)))
+      return;
     switch (key) {
-    case GLFW_KEY_ESCAPE: glfwSetWindowShouldClose(w, GLFW_TRUE); break;
-    case GLFW_KEY_SPACE: in->paused = !in->paused; break;
+    case GLFW_KEY_ESCAPE:
+      glfwSetWindowShouldClose(w, GLFW_TRUE);
+      break;
+    case GLFW_KEY_SPACE:
+      in->paused = !in->paused;
+      break;
     case GLFW_KEY_S:
     case GLFW_KEY_RIGHT:
       in->paused = true;
       in->step_once = true;
       break;
-    case GLFW_KEY_R: in->reset = true; break;
-    case GLFW_KEY_W: in->toggle_wind = true; break;
-    default: break;
+    case GLFW_KEY_R:
+      in->reset = true;
+      break;
+    case GLFW_KEY_W:
+      in->toggle_wind = true;
+      break;
+    default:
+      break;
     }
   });
   glfwSetMouseButtonCallback(window_, [](GLFWwindow* w, int button, int action, int) {
     auto* in = static_cast<Input*>(glfwGetWindowUserPointer(w));
-    if (button != GLFW_MOUSE_BUTTON_LEFT) return;
+    if (button != GLFW_MOUSE_BUTTON_LEFT)
+      return;
     in->left_down = action == GLFW_PRESS;
     (action == GLFW_PRESS ? in->left_pressed : in->left_released) = true;
   });
@@ -521,18 +578,25 @@ int Viewer::run(const ViewOptions& opt) {
     in->x = x;
     in->y = y;
   });
-  glfwSetScrollCallback(window_, [](GLFWwindow* w, double, double y) { static_cast<Input*>(glfwGetWindowUserPointer(w))->scroll += y; });
-  glfwSetFramebufferSizeCallback(window_, [](GLFWwindow* w, int, int) { static_cast<Input*>(glfwGetWindowUserPointer(w))->resized = true; });
+  glfwSetScrollCallback(window_, [](GLFWwindow* w, double, double y) {
+    static_cast<Input*>(glfwGetWindowUserPointer(w))->scroll += y;
+  });
+  glfwSetFramebufferSizeCallback(window_, [](GLFWwindow* w, int, int) {
+    static_cast<Input*>(glfwGetWindowUserPointer(w))->resized = true;
+  });
 
   gpu::ContextOptions co = render_context_options();
   std::uint32_t next = 0;
   const char** exts = glfwGetRequiredInstanceExtensions(&next);
-  if (!exts) return report(make_error(ErrorCode::no_device, "GLFW reports no Vulkan surface extensions for this display"));
+  if (!exts)
+    return report(
+        make_error(ErrorCode::no_device, "GLFW reports no Vulkan surface extensions for this display"));
   co.instance_extensions.assign(exts, exts + next);
   co.device_extensions = {VK_KHR_SWAPCHAIN_EXTENSION_NAME};
   co.queue_family_filter = [&](VkInstance instance, VkPhysicalDevice pd, std::uint32_t family) {
     if (!surface_) {
-      if (glfwCreateWindowSurface(instance, window_, nullptr, &surface_) != VK_SUCCESS) return false;
+      if (glfwCreateWindowSurface(instance, window_, nullptr, &surface_) != VK_SUCCESS)
+        return false;
     }
     auto support = reinterpret_cast<PFN_vkGetPhysicalDeviceSurfaceSupportKHR>(
         glfwGetInstanceProcAddress(instance, "vkGetPhysicalDeviceSurfaceSupportKHR"));
@@ -557,7 +621,8 @@ int Viewer::run(const ViewOptions& opt) {
   vkGetPhysicalDeviceSurfaceFormatsKHR(physical_, surface_, &nf, nullptr);
   std::vector<VkSurfaceFormatKHR> formats(nf);
   vkGetPhysicalDeviceSurfaceFormatsKHR(physical_, surface_, &nf, formats.data());
-  if (formats.empty()) return report(make_error(ErrorCode::unsupported, "the window surface offers no format"));
+  if (formats.empty())
+    return report(make_error(ErrorCode::unsupported, "the window surface offers no format"));
   color_format_ = formats[0].format;
   color_space_ = formats[0].colorSpace;
   for (const auto& f : formats)
@@ -566,7 +631,8 @@ int Viewer::run(const ViewOptions& opt) {
       color_space_ = f.colorSpace;
       break;
     }
-  for (VkFormat f : {VK_FORMAT_D32_SFLOAT, VK_FORMAT_X8_D24_UNORM_PACK32, VK_FORMAT_D24_UNORM_S8_UINT, VK_FORMAT_D16_UNORM}) {
+  for (VkFormat f : {VK_FORMAT_D32_SFLOAT, VK_FORMAT_X8_D24_UNORM_PACK32, VK_FORMAT_D24_UNORM_S8_UINT,
+                     VK_FORMAT_D16_UNORM}) {
     VkFormatProperties fp;
     vkGetPhysicalDeviceFormatProperties(physical_, f, &fp);
     if (fp.optimalTilingFeatures & VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT) {
@@ -574,16 +640,19 @@ int Viewer::run(const ViewOptions& opt) {
       break;
     }
   }
-  if (auto r = create_render_pass(); !r) return report(r.error());
+  if (auto r = create_render_pass(); !r)
+    return report(r.error());
   const Wind& w = scene_->params.wind;
   wind_on_ = w.strength != 0.0;
   base_wind_ = wind_on_ ? w : Wind{0.05, glm::dvec3(1.0, 0.0, 0.0)};
-  if (auto r = reset_solver(); !r) return report(r.error());
+  if (auto r = reset_solver(); !r)
+    return report(r.error());
   render::RendererOptions ro;
   ro.render_pass = render_pass_;
   ro.texture = texture_;
   auto rend = render::ClothRenderer::create(*context_, *solver_, scene_->system, ro);
-  if (!rend) return report(rend.error());
+  if (!rend)
+    return report(rend.error());
   renderer_.emplace(std::move(*rend));
   if (!renderer_->draws_cloth())
     fmt::print(stderr, "vkcloth: {} is a chain: masses drawn as spheres, springs as lines\n", scene_->name);
@@ -606,7 +675,8 @@ int Viewer::run(const ViewOptions& opt) {
   VkSemaphoreCreateInfo si{};
   si.sType = VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO;
   vkCreateSemaphore(device_, &si, nullptr, &acquired_);
-  if (auto r = create_swapchain(); !r) return report(r.error());
+  if (auto r = create_swapchain(); !r)
+    return report(r.error());
 
   const render::Bounds b = render::scene_bounds(scene_->system, scene_->params);
   const render::Camera start = render::Camera::frame(b, float(size->first) / float(size->second));
@@ -617,37 +687,46 @@ int Viewer::run(const ViewOptions& opt) {
   orbit_.pitch = std::asin(off.z / orbit_.distance);
   orbit_.fov = start.fov_y_degrees;
   orbit_.scene_radius = std::max(b.radius(), 0.05f);
-  steps_per_frame_ = opt.steps_per_frame ? opt.steps_per_frame
-                                         : std::uint32_t(std::max(1.0, std::round((1.0 / 60.0) / scene_->params.dt)));
-  fmt::print("vkcloth view: {} on {} — drag: orbit / move a particle, wheel: zoom, space: pause, S: step, R: reset, "
-             "W: wind, Esc: quit\n",
-             scene_->name, context_->device_name());
+  steps_per_frame_ = opt.steps_per_frame
+                         ? opt.steps_per_frame
+                         : std::uint32_t(std::max(1.0, std::round((1.0 / 60.0) / scene_->params.dt)));
+  fmt::print(
+      "vkcloth view: {} on {} — drag: orbit / move a particle, wheel: zoom, space: pause, S: step, R: reset, "
+      "W: wind, Esc: quit\n",
+      scene_->name, context_->device_name());
 
   std::uint64_t frame = 0;
   while (!glfwWindowShouldClose(window_)) {
     glfwPollEvents();
-    if (auto r = draw_frame(); !r) return report(r.error());
+    if (auto r = draw_frame(); !r)
+      return report(r.error());
     ++frame;
     if (frame % 30 == 0 || (opt.frames && frame >= opt.frames)) {
       vkWaitForFences(device_, 1, &in_flight_, VK_TRUE, UINT64_MAX);
-      if (auto r = solver_->check_divergence(); !r) return report(r.error());
+      if (auto r = solver_->check_divergence(); !r)
+        return report(r.error());
     }
-    if (opt.frames && frame >= opt.frames) break;
+    if (opt.frames && frame >= opt.frames)
+      break;
   }
   vkDeviceWaitIdle(device_);
   if (!opt.screenshot.empty()) {
     // The last frame, drawn again offscreen at the window's size with the same camera.
     const VkExtent2D e = sc_.extent.width ? sc_.extent : VkExtent2D{size->first, size->second};
     auto target = render::OffscreenTarget::create(*context_, e.width, e.height);
-    if (!target) return report(target.error());
+    if (!target)
+      return report(target.error());
     render::RendererOptions so;
     so.render_pass = target->render_pass();
     so.texture = texture_;
     auto shot_renderer = render::ClothRenderer::create(*context_, *solver_, scene_->system, so);
-    if (!shot_renderer) return report(shot_renderer.error());
+    if (!shot_renderer)
+      return report(shot_renderer.error());
     auto img = target->render(*solver_, *shot_renderer, orbit_.camera(), 0);
-    if (!img) return report(img.error());
-    if (auto wr = render::write_png(opt.screenshot, *img); !wr) return report(wr.error());
+    if (!img)
+      return report(img.error());
+    if (auto wr = render::write_png(opt.screenshot, *img); !wr)
+      return report(wr.error());
     fmt::print("screenshot of frame {} written to {}\n", frame, opt.screenshot);
   }
   fmt::print("vkcloth view: {} frames, step {}\n", frame, solver_->step_index());
@@ -658,15 +737,17 @@ int Viewer::run(const ViewOptions& opt) {
 
 void add_view_command(CLI::App& app, int* exit) {
   auto opt = std::make_shared<ViewOptions>();
-  CLI::App* cmd = app.add_subcommand("view", "Open a window and watch the GPU simulation live (orbit, pause, step, "
-                                             "reset, wind, drag a particle)");
+  CLI::App* cmd =
+      app.add_subcommand("view", "Open a window and watch the GPU simulation live (orbit, pause, step, "
+                                 "reset, wind, drag a particle)");
   cmd->footer(exit_codes_footer);
   add_scene_options(*cmd, opt->args);
   cmd->add_option("--size", opt->size, "Window size WxH (default 1024x768)");
   cmd->add_option("--texture", opt->texture, "Cloth texture (PNG or JPEG; default: the built-in fabric)");
   cmd->add_option("--frames", opt->frames, "Quit by itself after N frames (0: run until closed)");
   cmd->add_option("--screenshot", opt->screenshot, "Save the last frame as a PNG on exit");
-  cmd->add_option("--steps-per-frame", opt->steps_per_frame, "Solver steps per frame (default: about real time at 60 fps)");
+  cmd->add_option("--steps-per-frame", opt->steps_per_frame,
+                  "Solver steps per frame (default: about real time at 60 fps)");
   cmd->callback([opt, exit] {
     Viewer viewer;
     *exit = viewer.run(*opt);

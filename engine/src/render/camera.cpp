@@ -10,7 +10,9 @@
 
 namespace vkcloth::render {
 
-float Bounds::radius() const { return 0.5f * glm::length(hi - lo); }
+float Bounds::radius() const {
+  return 0.5f * glm::length(hi - lo);
+}
 
 Bounds scene_bounds(const ParticleSystem& system, const SimParams& params) {
   Bounds b{glm::vec3(INFINITY), glm::vec3(-INFINITY)};
@@ -18,8 +20,10 @@ Bounds scene_bounds(const ParticleSystem& system, const SimParams& params) {
     b.lo = glm::min(b.lo, p);
     b.hi = glm::max(b.hi, p);
   };
-  for (const Particle& p : system.particles) add(glm::vec3(p.position));
-  if (system.particles.empty()) add(glm::vec3(0.0f));
+  for (const Particle& p : system.particles)
+    add(glm::vec3(p.position));
+  if (system.particles.empty())
+    add(glm::vec3(0.0f));
   const glm::vec3 c = b.center();
   for (const Collider& k : params.colliders) {
     if (k.type == Collider::Type::sphere) {
@@ -33,7 +37,9 @@ Bounds scene_bounds(const ParticleSystem& system, const SimParams& params) {
   return b;
 }
 
-glm::mat4 Camera::view() const { return glm::lookAtRH(eye, target, up); }
+glm::mat4 Camera::view() const {
+  return glm::lookAtRH(eye, target, up);
+}
 
 glm::mat4 Camera::projection(float aspect) const {
   glm::mat4 p = glm::perspectiveRH_ZO(glm::radians(fov_y_degrees), aspect, near_plane, far_plane);
@@ -43,7 +49,8 @@ glm::mat4 Camera::projection(float aspect) const {
 
 std::optional<glm::vec3> Camera::project(glm::vec3 p, std::uint32_t width, std::uint32_t height) const {
   const glm::vec4 clip = view_projection(float(width) / float(height)) * glm::vec4(p, 1.0f);
-  if (clip.w <= 0.0f) return std::nullopt;
+  if (clip.w <= 0.0f)
+    return std::nullopt;
   const glm::vec3 ndc = glm::vec3(clip) / clip.w;
   return glm::vec3((ndc.x * 0.5f + 0.5f) * float(width), (ndc.y * 0.5f + 0.5f) * float(height), ndc.z);
 }

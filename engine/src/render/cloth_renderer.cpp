@@ -48,8 +48,8 @@ struct MeshRange {
   glm::vec3 color{1.0f};
 };
 
-void add_sphere(std::vector<MeshVertex>& v, std::vector<std::uint32_t>& idx, glm::vec3 c, float r, std::uint32_t slices,
-                std::uint32_t stacks) {
+void add_sphere(std::vector<MeshVertex>& v, std::vector<std::uint32_t>& idx, glm::vec3 c, float r,
+                std::uint32_t slices, std::uint32_t stacks) {
   const auto base = static_cast<std::uint32_t>(v.size());
   const float pi = 3.14159265358979f;
   for (std::uint32_t j = 0; j <= stacks; ++j) {
@@ -76,11 +76,11 @@ struct ClothRenderer::Impl {
   std::uint32_t particle_count = 0;
   float mass_radius = 0.02f;
 
-  Buffer cloth_index;             // grid triangles, or chain springs as a line list
+  Buffer cloth_index; // grid triangles, or chain springs as a line list
   std::uint32_t cloth_index_count = 0;
   Buffer mesh_vertices, mesh_index, zero_instance;
   std::vector<MeshRange> colliders;
-  MeshRange unit_sphere;          // chain masses (instanced at the solver's positions)
+  MeshRange unit_sphere; // chain masses (instanced at the solver's positions)
 
   detail::ImageResource texture;
   VkSampler sampler = VK_NULL_HANDLE;
@@ -94,33 +94,46 @@ struct ClothRenderer::Impl {
   Impl(const Impl&) = delete;
   Impl& operator=(const Impl&) = delete;
   ~Impl() {
-    if (!ctx || !ctx->device) return;
+    if (!ctx || !ctx->device)
+      return;
     const auto& v = ctx->vk;
     const VkDevice d = ctx->device;
     for (VkPipeline p : {cloth_pipeline, mesh_pipeline, line_pipeline})
-      if (p) v.vkDestroyPipeline(d, p, nullptr);
-    if (layout) v.vkDestroyPipelineLayout(d, layout, nullptr);
-    if (pool) v.vkDestroyDescriptorPool(d, pool, nullptr);
-    if (set_layout) v.vkDestroyDescriptorSetLayout(d, set_layout, nullptr);
-    if (sampler) v.vkDestroySampler(d, sampler, nullptr);
+      if (p)
+        v.vkDestroyPipeline(d, p, nullptr);
+    if (layout)
+      v.vkDestroyPipelineLayout(d, layout, nullptr);
+    if (pool)
+      v.vkDestroyDescriptorPool(d, pool, nullptr);
+    if (set_layout)
+      v.vkDestroyDescriptorSetLayout(d, set_layout, nullptr);
+    if (sampler)
+      v.vkDestroySampler(d, sampler, nullptr);
     detail::destroy_image(*ctx, texture);
-    for (Buffer* b : {&cloth_index, &mesh_vertices, &mesh_index, &zero_instance}) gpu::destroy_buffer(*ctx, *b);
+    for (Buffer* b : {&cloth_index, &mesh_vertices, &mesh_index, &zero_instance})
+      gpu::destroy_buffer(*ctx, *b);
   }
 
-  Result<Buffer> host_buffer(const void* data, VkDeviceSize bytes, VkBufferUsageFlags usage, const char* what) {
-    auto b = gpu::create_buffer(*ctx, std::max<VkDeviceSize>(bytes, 16), usage, MemoryUse::host_upload, true, what);
-    if (!b) return b.error();
+  Result<Buffer> host_buffer(const void* data, VkDeviceSize bytes, VkBufferUsageFlags usage,
+                             const char* what) {
+    auto b = gpu::create_buffer(*ctx, std::max<VkDeviceSize>(bytes, 16), usage, MemoryUse::host_upload, true,
+                                what);
+    if (!b)
+      return b.error();
     std::memset(b->mapped, 0, b->size);
-    if (bytes) std::memcpy(b->mapped, data, bytes); // host-coherent; visible to the device at submission
+    if (bytes)
+      std::memcpy(b->mapped, data, bytes); // host-coherent; visible to the device at submission
     return b;
   }
 
-  Result<void> build_geometry(const ParticleSystem& system, const SimParams& params, const RendererOptions& o);
+  Result<void> build_geometry(const ParticleSystem& system, const SimParams& params,
+                              const RendererOptions& o);
   Result<void> upload_texture(const Image& img);
   Result<void> build_pipelines(const RendererOptions& o);
 };
 
-Result<void> ClothRenderer::Impl::build_geometry(const ParticleSystem& system, const SimParams& params, const RendererOptions& o) {
+Result<void> ClothRenderer::Impl::build_geometry(const ParticleSystem& system, const SimParams& params,
+                                                 const RendererOptions& o) {
   // The cloth: two triangles per grid quad, (i, j) = j * nx + i; or a chain's springs as lines.
   std::vector<std::uint32_t> idx;
   if (system.grid) {
@@ -131,11 +144,14 @@ Result<void> ClothRenderer::Impl::build_geometry(const ParticleSystem& system, c
         idx.insert(idx.end(), {a, b, d, a, d, c});
       }
   } else {
-    for (const Spring& s : system.springs) idx.insert(idx.end(), {s.a, s.b});
+    for (const Spring& s : system.springs)
+      idx.insert(idx.end(), {s.a, s.b});
   }
   cloth_index_count = static_cast<std::uint32_t>(idx.size());
-  auto ci = host_buffer(idx.data(), idx.size() * sizeof(std::uint32_t), VK_BUFFER_USAGE_INDEX_BUFFER_BIT, "cloth indices");
-  if (!ci) return ci.error();
+  auto ci = host_buffer(idx.data(), idx.size() * sizeof(std::uint32_t), VK_BUFFER_USAGE_INDEX_BUFFER_BIT,
+                        "cloth indices");
+  if (!ci)
+    return ci.error();
   cloth_index = *ci;
 
   // Colliders, in world space; the floor is a square around the scene's centre.
@@ -156,7 +172,8 @@ Result<void> ClothRenderer::Impl::build_geometry(const ParticleSystem& system, c
       const glm::vec3 n = glm::normalize(glm::vec3(k.normal));
       // Drawn a hair below the surface: cloth resting at offset + eps never z-fights with it.
       const glm::vec3 centre = b.center() - (glm::dot(n, b.center()) - float(k.offset) + 1e-3f) * n;
-      const glm::vec3 t = glm::normalize(glm::cross(n, std::abs(n.z) < 0.9f ? glm::vec3(0, 0, 1) : glm::vec3(1, 0, 0)));
+      const glm::vec3 t =
+          glm::normalize(glm::cross(n, std::abs(n.z) < 0.9f ? glm::vec3(0, 0, 1) : glm::vec3(1, 0, 0)));
       const glm::vec3 s = glm::cross(n, t);
       const auto base = static_cast<std::uint32_t>(verts.size());
       for (int q = 0; q < 4; ++q) {
@@ -179,18 +196,24 @@ Result<void> ClothRenderer::Impl::build_geometry(const ParticleSystem& system, c
     mass_radius = o.mass_radius;
   } else if (!system.grid) {
     double shortest = INFINITY;
-    for (const Spring& s : system.springs) shortest = std::min(shortest, s.rest_length);
+    for (const Spring& s : system.springs)
+      shortest = std::min(shortest, s.rest_length);
     mass_radius = std::isfinite(shortest) && shortest > 0 ? float(shortest) * 0.12f : 0.03f;
   }
-  auto mv = host_buffer(verts.data(), verts.size() * sizeof(MeshVertex), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, "mesh vertices");
-  if (!mv) return mv.error();
+  auto mv = host_buffer(verts.data(), verts.size() * sizeof(MeshVertex), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
+                        "mesh vertices");
+  if (!mv)
+    return mv.error();
   mesh_vertices = *mv;
-  auto mi = host_buffer(midx.data(), midx.size() * sizeof(std::uint32_t), VK_BUFFER_USAGE_INDEX_BUFFER_BIT, "mesh indices");
-  if (!mi) return mi.error();
+  auto mi = host_buffer(midx.data(), midx.size() * sizeof(std::uint32_t), VK_BUFFER_USAGE_INDEX_BUFFER_BIT,
+                        "mesh indices");
+  if (!mi)
+    return mi.error();
   mesh_index = *mi;
   const glm::vec4 zero(0.0f);
   auto zi = host_buffer(&zero, sizeof(zero), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, "zero instance offset");
-  if (!zi) return zi.error();
+  if (!zi)
+    return zi.error();
   zero_instance = *zi;
   return {};
 }
@@ -198,20 +221,26 @@ Result<void> ClothRenderer::Impl::build_geometry(const ParticleSystem& system, c
 Result<void> ClothRenderer::Impl::upload_texture(const Image& img) {
   const auto& v = ctx->vk;
   const VkDevice d = ctx->device;
-  auto t = detail::create_image(*ctx, VK_FORMAT_R8G8B8A8_UNORM, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+  auto t = detail::create_image(*ctx, VK_FORMAT_R8G8B8A8_UNORM,
+                                VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
                                 VK_IMAGE_ASPECT_COLOR_BIT, img.width, img.height, "texture");
-  if (!t) return t.error();
+  if (!t)
+    return t.error();
   texture = *t;
-  auto st = host_buffer(img.rgba.data(), img.rgba.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, "texture staging");
-  if (!st) return st.error();
+  auto st =
+      host_buffer(img.rgba.data(), img.rgba.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, "texture staging");
+  if (!st)
+    return st.error();
   Buffer staging = *st;
 
   VkCommandPool cmd_pool = VK_NULL_HANDLE;
   VkCommandBuffer cmd = VK_NULL_HANDLE;
   VkFence fence = VK_NULL_HANDLE;
   auto cleanup = [&] {
-    if (fence) v.vkDestroyFence(d, fence, nullptr);
-    if (cmd_pool) v.vkDestroyCommandPool(d, cmd_pool, nullptr);
+    if (fence)
+      v.vkDestroyFence(d, fence, nullptr);
+    if (cmd_pool)
+      v.vkDestroyCommandPool(d, cmd_pool, nullptr);
     gpu::destroy_buffer(*ctx, staging);
   };
   auto run = [&]() -> Result<void> {
@@ -242,18 +271,20 @@ Result<void> ClothRenderer::Impl::upload_texture(const Image& img) {
     ib.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
     ib.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
     ib.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-    v.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0, nullptr, 1, &ib);
+    v.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0,
+                           nullptr, 0, nullptr, 1, &ib);
     VkBufferImageCopy region{};
     region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
     region.imageExtent = {img.width, img.height, 1};
-    v.vkCmdCopyBufferToImage(cmd, staging.buffer, texture.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+    v.vkCmdCopyBufferToImage(cmd, staging.buffer, texture.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
+                             &region);
     // The copy's writes -> visible to the fragment shader's sampling, in the sampled layout.
     ib.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
     ib.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
     ib.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
     ib.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
-    v.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, 0, 0, nullptr, 0, nullptr, 1,
-                           &ib);
+    v.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, 0, 0,
+                           nullptr, 0, nullptr, 1, &ib);
     VKCLOTH_VK_TRY(v.vkEndCommandBuffer(cmd), "vkEndCommandBuffer (texture upload)");
     VkSubmitInfo si{};
     si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
@@ -280,12 +311,14 @@ Result<void> ClothRenderer::Impl::upload_texture(const Image& img) {
 Result<void> ClothRenderer::Impl::build_pipelines(const RendererOptions& o) {
   const auto& v = ctx->vk;
   const VkDevice d = ctx->device;
-  const VkDescriptorSetLayoutBinding binding{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_FRAGMENT_BIT, nullptr};
+  const VkDescriptorSetLayoutBinding binding{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1,
+                                             VK_SHADER_STAGE_FRAGMENT_BIT, nullptr};
   VkDescriptorSetLayoutCreateInfo li{};
   li.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
   li.bindingCount = 1;
   li.pBindings = &binding;
-  VKCLOTH_VK_TRY(v.vkCreateDescriptorSetLayout(d, &li, nullptr, &set_layout), "vkCreateDescriptorSetLayout (renderer)");
+  VKCLOTH_VK_TRY(v.vkCreateDescriptorSetLayout(d, &li, nullptr, &set_layout),
+                 "vkCreateDescriptorSetLayout (renderer)");
   const VkDescriptorPoolSize ps{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1};
   VkDescriptorPoolCreateInfo dp{};
   dp.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
@@ -308,7 +341,8 @@ Result<void> ClothRenderer::Impl::build_pipelines(const RendererOptions& o) {
   w.pImageInfo = &ii;
   v.vkUpdateDescriptorSets(d, 1, &w, 0, nullptr);
 
-  const VkPushConstantRange range{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(DrawConstants)};
+  const VkPushConstantRange range{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+                                  sizeof(DrawConstants)};
   VkPipelineLayoutCreateInfo pl{};
   pl.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
   pl.setLayoutCount = 1;
@@ -328,15 +362,28 @@ Result<void> ClothRenderer::Impl::build_pipelines(const RendererOptions& o) {
                   const std::vector<VkVertexInputAttributeDescription>& attrs, VkPrimitiveTopology topology,
                   VkPipeline* out) -> Result<void> {
     auto vm = detail::create_shader(*ctx, sh.vs, sh.vs_words, sh.name);
-    if (!vm) return vm.error();
+    if (!vm)
+      return vm.error();
     auto fm = detail::create_shader(*ctx, sh.fs, sh.fs_words, sh.name);
     if (!fm) {
       v.vkDestroyShaderModule(d, *vm, nullptr);
       return fm.error();
     }
     VkPipelineShaderStageCreateInfo stages[2]{};
-    stages[0] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_VERTEX_BIT, *vm, "main", nullptr};
-    stages[1] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_FRAGMENT_BIT, *fm, "main", nullptr};
+    stages[0] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
+                 nullptr,
+                 0,
+                 VK_SHADER_STAGE_VERTEX_BIT,
+                 *vm,
+                 "main",
+                 nullptr};
+    stages[1] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
+                 nullptr,
+                 0,
+                 VK_SHADER_STAGE_FRAGMENT_BIT,
+                 *fm,
+                 "main",
+                 nullptr};
     VkPipelineVertexInputStateCreateInfo vi{};
     vi.sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO;
     vi.vertexBindingDescriptionCount = static_cast<std::uint32_t>(bindings.size());
@@ -365,7 +412,8 @@ Result<void> ClothRenderer::Impl::build_pipelines(const RendererOptions& o) {
     ds.depthWriteEnable = VK_TRUE;
     ds.depthCompareOp = VK_COMPARE_OP_LESS_OR_EQUAL;
     VkPipelineColorBlendAttachmentState att{};
-    att.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
+    att.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT |
+                         VK_COLOR_COMPONENT_A_BIT;
     VkPipelineColorBlendStateCreateInfo cb{};
     cb.sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO;
     cb.attachmentCount = 1;
@@ -393,51 +441,62 @@ Result<void> ClothRenderer::Impl::build_pipelines(const RendererOptions& o) {
     const VkResult r = v.vkCreateGraphicsPipelines(d, VK_NULL_HANDLE, 1, &gi, nullptr, out);
     v.vkDestroyShaderModule(d, *vm, nullptr);
     v.vkDestroyShaderModule(d, *fm, nullptr);
-    if (r != VK_SUCCESS) return gpu::vk_error(r, fmt::format("vkCreateGraphicsPipelines ({})", sh.name));
+    if (r != VK_SUCCESS)
+      return gpu::vk_error(r, fmt::format("vkCreateGraphicsPipelines ({})", sh.name));
     return {};
   };
   namespace sp = gpu::spirv;
   constexpr std::uint32_t vec4 = 16;
-  VKCLOTH_TRY(make({sp::cloth_vert_spv, std::size(sp::cloth_vert_spv), sp::cloth_frag_spv, std::size(sp::cloth_frag_spv), "cloth"},
-                   {{0, vec4, VK_VERTEX_INPUT_RATE_VERTEX}, {1, vec4, VK_VERTEX_INPUT_RATE_VERTEX}, {2, vec4, VK_VERTEX_INPUT_RATE_VERTEX}},
+  VKCLOTH_TRY(make({sp::cloth_vert_spv, std::size(sp::cloth_vert_spv), sp::cloth_frag_spv,
+                    std::size(sp::cloth_frag_spv), "cloth"},
+                   {{0, vec4, VK_VERTEX_INPUT_RATE_VERTEX},
+                    {1, vec4, VK_VERTEX_INPUT_RATE_VERTEX},
+                    {2, vec4, VK_VERTEX_INPUT_RATE_VERTEX}},
                    {{0, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 0},
                     {1, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 0},
                     {2, 2, VK_FORMAT_R32G32B32A32_SFLOAT, 0}},
                    VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST, &cloth_pipeline));
-  VKCLOTH_TRY(make({sp::mesh_vert_spv, std::size(sp::mesh_vert_spv), sp::mesh_frag_spv, std::size(sp::mesh_frag_spv), "mesh"},
-                   {{0, sizeof(MeshVertex), VK_VERTEX_INPUT_RATE_VERTEX}, {1, vec4, VK_VERTEX_INPUT_RATE_INSTANCE}},
-                   {{0, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 0},
-                    {1, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 16},
-                    {2, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 0}},
-                   VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST, &mesh_pipeline));
-  VKCLOTH_TRY(make({sp::line_vert_spv, std::size(sp::line_vert_spv), sp::line_frag_spv, std::size(sp::line_frag_spv), "line"},
+  VKCLOTH_TRY(
+      make({sp::mesh_vert_spv, std::size(sp::mesh_vert_spv), sp::mesh_frag_spv, std::size(sp::mesh_frag_spv),
+            "mesh"},
+           {{0, sizeof(MeshVertex), VK_VERTEX_INPUT_RATE_VERTEX}, {1, vec4, VK_VERTEX_INPUT_RATE_INSTANCE}},
+           {{0, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 0},
+            {1, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 16},
+            {2, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 0}},
+           VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST, &mesh_pipeline));
+  VKCLOTH_TRY(make({sp::line_vert_spv, std::size(sp::line_vert_spv), sp::line_frag_spv,
+                    std::size(sp::line_frag_spv), "line"},
                    {{0, vec4, VK_VERTEX_INPUT_RATE_VERTEX}}, {{0, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 0}},
                    VK_PRIMITIVE_TOPOLOGY_LINE_LIST, &line_pipeline));
   return {};
 }
 
-Result<ClothRenderer> ClothRenderer::create(gpu::Context& context, const gpu::GpuSolver& solver, const ParticleSystem& system,
-                                            RendererOptions options) {
+Result<ClothRenderer> ClothRenderer::create(gpu::Context& context, const gpu::GpuSolver& solver,
+                                            const ParticleSystem& system, RendererOptions options) {
   if (!options.render_pass)
     return make_error(ErrorCode::invalid_argument, "RendererOptions::render_pass is required");
   if (system.size() != solver.particle_count())
-    return make_error(ErrorCode::invalid_argument,
-                      fmt::format("the system has {} particles but the solver {}: pass the system the solver was created from",
-                                  system.size(), solver.particle_count()));
+    return make_error(
+        ErrorCode::invalid_argument,
+        fmt::format(
+            "the system has {} particles but the solver {}: pass the system the solver was created from",
+            system.size(), solver.particle_count()));
   auto impl = std::make_unique<Impl>();
   impl->ctx = context.impl();
   if (!detail::queue_has_graphics(*impl->ctx))
-    return make_error(ErrorCode::unsupported,
-                      fmt::format("the Context's queue family {} on '{}' has no graphics support (create the Context with "
-                                  "ContextOptions::require_graphics)",
-                                  impl->ctx->queue_family, impl->ctx->name));
+    return make_error(
+        ErrorCode::unsupported,
+        fmt::format("the Context's queue family {} on '{}' has no graphics support (create the Context with "
+                    "ContextOptions::require_graphics)",
+                    impl->ctx->queue_family, impl->ctx->name));
   impl->grid = system.grid.has_value();
   impl->particle_count = solver.particle_count();
   Image texture = options.texture.width ? std::move(options.texture) : default_fabric_texture();
   const std::uint32_t max_side = impl->ctx->properties.limits.maxImageDimension2D;
   if (texture.width > max_side || texture.height > max_side)
-    return make_error(ErrorCode::unsupported, fmt::format("the texture is {} x {} but the device allows at most {} a side",
-                                                          texture.width, texture.height, max_side));
+    return make_error(ErrorCode::unsupported,
+                      fmt::format("the texture is {} x {} but the device allows at most {} a side",
+                                  texture.width, texture.height, max_side));
   VKCLOTH_TRY(impl->build_geometry(system, solver.params(), options));
   VKCLOTH_TRY(impl->upload_texture(texture));
   VKCLOTH_TRY(impl->build_pipelines(options));
@@ -448,10 +507,15 @@ ClothRenderer::ClothRenderer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)
 ClothRenderer::ClothRenderer(ClothRenderer&&) noexcept = default;
 ClothRenderer& ClothRenderer::operator=(ClothRenderer&&) noexcept = default;
 ClothRenderer::~ClothRenderer() = default;
-const Palette& ClothRenderer::palette() const { return impl_->palette; }
-bool ClothRenderer::draws_cloth() const { return impl_->grid; }
+const Palette& ClothRenderer::palette() const {
+  return impl_->palette;
+}
+bool ClothRenderer::draws_cloth() const {
+  return impl_->grid;
+}
 
-void ClothRenderer::record_draw(VkCommandBuffer cmd, const gpu::GpuSolver& solver, const Camera& camera, VkExtent2D extent) const {
+void ClothRenderer::record_draw(VkCommandBuffer cmd, const gpu::GpuSolver& solver, const Camera& camera,
+                                VkExtent2D extent) const {
   const Impl& s = *impl_;
   const auto& v = s.ctx->vk;
   const VkViewport viewport{0.0f, 0.0f, float(extent.width), float(extent.height), 0.0f, 1.0f};

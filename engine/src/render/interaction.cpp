@@ -9,7 +9,8 @@ namespace vkcloth::render {
 
 void record_hold_particle(const gpu::Context& context, VkCommandBuffer cmd, const gpu::GpuSolver& solver,
                           std::uint32_t particle, glm::vec3 position) {
-  if (particle >= solver.particle_count()) return;
+  if (particle >= solver.particle_count())
+    return;
   const auto& v = context.impl()->vk;
   gpu::barriers::before_host_edit(v, cmd);
   const glm::vec4 p(position, 1.0f), zero(0.0f);

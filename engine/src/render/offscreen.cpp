@@ -24,37 +24,45 @@ struct OffscreenTarget::Impl {
   Impl(const Impl&) = delete;
   Impl& operator=(const Impl&) = delete;
   ~Impl() {
-    if (!ctx || !ctx->device) return;
+    if (!ctx || !ctx->device)
+      return;
     const auto& v = ctx->vk;
     const VkDevice d = ctx->device;
     if (fence) {
       v.vkWaitForFences(d, 1, &fence, VK_TRUE, UINT64_MAX);
       v.vkDestroyFence(d, fence, nullptr);
     }
-    if (cmd_pool) v.vkDestroyCommandPool(d, cmd_pool, nullptr);
-    if (framebuffer) v.vkDestroyFramebuffer(d, framebuffer, nullptr);
-    if (render_pass) v.vkDestroyRenderPass(d, render_pass, nullptr);
+    if (cmd_pool)
+      v.vkDestroyCommandPool(d, cmd_pool, nullptr);
+    if (framebuffer)
+      v.vkDestroyFramebuffer(d, framebuffer, nullptr);
+    if (render_pass)
+      v.vkDestroyRenderPass(d, render_pass, nullptr);
     detail::destroy_image(*ctx, color);
     detail::destroy_image(*ctx, depth);
     gpu::destroy_buffer(*ctx, readback);
   }
 };
 
-Result<OffscreenTarget> OffscreenTarget::create(gpu::Context& context, std::uint32_t width, std::uint32_t height) {
+Result<OffscreenTarget> OffscreenTarget::create(gpu::Context& context, std::uint32_t width,
+                                                std::uint32_t height) {
   if (width == 0 || height == 0 || width > 4096 || height > 4096)
-    return make_error(ErrorCode::invalid_argument, fmt::format("image size {}x{} is out of range (1..4096 a side)", width, height));
+    return make_error(ErrorCode::invalid_argument,
+                      fmt::format("image size {}x{} is out of range (1..4096 a side)", width, height));
   auto impl = std::make_unique<Impl>();
   Impl& s = *impl;
   s.ctx = context.impl();
   s.width = width;
   s.height = height;
   if (!detail::queue_has_graphics(*s.ctx))
-    return make_error(ErrorCode::unsupported, fmt::format("the Context's queue on '{}' has no graphics support (create it with "
-                                                          "ContextOptions::require_graphics)",
-                                                          s.ctx->name));
+    return make_error(ErrorCode::unsupported,
+                      fmt::format("the Context's queue on '{}' has no graphics support (create it with "
+                                  "ContextOptions::require_graphics)",
+                                  s.ctx->name));
   const auto& v = s.ctx->vk;
   const VkDevice d = s.ctx->device;
-  for (VkFormat f : {VK_FORMAT_D32_SFLOAT, VK_FORMAT_X8_D24_UNORM_PACK32, VK_FORMAT_D24_UNORM_S8_UINT, VK_FORMAT_D16_UNORM}) {
+  for (VkFormat f : {VK_FORMAT_D32_SFLOAT, VK_FORMAT_X8_D24_UNORM_PACK32, VK_FORMAT_D24_UNORM_S8_UINT,
+                     VK_FORMAT_D16_UNORM}) {
     VkFormatProperties fp{};
     auto get = reinterpret_cast<PFN_vkGetPhysicalDeviceFormatProperties>(
         s.ctx->get_instance_proc_addr(s.ctx->instance, "vkGetPhysicalDeviceFormatProperties"));
@@ -64,15 +72,19 @@ Result<OffscreenTarget> OffscreenTarget::create(gpu::Context& context, std::uint
       break;
     }
   }
-  if (s.depth_format == VK_FORMAT_UNDEFINED) return make_error(ErrorCode::unsupported, "no depth attachment format");
+  if (s.depth_format == VK_FORMAT_UNDEFINED)
+    return make_error(ErrorCode::unsupported, "no depth attachment format");
   constexpr VkFormat color_format = VK_FORMAT_R8G8B8A8_UNORM;
-  auto c = detail::create_image(*s.ctx, color_format, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+  auto c = detail::create_image(*s.ctx, color_format,
+                                VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
                                 VK_IMAGE_ASPECT_COLOR_BIT, width, height, "offscreen colour");
-  if (!c) return c.error();
+  if (!c)
+    return c.error();
   s.color = *c;
-  auto dd = detail::create_image(*s.ctx, s.depth_format, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, VK_IMAGE_ASPECT_DEPTH_BIT,
-                                 width, height, "offscreen depth");
-  if (!dd) return dd.error();
+  auto dd = detail::create_image(*s.ctx, s.depth_format, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT,
+                                 VK_IMAGE_ASPECT_DEPTH_BIT, width, height, "offscreen depth");
+  if (!dd)
+    return dd.error();
   s.depth = *dd;
 
   VkAttachmentDescription att[2]{};
@@ -101,12 +113,15 @@ Result<OffscreenTarget> OffscreenTarget::create(gpu::Context& context, std::uint
   dep[0].srcSubpass = VK_SUBPASS_EXTERNAL;
   dep[0].dstSubpass = 0;
   dep[0].srcStageMask = VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT |
-                        VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT;
+                        VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT |
+                        VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT;
   dep[0].srcAccessMask = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
-  dep[0].dstStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT | VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT |
+  dep[0].dstStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT |
+                        VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT |
                         VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT;
   dep[0].dstAccessMask = VK_ACCESS_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT |
-                         VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
+                         VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
+                         VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
   // After: the colour writes (and the transition to TRANSFER_SRC) before the readback copy.
   dep[1].srcSubpass = 0;
   dep[1].dstSubpass = VK_SUBPASS_EXTERNAL;
@@ -135,7 +150,8 @@ Result<OffscreenTarget> OffscreenTarget::create(gpu::Context& context, std::uint
   VKCLOTH_VK_TRY(v.vkCreateFramebuffer(d, &fb, nullptr, &s.framebuffer), "vkCreateFramebuffer (offscreen)");
   auto rb = gpu::create_buffer(*s.ctx, VkDeviceSize(width) * height * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                gpu::MemoryUse::host_readback, true, "frame readback");
-  if (!rb) return rb.error();
+  if (!rb)
+    return rb.error();
   s.readback = *rb;
   VkCommandPoolCreateInfo cp{};
   cp.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
@@ -158,12 +174,19 @@ OffscreenTarget::OffscreenTarget(std::unique_ptr<Impl> impl) : impl_(std::move(i
 OffscreenTarget::OffscreenTarget(OffscreenTarget&&) noexcept = default;
 OffscreenTarget& OffscreenTarget::operator=(OffscreenTarget&&) noexcept = default;
 OffscreenTarget::~OffscreenTarget() = default;
-VkRenderPass OffscreenTarget::render_pass() const { return impl_->render_pass; }
-std::uint32_t OffscreenTarget::width() const { return impl_->width; }
-std::uint32_t OffscreenTarget::height() const { return impl_->height; }
+VkRenderPass OffscreenTarget::render_pass() const {
+  return impl_->render_pass;
+}
+std::uint32_t OffscreenTarget::width() const {
+  return impl_->width;
+}
+std::uint32_t OffscreenTarget::height() const {
+  return impl_->height;
+}
 
-Result<Image> OffscreenTarget::render(gpu::GpuSolver& solver, const ClothRenderer& renderer, const Camera& camera,
-                                      std::uint32_t steps, const std::function<void(VkCommandBuffer)>& before_steps) {
+Result<Image> OffscreenTarget::render(gpu::GpuSolver& solver, const ClothRenderer& renderer,
+                                      const Camera& camera, std::uint32_t steps,
+                                      const std::function<void(VkCommandBuffer)>& before_steps) {
   Impl& s = *impl_;
   const auto& v = s.ctx->vk;
   VKCLOTH_VK_TRY(v.vkResetCommandBuffer(s.cmd, 0), "vkResetCommandBuffer (offscreen)");
@@ -171,7 +194,8 @@ Result<Image> OffscreenTarget::render(gpu::GpuSolver& solver, const ClothRendere
   bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
   bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   VKCLOTH_VK_TRY(v.vkBeginCommandBuffer(s.cmd, &bi), "vkBeginCommandBuffer (offscreen)");
-  if (before_steps) before_steps(s.cmd);
+  if (before_steps)
+    before_steps(s.cmd);
   solver.record_steps(s.cmd, steps);
   // THE compute -> graphics barrier: the steps' shader writes of positions[current] and normals
   // become visible to the vertex fetch of the draws below (VERTEX_INPUT / VERTEX_ATTRIBUTE_READ).
@@ -193,13 +217,15 @@ Result<Image> OffscreenTarget::render(gpu::GpuSolver& solver, const ClothRendere
   VkBufferImageCopy region{};
   region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
   region.imageExtent = {s.width, s.height, 1};
-  v.vkCmdCopyImageToBuffer(s.cmd, s.color.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, s.readback.buffer, 1, &region);
+  v.vkCmdCopyImageToBuffer(s.cmd, s.color.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, s.readback.buffer, 1,
+                           &region);
   // The copy's writes -> visible to the host's read of the mapped readback buffer.
   VkMemoryBarrier mb{};
   mb.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
   mb.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
   mb.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-  v.vkCmdPipelineBarrier(s.cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &mb, 0, nullptr, 0, nullptr);
+  v.vkCmdPipelineBarrier(s.cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &mb, 0,
+                         nullptr, 0, nullptr);
   VKCLOTH_VK_TRY(v.vkEndCommandBuffer(s.cmd), "vkEndCommandBuffer (offscreen)");
   VkSubmitInfo si{};
   si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
@@ -207,8 +233,10 @@ Result<Image> OffscreenTarget::render(gpu::GpuSolver& solver, const ClothRendere
   si.pCommandBuffers = &s.cmd;
   VKCLOTH_VK_TRY(v.vkResetFences(s.ctx->device, 1, &s.fence), "vkResetFences (offscreen)");
   VKCLOTH_VK_TRY(v.vkQueueSubmit(s.ctx->queue, 1, &si, s.fence), "vkQueueSubmit (offscreen)");
-  VKCLOTH_VK_TRY(v.vkWaitForFences(s.ctx->device, 1, &s.fence, VK_TRUE, UINT64_MAX), "vkWaitForFences (offscreen)");
-  if (steps) VKCLOTH_TRY(solver.check_divergence());
+  VKCLOTH_VK_TRY(v.vkWaitForFences(s.ctx->device, 1, &s.fence, VK_TRUE, UINT64_MAX),
+                 "vkWaitForFences (offscreen)");
+  if (steps)
+    VKCLOTH_TRY(solver.check_divergence());
   Image img;
   img.width = s.width;
   img.height = s.height;

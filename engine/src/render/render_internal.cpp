@@ -6,8 +6,9 @@
 
 namespace vkcloth::render::detail {
 
-Result<ImageResource> create_image(gpu::Context::Impl& ctx, VkFormat format, VkImageUsageFlags usage, VkImageAspectFlags aspect,
-                                   std::uint32_t width, std::uint32_t height, const char* what) {
+Result<ImageResource> create_image(gpu::Context::Impl& ctx, VkFormat format, VkImageUsageFlags usage,
+                                   VkImageAspectFlags aspect, std::uint32_t width, std::uint32_t height,
+                                   const char* what) {
   const auto& vk = ctx.vk;
   ImageResource r;
   VkImageCreateInfo ii{};
@@ -22,11 +23,13 @@ Result<ImageResource> create_image(gpu::Context::Impl& ctx, VkFormat format, VkI
   ii.usage = usage;
   ii.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
   ii.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-  VKCLOTH_VK_TRY(vk.vkCreateImage(ctx.device, &ii, nullptr, &r.image), fmt::format("vkCreateImage ({}, {}x{})", what, width, height));
+  VKCLOTH_VK_TRY(vk.vkCreateImage(ctx.device, &ii, nullptr, &r.image),
+                 fmt::format("vkCreateImage ({}, {}x{})", what, width, height));
   VkMemoryRequirements req;
   vk.vkGetImageMemoryRequirements(ctx.device, r.image, &req);
   int type = ctx.find_memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0);
-  if (type < 0) type = ctx.find_memory_type(req.memoryTypeBits, 0, 0);
+  if (type < 0)
+    type = ctx.find_memory_type(req.memoryTypeBits, 0, 0);
   if (type < 0) {
     destroy_image(ctx, r);
     return make_error(ErrorCode::unsupported, fmt::format("no memory type for the {} image", what));
@@ -57,19 +60,24 @@ Result<ImageResource> create_image(gpu::Context::Impl& ctx, VkFormat format, VkI
 }
 
 void destroy_image(gpu::Context::Impl& ctx, ImageResource& img) {
-  if (img.view) ctx.vk.vkDestroyImageView(ctx.device, img.view, nullptr);
-  if (img.image) ctx.vk.vkDestroyImage(ctx.device, img.image, nullptr);
-  if (img.memory) ctx.vk.vkFreeMemory(ctx.device, img.memory, nullptr);
+  if (img.view)
+    ctx.vk.vkDestroyImageView(ctx.device, img.view, nullptr);
+  if (img.image)
+    ctx.vk.vkDestroyImage(ctx.device, img.image, nullptr);
+  if (img.memory)
+    ctx.vk.vkFreeMemory(ctx.device, img.memory, nullptr);
   img = ImageResource{};
 }
 
-Result<VkShaderModule> create_shader(gpu::Context::Impl& ctx, const std::uint32_t* code, std::size_t words, const char* name) {
+Result<VkShaderModule> create_shader(gpu::Context::Impl& ctx, const std::uint32_t* code, std::size_t words,
+                                     const char* name) {
   VkShaderModuleCreateInfo ci{};
   ci.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
   ci.codeSize = words * sizeof(std::uint32_t);
   ci.pCode = code;
   VkShaderModule m = VK_NULL_HANDLE;
-  VKCLOTH_VK_TRY(ctx.vk.vkCreateShaderModule(ctx.device, &ci, nullptr, &m), fmt::format("vkCreateShaderModule ({})", name));
+  VKCLOTH_VK_TRY(ctx.vk.vkCreateShaderModule(ctx.device, &ci, nullptr, &m),
+                 fmt::format("vkCreateShaderModule ({})", name));
   return m;
 }
 

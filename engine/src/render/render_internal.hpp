@@ -15,11 +15,13 @@ struct ImageResource {
   VkImageView view = VK_NULL_HANDLE;
 };
 
-Result<ImageResource> create_image(gpu::Context::Impl& ctx, VkFormat format, VkImageUsageFlags usage, VkImageAspectFlags aspect,
-                                   std::uint32_t width, std::uint32_t height, const char* what);
+Result<ImageResource> create_image(gpu::Context::Impl& ctx, VkFormat format, VkImageUsageFlags usage,
+                                   VkImageAspectFlags aspect, std::uint32_t width, std::uint32_t height,
+                                   const char* what);
 void destroy_image(gpu::Context::Impl& ctx, ImageResource& img);
 
-Result<VkShaderModule> create_shader(gpu::Context::Impl& ctx, const std::uint32_t* code, std::size_t words, const char* name);
+Result<VkShaderModule> create_shader(gpu::Context::Impl& ctx, const std::uint32_t* code, std::size_t words,
+                                     const char* name);
 
 /// True when the Context's queue family can record graphics work.
 bool queue_has_graphics(gpu::Context::Impl& ctx);

@@ -43,7 +43,8 @@ struct Camera {
 
   /// A camera looking at `b` from direction `from` (towards the eye, default: front-right, above),
   /// far enough that the bounds' sphere fits the view at this aspect ratio.
-  static Camera frame(const Bounds& b, float aspect, glm::vec3 from = {0.9f, -1.6f, 1.0f}, float fov_y_degrees = 40.0f);
+  static Camera frame(const Bounds& b, float aspect, glm::vec3 from = {0.9f, -1.6f, 1.0f},
+                      float fov_y_degrees = 40.0f);
 };
 
 } // namespace vkcloth::render

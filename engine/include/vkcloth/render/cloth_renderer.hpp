@@ -61,8 +61,8 @@ public:
   /// quad) or the chain's line list, the collider meshes (from solver.params().colliders) and the
   /// texture. `system` must be the one the solver was created from. The Context's queue family
   /// must support graphics (ContextOptions::require_graphics): ErrorCode::unsupported otherwise.
-  static Result<ClothRenderer> create(gpu::Context& context, const gpu::GpuSolver& solver, const ParticleSystem& system,
-                                      RendererOptions options);
+  static Result<ClothRenderer> create(gpu::Context& context, const gpu::GpuSolver& solver,
+                                      const ParticleSystem& system, RendererOptions options);
 
   ClothRenderer(ClothRenderer&&) noexcept;
   ClothRenderer& operator=(ClothRenderer&&) noexcept;
@@ -74,7 +74,8 @@ public:
   /// Records the draws (floor, spheres, then the cloth or chain) inside the caller's render pass,
   /// with viewport and scissor set to `extent`. The solver's barrier (see the header comment)
   /// must already be recorded.
-  void record_draw(VkCommandBuffer cmd, const gpu::GpuSolver& solver, const Camera& camera, VkExtent2D extent) const;
+  void record_draw(VkCommandBuffer cmd, const gpu::GpuSolver& solver, const Camera& camera,
+                   VkExtent2D extent) const;
 
   const Palette& palette() const;
   /// True when `system` had a grid (a cloth is drawn); false: a chain (masses and springs).

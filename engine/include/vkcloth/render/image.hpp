@@ -15,7 +15,9 @@ struct Image {
   std::uint32_t height = 0;
   std::vector<std::uint8_t> rgba;
 
-  const std::uint8_t* pixel(std::uint32_t x, std::uint32_t y) const { return &rgba[(std::size_t(y) * width + x) * 4]; }
+  const std::uint8_t* pixel(std::uint32_t x, std::uint32_t y) const {
+    return &rgba[(std::size_t(y) * width + x) * 4];
+  }
   std::uint8_t* pixel(std::uint32_t x, std::uint32_t y) { return &rgba[(std::size_t(y) * width + x) * 4]; }
 };
 

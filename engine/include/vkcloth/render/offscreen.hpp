@@ -36,7 +36,8 @@ public:
   /// waits, checks the solver's divergence flags (ErrorCode::diverged), returns the frame.
   /// `before_steps`, when set, records the caller's own commands first (e.g. record_hold_particle).
   Result<Image> render(gpu::GpuSolver& solver, const ClothRenderer& renderer, const Camera& camera,
-                       std::uint32_t steps = 0, const std::function<void(VkCommandBuffer)>& before_steps = {});
+                       std::uint32_t steps = 0,
+                       const std::function<void(VkCommandBuffer)>& before_steps = {});
 
   struct Impl; ///< internal (engine/src/render)
 
