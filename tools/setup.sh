@@ -6,6 +6,7 @@ packages=(
   libvulkan-dev libvulkan-volk-dev glslang-tools glslang-dev spirv-tools
   libglm-dev doctest-dev nlohmann-json3-dev libfmt-dev libcli11-dev
   mesa-vulkan-drivers vulkan-validationlayers vulkan-tools
+  libglfw3-dev libstb-dev xvfb xauth
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -52,5 +52,7 @@ void add_compare_command(CLI::App& app, int* exit);
 void add_devices_command(CLI::App& app, int* exit);
 void add_figures_command(CLI::App& app, int* exit);
 void add_bench_command(CLI::App& app, int* exit);
+void add_render_command(CLI::App& app, int* exit);
+void add_view_command(CLI::App& app, int* exit);
 
 } // namespace vkcloth::cli

@@ -29,7 +29,9 @@ int devices_command() {
   }
   if (usable == 0)
     return report(make_error(ErrorCode::no_device, "no usable Vulkan device (install mesa-vulkan-drivers for lavapipe)"));
-  auto context = gpu::Context::create(gpu::ContextOptions{{}, false, true});
+  gpu::ContextOptions options;
+  options.validation = false;
+  auto context = gpu::Context::create(options);
   if (!context)
     return report(context.error());
   fmt::print("selected: {} (set VKCLOTH_DEVICE to a name or an index to choose)\n", context->device_name());

@@ -81,6 +81,8 @@ int main(int argc, char** argv) {
   add_devices_command(app, &exit);
   add_figures_command(app, &exit);
   add_bench_command(app, &exit);
+  add_render_command(app, &exit);
+  add_view_command(app, &exit);
 
   try {
     app.parse(argc, argv);

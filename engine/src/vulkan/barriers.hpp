@@ -60,3 +60,22 @@ inline void transfer_to_compute(const VolkDeviceTable& vk, VkCommandBuffer cmd) 
 }
 
 } // namespace vkcloth::gpu::barriers
+
+namespace vkcloth::gpu::barriers {
+
+/// Before the host's own edits of the state buffers (vkCmdUpdateBuffer of a held particle):
+/// every earlier access (dispatches' writes, the renderer's vertex reads) completes and earlier
+/// writes are visible before the transfer writes.
+inline void before_host_edit(const VolkDeviceTable& vk, VkCommandBuffer cmd) {
+  memory(vk, cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+         VK_ACCESS_TRANSFER_WRITE_BIT);
+}
+
+/// After those edits: the transfer writes are visible to the next steps and to vertex reads.
+inline void after_host_edit(const VolkDeviceTable& vk, VkCommandBuffer cmd) {
+  memory(vk, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_VERTEX_INPUT_BIT,
+         VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT);
+}
+
+} // namespace vkcloth::gpu::barriers

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 namespace vkcloth::gpu {
 namespace {
@@ -89,8 +90,10 @@ VKAPI_ATTR VkBool32 VKAPI_CALL debug_callback(VkDebugUtilsMessageSeverityFlagBit
   return VK_FALSE;
 }
 
-/// Compute-capable queue family, preferring one with timestamps; UINT32_MAX if none.
-std::uint32_t pick_queue_family(const InstanceFns& fi, VkPhysicalDevice pd) {
+/// Compute-capable queue family (also graphics-capable and accepted by `filter` when asked),
+/// preferring one with timestamps; UINT32_MAX if none.
+std::uint32_t pick_queue_family(const InstanceFns& fi, VkPhysicalDevice pd, const ContextOptions* options = nullptr,
+                                VkInstance instance = VK_NULL_HANDLE) {
   std::uint32_t n = 0;
   fi.vkGetPhysicalDeviceQueueFamilyProperties(pd, &n, nullptr);
   std::vector<VkQueueFamilyProperties> qf(n);
@@ -98,6 +101,8 @@ std::uint32_t pick_queue_family(const InstanceFns& fi, VkPhysicalDevice pd) {
   std::uint32_t best = UINT32_MAX;
   for (std::uint32_t i = 0; i < n; ++i) {
     if (!(qf[i].queueFlags & VK_QUEUE_COMPUTE_BIT) || qf[i].queueCount == 0) continue;
+    if (options && options->require_graphics && !(qf[i].queueFlags & VK_QUEUE_GRAPHICS_BIT)) continue;
+    if (options && options->queue_family_filter && !options->queue_family_filter(instance, pd, i)) continue;
     if (best == UINT32_MAX || (qf[best].timestampValidBits == 0 && qf[i].timestampValidBits > 0)) best = i;
   }
   return best;
@@ -128,7 +133,8 @@ struct OwnedInstance {
 };
 
 /// Creates an instance (validation optional; `impl` receives messages from creation on).
-Result<OwnedInstance> create_instance(Context::Impl* impl, bool validation) {
+Result<OwnedInstance> create_instance(Context::Impl* impl, bool validation,
+                                      const std::vector<const char*>& extra_extensions = {}) {
   std::lock_guard lock(volk_mutex());
   PFN_vkGetInstanceProcAddr gipa = nullptr;
   VKCLOTH_TRY(init_volk_locked(nullptr, &gipa));
@@ -183,8 +189,11 @@ Result<OwnedInstance> create_instance(Context::Impl* impl, bool validation) {
     next = &features;
   }
 
-  VkApplicationInfo app{};
+  for (const char* e : extra_extensions)
+    if (std::none_of(extensions.begin(), extensions.end(), [&](const char* x) { return std::strcmp(x, e) == 0; }))
+      extensions.push_back(e);
 
+  VkApplicationInfo app{};
   app.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO;
   app.pApplicationName = "vkcloth";
   app.pEngineName = "vkcloth";
@@ -199,6 +208,9 @@ Result<OwnedInstance> create_instance(Context::Impl* impl, bool validation) {
   ci.ppEnabledExtensionNames = extensions.data();
   VkInstance instance = VK_NULL_HANDLE;
   const VkResult r = vkCreateInstance(&ci, nullptr, &instance);
+  if (r == VK_ERROR_EXTENSION_NOT_PRESENT && !extra_extensions.empty())
+    return make_error(ErrorCode::unsupported, fmt::format("vkCreateInstance: an instance extension is missing (asked for: {})",
+                                                          fmt::join(extra_extensions, ", ")));
   if (r == VK_ERROR_INCOMPATIBLE_DRIVER)
     return make_error(ErrorCode::no_device, "vkCreateInstance: VK_ERROR_INCOMPATIBLE_DRIVER: no Vulkan driver is installed "
                                             "(install one, e.g. mesa-vulkan-drivers for the lavapipe CPU device)");
@@ -333,7 +345,7 @@ Result<Context> Context::create(const ContextOptions& options) {
   impl->owns = true;
   impl->validation = validation;
   impl->print_messages = options.print_validation_messages;
-  auto inst = create_instance(impl.get(), validation);
+  auto inst = create_instance(impl.get(), validation, options.instance_extensions);
   if (!inst) return inst.error();
   impl->instance = inst->instance;
   impl->api_version = inst->api_version;
@@ -372,7 +384,18 @@ Result<Context> Context::create(const ContextOptions& options) {
   std::vector<Candidate> all, usable;
   std::string listing;
   for (std::uint32_t i = 0; i < n; ++i) {
-    Candidate c{i, {}, pick_queue_family(impl->fi, pds[i])};
+    Candidate c{i, {}, pick_queue_family(impl->fi, pds[i], &options, impl->instance)};
+    if (c.family != UINT32_MAX && !options.device_extensions.empty()) {
+      auto enumerate = reinterpret_cast<PFN_vkEnumerateDeviceExtensionProperties>(
+          inst->gipa(impl->instance, "vkEnumerateDeviceExtensionProperties"));
+      std::uint32_t ne = 0;
+      enumerate(pds[i], nullptr, &ne, nullptr);
+      std::vector<VkExtensionProperties> de(ne);
+      enumerate(pds[i], nullptr, &ne, de.data());
+      for (const char* e : options.device_extensions)
+        if (std::none_of(de.begin(), de.end(), [&](const VkExtensionProperties& p) { return std::strcmp(p.extensionName, e) == 0; }))
+          c.family = UINT32_MAX;
+    }
     impl->fi.vkGetPhysicalDeviceProperties(pds[i], &c.props);
     listing += fmt::format("{}[{}] {} ({}, Vulkan {})", i ? ", " : "", i, c.props.deviceName, type_name(c.props.deviceType),
                            version_string(c.props.apiVersion));
@@ -381,7 +404,9 @@ Result<Context> Context::create(const ContextOptions& options) {
   }
   if (usable.empty())
     return make_error(ErrorCode::no_device,
-                      fmt::format("no device offers Vulkan 1.2 and a compute queue; devices: {}", listing));
+                      fmt::format("no device offers Vulkan 1.2 and a compute queue{}{}; devices: {}",
+                                  options.require_graphics ? " with graphics" : "",
+                                  options.queue_family_filter ? " (and presentation)" : "", listing));
 
   const Candidate* chosen = nullptr;
   if (!filter.empty()) {
@@ -417,6 +442,8 @@ Result<Context> Context::create(const ContextOptions& options) {
   di.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
   di.queueCreateInfoCount = 1;
   di.pQueueCreateInfos = &qi;
+  di.enabledExtensionCount = static_cast<std::uint32_t>(options.device_extensions.size());
+  di.ppEnabledExtensionNames = options.device_extensions.data();
   VKCLOTH_VK_TRY(impl->fi.vkCreateDevice(impl->physical_device, &di, nullptr, &impl->device),
                  fmt::format("vkCreateDevice on '{}'", chosen->props.deviceName));
   VKCLOTH_TRY(impl->load(VK_API_VERSION_1_2));

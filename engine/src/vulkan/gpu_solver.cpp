@@ -441,8 +441,9 @@ Result<GpuSolver> GpuSolver::create(Context& context, const ParticleSystem& syst
   const VkDevice d = ctx->device;
 
   // Buffers. Bulk ones prefer device-local + host-visible (mapped) unless staging is forced.
-  const VkBufferUsageFlags usage =
-      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  // VERTEX_BUFFER: a renderer binds positions, normals and uvs as vertex buffers (render/).
+  const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                                   VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT;
   const VkDeviceSize vec4_bytes = VkDeviceSize(n) * 16;
   const bool allow_map = !options.force_staging;
   const std::pair<Buffer*, const char*> vec4_buffers[] = {

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -30,6 +31,15 @@ struct ContextOptions {
   std::optional<bool> validation;
   /// Print each validation message to stderr (they are counted either way).
   bool print_validation_messages = true;
+  /// Extra instance extensions (e.g. glfwGetRequiredInstanceExtensions() for a window surface).
+  std::vector<const char*> instance_extensions;
+  /// Extra device extensions (e.g. VK_KHR_SWAPCHAIN_EXTENSION_NAME); a device lacking one is skipped.
+  std::vector<const char*> device_extensions;
+  /// The queue must also support graphics (for the renderer); compute is always required.
+  bool require_graphics = false;
+  /// Optional further test of a queue family, called after the instance exists (e.g. present
+  /// support to a surface created from that instance); families for which it returns false are skipped.
+  std::function<bool(VkInstance, VkPhysicalDevice, std::uint32_t queue_family)> queue_family_filter;
 };
 
 /// A host's Vulkan handles, adopted as they are (nothing is created or destroyed but the

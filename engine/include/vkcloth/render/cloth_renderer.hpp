@@ -1,0 +1,91 @@
+// Draws a GpuSolver's cloth (or chain) and its colliders with Vulkan graphics, straight from the
+// solver's buffers: positions[current], normals and uvs are bound as vertex buffers (vec4, stride
+// 16); nothing goes through the CPU. It records into the caller's command buffer, inside the
+// caller's render pass (a VkRenderPass subpass with one colour and one depth attachment), so an
+// engine can embed it, or ignore it and bind the same buffers itself.
+//
+// Synchronisation (the caller's, once per frame): after GpuSolver::record_steps() and BEFORE the
+// render pass, call
+//   solver.record_barrier_to(cmd, VK_PIPELINE_STAGE_VERTEX_INPUT_BIT, VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT);
+// so the compute writes of positions and normals are visible to the vertex fetch. The next
+// record_steps() starts with a barrier from ALL_COMMANDS, which orders these vertex reads before
+// the next compute writes (write-after-read).
+//
+// Thread safety: none; one thread records. create() submits one upload to the Context's queue
+// (texture), so it must not race other submissions on that queue.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include <glm/vec3.hpp>
+#include <vulkan/vulkan_core.h>
+
+#include "vkcloth/gpu/context.hpp"
+#include "vkcloth/gpu/gpu_solver.hpp"
+#include "vkcloth/render/camera.hpp"
+#include "vkcloth/render/image.hpp"
+#include "vkcloth/result.hpp"
+#include "vkcloth/system.hpp"
+
+namespace vkcloth::render {
+
+struct RendererOptions {
+  /// The render pass and subpass the pipelines are used in (one colour + one depth attachment).
+  VkRenderPass render_pass = VK_NULL_HANDLE;
+  std::uint32_t subpass = 0;
+  VkSampleCountFlagBits samples = VK_SAMPLE_COUNT_1_BIT;
+  /// The cloth's texture; empty (0 x 0): the built-in fabric (default_fabric_texture()).
+  Image texture;
+  /// Where the floor plane is drawn (a square of this half-size around the scene's bounds
+  /// centre projected onto the plane); 0: from the scene's bounds.
+  float floor_half_size = 0.0f;
+  /// Radius of the spheres drawn at a chain's masses; 0: from the spring rest lengths.
+  float mass_radius = 0.0f;
+};
+
+/// Colours the renderer uses (linear RGB), public so tests and hosts can reason about them.
+struct Palette {
+  glm::vec3 background{0.62f, 0.72f, 0.84f}; ///< clear colour suggested to callers
+  glm::vec3 sphere{0.85f, 0.25f, 0.18f};     ///< sphere colliders: brick red
+  glm::vec3 floor{0.80f, 0.80f, 0.74f};      ///< floor checker: light cells (dark = 0.55x)
+  glm::vec3 back_tint{0.55f, 0.62f, 0.95f};  ///< multiplies the texture on the cloth's back side
+  glm::vec3 chain{0.20f, 0.20f, 0.22f};      ///< chain springs (lines) and masses
+  glm::vec3 light_dir{0.35f, -0.45f, 0.82f}; ///< towards the light (normalised on use)
+  float ambient = 0.35f;
+};
+
+class ClothRenderer {
+public:
+  /// Builds the pipelines for `options.render_pass`, the grid's index buffer (two triangles per
+  /// quad) or the chain's line list, the collider meshes (from solver.params().colliders) and the
+  /// texture. `system` must be the one the solver was created from. The Context's queue family
+  /// must support graphics (ContextOptions::require_graphics): ErrorCode::unsupported otherwise.
+  static Result<ClothRenderer> create(gpu::Context& context, const gpu::GpuSolver& solver,
+                                      const ParticleSystem& system, RendererOptions options);
+
+  ClothRenderer(ClothRenderer&&) noexcept;
+  ClothRenderer& operator=(ClothRenderer&&) noexcept;
+  ClothRenderer(const ClothRenderer&) = delete;
+  ClothRenderer& operator=(const ClothRenderer&) = delete;
+  /// Command buffers that recorded draws must have finished executing.
+  ~ClothRenderer();
+
+  /// Records the draws (floor, spheres, then the cloth or chain) inside the caller's render pass,
+  /// with viewport and scissor set to `extent`. The solver's barrier (see the header comment)
+  /// must already be recorded.
+  void record_draw(VkCommandBuffer cmd, const gpu::GpuSolver& solver, const Camera& camera,
+                   VkExtent2D extent) const;
+
+  const Palette& palette() const;
+  /// True when `system` had a grid (a cloth is drawn); false: a chain (masses and springs).
+  bool draws_cloth() const;
+
+  struct Impl; ///< internal (engine/src/render)
+
+private:
+  explicit ClothRenderer(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+} // namespace vkcloth::render

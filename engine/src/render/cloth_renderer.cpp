@@ -1,0 +1,581 @@
+#include "render_internal.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <vector>
+
+#include <fmt/format.h>
+#include <glm/geometric.hpp>
+#include <glm/mat4x4.hpp>
+#include <glm/vec4.hpp>
+
+#include "vkcloth/render/cloth_renderer.hpp"
+#include "vkcloth/shaders/render/cloth_frag_spv.hpp"
+#include "vkcloth/shaders/render/cloth_vert_spv.hpp"
+#include "vkcloth/shaders/render/line_frag_spv.hpp"
+#include "vkcloth/shaders/render/line_vert_spv.hpp"
+#include "vkcloth/shaders/render/mesh_frag_spv.hpp"
+#include "vkcloth/shaders/render/mesh_vert_spv.hpp"
+
+namespace vkcloth::render {
+
+using gpu::Buffer;
+using gpu::MemoryUse;
+
+namespace {
+
+/// The shaders' push constants (shaders/render/render_common.glsl).
+struct DrawConstants {
+  glm::mat4 view_proj;
+  glm::vec4 eye;
+  glm::vec4 light;  // xyz towards the light, w ambient
+  glm::vec4 color;  // mesh colour or the cloth's back tint
+  glm::vec4 params; // x mode, y checker cell, z instance scale
+};
+static_assert(sizeof(DrawConstants) == 128, "push constants must fit the guaranteed 128 bytes");
+
+/// Mesh vertex: position (w: checker u) and normal (w: checker v), as mesh.vert reads them.
+struct MeshVertex {
+  glm::vec4 pos;
+  glm::vec4 normal;
+};
+
+struct MeshRange {
+  std::uint32_t first = 0, count = 0;
+  float mode = 0.0f, cell = 1.0f;
+  glm::vec3 color{1.0f};
+};
+
+void add_sphere(std::vector<MeshVertex>& v, std::vector<std::uint32_t>& idx, glm::vec3 c, float r,
+                std::uint32_t slices, std::uint32_t stacks) {
+  const auto base = static_cast<std::uint32_t>(v.size());
+  const float pi = 3.14159265358979f;
+  for (std::uint32_t j = 0; j <= stacks; ++j) {
+    const float th = pi * float(j) / float(stacks);
+    for (std::uint32_t i = 0; i <= slices; ++i) {
+      const float ph = 2.0f * pi * float(i) / float(slices);
+      const glm::vec3 n(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th));
+      v.push_back({glm::vec4(c + r * n, 0.0f), glm::vec4(n, 0.0f)});
+    }
+  }
+  for (std::uint32_t j = 0; j < stacks; ++j)
+    for (std::uint32_t i = 0; i < slices; ++i) {
+      const std::uint32_t a = base + j * (slices + 1) + i, b = a + slices + 1;
+      idx.insert(idx.end(), {a, b, a + 1, a + 1, b, b + 1});
+    }
+}
+
+} // namespace
+
+struct ClothRenderer::Impl {
+  std::shared_ptr<gpu::Context::Impl> ctx;
+  Palette palette;
+  bool grid = false;
+  std::uint32_t particle_count = 0;
+  float mass_radius = 0.02f;
+
+  Buffer cloth_index; // grid triangles, or chain springs as a line list
+  std::uint32_t cloth_index_count = 0;
+  Buffer mesh_vertices, mesh_index, zero_instance;
+  std::vector<MeshRange> colliders;
+  MeshRange unit_sphere; // chain masses (instanced at the solver's positions)
+
+  detail::ImageResource texture;
+  VkSampler sampler = VK_NULL_HANDLE;
+  VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
+  VkDescriptorPool pool = VK_NULL_HANDLE;
+  VkDescriptorSet set = VK_NULL_HANDLE;
+  VkPipelineLayout layout = VK_NULL_HANDLE;
+  VkPipeline cloth_pipeline = VK_NULL_HANDLE, mesh_pipeline = VK_NULL_HANDLE, line_pipeline = VK_NULL_HANDLE;
+
+  Impl() = default;
+  Impl(const Impl&) = delete;
+  Impl& operator=(const Impl&) = delete;
+  ~Impl() {
+    if (!ctx || !ctx->device)
+      return;
+    const auto& v = ctx->vk;
+    const VkDevice d = ctx->device;
+    for (VkPipeline p : {cloth_pipeline, mesh_pipeline, line_pipeline})
+      if (p)
+        v.vkDestroyPipeline(d, p, nullptr);
+    if (layout)
+      v.vkDestroyPipelineLayout(d, layout, nullptr);
+    if (pool)
+      v.vkDestroyDescriptorPool(d, pool, nullptr);
+    if (set_layout)
+      v.vkDestroyDescriptorSetLayout(d, set_layout, nullptr);
+    if (sampler)
+      v.vkDestroySampler(d, sampler, nullptr);
+    detail::destroy_image(*ctx, texture);
+    for (Buffer* b : {&cloth_index, &mesh_vertices, &mesh_index, &zero_instance})
+      gpu::destroy_buffer(*ctx, *b);
+  }
+
+  Result<Buffer> host_buffer(const void* data, VkDeviceSize bytes, VkBufferUsageFlags usage,
+                             const char* what) {
+    auto b = gpu::create_buffer(*ctx, std::max<VkDeviceSize>(bytes, 16), usage, MemoryUse::host_upload, true,
+                                what);
+    if (!b)
+      return b.error();
+    std::memset(b->mapped, 0, b->size);
+    if (bytes)
+      std::memcpy(b->mapped, data, bytes); // host-coherent; visible to the device at submission
+    return b;
+  }
+
+  Result<void> build_geometry(const ParticleSystem& system, const SimParams& params,
+                              const RendererOptions& o);
+  Result<void> upload_texture(const Image& img);
+  Result<void> build_pipelines(const RendererOptions& o);
+};
+
+Result<void> ClothRenderer::Impl::build_geometry(const ParticleSystem& system, const SimParams& params,
+                                                 const RendererOptions& o) {
+  // The cloth: two triangles per grid quad, (i, j) = j * nx + i; or a chain's springs as lines.
+  std::vector<std::uint32_t> idx;
+  if (system.grid) {
+    const std::uint32_t nx = system.grid->nx, ny = system.grid->ny;
+    for (std::uint32_t j = 0; j + 1 < ny; ++j)
+      for (std::uint32_t i = 0; i + 1 < nx; ++i) {
+        const std::uint32_t a = j * nx + i, b = a + 1, c = a + nx, d = c + 1;
+        idx.insert(idx.end(), {a, b, d, a, d, c});
+      }
+  } else {
+    for (const Spring& s : system.springs)
+      idx.insert(idx.end(), {s.a, s.b});
+  }
+  cloth_index_count = static_cast<std::uint32_t>(idx.size());
+  auto ci = host_buffer(idx.data(), idx.size() * sizeof(std::uint32_t), VK_BUFFER_USAGE_INDEX_BUFFER_BIT,
+                        "cloth indices");
+  if (!ci)
+    return ci.error();
+  cloth_index = *ci;
+
+  // Colliders, in world space; the floor is a square around the scene's centre.
+  const Bounds b = scene_bounds(system, params);
+  const float half = o.floor_half_size > 0.0f ? o.floor_half_size : std::max(1.0f, 1.6f * b.radius());
+  std::vector<MeshVertex> verts;
+  std::vector<std::uint32_t> midx;
+  for (const Collider& k : params.colliders) {
+    MeshRange r;
+    r.first = static_cast<std::uint32_t>(midx.size());
+    if (k.type == Collider::Type::sphere) {
+      // Drawn 5% smaller: the cloth's particles rest on the true surface, but its flat triangles
+      // between them cut chords through it (sag h^2 / 8r); a coarse grid would show the sphere
+      // poking through.
+      add_sphere(verts, midx, glm::vec3(k.center), float(k.radius) * 0.95f, 48, 24);
+      r.color = palette.sphere;
+    } else {
+      const glm::vec3 n = glm::normalize(glm::vec3(k.normal));
+      // Drawn a hair below the surface: cloth resting at offset + eps never z-fights with it.
+      const glm::vec3 centre = b.center() - (glm::dot(n, b.center()) - float(k.offset) + 1e-3f) * n;
+      const glm::vec3 t =
+          glm::normalize(glm::cross(n, std::abs(n.z) < 0.9f ? glm::vec3(0, 0, 1) : glm::vec3(1, 0, 0)));
+      const glm::vec3 s = glm::cross(n, t);
+      const auto base = static_cast<std::uint32_t>(verts.size());
+      for (int q = 0; q < 4; ++q) {
+        const float u = (q == 1 || q == 2) ? half : -half, w = q >= 2 ? half : -half;
+        verts.push_back({glm::vec4(centre + u * t + w * s, u + half), glm::vec4(n, w + half)});
+      }
+      midx.insert(midx.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+      r.mode = 1.0f;
+      r.cell = half / 5.0f;
+      r.color = palette.floor;
+    }
+    r.count = static_cast<std::uint32_t>(midx.size()) - r.first;
+    colliders.push_back(r);
+  }
+  unit_sphere.first = static_cast<std::uint32_t>(midx.size());
+  add_sphere(verts, midx, glm::vec3(0.0f), 1.0f, 16, 8);
+  unit_sphere.count = static_cast<std::uint32_t>(midx.size()) - unit_sphere.first;
+  unit_sphere.color = palette.chain;
+  if (o.mass_radius > 0.0f) {
+    mass_radius = o.mass_radius;
+  } else if (!system.grid) {
+    double shortest = INFINITY;
+    for (const Spring& s : system.springs)
+      shortest = std::min(shortest, s.rest_length);
+    mass_radius = std::isfinite(shortest) && shortest > 0 ? float(shortest) * 0.12f : 0.03f;
+  }
+  auto mv = host_buffer(verts.data(), verts.size() * sizeof(MeshVertex), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
+                        "mesh vertices");
+  if (!mv)
+    return mv.error();
+  mesh_vertices = *mv;
+  auto mi = host_buffer(midx.data(), midx.size() * sizeof(std::uint32_t), VK_BUFFER_USAGE_INDEX_BUFFER_BIT,
+                        "mesh indices");
+  if (!mi)
+    return mi.error();
+  mesh_index = *mi;
+  const glm::vec4 zero(0.0f);
+  auto zi = host_buffer(&zero, sizeof(zero), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, "zero instance offset");
+  if (!zi)
+    return zi.error();
+  zero_instance = *zi;
+  return {};
+}
+
+Result<void> ClothRenderer::Impl::upload_texture(const Image& img) {
+  const auto& v = ctx->vk;
+  const VkDevice d = ctx->device;
+  auto t = detail::create_image(*ctx, VK_FORMAT_R8G8B8A8_UNORM,
+                                VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+                                VK_IMAGE_ASPECT_COLOR_BIT, img.width, img.height, "texture");
+  if (!t)
+    return t.error();
+  texture = *t;
+  auto st =
+      host_buffer(img.rgba.data(), img.rgba.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, "texture staging");
+  if (!st)
+    return st.error();
+  Buffer staging = *st;
+
+  VkCommandPool cmd_pool = VK_NULL_HANDLE;
+  VkCommandBuffer cmd = VK_NULL_HANDLE;
+  VkFence fence = VK_NULL_HANDLE;
+  auto cleanup = [&] {
+    if (fence)
+      v.vkDestroyFence(d, fence, nullptr);
+    if (cmd_pool)
+      v.vkDestroyCommandPool(d, cmd_pool, nullptr);
+    gpu::destroy_buffer(*ctx, staging);
+  };
+  auto run = [&]() -> Result<void> {
+    VkCommandPoolCreateInfo cp{};
+    cp.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
+    cp.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;
+    cp.queueFamilyIndex = ctx->queue_family;
+    VKCLOTH_VK_TRY(v.vkCreateCommandPool(d, &cp, nullptr, &cmd_pool), "vkCreateCommandPool (texture upload)");
+    VkCommandBufferAllocateInfo ca{};
+    ca.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
+    ca.commandPool = cmd_pool;
+    ca.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    ca.commandBufferCount = 1;
+    VKCLOTH_VK_TRY(v.vkAllocateCommandBuffers(d, &ca, &cmd), "vkAllocateCommandBuffers (texture upload)");
+    VkFenceCreateInfo fi{};
+    fi.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
+    VKCLOTH_VK_TRY(v.vkCreateFence(d, &fi, nullptr, &fence), "vkCreateFence (texture upload)");
+    VkCommandBufferBeginInfo bi{};
+    bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+    bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    VKCLOTH_VK_TRY(v.vkBeginCommandBuffer(cmd, &bi), "vkBeginCommandBuffer (texture upload)");
+    VkImageMemoryBarrier ib{};
+    ib.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
+    ib.srcQueueFamilyIndex = ib.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    ib.image = texture.image;
+    ib.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    // Undefined -> transfer destination (nothing to wait for: the image is new).
+    ib.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    ib.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    ib.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    v.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0,
+                           nullptr, 0, nullptr, 1, &ib);
+    VkBufferImageCopy region{};
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    region.imageExtent = {img.width, img.height, 1};
+    v.vkCmdCopyBufferToImage(cmd, staging.buffer, texture.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
+                             &region);
+    // The copy's writes -> visible to the fragment shader's sampling, in the sampled layout.
+    ib.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    ib.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+    ib.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    ib.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
+    v.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, 0, 0,
+                           nullptr, 0, nullptr, 1, &ib);
+    VKCLOTH_VK_TRY(v.vkEndCommandBuffer(cmd), "vkEndCommandBuffer (texture upload)");
+    VkSubmitInfo si{};
+    si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
+    si.commandBufferCount = 1;
+    si.pCommandBuffers = &cmd;
+    VKCLOTH_VK_TRY(v.vkQueueSubmit(ctx->queue, 1, &si, fence), "vkQueueSubmit (texture upload)");
+    VKCLOTH_VK_TRY(v.vkWaitForFences(d, 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences (texture upload)");
+    return {};
+  };
+  auto r = run();
+  cleanup();
+  VKCLOTH_TRY(r);
+
+  VkSamplerCreateInfo si{};
+  si.sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO;
+  si.magFilter = si.minFilter = VK_FILTER_LINEAR;
+  si.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST;
+  si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_REPEAT;
+  si.maxLod = 0.0f;
+  VKCLOTH_VK_TRY(v.vkCreateSampler(d, &si, nullptr, &sampler), "vkCreateSampler");
+  return {};
+}
+
+Result<void> ClothRenderer::Impl::build_pipelines(const RendererOptions& o) {
+  const auto& v = ctx->vk;
+  const VkDevice d = ctx->device;
+  const VkDescriptorSetLayoutBinding binding{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1,
+                                             VK_SHADER_STAGE_FRAGMENT_BIT, nullptr};
+  VkDescriptorSetLayoutCreateInfo li{};
+  li.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
+  li.bindingCount = 1;
+  li.pBindings = &binding;
+  VKCLOTH_VK_TRY(v.vkCreateDescriptorSetLayout(d, &li, nullptr, &set_layout),
+                 "vkCreateDescriptorSetLayout (renderer)");
+  const VkDescriptorPoolSize ps{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1};
+  VkDescriptorPoolCreateInfo dp{};
+  dp.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
+  dp.maxSets = 1;
+  dp.poolSizeCount = 1;
+  dp.pPoolSizes = &ps;
+  VKCLOTH_VK_TRY(v.vkCreateDescriptorPool(d, &dp, nullptr, &pool), "vkCreateDescriptorPool (renderer)");
+  VkDescriptorSetAllocateInfo ai{};
+  ai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
+  ai.descriptorPool = pool;
+  ai.descriptorSetCount = 1;
+  ai.pSetLayouts = &set_layout;
+  VKCLOTH_VK_TRY(v.vkAllocateDescriptorSets(d, &ai, &set), "vkAllocateDescriptorSets (renderer)");
+  const VkDescriptorImageInfo ii{sampler, texture.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+  VkWriteDescriptorSet w{};
+  w.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+  w.dstSet = set;
+  w.descriptorCount = 1;
+  w.descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+  w.pImageInfo = &ii;
+  v.vkUpdateDescriptorSets(d, 1, &w, 0, nullptr);
+
+  const VkPushConstantRange range{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+                                  sizeof(DrawConstants)};
+  VkPipelineLayoutCreateInfo pl{};
+  pl.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
+  pl.setLayoutCount = 1;
+  pl.pSetLayouts = &set_layout;
+  pl.pushConstantRangeCount = 1;
+  pl.pPushConstantRanges = &range;
+  VKCLOTH_VK_TRY(v.vkCreatePipelineLayout(d, &pl, nullptr, &layout), "vkCreatePipelineLayout (renderer)");
+
+  struct Shaders {
+    const std::uint32_t* vs;
+    std::size_t vs_words;
+    const std::uint32_t* fs;
+    std::size_t fs_words;
+    const char* name;
+  };
+  auto make = [&](const Shaders& sh, const std::vector<VkVertexInputBindingDescription>& bindings,
+                  const std::vector<VkVertexInputAttributeDescription>& attrs, VkPrimitiveTopology topology,
+                  VkPipeline* out) -> Result<void> {
+    auto vm = detail::create_shader(*ctx, sh.vs, sh.vs_words, sh.name);
+    if (!vm)
+      return vm.error();
+    auto fm = detail::create_shader(*ctx, sh.fs, sh.fs_words, sh.name);
+    if (!fm) {
+      v.vkDestroyShaderModule(d, *vm, nullptr);
+      return fm.error();
+    }
+    VkPipelineShaderStageCreateInfo stages[2]{};
+    stages[0] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
+                 nullptr,
+                 0,
+                 VK_SHADER_STAGE_VERTEX_BIT,
+                 *vm,
+                 "main",
+                 nullptr};
+    stages[1] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
+                 nullptr,
+                 0,
+                 VK_SHADER_STAGE_FRAGMENT_BIT,
+                 *fm,
+                 "main",
+                 nullptr};
+    VkPipelineVertexInputStateCreateInfo vi{};
+    vi.sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO;
+    vi.vertexBindingDescriptionCount = static_cast<std::uint32_t>(bindings.size());
+    vi.pVertexBindingDescriptions = bindings.data();
+    vi.vertexAttributeDescriptionCount = static_cast<std::uint32_t>(attrs.size());
+    vi.pVertexAttributeDescriptions = attrs.data();
+    VkPipelineInputAssemblyStateCreateInfo ia{};
+    ia.sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO;
+    ia.topology = topology;
+    VkPipelineViewportStateCreateInfo vp{};
+    vp.sType = VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO;
+    vp.viewportCount = 1;
+    vp.scissorCount = 1;
+    VkPipelineRasterizationStateCreateInfo rs{};
+    rs.sType = VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO;
+    rs.polygonMode = VK_POLYGON_MODE_FILL;
+    rs.cullMode = VK_CULL_MODE_NONE; // the cloth is seen from both sides; the shaders pick the side
+    rs.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
+    rs.lineWidth = 1.0f;
+    VkPipelineMultisampleStateCreateInfo ms{};
+    ms.sType = VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO;
+    ms.rasterizationSamples = o.samples;
+    VkPipelineDepthStencilStateCreateInfo ds{};
+    ds.sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO;
+    ds.depthTestEnable = VK_TRUE;
+    ds.depthWriteEnable = VK_TRUE;
+    ds.depthCompareOp = VK_COMPARE_OP_LESS_OR_EQUAL;
+    VkPipelineColorBlendAttachmentState att{};
+    att.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT |
+                         VK_COLOR_COMPONENT_A_BIT;
+    VkPipelineColorBlendStateCreateInfo cb{};
+    cb.sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO;
+    cb.attachmentCount = 1;
+    cb.pAttachments = &att;
+    const VkDynamicState dyn[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+    VkPipelineDynamicStateCreateInfo dy{};
+    dy.sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO;
+    dy.dynamicStateCount = 2;
+    dy.pDynamicStates = dyn;
+    VkGraphicsPipelineCreateInfo gi{};
+    gi.sType = VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO;
+    gi.stageCount = 2;
+    gi.pStages = stages;
+    gi.pVertexInputState = &vi;
+    gi.pInputAssemblyState = &ia;
+    gi.pViewportState = &vp;
+    gi.pRasterizationState = &rs;
+    gi.pMultisampleState = &ms;
+    gi.pDepthStencilState = &ds;
+    gi.pColorBlendState = &cb;
+    gi.pDynamicState = &dy;
+    gi.layout = layout;
+    gi.renderPass = o.render_pass;
+    gi.subpass = o.subpass;
+    const VkResult r = v.vkCreateGraphicsPipelines(d, VK_NULL_HANDLE, 1, &gi, nullptr, out);
+    v.vkDestroyShaderModule(d, *vm, nullptr);
+    v.vkDestroyShaderModule(d, *fm, nullptr);
+    if (r != VK_SUCCESS)
+      return gpu::vk_error(r, fmt::format("vkCreateGraphicsPipelines ({})", sh.name));
+    return {};
+  };
+  namespace sp = gpu::spirv;
+  constexpr std::uint32_t vec4 = 16;
+  VKCLOTH_TRY(make({sp::cloth_vert_spv, std::size(sp::cloth_vert_spv), sp::cloth_frag_spv,
+                    std::size(sp::cloth_frag_spv), "cloth"},
+                   {{0, vec4, VK_VERTEX_INPUT_RATE_VERTEX},
+                    {1, vec4, VK_VERTEX_INPUT_RATE_VERTEX},
+                    {2, vec4, VK_VERTEX_INPUT_RATE_VERTEX}},
+                   {{0, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 0},
+                    {1, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 0},
+                    {2, 2, VK_FORMAT_R32G32B32A32_SFLOAT, 0}},
+                   VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST, &cloth_pipeline));
+  VKCLOTH_TRY(
+      make({sp::mesh_vert_spv, std::size(sp::mesh_vert_spv), sp::mesh_frag_spv, std::size(sp::mesh_frag_spv),
+            "mesh"},
+           {{0, sizeof(MeshVertex), VK_VERTEX_INPUT_RATE_VERTEX}, {1, vec4, VK_VERTEX_INPUT_RATE_INSTANCE}},
+           {{0, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 0},
+            {1, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 16},
+            {2, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 0}},
+           VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST, &mesh_pipeline));
+  VKCLOTH_TRY(make({sp::line_vert_spv, std::size(sp::line_vert_spv), sp::line_frag_spv,
+                    std::size(sp::line_frag_spv), "line"},
+                   {{0, vec4, VK_VERTEX_INPUT_RATE_VERTEX}}, {{0, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 0}},
+                   VK_PRIMITIVE_TOPOLOGY_LINE_LIST, &line_pipeline));
+  return {};
+}
+
+Result<ClothRenderer> ClothRenderer::create(gpu::Context& context, const gpu::GpuSolver& solver,
+                                            const ParticleSystem& system, RendererOptions options) {
+  if (!options.render_pass)
+    return make_error(ErrorCode::invalid_argument, "RendererOptions::render_pass is required");
+  if (system.size() != solver.particle_count())
+    return make_error(
+        ErrorCode::invalid_argument,
+        fmt::format(
+            "the system has {} particles but the solver {}: pass the system the solver was created from",
+            system.size(), solver.particle_count()));
+  auto impl = std::make_unique<Impl>();
+  impl->ctx = context.impl();
+  if (!detail::queue_has_graphics(*impl->ctx))
+    return make_error(
+        ErrorCode::unsupported,
+        fmt::format("the Context's queue family {} on '{}' has no graphics support (create the Context with "
+                    "ContextOptions::require_graphics)",
+                    impl->ctx->queue_family, impl->ctx->name));
+  impl->grid = system.grid.has_value();
+  impl->particle_count = solver.particle_count();
+  Image texture = options.texture.width ? std::move(options.texture) : default_fabric_texture();
+  const std::uint32_t max_side = impl->ctx->properties.limits.maxImageDimension2D;
+  if (texture.width > max_side || texture.height > max_side)
+    return make_error(ErrorCode::unsupported,
+                      fmt::format("the texture is {} x {} but the device allows at most {} a side",
+                                  texture.width, texture.height, max_side));
+  VKCLOTH_TRY(impl->build_geometry(system, solver.params(), options));
+  VKCLOTH_TRY(impl->upload_texture(texture));
+  VKCLOTH_TRY(impl->build_pipelines(options));
+  return ClothRenderer(std::move(impl));
+}
+
+ClothRenderer::ClothRenderer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+ClothRenderer::ClothRenderer(ClothRenderer&&) noexcept = default;
+ClothRenderer& ClothRenderer::operator=(ClothRenderer&&) noexcept = default;
+ClothRenderer::~ClothRenderer() = default;
+const Palette& ClothRenderer::palette() const {
+  return impl_->palette;
+}
+bool ClothRenderer::draws_cloth() const {
+  return impl_->grid;
+}
+
+void ClothRenderer::record_draw(VkCommandBuffer cmd, const gpu::GpuSolver& solver, const Camera& camera,
+                                VkExtent2D extent) const {
+  const Impl& s = *impl_;
+  const auto& v = s.ctx->vk;
+  const VkViewport viewport{0.0f, 0.0f, float(extent.width), float(extent.height), 0.0f, 1.0f};
+  const VkRect2D scissor{{0, 0}, extent};
+  v.vkCmdSetViewport(cmd, 0, 1, &viewport);
+  v.vkCmdSetScissor(cmd, 0, 1, &scissor);
+  DrawConstants pc{};
+  pc.view_proj = camera.view_projection(float(extent.width) / float(std::max(extent.height, 1u)));
+  pc.eye = glm::vec4(camera.eye, 1.0f);
+  pc.light = glm::vec4(glm::normalize(s.palette.light_dir), s.palette.ambient);
+  constexpr VkShaderStageFlags stages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
+  const VkDeviceSize zero = 0;
+  const VkBuffer positions = solver.current_position_buffer();
+
+  // Colliders: world-space meshes, one zero instance offset.
+  v.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.mesh_pipeline);
+  v.vkCmdBindIndexBuffer(cmd, s.mesh_index.buffer, 0, VK_INDEX_TYPE_UINT32);
+  {
+    const VkBuffer bufs[2] = {s.mesh_vertices.buffer, s.zero_instance.buffer};
+    const VkDeviceSize offs[2] = {0, 0};
+    v.vkCmdBindVertexBuffers(cmd, 0, 2, bufs, offs);
+  }
+  for (const MeshRange& r : s.colliders) {
+    pc.color = glm::vec4(r.color, 1.0f);
+    pc.params = glm::vec4(r.mode, r.cell, 1.0f, 0.0f);
+    v.vkCmdPushConstants(cmd, s.layout, stages, 0, sizeof(pc), &pc);
+    v.vkCmdDrawIndexed(cmd, r.count, 1, r.first, 0, 0);
+  }
+
+  if (s.grid) {
+    // The cloth: the solver's current positions, normals and uvs as vertex buffers.
+    v.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.cloth_pipeline);
+    v.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.layout, 0, 1, &s.set, 0, nullptr);
+    const VkBuffer bufs[3] = {positions, solver.normal_buffer(), solver.uv_buffer()};
+    const VkDeviceSize offs[3] = {0, 0, 0};
+    v.vkCmdBindVertexBuffers(cmd, 0, 3, bufs, offs);
+    v.vkCmdBindIndexBuffer(cmd, s.cloth_index.buffer, 0, VK_INDEX_TYPE_UINT32);
+    pc.color = glm::vec4(s.palette.back_tint, 1.0f);
+    pc.params = glm::vec4(0.0f, 1.0f, 1.0f, 0.0f);
+    v.vkCmdPushConstants(cmd, s.layout, stages, 0, sizeof(pc), &pc);
+    v.vkCmdDrawIndexed(cmd, s.cloth_index_count, 1, 0, 0, 0);
+    return;
+  }
+  // A chain: springs as lines, masses as small spheres instanced at the current positions.
+  pc.color = glm::vec4(s.palette.chain, 1.0f);
+  pc.params = glm::vec4(0.0f, 1.0f, s.mass_radius, 0.0f);
+  if (s.cloth_index_count) {
+    v.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.line_pipeline);
+    v.vkCmdBindVertexBuffers(cmd, 0, 1, &positions, &zero);
+    v.vkCmdBindIndexBuffer(cmd, s.cloth_index.buffer, 0, VK_INDEX_TYPE_UINT32);
+    v.vkCmdPushConstants(cmd, s.layout, stages, 0, sizeof(pc), &pc);
+    v.vkCmdDrawIndexed(cmd, s.cloth_index_count, 1, 0, 0, 0);
+  }
+  v.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.mesh_pipeline);
+  const VkBuffer bufs[2] = {s.mesh_vertices.buffer, positions};
+  const VkDeviceSize offs[2] = {0, 0};
+  v.vkCmdBindVertexBuffers(cmd, 0, 2, bufs, offs);
+  v.vkCmdBindIndexBuffer(cmd, s.mesh_index.buffer, 0, VK_INDEX_TYPE_UINT32);
+  v.vkCmdPushConstants(cmd, s.layout, stages, 0, sizeof(pc), &pc);
+  v.vkCmdDrawIndexed(cmd, s.unit_sphere.count, s.particle_count, s.unit_sphere.first, 0, 0);
+}
+
+} // namespace vkcloth::render

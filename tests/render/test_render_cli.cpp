@@ -1,0 +1,116 @@
+// `vkcloth render` as a separate process: texture errors (exit 2, the file named), --video
+// without ffmpeg, PNG outputs, a chain scene.
+#include <doctest/doctest.h>
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Outcome {
+  int code = -1;
+  std::string out, err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+fs::path tmp_dir() {
+  fs::path d = fs::path(VKCLOTH_RENDER_OUT) / "cli";
+  fs::create_directories(d);
+  return d;
+}
+
+Outcome vkcloth(const std::string& tag, const std::string& args, const std::string& env = "") {
+  const fs::path out = tmp_dir() / (tag + ".stdout"), err = tmp_dir() / (tag + ".stderr");
+  const std::string cmd = env + " '" + VKCLOTH_CLI_PATH + "' " + args + " >'" + out.string() + "' 2>'" +
+                          err.string() + "' </dev/null";
+  const int status = std::system(cmd.c_str());
+  Outcome o;
+  o.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  o.out = slurp(out);
+  o.err = slurp(err);
+  return o;
+}
+
+bool on_ci() {
+  const char* v = std::getenv("CI");
+  return v && (std::strcmp(v, "true") == 0 || std::strcmp(v, "1") == 0);
+}
+
+/// Exit 4 (no device) skips the check off CI.
+bool device_missing(const Outcome& o) {
+  if (o.code != 4)
+    return false;
+  if (on_ci())
+    FAIL("CI=true but no Vulkan device: " << o.err);
+  MESSAGE("skipped, no Vulkan device: " << o.err);
+  return true;
+}
+
+const std::string scenes = VKCLOTH_SCENES_DIR;
+
+} // namespace
+
+TEST_CASE("render: a missing texture file is exit 2 naming the file") {
+  const fs::path tex = tmp_dir() / "does_not_exist.png";
+  const Outcome o = vkcloth("tex_missing", "render " + scenes + "/cloth_on_sphere.json --steps 1 --out " +
+                                               (tmp_dir() / "x.png").string() + " --texture " + tex.string());
+  CHECK(o.code == 2);
+  CHECK(o.err.find("does_not_exist.png") != std::string::npos);
+  CHECK(o.err.find("does not exist") != std::string::npos);
+}
+
+TEST_CASE("render: a corrupt texture file is exit 2 naming the file") {
+  const fs::path tex = tmp_dir() / "corrupt_texture.jpg";
+  std::ofstream(tex) << "\xff\xd8\xff garbage, not a JPEG";
+  const Outcome o = vkcloth("tex_corrupt", "render " + scenes + "/cloth_on_sphere.json --steps 1 --out " +
+                                               (tmp_dir() / "x.png").string() + " --texture " + tex.string());
+  CHECK(o.code == 2);
+  CHECK(o.err.find("corrupt_texture.jpg") != std::string::npos);
+}
+
+TEST_CASE("render: --video without ffmpeg is exit 2 with a clear message") {
+  const Outcome o = vkcloth("video_no_ffmpeg",
+                            "render " + scenes + "/cloth_on_sphere.json --steps 2 --video " +
+                                (tmp_dir() / "v.mp4").string(),
+                            "PATH=/nonexistent");
+  CHECK(o.code == 2);
+  CHECK(o.err.find("needs ffmpeg") != std::string::npos);
+}
+
+TEST_CASE("render: --out and --frames write PNGs, a chain renders too") {
+  const fs::path frames = tmp_dir() / "frames";
+  fs::remove_all(frames);
+  const fs::path out = tmp_dir() / "final.png";
+  fs::remove(out);
+  const Outcome o = vkcloth("frames", "render " + scenes +
+                                          "/cloth_on_sphere.json --steps 6 --every 3 --size 64x48 --frames " +
+                                          frames.string() + " --out " + out.string());
+  if (device_missing(o))
+    return;
+  REQUIRE_MESSAGE(o.code == 0, o.err);
+  CHECK(fs::file_size(frames / "frame_00000.png") > 0);
+  CHECK(fs::file_size(frames / "frame_00002.png") > 0);
+  CHECK_FALSE(fs::exists(frames / "frame_00003.png"));
+  CHECK(fs::file_size(out) > 0);
+
+  const Outcome c = vkcloth("chain", "render " + scenes + "/spring.json --steps 5 --size 64x48 --out " +
+                                         (tmp_dir() / "spring.png").string());
+  REQUIRE_MESSAGE(c.code == 0, c.err);
+  CHECK(c.err.find("chain") != std::string::npos);
+  CHECK(fs::file_size(tmp_dir() / "spring.png") > 0);
+}
