@@ -240,6 +240,21 @@ TEST_CASE("an outward velocity or force is not cancelled by a contact (the hand 
   }
 }
 
+TEST_CASE("contact_inward_only = false (Figure 12's variant) also cancels outward parts: the particle sticks") {
+  ValidationScope validation;
+  for (Backend b : backends()) {
+    CAPTURE(to_string(b));
+    SimParams p = no_forces();
+    p.colliders = {Collider::plane({0, 0, 1}, 0.0)};
+    p.contact_inward_only = false;
+    auto s = make_sim(b, particle({0, 0, 0.001}, {0.5, 0, 1.0}), p);
+    REQUIRE(s->run(10).ok());
+    CHECK(s->velocity(0).z == 0.0);  // the outward velocity was removed...
+    CHECK(s->velocity(0).x == 0.5);  // ...the tangential part kept
+    CHECK(std::abs(s->position(0).z - 0.001) < 1e-7);
+  }
+}
+
 TEST_CASE("wind F = Kw <n, u> n: zero when the wind lies in the cloth plane, along the normal otherwise") {
   ValidationScope validation;
   ClothDesc d;

@@ -64,10 +64,11 @@ void particle_force(uint p, inout vec3 v_io, out vec3 f_out, out vec3 nrm_out) {
       vec3 n;
       collider_contact(c, x, dist, n);
       if (!(dist < pc.band)) continue;
+      const bool both = (pc.flags & VKCLOTH_FLAG_CONTACT_BOTH) != 0u;
       precise float vn = dot3(v, n);
-      if (vn < 0.0) v = v - n * vn;
+      if (vn < 0.0 || (both && vn != 0.0)) v = v - n * vn;
       precise float fn = dot3(f, n);
-      if (fn < 0.0) f = f - n * fn;
+      if (fn < 0.0 || (both && fn != 0.0)) f = f - n * fn;
     }
   }
 

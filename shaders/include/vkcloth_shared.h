@@ -42,6 +42,7 @@ struct vec4 {
 // PushConstants::flags bits.
 #define VKCLOTH_FLAG_HAS_GRID 1u // the system is a cloth grid: rebuild normals
 #define VKCLOTH_FLAG_WIND 2u     // wind strength != 0
+#define VKCLOTH_FLAG_CONTACT_BOTH 4u // contacts remove the whole normal part (Figure 12 variant)
 
 // PushConstants::integrator (same values as vkcloth::Integrator).
 #define VKCLOTH_INTEGRATOR_EXPLICIT_EULER 0u

@@ -212,3 +212,12 @@ TEST_CASE("overrides set values before validation") {
   // Later overrides win.
   CHECK(load_ok(R"({"system": "chain"})", {"integrator.dt=0.1", "integrator.dt=0.2"}).params.dt == 0.2);
 }
+
+TEST_CASE("contact_inward_only: defaults to true (report §4), reads a boolean, rejects other types") {
+  CHECK(load_ok(R"({"system": "chain"})").params.contact_inward_only);
+  CHECK_FALSE(load_ok(R"({"system": "chain", "contact_inward_only": false})").params.contact_inward_only);
+  CHECK_FALSE(load_ok(R"({"system": "chain"})", {"contact_inward_only=false"}).params.contact_inward_only);
+  auto bad = parse_scene(R"({"system": "chain", "contact_inward_only": 1})", "t.json");
+  REQUIRE_FALSE(bad.ok());
+  CHECK(bad.error().message.find("contact_inward_only") != std::string::npos);
+}

@@ -56,6 +56,9 @@ struct SimParams {
   /// Projection distance eps: a particle found inside a collider is put back at surface + eps.
   /// A particle closer than 2 eps to a surface is "in contact" (its inward v and F are removed).
   double contact_epsilon = 1e-3;
+  /// Remove only the parts of v and F that point INTO a collider (report §4, the default). False
+  /// removes the whole normal part, the variant of the report's Figure 12 where the cloth sticks.
+  bool contact_inward_only = true;
   /// A position farther than this from the origin (or non-finite) counts as a blow-up.
   double divergence_limit = 1e4;
 

@@ -193,10 +193,11 @@ template <typename Real> void CpuSolver<Real>::contact_at(Vec3 pos, Vec3& vel, V
     if (!(ct.distance < band)) continue;
     // Only the part pointing INTO the collider is removed: a hand lifting the cloth keeps
     // its outward pull (report §4, Figure 12).
+    const bool both = !params_.contact_inward_only; // Figure 12's variant: outward parts go too
     const Real vn = dot3(vel, ct.normal);
-    if (vn < Real(0)) vel -= ct.normal * vn;
+    if (vn < Real(0) || (both && vn != Real(0))) vel -= ct.normal * vn;
     const Real fn = dot3(force, ct.normal);
-    if (fn < Real(0)) force -= ct.normal * fn;
+    if (fn < Real(0) || (both && fn != Real(0))) force -= ct.normal * fn;
   }
 }
 

@@ -137,6 +137,16 @@ Result<void> read(const json& obj, std::string_view path, const char* key, std::
   return {};
 }
 
+Result<void> read(const json& obj, std::string_view path, const char* key, bool& out) {
+  auto it = obj.find(key);
+  if (it == obj.end())
+    return {};
+  if (!it->is_boolean())
+    return type_error(join(path, key), "true or false", *it);
+  out = it->get<bool>();
+  return {};
+}
+
 Result<void> read(const json& obj, std::string_view path, const char* key, glm::dvec3& out) {
   auto it = obj.find(key);
   if (it == obj.end())

@@ -35,6 +35,7 @@ Result<const json*> read_object(const json& obj, std::string_view path, const ch
 Result<const json*> read_array(const json& obj, std::string_view path, const char* key);
 Result<void> read(const json& obj, std::string_view path, const char* key, double& out);
 Result<void> read(const json& obj, std::string_view path, const char* key, std::string& out);
+Result<void> read(const json& obj, std::string_view path, const char* key, bool& out);
 Result<void> read(const json& obj, std::string_view path, const char* key, glm::dvec3& out);
 Result<void> read(const json& obj, std::string_view path, const char* key, glm::dvec2& out);
 /// A number or an array of numbers (a single number becomes a one-element array).

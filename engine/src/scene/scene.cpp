@@ -188,7 +188,7 @@ Result<Scene> build_scene(const json& doc, std::string_view source_name) {
     return sd::shape_error(fmt::format("the scene must be a JSON object, got {}", doc.type_name()));
   VKCLOTH_TRY(sd::check_keys(doc, "",
                              {"name", "system", "integrator", "physics", "chain", "cloth", "wind",
-                              "colliders", "contact_epsilon", "divergence_limit"}));
+                              "colliders", "contact_epsilon", "contact_inward_only", "divergence_limit"}));
   Scene scene;
   if (!doc.contains("system"))
     return sd::shape_error("missing required key system (\"chain\" or \"cloth\")");
@@ -209,6 +209,7 @@ Result<Scene> build_scene(const json& doc, std::string_view source_name) {
   VKCLOTH_TRY(read_colliders(doc, scene.params));
   VKCLOTH_TRY(sd::read(doc, "", "contact_epsilon", scene.params.contact_epsilon));
   VKCLOTH_TRY(sd::read(doc, "", "divergence_limit", scene.params.divergence_limit));
+  VKCLOTH_TRY(sd::read(doc, "", "contact_inward_only", scene.params.contact_inward_only));
   VKCLOTH_TRY(scene.params.validate()); // ranges, before any large allocation below
 
   auto system = scene.system_kind == "chain" ? read_chain(doc) : read_cloth(doc);

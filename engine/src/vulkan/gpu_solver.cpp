@@ -254,7 +254,8 @@ void GpuSolver::Impl::set_push_constants() {
   pc.count = count;
   pc.nx = nx;
   pc.ny = ny;
-  pc.flags = (nx ? VKCLOTH_FLAG_HAS_GRID : 0u) | (float(params.wind.strength) != 0.0f ? VKCLOTH_FLAG_WIND : 0u);
+  pc.flags = (nx ? VKCLOTH_FLAG_HAS_GRID : 0u) | (float(params.wind.strength) != 0.0f ? VKCLOTH_FLAG_WIND : 0u) |
+             (params.contact_inward_only ? 0u : VKCLOTH_FLAG_CONTACT_BOTH);
   pc.integrator = static_cast<std::uint32_t>(params.integrator);
   pc.collider_count = static_cast<std::uint32_t>(params.colliders.size());
   pc.gravity_damping = {float(params.gravity.x), float(params.gravity.y), float(params.gravity.z), float(params.damping)};
