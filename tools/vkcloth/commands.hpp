@@ -50,5 +50,6 @@ void add_run_command(CLI::App& app, int* exit);
 void add_info_command(CLI::App& app, int* exit);
 void add_compare_command(CLI::App& app, int* exit);
 void add_devices_command(CLI::App& app, int* exit);
+void add_soak_command(CLI::App& app, int* exit);
 
 } // namespace vkcloth::cli
