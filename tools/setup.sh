@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
 # Installs the Debian packages vkcloth needs. Idempotent; prints nothing when all is present.
+# Usage: tools/setup.sh [fuzz]   (fuzz: also clang and its libFuzzer runtime, for tools/fuzz.sh)
 set -euo pipefail
 packages=(
   cmake ninja-build g++ pkg-config
@@ -8,6 +9,7 @@ packages=(
   mesa-vulkan-drivers vulkan-validationlayers vulkan-tools
   libglfw3-dev libstb-dev xvfb xauth
 )
+[[ ${1:-} == fuzz ]] && packages+=(clang libclang-rt-14-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -178,3 +178,55 @@ TEST_CASE("vkcloth on Vulkan: divergence exits 3, no device exits 4, bad compare
   CHECK(tol.err.find("--tolerance") != std::string::npos);
   CHECK(run_cli("gpu_double", "run " + sample("spring.json") + " --backend vulkan --precision double").code == 2);
 }
+
+TEST_CASE("cli: hostile command-line values exit 2 and name the option or key") {
+  const Outcome huge = run_cli("host_steps_huge", "run " + sample("spring.json") + " --steps 99999999999999999999999");
+  CHECK(huge.code == 2);
+  CHECK(huge.err.find("steps") != std::string::npos);
+  const Outcome big = run_cli("host_steps_big", "run " + sample("spring.json") + " --steps 1000000000000");
+  CHECK(big.code == 2);
+  CHECK(big.err.find("integrator.steps") != std::string::npos);
+  const Outcome neg = run_cli("host_steps_neg", "run " + sample("spring.json") + " --steps -5");
+  CHECK(neg.code == 2);
+  for (const char* dt : {"0", "-1", "nan", "inf", "1e999"}) {
+    CAPTURE(dt);
+    const Outcome o = run_cli("host_dt", "run " + sample("spring.json") + " --dt " + dt);
+    CHECK(o.code == 2);
+    CHECK((o.err.find("dt") != std::string::npos));
+  }
+  const Outcome setbad = run_cli("host_set", "run " + sample("spring.json") + " --set colliders.0.radius");
+  CHECK(setbad.code == 2);
+  CHECK(setbad.err.find("key.path=value") != std::string::npos);
+  const Outcome dev = run_cli("host_devzero", "run /dev/zero");
+  CHECK(dev.code == 2);
+  CHECK(dev.err.find("scene size limit") != std::string::npos);
+  const Outcome dir = run_cli("host_dir", "run /");
+  CHECK(dir.code == 2);
+  const Outcome out = run_cli("host_out", "run " + sample("spring.json") + " --steps 1 --positions /nonexistent/dir/p.csv");
+  CHECK(out.code == 2);
+  CHECK(out.err.find("/nonexistent/dir/p.csv") != std::string::npos);
+}
+
+TEST_CASE("cli: soak runs a short soak and reports drift and RSS") {
+  const Outcome o = run_cli("soak", "soak " + sample("cloth_hanging.json") + " --steps 500 --checks 5");
+  CHECK(o.code == 0);
+  CHECK(o.out.find("max pinned drift 0 m") != std::string::npos);
+  CHECK(o.out.find("RSS") != std::string::npos);
+  CHECK(run_cli("soak_bad", "soak " + sample("spring.json") + " --steps 0").code == 2);
+  const Outcome div = run_cli("soak_div", "soak " + sample("spring.json") + " --set integrator.dt=0.45 --steps 1000");
+  CHECK(div.code == 3);
+}
+
+TEST_CASE("cli: --validate runs under the validation layer and passes on a clean run") {
+  if (!have_vulkan_device())
+    return;
+  const Outcome o = run_cli("validate_run", "--validate run " + sample("cloth_wind.json") + " --steps 50 --backend vulkan");
+  CHECK(o.code == 0);
+  CHECK(o.err.find("validation") == std::string::npos);
+  const Outcome c = run_cli("validate_cmp", "--validate compare " + sample("cloth_on_sphere.json") + " --steps 50");
+  CHECK(c.code == 0);
+  const Outcome s = run_cli("validate_soak", "--validate soak " + sample("cloth_hanging.json") + " --steps 200 --backend vulkan --max-rss-growth 1000000");
+  CHECK(s.code == 0);
+  CHECK(s.out.find("max pinned drift 0 m") != std::string::npos);
+  CHECK(run_cli("validate_help", "--help").out.find("--validate") != std::string::npos);
+}

@@ -54,5 +54,6 @@ void add_figures_command(CLI::App& app, int* exit);
 void add_bench_command(CLI::App& app, int* exit);
 void add_render_command(CLI::App& app, int* exit);
 void add_view_command(CLI::App& app, int* exit);
+void add_soak_command(CLI::App& app, int* exit);
 
 } // namespace vkcloth::cli

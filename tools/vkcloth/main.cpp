@@ -1,9 +1,13 @@
 // vkcloth: command-line front end to the scene loader and the solvers.
+#include <cstdlib>
+#include <cstring>
+
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "vkcloth/gpu/context.hpp"
 
 namespace vkcloth::cli {
 
@@ -33,7 +37,8 @@ int report(const Error& e) {
 
 const char* const exit_codes_footer = R"(Exit codes:
   0  success
-  1  unexpected runtime failure (Vulkan error, out of memory)
+  1  unexpected runtime failure (Vulkan error, out of memory), or Vulkan validation messages
+     were reported with --validate / VKCLOTH_VALIDATION=1
   2  bad input or usage: command line, scene file (the message names the key), output file
   3  the simulation diverged (the message names the step and time; --trace keeps the rows before it)
   4  no usable Vulkan device
@@ -75,6 +80,13 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
 
   int exit = exit_ok; // set by the chosen command's callback
+  // Global, before the subcommand: sets VKCLOTH_VALIDATION=1 as soon as it is parsed, so before any
+  // command callback creates a Context.
+  app.add_flag_callback(
+         "--validate", [] { ::setenv("VKCLOTH_VALIDATION", "1", 1); },
+         "Run Vulkan work under VK_LAYER_KHRONOS_validation with synchronization validation (same as "
+         "VKCLOTH_VALIDATION=1); any validation message makes the command exit 1")
+      ->trigger_on_parse();
   add_run_command(app, &exit);
   add_compare_command(app, &exit);
   add_info_command(app, &exit);
@@ -83,6 +95,7 @@ int main(int argc, char** argv) {
   add_bench_command(app, &exit);
   add_render_command(app, &exit);
   add_view_command(app, &exit);
+  add_soak_command(app, &exit);
 
   try {
     app.parse(argc, argv);
@@ -96,6 +109,14 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     fmt::print(stderr, "vkcloth: unexpected error: {}\n", e.what());
     return exit_failure;
+  }
+  // With validation on, a validation message is a failure even when the command succeeded.
+  const char* v = std::getenv("VKCLOTH_VALIDATION");
+  const bool validating = v && *v && std::strcmp(v, "0") != 0 && std::strcmp(v, "false") != 0;
+  if (const auto n = vkcloth::gpu::Context::process_validation_message_count(); validating && n > 0) {
+    fmt::print(stderr, "vkcloth: Vulkan validation reported {} message{} (see above)\n", n, n == 1 ? "" : "s");
+    if (exit == exit_ok)
+      return exit_failure;
   }
   return exit;
 }

@@ -73,7 +73,9 @@ public:
   const ParticleSystem& system() const { return *system_; }
 
   /// Moves one particle (a "hand"): sets its position and velocity for the next step.
-  void set_particle(std::uint32_t index, Vec3 position, Vec3 velocity);
+  /// ErrorCode::invalid_argument (state unchanged) when `index` >= the particle count or a
+  /// component is NaN/inf.
+  Result<void> set_particle(std::uint32_t index, Vec3 position, Vec3 velocity);
 
   /// Kinetic energy sum 1/2 m v^2, gravitational and spring potential energies (for studies).
   struct Energy {

@@ -26,15 +26,22 @@ struct Scene {
 /// Largest "integrator.steps" a scene may ask for.
 inline constexpr std::uint64_t max_scene_steps = 1'000'000'000;
 
+/// Largest scene text accepted (bytes), by parse_scene() and load_scene_file() (which checks the
+/// file size before reading). The samples are under 2 KiB; a 8192 x 8192 cloth is a few lines.
+inline constexpr std::size_t max_scene_bytes = std::size_t{16} << 20;
+
 /// Parses and validates a scene. `overrides` are "key.path=value" strings (e.g.
 /// "cloth.stiffness.bend=15", "colliders.0.radius=0.3", "colliders[0].radius=0.3"); each value is
 /// parsed as JSON, or taken as a plain string when it is not JSON. They are applied to the document
 /// before validation, so errors name the key. Errors: ErrorCode::parse (bad JSON, unknown key,
-/// wrong type, bad override) or ErrorCode::invalid_argument (a value out of range). Never throws.
+/// wrong type, bad override, text over max_scene_bytes, nesting deeper than 64 levels) or
+/// ErrorCode::invalid_argument (a value out of range); ErrorCode::out_of_memory if the host runs
+/// out of memory. Never throws.
 Result<Scene> parse_scene(std::string_view json_text, std::string_view source_name,
                           std::span<const std::string> overrides = {});
 
-/// Reads `path` and calls parse_scene(). A missing or unreadable file is ErrorCode::io.
+/// Reads `path` and calls parse_scene(). A missing or unreadable file, a directory or a file larger
+/// than max_scene_bytes is ErrorCode::io (checked before reading).
 Result<Scene> load_scene_file(const std::filesystem::path& path, std::span<const std::string> overrides = {});
 
 } // namespace vkcloth

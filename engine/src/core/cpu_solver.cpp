@@ -89,10 +89,20 @@ template <typename Real> Result<void> CpuSolver<Real>::set_params(SimParams para
   return {};
 }
 
-template <typename Real> void CpuSolver<Real>::set_particle(std::uint32_t index, Vec3 position, Vec3 velocity) {
-  if (index >= pos_.size()) return;
+template <typename Real>
+Result<void> CpuSolver<Real>::set_particle(std::uint32_t index, Vec3 position, Vec3 velocity) {
+  if (index >= pos_.size())
+    return make_error(ErrorCode::invalid_argument,
+                      fmt::format("set_particle: index {} is out of range (the system has {} particles)", index,
+                                  pos_.size()));
+  for (int k = 0; k < 3; ++k)
+    if (!std::isfinite(position[k]) || !std::isfinite(velocity[k]))
+      return make_error(ErrorCode::invalid_argument,
+                        fmt::format("set_particle: particle {} position ({}, {}, {}) and velocity ({}, {}, {}) must be finite",
+                                    index, position.x, position.y, position.z, velocity.x, velocity.y, velocity.z));
   pos_[index] = position;
   vel_[index] = pinned_[index] ? Vec3(0) : velocity;
+  return {};
 }
 
 template <typename Real>

@@ -71,7 +71,41 @@ private:
 
 } // namespace
 
+/// Byte offset of the first '[' or '{' nested deeper than `max_depth` (outside strings), or npos.
+/// Checked before parsing so that no recursive code (dump, copy, compare) ever meets a deep document.
+std::size_t too_deep_at(std::string_view text, std::size_t max_depth) {
+  std::size_t depth = 0;
+  bool in_string = false, escaped = false;
+  for (std::size_t k = 0; k < text.size(); ++k) {
+    const char c = text[k];
+    if (in_string) {
+      if (escaped)
+        escaped = false;
+      else if (c == '\\')
+        escaped = true;
+      else if (c == '"')
+        in_string = false;
+      continue;
+    }
+    if (c == '"')
+      in_string = true;
+    else if (c == '[' || c == '{') {
+      if (++depth > max_depth)
+        return k;
+    } else if ((c == ']' || c == '}') && depth > 0)
+      --depth;
+  }
+  return std::string_view::npos;
+}
+
 bool parse_json(std::string_view text, json& out, JsonParseFailure& failure) {
+  if (const std::size_t at = too_deep_at(text, max_json_depth); at != std::string_view::npos) {
+    failure = JsonParseFailure{};
+    failure.byte = at;
+    failure.message = fmt::format("arrays and objects are nested more than {} levels deep", max_json_depth);
+    out = json();
+    return false;
+  }
   PathTrackingSax sax(out);
   if (json::sax_parse(text, &sax))
     return true;

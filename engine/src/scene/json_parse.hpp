@@ -17,7 +17,10 @@ struct JsonParseFailure {
   bool overflow = false; ///< a number out of the double range
 };
 
-/// Parses `text`; on failure fills `failure` and returns false. Never throws (except bad_alloc).
+/// Deepest nesting of arrays and objects accepted (the scene format needs 4).
+inline constexpr std::size_t max_json_depth = 64;
+
+/// Parses `text` (refusing nesting deeper than max_json_depth); on failure fills `failure` and returns false. Never throws (except bad_alloc).
 bool parse_json(std::string_view text, nlohmann::json& out, JsonParseFailure& failure);
 
 /// 1-based line and column of a byte offset.

@@ -16,7 +16,7 @@ std::string show(const json& v) {
   // dump() would print inf as null; say what the parser really produced.
   if (v.is_number_float() && !std::isfinite(v.get<double>()))
     return fmt::format("{}", v.get<double>());
-  std::string s = v.dump();
+  std::string s = v.dump(-1, ' ', false, json::error_handler_t::replace); // invalid UTF-8 -> U+FFFD
   if (s.size() > 60)
     s = s.substr(0, 57) + "...";
   return s;

@@ -9,6 +9,9 @@
 
 namespace vkcloth::scene_detail {
 
+/// Most parts a key path may have ("a.b.c" has 3); the scene format needs 4.
+inline constexpr std::size_t max_override_depth = 16;
+
 /// Sets the value at `key.path` in `doc` (an object), creating missing objects/arrays on the way.
 /// The value is parsed as JSON, or kept as a string when it is not valid JSON ("rk4", "cloth").
 /// Array elements are addressed as `colliders.0.radius` or `colliders[0].radius`; index == size

@@ -167,6 +167,10 @@ Result<ParticleSystem> read_cloth(const json& doc) {
     SCENE_TRY_ASSIGN(pins, sd::read_array(*obj, "cloth", "pins"));
     if (pins) {
       d.pin_default_corners = false; // "pins": [] means nothing pinned
+      if (const std::uint64_t cells = std::uint64_t(d.nx) * d.ny; pins->size() > cells)
+        return make_error(ErrorCode::invalid_argument,
+                          fmt::format("cloth.pins holds {} entries, more than the {} x {} grid's {} particles",
+                                      pins->size(), d.nx, d.ny, cells));
       for (std::size_t n = 0; n < pins->size(); ++n) {
         const json& p = (*pins)[n];
         const std::string path = fmt::format("cloth.pins[{}]", n);
@@ -229,6 +233,10 @@ Error with_source(Error e, std::string_view source) {
 Result<Scene> parse_scene(std::string_view json_text, std::string_view source_name,
                           std::span<const std::string> overrides) {
   try {
+    if (json_text.size() > max_scene_bytes)
+      return make_error(ErrorCode::parse, fmt::format("{}: the scene is {} bytes, more than the limit {} ({} MiB)",
+                                                      source_name, json_text.size(), max_scene_bytes,
+                                                      max_scene_bytes >> 20));
     json doc;
     if (sd::JsonParseFailure f; !sd::parse_json(json_text, doc, f)) {
       const auto [line, col] = sd::line_col(json_text, f.byte);
@@ -260,14 +268,24 @@ Result<Scene> load_scene_file(const std::filesystem::path& path, std::span<const
     std::error_code ec;
     if (std::filesystem::is_directory(path, ec))
       return make_error(ErrorCode::io, fmt::format("{}: is a directory, not a scene file", path.string()));
+    if (const auto size = std::filesystem::file_size(path, ec); !ec && size > max_scene_bytes)
+      return make_error(ErrorCode::io, fmt::format("{}: the file is {} bytes, more than the scene size limit {} ({} MiB)",
+                                                   path.string(), size, max_scene_bytes, max_scene_bytes >> 20));
     std::ifstream in(path, std::ios::binary);
     if (!in)
       return make_error(ErrorCode::io, fmt::format("{}: cannot open the scene file", path.string()));
-    std::ostringstream text;
-    text << in.rdbuf();
+    // Bounded read: a device or pipe (/dev/zero, a FIFO) has no size to check up front.
+    std::string text;
+    char chunk[1 << 16];
+    while (in.read(chunk, sizeof chunk) || in.gcount() > 0) {
+      text.append(chunk, static_cast<std::size_t>(in.gcount()));
+      if (text.size() > max_scene_bytes)
+        return make_error(ErrorCode::io, fmt::format("{}: more than the scene size limit {} bytes ({} MiB)",
+                                                     path.string(), max_scene_bytes, max_scene_bytes >> 20));
+    }
     if (in.bad())
       return make_error(ErrorCode::io, fmt::format("{}: read error", path.string()));
-    return parse_scene(text.str(), path.string(), overrides);
+    return parse_scene(text, path.string(), overrides);
   } catch (const std::exception& e) {
     return make_error(ErrorCode::io, fmt::format("{}: {}", path.string(), e.what()));
   }

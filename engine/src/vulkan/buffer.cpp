@@ -1,8 +1,31 @@
 #include "vk_internal.hpp"
 
+#include <cstdlib>
+#include <mutex>
+#include <string>
+
 #include <fmt/format.h>
 
 namespace vkcloth::gpu {
+namespace {
+
+/// Test hook: VKCLOTH_TEST_FAIL_ALLOCATION=N makes the Nth vkAllocateMemory of this process, counted
+/// from the moment the variable took its current value, fail with VK_ERROR_OUT_OF_DEVICE_MEMORY
+/// (without calling the driver). Unset or 0: no effect. Lets tests walk every allocation of a
+/// solver's creation and check that the failure is reported and everything before it is released.
+bool injected_allocation_failure() {
+  static std::mutex m;
+  static std::string seen;
+  static unsigned long count = 0;
+  const char* v = std::getenv("VKCLOTH_TEST_FAIL_ALLOCATION");
+  const std::string value = v ? v : "";
+  const std::lock_guard lock(m);
+  if (value != seen) seen = value, count = 0;
+  const unsigned long n = std::strtoul(value.c_str(), nullptr, 10);
+  return n != 0 && ++count == n;
+}
+
+} // namespace
 
 Result<Buffer> create_buffer(Context::Impl& ctx, VkDeviceSize size, VkBufferUsageFlags usage, MemoryUse use, bool allow_map,
                              const char* what) {
@@ -45,7 +68,10 @@ Result<Buffer> create_buffer(Context::Impl& ctx, VkDeviceSize size, VkBufferUsag
   ai.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
   ai.allocationSize = req.size;
   ai.memoryTypeIndex = static_cast<std::uint32_t>(type);
-  if (const VkResult r = vk.vkAllocateMemory(ctx.device, &ai, nullptr, &b.memory); r != VK_SUCCESS) {
+  const VkResult alloc = injected_allocation_failure() ? VK_ERROR_OUT_OF_DEVICE_MEMORY
+                                                       : vk.vkAllocateMemory(ctx.device, &ai, nullptr, &b.memory);
+  if (alloc == VK_SUCCESS) ctx.live_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (const VkResult r = alloc; r != VK_SUCCESS) {
     destroy_buffer(ctx, b);
     return vk_error(r, fmt::format("vkAllocateMemory ({}, {} bytes)", what, req.size));
   }
@@ -64,7 +90,10 @@ Result<Buffer> create_buffer(Context::Impl& ctx, VkDeviceSize size, VkBufferUsag
 
 void destroy_buffer(Context::Impl& ctx, Buffer& b) {
   if (b.buffer) ctx.vk.vkDestroyBuffer(ctx.device, b.buffer, nullptr);
-  if (b.memory) ctx.vk.vkFreeMemory(ctx.device, b.memory, nullptr); // unmaps implicitly
+  if (b.memory) {
+    ctx.vk.vkFreeMemory(ctx.device, b.memory, nullptr); // unmaps implicitly
+    ctx.live_allocations.fetch_sub(1, std::memory_order_relaxed);
+  }
   b = Buffer{};
 }
 

@@ -77,12 +77,17 @@ std::string version_string(std::uint32_t v) {
   return fmt::format("{}.{}.{}", VK_API_VERSION_MAJOR(v), VK_API_VERSION_MINOR(v), VK_API_VERSION_PATCH(v));
 }
 
+/// Validation messages of every Context of the process, including those reported while a Context
+/// is destroyed (leaked objects).
+std::atomic<std::uint64_t> g_process_messages{0};
+
 VKAPI_ATTR VkBool32 VKAPI_CALL debug_callback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                               VkDebugUtilsMessageTypeFlagsEXT, const VkDebugUtilsMessengerCallbackDataEXT* data,
                                               void* user) {
   auto* ctx = static_cast<Context::Impl*>(user);
   if (severity < VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT) return VK_FALSE;
   ctx->messages.fetch_add(1, std::memory_order_relaxed);
+  g_process_messages.fetch_add(1, std::memory_order_relaxed);
   if (ctx->print_messages)
     std::fprintf(stderr, "vkcloth: Vulkan validation %s: %s\n",
                  severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT ? "error" : "warning",
@@ -482,6 +487,8 @@ const VkPhysicalDeviceLimits& Context::limits() const { return impl_->properties
 bool Context::owns_device() const { return impl_->owns; }
 bool Context::validation_enabled() const { return impl_->validation; }
 std::uint64_t Context::validation_message_count() const { return impl_->messages.load(std::memory_order_relaxed); }
+std::uint64_t Context::process_validation_message_count() { return g_process_messages.load(std::memory_order_relaxed); }
+std::int64_t Context::live_allocation_count() const { return impl_->live_allocations.load(std::memory_order_relaxed); }
 Result<void> Context::wait_idle() const {
   VKCLOTH_VK_TRY(impl_->vk.vkDeviceWaitIdle(impl_->device), "vkDeviceWaitIdle");
   return {};

@@ -65,6 +65,7 @@ struct Context::Impl {
   bool print_messages = true;
   VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
   std::atomic<std::uint64_t> messages{0};
+  std::atomic<std::int64_t> live_allocations{0}; ///< create_buffer() allocations not yet freed
 
   Impl() = default;
   Impl(const Impl&) = delete;

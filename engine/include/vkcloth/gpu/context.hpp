@@ -97,6 +97,12 @@ public:
   bool validation_enabled() const;
   /// Validation warnings and errors reported so far (0 when validation is off).
   std::uint64_t validation_message_count() const;
+  /// Validation warnings and errors of every Context of this process so far, including those
+  /// reported while a Context was destroyed (e.g. leaked objects). The CLI's --validate uses it.
+  static std::uint64_t process_validation_message_count();
+  /// Device memory allocations vkcloth's solvers hold on this Context right now (0 once every
+  /// solver is destroyed, or after a failed GpuSolver::create: tests use it to check for leaks).
+  std::int64_t live_allocation_count() const;
 
   /// vkDeviceWaitIdle.
   Result<void> wait_idle() const;

@@ -1,0 +1,122 @@
+// Vulkan failure paths (issue #9): an allocation failing at any point of a solver's life is a clear
+// error, everything allocated before it is released, and the Context stays usable.
+#include <cstdlib>
+#include <string>
+
+#include "gpu_test_util.hpp"
+
+using namespace vkcloth;
+using namespace vkcloth::gpu;
+
+namespace {
+
+/// Sets VKCLOTH_TEST_FAIL_ALLOCATION for the scope (see engine/src/vulkan/buffer.cpp).
+struct FailAllocation {
+  explicit FailAllocation(unsigned n) { ::setenv("VKCLOTH_TEST_FAIL_ALLOCATION", std::to_string(n).c_str(), 1); }
+  ~FailAllocation() { ::unsetenv("VKCLOTH_TEST_FAIL_ALLOCATION"); }
+};
+
+bool is_injected_oom(const Error& e) {
+  return e.code == ErrorCode::out_of_memory && e.message.find("VK_ERROR_OUT_OF_DEVICE_MEMORY") != std::string::npos;
+}
+
+} // namespace
+
+TEST_CASE("GpuSolver: out of device memory at every allocation is reported, leaks nothing, keeps the Context usable") {
+  VKCLOTH_GPU_TEST_BEGIN(ctx);
+  ClothDesc d;
+  d.nx = 12;
+  d.ny = 9;
+  auto cloth = make_cloth(d);
+  REQUIRE(cloth.ok());
+  SimParams params;
+  params.colliders.push_back(Collider::sphere({0.5, 0.5, -1.0}, 0.3));
+  for (bool staging : {false, true}) {
+    CAPTURE(staging);
+    GpuSolverOptions o;
+    o.force_staging = staging;
+    REQUIRE(ctx.live_allocation_count() == 0);
+    unsigned failures = 0;
+    for (unsigned n = 1; n < 200; ++n) {
+      CAPTURE(n);
+      bool failed = false;
+      {
+        FailAllocation hook(n);
+        auto gpu = GpuSolver::create(ctx, *cloth, params, o);
+        if (!gpu.ok()) {
+          CHECK_MESSAGE(is_injected_oom(gpu.error()), gpu.error().message);
+          CHECK(gpu.error().message.find("vkAllocateMemory") != std::string::npos);
+          failed = true;
+        } else {
+          // Allocations after creation (readbacks, staging) fail cleanly too.
+          auto sim = gpu->simulate(3);
+          if (!sim.ok()) {
+            CHECK_MESSAGE(is_injected_oom(sim.error()), sim.error().message);
+            failed = true;
+          }
+          auto pos = gpu->positions();
+          if (!pos.ok()) {
+            CHECK_MESSAGE(is_injected_oom(pos.error()), pos.error().message);
+            failed = true;
+          }
+        }
+      }
+      CHECK(ctx.live_allocation_count() == 0); // everything released, solver or not
+      if (!failed) break;
+      ++failures;
+    }
+    CHECK(failures >= 5); // the walk really went through the solver's buffers
+    MESSAGE("staging=" << staging << ": " << failures << " allocation points failed cleanly");
+    // The Context works as before.
+    auto gpu = GpuSolver::create(ctx, *cloth, params, o);
+    REQUIRE(gpu.ok());
+    REQUIRE(gpu->simulate(20).ok());
+    CHECK(gpu->positions().ok());
+    CHECK(ctx.wait_idle().ok());
+  }
+  CHECK(ctx.live_allocation_count() == 0);
+}
+
+TEST_CASE("GpuSolver: the max_storage_buffer_bytes limit refuses before allocating anything") {
+  VKCLOTH_GPU_TEST_BEGIN(ctx);
+  auto cloth = make_cloth(ClothDesc{});
+  REQUIRE(cloth.ok());
+  GpuSolverOptions o;
+  o.max_storage_buffer_bytes = 16;
+  auto gpu = GpuSolver::create(ctx, *cloth, SimParams{}, o);
+  REQUIRE(!gpu.ok());
+  CHECK(gpu.error().code == ErrorCode::unsupported);
+  CHECK(ctx.live_allocation_count() == 0);
+}
+
+TEST_CASE("GpuSolver: simulate with steps_per_submit = 0 is an error, not a hang") {
+  VKCLOTH_GPU_TEST_BEGIN(ctx);
+  auto cloth = make_cloth(ClothDesc{});
+  REQUIRE(cloth.ok());
+  auto gpu = GpuSolver::create(ctx, *cloth, SimParams{});
+  REQUIRE(gpu.ok());
+  auto r = gpu->simulate(10, 0);
+  REQUIRE(!r.ok());
+  CHECK(r.error().code == ErrorCode::invalid_argument);
+  CHECK(r.error().message.find("steps_per_submit") != std::string::npos);
+  CHECK(gpu->simulate(0).ok());
+  CHECK(gpu->step_index() == 0);
+}
+
+TEST_CASE("Context: a device filter that selects nothing leaves nothing behind and a later Context works") {
+  ContextOptions o;
+  o.device_filter = "no-such-device-xyz";
+  o.validation = false;
+  for (int k = 0; k < 3; ++k) {
+    auto c = Context::create(o);
+    REQUIRE(!c.ok());
+    CHECK(c.error().code == ErrorCode::no_device);
+    CHECK(c.error().message.find("no-such-device-xyz") != std::string::npos);
+  }
+  VKCLOTH_GPU_TEST_BEGIN(ctx);
+  auto cloth = make_cloth(ClothDesc{});
+  REQUIRE(cloth.ok());
+  auto gpu = GpuSolver::create(ctx, *cloth, SimParams{});
+  REQUIRE(gpu.ok());
+  CHECK(gpu->simulate(5).ok());
+}
