@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_util.hpp"
+#include "vkcloth/render/image.hpp"
 
 using namespace vkcloth::test;
 
@@ -37,6 +38,54 @@ void check_spring_physics(const nlohmann::json& m) {
   CHECK(m["spring"]["double_spring"]["energy_end"].get<double>() < m["spring"]["double_spring"]["energy_start"].get<double>());
 }
 
+/// The cloth figures' numbers (report §3-4): each parameter study moves the way the report says.
+void check_cloth_physics(const nlohmann::json& m) {
+  const auto& c = m["cloth"];
+  auto num = [](const nlohmann::json& j) { return j.get<double>(); };
+  const auto& ks = c["k_struct"]; // Figure 7: the sag decreases as K_struct grows
+  CHECK(num(ks["5"]["sag"]) > num(ks["20"]["sag"]));
+  CHECK(num(ks["20"]["sag"]) > num(ks["50"]["sag"]));
+  for (const char* k : {"5", "20", "50"}) CHECK_FALSE(ks[k]["diverged"].get<bool>());
+  const auto& sh = c["k_shear"]; // Figure 8: the diagonal shear decreases as K_shear grows
+  CHECK(num(sh["1"]["diagonal_shear"]) > num(sh["10"]["diagonal_shear"]));
+  CHECK(num(sh["10"]["diagonal_shear"]) > num(sh["40"]["diagonal_shear"]));
+  const auto& kb = c["k_bend"]; // Figure 9: less folding (at the bend springs' span) as K_bend grows
+  CHECK(num(kb["2"]["fold_angle_deg"]) > num(kb["15"]["fold_angle_deg"]));
+  CHECK(num(kb["15"]["fold_angle_deg"]) > num(kb["40"]["fold_angle_deg"]));
+  const auto& w = c["wind"]; // Figure 13: the push grows with K_w
+  CHECK(num(w["0.01"]["displacement"]) > 0.0);
+  CHECK(num(w["0.02"]["displacement"]) > num(w["0.01"]["displacement"]));
+  CHECK(num(w["0.05"]["displacement"]) > num(w["0.02"]["displacement"]));
+  const auto& ct = c["contact"]; // Figure 12: without the into-collider test the cloth sticks
+  CHECK(num(ct["cancel_all"]["on_sphere_fraction"]) > 0.9);  // glued under the sphere
+  CHECK(num(ct["inward_only"]["on_sphere_fraction"]) < 0.1); // fell off
+  CHECK(num(ct["inward_only"]["mean_z"]) < num(ct["cancel_all"]["mean_z"]) - 0.3);
+  const auto& ns = c["no_structural"]; // Figure 5: holes (neighbours far apart) without structural springs
+  CHECK(num(ns["without_structural"]["max_neighbour_ratio"]) > 4.0);
+  CHECK(num(ns["with_structural"]["max_neighbour_ratio"]) < 2.5);
+  const auto& col = c["collisions"]; // Figure 11: nothing goes through the floor
+  CHECK(num(col["plane"]["min_z"]) > -1e-6);
+  CHECK(num(col["plane_sphere"]["min_z"]) > -1e-6);
+}
+
+/// The render golden-image metric (tests/render/render_test_util.hpp): a pixel differs when a
+/// channel differs by more than 8; the images match when under 0.5% of the pixels differ.
+double differing_fraction(const fs::path& a, const fs::path& b) {
+  auto ia = vkcloth::render::load_image(a), ib = vkcloth::render::load_image(b);
+  REQUIRE_MESSAGE(ia, a.string());
+  REQUIRE_MESSAGE(ib, b.string());
+  REQUIRE(ia->width == ib->width);
+  REQUIRE(ia->height == ib->height);
+  std::size_t differ = 0;
+  for (std::size_t p = 0; p < ia->rgba.size(); p += 4)
+    for (std::size_t ch = 0; ch < 3; ++ch)
+      if (std::abs(int(ia->rgba[p + ch]) - int(ib->rgba[p + ch])) > 8) {
+        ++differ;
+        break;
+      }
+  return double(differ) / double(ia->width * ia->height);
+}
+
 void check_gallery(const fs::path& dir) {
   const std::string html = slurp(dir / "index.html");
   REQUIRE_FALSE(html.empty());
@@ -51,13 +100,22 @@ void check_gallery(const fs::path& dir) {
 
 } // namespace
 
+// The suite runs the gallery with --quick: smaller cloth pictures, the same simulations and numbers.
 TEST_CASE("vkcloth figures (cpu): the gallery and the physics behind it") {
   const fs::path out = tmp_dir() / "figures_cpu";
   fs::remove_all(out);
-  const Outcome o = run_cli("figures_cpu", "figures --out " + quote(out.string()));
+  const Outcome o = run_cli("figures_cpu", "figures --quick --out " + quote(out.string()), validate);
   REQUIRE_MESSAGE(o.code == 0, o.err);
+  CHECK(o.err.find("validation") == std::string::npos);
+  CHECK(o.err.find("figures: cloth Figure 7") != std::string::npos); // progress per figure
   check_gallery(out);
-  check_spring_physics(nlohmann::json::parse(slurp(out / "figures.json")));
+  const auto m = nlohmann::json::parse(slurp(out / "figures.json"));
+  check_spring_physics(m);
+  check_cloth_physics(m);
+  if (have_vulkan_device())
+    for (const char* f : {"cloth_k_struct.png", "cloth_k_shear.png", "cloth_k_bend.png", "cloth_wind.png",
+                          "cloth_contact.png", "cloth_collisions.png", "cloth_no_structural.png", "cloth_gpu.png"})
+      CHECK_MESSAGE(fs::exists(out / f), f);
 }
 
 TEST_CASE("vkcloth figures --backend vulkan: the same physics on the GPU, zero validation messages") {
@@ -65,9 +123,22 @@ TEST_CASE("vkcloth figures --backend vulkan: the same physics on the GPU, zero v
     return;
   const fs::path out = tmp_dir() / "figures_vulkan";
   fs::remove_all(out);
-  const Outcome o = run_cli("figures_vulkan", "figures --backend vulkan --out " + quote(out.string()), validate);
+  const Outcome o = run_cli("figures_vulkan", "figures --quick --backend vulkan --out " + quote(out.string()), validate);
   REQUIRE_MESSAGE(o.code == 0, o.err);
   CHECK(o.err.find("validation") == std::string::npos);
   check_gallery(out);
-  check_spring_physics(nlohmann::json::parse(slurp(out / "figures.json")));
+  const auto m = nlohmann::json::parse(slurp(out / "figures.json"));
+  check_spring_physics(m);
+  check_cloth_physics(m);
+  // The same pictures as the CPU backend, within the golden-image threshold.
+  const fs::path cpu = tmp_dir() / "figures_vulkan_cpu_reference";
+  fs::remove_all(cpu);
+  const Outcome oc = run_cli("figures_vulkan_cpu_reference", "figures --quick --out " + quote(cpu.string()));
+  REQUIRE_MESSAGE(oc.code == 0, oc.err);
+  for (const char* f : {"cloth_k_struct.png", "cloth_k_shear.png", "cloth_k_bend.png", "cloth_wind.png",
+                        "cloth_contact.png", "cloth_collisions.png", "cloth_no_structural.png"}) {
+    const std::string file = f;
+    CAPTURE(file);
+    CHECK(differing_fraction(out / file, cpu / file) < 0.005);
+  }
 }

@@ -26,6 +26,7 @@ struct Gallery {
   std::string backend; ///< "cpu" | "vulkan"
   std::vector<Figure> figures;
   nlohmann::json metrics = nlohmann::json::object(); ///< the numbers behind the pictures
+  bool quick = false; ///< --quick: smaller cloth pictures (same physics, same numbers)
 
   Result<void> write_text(const std::string& file, const std::string& text) const;
   Result<void> write_index() const; ///< index.html and figures.json
@@ -44,5 +45,8 @@ Result<Trace> simulate(const Scene& scene, const std::string& backend, std::uint
 double total_energy(const Scene& scene, const std::vector<glm::dvec3>& pos, const std::vector<glm::dvec3>& vel);
 
 Result<void> spring_figures(Gallery& gallery);
+/// Figures 5, 7-9, 11-14: labelled image grids (rendered offscreen; skipped without a Vulkan device
+/// on the CPU backend, the numbers are computed either way) and metrics["cloth"].
+Result<void> cloth_figures(Gallery& gallery);
 
 } // namespace vkcloth::figures

@@ -5,9 +5,14 @@
 #include <fmt/format.h>
 
 #include "figures.hpp"
-#include "svg_plot.hpp"
+#include "vkcloth_plot/svg_plot.hpp"
 
 namespace vkcloth::figures {
+using plot::palette;
+using plot::Plot;
+using plot::Series;
+using plot::to_svg;
+
 namespace {
 
 constexpr double g = 9.81, L0 = 0.4;

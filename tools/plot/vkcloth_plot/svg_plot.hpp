@@ -1,10 +1,11 @@
-// Line plots written as standalone SVG files: the figures' plots need nothing but this.
+// Line plots written as standalone SVG files (library vkcloth_plot): used by `vkcloth figures`
+// and by the samples (spring, double_spring), which write their position and energy plots with it.
 #pragma once
 
 #include <string>
 #include <vector>
 
-namespace vkcloth::figures {
+namespace vkcloth::plot {
 
 struct Series {
   std::string label;
@@ -29,4 +30,4 @@ std::string to_svg(const Plot& plot);
 /// The default palette, one colour per series index.
 const char* palette(std::size_t index);
 
-} // namespace vkcloth::figures
+} // namespace vkcloth::plot

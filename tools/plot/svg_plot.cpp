@@ -1,11 +1,11 @@
-#include "svg_plot.hpp"
+#include "vkcloth_plot/svg_plot.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
 
-namespace vkcloth::figures {
+namespace vkcloth::plot {
 namespace {
 
 std::string escape(const std::string& s) {
@@ -113,4 +113,4 @@ std::string to_svg(const Plot& plot) {
   return svg;
 }
 
-} // namespace vkcloth::figures
+} // namespace vkcloth::plot
