@@ -350,10 +350,15 @@ TEST_CASE("the CPU grid stencil gives the same results as the CSR gather lists")
   ParticleSystem irregular = regular;
   irregular.springs.push_back(Spring{5 * d.nx + 5, 6 * d.nx + 7, 0.1, 0.0, SpringKind::plain});
   irregular.finalize();
+  // With and without colliders: without, the vectorised row kernel also integrates.
+  for (int colliders = 0; colliders < 2; ++colliders)
   for (Integrator integ : {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::rk4}) {
     CAPTURE(to_string(integ));
+    CAPTURE(colliders);
     p.integrator = integ;
     p.dt = integ == Integrator::explicit_euler ? 0.005 : 0.02;
+    if (colliders == 0) p.colliders.clear();
+    else p.colliders = {Collider::sphere({0, 0.2, 0.2}, 0.3)};
     auto a = CpuSolver<float>::create(regular, p, {1});
     auto b = CpuSolver<float>::create(irregular, p, {2});
     REQUIRE(a.ok());

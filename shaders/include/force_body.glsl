@@ -9,14 +9,65 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_POS_IN) readonly buffer PosIn 
 layout(std430, set = 0, binding = VKCLOTH_BINDING_OFFSETS) readonly buffer OffsetBuf { uint offsets[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_EDGES) readonly buffer EdgeBuf { Edge edges[]; };
 
+// Grid stencil (specialisation constants, set by the host when every interior particle's gather
+// list is the same up to translation: GpuSolver detect_stencil, like CpuSolver::detect_stencil).
+// Interior particles (2 <= i < nx-2, 2 <= j < ny-2) then sum their 12 springs from compile-time
+// offsets and constants instead of the CSR lists: same terms in the same (CSR) order, same bits.
+layout(constant_id = 0) const bool SC_STENCIL = false;
+layout(constant_id = 1) const uint SC_NX = 1u;
+layout(constant_id = 2) const uint SC_NY = 1u;
+layout(constant_id = 3) const int SC_OFF0 = 0;
+layout(constant_id = 4) const int SC_OFF1 = 0;
+layout(constant_id = 5) const int SC_OFF2 = 0;
+layout(constant_id = 6) const int SC_OFF3 = 0;
+layout(constant_id = 7) const int SC_OFF4 = 0;
+layout(constant_id = 8) const int SC_OFF5 = 0;
+layout(constant_id = 9) const int SC_OFF6 = 0;
+layout(constant_id = 10) const int SC_OFF7 = 0;
+layout(constant_id = 11) const int SC_OFF8 = 0;
+layout(constant_id = 12) const int SC_OFF9 = 0;
+layout(constant_id = 13) const int SC_OFF10 = 0;
+layout(constant_id = 14) const int SC_OFF11 = 0;
+layout(constant_id = 15) const float SC_L0 = 0.0;
+layout(constant_id = 16) const float SC_L1 = 0.0;
+layout(constant_id = 17) const float SC_L2 = 0.0;
+layout(constant_id = 18) const float SC_L3 = 0.0;
+layout(constant_id = 19) const float SC_L4 = 0.0;
+layout(constant_id = 20) const float SC_L5 = 0.0;
+layout(constant_id = 21) const float SC_L6 = 0.0;
+layout(constant_id = 22) const float SC_L7 = 0.0;
+layout(constant_id = 23) const float SC_L8 = 0.0;
+layout(constant_id = 24) const float SC_L9 = 0.0;
+layout(constant_id = 25) const float SC_L10 = 0.0;
+layout(constant_id = 26) const float SC_L11 = 0.0;
+layout(constant_id = 27) const float SC_K0 = 0.0;
+layout(constant_id = 28) const float SC_K1 = 0.0;
+layout(constant_id = 29) const float SC_K2 = 0.0;
+layout(constant_id = 30) const float SC_K3 = 0.0;
+layout(constant_id = 31) const float SC_K4 = 0.0;
+layout(constant_id = 32) const float SC_K5 = 0.0;
+layout(constant_id = 33) const float SC_K6 = 0.0;
+layout(constant_id = 34) const float SC_K7 = 0.0;
+layout(constant_id = 35) const float SC_K8 = 0.0;
+layout(constant_id = 36) const float SC_K9 = 0.0;
+layout(constant_id = 37) const float SC_K10 = 0.0;
+layout(constant_id = 38) const float SC_K11 = 0.0;
+
+// One spring term of report eq. 2, exactly as the CSR loop below.
+void spring_term(inout precise vec3 f, vec3 x, uint q, float rest, float k) {
+  precise vec3 u = pos_in[q].xyz - x;
+  precise float len = sqrt(dot3(u, u));
+  if (len > 0.0) f = f + u * (k * (len - rest) / len);
+}
+
 // CpuSolver::normal_at for particle (i, j): fan right, up, left, down; area-weighted sum of the
 // cross products of consecutive present edges, k = 0..3 in that order (the CPU's loop, unrolled:
 // no local arrays, which llvmpipe would keep in memory with per-lane gathers).
 vec3 grid_normal(uint p) {
-  const uint nx = pc.nx;
+  const uint nx = SC_STENCIL ? SC_NX : pc.nx; // a constant divisor when specialised
   const uint i = p % nx, j = p / nx;
   const vec3 x = pos_in[p].xyz;
-  const bool h0 = i + 1u < nx, h1 = j + 1u < pc.ny, h2 = i > 0u, h3 = j > 0u;
+  const bool h0 = i + 1u < nx, h1 = j + 1u < (SC_STENCIL ? SC_NY : pc.ny), h2 = i > 0u, h3 = j > 0u;
   precise vec3 e0 = vec3(0.0), e1 = vec3(0.0), e2 = vec3(0.0), e3 = vec3(0.0);
   if (h0) e0 = pos_in[p + 1u].xyz - x;
   if (h1) e1 = pos_in[p + nx].xyz - x;
@@ -40,12 +91,31 @@ void particle_force(uint p, inout vec3 v_io, out vec3 f_out, out vec3 nrm_out) {
 
   const vec3 x = pos_in[p].xyz;
   precise vec3 f = vec3(0.0);
-  const uint end = offsets[p + 1];
-  for (uint e = offsets[p]; e < end; ++e) {
-    const Edge s = edges[e];
-    precise vec3 u = pos_in[s.other].xyz - x;
-    precise float len = sqrt(dot3(u, u));
-    if (len > 0.0) f = f + u * (s.stiffness * (len - s.rest_length) / len); // report eq. 2
+  bool interior = false;
+  if (SC_STENCIL) {
+    const uint i = p % SC_NX, j = p / SC_NX;
+    interior = i >= 2u && i + 2u < SC_NX && j >= 2u && j + 2u < SC_NY;
+  }
+  if (interior) {
+    const int q = int(p);
+    spring_term(f, x, uint(q + SC_OFF0), SC_L0, SC_K0);
+    spring_term(f, x, uint(q + SC_OFF1), SC_L1, SC_K1);
+    spring_term(f, x, uint(q + SC_OFF2), SC_L2, SC_K2);
+    spring_term(f, x, uint(q + SC_OFF3), SC_L3, SC_K3);
+    spring_term(f, x, uint(q + SC_OFF4), SC_L4, SC_K4);
+    spring_term(f, x, uint(q + SC_OFF5), SC_L5, SC_K5);
+    spring_term(f, x, uint(q + SC_OFF6), SC_L6, SC_K6);
+    spring_term(f, x, uint(q + SC_OFF7), SC_L7, SC_K7);
+    spring_term(f, x, uint(q + SC_OFF8), SC_L8, SC_K8);
+    spring_term(f, x, uint(q + SC_OFF9), SC_L9, SC_K9);
+    spring_term(f, x, uint(q + SC_OFF10), SC_L10, SC_K10);
+    spring_term(f, x, uint(q + SC_OFF11), SC_L11, SC_K11);
+  } else {
+    const uint end = offsets[p + 1];
+    for (uint e = offsets[p]; e < end; ++e) {
+      const Edge s = edges[e];
+      spring_term(f, x, s.other, s.rest_length, s.stiffness); // report eq. 2
+    }
   }
   const float m = particle[p].mass;
   f = f + pc.gravity_damping.xyz * m;

@@ -120,6 +120,8 @@ private:
   bool stencil_ = false;
   std::array<std::int64_t, 12> stencil_offset_{};
   std::array<Edge, 12> stencil_edge_{};
+  std::array<Real, 12> stencil_rest_{}, stencil_stiff_{};
+  std::vector<Real> soa_; // positions as x[n], y[n], z[n] for the row kernel
   std::uint64_t step_ = 0;
   std::unique_ptr<detail::ThreadPool> pool_;
 };

@@ -36,6 +36,182 @@ template <typename Real> Contact<Real> collider_contact(const Collider& c, glm::
   return {len - Real(c.radius), n};
 }
 
+// ---- Interior row kernel (grid stencil) ----------------------------------------------------------
+// One contiguous run of interior particles [q0, q1) of one grid row, vectorised ACROSS particles:
+// positions are read from structure-of-arrays copies (px, py, pz) at the 12 fixed stencil offsets
+// and the 4 normal-fan offsets, so every load is unit-stride. Each particle's arithmetic is the
+// scalar path's, term for term and in the same order (normal_at, force_at, step()); `if (len > 0)`
+// becomes a select of the unchanged sum, which is the same value. sqrt and division are correctly
+// rounded in SIMD as in scalar code and -ffp-contract=off forbids FMA, so every lane computes the
+// bits the scalar code computes, on every ISA the clones below target.
+template <typename Real> struct RowArgs {
+  const Real *px, *py, *pz;    // positions, SoA
+  const Real* vel;             // velocities, AoS (x, y, z) per particle; written when integrating
+  Real* vel_out;               // == vel storage (in-place update), may be null when !integrate
+  const Real* mass;
+  const std::uint8_t* pinned;
+  Real* force_out;             // AoS
+  Real* normal_out;            // AoS
+  const Real* pos_aos;         // current positions, AoS (pinned particles copy theirs)
+  Real* pos_next;              // AoS, written when integrating
+  std::int64_t nx;
+  const std::int64_t* off;     // 12 stencil offsets
+  const Real* rest;            // 12
+  const Real* stiff;           // 12
+  Real gx, gy, gz, damping, kw, wx, wy, wz, dt;
+  bool wind, integrate, semi;
+};
+
+template <typename Real, bool wind, bool integrate, bool semi>
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+inline void row_kernel_body(const RowArgs<Real>& a, std::int64_t q0, std::int64_t q1) {
+  const Real* __restrict px = a.px;
+  const Real* __restrict py = a.py;
+  const Real* __restrict pz = a.pz;
+  const Real* __restrict mass = a.mass;
+  const std::uint8_t* __restrict pinned = a.pinned;
+  Real* __restrict fo = a.force_out;
+  Real* __restrict no = a.normal_out;
+  Real* __restrict vel = a.vel_out; // read and written in place (own particle only)
+  const Real* __restrict pos_aos = a.pos_aos;
+  Real* __restrict pos_next = a.pos_next;
+  const Real gx = a.gx, gy = a.gy, gz = a.gz, damping = a.damping, kw = a.kw, wx = a.wx, wy = a.wy, wz = a.wz,
+             dt = a.dt;
+  const std::int64_t nx = a.nx;
+  const std::int64_t o0 = a.off[0], o1 = a.off[1], o2 = a.off[2], o3 = a.off[3], o4 = a.off[4], o5 = a.off[5],
+                     o6 = a.off[6], o7 = a.off[7], o8 = a.off[8], o9 = a.off[9], o10 = a.off[10], o11 = a.off[11];
+  const Real L[12] = {a.rest[0], a.rest[1], a.rest[2], a.rest[3], a.rest[4],  a.rest[5],
+                      a.rest[6], a.rest[7], a.rest[8], a.rest[9], a.rest[10], a.rest[11]};
+  const Real K[12] = {a.stiff[0], a.stiff[1], a.stiff[2], a.stiff[3], a.stiff[4],  a.stiff[5],
+                      a.stiff[6], a.stiff[7], a.stiff[8], a.stiff[9], a.stiff[10], a.stiff[11]};
+  const std::int64_t O[12] = {o0, o1, o2, o3, o4, o5, o6, o7, o8, o9, o10, o11};
+  for (std::int64_t q = q0; q < q1; ++q) {
+    const Real x0 = px[q], y0 = py[q], z0 = pz[q];
+    // normal_at: fan right (e0), up (e1), left (e2), down (e3); all present inside.
+    const Real e0x = px[q + 1] - x0, e0y = py[q + 1] - y0, e0z = pz[q + 1] - z0;
+    const Real e1x = px[q + nx] - x0, e1y = py[q + nx] - y0, e1z = pz[q + nx] - z0;
+    const Real e2x = px[q - 1] - x0, e2y = py[q - 1] - y0, e2z = pz[q - 1] - z0;
+    const Real e3x = px[q - nx] - x0, e3y = py[q - nx] - y0, e3z = pz[q - nx] - z0;
+    // sum = 0; sum += cross(e_k, e_k+1) (glm::cross order), k = 0..3
+    Real sx = Real(0), sy = Real(0), sz = Real(0);
+#define VKCLOTH_CROSS_ADD(ax, ay, az, bx, by, bz)                                                                       \
+  sx = sx + (ay * bz - by * az);                                                                                       \
+  sy = sy + (az * bx - bz * ax);                                                                                       \
+  sz = sz + (ax * by - bx * ay);
+    VKCLOTH_CROSS_ADD(e0x, e0y, e0z, e1x, e1y, e1z)
+    VKCLOTH_CROSS_ADD(e1x, e1y, e1z, e2x, e2y, e2z)
+    VKCLOTH_CROSS_ADD(e2x, e2y, e2z, e3x, e3y, e3z)
+    VKCLOTH_CROSS_ADD(e3x, e3y, e3z, e0x, e0y, e0z)
+#undef VKCLOTH_CROSS_ADD
+    const Real nlen = std::sqrt(sx * sx + sy * sy + sz * sz);
+    const bool npos = nlen > Real(0);
+    // Computed unconditionally, then selected (no speculation for the vectoriser to refuse).
+    const Real qx = sx / nlen, qy = sy / nlen, qz = sz / nlen;
+    const Real nxv = npos ? qx : Real(0), nyv = npos ? qy : Real(0), nzv = npos ? qz : Real(0);
+    // force_at: the 12 stencil springs in CSR order.
+    Real fx = Real(0), fy = Real(0), fz = Real(0);
+#define VKCLOTH_SPRING(k)                                                                                              \
+  {                                                                                                                    \
+    const std::int64_t r = q + O[k];                                                                                   \
+    const Real ux = px[r] - x0, uy = py[r] - y0, uz = pz[r] - z0;                                                      \
+    const Real len = std::sqrt(ux * ux + uy * uy + uz * uz);                                                           \
+    const Real c = K[k] * (len - L[k]) / len;                                                                          \
+    const bool pos = len > Real(0);                                                                                    \
+    const Real tx = fx + ux * c, ty = fy + uy * c, tz = fz + uz * c;                                                   \
+    fx = pos ? tx : fx;                                                                                                \
+    fy = pos ? ty : fy;                                                                                                \
+    fz = pos ? tz : fz;                                                                                                \
+  }
+    VKCLOTH_SPRING(0) VKCLOTH_SPRING(1) VKCLOTH_SPRING(2) VKCLOTH_SPRING(3) VKCLOTH_SPRING(4) VKCLOTH_SPRING(5)
+    VKCLOTH_SPRING(6) VKCLOTH_SPRING(7) VKCLOTH_SPRING(8) VKCLOTH_SPRING(9) VKCLOTH_SPRING(10) VKCLOTH_SPRING(11)
+#undef VKCLOTH_SPRING
+    const Real m = mass[q];
+    fx = fx + gx * m;
+    fy = fy + gy * m;
+    fz = fz + gz * m;
+    const Real vx = vel[3 * q], vy = vel[3 * q + 1], vz = vel[3 * q + 2];
+    const Real dm = damping * m;
+    fx = fx - vx * dm;
+    fy = fy - vy * dm;
+    fz = fz - vz * dm;
+    if constexpr (wind) {
+      const Real kn = kw * (nxv * wx + nyv * wy + nzv * wz);
+      fx = fx + nxv * kn;
+      fy = fy + nyv * kn;
+      fz = fz + nzv * kn;
+    }
+    no[3 * q] = nxv;
+    no[3 * q + 1] = nyv;
+    no[3 * q + 2] = nzv;
+    fo[3 * q] = fx;
+    fo[3 * q + 1] = fy;
+    fo[3 * q + 2] = fz;
+    if constexpr (integrate) { // no colliders: contact_at and project_at do nothing
+      const Real ax = fx / m, ay = fy / m, az = fz / m;
+      const Real xx = pos_aos[3 * q], xy = pos_aos[3 * q + 1], xz = pos_aos[3 * q + 2];
+      Real nvx, nvy, nvz, nxx, nxy, nxz;
+      if constexpr (semi) {
+        nvx = vx + ax * dt;
+        nvy = vy + ay * dt;
+        nvz = vz + az * dt;
+        nxx = xx + nvx * dt;
+        nxy = xy + nvy * dt;
+        nxz = xz + nvz * dt;
+      } else {
+        nxx = xx + vx * dt;
+        nxy = xy + vy * dt;
+        nxz = xz + vz * dt;
+        nvx = vx + ax * dt;
+        nvy = vy + ay * dt;
+        nvz = vz + az * dt;
+      }
+      const bool pin = pinned[q] != 0;
+      pos_next[3 * q] = pin ? xx : nxx;
+      pos_next[3 * q + 1] = pin ? xy : nxy;
+      pos_next[3 * q + 2] = pin ? xz : nxz;
+      vel[3 * q] = pin ? vx : nvx;
+      vel[3 * q + 1] = pin ? vy : nvy;
+      vel[3 * q + 2] = pin ? vz : nvz;
+    }
+  }
+}
+
+// Runtime-dispatched clones (GCC/Clang ifunc): the default build stays portable (x86-64 baseline),
+// AVX2 / AVX-512 machines get wider vectors. Same bits on every clone (see above).
+#if defined(__x86_64__) && defined(__ELF__) && (defined(__GNUC__) || defined(__clang__)) && \
+    !defined(VKCLOTH_NO_TARGET_CLONES)
+#define VKCLOTH_ROW_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
+#else
+#define VKCLOTH_ROW_CLONES
+#endif
+template <typename Real>
+#if defined(__GNUC__)
+__attribute__((always_inline)) // into each clone below, so that each is compiled for its ISA
+#endif
+inline void row_kernel_dispatch(const RowArgs<Real>& a, std::int64_t q0, std::int64_t q1) {
+  const int v = (a.wind ? 4 : 0) | (a.integrate ? 2 : 0) | (a.semi ? 1 : 0);
+  switch (v) {
+  case 0: row_kernel_body<Real, false, false, false>(a, q0, q1); break;
+  case 1: row_kernel_body<Real, false, false, true>(a, q0, q1); break;
+  case 2: row_kernel_body<Real, false, true, false>(a, q0, q1); break;
+  case 3: row_kernel_body<Real, false, true, true>(a, q0, q1); break;
+  case 4: row_kernel_body<Real, true, false, false>(a, q0, q1); break;
+  case 5: row_kernel_body<Real, true, false, true>(a, q0, q1); break;
+  case 6: row_kernel_body<Real, true, true, false>(a, q0, q1); break;
+  default: row_kernel_body<Real, true, true, true>(a, q0, q1); break;
+  }
+}
+VKCLOTH_ROW_CLONES void row_kernel_f(const RowArgs<float>& a, std::int64_t q0, std::int64_t q1) {
+  row_kernel_dispatch(a, q0, q1);
+}
+VKCLOTH_ROW_CLONES void row_kernel_d(const RowArgs<double>& a, std::int64_t q0, std::int64_t q1) {
+  row_kernel_dispatch(a, q0, q1);
+}
+inline void row_kernel(const RowArgs<float>& a, std::int64_t q0, std::int64_t q1) { row_kernel_f(a, q0, q1); }
+inline void row_kernel(const RowArgs<double>& a, std::int64_t q0, std::int64_t q1) { row_kernel_d(a, q0, q1); }
+
 } // namespace
 
 template <typename Real> CpuSolver<Real>::CpuSolver() = default;
@@ -254,6 +430,101 @@ template <typename Real> Result<void> CpuSolver<Real>::step() {
   case Integrator::explicit_euler:
   case Integrator::semi_implicit_euler: {
     const bool semi = params_.integrator == Integrator::semi_implicit_euler;
+    // Grid stencil: interior runs of each row go through the vectorised row kernel (positions
+    // transposed to SoA first); the border particles through the per-particle code below.
+    const bool rows = stencil_;
+    const bool kernel_integrates = params_.colliders.empty();
+    RowArgs<Real> ra{};
+    std::int64_t gnx = 0, gny = 0;
+    if (rows) {
+      const std::size_t n = pos_.size();
+      if (soa_.size() != 3 * n) soa_.resize(3 * n);
+      Real* sx = soa_.data();
+      Real* sy = sx + n;
+      Real* sz = sy + n;
+      pool_->parallel_for(n, [&](std::size_t b, std::size_t e) {
+        for (std::size_t p = b; p < e; ++p) {
+          sx[p] = pos_[p].x;
+          sy[p] = pos_[p].y;
+          sz[p] = pos_[p].z;
+        }
+      });
+      gnx = system_->grid->nx;
+      gny = system_->grid->ny;
+      ra.px = sx;
+      ra.py = sy;
+      ra.pz = sz;
+      ra.vel = &vel_[0].x;
+      ra.vel_out = &vel_[0].x;
+      ra.mass = mass_.data();
+      ra.pinned = pinned_.data();
+      ra.force_out = &force_[0].x;
+      ra.normal_out = &normal_[0].x;
+      ra.pos_aos = &pos_[0].x;
+      ra.pos_next = &pos_next_[0].x;
+      ra.nx = gnx;
+      ra.off = stencil_offset_.data();
+      for (int k = 0; k < 12; ++k) {
+        stencil_rest_[k] = stencil_edge_[k].rest_length;
+        stencil_stiff_[k] = stencil_edge_[k].stiffness;
+      }
+      ra.rest = stencil_rest_.data();
+      ra.stiff = stencil_stiff_.data();
+      const Vec3 g{params_.gravity}, w{params_.wind.direction};
+      ra.gx = g.x;
+      ra.gy = g.y;
+      ra.gz = g.z;
+      ra.damping = Real(params_.damping);
+      ra.kw = Real(params_.wind.strength);
+      ra.wind = ra.kw != Real(0);
+      ra.wx = w.x;
+      ra.wy = w.y;
+      ra.wz = w.z;
+      ra.dt = dt;
+      ra.integrate = kernel_integrates;
+      ra.semi = semi;
+    }
+    auto finish = [&](std::size_t p, Vec3 f) {
+      if (pinned_[p]) {
+        force_[p] = f;
+        pos_next_[p] = pos_[p];
+        return;
+      }
+      Vec3 v = vel_[p];
+      contact_at(pos_[p], v, f);
+      force_[p] = f;
+      const Vec3 a = f / mass_[p];
+      Vec3 x = pos_[p];
+      if (semi) {
+        v += a * dt;
+        x += v * dt;
+      } else {
+        x += v * dt;
+        v += a * dt;
+      }
+      project_at(x, v);
+      pos_next_[p] = x;
+      vel_[p] = v; // only particle p reads its own velocity: updating in place is safe
+    };
+    if (rows) {
+      pool_->parallel_for(pos_.size(), [&](std::size_t b, std::size_t e) {
+        for (std::size_t p = b; p < e;) {
+          const std::int64_t j = std::int64_t(p) / gnx, i = std::int64_t(p) % gnx;
+          if (j >= 2 && j + 2 < gny && i >= 2 && i + 2 < gnx) {
+            const std::size_t run_end = std::min<std::size_t>(e, std::size_t(j * gnx + gnx - 2));
+            row_kernel(ra, std::int64_t(p), std::int64_t(run_end));
+            if (!kernel_integrates)
+              for (std::size_t q = p; q < run_end; ++q) finish(q, force_[q]);
+            p = run_end;
+            continue;
+          }
+          finish(p, normal_force_at(pos_, vel_, p));
+          ++p;
+        }
+      });
+      std::swap(pos_, pos_next_);
+      break;
+    }
     // One sweep: p's normal needs only positions (read-only here), and force_at reads p's own.
     for_particles([&](std::size_t p) {
       Vec3 f = normal_force_at(pos_, vel_, p);

@@ -44,6 +44,13 @@ struct GpuSolver::Impl {
   VkFence fence = VK_NULL_HANDLE;
   VkQueryPool queries = VK_NULL_HANDLE;
   std::uint32_t groups_x = 1, groups_y = 1;
+  // Grid stencil (force_body.glsl's specialisation constants 0..38): constant_id order.
+  struct Stencil {
+    std::uint32_t enabled = 0; // VkBool32
+    std::uint32_t nx = 1, ny = 1;
+    std::int32_t offset[12] = {};
+    float rest[12] = {}, stiffness[12] = {};
+  } stencil;
 
   sh::PushConstants pc{};
   std::uint64_t step = 0;     // completed steps (the bad one when diverged)
@@ -61,6 +68,7 @@ struct GpuSolver::Impl {
   std::uint32_t current() const { return static_cast<std::uint32_t>(recorded & 1u); }
 
   Result<void> init_pipelines();
+  void detect_stencil(const ParticleSystem& system);
   Result<void> write_sets();
   Result<void> upload_colliders();
   void set_push_constants();
@@ -166,11 +174,17 @@ Result<void> GpuSolver::Impl::init_pipelines() {
     }
     modules[2] = *um;
   }
+  // Specialisation constants of force_body.glsl (force.comp, fused.comp): the grid stencil.
+  static_assert(sizeof(Stencil) == 39 * 4);
+  std::array<VkSpecializationMapEntry, 39> entries{};
+  for (std::uint32_t k = 0; k < entries.size(); ++k) entries[k] = VkSpecializationMapEntry{k, k * 4, 4};
+  const VkSpecializationInfo spec{static_cast<std::uint32_t>(entries.size()), entries.data(), sizeof(Stencil), &stencil};
   VkComputePipelineCreateInfo ci[3]{};
   for (int k = 0; k < 3; ++k) {
     ci[k].sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
     ci[k].stage = VkPipelineShaderStageCreateInfo{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0,
-                                                  VK_SHADER_STAGE_COMPUTE_BIT, modules[k], "main", nullptr};
+                                                  VK_SHADER_STAGE_COMPUTE_BIT, modules[k], "main",
+                                                  k == 1 ? nullptr : &spec};
     ci[k].layout = layout;
   }
   VkPipeline pipes[3] = {};
@@ -181,6 +195,43 @@ Result<void> GpuSolver::Impl::init_pipelines() {
   integrate_pipeline = pipes[1];
   fused_pipeline = pipes[2];
   return {};
+}
+
+// Like CpuSolver::detect_stencil: the stencil applies when every interior particle's gather list
+// (2 <= i < nx-2, 2 <= j < ny-2) is the same up to translation, in the same order, with the same
+// float constants. Then the shaders' interior branch sums exactly the CSR terms in CSR order.
+void GpuSolver::Impl::detect_stencil(const ParticleSystem& system) {
+  stencil = Stencil{};
+  if (!system.grid) return;
+  const std::int64_t gx = system.grid->nx, gy = system.grid->ny;
+  if (gx < 5 || gy < 5) return;
+  const auto& off = system.adjacency.offsets;
+  const auto& refs = system.adjacency.refs;
+  const std::int64_t first = 2 * gx + 2;
+  if (off[first + 1] - off[first] != 12) return;
+  Stencil st;
+  st.enabled = 1;
+  st.nx = static_cast<std::uint32_t>(gx);
+  st.ny = static_cast<std::uint32_t>(gy);
+  for (int k = 0; k < 12; ++k) {
+    const SpringRef& r = refs[off[first] + k];
+    st.offset[k] = static_cast<std::int32_t>(std::int64_t(r.other) - first);
+    st.rest[k] = float(system.springs[r.spring].rest_length);
+    st.stiffness[k] = float(system.springs[r.spring].stiffness);
+  }
+  for (std::int64_t j = 2; j < gy - 2; ++j)
+    for (std::int64_t i = 2; i < gx - 2; ++i) {
+      const std::int64_t p = j * gx + i;
+      if (off[p + 1] - off[p] != 12) return;
+      for (int k = 0; k < 12; ++k) {
+        const SpringRef& r = refs[off[p] + k];
+        const Spring& sp = system.springs[r.spring];
+        if (std::int64_t(r.other) - p != st.offset[k] || float(sp.rest_length) != st.rest[k] ||
+            float(sp.stiffness) != st.stiffness[k])
+          return;
+      }
+    }
+  stencil = st;
 }
 
 Result<void> GpuSolver::Impl::write_sets() {
@@ -498,6 +549,7 @@ Result<GpuSolver> GpuSolver::create(Context& context, const ParticleSystem& syst
     qi.queryCount = 2;
     VKCLOTH_VK_TRY(v.vkCreateQueryPool(d, &qi, nullptr, &s.queries), "vkCreateQueryPool");
   }
+  if (!options.csr_only) s.detect_stencil(system);
   VKCLOTH_TRY(s.init_pipelines());
   VKCLOTH_TRY(s.write_sets());
   s.set_push_constants();

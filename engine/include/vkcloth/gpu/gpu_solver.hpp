@@ -45,6 +45,11 @@ struct GpuSolverOptions {
   /// Lower the workgroups per dispatch row below maxComputeWorkGroupCount[0] (0: the device's);
   /// larger systems then dispatch a second grid dimension (tests use it to exercise that path).
   std::uint32_t max_workgroups_x = 0;
+  /// Cloth grids: interior particles whose gather lists are all the same up to translation sum
+  /// their springs from a compile-time stencil (specialisation constants) instead of the CSR
+  /// lists; same terms in the same order, so the same bits. `true` keeps the CSR gather for every
+  /// particle (tests, comparison).
+  bool csr_only = false;
 };
 
 class GpuSolver {
