@@ -11,8 +11,29 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#if defined(__SANITIZE_ADDRESS__)
+#include <dlfcn.h>
+#include <link.h>
+#endif
+
 namespace vkcloth::gpu {
 namespace {
+
+/// Under AddressSanitizer only: keeps every library loaded so far (the Vulkan loader, the driver,
+/// the layers) loaded until exit. The loader unloads the driver at vkDestroyInstance, and
+/// LeakSanitizer's end-of-process report then cannot name the driver's one-time allocations, nor
+/// match them against tests/lsan.supp, which lists these libraries by name.
+void keep_vulkan_libraries_loaded_for_lsan() {
+#if defined(__SANITIZE_ADDRESS__)
+  dl_iterate_phdr(
+      [](dl_phdr_info* info, std::size_t, void*) -> int {
+        if (info->dlpi_name && *info->dlpi_name) dlopen(info->dlpi_name, RTLD_NOW | RTLD_NOLOAD | RTLD_NODELETE);
+        return 0;
+      },
+      nullptr);
+#endif
+}
+
 
 // volk's function pointers are process globals: every use of them goes through this mutex, and
 // each Context keeps its own vkGetInstanceProcAddr and tables so they never depend on the globals.
@@ -330,6 +351,7 @@ Result<std::vector<DeviceInfo>> Context::list_devices() {
   VKCLOTH_VK_TRY(impl->fi.vkEnumeratePhysicalDevices(impl->instance, &n, nullptr), "vkEnumeratePhysicalDevices");
   std::vector<VkPhysicalDevice> pds(n);
   VKCLOTH_VK_TRY(impl->fi.vkEnumeratePhysicalDevices(impl->instance, &n, pds.data()), "vkEnumeratePhysicalDevices");
+  keep_vulkan_libraries_loaded_for_lsan(); // the drivers are loaded now
   std::vector<DeviceInfo> out;
   for (std::uint32_t i = 0; i < n; ++i) {
     VkPhysicalDeviceProperties p;
@@ -380,6 +402,7 @@ Result<Context> Context::create(const ContextOptions& options) {
                                             "mesa-vulkan-drivers for the lavapipe CPU device)");
   std::vector<VkPhysicalDevice> pds(n);
   VKCLOTH_VK_TRY(impl->fi.vkEnumeratePhysicalDevices(impl->instance, &n, pds.data()), "vkEnumeratePhysicalDevices");
+  keep_vulkan_libraries_loaded_for_lsan(); // the drivers are loaded now
 
   struct Candidate {
     std::uint32_t index;
