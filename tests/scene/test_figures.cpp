@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_util.hpp"
+#include "stability_map_check.hpp"
 
 using namespace vkcloth::test;
 
@@ -58,6 +59,7 @@ TEST_CASE("vkcloth figures (cpu): the gallery and the physics behind it") {
   REQUIRE_MESSAGE(o.code == 0, o.err);
   check_gallery(out);
   check_spring_physics(nlohmann::json::parse(slurp(out / "figures.json")));
+  check_stability_map(nlohmann::json::parse(slurp(out / "figures.json")));
 }
 
 TEST_CASE("vkcloth figures --backend vulkan: the same physics on the GPU, zero validation messages") {

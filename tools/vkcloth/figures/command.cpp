@@ -25,6 +25,7 @@ int figures_command(const FiguresOptions& opt) {
   fmt::print(stderr, "figures: springs...\n");
   if (auto r = figures::spring_figures(gallery); !r)
     return report(r.error());
+  if (auto r = figures::stability_figures(gallery); !r) return report(r.error());
   if (auto r = gallery.write_index(); !r)
     return report(r.error());
   fmt::print("{} figures in {}/index.html\n", gallery.figures.size(), opt.out);

@@ -44,5 +44,7 @@ Result<Trace> simulate(const Scene& scene, const std::string& backend, std::uint
 double total_energy(const Scene& scene, const std::vector<glm::dvec3>& pos, const std::vector<glm::dvec3>& vel);
 
 Result<void> spring_figures(Gallery& gallery);
+/// The (K_struct, dt) stability map of semi-implicit Euler, RK4 and implicit Euler (stability.cpp).
+Result<void> stability_figures(Gallery& gallery);
 
 } // namespace vkcloth::figures
