@@ -7,6 +7,7 @@
 
 #include "cli_util.hpp"
 #include "vkcloth/render/image.hpp"
+#include "stability_map_check.hpp"
 
 using namespace vkcloth::test;
 
@@ -112,6 +113,7 @@ TEST_CASE("vkcloth figures (cpu): the gallery and the physics behind it") {
   const auto m = nlohmann::json::parse(slurp(out / "figures.json"));
   check_spring_physics(m);
   check_cloth_physics(m);
+  check_stability_map(m);
   if (have_vulkan_device())
     for (const char* f : {"cloth_k_struct.png", "cloth_k_shear.png", "cloth_k_bend.png", "cloth_wind.png",
                           "cloth_contact.png", "cloth_collisions.png", "cloth_no_structural.png", "cloth_gpu.png"})

@@ -120,8 +120,14 @@ TEST_CASE("system: required, known, and only its own section") {
 }
 
 TEST_CASE("unknown integrator names the key and the value") {
-  expect_error(R"({"system": "chain", "integrator": {"method": "implicit_euler"}})",
-               {"integrator.method", "implicit_euler", "rk4"});
+  expect_error(R"({"system": "chain", "integrator": {"method": "verlet"}})",
+               {"integrator.method", "verlet", "rk4", "implicit_euler"});
+}
+
+TEST_CASE("substeps and the CG keys are range-checked") {
+  expect_error(R"({"system": "chain", "integrator": {"substeps": 0}})", {"integrator.substeps", "0"});
+  expect_error(R"({"system": "chain", "integrator": {"cg_tolerance": 2}})", {"integrator.cg_tolerance", "2"});
+  expect_error(R"({"system": "chain", "integrator": {"cg_max_iterations": 0}})", {"integrator.cg_max_iterations", "0"});
 }
 
 TEST_CASE("bad overrides name the override and the path") {

@@ -32,6 +32,8 @@ public:
   /// Steps taken so far, and the simulated time step_index() * dt.
   virtual std::uint64_t step_index() const = 0;
   virtual double time() const = 0;
+  /// implicit_euler: the last substep's CG iterations and relative residual.
+  virtual SolveStats last_solve() const { return {}; }
 };
 
 /// "cpu" or "vulkan". Unknown name: ErrorCode::invalid_argument; no Vulkan device: ErrorCode::no_device.

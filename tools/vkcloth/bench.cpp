@@ -110,6 +110,8 @@ struct Row {
   unsigned reps = 0;
   double wall_ms = 0;          // median over reps of the wall time of `steps` steps
   double gpu_ms = -1;          // median GPU (timestamp) time of `steps` steps; -1 for the CPU
+  std::string integrator;      // the scheme timed (implicit runs add a semi-implicit baseline row)
+  std::uint32_t cg_iterations = 0; // implicit_euler: CG iterations of the last step
   Cost cost;
 };
 
@@ -137,6 +139,8 @@ Result<Row> bench_cpu(const BenchScene& sc, std::uint32_t n, const BenchOptions&
   Row row;
   row.backend = "cpu";
   row.variant = "cpu";
+  row.integrator = to_string(sc.params.integrator);
+  row.cg_iterations = s->last_solve().iterations;
   row.threads = s->threads();
   row.size = n;
   row.wall_ms = median(wall);
@@ -158,7 +162,11 @@ Result<Row> bench_vulkan(gpu::Context& ctx, const BenchScene& sc, std::uint32_t 
   }
   Row row;
   row.backend = "vulkan";
-  row.variant = fused && sc.params.integrator != Integrator::rk4 ? "fused" : "two_pass";
+  row.variant = sc.params.integrator == Integrator::implicit_euler ? "implicit"
+                : fused && sc.params.integrator != Integrator::rk4 ? "fused"
+                                                                   : "two_pass";
+  row.integrator = to_string(sc.params.integrator);
+  row.cg_iterations = s->last_solve().iterations;
   row.size = n;
   row.wall_ms = median(wall);
   row.gpu_ms = median(gpu_ms);
@@ -193,7 +201,7 @@ int bench_command(const BenchOptions& o) {
   const auto integrator = parse_integrator(o.integrator);
   if (!integrator)
     return report(make_error(ErrorCode::invalid_argument,
-                             fmt::format("--integrator must be explicit_euler, semi_implicit_euler or rk4, got '{}'",
+                             fmt::format("--integrator must be explicit_euler, semi_implicit_euler, rk4 or implicit_euler, got '{}'",
                                          o.integrator)));
   auto sizes = parse_sizes(o.sizes);
   if (!sizes) return report(sizes.error());
@@ -231,12 +239,21 @@ int bench_command(const BenchOptions& o) {
       rows.push_back(*r);
       return exit_ok;
     };
+    const bool implicit = *integrator == Integrator::implicit_euler;
     if (o.backend != "vulkan")
       if (int e = add(bench_cpu(*sc, n, o))) return e;
     if (ctx) {
       if (int e = add(bench_vulkan(*ctx, *sc, n, true, o))) return e;
-      if (*integrator != Integrator::rk4)
+      if (*integrator != Integrator::rk4 && !implicit)
         if (int e = add(bench_vulkan(*ctx, *sc, n, false, o))) return e;
+    }
+    if (implicit) { // the explicit baseline at the same size and dt, for the cost ratio
+      auto base = bench_scene(n, Integrator::semi_implicit_euler, dt);
+      if (!base) return report(base.error());
+      if (o.backend != "vulkan")
+        if (int e = add(bench_cpu(*base, n, o))) return e;
+      if (ctx)
+        if (int e = add(bench_vulkan(*ctx, *base, n, true, o))) return e;
     }
   }
 
@@ -266,6 +283,13 @@ int bench_command(const BenchOptions& o) {
     nlohmann::json j;
     j["backend"] = r.backend;
     j["variant"] = r.variant;
+    j["integrator"] = r.integrator;
+    if (r.integrator == "implicit_euler") {
+      j["cg_iterations_last_step"] = r.cg_iterations;
+      for (const Row& e : rows) // the semi-implicit baseline of the same backend and size
+        if (e.backend == r.backend && e.size == r.size && e.integrator == "semi_implicit_euler")
+          j["implicit_over_explicit"] = r.wall_ms / e.wall_ms;
+    }
     j["size"] = r.size;
     j["particles"] = r.particles;
     j["springs"] = r.springs;
@@ -285,6 +309,14 @@ int bench_command(const BenchOptions& o) {
     j["compute_fraction"] = gflops / o.compute_gflops;
     results.push_back(std::move(j));
   }
+  for (const Row& r : rows)
+    if (r.integrator == "implicit_euler")
+      for (const Row& e : rows)
+        if (e.backend == r.backend && e.size == r.size && e.integrator == "semi_implicit_euler")
+          fmt::print("{} n = {}: implicit step {:.4f} ms vs semi-implicit {:.4f} ms: {:.1f}x the explicit cost "
+                     "({} CG iterations in the last step)\n",
+                     r.backend, r.size, r.wall_ms / double(r.steps), e.wall_ms / double(e.steps), r.wall_ms / e.wall_ms,
+                     r.cg_iterations);
   if (!o.json.empty()) {
     nlohmann::json doc;
     doc["schema"] = "vkcloth-bench/1";
@@ -321,7 +353,7 @@ void add_bench_command(CLI::App& app, int* exit) {
   cmd->add_option("--steps", opt->steps, "Timed steps per repetition")->capture_default_str();
   cmd->add_option("--warmup", opt->warmup, "Untimed steps before the first repetition")->capture_default_str();
   cmd->add_option("--reps", opt->reps, "Repetitions; the median is reported")->capture_default_str();
-  cmd->add_option("--integrator", opt->integrator, "explicit_euler | semi_implicit_euler | rk4")->capture_default_str();
+  cmd->add_option("--integrator", opt->integrator, "explicit_euler | semi_implicit_euler | rk4 | implicit_euler (adds a semi-implicit baseline row and the cost ratio)")->capture_default_str();
   cmd->add_option("--threads", opt->threads, "CPU solver threads (0: the host's hardware threads)")->capture_default_str();
   cmd->add_option("--steps-per-submit", opt->steps_per_submit, "Vulkan: steps recorded per command buffer")
       ->capture_default_str();

@@ -166,6 +166,11 @@ int run_command(const RunOptions& opt) {
       "max displacement {:.6g} m\n",
       scene->name, scene->system.size(), scene->system.springs.size(), backend.step_index(), scene->params.dt,
       to_string(scene->params.integrator), opt.backend, opt.precision, backend.time(), wall, max_disp);
+  if (scene->params.integrator == Integrator::implicit_euler) {
+    const SolveStats cg = backend.last_solve();
+    fmt::print("implicit_euler: last solve {} CG iterations, relative residual {:.3g} (tolerance {:g}, cap {})\n",
+               cg.iterations, cg.residual, scene->params.cg_tolerance, scene->params.cg_max_iterations);
+  }
   return exit_ok;
 }
 

@@ -7,7 +7,9 @@
 //                      + m g - mu m v + Kw <n, u_w> n
 //   3. contact   for each collider the particle touches (distance < 2 eps): remove the normal
 //                part of v and F only where it points into the collider (report §4, Figure 12)
-//   4. integrate explicit / semi-implicit Euler, or RK4 (steps 1-3 at each stage)
+//   4. integrate explicit / semi-implicit Euler, RK4 (steps 1-3 at each stage), or implicit Euler
+//                (linearised backward Euler solved by PCG, implicit_euler.hpp; the new velocity's
+//                inward part removed for particles in contact)
 //   5. project   a particle inside a collider is put back at surface + eps, and its inward
 //                velocity removed; pinned particles are left where they are
 //   6. check     NaN/inf or |p| > divergence_limit -> Error{diverged} naming the step and time
@@ -29,6 +31,7 @@ namespace vkcloth {
 
 namespace detail {
 class ThreadPool;
+template <typename Real> struct ImplicitWorkspace;
 }
 
 struct CpuSolverOptions {
@@ -52,7 +55,7 @@ public:
 
   unsigned threads() const;
 
-  /// Advances one time step. On a blow-up the state is left as it was after the bad step.
+  /// Advances one time step (params().substeps substeps of dt / substeps). On a blow-up the state is left as it was after the bad step.
   Result<void> step();
   /// Advances `steps` steps, stopping at the first error.
   Result<void> run(std::uint64_t steps);
@@ -67,6 +70,9 @@ public:
   std::span<const Vec3> forces() const { return force_; }
   /// Unit normals of the last evaluation (zero for chains and degenerate fans).
   std::span<const Vec3> normals() const { return normal_; }
+
+  /// implicit_euler: CG iterations and relative residual of the last substep's solve.
+  const SolveStats& last_solve() const { return solve_; }
 
   std::uint64_t step_index() const { return step_; }
   double time() const { return static_cast<double>(step_) * params_.dt; }
@@ -96,6 +102,8 @@ private:
   void project_at(Vec3& pos, Vec3& vel) const;
   template <typename F> void for_particles(F&& body);
   Result<void> check_finite() const;
+  void substep(Real h);
+  void implicit_substep(Real h); // implicit_euler.cpp
 
   struct Edge {
     std::uint32_t other;
@@ -124,6 +132,8 @@ private:
   std::vector<Real> soa_; // positions as x[n], y[n], z[n] for the row kernel
   std::uint64_t step_ = 0;
   std::unique_ptr<detail::ThreadPool> pool_;
+  std::unique_ptr<detail::ImplicitWorkspace<Real>> implicit_; // created by the first implicit step
+  SolveStats solve_;
 };
 
 extern template class CpuSolver<float>;

@@ -18,6 +18,13 @@ enum class Integrator : std::uint32_t {
   explicit_euler = 0,      ///< p += dt v_old; v += dt a   (report eq. 3 as written)
   semi_implicit_euler = 1, ///< v += dt a; p += dt v_new   (what the report observed; the default)
   rk4 = 2,                 ///< classic 4-stage Runge-Kutta on (p, v)
+  implicit_euler = 3,      ///< backward Euler (Baraff & Witkin 1998), linearised, solved by PCG
+};
+
+/// What the last implicit solve achieved (zero for the explicit integrators).
+struct SolveStats {
+  std::uint32_t iterations = 0; ///< CG iterations of the last (sub)step
+  double residual = 0.0;        ///< |r| / |S b| at the end (0 when the right-hand side is 0)
 };
 
 const char* to_string(Integrator integrator);
@@ -47,6 +54,12 @@ struct Wind {
 struct SimParams {
   Integrator integrator = Integrator::semi_implicit_euler;
   double dt = 0.02;
+  /// One step = `substeps` substeps of dt / substeps (every integrator); time advances by dt.
+  std::uint32_t substeps = 1;
+  /// implicit_euler: CG stops when |r| <= cg_tolerance |S b| (relative residual) ...
+  double cg_tolerance = 1e-6;
+  /// ... or after this many iterations (then the step uses the last iterate).
+  std::uint32_t cg_max_iterations = 200;
   glm::dvec3 gravity{0.0, 0.0, -9.81};
   /// Fluid damping mu (1/s): the force -mu m v. With m = 1 it is the report's -mu v (§2);
   /// on a cloth it is eq. 4's (1 - dt mu) velocity factor.

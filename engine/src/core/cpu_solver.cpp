@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
 
+#include "implicit_euler.hpp"
 #include "thread_pool.hpp"
 
 // Floating-point expressions below are written in the exact order the GLSL passes use
@@ -425,8 +426,19 @@ template <typename Real> Result<void> CpuSolver<Real>::check_finite() const {
 }
 
 template <typename Real> Result<void> CpuSolver<Real>::step() {
-  const Real dt = Real(params_.dt);
+  // integrator.substeps = k: k substeps of dt / k (bit-identical to k steps with dt / k).
+  const std::uint32_t k = params_.substeps;
+  const Real h = Real(k == 1 ? params_.dt : params_.dt / double(k));
+  for (std::uint32_t s = 0; s < k; ++s) substep(h);
+  ++step_;
+  return check_finite();
+}
+
+template <typename Real> void CpuSolver<Real>::substep(const Real dt) {
   switch (params_.integrator) {
+  case Integrator::implicit_euler:
+    implicit_substep(dt);
+    break;
   case Integrator::explicit_euler:
   case Integrator::semi_implicit_euler: {
     const bool semi = params_.integrator == Integrator::semi_implicit_euler;
@@ -596,8 +608,6 @@ template <typename Real> Result<void> CpuSolver<Real>::step() {
     break;
   }
   }
-  ++step_;
-  return check_finite();
 }
 
 template <typename Real> Result<void> CpuSolver<Real>::run(std::uint64_t steps) {

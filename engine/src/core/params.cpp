@@ -19,20 +19,28 @@ const char* to_string(Integrator integrator) {
   case Integrator::explicit_euler: return "explicit_euler";
   case Integrator::semi_implicit_euler: return "semi_implicit_euler";
   case Integrator::rk4: return "rk4";
+  case Integrator::implicit_euler: return "implicit_euler";
   }
   return "?";
 }
 
 std::optional<Integrator> parse_integrator(std::string_view name) {
-  for (Integrator i : {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::rk4})
+  for (Integrator i : {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::rk4,
+                         Integrator::implicit_euler})
     if (name == to_string(i)) return i;
   return std::nullopt;
 }
 
 Result<void> SimParams::validate() {
-  if (static_cast<std::uint32_t>(integrator) > static_cast<std::uint32_t>(Integrator::rk4))
+  if (static_cast<std::uint32_t>(integrator) > static_cast<std::uint32_t>(Integrator::implicit_euler))
     return bad(fmt::format("integrator.method: unknown integrator {}", static_cast<std::uint32_t>(integrator)));
   if (!std::isfinite(dt) || dt <= 0.0) return bad(fmt::format("integrator.dt must be finite and > 0, got {}", dt));
+  if (substeps < 1 || substeps > 1000000)
+    return bad(fmt::format("integrator.substeps must be in 1..1000000, got {}", substeps));
+  if (!std::isfinite(cg_tolerance) || cg_tolerance < 0.0 || cg_tolerance >= 1.0)
+    return bad(fmt::format("integrator.cg_tolerance must be finite and in [0, 1), got {}", cg_tolerance));
+  if (cg_max_iterations < 1 || cg_max_iterations > 100000)
+    return bad(fmt::format("integrator.cg_max_iterations must be in 1..100000, got {}", cg_max_iterations));
   if (!finite(gravity)) return bad("physics.gravity must be finite, got " + str(gravity));
   if (!std::isfinite(damping) || damping < 0.0)
     return bad(fmt::format("physics.damping must be finite and >= 0, got {}", damping));

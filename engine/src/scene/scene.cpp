@@ -30,17 +30,26 @@ Result<void> read_integrator(const json& doc, SimParams& params, std::uint64_t& 
   SCENE_TRY_ASSIGN(obj, sd::read_object(doc, "", "integrator"));
   if (!obj)
     return {};
-  VKCLOTH_TRY(sd::check_keys(*obj, "integrator", {"method", "dt", "steps"}));
+  VKCLOTH_TRY(sd::check_keys(*obj, "integrator", {"method", "dt", "steps", "substeps", "cg_tolerance", "cg_max_iterations"}));
   std::string method = to_string(params.integrator);
   VKCLOTH_TRY(sd::read(*obj, "integrator", "method", method));
   const auto integ = parse_integrator(method);
   if (!integ)
     return make_error(ErrorCode::invalid_argument,
                       fmt::format("integrator.method: unknown integrator \"{}\" (known: explicit_euler, "
-                                  "semi_implicit_euler, rk4)",
+                                  "semi_implicit_euler, rk4, implicit_euler)",
                                   method));
   params.integrator = *integ;
   VKCLOTH_TRY(sd::read(*obj, "integrator", "dt", params.dt));
+  if (auto it = obj->find("substeps"); it != obj->end()) {
+    SCENE_TRY_ASSIGN(n, sd::as_integer(*it, "integrator.substeps", 1000000));
+    params.substeps = static_cast<std::uint32_t>(n);
+  }
+  VKCLOTH_TRY(sd::read(*obj, "integrator", "cg_tolerance", params.cg_tolerance));
+  if (auto it = obj->find("cg_max_iterations"); it != obj->end()) {
+    SCENE_TRY_ASSIGN(n, sd::as_integer(*it, "integrator.cg_max_iterations", 100000));
+    params.cg_max_iterations = static_cast<std::uint32_t>(n);
+  }
   if (auto it = obj->find("steps"); it != obj->end()) {
     SCENE_TRY_ASSIGN(n, sd::as_integer(*it, "integrator.steps", max_scene_steps));
     steps = n;

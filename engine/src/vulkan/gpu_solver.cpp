@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "barriers.hpp"
+#include "implicit_gpu.hpp"
 #include "vkcloth/gpu/gpu_solver.hpp"
 #include "vkcloth/shaders/force_comp_spv.hpp"
 #include "vkcloth/shaders/integrate_comp_spv.hpp"
@@ -51,10 +52,13 @@ struct GpuSolver::Impl {
     std::int32_t offset[12] = {};
     float rest[12] = {}, stiffness[12] = {};
   } stencil;
+  std::uint64_t edges_count = 0;
 
   sh::PushConstants pc{};
   std::uint64_t step = 0;     // completed steps (the bad one when diverged)
-  std::uint64_t recorded = 0; // recorded steps: parity of the current positions, flag step numbers
+  std::uint64_t recorded = 0; // recorded steps: flag step numbers
+  std::uint32_t parity = 0;   // positions[parity] is current; flipped by every recorded substep
+  std::unique_ptr<ImplicitGpu> implicit; // created when the integrator is implicit_euler
   std::vector<glm::vec2> uvs;
   double last_ms = -1.0;
   std::optional<Error> diverged;
@@ -65,7 +69,9 @@ struct GpuSolver::Impl {
   ~Impl();
 
   const VolkDeviceTable& vk() const { return ctx->vk; }
-  std::uint32_t current() const { return static_cast<std::uint32_t>(recorded & 1u); }
+  std::uint32_t current() const { return parity; }
+  Result<void> ensure_implicit();
+  void record_substep(VkCommandBuffer cmd, bool first);
 
   Result<void> init_pipelines();
   void detect_stencil(const ParticleSystem& system);
@@ -270,6 +276,9 @@ Result<void> GpuSolver::Impl::write_sets() {
       }
     }
   vk().vkUpdateDescriptorSets(ctx->device, static_cast<std::uint32_t>(writes.size()), writes.data(), 0, nullptr);
+  if (implicit)
+    return implicit->write_sets({{pos[0].buffer, pos[1].buffer}, vel.buffer, force.buffer, normal.buffer, particle.buffer,
+                                 offsets.buffer, edges.buffer, colliders.buffer, flags.buffer});
   return {};
 }
 
@@ -301,7 +310,7 @@ Result<void> GpuSolver::Impl::upload_colliders() {
 
 void GpuSolver::Impl::set_push_constants() {
   // Conversions exactly as CpuSolver<float>: each double field cast to float, then float math.
-  const float dt = float(params.dt);
+  const float dt = float(params.substeps == 1 ? params.dt : params.dt / double(params.substeps)); // as the CPU
   pc.count = count;
   pc.nx = nx;
   pc.ny = ny;
@@ -382,57 +391,68 @@ Result<void> GpuSolver::Impl::check_flags() {
   return *diverged;
 }
 
+Result<void> GpuSolver::Impl::ensure_implicit() {
+  if (params.integrator != Integrator::implicit_euler || implicit) return {};
+  auto r = ImplicitGpu::create(ctx, count, edges_count, groups_x, groups_y, !options.force_staging);
+  if (!r) return r.error();
+  implicit = std::move(*r);
+  return write_sets();
+}
+
 void GpuSolver::Impl::record(VkCommandBuffer c, std::uint32_t steps) {
   if (steps == 0) return;
+  barriers::before_steps(vk(), c);
+  bool first = true;
+  for (std::uint32_t s = 0; s < steps; ++s) {
+    pc.step = static_cast<std::uint32_t>(recorded + 1); // 1-based number of the step being computed
+    for (std::uint32_t k = 0; k < params.substeps; ++k) {
+      record_substep(c, first);
+      first = false;
+      parity ^= 1u; // positions[read ^ 1] now holds the new state
+    }
+    ++recorded;
+    if (!diverged) ++step;
+  }
+}
+
+void GpuSolver::Impl::record_substep(VkCommandBuffer c, bool first) {
   const auto& v = vk();
-  barriers::before_steps(v, c);
+  const std::uint32_t read = current();
+  if (params.integrator == Integrator::implicit_euler) {
+    implicit->record_substep(c, read, pc, params, first);
+    return;
+  }
   const bool rk4 = params.integrator == Integrator::rk4;
+  if (options.fused && !rk4) {
+    // One dispatch per (sub)step (fused.comp); the descriptor set alternates with the parity.
+    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, fused_pipeline);
+    pc.stage = 0;
+    const VkDescriptorSet set = sets[read][0];
+    v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &set, 0, nullptr);
+    v.vkCmdPushConstants(c, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
+    if (!first) barriers::dispatch_to_dispatch(v, c); // previous step -> this step
+    v.vkCmdDispatch(c, groups_x, groups_y, 1);
+    return;
+  }
   const std::uint32_t stages = rk4 ? 4 : 1;
   const float half = pc.dt / 2.0f; // CPU: c = {0, dt/2, dt/2, dt}
   const float c_next[4] = {half, half, pc.dt, 0.0f};
   VkDescriptorSet bound = VK_NULL_HANDLE;
-  bool first = true;
-  if (options.fused && !rk4) {
-    // One dispatch per step (fused.comp): the pipeline is bound once, the descriptor set
-    // alternates with the position parity, one barrier between consecutive steps.
-    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, fused_pipeline);
-    pc.stage = 0;
-    pc.c_next = c_next[0];
-    for (std::uint32_t s = 0; s < steps; ++s) {
-      pc.step = static_cast<std::uint32_t>(recorded + 1);
-      const VkDescriptorSet set = sets[current()][0];
+  for (std::uint32_t k = 0; k < stages; ++k) {
+    pc.stage = k;
+    pc.c_next = c_next[k];
+    const VkDescriptorSet set = sets[read][k == 0 ? 0 : 1];
+    if (set != bound) {
       v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &set, 0, nullptr);
-      v.vkCmdPushConstants(c, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
-      if (!first) barriers::dispatch_to_dispatch(v, c); // previous step -> this step
-      first = false;
-      v.vkCmdDispatch(c, groups_x, groups_y, 1);
-      ++recorded;
-      if (!diverged) ++step;
+      bound = set;
     }
-    return;
-  }
-  for (std::uint32_t s = 0; s < steps; ++s) {
-    const std::uint32_t read = current();
-    pc.step = static_cast<std::uint32_t>(recorded + 1); // 1-based number of the step being computed
-    for (std::uint32_t k = 0; k < stages; ++k) {
-      pc.stage = k;
-      pc.c_next = c_next[k];
-      const VkDescriptorSet set = sets[read][k == 0 ? 0 : 1];
-      if (set != bound) {
-        v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &set, 0, nullptr);
-        bound = set;
-      }
-      v.vkCmdPushConstants(c, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
-      if (!first) barriers::dispatch_to_dispatch(v, c); // integrate (previous stage/step) -> force
-      first = false;
-      v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, force_pipeline);
-      v.vkCmdDispatch(c, groups_x, groups_y, 1);
-      barriers::dispatch_to_dispatch(v, c); // force -> integrate
-      v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, integrate_pipeline);
-      v.vkCmdDispatch(c, groups_x, groups_y, 1);
-    }
-    ++recorded; // positions[read ^ 1] now holds the new state
-    if (!diverged) ++step;
+    v.vkCmdPushConstants(c, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
+    if (!first || k > 0) barriers::dispatch_to_dispatch(v, c); // integrate (previous stage/step) -> force
+    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, force_pipeline);
+    v.vkCmdDispatch(c, groups_x, groups_y, 1);
+    barriers::dispatch_to_dispatch(v, c); // force -> integrate
+    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, integrate_pipeline);
+    v.vkCmdDispatch(c, groups_x, groups_y, 1);
   }
 }
 
@@ -483,6 +503,7 @@ Result<GpuSolver> GpuSolver::create(Context& context, const ParticleSystem& syst
   s.params = std::move(params);
   s.options = options;
   s.count = static_cast<std::uint32_t>(n);
+  s.edges_count = edges_n;
   s.groups_x = static_cast<std::uint32_t>(gx);
   s.groups_y = static_cast<std::uint32_t>(gy);
   if (system.grid) {
@@ -552,6 +573,7 @@ Result<GpuSolver> GpuSolver::create(Context& context, const ParticleSystem& syst
   if (!options.csr_only) s.detect_stencil(system);
   VKCLOTH_TRY(s.init_pipelines());
   VKCLOTH_TRY(s.write_sets());
+  VKCLOTH_TRY(s.ensure_implicit());
   s.set_push_constants();
 
   // Initial state, converted as CpuSolver<float>::create converts it.
@@ -642,6 +664,7 @@ Result<void> GpuSolver::set_params(SimParams params) {
   VKCLOTH_TRY(params.validate());
   impl_->params = std::move(params);
   VKCLOTH_TRY(impl_->upload_colliders());
+  VKCLOTH_TRY(impl_->ensure_implicit());
   impl_->set_push_constants();
   return {};
 }
@@ -708,6 +731,7 @@ VkBuffer GpuSolver::current_position_buffer() const { return impl_->pos[impl_->c
 VkBuffer GpuSolver::velocity_buffer() const { return impl_->vel.buffer; }
 VkBuffer GpuSolver::normal_buffer() const { return impl_->normal.buffer; }
 VkBuffer GpuSolver::uv_buffer() const { return impl_->uv.buffer; }
+SolveStats GpuSolver::last_solve() const { return impl_->implicit ? impl_->implicit->stats() : SolveStats{}; }
 double GpuSolver::last_gpu_ms() const { return impl_->last_ms; }
 bool GpuSolver::uses_staging() const { return impl_->staging; }
 

@@ -32,6 +32,7 @@ int figures_command(const FiguresOptions& opt) {
              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   if (auto r = figures::cloth_figures(gallery); !r)
     return report(r.error());
+  if (auto r = figures::stability_figures(gallery); !r) return report(r.error());
   if (auto r = gallery.write_index(); !r)
     return report(r.error());
   fmt::print("{} figures in {}/index.html ({:.1f} s)\n", gallery.figures.size(), opt.out,

@@ -48,5 +48,7 @@ Result<void> spring_figures(Gallery& gallery);
 /// Figures 5, 7-9, 11-14: labelled image grids (rendered offscreen; skipped without a Vulkan device
 /// on the CPU backend, the numbers are computed either way) and metrics["cloth"].
 Result<void> cloth_figures(Gallery& gallery);
+/// The (K_struct, dt) stability map of semi-implicit Euler, RK4 and implicit Euler (stability.cpp).
+Result<void> stability_figures(Gallery& gallery);
 
 } // namespace vkcloth::figures

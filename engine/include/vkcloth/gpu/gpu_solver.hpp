@@ -5,6 +5,9 @@
 // Per step (Euler):      fused(positions[read] -> positions[write]) -> swap   (GpuSolverOptions::fused)
 //                   or   force(positions[read]) -> integrate(-> positions[write]) -> swap
 // Per step (RK4):        4 x (force(stage input) -> integrate(stage k)); the last writes positions[write]
+// Per step (implicit):   force -> system -> reduce -> cg_max_iterations x (matvec -> reduce -> update
+//                        -> reduce -> direction, indirect: empty once converged) -> finish
+//                        (implicit_gpu.hpp); every scheme repeats its passes `substeps` times per step
 //
 // Buffers (device-local storage buffers, vec4 per particle, w unused; positions have w = 1):
 // positions[2] (ping-pong), velocities, forces, normals (unit, rebuilt every force pass, zero for
@@ -107,7 +110,7 @@ public:
   std::uint32_t particle_count() const;
 
   /// Index (0 or 1) of the positions buffer holding the current positions: 0 at creation,
-  /// flipped by every recorded step (so step_index() % 2, unless a step diverged).
+  /// flipped by every recorded substep (so (step_index() * substeps) % 2, unless a step diverged).
   std::uint32_t current_position_index() const;
   VkBuffer position_buffer(std::uint32_t index) const;
   VkBuffer current_position_buffer() const;
@@ -116,6 +119,10 @@ public:
   VkBuffer uv_buffer() const;
   /// Byte stride of every per-particle buffer above (vec4).
   static constexpr VkDeviceSize stride = 16;
+
+  /// implicit_euler: CG iterations and relative residual of the last completed substep's solve
+  /// (read from host-visible memory: valid once the recorded work has finished).
+  SolveStats last_solve() const;
 
   /// GPU time of the last simulate() (sum over its submissions, timestamps), in milliseconds;
   /// negative when the queue has no timestamp support.

@@ -1,0 +1,59 @@
+// The implicit-Euler step on Vulkan (internal to GpuSolver): the CPU reference's linearised
+// backward Euler + PCG (engine/src/core/implicit_euler.hpp) as compute passes, recorded without a
+// CPU round trip per iteration. Per substep:
+//
+//   FORCE -> SYSTEM -> reduce(INIT) -> cg_max_iterations x [ MATVEC -> reduce(ALPHA) -> UPDATE
+//          -> reduce(BETA) -> DIRECTION ] -> FINISH
+//
+// one barrier between consecutive passes (barriers::implicit_pass). Every reduce rewrites the
+// indirect dispatch arguments of the CG passes and of the next reduce: zero groups once converged,
+// so the iterations left are empty dispatches. Dot products: a fixed-shape tree per workgroup, then
+// one workgroup sums the partials in a fixed order (deterministic; not the CPU's sequential sum,
+// hence results equal the CPU's to rounding, not bit for bit).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include "vk_internal.hpp"
+#include "vkcloth/params.hpp"
+#include "vkcloth_shared.h"
+
+namespace vkcloth::gpu {
+
+/// The solver's buffers the implicit passes share (same bindings as the main layout).
+struct ImplicitInputs {
+  VkBuffer pos[2], vel, force, normal, particle, offsets, edges, colliders, flags;
+};
+
+class ImplicitGpu {
+public:
+  static Result<std::unique_ptr<ImplicitGpu>> create(const std::shared_ptr<Context::Impl>& ctx, std::uint32_t count,
+                                                     std::uint64_t entries, std::uint32_t groups_x, std::uint32_t groups_y,
+                                                     bool allow_map);
+  ~ImplicitGpu();
+  ImplicitGpu(const ImplicitGpu&) = delete;
+  ImplicitGpu& operator=(const ImplicitGpu&) = delete;
+
+  /// (Re)writes the two descriptor sets (position parity); call again when an input buffer changes.
+  Result<void> write_sets(const ImplicitInputs& in);
+  /// Records one substep reading positions[read], writing positions[read ^ 1]. `pc` is the main
+  /// push-constant block with dt = the substep; `first`: no barrier needed before the first pass.
+  void record_substep(VkCommandBuffer cmd, std::uint32_t read, shared::PushConstants pc, const SimParams& params,
+                      bool first);
+  /// The last completed solve (host-visible state; valid once the recorded work finished).
+  SolveStats stats() const;
+
+private:
+  ImplicitGpu() = default;
+  std::shared_ptr<Context::Impl> ctx_;
+  std::uint32_t count_ = 0, groups_x_ = 1, groups_y_ = 1;
+  Buffer vf_, ks_, diag_inv_, x_, r_, z_, d_, q_, partials_, state_, args_;
+  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
+  VkDescriptorPool pool_ = VK_NULL_HANDLE;
+  VkDescriptorSet sets_[2] = {};
+  VkPipelineLayout layout_ = VK_NULL_HANDLE;
+  VkPipeline pass_ = VK_NULL_HANDLE, reduce_ = VK_NULL_HANDLE;
+};
+
+} // namespace vkcloth::gpu

@@ -1,0 +1,69 @@
+// Declarations shared by the implicit-Euler shaders (implicit.comp, implicit_reduce.comp) and the
+// C++ side (engine/src/vulkan/implicit_gpu.cpp). The implicit passes use their own descriptor set
+// layout: the main layout's bindings they need (same numbers, same buffers, vkcloth_shared.h)
+// plus the CG buffers below. Push constants: the main PushConstants, with fields the implicit
+// passes do not otherwise use carrying the pass parameters (VKCLOTH_IMPL_* below).
+#ifndef VKCLOTH_IMPLICIT_SHARED_H
+#define VKCLOTH_IMPLICIT_SHARED_H
+
+#include "vkcloth_shared.h"
+
+#ifdef __cplusplus
+namespace vkcloth::gpu::shared {
+#endif
+
+#define VKCLOTH_BINDING_IMPL_VF 17       // contact-filtered velocity (vec4)
+#define VKCLOTH_BINDING_IMPL_KS 18       // per CSR entry: K_s as 2 vec4 (xx yy zz xy | xz yz - -)
+#define VKCLOTH_BINDING_IMPL_DIAG_INV 19 // 1 / diag(A), zero for pinned particles (vec4)
+#define VKCLOTH_BINDING_IMPL_X 20        // CG solution dv (vec4)
+#define VKCLOTH_BINDING_IMPL_R 21        // residual
+#define VKCLOTH_BINDING_IMPL_Z 22        // preconditioned residual
+#define VKCLOTH_BINDING_IMPL_D 23        // search direction
+#define VKCLOTH_BINDING_IMPL_Q 24        // S A d
+#define VKCLOTH_BINDING_IMPL_PARTIALS 25 // one vec2 per workgroup: its partial dot products
+#define VKCLOTH_BINDING_IMPL_STATE 26    // CgState
+#define VKCLOTH_BINDING_IMPL_ARGS 27     // indirect dispatch arguments (CgArgs)
+
+// implicit.comp passes (PushConstants::stage).
+#define VKCLOTH_IMPL_FORCE 0u     // normal, force, contact filtering -> FORCE_OUT, NORMAL, VF
+#define VKCLOTH_IMPL_SYSTEM 1u    // K_s per entry, diag, b -> r, z, d; partials (r.z, r.r)
+#define VKCLOTH_IMPL_MATVEC 2u    // q = S A d; partials (d.q, 0)
+#define VKCLOTH_IMPL_UPDATE 3u    // x += alpha d, r -= alpha q, z = P^-1 r; partials (r.z, r.r)
+#define VKCLOTH_IMPL_DIRECTION 4u // d = z + beta d
+#define VKCLOTH_IMPL_FINISH 5u    // v' = v + x, contacts, x' = x + h v', projection, flags
+// implicit_reduce.comp modes (PushConstants::stage).
+#define VKCLOTH_REDUCE_INIT 0u  // rz, rr, rr0 from SYSTEM's partials
+#define VKCLOTH_REDUCE_ALPHA 1u // alpha = rz / d.q (stop if d.q <= 0)
+#define VKCLOTH_REDUCE_BETA 2u  // beta = rz_new / rz, iterations + 1, convergence test
+// Repurposed PushConstants fields (unused by the implicit passes otherwise):
+//   c_next = cg_tolerance^2, pad0 = cg_max_iterations, pad1 = number of partials (workgroups).
+
+/// CG scalars, written only by implicit_reduce.comp (one invocation).
+struct CgState {
+  float rz;
+  float rr;
+  float rr0;
+  float alpha;
+  float beta;
+  uint done; // 1: converged / stopped; the remaining passes are dispatched with zero groups
+  uint iterations;
+  uint pad0;
+  uint groups_x; // the particle passes' dispatch size (set by the host at creation)
+  uint groups_y;
+  uint pad1;
+  uint pad2;
+};
+
+/// Indirect dispatch arguments, rewritten by every reduce: zero groups once `done`.
+struct CgArgs {
+  uint particle_x, particle_y, particle_z, pad0; // the per-particle CG passes
+  uint reduce_x, reduce_y, reduce_z, pad1;       // the next reduce
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(CgState) == 48);
+static_assert(sizeof(CgArgs) == 32);
+} // namespace vkcloth::gpu::shared
+#endif
+
+#endif // VKCLOTH_IMPLICIT_SHARED_H
