@@ -100,15 +100,15 @@ struct ClothRenderer::Impl {
     const VkDevice d = ctx->device;
     for (VkPipeline p : {cloth_pipeline, mesh_pipeline, line_pipeline})
       if (p)
-        v.vkDestroyPipeline(d, p, nullptr);
+        v.vkDestroyPipeline(d, p, v.allocator);
     if (layout)
-      v.vkDestroyPipelineLayout(d, layout, nullptr);
+      v.vkDestroyPipelineLayout(d, layout, v.allocator);
     if (pool)
-      v.vkDestroyDescriptorPool(d, pool, nullptr);
+      v.vkDestroyDescriptorPool(d, pool, v.allocator);
     if (set_layout)
-      v.vkDestroyDescriptorSetLayout(d, set_layout, nullptr);
+      v.vkDestroyDescriptorSetLayout(d, set_layout, v.allocator);
     if (sampler)
-      v.vkDestroySampler(d, sampler, nullptr);
+      v.vkDestroySampler(d, sampler, v.allocator);
     detail::destroy_image(*ctx, texture);
     for (Buffer* b : {&cloth_index, &mesh_vertices, &mesh_index, &zero_instance})
       gpu::destroy_buffer(*ctx, *b);
@@ -238,9 +238,9 @@ Result<void> ClothRenderer::Impl::upload_texture(const Image& img) {
   VkFence fence = VK_NULL_HANDLE;
   auto cleanup = [&] {
     if (fence)
-      v.vkDestroyFence(d, fence, nullptr);
+      v.vkDestroyFence(d, fence, v.allocator);
     if (cmd_pool)
-      v.vkDestroyCommandPool(d, cmd_pool, nullptr);
+      v.vkDestroyCommandPool(d, cmd_pool, v.allocator);
     gpu::destroy_buffer(*ctx, staging);
   };
   auto run = [&]() -> Result<void> {
@@ -248,7 +248,7 @@ Result<void> ClothRenderer::Impl::upload_texture(const Image& img) {
     cp.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
     cp.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;
     cp.queueFamilyIndex = ctx->queue_family;
-    VKCLOTH_VK_TRY(v.vkCreateCommandPool(d, &cp, nullptr, &cmd_pool), "vkCreateCommandPool (texture upload)");
+    VKCLOTH_VK_TRY(v.vkCreateCommandPool(d, &cp, v.allocator, &cmd_pool), "vkCreateCommandPool (texture upload)");
     VkCommandBufferAllocateInfo ca{};
     ca.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
     ca.commandPool = cmd_pool;
@@ -257,7 +257,7 @@ Result<void> ClothRenderer::Impl::upload_texture(const Image& img) {
     VKCLOTH_VK_TRY(v.vkAllocateCommandBuffers(d, &ca, &cmd), "vkAllocateCommandBuffers (texture upload)");
     VkFenceCreateInfo fi{};
     fi.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
-    VKCLOTH_VK_TRY(v.vkCreateFence(d, &fi, nullptr, &fence), "vkCreateFence (texture upload)");
+    VKCLOTH_VK_TRY(v.vkCreateFence(d, &fi, v.allocator, &fence), "vkCreateFence (texture upload)");
     VkCommandBufferBeginInfo bi{};
     bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
     bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
@@ -304,7 +304,7 @@ Result<void> ClothRenderer::Impl::upload_texture(const Image& img) {
   si.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST;
   si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_REPEAT;
   si.maxLod = 0.0f;
-  VKCLOTH_VK_TRY(v.vkCreateSampler(d, &si, nullptr, &sampler), "vkCreateSampler");
+  VKCLOTH_VK_TRY(v.vkCreateSampler(d, &si, v.allocator, &sampler), "vkCreateSampler");
   return {};
 }
 
@@ -317,7 +317,7 @@ Result<void> ClothRenderer::Impl::build_pipelines(const RendererOptions& o) {
   li.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
   li.bindingCount = 1;
   li.pBindings = &binding;
-  VKCLOTH_VK_TRY(v.vkCreateDescriptorSetLayout(d, &li, nullptr, &set_layout),
+  VKCLOTH_VK_TRY(v.vkCreateDescriptorSetLayout(d, &li, v.allocator, &set_layout),
                  "vkCreateDescriptorSetLayout (renderer)");
   const VkDescriptorPoolSize ps{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1};
   VkDescriptorPoolCreateInfo dp{};
@@ -325,7 +325,7 @@ Result<void> ClothRenderer::Impl::build_pipelines(const RendererOptions& o) {
   dp.maxSets = 1;
   dp.poolSizeCount = 1;
   dp.pPoolSizes = &ps;
-  VKCLOTH_VK_TRY(v.vkCreateDescriptorPool(d, &dp, nullptr, &pool), "vkCreateDescriptorPool (renderer)");
+  VKCLOTH_VK_TRY(v.vkCreateDescriptorPool(d, &dp, v.allocator, &pool), "vkCreateDescriptorPool (renderer)");
   VkDescriptorSetAllocateInfo ai{};
   ai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
   ai.descriptorPool = pool;
@@ -349,7 +349,7 @@ Result<void> ClothRenderer::Impl::build_pipelines(const RendererOptions& o) {
   pl.pSetLayouts = &set_layout;
   pl.pushConstantRangeCount = 1;
   pl.pPushConstantRanges = &range;
-  VKCLOTH_VK_TRY(v.vkCreatePipelineLayout(d, &pl, nullptr, &layout), "vkCreatePipelineLayout (renderer)");
+  VKCLOTH_VK_TRY(v.vkCreatePipelineLayout(d, &pl, v.allocator, &layout), "vkCreatePipelineLayout (renderer)");
 
   struct Shaders {
     const std::uint32_t* vs;
@@ -366,7 +366,7 @@ Result<void> ClothRenderer::Impl::build_pipelines(const RendererOptions& o) {
       return vm.error();
     auto fm = detail::create_shader(*ctx, sh.fs, sh.fs_words, sh.name);
     if (!fm) {
-      v.vkDestroyShaderModule(d, *vm, nullptr);
+      v.vkDestroyShaderModule(d, *vm, v.allocator);
       return fm.error();
     }
     VkPipelineShaderStageCreateInfo stages[2]{};
@@ -438,9 +438,9 @@ Result<void> ClothRenderer::Impl::build_pipelines(const RendererOptions& o) {
     gi.layout = layout;
     gi.renderPass = o.render_pass;
     gi.subpass = o.subpass;
-    const VkResult r = v.vkCreateGraphicsPipelines(d, VK_NULL_HANDLE, 1, &gi, nullptr, out);
-    v.vkDestroyShaderModule(d, *vm, nullptr);
-    v.vkDestroyShaderModule(d, *fm, nullptr);
+    const VkResult r = v.vkCreateGraphicsPipelines(d, VK_NULL_HANDLE, 1, &gi, v.allocator, out);
+    v.vkDestroyShaderModule(d, *vm, v.allocator);
+    v.vkDestroyShaderModule(d, *fm, v.allocator);
     if (r != VK_SUCCESS)
       return gpu::vk_error(r, fmt::format("vkCreateGraphicsPipelines ({})", sh.name));
     return {};

@@ -30,14 +30,14 @@ struct OffscreenTarget::Impl {
     const VkDevice d = ctx->device;
     if (fence) {
       v.vkWaitForFences(d, 1, &fence, VK_TRUE, UINT64_MAX);
-      v.vkDestroyFence(d, fence, nullptr);
+      v.vkDestroyFence(d, fence, v.allocator);
     }
     if (cmd_pool)
-      v.vkDestroyCommandPool(d, cmd_pool, nullptr);
+      v.vkDestroyCommandPool(d, cmd_pool, v.allocator);
     if (framebuffer)
-      v.vkDestroyFramebuffer(d, framebuffer, nullptr);
+      v.vkDestroyFramebuffer(d, framebuffer, v.allocator);
     if (render_pass)
-      v.vkDestroyRenderPass(d, render_pass, nullptr);
+      v.vkDestroyRenderPass(d, render_pass, v.allocator);
     detail::destroy_image(*ctx, color);
     detail::destroy_image(*ctx, depth);
     gpu::destroy_buffer(*ctx, readback);
@@ -137,7 +137,7 @@ Result<OffscreenTarget> OffscreenTarget::create(gpu::Context& context, std::uint
   rp.pSubpasses = &sub;
   rp.dependencyCount = 2;
   rp.pDependencies = dep;
-  VKCLOTH_VK_TRY(v.vkCreateRenderPass(d, &rp, nullptr, &s.render_pass), "vkCreateRenderPass (offscreen)");
+  VKCLOTH_VK_TRY(v.vkCreateRenderPass(d, &rp, v.allocator, &s.render_pass), "vkCreateRenderPass (offscreen)");
   const VkImageView views[2] = {s.color.view, s.depth.view};
   VkFramebufferCreateInfo fb{};
   fb.sType = VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO;
@@ -147,7 +147,7 @@ Result<OffscreenTarget> OffscreenTarget::create(gpu::Context& context, std::uint
   fb.width = width;
   fb.height = height;
   fb.layers = 1;
-  VKCLOTH_VK_TRY(v.vkCreateFramebuffer(d, &fb, nullptr, &s.framebuffer), "vkCreateFramebuffer (offscreen)");
+  VKCLOTH_VK_TRY(v.vkCreateFramebuffer(d, &fb, v.allocator, &s.framebuffer), "vkCreateFramebuffer (offscreen)");
   auto rb = gpu::create_buffer(*s.ctx, VkDeviceSize(width) * height * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                gpu::MemoryUse::host_readback, true, "frame readback");
   if (!rb)
@@ -157,7 +157,7 @@ Result<OffscreenTarget> OffscreenTarget::create(gpu::Context& context, std::uint
   cp.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
   cp.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
   cp.queueFamilyIndex = s.ctx->queue_family;
-  VKCLOTH_VK_TRY(v.vkCreateCommandPool(d, &cp, nullptr, &s.cmd_pool), "vkCreateCommandPool (offscreen)");
+  VKCLOTH_VK_TRY(v.vkCreateCommandPool(d, &cp, v.allocator, &s.cmd_pool), "vkCreateCommandPool (offscreen)");
   VkCommandBufferAllocateInfo ca{};
   ca.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
   ca.commandPool = s.cmd_pool;
@@ -166,7 +166,7 @@ Result<OffscreenTarget> OffscreenTarget::create(gpu::Context& context, std::uint
   VKCLOTH_VK_TRY(v.vkAllocateCommandBuffers(d, &ca, &s.cmd), "vkAllocateCommandBuffers (offscreen)");
   VkFenceCreateInfo fi{};
   fi.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
-  VKCLOTH_VK_TRY(v.vkCreateFence(d, &fi, nullptr, &s.fence), "vkCreateFence (offscreen)");
+  VKCLOTH_VK_TRY(v.vkCreateFence(d, &fi, v.allocator, &s.fence), "vkCreateFence (offscreen)");
   return OffscreenTarget(std::move(impl));
 }
 

@@ -23,7 +23,7 @@ Result<ImageResource> create_image(gpu::Context::Impl& ctx, VkFormat format, VkI
   ii.usage = usage;
   ii.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
   ii.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-  VKCLOTH_VK_TRY(vk.vkCreateImage(ctx.device, &ii, nullptr, &r.image),
+  VKCLOTH_VK_TRY(vk.vkCreateImage(ctx.device, &ii, vk.allocator, &r.image),
                  fmt::format("vkCreateImage ({}, {}x{})", what, width, height));
   VkMemoryRequirements req;
   vk.vkGetImageMemoryRequirements(ctx.device, r.image, &req);
@@ -38,7 +38,7 @@ Result<ImageResource> create_image(gpu::Context::Impl& ctx, VkFormat format, VkI
   ai.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
   ai.allocationSize = req.size;
   ai.memoryTypeIndex = static_cast<std::uint32_t>(type);
-  if (const VkResult e = vk.vkAllocateMemory(ctx.device, &ai, nullptr, &r.memory); e != VK_SUCCESS) {
+  if (const VkResult e = vk.vkAllocateMemory(ctx.device, &ai, vk.allocator, &r.memory); e != VK_SUCCESS) {
     destroy_image(ctx, r);
     return gpu::vk_error(e, fmt::format("vkAllocateMemory ({} image)", what));
   }
@@ -52,7 +52,7 @@ Result<ImageResource> create_image(gpu::Context::Impl& ctx, VkFormat format, VkI
   vi.viewType = VK_IMAGE_VIEW_TYPE_2D;
   vi.format = format;
   vi.subresourceRange = {aspect, 0, 1, 0, 1};
-  if (const VkResult e = vk.vkCreateImageView(ctx.device, &vi, nullptr, &r.view); e != VK_SUCCESS) {
+  if (const VkResult e = vk.vkCreateImageView(ctx.device, &vi, vk.allocator, &r.view); e != VK_SUCCESS) {
     destroy_image(ctx, r);
     return gpu::vk_error(e, fmt::format("vkCreateImageView ({} image)", what));
   }
@@ -61,11 +61,11 @@ Result<ImageResource> create_image(gpu::Context::Impl& ctx, VkFormat format, VkI
 
 void destroy_image(gpu::Context::Impl& ctx, ImageResource& img) {
   if (img.view)
-    ctx.vk.vkDestroyImageView(ctx.device, img.view, nullptr);
+    ctx.vk.vkDestroyImageView(ctx.device, img.view, ctx.vk.allocator);
   if (img.image)
-    ctx.vk.vkDestroyImage(ctx.device, img.image, nullptr);
+    ctx.vk.vkDestroyImage(ctx.device, img.image, ctx.vk.allocator);
   if (img.memory)
-    ctx.vk.vkFreeMemory(ctx.device, img.memory, nullptr);
+    ctx.vk.vkFreeMemory(ctx.device, img.memory, ctx.vk.allocator);
   img = ImageResource{};
 }
 
@@ -76,7 +76,7 @@ Result<VkShaderModule> create_shader(gpu::Context::Impl& ctx, const std::uint32_
   ci.codeSize = words * sizeof(std::uint32_t);
   ci.pCode = code;
   VkShaderModule m = VK_NULL_HANDLE;
-  VKCLOTH_VK_TRY(ctx.vk.vkCreateShaderModule(ctx.device, &ci, nullptr, &m),
+  VKCLOTH_VK_TRY(ctx.vk.vkCreateShaderModule(ctx.device, &ci, ctx.vk.allocator, &m),
                  fmt::format("vkCreateShaderModule ({})", name));
   return m;
 }

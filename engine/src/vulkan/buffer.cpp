@@ -1,5 +1,6 @@
 #include "vk_internal.hpp"
 
+#include <algorithm>
 #include <cstdlib>
 #include <mutex>
 #include <string>
@@ -28,7 +29,7 @@ bool injected_allocation_failure() {
 } // namespace
 
 Result<Buffer> create_buffer(Context::Impl& ctx, VkDeviceSize size, VkBufferUsageFlags usage, MemoryUse use, bool allow_map,
-                             const char* what) {
+                             const char* what, const std::vector<std::uint32_t>& sharing_families) {
   const auto& vk = ctx.vk;
   Buffer b;
   b.size = size;
@@ -37,7 +38,15 @@ Result<Buffer> create_buffer(Context::Impl& ctx, VkDeviceSize size, VkBufferUsag
   bi.size = size;
   bi.usage = usage;
   bi.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-  VKCLOTH_VK_TRY(vk.vkCreateBuffer(ctx.device, &bi, nullptr, &b.buffer), fmt::format("vkCreateBuffer ({}, {} bytes)", what, size));
+  std::vector<std::uint32_t> families;
+  for (std::uint32_t f : sharing_families)
+    if (std::find(families.begin(), families.end(), f) == families.end()) families.push_back(f);
+  if (families.size() >= 2) {
+    bi.sharingMode = VK_SHARING_MODE_CONCURRENT;
+    bi.queueFamilyIndexCount = static_cast<std::uint32_t>(families.size());
+    bi.pQueueFamilyIndices = families.data();
+  }
+  VKCLOTH_VK_TRY(vk.vkCreateBuffer(ctx.device, &bi, vk.allocator, &b.buffer), fmt::format("vkCreateBuffer ({}, {} bytes)", what, size));
   VkMemoryRequirements req;
   vk.vkGetBufferMemoryRequirements(ctx.device, b.buffer, &req);
 
@@ -69,7 +78,7 @@ Result<Buffer> create_buffer(Context::Impl& ctx, VkDeviceSize size, VkBufferUsag
   ai.allocationSize = req.size;
   ai.memoryTypeIndex = static_cast<std::uint32_t>(type);
   const VkResult alloc = injected_allocation_failure() ? VK_ERROR_OUT_OF_DEVICE_MEMORY
-                                                       : vk.vkAllocateMemory(ctx.device, &ai, nullptr, &b.memory);
+                                                       : vk.vkAllocateMemory(ctx.device, &ai, vk.allocator, &b.memory);
   if (alloc == VK_SUCCESS) ctx.live_allocations.fetch_add(1, std::memory_order_relaxed);
   if (const VkResult r = alloc; r != VK_SUCCESS) {
     destroy_buffer(ctx, b);
@@ -89,9 +98,9 @@ Result<Buffer> create_buffer(Context::Impl& ctx, VkDeviceSize size, VkBufferUsag
 }
 
 void destroy_buffer(Context::Impl& ctx, Buffer& b) {
-  if (b.buffer) ctx.vk.vkDestroyBuffer(ctx.device, b.buffer, nullptr);
+  if (b.buffer) ctx.vk.vkDestroyBuffer(ctx.device, b.buffer, ctx.vk.allocator);
   if (b.memory) {
-    ctx.vk.vkFreeMemory(ctx.device, b.memory, nullptr); // unmaps implicitly
+    ctx.vk.vkFreeMemory(ctx.device, b.memory, ctx.vk.allocator); // unmaps implicitly
     ctx.live_allocations.fetch_sub(1, std::memory_order_relaxed);
   }
   b = Buffer{};

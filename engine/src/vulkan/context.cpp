@@ -496,12 +496,14 @@ Result<Context> Context::adopt(const HostHandles& h) {
   if (!fi) return fi.error();
   impl->fi = *fi;
   VKCLOTH_TRY(impl->load(VK_API_VERSION_1_2));
+  impl->vk.allocator = h.allocator;
   return Context(std::move(impl));
 }
 
 HostHandles Context::handles() const {
   return HostHandles{impl_->instance,     impl_->physical_device,        impl_->device,     impl_->queue_family,
-                     impl_->queue,        impl_->get_instance_proc_addr, impl_->api_version};
+                     impl_->queue,        impl_->get_instance_proc_addr, impl_->api_version,
+                     impl_->vk.allocator};
 }
 PFN_vkGetDeviceProcAddr Context::device_proc_addr() const { return impl_->fi.vkGetDeviceProcAddr; }
 const std::string& Context::device_name() const { return impl_->name; }

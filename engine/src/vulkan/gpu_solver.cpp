@@ -68,7 +68,7 @@ struct GpuSolver::Impl {
   Impl& operator=(const Impl&) = delete;
   ~Impl();
 
-  const VolkDeviceTable& vk() const { return ctx->vk; }
+  const DeviceFns& vk() const { return ctx->vk; }
   std::uint32_t current() const { return parity; }
   Result<void> ensure_implicit();
   void record_substep(VkCommandBuffer cmd, bool first);
@@ -90,16 +90,16 @@ GpuSolver::Impl::~Impl() {
   const VkDevice d = ctx->device;
   if (fence) {
     v.vkWaitForFences(d, 1, &fence, VK_TRUE, UINT64_MAX); // our own submissions (always waited already)
-    v.vkDestroyFence(d, fence, nullptr);
+    v.vkDestroyFence(d, fence, v.allocator);
   }
-  if (queries) v.vkDestroyQueryPool(d, queries, nullptr);
-  if (cmd_pool) v.vkDestroyCommandPool(d, cmd_pool, nullptr);
-  if (force_pipeline) v.vkDestroyPipeline(d, force_pipeline, nullptr);
-  if (integrate_pipeline) v.vkDestroyPipeline(d, integrate_pipeline, nullptr);
-  if (fused_pipeline) v.vkDestroyPipeline(d, fused_pipeline, nullptr);
-  if (layout) v.vkDestroyPipelineLayout(d, layout, nullptr);
-  if (pool) v.vkDestroyDescriptorPool(d, pool, nullptr);
-  if (set_layout) v.vkDestroyDescriptorSetLayout(d, set_layout, nullptr);
+  if (queries) v.vkDestroyQueryPool(d, queries, v.allocator);
+  if (cmd_pool) v.vkDestroyCommandPool(d, cmd_pool, v.allocator);
+  if (force_pipeline) v.vkDestroyPipeline(d, force_pipeline, v.allocator);
+  if (integrate_pipeline) v.vkDestroyPipeline(d, integrate_pipeline, v.allocator);
+  if (fused_pipeline) v.vkDestroyPipeline(d, fused_pipeline, v.allocator);
+  if (layout) v.vkDestroyPipelineLayout(d, layout, v.allocator);
+  if (pool) v.vkDestroyDescriptorPool(d, pool, v.allocator);
+  if (set_layout) v.vkDestroyDescriptorSetLayout(d, set_layout, v.allocator);
   for (Buffer* b : {&pos[0], &pos[1], &vel, &force, &force_stage, &vel_filt, &normal, &uv, &stage_pos, &stage_vel, &acc_pos,
                     &acc_vel, &particle, &offsets, &edges, &colliders, &flags})
     destroy_buffer(*ctx, *b);
@@ -107,14 +107,14 @@ GpuSolver::Impl::~Impl() {
 
 namespace {
 
-template <std::size_t N> Result<VkShaderModule> make_module(const VolkDeviceTable& vk, VkDevice d, const std::uint32_t (&code)[N],
+template <std::size_t N> Result<VkShaderModule> make_module(const DeviceFns& vk, VkDevice d, const std::uint32_t (&code)[N],
                                                             const char* name) {
   VkShaderModuleCreateInfo ci{};
   ci.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
   ci.codeSize = N * sizeof(std::uint32_t);
   ci.pCode = code;
   VkShaderModule m = VK_NULL_HANDLE;
-  VKCLOTH_VK_TRY(vk.vkCreateShaderModule(d, &ci, nullptr, &m), fmt::format("vkCreateShaderModule ({})", name));
+  VKCLOTH_VK_TRY(vk.vkCreateShaderModule(d, &ci, vk.allocator, &m), fmt::format("vkCreateShaderModule ({})", name));
   return m;
 }
 
@@ -132,7 +132,7 @@ Result<void> GpuSolver::Impl::init_pipelines() {
   li.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
   li.bindingCount = static_cast<std::uint32_t>(bindings.size());
   li.pBindings = bindings.data();
-  VKCLOTH_VK_TRY(v.vkCreateDescriptorSetLayout(d, &li, nullptr, &set_layout), "vkCreateDescriptorSetLayout");
+  VKCLOTH_VK_TRY(v.vkCreateDescriptorSetLayout(d, &li, v.allocator, &set_layout), "vkCreateDescriptorSetLayout");
 
   const VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(sh::PushConstants)};
   VkPipelineLayoutCreateInfo pi{};
@@ -141,7 +141,7 @@ Result<void> GpuSolver::Impl::init_pipelines() {
   pi.pSetLayouts = &set_layout;
   pi.pushConstantRangeCount = 1;
   pi.pPushConstantRanges = &range;
-  VKCLOTH_VK_TRY(v.vkCreatePipelineLayout(d, &pi, nullptr, &layout), "vkCreatePipelineLayout");
+  VKCLOTH_VK_TRY(v.vkCreatePipelineLayout(d, &pi, v.allocator, &layout), "vkCreatePipelineLayout");
 
   const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 4 * VKCLOTH_BINDING_COUNT};
   VkDescriptorPoolCreateInfo dp{};
@@ -149,7 +149,7 @@ Result<void> GpuSolver::Impl::init_pipelines() {
   dp.maxSets = 4;
   dp.poolSizeCount = 1;
   dp.pPoolSizes = &size;
-  VKCLOTH_VK_TRY(v.vkCreateDescriptorPool(d, &dp, nullptr, &pool), "vkCreateDescriptorPool");
+  VKCLOTH_VK_TRY(v.vkCreateDescriptorPool(d, &dp, v.allocator, &pool), "vkCreateDescriptorPool");
   const VkDescriptorSetLayout layouts[4] = {set_layout, set_layout, set_layout, set_layout};
   VkDescriptorSetAllocateInfo ai{};
   ai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
@@ -161,7 +161,7 @@ Result<void> GpuSolver::Impl::init_pipelines() {
   VkShaderModule modules[3] = {};
   auto destroy_modules = [&] {
     for (VkShaderModule m : modules)
-      if (m) v.vkDestroyShaderModule(d, m, nullptr);
+      if (m) v.vkDestroyShaderModule(d, m, v.allocator);
   };
   {
     auto fm = make_module(v, d, spirv::force_comp_spv, "force.comp");
@@ -194,7 +194,7 @@ Result<void> GpuSolver::Impl::init_pipelines() {
     ci[k].layout = layout;
   }
   VkPipeline pipes[3] = {};
-  const VkResult r = v.vkCreateComputePipelines(d, VK_NULL_HANDLE, 3, ci, nullptr, pipes);
+  const VkResult r = v.vkCreateComputePipelines(d, VK_NULL_HANDLE, 3, ci, v.allocator, pipes);
   destroy_modules();
   if (r != VK_SUCCESS) return vk_error(r, "vkCreateComputePipelines (force.comp, integrate.comp, fused.comp)");
   force_pipeline = pipes[0];
@@ -519,13 +519,18 @@ Result<GpuSolver> GpuSolver::create(Context& context, const ParticleSystem& syst
                                    VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT;
   const VkDeviceSize vec4_bytes = VkDeviceSize(n) * 16;
   const bool allow_map = !options.force_staging;
+  std::vector<std::uint32_t> families;
+  if (!options.sharing_queue_families.empty()) {
+    families = options.sharing_queue_families;
+    families.push_back(ctx->queue_family); // the solver's own queue always uses them
+  }
   const std::pair<Buffer*, const char*> vec4_buffers[] = {
       {&s.pos[0], "positions[0]"}, {&s.pos[1], "positions[1]"}, {&s.vel, "velocities"},     {&s.force, "forces"},
       {&s.force_stage, "stage forces"}, {&s.vel_filt, "contact velocities"}, {&s.normal, "normals"}, {&s.uv, "uvs"},
       {&s.stage_pos, "stage positions"}, {&s.stage_vel, "stage velocities"}, {&s.acc_pos, "rk4 sums (positions)"},
       {&s.acc_vel, "rk4 sums (velocities)"}};
   for (auto [b, what] : vec4_buffers) {
-    auto r = create_buffer(*ctx, vec4_bytes, usage, MemoryUse::device, allow_map, what);
+    auto r = create_buffer(*ctx, vec4_bytes, usage, MemoryUse::device, allow_map, what, families);
     if (!r) return r.error();
     *b = *r;
   }
@@ -534,7 +539,7 @@ Result<GpuSolver> GpuSolver::create(Context& context, const ParticleSystem& syst
       {&s.offsets, std::max<VkDeviceSize>((n + 1) * sizeof(std::uint32_t), 16), "adjacency offsets"},
       {&s.edges, std::max<VkDeviceSize>(edges_n * sizeof(sh::Edge), 16), "adjacency"}};
   for (auto [b, bytes, what] : const_buffers) {
-    auto r = create_buffer(*ctx, bytes, usage, MemoryUse::device, allow_map, what);
+    auto r = create_buffer(*ctx, bytes, usage, MemoryUse::device, allow_map, what, families);
     if (!r) return r.error();
     *b = *r;
   }
@@ -552,7 +557,7 @@ Result<GpuSolver> GpuSolver::create(Context& context, const ParticleSystem& syst
   cp.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
   cp.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
   cp.queueFamilyIndex = ctx->queue_family;
-  VKCLOTH_VK_TRY(v.vkCreateCommandPool(d, &cp, nullptr, &s.cmd_pool), "vkCreateCommandPool");
+  VKCLOTH_VK_TRY(v.vkCreateCommandPool(d, &cp, v.allocator, &s.cmd_pool), "vkCreateCommandPool");
   VkCommandBufferAllocateInfo ca{};
   ca.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
   ca.commandPool = s.cmd_pool;
@@ -562,13 +567,13 @@ Result<GpuSolver> GpuSolver::create(Context& context, const ParticleSystem& syst
   VkFenceCreateInfo fi{};
   fi.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
   fi.flags = VK_FENCE_CREATE_SIGNALED_BIT;
-  VKCLOTH_VK_TRY(v.vkCreateFence(d, &fi, nullptr, &s.fence), "vkCreateFence");
+  VKCLOTH_VK_TRY(v.vkCreateFence(d, &fi, v.allocator, &s.fence), "vkCreateFence");
   if (ctx->timestamp_valid_bits > 0) {
     VkQueryPoolCreateInfo qi{};
     qi.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
     qi.queryType = VK_QUERY_TYPE_TIMESTAMP;
     qi.queryCount = 2;
-    VKCLOTH_VK_TRY(v.vkCreateQueryPool(d, &qi, nullptr, &s.queries), "vkCreateQueryPool");
+    VKCLOTH_VK_TRY(v.vkCreateQueryPool(d, &qi, v.allocator, &s.queries), "vkCreateQueryPool");
   }
   if (!options.csr_only) s.detect_stencil(system);
   VKCLOTH_TRY(s.init_pipelines());
@@ -671,6 +676,7 @@ Result<void> GpuSolver::set_params(SimParams params) {
 const SimParams& GpuSolver::params() const { return impl_->params; }
 
 void GpuSolver::record_steps(VkCommandBuffer cmd, std::uint32_t steps) { impl_->record(cmd, steps); }
+void GpuSolver::record_step(VkCommandBuffer cmd) { impl_->record(cmd, 1); }
 
 void GpuSolver::record_barrier_to(VkCommandBuffer cmd, VkPipelineStageFlags dst_stage, VkAccessFlags dst_access) const {
   barriers::after_steps(impl_->vk(), cmd, dst_stage, dst_access);

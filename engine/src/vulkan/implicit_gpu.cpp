@@ -28,13 +28,13 @@ constexpr std::uint32_t kBindings[] = {
 constexpr std::uint32_t kBindingCount = sizeof(kBindings) / sizeof(kBindings[0]);
 
 template <std::size_t N>
-Result<VkShaderModule> module(const VolkDeviceTable& vk, VkDevice d, const std::uint32_t (&code)[N], const char* name) {
+Result<VkShaderModule> module(const DeviceFns& vk, VkDevice d, const std::uint32_t (&code)[N], const char* name) {
   VkShaderModuleCreateInfo ci{};
   ci.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
   ci.codeSize = N * sizeof(std::uint32_t);
   ci.pCode = code;
   VkShaderModule m = VK_NULL_HANDLE;
-  VKCLOTH_VK_TRY(vk.vkCreateShaderModule(d, &ci, nullptr, &m), fmt::format("vkCreateShaderModule ({})", name));
+  VKCLOTH_VK_TRY(vk.vkCreateShaderModule(d, &ci, vk.allocator, &m), fmt::format("vkCreateShaderModule ({})", name));
   return m;
 }
 
@@ -44,11 +44,11 @@ ImplicitGpu::~ImplicitGpu() {
   if (!ctx_ || !ctx_->device) return;
   const auto& v = ctx_->vk;
   const VkDevice d = ctx_->device;
-  if (pass_) v.vkDestroyPipeline(d, pass_, nullptr);
-  if (reduce_) v.vkDestroyPipeline(d, reduce_, nullptr);
-  if (layout_) v.vkDestroyPipelineLayout(d, layout_, nullptr);
-  if (pool_) v.vkDestroyDescriptorPool(d, pool_, nullptr);
-  if (set_layout_) v.vkDestroyDescriptorSetLayout(d, set_layout_, nullptr);
+  if (pass_) v.vkDestroyPipeline(d, pass_, v.allocator);
+  if (reduce_) v.vkDestroyPipeline(d, reduce_, v.allocator);
+  if (layout_) v.vkDestroyPipelineLayout(d, layout_, v.allocator);
+  if (pool_) v.vkDestroyDescriptorPool(d, pool_, v.allocator);
+  if (set_layout_) v.vkDestroyDescriptorSetLayout(d, set_layout_, v.allocator);
   for (Buffer* b : {&vf_, &ks_, &diag_inv_, &x_, &r_, &z_, &d_, &q_, &partials_, &state_, &args_}) destroy_buffer(*ctx_, *b);
 }
 
@@ -108,7 +108,7 @@ Result<std::unique_ptr<ImplicitGpu>> ImplicitGpu::create(const std::shared_ptr<C
   li.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
   li.bindingCount = kBindingCount;
   li.pBindings = bindings.data();
-  VKCLOTH_VK_TRY(v.vkCreateDescriptorSetLayout(d, &li, nullptr, &s->set_layout_), "vkCreateDescriptorSetLayout (implicit)");
+  VKCLOTH_VK_TRY(v.vkCreateDescriptorSetLayout(d, &li, v.allocator, &s->set_layout_), "vkCreateDescriptorSetLayout (implicit)");
   const VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(sh::PushConstants)};
   VkPipelineLayoutCreateInfo pi{};
   pi.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
@@ -116,14 +116,14 @@ Result<std::unique_ptr<ImplicitGpu>> ImplicitGpu::create(const std::shared_ptr<C
   pi.pSetLayouts = &s->set_layout_;
   pi.pushConstantRangeCount = 1;
   pi.pPushConstantRanges = &range;
-  VKCLOTH_VK_TRY(v.vkCreatePipelineLayout(d, &pi, nullptr, &s->layout_), "vkCreatePipelineLayout (implicit)");
+  VKCLOTH_VK_TRY(v.vkCreatePipelineLayout(d, &pi, v.allocator, &s->layout_), "vkCreatePipelineLayout (implicit)");
   const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2 * kBindingCount};
   VkDescriptorPoolCreateInfo dp{};
   dp.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
   dp.maxSets = 2;
   dp.poolSizeCount = 1;
   dp.pPoolSizes = &size;
-  VKCLOTH_VK_TRY(v.vkCreateDescriptorPool(d, &dp, nullptr, &s->pool_), "vkCreateDescriptorPool (implicit)");
+  VKCLOTH_VK_TRY(v.vkCreateDescriptorPool(d, &dp, v.allocator, &s->pool_), "vkCreateDescriptorPool (implicit)");
   const VkDescriptorSetLayout layouts[2] = {s->set_layout_, s->set_layout_};
   VkDescriptorSetAllocateInfo ai{};
   ai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
@@ -136,7 +136,7 @@ Result<std::unique_ptr<ImplicitGpu>> ImplicitGpu::create(const std::shared_ptr<C
   if (!pm) return pm.error();
   auto rm = module(v, d, spirv::implicit_reduce_comp_spv, "implicit_reduce.comp");
   if (!rm) {
-    v.vkDestroyShaderModule(d, *pm, nullptr);
+    v.vkDestroyShaderModule(d, *pm, v.allocator);
     return rm.error();
   }
   VkComputePipelineCreateInfo ci[2]{};
@@ -148,9 +148,9 @@ Result<std::unique_ptr<ImplicitGpu>> ImplicitGpu::create(const std::shared_ptr<C
     ci[k].layout = s->layout_;
   }
   VkPipeline pipes[2] = {};
-  const VkResult res = v.vkCreateComputePipelines(d, VK_NULL_HANDLE, 2, ci, nullptr, pipes);
-  v.vkDestroyShaderModule(d, *pm, nullptr);
-  v.vkDestroyShaderModule(d, *rm, nullptr);
+  const VkResult res = v.vkCreateComputePipelines(d, VK_NULL_HANDLE, 2, ci, v.allocator, pipes);
+  v.vkDestroyShaderModule(d, *pm, v.allocator);
+  v.vkDestroyShaderModule(d, *rm, v.allocator);
   if (res != VK_SUCCESS) return vk_error(res, "vkCreateComputePipelines (implicit.comp, implicit_reduce.comp)");
   s->pass_ = pipes[0];
   s->reduce_ = pipes[1];

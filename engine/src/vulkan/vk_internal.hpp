@@ -10,6 +10,7 @@
 #include <atomic>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "vkcloth/gpu/context.hpp"
 #include "vkcloth/result.hpp"
@@ -43,6 +44,12 @@ struct InstanceFns {
   PFN_vkDestroyDebugUtilsMessengerEXT vkDestroyDebugUtilsMessengerEXT = nullptr;
 };
 
+/// The device functions of one device plus the VkAllocationCallbacks (HostHandles::allocator, null:
+/// the driver's) that every vkCreate*/vkAllocateMemory/vkDestroy*/vkFreeMemory of vkcloth passes.
+struct DeviceFns : VolkDeviceTable {
+  const VkAllocationCallbacks* allocator = nullptr;
+};
+
 struct Context::Impl {
   VkInstance instance = VK_NULL_HANDLE;
   VkPhysicalDevice physical_device = VK_NULL_HANDLE;
@@ -53,7 +60,7 @@ struct Context::Impl {
   std::uint32_t api_version = 0;
 
   InstanceFns fi;
-  VolkDeviceTable vk{}; ///< device functions of `device`
+  DeviceFns vk{}; ///< device functions of `device`, and the host's allocation callbacks
 
   VkPhysicalDeviceProperties properties{};
   VkPhysicalDeviceMemoryProperties memory{};
@@ -94,8 +101,10 @@ enum class MemoryUse {
   host_readback,  ///< host-visible+coherent, cached if possible, for readbacks and flags
 };
 
+/// `sharing_families`: queue families that use the buffer without ownership transfers; two or more
+/// distinct ones make it VK_SHARING_MODE_CONCURRENT, otherwise it is EXCLUSIVE.
 Result<Buffer> create_buffer(Context::Impl& ctx, VkDeviceSize size, VkBufferUsageFlags usage, MemoryUse use,
-                             bool allow_map, const char* what);
+                             bool allow_map, const char* what, const std::vector<std::uint32_t>& sharing_families = {});
 void destroy_buffer(Context::Impl& ctx, Buffer& b);
 
 } // namespace vkcloth::gpu

@@ -43,7 +43,8 @@ struct ContextOptions {
 };
 
 /// A host's Vulkan handles, adopted as they are (nothing is created or destroyed but the
-/// solver's own objects). The device needs one queue of `queue_family` with compute support;
+/// solver's own objects: the host's instance, device and queue stay valid and usable after every
+/// vkcloth object is gone). The device needs one queue of `queue_family` with compute support;
 /// no extension or feature beyond Vulkan 1.2 core is required.
 struct HostHandles {
   VkInstance instance = VK_NULL_HANDLE;
@@ -54,6 +55,10 @@ struct HostHandles {
   PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr;
   /// The API version the instance and device were created for; the shaders need 1.2.
   std::uint32_t api_version = VK_API_VERSION_1_2;
+  /// The host's allocation callbacks, passed to EVERY vkCreate* / vkAllocateMemory / vkDestroy* /
+  /// vkFreeMemory that vkcloth makes on `device` (solvers, worlds, renderer, offscreen targets).
+  /// Null: the driver's allocator. Must outlive every vkcloth object created on this Context.
+  const VkAllocationCallbacks* allocator = nullptr;
 };
 
 /// One physical device as listed by Context::list_devices().

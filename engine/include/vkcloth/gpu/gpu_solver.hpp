@@ -53,6 +53,12 @@ struct GpuSolverOptions {
   /// lists; same terms in the same order, so the same bits. `true` keeps the CSR gather for every
   /// particle (tests, comparison).
   bool csr_only = false;
+  /// Queue families (besides the Context's, which is always added) that use the per-particle and
+  /// topology buffers, e.g. the host's graphics family when it differs from the compute family.
+  /// Two or more distinct families create the buffers VK_SHARING_MODE_CONCURRENT, so the host
+  /// needs no queue-family ownership transfer (it still needs a semaphore between the compute
+  /// and the graphics submissions). Empty: VK_SHARING_MODE_EXCLUSIVE (see record_steps()).
+  std::vector<std::uint32_t> sharing_queue_families;
 };
 
 class GpuSolver {
@@ -82,7 +88,19 @@ public:
   /// buffers are left as compute-shader writes NOT yet visible to any later stage. Before reading
   /// them (drawing the current positions and normals, copying), record the caller's barrier or
   /// call record_barrier_to(cmd, dst_stage, dst_access).
+  ///
+  /// Different queue families for compute and graphics, with EXCLUSIVE buffers (the default):
+  /// after record_steps() the host records, on the compute queue's command buffer, a
+  /// VkBufferMemoryBarrier per buffer it reads (current positions, normals; uvs once) with
+  /// srcAccessMask = SHADER_WRITE, srcQueueFamilyIndex = compute family, dstQueueFamilyIndex =
+  /// graphics family (the RELEASE), submits it signalling a semaphore; the graphics submission
+  /// waits on that semaphore (dst stage VERTEX_INPUT) and records the same barriers with
+  /// dstAccessMask = VERTEX_ATTRIBUTE_READ (the ACQUIRE) before drawing; the next frame transfers
+  /// them back the same way before record_steps(). Or set GpuSolverOptions::sharing_queue_families
+  /// (CONCURRENT buffers): then only the semaphore and record_barrier_to() are needed.
   void record_steps(VkCommandBuffer cmd, std::uint32_t steps);
+  /// record_steps(cmd, 1): one step (the whole step: all substeps, RK4 stages or CG passes).
+  void record_step(VkCommandBuffer cmd);
   /// Records the barrier that makes the last record_steps() writes visible to `dst_stage` /
   /// `dst_access` (e.g. VK_PIPELINE_STAGE_VERTEX_INPUT_BIT / VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT).
   void record_barrier_to(VkCommandBuffer cmd, VkPipelineStageFlags dst_stage, VkAccessFlags dst_access) const;
