@@ -8,3 +8,4 @@
 #include "vkcloth/system.hpp"
 #include "vkcloth/scene.hpp"
 #include "vkcloth/gpu/gpu_solver.hpp"
+#include "vkcloth/gpu/world.hpp"

@@ -1,0 +1,44 @@
+// A test "host application": its own Vulkan instance, device, queue, command buffer and fence,
+// created through its own volk (host_vulkan.cpp), NOT through vkcloth::gpu::Context::create.
+// Validation + synchronization validation on; messages are counted (and printed).
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include <vulkan/vulkan_core.h>
+
+namespace vkcloth::gpu::test {
+
+struct HostVulkan {
+  VkInstance instance = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
+  VkPhysicalDevice physical_device = VK_NULL_HANDLE;
+  VkDevice device = VK_NULL_HANDLE;
+  std::uint32_t family = 0;
+  VkQueue queue = VK_NULL_HANDLE;
+  VkCommandPool pool = VK_NULL_HANDLE;
+  VkCommandBuffer cmd = VK_NULL_HANDLE;
+  VkFence fence = VK_NULL_HANDLE;
+  PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr;
+  std::atomic<std::uint64_t> messages{0};
+
+  /// Null with `error` set when no Vulkan 1.2 device with a compute queue (or no validation layer).
+  static std::unique_ptr<HostVulkan> create(std::string& error);
+  HostVulkan() = default;
+  HostVulkan(const HostVulkan&) = delete;
+  HostVulkan& operator=(const HostVulkan&) = delete;
+  ~HostVulkan();
+
+  /// Resets and begins `cmd`.
+  bool begin();
+  /// Ends `cmd`, submits it on `queue` and waits for `fence`.
+  bool submit_and_wait();
+  /// The host's device still works: creates and destroys a buffer, submits an empty command
+  /// buffer and waits, vkDeviceWaitIdle.
+  bool still_usable();
+};
+
+} // namespace vkcloth::gpu::test
