@@ -414,6 +414,19 @@ template <typename Real> template <typename F> void CpuSolver<Real>::for_particl
 
 template <typename Real> Result<void> CpuSolver<Real>::check_finite() const {
   const Real limit = Real(params_.divergence_limit);
+  // Fast pass without early exit (vectorisable OR-reduction over the flat arrays): a component
+  // is bad when not finite (c - c != 0 for inf and NaN) or, for positions, |x| > limit (or NaN).
+  // Only when something is bad does the loop below look for the first particle, for the message.
+  {
+    const Real* x = pos_.empty() ? nullptr : &pos_[0].x;
+    const Real* v = vel_.empty() ? nullptr : &vel_[0].x;
+    const std::size_t n3 = 3 * pos_.size();
+    unsigned bad = 0;
+    for (std::size_t i = 0; i < n3; ++i)
+      bad |= unsigned(!(std::abs(x[i]) <= limit)) | unsigned(!(x[i] - x[i] == Real(0))) |
+             unsigned(!(v[i] - v[i] == Real(0)));
+    if (!bad) return {};
+  }
   for (std::size_t p = 0; p < pos_.size(); ++p) {
     const Vec3 x = pos_[p], v = vel_[p];
     const bool finite = std::isfinite(x.x) && std::isfinite(x.y) && std::isfinite(x.z) && std::isfinite(v.x) &&

@@ -4,6 +4,7 @@
 // compiled with its own -m flags and only called after __builtin_cpu_supports said yes.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 
 namespace vkcloth::detail {

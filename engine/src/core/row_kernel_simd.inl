@@ -18,6 +18,10 @@ template <typename T> inline typename T::V ld(const typename T::Real* p) {
 }
 template <typename T> inline typename T::V bc(typename T::Real x) { return typename T::V{} + x; }
 
+template <bool B> struct Flag {
+  static constexpr bool value = B;
+};
+
 template <typename T, bool wind, bool integrate, bool semi>
 std::int64_t simd_body(const vkcloth::detail::RowArgs<typename T::Real>& a, std::int64_t q0, std::int64_t q1) {
   using Real = typename T::Real;
@@ -45,8 +49,20 @@ std::int64_t simd_body(const vkcloth::detail::RowArgs<typename T::Real>& a, std:
     L[k] = bc<T>(a.rest[k]);
     K[k] = bc<T>(a.stiff[k]);
   }
-  std::int64_t q = q0;
-  for (; q + W <= q1; q += W) {
+  // One vector of W particles from q; with Tail, the first `skip` lanes were done already and only
+  // the others are stored (the overlapped last vector of a run: the skipped lanes read velocities
+  // updated in place, but their results are thrown away; the stored lanes read only their own).
+  auto vec = [&](std::int64_t q, int skip, auto tail) {
+    constexpr bool Tail = decltype(tail)::value;
+    auto put3 = [&](Real* p, V x, V y, V z) {
+      if constexpr (!Tail) {
+        T::store3(p, x, y, z);
+      } else {
+        Real buf[3 * W];
+        T::store3(buf, x, y, z);
+        __builtin_memcpy(p + 3 * skip, buf + 3 * skip, sizeof(Real) * std::size_t(3 * (W - skip)));
+      }
+    };
     const V x0 = ld<T>(px + q), y0 = ld<T>(py + q), z0 = ld<T>(pz + q);
     const V e0x = ld<T>(px + q + 1) - x0, e0y = ld<T>(py + q + 1) - y0, e0z = ld<T>(pz + q + 1) - z0;
     const V e1x = ld<T>(px + q + nx) - x0, e1y = ld<T>(py + q + nx) - y0, e1z = ld<T>(pz + q + nx) - z0;
@@ -95,8 +111,8 @@ std::int64_t simd_body(const vkcloth::detail::RowArgs<typename T::Real>& a, std:
       fy = fy + nyv * kn;
       fz = fz + nzv * kn;
     }
-    T::store3(no + 3 * q, nxv, nyv, nzv);
-    T::store3(fo + 3 * q, fx, fy, fz);
+    put3(no + 3 * q, nxv, nyv, nzv);
+    put3(fo + 3 * q, fx, fy, fz);
     if constexpr (integrate) {
       const V ax = fx / m, ay = fy / m, az = fz / m;
       V xx, xy, xz;
@@ -118,11 +134,17 @@ std::int64_t simd_body(const vkcloth::detail::RowArgs<typename T::Real>& a, std:
         nvz = vz + az * dt;
       }
       const M pin = T::pinmask(pinned + q);
-      T::store3(pos_next + 3 * q, pin ? xx : nxx, pin ? xy : nxy, pin ? xz : nxz);
-      T::store3(vel + 3 * q, pin ? vx : nvx, pin ? vy : nvy, pin ? vz : nvz);
+      put3(pos_next + 3 * q, pin ? xx : nxx, pin ? xy : nxy, pin ? xz : nxz);
+      put3(vel + 3 * q, pin ? vx : nvx, pin ? vy : nvy, pin ? vz : nvz);
     }
+  };
+  std::int64_t done = q0;
+  for (; done + W <= q1; done += W) vec(done, 0, Flag<false>{});
+  if (done < q1 && q1 - q0 >= W) { // the remainder as one vector overlapping the previous one
+    vec(q1 - W, int(W - (q1 - done)), Flag<true>{});
+    done = q1;
   }
-  return q;
+  return done;
 }
 
 template <typename T>
