@@ -130,6 +130,7 @@ private:
   std::array<Edge, 12> stencil_edge_{};
   std::array<Real, 12> stencil_rest_{}, stencil_stiff_{};
   std::vector<Real> soa_; // positions as x[n], y[n], z[n] for the row kernel
+  int simd_ = 0;           // row kernel ISA: 0 scalar, 1 AVX2, 2 AVX-512F (cpu_solver.cpp)
   std::uint64_t step_ = 0;
   std::unique_ptr<detail::ThreadPool> pool_;
   std::unique_ptr<detail::ImplicitWorkspace<Real>> implicit_; // created by the first implicit step

@@ -2,12 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <thread>
 
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
 
 #include "implicit_euler.hpp"
+#include "row_kernel.hpp"
 #include "thread_pool.hpp"
 
 // Floating-point expressions below are written in the exact order the GLSL passes use
@@ -45,23 +48,7 @@ template <typename Real> Contact<Real> collider_contact(const Collider& c, glm::
 // becomes a select of the unchanged sum, which is the same value. sqrt and division are correctly
 // rounded in SIMD as in scalar code and -ffp-contract=off forbids FMA, so every lane computes the
 // bits the scalar code computes, on every ISA the clones below target.
-template <typename Real> struct RowArgs {
-  const Real *px, *py, *pz;    // positions, SoA
-  const Real* vel;             // velocities, AoS (x, y, z) per particle; written when integrating
-  Real* vel_out;               // == vel storage (in-place update), may be null when !integrate
-  const Real* mass;
-  const std::uint8_t* pinned;
-  Real* force_out;             // AoS
-  Real* normal_out;            // AoS
-  const Real* pos_aos;         // current positions, AoS (pinned particles copy theirs)
-  Real* pos_next;              // AoS, written when integrating
-  std::int64_t nx;
-  const std::int64_t* off;     // 12 stencil offsets
-  const Real* rest;            // 12
-  const Real* stiff;           // 12
-  Real gx, gy, gz, damping, kw, wx, wy, wz, dt;
-  bool wind, integrate, semi;
-};
+using detail::RowArgs;
 
 template <typename Real, bool wind, bool integrate, bool semi>
 #if defined(__GNUC__)
@@ -213,6 +200,22 @@ VKCLOTH_ROW_CLONES void row_kernel_d(const RowArgs<double>& a, std::int64_t q0, 
 inline void row_kernel(const RowArgs<float>& a, std::int64_t q0, std::int64_t q1) { row_kernel_f(a, q0, q1); }
 inline void row_kernel(const RowArgs<double>& a, std::int64_t q0, std::int64_t q1) { row_kernel_d(a, q0, q1); }
 
+/// Row kernel ISA: 2 = AVX-512F, 1 = AVX2, 0 = scalar; the widest the CPU has, capped by the
+/// environment variable VKCLOTH_CPU_SIMD = scalar | avx2 | avx512 (tests compare them bitwise).
+int detect_simd() {
+  int best = 0;
+#if VKCLOTH_ROW_SIMD
+  __builtin_cpu_init();
+  if (__builtin_cpu_supports("avx2")) best = 1;
+  if (__builtin_cpu_supports("avx512f")) best = 2;
+#endif
+  if (const char* env = std::getenv("VKCLOTH_CPU_SIMD")) {
+    if (std::strcmp(env, "scalar") == 0) best = 0;
+    else if (std::strcmp(env, "avx2") == 0) best = std::min(best, 1);
+  }
+  return best;
+}
+
 } // namespace
 
 template <typename Real> CpuSolver<Real>::CpuSolver() = default;
@@ -257,6 +260,7 @@ Result<CpuSolver<Real>> CpuSolver<Real>::create(const ParticleSystem& system, Si
   const auto useful = static_cast<unsigned>(std::max<std::size_t>(1, n / 1024));
   s.pool_ = std::make_unique<detail::ThreadPool>(std::min(wanted, useful));
   s.detect_stencil();
+  s.simd_ = detect_simd();
   return s;
 }
 
@@ -410,6 +414,19 @@ template <typename Real> template <typename F> void CpuSolver<Real>::for_particl
 
 template <typename Real> Result<void> CpuSolver<Real>::check_finite() const {
   const Real limit = Real(params_.divergence_limit);
+  // Fast pass without early exit (vectorisable OR-reduction over the flat arrays): a component
+  // is bad when not finite (c - c != 0 for inf and NaN) or, for positions, |x| > limit (or NaN).
+  // Only when something is bad does the loop below look for the first particle, for the message.
+  {
+    const Real* x = pos_.empty() ? nullptr : &pos_[0].x;
+    const Real* v = vel_.empty() ? nullptr : &vel_[0].x;
+    const std::size_t n3 = 3 * pos_.size();
+    unsigned bad = 0;
+    for (std::size_t i = 0; i < n3; ++i)
+      bad |= unsigned(!(std::abs(x[i]) <= limit)) | unsigned(!(x[i] - x[i] == Real(0))) |
+             unsigned(!(v[i] - v[i] == Real(0)));
+    if (!bad) return {};
+  }
   for (std::size_t p = 0; p < pos_.size(); ++p) {
     const Vec3 x = pos_[p], v = vel_[p];
     const bool finite = std::isfinite(x.x) && std::isfinite(x.y) && std::isfinite(x.z) && std::isfinite(v.x) &&
@@ -524,7 +541,12 @@ template <typename Real> void CpuSolver<Real>::substep(const Real dt) {
           const std::int64_t j = std::int64_t(p) / gnx, i = std::int64_t(p) % gnx;
           if (j >= 2 && j + 2 < gny && i >= 2 && i + 2 < gnx) {
             const std::size_t run_end = std::min<std::size_t>(e, std::size_t(j * gnx + gnx - 2));
-            row_kernel(ra, std::int64_t(p), std::int64_t(run_end));
+            std::int64_t done = std::int64_t(p); // whole vectors in SIMD, the remainder scalar
+#if VKCLOTH_ROW_SIMD
+            if (simd_ == 2) done = detail::row_kernel_avx512(ra, done, std::int64_t(run_end));
+            else if (simd_ == 1) done = detail::row_kernel_avx2(ra, done, std::int64_t(run_end));
+#endif
+            if (done < std::int64_t(run_end)) row_kernel(ra, done, std::int64_t(run_end));
             if (!kernel_integrates)
               for (std::size_t q = p; q < run_end; ++q) finish(q, force_[q]);
             p = run_end;

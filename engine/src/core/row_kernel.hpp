@@ -1,0 +1,37 @@
+// The CPU solver's interior row kernel: its arguments and the per-ISA SIMD entry points.
+// cpu_solver.cpp holds the scalar kernel (the reference); row_kernel_avx2.cpp and
+// row_kernel_avx512.cpp hold the same arithmetic with 8 / 16 particles per vector, each file
+// compiled with its own -m flags and only called after __builtin_cpu_supports said yes.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+namespace vkcloth::detail {
+
+template <typename Real> struct RowArgs {
+  const Real *px, *py, *pz;    // positions, SoA
+  const Real* vel;             // velocities, AoS (x, y, z) per particle; written when integrating
+  Real* vel_out;               // == vel storage (in-place update), may be null when !integrate
+  const Real* mass;
+  const std::uint8_t* pinned;
+  Real* force_out;             // AoS
+  Real* normal_out;            // AoS
+  const Real* pos_aos;         // current positions, AoS (pinned particles copy theirs)
+  Real* pos_next;              // AoS, written when integrating
+  std::int64_t nx;
+  const std::int64_t* off;     // 12 stencil offsets
+  const Real* rest;            // 12
+  const Real* stiff;           // 12
+  Real gx, gy, gz, damping, kw, wx, wy, wz, dt;
+  bool wind, integrate, semi;
+};
+
+// Each processes whole vectors from q0 and returns where it stopped (q1 minus the remainder,
+// fewer than one vector, which the caller runs through the scalar kernel).
+std::int64_t row_kernel_avx512(const RowArgs<float>& a, std::int64_t q0, std::int64_t q1);
+std::int64_t row_kernel_avx512(const RowArgs<double>& a, std::int64_t q0, std::int64_t q1);
+std::int64_t row_kernel_avx2(const RowArgs<float>& a, std::int64_t q0, std::int64_t q1);
+std::int64_t row_kernel_avx2(const RowArgs<double>& a, std::int64_t q0, std::int64_t q1);
+
+} // namespace vkcloth::detail

@@ -1,0 +1,188 @@
+// The interior row kernel, vectorised across particles with GCC vector extensions. Included by
+// row_kernel_avx2.cpp / row_kernel_avx512.cpp after they define, inside an anonymous namespace,
+// the ISA traits `IsaF` / `IsaD` (Real, V = W lanes of Real, M = W lanes of same-width ints,
+// sqrt, pin mask, AoS load3/store3). Everything here has internal linkage, so the two ISA
+// translation units never share (ODR-merge) a function compiled for the other's ISA.
+//
+// Bits: every lane performs the scalar kernel's operations (cpu_solver.cpp, row_kernel_body) on
+// its particle, one for one and in the same order; IEEE +, -, *, / and sqrt are correctly rounded
+// in SIMD as in scalar code, -ffp-contract=off forbids FMA, `if (len > 0)` is the same select.
+// Do not include anything else here (no std headers with inline functions: see above).
+
+namespace {
+
+template <typename T> inline typename T::V ld(const typename T::Real* p) {
+  typename T::V v;
+  __builtin_memcpy(&v, p, sizeof v);
+  return v;
+}
+template <typename T> inline typename T::V bc(typename T::Real x) { return typename T::V{} + x; }
+
+template <bool B> struct Flag {
+  static constexpr bool value = B;
+};
+
+template <typename T, bool wind, bool integrate, bool semi>
+std::int64_t simd_body(const vkcloth::detail::RowArgs<typename T::Real>& a, std::int64_t q0, std::int64_t q1) {
+  using Real = typename T::Real;
+  using V = typename T::V;
+  using M = typename T::M;
+  constexpr int W = T::W;
+  const Real* __restrict px = a.px;
+  const Real* __restrict py = a.py;
+  const Real* __restrict pz = a.pz;
+  const Real* __restrict mass = a.mass;
+  const std::uint8_t* __restrict pinned = a.pinned;
+  Real* __restrict fo = a.force_out;
+  Real* __restrict no = a.normal_out;
+  Real* __restrict vel = a.vel_out;
+  const Real* __restrict pos_aos = a.pos_aos;
+  Real* __restrict pos_next = a.pos_next;
+  const V zero = V{};
+  const V gx = bc<T>(a.gx), gy = bc<T>(a.gy), gz = bc<T>(a.gz), damping = bc<T>(a.damping), kw = bc<T>(a.kw),
+          wx = bc<T>(a.wx), wy = bc<T>(a.wy), wz = bc<T>(a.wz), dt = bc<T>(a.dt);
+  const std::int64_t nx = a.nx;
+  std::int64_t O[12];
+  V L[12], K[12];
+  for (int k = 0; k < 12; ++k) {
+    O[k] = a.off[k];
+    L[k] = bc<T>(a.rest[k]);
+    K[k] = bc<T>(a.stiff[k]);
+  }
+  // One vector of W particles from q; with Tail, the first `skip` lanes were done already and only
+  // the others are stored (the overlapped last vector of a run: the skipped lanes read velocities
+  // updated in place, but their results are thrown away; the stored lanes read only their own).
+  auto vec = [&](std::int64_t q, int skip, auto tail) {
+    constexpr bool Tail = decltype(tail)::value;
+    auto put3 = [&](Real* p, V x, V y, V z) {
+      if constexpr (!Tail) {
+        T::store3(p, x, y, z);
+      } else {
+        Real buf[3 * W];
+        T::store3(buf, x, y, z);
+        __builtin_memcpy(p + 3 * skip, buf + 3 * skip, sizeof(Real) * std::size_t(3 * (W - skip)));
+      }
+    };
+    const V x0 = ld<T>(px + q), y0 = ld<T>(py + q), z0 = ld<T>(pz + q);
+    const V e0x = ld<T>(px + q + 1) - x0, e0y = ld<T>(py + q + 1) - y0, e0z = ld<T>(pz + q + 1) - z0;
+    const V e1x = ld<T>(px + q + nx) - x0, e1y = ld<T>(py + q + nx) - y0, e1z = ld<T>(pz + q + nx) - z0;
+    const V e2x = ld<T>(px + q - 1) - x0, e2y = ld<T>(py + q - 1) - y0, e2z = ld<T>(pz + q - 1) - z0;
+    const V e3x = ld<T>(px + q - nx) - x0, e3y = ld<T>(py + q - nx) - y0, e3z = ld<T>(pz + q - nx) - z0;
+    V sx = zero, sy = zero, sz = zero;
+#define VKCLOTH_CROSS_ADD(ax, ay, az, bx, by, bz)                                                                       \
+  sx = sx + (ay * bz - by * az);                                                                                       \
+  sy = sy + (az * bx - bz * ax);                                                                                       \
+  sz = sz + (ax * by - bx * ay);
+    VKCLOTH_CROSS_ADD(e0x, e0y, e0z, e1x, e1y, e1z)
+    VKCLOTH_CROSS_ADD(e1x, e1y, e1z, e2x, e2y, e2z)
+    VKCLOTH_CROSS_ADD(e2x, e2y, e2z, e3x, e3y, e3z)
+    VKCLOTH_CROSS_ADD(e3x, e3y, e3z, e0x, e0y, e0z)
+#undef VKCLOTH_CROSS_ADD
+    const V nlen = T::sqrt(sx * sx + sy * sy + sz * sz);
+    const M npos = nlen > zero;
+    const V qx = sx / nlen, qy = sy / nlen, qz = sz / nlen;
+    const V nxv = npos ? qx : zero, nyv = npos ? qy : zero, nzv = npos ? qz : zero;
+    V fx = zero, fy = zero, fz = zero;
+#pragma GCC unroll 12
+    for (int k = 0; k < 12; ++k) {
+      const std::int64_t r = q + O[k];
+      const V ux = ld<T>(px + r) - x0, uy = ld<T>(py + r) - y0, uz = ld<T>(pz + r) - z0;
+      const V len = T::sqrt(ux * ux + uy * uy + uz * uz);
+      const V c = K[k] * (len - L[k]) / len;
+      const M pos = len > zero;
+      const V tx = fx + ux * c, ty = fy + uy * c, tz = fz + uz * c;
+      fx = pos ? tx : fx;
+      fy = pos ? ty : fy;
+      fz = pos ? tz : fz;
+    }
+    const V m = ld<T>(mass + q);
+    fx = fx + gx * m;
+    fy = fy + gy * m;
+    fz = fz + gz * m;
+    V vx, vy, vz;
+    T::load3(vel + 3 * q, vx, vy, vz);
+    const V dm = damping * m;
+    fx = fx - vx * dm;
+    fy = fy - vy * dm;
+    fz = fz - vz * dm;
+    if constexpr (wind) {
+      const V kn = kw * (nxv * wx + nyv * wy + nzv * wz);
+      fx = fx + nxv * kn;
+      fy = fy + nyv * kn;
+      fz = fz + nzv * kn;
+    }
+    put3(no + 3 * q, nxv, nyv, nzv);
+    put3(fo + 3 * q, fx, fy, fz);
+    if constexpr (integrate) {
+      const V ax = fx / m, ay = fy / m, az = fz / m;
+      V xx, xy, xz;
+      T::load3(pos_aos + 3 * q, xx, xy, xz);
+      V nvx, nvy, nvz, nxx, nxy, nxz;
+      if constexpr (semi) {
+        nvx = vx + ax * dt;
+        nvy = vy + ay * dt;
+        nvz = vz + az * dt;
+        nxx = xx + nvx * dt;
+        nxy = xy + nvy * dt;
+        nxz = xz + nvz * dt;
+      } else {
+        nxx = xx + vx * dt;
+        nxy = xy + vy * dt;
+        nxz = xz + vz * dt;
+        nvx = vx + ax * dt;
+        nvy = vy + ay * dt;
+        nvz = vz + az * dt;
+      }
+      const M pin = T::pinmask(pinned + q);
+      put3(pos_next + 3 * q, pin ? xx : nxx, pin ? xy : nxy, pin ? xz : nxz);
+      put3(vel + 3 * q, pin ? vx : nvx, pin ? vy : nvy, pin ? vz : nvz);
+    }
+  };
+  std::int64_t done = q0;
+  for (; done + W <= q1; done += W) vec(done, 0, Flag<false>{});
+  if (done < q1 && q1 - q0 >= W) { // the remainder as one vector overlapping the previous one
+    vec(q1 - W, int(W - (q1 - done)), Flag<true>{});
+    done = q1;
+  }
+  return done;
+}
+
+template <typename T>
+std::int64_t simd_dispatch(const vkcloth::detail::RowArgs<typename T::Real>& a, std::int64_t q0, std::int64_t q1) {
+  const int v = (a.wind ? 4 : 0) | (a.integrate ? 2 : 0) | (a.semi ? 1 : 0);
+  switch (v) {
+  case 0: return simd_body<T, false, false, false>(a, q0, q1);
+  case 1: return simd_body<T, false, false, true>(a, q0, q1);
+  case 2: return simd_body<T, false, true, false>(a, q0, q1);
+  case 3: return simd_body<T, false, true, true>(a, q0, q1);
+  case 4: return simd_body<T, true, false, false>(a, q0, q1);
+  case 5: return simd_body<T, true, false, true>(a, q0, q1);
+  case 6: return simd_body<T, true, true, false>(a, q0, q1);
+  default: return simd_body<T, true, true, true>(a, q0, q1);
+  }
+}
+
+// Generic AoS <-> SoA and pin mask by lanes (the ISA files specialise the hot float cases).
+template <typename Real, typename V, typename M, int W> struct IsaGeneric {
+  static void load3(const Real* p, V& x, V& y, V& z) {
+    for (int l = 0; l < W; ++l) {
+      x[l] = p[3 * l];
+      y[l] = p[3 * l + 1];
+      z[l] = p[3 * l + 2];
+    }
+  }
+  static void store3(Real* p, V x, V y, V z) {
+    for (int l = 0; l < W; ++l) {
+      p[3 * l] = x[l];
+      p[3 * l + 1] = y[l];
+      p[3 * l + 2] = z[l];
+    }
+  }
+  static M pinmask(const std::uint8_t* p) {
+    M m;
+    for (int l = 0; l < W; ++l) m[l] = p[l] ? -1 : 0;
+    return m;
+  }
+};
+
+} // namespace
