@@ -497,6 +497,7 @@ Result<Context> Context::adopt(const HostHandles& h) {
   impl->fi = *fi;
   VKCLOTH_TRY(impl->load(VK_API_VERSION_1_2));
   impl->vk.allocator = h.allocator;
+  keep_vulkan_libraries_loaded_for_lsan(); // the host's driver, for the same reason
   return Context(std::move(impl));
 }
 
