@@ -153,8 +153,14 @@ TEST_CASE("implicit Euler: pinned particles stay put and collisions still hold")
 
 TEST_CASE("implicit Euler: the stiff 64x64 cloth hangs stably where semi-implicit Euler diverges") {
   // CPU float. 1000 steps here (~25 s on one core); VKCLOTH_LONG_TESTS=1 runs the issue's 10 000.
+  // Under AddressSanitizer (10x slower; that run looks for memory errors) 100 steps, and the
+  // energy-decay check, which needs the long run, is left to the release suite.
   const bool long_run = std::getenv("VKCLOTH_LONG_TESTS") != nullptr;
+#if defined(__SANITIZE_ADDRESS__)
+  const std::uint64_t steps = long_run ? 10000 : 100;
+#else
   const std::uint64_t steps = long_run ? 10000 : 1000;
+#endif
   const ParticleSystem cloth = stiff_cloth(64);
   auto s = CpuSolver<float>::create(cloth, implicit_params(0.02));
   REQUIRE(s.ok());
@@ -179,7 +185,8 @@ TEST_CASE("implicit Euler: the stiff 64x64 cloth hangs stably where semi-implici
                                            << ke_end << " J; CG at most " << max_it << " iterations, worst residual "
                                            << max_res);
   CHECK(max_strain < 0.05); // stated bound: 5 % stretch
-  CHECK(ke_end < 1e-3 * ke_early); // the fall from rest is damped out
+  if (steps >= 1000)
+    CHECK(ke_end < 1e-3 * ke_early); // the fall from rest is damped out
   SimParams semi = implicit_params(0.02);
   semi.integrator = Integrator::semi_implicit_euler;
   auto e = CpuSolver<float>::create(cloth, semi);
