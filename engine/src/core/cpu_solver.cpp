@@ -560,29 +560,7 @@ template <typename Real> void CpuSolver<Real>::substep(const Real dt) {
       break;
     }
     // One sweep: p's normal needs only positions (read-only here), and force_at reads p's own.
-    for_particles([&](std::size_t p) {
-      Vec3 f = normal_force_at(pos_, vel_, p);
-      if (pinned_[p]) {
-        force_[p] = f;
-        pos_next_[p] = pos_[p];
-        return;
-      }
-      Vec3 v = vel_[p];
-      contact_at(pos_[p], v, f);
-      force_[p] = f;
-      const Vec3 a = f / mass_[p];
-      Vec3 x = pos_[p];
-      if (semi) {
-        v += a * dt;
-        x += v * dt;
-      } else {
-        x += v * dt;
-        v += a * dt;
-      }
-      project_at(x, v);
-      pos_next_[p] = x;
-      vel_[p] = v; // only particle p reads its own velocity: updating in place is safe
-    });
+    for_particles([&](std::size_t p) { finish(p, normal_force_at(pos_, vel_, p)); });
     std::swap(pos_, pos_next_);
     break;
   }
