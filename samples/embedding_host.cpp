@@ -251,9 +251,9 @@ int main(int argc, char** argv) {
     render::RendererOptions ro;
     ro.render_pass = render_pass;
     ro.floor_half_size = 1.2f;
-    auto ra = render::ClothRenderer::create(*context, *world->solver(*a), *falling_topo, ro);
+    auto ra = render::ClothRenderer::create(*context, on_sphere, *falling_topo, ro);
     ro.floor_half_size = 0.0f;
-    auto rb = render::ClothRenderer::create(*context, *world->solver(*b), *hanging_topo, ro);
+    auto rb = render::ClothRenderer::create(*context, windy, *hanging_topo, ro);
     if (!ra || !rb) return std::fprintf(stderr, "ClothRenderer::create: %s\n", (!ra ? ra : rb).error().message.c_str()), 1;
     render::Camera camera;
     camera.eye = {0.4f, -2.6f, 1.5f};
@@ -271,8 +271,9 @@ int main(int argc, char** argv) {
       VkRenderPassBeginInfo rb_info{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO, nullptr, render_pass, framebuffer,
                                     {{0, 0}, {width, height}}, 2, clears};
       vkCmdBeginRenderPass(cmd, &rb_info, VK_SUBPASS_CONTENTS_INLINE);
-      ra->record_draw(cmd, *world->solver(*a), camera, {width, height});
-      rb->record_draw(cmd, *world->solver(*b), camera, {width, height});
+      // Each instance's buffers (and offset in them): the current positions alternate every step.
+      ra->record_draw(cmd, *world->buffers(*a), camera, {width, height});
+      rb->record_draw(cmd, *world->buffers(*b), camera, {width, height});
       vkCmdEndRenderPass(cmd);
       if (frame + 1 == frames) {
         VkBufferImageCopy region{};

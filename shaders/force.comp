@@ -13,12 +13,14 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_VEL_FILT) writeonly buffer Vel
 layout(std430, set = 0, binding = VKCLOTH_BINDING_NORMAL) writeonly buffer NormalOut { vec4 normal_out[]; };
 
 void main() {
+  begin_instance();
   const uint p = particle_index();
   if (p >= pc.count || frozen()) return;
-  vec3 v = vel_in[p].xyz;
+  const uint g = base + p; // this particle's entry in the state buffers
+  vec3 v = vel_in[g].xyz;
   vec3 f, nrm;
   particle_force(p, v, f, nrm);
-  force_out[p] = vec4(f, 0.0);
-  vel_filt[p] = vec4(v, 0.0);
-  normal_out[p] = vec4(nrm, 0.0);
+  force_out[g] = vec4(f, 0.0);
+  vel_filt[g] = vec4(v, 0.0);
+  normal_out[g] = vec4(nrm, 0.0);
 }

@@ -1,6 +1,6 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// Fused Euler step, one invocation per particle, one dispatch per step (GpuSolverOptions::fused):
+// Fused Euler step, one invocation per particle of every instance of the batch, one dispatch per step (GpuSolverOptions::fused):
 // the force pass (force_body.glsl: normal rebuilt from the neighbours' POS_IN, spring gather,
 // contacts) followed by the Euler update and projection (finish.glsl) in registers. Valid in one
 // dispatch because positions are ping-ponged (every invocation reads POS_IN = positions[read] and
@@ -20,30 +20,32 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_VEL) buffer VelBuf { vec4 vel[
 #include "finish.glsl"
 
 void main() {
+  begin_instance();
   const uint p = particle_index();
   if (p >= pc.count) return;
+  const uint g = base + p; // this particle's entry in the state buffers
   if (frozen()) {
-    pos_out[p] = pos_in[p]; // keep the frozen state in the buffer that becomes current
+    pos_out[g] = pos_in[g]; // keep the frozen state in the buffer that becomes current
     return;
   }
-  vec3 vf = vel[p].xyz;
+  vec3 vf = vel[g].xyz;
   vec3 f, nrm;
   particle_force(p, vf, f, nrm);
-  force_out[p] = vec4(f, 0.0);
-  normal_out[p] = vec4(nrm, 0.0);
+  force_out[g] = vec4(f, 0.0);
+  normal_out[g] = vec4(nrm, 0.0);
 
   const bool pinned = particle[p].pinned != 0u;
   const float m = particle[p].mass;
-  precise vec3 x = pos_in[p].xyz;
+  precise vec3 x = pos_in[g].xyz;
   precise vec3 v = vf;
   if (!pinned) {
     precise vec3 a = f / m;
-    if (pc.integrator == VKCLOTH_INTEGRATOR_SEMI_IMPLICIT_EULER) {
-      v = v + a * pc.dt;
-      x = x + v * pc.dt;
+    if (ip.integrator == VKCLOTH_INTEGRATOR_SEMI_IMPLICIT_EULER) {
+      v = v + a * ip.dt;
+      x = x + v * ip.dt;
     } else {
-      x = x + v * pc.dt;
-      v = v + a * pc.dt;
+      x = x + v * ip.dt;
+      v = v + a * ip.dt;
     }
   }
   finish(p, pinned, x, v);

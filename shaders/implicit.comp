@@ -54,11 +54,12 @@ precise vec3 apply_ks(uint e, vec3 w) {
 }
 
 void main() {
+  begin_instance(); // always instance 0: implicit passes run batches of one
   const uint p = particle_index();
   const bool live = p < pc.count;
   const uint mode = pc.stage;
-  const float h = pc.dt;
-  precise float mu_h = 1.0 + h * pc.gravity_damping.w;
+  const float h = ip.dt;
+  precise float mu_h = 1.0 + h * ip.gravity_damping.w;
   precise float h2 = h * h;
   const bool pinned = live && particle[p].pinned != 0u;
 
@@ -167,12 +168,12 @@ void main() {
     return;
   }
   precise vec3 v = vf[p].xyz + cx[p].xyz;
-  for (uint c = 0u; c < pc.collider_count; ++c) { // CpuSolver::contact_at on the new velocity
+  for (uint c = 0u; c < ip.collider_count; ++c) { // CpuSolver::contact_at on the new velocity
     float dist;
     vec3 n;
     collider_contact(c, x0, dist, n);
-    if (!(dist < pc.band)) continue;
-    const bool both = (pc.flags & VKCLOTH_FLAG_CONTACT_BOTH) != 0u;
+    if (!(dist < ip.band)) continue;
+    const bool both = (ip.flags & VKCLOTH_FLAG_CONTACT_BOTH) != 0u;
     precise float vn = dot3(v, n);
     if (vn < 0.0 || (both && vn != 0.0)) v = v - n * vn;
   }

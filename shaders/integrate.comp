@@ -20,30 +20,32 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_ACC_VEL) buffer AccVel { vec4 
 #include "finish.glsl"
 
 void main() {
+  begin_instance();
   const uint p = particle_index();
   if (p >= pc.count) return;
-  const bool last = pc.integrator != VKCLOTH_INTEGRATOR_RK4 || pc.stage == 3u;
+  const uint g = base + p; // this particle's entry in the state buffers
+  const bool last = ip.integrator != VKCLOTH_INTEGRATOR_RK4 || pc.stage == 3u;
   if (frozen()) {
-    if (last) pos_out[p] = pos_base[p]; // keep the frozen state in the buffer that becomes current
+    if (last) pos_out[g] = pos_base[g]; // keep the frozen state in the buffer that becomes current
     return;
   }
   const bool pinned = particle[p].pinned != 0u;
   const float m = particle[p].mass;
-  const vec3 base = pos_base[p].xyz;
-  const vec3 f = force_in[p].xyz;
-  const vec3 vf = vel_filt[p].xyz;
+  const vec3 x0 = pos_base[g].xyz; // positions at the start of the step
+  const vec3 f = force_in[g].xyz;
+  const vec3 vf = vel_filt[g].xyz;
 
-  if (pc.integrator != VKCLOTH_INTEGRATOR_RK4) {
-    precise vec3 x = base;
+  if (ip.integrator != VKCLOTH_INTEGRATOR_RK4) {
+    precise vec3 x = x0;
     precise vec3 v = vf;
     if (!pinned) {
       precise vec3 a = f / m;
-      if (pc.integrator == VKCLOTH_INTEGRATOR_SEMI_IMPLICIT_EULER) {
-        v = v + a * pc.dt;
-        x = x + v * pc.dt;
+      if (ip.integrator == VKCLOTH_INTEGRATOR_SEMI_IMPLICIT_EULER) {
+        v = v + a * ip.dt;
+        x = x + v * ip.dt;
       } else {
-        x = x + v * pc.dt;
-        v = v + a * pc.dt;
+        x = x + v * ip.dt;
+        v = v + a * ip.dt;
       }
     }
     finish(p, pinned, x, v);
@@ -58,27 +60,28 @@ void main() {
     sp = kp;
     sv = kv;
   } else if (pc.stage < 3u) {
-    sp = acc_pos[p].xyz + kp * 2.0; // CPU: dp = k0 + k1 * 2; dp += k2 * 2
-    sv = acc_vel[p].xyz + kv * 2.0;
+    sp = acc_pos[g].xyz + kp * 2.0; // CPU: dp = k0 + k1 * 2; dp += k2 * 2
+    sv = acc_vel[g].xyz + kv * 2.0;
   } else {
-    sp = acc_pos[p].xyz + kp; // dp += k3
-    sv = acc_vel[p].xyz + kv;
+    sp = acc_pos[g].xyz + kp; // dp += k3
+    sv = acc_vel[g].xyz + kv;
   }
-  const vec3 v0 = vel[p].xyz;
+  const vec3 v0 = vel[g].xyz;
   if (pc.stage < 3u) {
-    acc_pos[p] = vec4(sp, 0.0);
-    acc_vel[p] = vec4(sv, 0.0);
-    precise vec3 y = base + kp * pc.c_next; // y_{k+1} = y0 + c_{k+1} k_k
-    precise vec3 w = v0 + kv * pc.c_next;
-    stage_pos[p] = vec4(y, 1.0);
-    stage_vel[p] = vec4(w, 0.0);
+    precise float c_next = pc.stage < 2u ? ip.dt / 2.0 : ip.dt; // CPU: c = {0, dt/2, dt/2, dt}
+    acc_pos[g] = vec4(sp, 0.0);
+    acc_vel[g] = vec4(sv, 0.0);
+    precise vec3 y = x0 + kp * c_next; // y_{k+1} = y0 + c_{k+1} k_k
+    precise vec3 w = v0 + kv * c_next;
+    stage_pos[g] = vec4(y, 1.0);
+    stage_vel[g] = vec4(w, 0.0);
     return;
   }
-  precise vec3 x = base;
+  precise vec3 x = x0;
   precise vec3 v = v0;
   if (!pinned) {
-    x = x + sp * pc.w6;
-    v = v + sv * pc.w6;
+    x = x + sp * ip.w6;
+    v = v + sv * ip.w6;
   }
   finish(p, pinned, x, v);
 }

@@ -10,16 +10,29 @@ layout(push_constant) uniform PushBlock { PushConstants pc; };
 
 layout(std430, set = 0, binding = VKCLOTH_BINDING_PARTICLE) readonly buffer ParticleBuf { ParticleInfo particle[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_COLLIDERS) readonly buffer ColliderBuf { Collider colliders[]; };
-layout(std430, set = 0, binding = VKCLOTH_BINDING_FLAGS) buffer FlagBuf { Flags flags; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_FLAGS) buffer FlagBuf { Flags flags[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_INSTANCES) readonly buffer InstanceBuf { InstanceParams instances[]; };
 
-// Particle index: 1-D, with a second grid dimension when one row of workgroups is not enough.
+// This invocation's instance of the batch, the index of its particle 0 in the state buffers and
+// its parameters; set by begin_instance(), the first call of every main().
+uint inst;
+uint base;
+InstanceParams ip;
+
+void begin_instance() {
+  inst = gl_WorkGroupID.z;
+  base = inst * pc.count;
+  ip = instances[inst];
+}
+
+// Particle index within the instance: 1-D, with a second grid dimension when one row of workgroups is not enough.
 uint particle_index() {
   return gl_WorkGroupID.y * gl_NumWorkGroups.x * uint(VKCLOTH_WORKGROUP_SIZE) + gl_GlobalInvocationID.x;
 }
 
 // A step after the first diverged one leaves the state as it was after the bad step (like the
 // CPU, which stops there). Stable within a dispatch: first_bad_step only takes this step's value.
-bool frozen() { return flags.first_bad_step < pc.step; }
+bool frozen() { return flags[inst].first_bad_step < pc.step; }
 
 // dot3(a, b) = a.x*b.x + a.y*b.y + a.z*b.z, left to right (CPU dot3).
 precise float dot3(vec3 a, vec3 b) {
@@ -36,10 +49,10 @@ precise vec3 cross3(vec3 x, vec3 y) {
   return vec3(cx, cy, cz);
 }
 
-// Signed distance to collider c and its outward unit normal (CPU collider_contact).
+// Signed distance to the instance's collider c and its outward unit normal (CPU collider_contact).
 void collider_contact(uint c, vec3 p, out float distance, out vec3 normal) {
-  const vec4 shape = colliders[c].shape;
-  if (colliders[c].type == VKCLOTH_COLLIDER_PLANE) {
+  const vec4 shape = colliders[ip.collider_first + c].shape;
+  if (colliders[ip.collider_first + c].type == VKCLOTH_COLLIDER_PLANE) {
     normal = shape.xyz;
     precise float d = dot3(shape.xyz, p) - shape.w;
     distance = d;

@@ -8,34 +8,35 @@ bool is_finite(vec3 v) {
   return all(notEqual(bits, uvec3(0x7f800000u)));
 }
 
-// CpuSolver::project for one particle, then check_finite; writes the new state.
+// CpuSolver::project for particle p of this instance, then check_finite; writes the new state.
 void finish(uint p, bool pinned, vec3 x_in, vec3 v_in) {
   precise vec3 x = x_in;
   precise vec3 v = v_in;
   if (!pinned) {
-    for (uint c = 0u; c < pc.collider_count; ++c) {
+    for (uint c = 0u; c < ip.collider_count; ++c) {
       float dist;
       vec3 n;
       collider_contact(c, x, dist, n);
       if (!(dist < 0.0)) continue;
-      if (colliders[c].type == VKCLOTH_COLLIDER_PLANE) {
-        precise float back = pc.eps - dist;
+      const Collider col = colliders[ip.collider_first + c];
+      if (col.type == VKCLOTH_COLLIDER_PLANE) {
+        precise float back = ip.eps - dist;
         x = x + n * back; // report eq. 5: back to z_s + eps
       } else {
-        precise float r = colliders[c].shape.w + pc.eps;
-        x = colliders[c].shape.xyz + n * r; // report eq. 6
+        precise float r = col.shape.w + ip.eps;
+        x = col.shape.xyz + n * r; // report eq. 6
       }
       precise float vn = dot3(v, n);
       if (vn < 0.0) v = v - n * vn;
     }
   }
-  pos_out[p] = vec4(x, 1.0);
-  vel[p] = vec4(v, 0.0);
+  pos_out[base + p] = vec4(x, 1.0);
+  vel[base + p] = vec4(v, 0.0);
   const vec3 ax = abs(x);
-  if (!is_finite(x) || !is_finite(v) || ax.x > pc.limit || ax.y > pc.limit || ax.z > pc.limit) {
-    atomicOr(flags.diverged, 1u);
-    atomicMin(flags.first_bad_step, pc.step);
-    atomicMin(flags.bad_particle, p);
+  if (!is_finite(x) || !is_finite(v) || ax.x > ip.limit || ax.y > ip.limit || ax.z > ip.limit) {
+    atomicOr(flags[inst].diverged, 1u);
+    atomicMin(flags[inst].first_bad_step, pc.step);
+    atomicMin(flags[inst].bad_particle, p); // the particle index within the instance
   }
 }
 

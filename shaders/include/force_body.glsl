@@ -53,9 +53,12 @@ layout(constant_id = 36) const float SC_K9 = 0.0;
 layout(constant_id = 37) const float SC_K10 = 0.0;
 layout(constant_id = 38) const float SC_K11 = 0.0;
 
+// Position of this instance's particle q (q indexes the shared topology).
+vec3 pos_of(uint q) { return pos_in[base + q].xyz; }
+
 // One spring term of report eq. 2, exactly as the CSR loop below.
 void spring_term(inout precise vec3 f, vec3 x, uint q, float rest, float k) {
-  precise vec3 u = pos_in[q].xyz - x;
+  precise vec3 u = pos_of(q) - x;
   precise float len = sqrt(dot3(u, u));
   if (len > 0.0) f = f + u * (k * (len - rest) / len);
 }
@@ -66,13 +69,13 @@ void spring_term(inout precise vec3 f, vec3 x, uint q, float rest, float k) {
 vec3 grid_normal(uint p) {
   const uint nx = SC_STENCIL ? SC_NX : pc.nx; // a constant divisor when specialised
   const uint i = p % nx, j = p / nx;
-  const vec3 x = pos_in[p].xyz;
+  const vec3 x = pos_of(p);
   const bool h0 = i + 1u < nx, h1 = j + 1u < (SC_STENCIL ? SC_NY : pc.ny), h2 = i > 0u, h3 = j > 0u;
   precise vec3 e0 = vec3(0.0), e1 = vec3(0.0), e2 = vec3(0.0), e3 = vec3(0.0);
-  if (h0) e0 = pos_in[p + 1u].xyz - x;
-  if (h1) e1 = pos_in[p + nx].xyz - x;
-  if (h2) e2 = pos_in[p - 1u].xyz - x;
-  if (h3) e3 = pos_in[p - nx].xyz - x;
+  if (h0) e0 = pos_of(p + 1u) - x;
+  if (h1) e1 = pos_of(p + nx) - x;
+  if (h2) e2 = pos_of(p - 1u) - x;
+  if (h3) e3 = pos_of(p - nx) - x;
   precise vec3 sum = vec3(0.0);
   if (h0 && h1) sum = sum + cross3(e0, e1);
   if (h1 && h2) sum = sum + cross3(e1, e2);
@@ -83,13 +86,13 @@ vec3 grid_normal(uint p) {
   return n;
 }
 
-// Force on particle p after contacts (f), its velocity after contacts (v, in: the state velocity)
+// Force on particle p (index within the instance) after contacts (f), its velocity after contacts (v, in: the state velocity)
 // and its unit normal (nrm).
 void particle_force(uint p, inout vec3 v_io, out vec3 f_out, out vec3 nrm_out) {
   precise vec3 nrm = vec3(0.0);
-  if ((pc.flags & VKCLOTH_FLAG_HAS_GRID) != 0u) nrm = grid_normal(p);
+  if ((ip.flags & VKCLOTH_FLAG_HAS_GRID) != 0u) nrm = grid_normal(p);
 
-  const vec3 x = pos_in[p].xyz;
+  const vec3 x = pos_of(p);
   precise vec3 f = vec3(0.0);
   bool interior = false;
   if (SC_STENCIL) {
@@ -118,23 +121,23 @@ void particle_force(uint p, inout vec3 v_io, out vec3 f_out, out vec3 nrm_out) {
     }
   }
   const float m = particle[p].mass;
-  f = f + pc.gravity_damping.xyz * m;
-  precise float mu_m = pc.gravity_damping.w * m;
+  f = f + ip.gravity_damping.xyz * m;
+  precise float mu_m = ip.gravity_damping.w * m;
   precise vec3 v = v_io;
   f = f - v * mu_m;
-  if ((pc.flags & VKCLOTH_FLAG_WIND) != 0u) {
-    precise float kn = pc.wind.w * dot3(nrm, pc.wind.xyz);
+  if ((ip.flags & VKCLOTH_FLAG_WIND) != 0u) {
+    precise float kn = ip.wind.w * dot3(nrm, ip.wind.xyz);
     f = f + nrm * kn;
   }
 
   // Contacts: inside the 2 eps band, remove only the parts of v and F pointing into the collider.
   if (particle[p].pinned == 0u) {
-    for (uint c = 0u; c < pc.collider_count; ++c) {
+    for (uint c = 0u; c < ip.collider_count; ++c) {
       float dist;
       vec3 n;
       collider_contact(c, x, dist, n);
-      if (!(dist < pc.band)) continue;
-      const bool both = (pc.flags & VKCLOTH_FLAG_CONTACT_BOTH) != 0u;
+      if (!(dist < ip.band)) continue;
+      const bool both = (ip.flags & VKCLOTH_FLAG_CONTACT_BOTH) != 0u;
       precise float vn = dot3(v, n);
       if (vn < 0.0 || (both && vn != 0.0)) v = v - n * vn;
       precise float fn = dot3(f, n);

@@ -1,7 +1,7 @@
 // Declarations shared by the implicit-Euler shaders (implicit.comp, implicit_reduce.comp) and the
 // C++ side (engine/src/vulkan/implicit_gpu.cpp). The implicit passes use their own descriptor set
 // layout: the main layout's bindings they need (same numbers, same buffers, vkcloth_shared.h)
-// plus the CG buffers below. Push constants: the main PushConstants, with fields the implicit
+// plus the CG buffers below. The implicit passes run batches of one instance. Push constants: the main PushConstants, with fields the implicit
 // passes do not otherwise use carrying the pass parameters (VKCLOTH_IMPL_* below).
 #ifndef VKCLOTH_IMPLICIT_SHARED_H
 #define VKCLOTH_IMPLICIT_SHARED_H
@@ -12,17 +12,17 @@
 namespace vkcloth::gpu::shared {
 #endif
 
-#define VKCLOTH_BINDING_IMPL_VF 17       // contact-filtered velocity (vec4)
-#define VKCLOTH_BINDING_IMPL_KS 18       // per CSR entry: K_s as 2 vec4 (xx yy zz xy | xz yz - -)
-#define VKCLOTH_BINDING_IMPL_DIAG_INV 19 // 1 / diag(A), zero for pinned particles (vec4)
-#define VKCLOTH_BINDING_IMPL_X 20        // CG solution dv (vec4)
-#define VKCLOTH_BINDING_IMPL_R 21        // residual
-#define VKCLOTH_BINDING_IMPL_Z 22        // preconditioned residual
-#define VKCLOTH_BINDING_IMPL_D 23        // search direction
-#define VKCLOTH_BINDING_IMPL_Q 24        // S A d
-#define VKCLOTH_BINDING_IMPL_PARTIALS 25 // one vec2 per workgroup: its partial dot products
-#define VKCLOTH_BINDING_IMPL_STATE 26    // CgState
-#define VKCLOTH_BINDING_IMPL_ARGS 27     // indirect dispatch arguments (CgArgs)
+#define VKCLOTH_BINDING_IMPL_VF 18       // contact-filtered velocity (vec4)
+#define VKCLOTH_BINDING_IMPL_KS 19       // per CSR entry: K_s as 2 vec4 (xx yy zz xy | xz yz - -)
+#define VKCLOTH_BINDING_IMPL_DIAG_INV 20 // 1 / diag(A), zero for pinned particles (vec4)
+#define VKCLOTH_BINDING_IMPL_X 21        // CG solution dv (vec4)
+#define VKCLOTH_BINDING_IMPL_R 22        // residual
+#define VKCLOTH_BINDING_IMPL_Z 23        // preconditioned residual
+#define VKCLOTH_BINDING_IMPL_D 24        // search direction
+#define VKCLOTH_BINDING_IMPL_Q 25        // S A d
+#define VKCLOTH_BINDING_IMPL_PARTIALS 26 // one vec2 per workgroup: its partial dot products
+#define VKCLOTH_BINDING_IMPL_STATE 27    // CgState
+#define VKCLOTH_BINDING_IMPL_ARGS 28     // indirect dispatch arguments (CgArgs)
 
 // implicit.comp passes (PushConstants::stage).
 #define VKCLOTH_IMPL_FORCE 0u     // normal, force, contact filtering -> FORCE_OUT, NORMAL, VF

@@ -17,6 +17,12 @@ struct vec4 {
 // Invocations per workgroup (1-D). Dispatches round up and every shader guards `p < count`.
 #define VKCLOTH_WORKGROUP_SIZE 64
 
+// Batches: one dispatch serves every instance (cloth) of a batch that shares one topology;
+// instance = gl_WorkGroupID.z. Per-particle state buffers hold the instances one after the other
+// (instance i's particle p at i * count + p); topology buffers (PARTICLE, OFFSETS, EDGES) are
+// shared; each instance has its InstanceParams, its colliders (a range of COLLIDERS) and its Flags.
+// A standalone GpuSolver is a batch of one.
+
 // Descriptor bindings (set 0). One layout serves both pipelines; each shader declares the
 // bindings it uses. Four descriptor sets differ only in which buffers sit behind the
 // *_IN / *_BASE / *_OUT / FORCE_OUT bindings (position parity x state-or-RK4-stage input).
@@ -36,8 +42,9 @@ struct vec4 {
 #define VKCLOTH_BINDING_OFFSETS 13   // CSR offsets, count + 1 entries (SpringAdjacency::offsets)
 #define VKCLOTH_BINDING_EDGES 14     // CSR entries in gather order (Edge)
 #define VKCLOTH_BINDING_COLLIDERS 15 // Collider array (collider_count entries, at least one slot)
-#define VKCLOTH_BINDING_FLAGS 16     // Flags (divergence detection)
-#define VKCLOTH_BINDING_COUNT 17
+#define VKCLOTH_BINDING_FLAGS 16     // Flags per instance (divergence detection)
+#define VKCLOTH_BINDING_INSTANCES 17 // InstanceParams per instance
+#define VKCLOTH_BINDING_COUNT 18
 
 // PushConstants::flags bits.
 #define VKCLOTH_FLAG_HAS_GRID 1u // the system is a cloth grid: rebuild normals
@@ -56,27 +63,36 @@ struct vec4 {
 // Flags::first_bad_step before anything diverged.
 #define VKCLOTH_NO_BAD_STEP 0xffffffffu
 
-/// Per-dispatch parameters (96 bytes; Vulkan guarantees 128). Floats are converted from the
-/// double SimParams on the host exactly as CpuSolver<float> converts them.
+/// Per-dispatch parameters (32 bytes), the same for every instance of the batch.
 struct PushConstants {
-  uint count;          // particles
-  uint nx;             // grid width (0 for chains)
-  uint ny;             // grid height
+  uint count; // particles per instance
+  uint nx;    // grid width (0 for chains)
+  uint ny;    // grid height
+  uint stage; // RK4 stage 0..3 (0 for Euler); implicit passes: the pass
+  uint step;  // 1-based step number since the batch's flag epoch (the step being computed)
+  uint pad0;  // implicit passes only (implicit_shared.h)
+  uint pad1;  // implicit passes only
+  float c_next; // implicit passes only
+};
+
+/// Per-instance parameters (80 bytes; InstanceParams[instance] at VKCLOTH_BINDING_INSTANCES).
+/// Floats are converted from the double SimParams on the host exactly as CpuSolver<float>
+/// converts them.
+struct InstanceParams {
   uint flags;          // VKCLOTH_FLAG_*
   uint integrator;     // VKCLOTH_INTEGRATOR_*
-  uint stage;          // RK4 stage 0..3 (0 for Euler)
-  uint step;           // 1-based step number since the flag epoch (the step being computed)
-  uint collider_count; // entries used in the collider array
+  uint collider_first; // this instance's colliders: COLLIDERS[collider_first ..]
+  uint collider_count;
   vec4 gravity_damping; // xyz: gravity, w: damping mu
   vec4 wind;            // xyz: unit wind direction, w: strength Kw
-  float dt;             // time step
-  float c_next;         // RK4: c[stage + 1] (dt/2, dt/2, dt), the next stage's offset
+  float dt;             // time step (of one substep)
   float w6;             // RK4: dt / 6
   float band;           // contact band 2 eps
   float eps;            // projection distance eps
   float limit;          // divergence limit
   uint pad0;
   uint pad1;
+  uint pad2;
 };
 
 /// Per-particle constants (std430: 8 bytes).
@@ -101,7 +117,7 @@ struct Collider {
   uint pad2;
 };
 
-/// Divergence flags, written with integer atomics by integrate.comp.
+/// Divergence flags of one instance, written with integer atomics (finish.glsl).
 struct Flags {
   uint diverged;       // non-zero once any particle went non-finite or past the limit
   uint first_bad_step; // smallest PushConstants::step that diverged (VKCLOTH_NO_BAD_STEP if none)
@@ -110,11 +126,13 @@ struct Flags {
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(PushConstants) == 96);
-static_assert(offsetof(PushConstants, gravity_damping) == 32);
-static_assert(offsetof(PushConstants, wind) == 48);
-static_assert(offsetof(PushConstants, dt) == 64);
-static_assert(offsetof(PushConstants, limit) == 84);
+static_assert(sizeof(PushConstants) == 32);
+static_assert(offsetof(PushConstants, c_next) == 28);
+static_assert(sizeof(InstanceParams) == 80);
+static_assert(offsetof(InstanceParams, gravity_damping) == 16);
+static_assert(offsetof(InstanceParams, wind) == 32);
+static_assert(offsetof(InstanceParams, dt) == 48);
+static_assert(offsetof(InstanceParams, limit) == 64);
 static_assert(sizeof(ParticleInfo) == 8);
 static_assert(sizeof(Edge) == 12);
 static_assert(sizeof(Collider) == 32);

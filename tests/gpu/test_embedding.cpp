@@ -264,12 +264,151 @@ TEST_CASE("ClothWorld: many cloths, shared topology, add/remove, set_params == e
   // Buffers for drawing.
   const auto bufs = world->buffers(ids[3]);
   REQUIRE(bufs.ok());
-  CHECK(bufs->positions == world->solver(ids[3])->current_position_buffer());
   CHECK(bufs->count == 15u * 13u);
+  CHECK(bufs->offset == 0); // alone in its batch
   CHECK(bufs->nx == 15u);
   CHECK(grid_triangle_indices(bufs->nx, bufs->ny).size() == 14u * 12u * 6u);
   CHECK(!world->add(nullptr, p0).ok());
   InitialState wrong;
   wrong.positions.resize(3);
   CHECK(world->add(small, p0, wrong).error().code == ErrorCode::invalid_argument);
+}
+
+namespace {
+
+/// Euler parameters that differ in every per-instance field the shaders read.
+std::vector<SimParams> varied_euler_params() {
+  std::vector<SimParams> out(6);
+  out[1].integrator = Integrator::explicit_euler;
+  out[1].dt = 0.004;
+  out[2].damping = 0.5;
+  out[2].wind.strength = 0.08;
+  out[2].wind.direction = {0.2, 1.0, 0.3};
+  out[3].gravity = {0.5, 0.0, -4.0};
+  out[3].colliders = {Collider::sphere({0.1, 0.05, -0.3}, 0.2)};
+  out[4].colliders = {Collider::plane({0, 0, 1}, -0.35), Collider::sphere({-0.1, 0.0, -0.2}, 0.12)};
+  out[4].contact_inward_only = false;
+  out[5].dt = 0.02;
+  out[5].wind.strength = 0.03;
+  return out;
+}
+
+} // namespace
+
+TEST_CASE("ClothWorld batches: one dispatch per pass for every instance of a topology, each bitwise == alone") {
+  VKCLOTH_GPU_TEST_BEGIN(ctx);
+  auto topo = make_topology(12, 9);
+  const std::vector<SimParams> params = varied_euler_params();
+  auto world = ClothWorld::create(ctx);
+  REQUIRE(world.ok());
+  std::vector<InstanceId> ids;
+  std::vector<GpuSolver> alone;
+  for (std::size_t k = 0; k < params.size(); ++k) {
+    InitialState init; // instance k starts k cm higher: distinct states in one batch
+    for (const Particle& q : topo->particles) init.positions.push_back(q.position + glm::dvec3(0.0, 0.0, 0.01 * double(k)));
+    auto id = world->add(topo, params[k], init);
+    REQUIRE(id.ok());
+    ids.push_back(*id);
+    ParticleSystem moved = *topo;
+    for (std::size_t p = 0; p < moved.particles.size(); ++p) moved.particles[p].position = init.positions[p];
+    auto g = GpuSolver::create(ctx, moved, params[k]);
+    REQUIRE(g.ok());
+    alone.push_back(std::move(g.value()));
+  }
+  CHECK(world->batch_count() == 1); // explicit and semi-implicit Euler share the batch
+  auto compare = [&](std::size_t k, const char* when) {
+    const auto w = world->positions(ids[k]);
+    const auto a = alone[k].positions();
+    REQUIRE(w.ok());
+    REQUIRE(a.ok());
+    const auto d = diff(*w, *a);
+    CHECK_MESSAGE(d.bitwise, when << ": instance " << k << " differs from its own GpuSolver by " << d.max_abs);
+    CHECK(diff(*world->velocities(ids[k]), *alone[k].velocities()).bitwise);
+    CHECK(diff(*world->normals(ids[k]), *alone[k].normals()).bitwise);
+  };
+
+  const std::uint64_t before = world->dispatches_recorded();
+  REQUIRE(world->simulate(25, 10).ok());
+  CHECK(world->dispatches_recorded() - before == 25); // one fused dispatch per step for 6 cloths
+  for (auto& g : alone) REQUIRE(g.simulate(25).ok());
+  for (std::size_t k = 0; k < ids.size(); ++k) compare(k, "after 25 batched steps");
+  CHECK(world->step_index(ids[0]) == 25);
+
+  // Drawing: one set of buffers, each instance at its own offset.
+  const auto b0 = world->buffers(ids[0]);
+  const auto b3 = world->buffers(ids[3]);
+  REQUIRE(b0.ok());
+  REQUIRE(b3.ok());
+  CHECK(b0->positions == b3->positions);
+  CHECK(b3->offset == 3 * VkDeviceSize(topo->size()) * GpuSolver::stride);
+
+  // Remove one from the middle, add one: the batch is rebuilt, the others go on bit for bit.
+  REQUIRE(world->remove(ids[2]).ok());
+  auto late = world->add(topo, params[2]);
+  REQUIRE(late.ok());
+  auto late_alone = GpuSolver::create(ctx, *topo, params[2]);
+  REQUIRE(late_alone.ok());
+  CHECK(world->batch_count() == 1);
+  // set_params within the batch (new wind, new colliders) and across batches (to RK4).
+  SimParams changed = params[0];
+  changed.wind.strength = 0.06;
+  changed.colliders = {Collider::plane({0, 0, 1}, -0.3)};
+  REQUIRE(world->set_params(ids[0], changed).ok());
+  REQUIRE(alone[0].set_params(changed).ok());
+  SimParams rk = params[5];
+  rk.integrator = Integrator::rk4;
+  REQUIRE(world->set_params(ids[5], rk).ok());
+  REQUIRE(alone[5].set_params(rk).ok());
+  CHECK(world->batch_count() == 2);
+
+  const std::uint64_t before2 = world->dispatches_recorded();
+  REQUIRE(world->simulate(10).ok());
+  CHECK(world->dispatches_recorded() - before2 == 10 * (1 + 8)); // Euler batch + RK4 batch (2 passes x 4 stages)
+  for (std::size_t k : {0u, 1u, 3u, 4u, 5u}) REQUIRE(alone[k].simulate(10).ok());
+  REQUIRE(late_alone->simulate(10).ok());
+  for (std::size_t k : {0u, 1u, 3u, 4u, 5u}) compare(k, "after rebuilds + 10 steps");
+  CHECK(diff(*world->positions(*late), *late_alone->positions()).bitwise);
+  CHECK(world->step_index(ids[0]) == 35);
+  CHECK(world->step_index(*late) == 10);
+}
+
+TEST_CASE("ClothWorld batches: a diverging instance is frozen and named, the others go on") {
+  VKCLOTH_GPU_TEST_BEGIN(ctx);
+  auto topo = make_topology(9, 7);
+  SimParams calm;
+  SimParams wild; // explicit Euler far past its stability limit
+  wild.integrator = Integrator::explicit_euler;
+  wild.dt = 0.5;
+  auto world = ClothWorld::create(ctx);
+  REQUIRE(world.ok());
+  auto a = world->add(topo, calm);
+  auto b = world->add(topo, wild);
+  auto c = world->add(topo, calm);
+  REQUIRE(a.ok());
+  REQUIRE(b.ok());
+  REQUIRE(c.ok());
+  CHECK(world->batch_count() == 1);
+  auto wild_alone = GpuSolver::create(ctx, *topo, wild);
+  REQUIRE(wild_alone.ok());
+  const auto alone_result = wild_alone->simulate(40, 40);
+  REQUIRE(!alone_result.ok());
+  auto calm_alone = GpuSolver::create(ctx, *topo, calm);
+  REQUIRE(calm_alone.ok());
+  REQUIRE(calm_alone->simulate(40).ok());
+
+  const auto r = world->simulate(40, 40); // one submission: the others finish their 40 steps
+  REQUIRE(!r.ok());
+  CHECK(r.error().code == ErrorCode::diverged);
+  CHECK_MESSAGE(r.error().message.find("cloth instance " + std::to_string(*b)) != std::string::npos, r.error().message);
+  CHECK(world->step_index(*b) == wild_alone->step_index()); // the same first bad step
+  CHECK(diff(*world->positions(*b), *wild_alone->positions()).bitwise); // frozen as after that step
+  CHECK(diff(*world->positions(*a), *calm_alone->positions()).bitwise);
+  CHECK(diff(*world->positions(*c), *calm_alone->positions()).bitwise);
+  // Removing the healthy neighbour rebuilds the batch: the diverged one stays frozen and reported.
+  REQUIRE(world->remove(*a).ok());
+  const auto frozen_at = *world->positions(*b);
+  const auto again = world->check_divergence();
+  REQUIRE(!again.ok());
+  CHECK(world->step_index(*b) == wild_alone->step_index());
+  CHECK(diff(*world->positions(*b), frozen_at).bitwise);
 }

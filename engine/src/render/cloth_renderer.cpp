@@ -473,14 +473,19 @@ Result<void> ClothRenderer::Impl::build_pipelines(const RendererOptions& o) {
 
 Result<ClothRenderer> ClothRenderer::create(gpu::Context& context, const gpu::GpuSolver& solver,
                                             const ParticleSystem& system, RendererOptions options) {
-  if (!options.render_pass)
-    return make_error(ErrorCode::invalid_argument, "RendererOptions::render_pass is required");
   if (system.size() != solver.particle_count())
     return make_error(
         ErrorCode::invalid_argument,
         fmt::format(
             "the system has {} particles but the solver {}: pass the system the solver was created from",
             system.size(), solver.particle_count()));
+  return create(context, solver.params(), system, std::move(options));
+}
+
+Result<ClothRenderer> ClothRenderer::create(gpu::Context& context, const SimParams& params, const ParticleSystem& system,
+                                            RendererOptions options) {
+  if (!options.render_pass)
+    return make_error(ErrorCode::invalid_argument, "RendererOptions::render_pass is required");
   auto impl = std::make_unique<Impl>();
   impl->ctx = context.impl();
   if (!detail::queue_has_graphics(*impl->ctx))
@@ -490,14 +495,14 @@ Result<ClothRenderer> ClothRenderer::create(gpu::Context& context, const gpu::Gp
                     "ContextOptions::require_graphics)",
                     impl->ctx->queue_family, impl->ctx->name));
   impl->grid = system.grid.has_value();
-  impl->particle_count = solver.particle_count();
+  impl->particle_count = static_cast<std::uint32_t>(system.size());
   Image texture = options.texture.width ? std::move(options.texture) : default_fabric_texture();
   const std::uint32_t max_side = impl->ctx->properties.limits.maxImageDimension2D;
   if (texture.width > max_side || texture.height > max_side)
     return make_error(ErrorCode::unsupported,
                       fmt::format("the texture is {} x {} but the device allows at most {} a side",
                                   texture.width, texture.height, max_side));
-  VKCLOTH_TRY(impl->build_geometry(system, solver.params(), options));
+  VKCLOTH_TRY(impl->build_geometry(system, params, options));
   VKCLOTH_TRY(impl->upload_texture(texture));
   VKCLOTH_TRY(impl->build_pipelines(options));
   return ClothRenderer(std::move(impl));
@@ -516,6 +521,11 @@ bool ClothRenderer::draws_cloth() const {
 
 void ClothRenderer::record_draw(VkCommandBuffer cmd, const gpu::GpuSolver& solver, const Camera& camera,
                                 VkExtent2D extent) const {
+  record_draw(cmd, solver.buffers(), camera, extent);
+}
+
+void ClothRenderer::record_draw(VkCommandBuffer cmd, const gpu::InstanceBuffers& buffers, const Camera& camera,
+                                VkExtent2D extent) const {
   const Impl& s = *impl_;
   const auto& v = s.ctx->vk;
   const VkViewport viewport{0.0f, 0.0f, float(extent.width), float(extent.height), 0.0f, 1.0f};
@@ -527,8 +537,8 @@ void ClothRenderer::record_draw(VkCommandBuffer cmd, const gpu::GpuSolver& solve
   pc.eye = glm::vec4(camera.eye, 1.0f);
   pc.light = glm::vec4(glm::normalize(s.palette.light_dir), s.palette.ambient);
   constexpr VkShaderStageFlags stages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
-  const VkDeviceSize zero = 0;
-  const VkBuffer positions = solver.current_position_buffer();
+  const VkDeviceSize at = buffers.offset; // this instance's first particle (ClothWorld batches)
+  const VkBuffer positions = buffers.positions;
 
   // Colliders: world-space meshes, one zero instance offset.
   v.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.mesh_pipeline);
@@ -549,8 +559,8 @@ void ClothRenderer::record_draw(VkCommandBuffer cmd, const gpu::GpuSolver& solve
     // The cloth: the solver's current positions, normals and uvs as vertex buffers.
     v.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.cloth_pipeline);
     v.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.layout, 0, 1, &s.set, 0, nullptr);
-    const VkBuffer bufs[3] = {positions, solver.normal_buffer(), solver.uv_buffer()};
-    const VkDeviceSize offs[3] = {0, 0, 0};
+    const VkBuffer bufs[3] = {positions, buffers.normals, buffers.uvs};
+    const VkDeviceSize offs[3] = {at, at, at};
     v.vkCmdBindVertexBuffers(cmd, 0, 3, bufs, offs);
     v.vkCmdBindIndexBuffer(cmd, s.cloth_index.buffer, 0, VK_INDEX_TYPE_UINT32);
     pc.color = glm::vec4(s.palette.back_tint, 1.0f);
@@ -564,14 +574,14 @@ void ClothRenderer::record_draw(VkCommandBuffer cmd, const gpu::GpuSolver& solve
   pc.params = glm::vec4(0.0f, 1.0f, s.mass_radius, 0.0f);
   if (s.cloth_index_count) {
     v.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.line_pipeline);
-    v.vkCmdBindVertexBuffers(cmd, 0, 1, &positions, &zero);
+    v.vkCmdBindVertexBuffers(cmd, 0, 1, &positions, &at);
     v.vkCmdBindIndexBuffer(cmd, s.cloth_index.buffer, 0, VK_INDEX_TYPE_UINT32);
     v.vkCmdPushConstants(cmd, s.layout, stages, 0, sizeof(pc), &pc);
     v.vkCmdDrawIndexed(cmd, s.cloth_index_count, 1, 0, 0, 0);
   }
   v.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.mesh_pipeline);
   const VkBuffer bufs[2] = {s.mesh_vertices.buffer, positions};
-  const VkDeviceSize offs[2] = {0, 0};
+  const VkDeviceSize offs[2] = {0, at};
   v.vkCmdBindVertexBuffers(cmd, 0, 2, bufs, offs);
   v.vkCmdBindIndexBuffer(cmd, s.mesh_index.buffer, 0, VK_INDEX_TYPE_UINT32);
   v.vkCmdPushConstants(cmd, s.layout, stages, 0, sizeof(pc), &pc);

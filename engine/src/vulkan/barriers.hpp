@@ -59,6 +59,23 @@ inline void transfer_to_compute(const VolkDeviceTable& vk, VkCommandBuffer cmd) 
          VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
 }
 
+/// ClothWorld moving instances into a rebuilt batch: every earlier command's writes (the old
+/// batch's dispatches, the new batch's fills and uploads) are visible to the copies, which also
+/// wait for earlier reads of the destination (a fresh buffer: none, but cheap to state).
+inline void before_batch_copy(const VolkDeviceTable& vk, VkCommandBuffer cmd) {
+  memory(vk, cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+         VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT);
+}
+
+/// After those copies: visible to the next steps, to a renderer's vertex reads and to the host
+/// (the old batch's divergence flags are read right after this submission).
+inline void after_batch_copy(const VolkDeviceTable& vk, VkCommandBuffer cmd) {
+  memory(vk, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT |
+         VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_VERTEX_INPUT_BIT |
+         VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT |
+         VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT | VK_ACCESS_HOST_READ_BIT);
+}
+
 } // namespace vkcloth::gpu::barriers
 
 namespace vkcloth::gpu::barriers {

@@ -11,6 +11,7 @@
 
 #include "barriers.hpp"
 #include "implicit_gpu.hpp"
+#include "solver_batch.hpp"
 #include "vkcloth/gpu/gpu_solver.hpp"
 #include "vkcloth/shaders/force_comp_spv.hpp"
 #include "vkcloth/shaders/integrate_comp_spv.hpp"
@@ -20,69 +21,6 @@
 namespace vkcloth::gpu {
 
 namespace sh = shared;
-
-struct GpuSolver::Impl {
-  std::shared_ptr<Context::Impl> ctx;
-  SimParams params;
-  GpuSolverOptions options;
-  std::uint32_t count = 0;
-  std::uint32_t nx = 0, ny = 0;
-  bool staging = false;
-
-  // Per-particle vec4 buffers, then the constant topology, then the small host-visible ones.
-  Buffer pos[2], vel, force, force_stage, vel_filt, normal, uv, stage_pos, stage_vel, acc_pos, acc_vel;
-  Buffer particle, offsets, edges;
-  Buffer colliders, flags; // host-visible (small; written / read by the host)
-  std::uint32_t collider_capacity = 0;
-
-  VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
-  VkDescriptorPool pool = VK_NULL_HANDLE;
-  VkDescriptorSet sets[2][2] = {}; // [positions read index][0: state input, 1: RK4 stage input]
-  VkPipelineLayout layout = VK_NULL_HANDLE;
-  VkPipeline force_pipeline = VK_NULL_HANDLE, integrate_pipeline = VK_NULL_HANDLE, fused_pipeline = VK_NULL_HANDLE;
-  VkCommandPool cmd_pool = VK_NULL_HANDLE;
-  VkCommandBuffer cmd = VK_NULL_HANDLE;
-  VkFence fence = VK_NULL_HANDLE;
-  VkQueryPool queries = VK_NULL_HANDLE;
-  std::uint32_t groups_x = 1, groups_y = 1;
-  // Grid stencil (force_body.glsl's specialisation constants 0..38): constant_id order.
-  struct Stencil {
-    std::uint32_t enabled = 0; // VkBool32
-    std::uint32_t nx = 1, ny = 1;
-    std::int32_t offset[12] = {};
-    float rest[12] = {}, stiffness[12] = {};
-  } stencil;
-  std::uint64_t edges_count = 0;
-
-  sh::PushConstants pc{};
-  std::uint64_t step = 0;     // completed steps (the bad one when diverged)
-  std::uint64_t recorded = 0; // recorded steps: flag step numbers
-  std::uint32_t parity = 0;   // positions[parity] is current; flipped by every recorded substep
-  std::unique_ptr<ImplicitGpu> implicit; // created when the integrator is implicit_euler
-  std::vector<glm::vec2> uvs;
-  double last_ms = -1.0;
-  std::optional<Error> diverged;
-
-  Impl() = default;
-  Impl(const Impl&) = delete;
-  Impl& operator=(const Impl&) = delete;
-  ~Impl();
-
-  const DeviceFns& vk() const { return ctx->vk; }
-  std::uint32_t current() const { return parity; }
-  Result<void> ensure_implicit();
-  void record_substep(VkCommandBuffer cmd, bool first);
-
-  Result<void> init_pipelines();
-  void detect_stencil(const ParticleSystem& system);
-  Result<void> write_sets();
-  Result<void> upload_colliders();
-  void set_push_constants();
-  template <typename F> Result<void> submit_and_wait(F&& record);
-  Result<std::vector<glm::vec3>> read_vec3(const Buffer& b);
-  Result<void> check_flags();
-  void record(VkCommandBuffer cmd, std::uint32_t steps);
-};
 
 GpuSolver::Impl::~Impl() {
   if (!ctx || !ctx->device) return;
@@ -101,7 +39,7 @@ GpuSolver::Impl::~Impl() {
   if (pool) v.vkDestroyDescriptorPool(d, pool, v.allocator);
   if (set_layout) v.vkDestroyDescriptorSetLayout(d, set_layout, v.allocator);
   for (Buffer* b : {&pos[0], &pos[1], &vel, &force, &force_stage, &vel_filt, &normal, &uv, &stage_pos, &stage_vel, &acc_pos,
-                    &acc_vel, &particle, &offsets, &edges, &colliders, &flags})
+                    &acc_vel, &particle, &offsets, &edges, &colliders, &flags, &instances})
     destroy_buffer(*ctx, *b);
 }
 
@@ -264,6 +202,7 @@ Result<void> GpuSolver::Impl::write_sets() {
       by_binding[VKCLOTH_BINDING_EDGES] = &edges;
       by_binding[VKCLOTH_BINDING_COLLIDERS] = &colliders;
       by_binding[VKCLOTH_BINDING_FLAGS] = &flags;
+      by_binding[VKCLOTH_BINDING_INSTANCES] = &instances;
       for (std::uint32_t b = 0; b < VKCLOTH_BINDING_COUNT; ++b, ++k) {
         infos[k] = VkDescriptorBufferInfo{by_binding[b]->buffer, 0, VK_WHOLE_SIZE};
         writes[k] = VkWriteDescriptorSet{};
@@ -278,12 +217,15 @@ Result<void> GpuSolver::Impl::write_sets() {
   vk().vkUpdateDescriptorSets(ctx->device, static_cast<std::uint32_t>(writes.size()), writes.data(), 0, nullptr);
   if (implicit)
     return implicit->write_sets({{pos[0].buffer, pos[1].buffer}, vel.buffer, force.buffer, normal.buffer, particle.buffer,
-                                 offsets.buffer, edges.buffer, colliders.buffer, flags.buffer});
+                                 offsets.buffer, edges.buffer, colliders.buffer, flags.buffer,
+                                 instances.buffer});
   return {};
 }
 
+// Every instance's colliders, one after the other (InstanceParams::collider_first).
 Result<void> GpuSolver::Impl::upload_colliders() {
-  const std::uint32_t n = static_cast<std::uint32_t>(params.colliders.size());
+  std::uint32_t n = 0;
+  for (const Slot& slot : slots) n += static_cast<std::uint32_t>(slot.params.colliders.size());
   if (n > collider_capacity || !colliders.buffer) {
     const std::uint32_t cap = std::max<std::uint32_t>(n, 4);
     auto b = create_buffer(*ctx, cap * sizeof(sh::Collider), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::host_upload, true,
@@ -295,37 +237,46 @@ Result<void> GpuSolver::Impl::upload_colliders() {
     if (sets[0][0]) VKCLOTH_TRY(write_sets());
   }
   auto* out = static_cast<sh::Collider*>(colliders.mapped);
-  for (std::uint32_t i = 0; i < n; ++i) {
-    const Collider& c = params.colliders[i];
-    sh::Collider g{};
-    g.type = static_cast<std::uint32_t>(c.type);
-    if (c.type == Collider::Type::plane)
-      g.shape = {float(c.normal.x), float(c.normal.y), float(c.normal.z), float(c.offset)};
-    else
-      g.shape = {float(c.center.x), float(c.center.y), float(c.center.z), float(c.radius)};
-    out[i] = g;
-  }
+  for (const Slot& slot : slots)
+    for (const Collider& c : slot.params.colliders) {
+      sh::Collider g{};
+      g.type = static_cast<std::uint32_t>(c.type);
+      if (c.type == Collider::Type::plane)
+        g.shape = {float(c.normal.x), float(c.normal.y), float(c.normal.z), float(c.offset)};
+      else
+        g.shape = {float(c.center.x), float(c.center.y), float(c.center.z), float(c.radius)};
+      *out++ = g;
+    }
   return {};
 }
 
-void GpuSolver::Impl::set_push_constants() {
-  // Conversions exactly as CpuSolver<float>: each double field cast to float, then float math.
-  const float dt = float(params.substeps == 1 ? params.dt : params.dt / double(params.substeps)); // as the CPU
+void GpuSolver::Impl::upload_instance_params() {
+  auto* out = static_cast<sh::InstanceParams*>(instances.mapped);
+  std::uint32_t first_collider = 0;
+  for (const Slot& slot : slots) {
+    const SimParams& params = slot.params;
+    // Conversions exactly as CpuSolver<float>: each double field cast to float, then float math.
+    const float dt = float(params.substeps == 1 ? params.dt : params.dt / double(params.substeps)); // as the CPU
+    sh::InstanceParams ip{};
+    ip.flags = (nx ? VKCLOTH_FLAG_HAS_GRID : 0u) | (float(params.wind.strength) != 0.0f ? VKCLOTH_FLAG_WIND : 0u) |
+               (params.contact_inward_only ? 0u : VKCLOTH_FLAG_CONTACT_BOTH);
+    ip.integrator = static_cast<std::uint32_t>(params.integrator);
+    ip.collider_first = first_collider;
+    ip.collider_count = static_cast<std::uint32_t>(params.colliders.size());
+    first_collider += ip.collider_count;
+    ip.gravity_damping = {float(params.gravity.x), float(params.gravity.y), float(params.gravity.z), float(params.damping)};
+    ip.wind = {float(params.wind.direction.x), float(params.wind.direction.y), float(params.wind.direction.z),
+               float(params.wind.strength)};
+    ip.dt = dt;
+    ip.w6 = dt / 6.0f;
+    ip.eps = float(params.contact_epsilon);
+    ip.band = 2.0f * ip.eps;
+    ip.limit = float(params.divergence_limit);
+    *out++ = ip;
+  }
   pc.count = count;
   pc.nx = nx;
   pc.ny = ny;
-  pc.flags = (nx ? VKCLOTH_FLAG_HAS_GRID : 0u) | (float(params.wind.strength) != 0.0f ? VKCLOTH_FLAG_WIND : 0u) |
-             (params.contact_inward_only ? 0u : VKCLOTH_FLAG_CONTACT_BOTH);
-  pc.integrator = static_cast<std::uint32_t>(params.integrator);
-  pc.collider_count = static_cast<std::uint32_t>(params.colliders.size());
-  pc.gravity_damping = {float(params.gravity.x), float(params.gravity.y), float(params.gravity.z), float(params.damping)};
-  pc.wind = {float(params.wind.direction.x), float(params.wind.direction.y), float(params.wind.direction.z),
-             float(params.wind.strength)};
-  pc.dt = dt;
-  pc.w6 = dt / 6.0f;
-  pc.eps = float(params.contact_epsilon);
-  pc.band = 2.0f * pc.eps;
-  pc.limit = float(params.divergence_limit);
 }
 
 template <typename F> Result<void> GpuSolver::Impl::submit_and_wait(F&& record_fn) {
@@ -347,24 +298,26 @@ template <typename F> Result<void> GpuSolver::Impl::submit_and_wait(F&& record_f
   return {};
 }
 
-Result<std::vector<glm::vec3>> GpuSolver::Impl::read_vec3(const Buffer& b) {
+// One instance's entries of a per-particle buffer.
+Result<std::vector<glm::vec3>> GpuSolver::Impl::read_vec3(const Buffer& b, std::uint32_t slot) {
   std::optional<Buffer> tmp;
   if (!b.mapped) {
-    auto s = create_buffer(*ctx, b.size, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUse::host_readback, true, "readback staging");
+    auto s = create_buffer(*ctx, slot_bytes(), VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUse::host_readback, true,
+                           "readback staging");
     if (!s) return s.error();
     tmp = *s;
   }
   auto r = submit_and_wait([&](VkCommandBuffer c) {
     barriers::before_readback(vk(), c);
     if (tmp) {
-      const VkBufferCopy region{0, 0, b.size};
+      const VkBufferCopy region{slot_offset(slot), 0, slot_bytes()};
       vk().vkCmdCopyBuffer(c, b.buffer, tmp->buffer, 1, &region);
       barriers::transfer_to_host(vk(), c);
     }
   });
   std::vector<glm::vec3> out;
   if (r) {
-    const auto* src = static_cast<const sh::vec4*>(tmp ? tmp->mapped : b.mapped);
+    const auto* src = static_cast<const sh::vec4*>(tmp ? tmp->mapped : b.mapped) + (tmp ? 0 : std::size_t(slot) * count);
     out.resize(count);
     for (std::uint32_t i = 0; i < count; ++i) out[i] = glm::vec3(src[i].x, src[i].y, src[i].z);
   }
@@ -373,26 +326,41 @@ Result<std::vector<glm::vec3>> GpuSolver::Impl::read_vec3(const Buffer& b) {
   return out;
 }
 
-Result<void> GpuSolver::Impl::check_flags() {
-  if (diverged) return *diverged;
+void GpuSolver::Impl::refresh_flags() {
   const auto* f = static_cast<const sh::Flags*>(flags.mapped);
-  if (!f->diverged) return {};
-  step = f->first_bad_step; // the flag epoch is creation (step 0), so relative == absolute
-  const std::uint32_t p = std::min(f->bad_particle, count - 1);
-  std::string where;
-  auto x = read_vec3(pos[current()]);
-  auto v = read_vec3(vel);
-  if (x && v) where = fmt::format(": particle {} is at {} with velocity {}", p, vec_str((*x)[p]), vec_str((*v)[p]));
-  diverged = make_error(ErrorCode::diverged,
-                        fmt::format("simulation diverged at step {} (t = {:.4g} s) on the GPU{} (limit {:g}); the state "
-                                    "is left as after that step; try a smaller integrator.dt, lower stiffness or more "
-                                    "damping",
-                                    step, double(step) * params.dt, where, params.divergence_limit));
-  return *diverged;
+  for (std::uint32_t k = 0; k < batch(); ++k) {
+    Slot& slot = slots[k];
+    if (slot.diverged || !f[k].diverged) continue;
+    slot.step = slot.epoch_step + f[k].first_bad_step; // flag steps count from the batch's creation
+    const std::uint32_t p = std::min(f[k].bad_particle, count - 1);
+    std::string where;
+    auto x = read_vec3(pos[current()], k);
+    auto v = read_vec3(vel, k);
+    if (x && v) where = fmt::format(": particle {} is at {} with velocity {}", p, vec_str((*x)[p]), vec_str((*v)[p]));
+    slot.diverged = make_error(ErrorCode::diverged,
+                               fmt::format("simulation diverged at step {} (t = {:.4g} s) on the GPU{} (limit {:g}); the "
+                                           "state is left as after that step; try a smaller integrator.dt, lower "
+                                           "stiffness or more damping",
+                                           slot.step, double(slot.step) * slot.params.dt, where,
+                                           slot.params.divergence_limit));
+  }
+}
+
+void GpuSolver::Impl::freeze_slot(std::uint32_t slot) {
+  // first_bad_step 0 is before every recorded step (1-based): frozen() holds from the first one.
+  static_cast<sh::Flags*>(flags.mapped)[slot] = sh::Flags{1, 0, 0, 0};
+}
+
+Result<void> GpuSolver::Impl::set_slot_params(std::uint32_t slot, SimParams params) {
+  slots[slot].params = std::move(params);
+  VKCLOTH_TRY(upload_colliders());
+  VKCLOTH_TRY(ensure_implicit());
+  upload_instance_params();
+  return {};
 }
 
 Result<void> GpuSolver::Impl::ensure_implicit() {
-  if (params.integrator != Integrator::implicit_euler || implicit) return {};
+  if (family().integrator != Integrator::implicit_euler || implicit) return {};
   auto r = ImplicitGpu::create(ctx, count, edges_count, groups_x, groups_y, !options.force_staging);
   if (!r) return r.error();
   implicit = std::move(*r);
@@ -405,24 +373,37 @@ void GpuSolver::Impl::record(VkCommandBuffer c, std::uint32_t steps) {
   bool first = true;
   for (std::uint32_t s = 0; s < steps; ++s) {
     pc.step = static_cast<std::uint32_t>(recorded + 1); // 1-based number of the step being computed
-    for (std::uint32_t k = 0; k < params.substeps; ++k) {
+    for (std::uint32_t k = 0; k < family().substeps; ++k) {
       record_substep(c, first);
       first = false;
       parity ^= 1u; // positions[read ^ 1] now holds the new state
     }
     ++recorded;
-    if (!diverged) ++step;
+    for (Slot& slot : slots)
+      if (!slot.diverged) ++slot.step;
   }
+}
+
+void GpuSolver::Impl::record_copy_slot(VkCommandBuffer c, const Impl& from, std::uint32_t from_slot,
+                                       std::uint32_t to_slot) const {
+  const VkBufferCopy region{from.slot_offset(from_slot), slot_offset(to_slot), slot_bytes()};
+  const std::pair<const Buffer*, const Buffer*> copies[] = {{&from.pos[from.current()], &pos[0]},
+                                                            {&from.pos[from.current()], &pos[1]},
+                                                            {&from.vel, &vel},
+                                                            {&from.normal, &normal},
+                                                            {&from.force, &force}};
+  for (auto [src, dst] : copies) vk().vkCmdCopyBuffer(c, src->buffer, dst->buffer, 1, &region);
 }
 
 void GpuSolver::Impl::record_substep(VkCommandBuffer c, bool first) {
   const auto& v = vk();
   const std::uint32_t read = current();
-  if (params.integrator == Integrator::implicit_euler) {
-    implicit->record_substep(c, read, pc, params, first);
+  if (family().integrator == Integrator::implicit_euler) {
+    dispatches += implicit->record_substep(c, read, pc, family(), first);
     return;
   }
-  const bool rk4 = params.integrator == Integrator::rk4;
+  const std::uint32_t instances_z = batch(); // one dispatch serves every instance (gl_WorkGroupID.z)
+  const bool rk4 = family().integrator == Integrator::rk4;
   if (options.fused && !rk4) {
     // One dispatch per (sub)step (fused.comp); the descriptor set alternates with the parity.
     v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, fused_pipeline);
@@ -431,16 +412,14 @@ void GpuSolver::Impl::record_substep(VkCommandBuffer c, bool first) {
     v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &set, 0, nullptr);
     v.vkCmdPushConstants(c, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
     if (!first) barriers::dispatch_to_dispatch(v, c); // previous step -> this step
-    v.vkCmdDispatch(c, groups_x, groups_y, 1);
+    v.vkCmdDispatch(c, groups_x, groups_y, instances_z);
+    ++dispatches;
     return;
   }
   const std::uint32_t stages = rk4 ? 4 : 1;
-  const float half = pc.dt / 2.0f; // CPU: c = {0, dt/2, dt/2, dt}
-  const float c_next[4] = {half, half, pc.dt, 0.0f};
   VkDescriptorSet bound = VK_NULL_HANDLE;
   for (std::uint32_t k = 0; k < stages; ++k) {
     pc.stage = k;
-    pc.c_next = c_next[k];
     const VkDescriptorSet set = sets[read][k == 0 ? 0 : 1];
     if (set != bound) {
       v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &set, 0, nullptr);
@@ -449,21 +428,25 @@ void GpuSolver::Impl::record_substep(VkCommandBuffer c, bool first) {
     v.vkCmdPushConstants(c, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
     if (!first || k > 0) barriers::dispatch_to_dispatch(v, c); // integrate (previous stage/step) -> force
     v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, force_pipeline);
-    v.vkCmdDispatch(c, groups_x, groups_y, 1);
+    v.vkCmdDispatch(c, groups_x, groups_y, instances_z);
     barriers::dispatch_to_dispatch(v, c); // force -> integrate
     v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, integrate_pipeline);
-    v.vkCmdDispatch(c, groups_x, groups_y, 1);
+    v.vkCmdDispatch(c, groups_x, groups_y, instances_z);
+    dispatches += 2;
   }
 }
 
-Result<GpuSolver> GpuSolver::create(Context& context, const ParticleSystem& system, SimParams params,
-                                    const GpuSolverOptions& options) {
-  VKCLOTH_TRY(params.validate());
+Result<std::unique_ptr<GpuSolver::Impl>> GpuSolver::Impl::create(const std::shared_ptr<Context::Impl>& ctx,
+                                                                  const ParticleSystem& system,
+                                                                  std::vector<SimParams> params,
+                                                                  const GpuSolverOptions& options,
+                                                                  const std::vector<SlotState>& states) {
+  for (SimParams& p : params) VKCLOTH_TRY(p.validate());
   VKCLOTH_TRY(system.validate());
   const std::size_t n = system.size();
+  const std::uint64_t batch = params.size();
 
   // Device limits, checked before any allocation.
-  const std::shared_ptr<Context::Impl>& ctx = context.impl();
   const VkPhysicalDeviceLimits& lim = ctx->properties.limits;
   std::uint64_t max_bytes = lim.maxStorageBufferRange;
   const bool overridden = options.max_storage_buffer_bytes && options.max_storage_buffer_bytes < max_bytes;
@@ -474,14 +457,15 @@ Result<GpuSolver> GpuSolver::create(Context& context, const ParticleSystem& syst
     std::uint64_t bytes;
     std::uint64_t per;
     std::uint64_t items;
-  } needs[] = {{"per-particle (vec4)", std::uint64_t(n) * 16, 16, n},
+  } needs[] = {{"per-particle (vec4)", batch * n * 16, 16, batch * n},
                {"spring adjacency", edges_n * sizeof(sh::Edge), sizeof(sh::Edge), edges_n},
                {"particle constants", std::uint64_t(n) * sizeof(sh::ParticleInfo), sizeof(sh::ParticleInfo), n}};
   for (const auto& need : needs)
     if (need.bytes > max_bytes)
       return make_error(ErrorCode::unsupported,
                         fmt::format("the system is too large for device '{}': its {} buffer needs {} bytes ({} x {} "
-                                    "bytes) but a storage buffer may hold at most {} bytes ({}); use fewer particles",
+                                    "bytes) but a storage buffer may hold at most {} bytes ({}); use fewer particles "
+                                    "or fewer instances of one topology",
                                     ctx->name, need.what, need.bytes, need.items, need.per, max_bytes,
                                     overridden ? "GpuSolverOptions::max_storage_buffer_bytes"
                                                : "maxStorageBufferRange"));
@@ -496,11 +480,16 @@ Result<GpuSolver> GpuSolver::create(Context& context, const ParticleSystem& syst
                                   "the device dispatches at most {} x {}",
                                   ctx->name, n, groups, VKCLOTH_WORKGROUP_SIZE, lim.maxComputeWorkGroupCount[0],
                                   lim.maxComputeWorkGroupCount[1]));
+  if (batch == 0 || batch > lim.maxComputeWorkGroupCount[2])
+    return make_error(ErrorCode::unsupported,
+                      fmt::format("a batch of {} instances of one topology does not fit device '{}' (at most {} per "
+                                  "dispatch: maxComputeWorkGroupCount[2])",
+                                  batch, ctx->name, lim.maxComputeWorkGroupCount[2]));
 
   auto impl = std::make_unique<Impl>();
   Impl& s = *impl;
   s.ctx = ctx;
-  s.params = std::move(params);
+  for (SimParams& p : params) s.slots.push_back(Slot{std::move(p)});
   s.options = options;
   s.count = static_cast<std::uint32_t>(n);
   s.edges_count = edges_n;
@@ -517,7 +506,7 @@ Result<GpuSolver> GpuSolver::create(Context& context, const ParticleSystem& syst
   // VERTEX_BUFFER: a renderer binds positions, normals and uvs as vertex buffers (render/).
   const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
                                    VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT;
-  const VkDeviceSize vec4_bytes = VkDeviceSize(n) * 16;
+  const VkDeviceSize vec4_bytes = VkDeviceSize(batch) * n * 16;
   const bool allow_map = !options.force_staging;
   std::vector<std::uint32_t> families;
   if (!options.sharing_queue_families.empty()) {
@@ -545,10 +534,18 @@ Result<GpuSolver> GpuSolver::create(Context& context, const ParticleSystem& syst
   }
   s.staging = s.pos[0].mapped == nullptr;
   {
-    auto r = create_buffer(*ctx, sizeof(sh::Flags), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::host_readback, true, "flags");
+    auto r = create_buffer(*ctx, batch * sizeof(sh::Flags), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::host_readback,
+                           true, "flags");
     if (!r) return r.error();
     s.flags = *r;
-    *static_cast<sh::Flags*>(s.flags.mapped) = sh::Flags{0, VKCLOTH_NO_BAD_STEP, VKCLOTH_NO_BAD_STEP, 0};
+    for (std::uint64_t k = 0; k < batch; ++k)
+      static_cast<sh::Flags*>(s.flags.mapped)[k] = sh::Flags{0, VKCLOTH_NO_BAD_STEP, VKCLOTH_NO_BAD_STEP, 0};
+  }
+  {
+    auto r = create_buffer(*ctx, batch * sizeof(sh::InstanceParams), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                           MemoryUse::host_upload, true, "instance parameters");
+    if (!r) return r.error();
+    s.instances = *r;
   }
   VKCLOTH_TRY(s.upload_colliders());
 
@@ -579,24 +576,30 @@ Result<GpuSolver> GpuSolver::create(Context& context, const ParticleSystem& syst
   VKCLOTH_TRY(s.init_pipelines());
   VKCLOTH_TRY(s.write_sets());
   VKCLOTH_TRY(s.ensure_implicit());
-  s.set_push_constants();
+  s.upload_instance_params();
 
-  // Initial state, converted as CpuSolver<float>::create converts it.
-  std::vector<sh::vec4> pos(n), vel(n), uv(n);
+  // Initial state of every instance, converted as CpuSolver<float>::create converts it.
+  const std::size_t total = std::size_t(batch) * n;
+  std::vector<sh::vec4> pos(total), vel(total), uv(total);
   std::vector<sh::ParticleInfo> info(n);
   s.uvs.assign(n, glm::vec2(0.0f));
-  for (std::size_t p = 0; p < n; ++p) {
-    const Particle& q = system.particles[p];
-    pos[p] = {float(q.position.x), float(q.position.y), float(q.position.z), 1.0f};
-    vel[p] = q.pinned ? sh::vec4{0, 0, 0, 0} : sh::vec4{float(q.velocity.x), float(q.velocity.y), float(q.velocity.z), 0.0f};
-    info[p] = {float(q.mass), q.pinned ? 1u : 0u};
+  for (std::size_t k = 0; k < batch; ++k) {
+    const SlotState state = k < states.size() ? states[k] : SlotState{};
+    for (std::size_t p = 0; p < n; ++p) {
+      const Particle& q = system.particles[p];
+      const glm::dvec3 x = state.positions && !state.positions->empty() ? (*state.positions)[p] : q.position;
+      const glm::dvec3 u = state.velocities && !state.velocities->empty() ? (*state.velocities)[p] : q.velocity;
+      pos[k * n + p] = {float(x.x), float(x.y), float(x.z), 1.0f};
+      vel[k * n + p] = q.pinned ? sh::vec4{0, 0, 0, 0} : sh::vec4{float(u.x), float(u.y), float(u.z), 0.0f};
+      info[p] = {float(q.mass), q.pinned ? 1u : 0u};
+    }
   }
   if (system.grid) {
     for (std::uint32_t j = 0; j < s.ny; ++j)
       for (std::uint32_t i = 0; i < s.nx; ++i) {
         const glm::vec2 t(s.nx > 1 ? float(i) / float(s.nx - 1) : 0.0f, s.ny > 1 ? float(j) / float(s.ny - 1) : 0.0f);
         s.uvs[std::size_t(j) * s.nx + i] = t;
-        uv[std::size_t(j) * s.nx + i] = {t.x, t.y, 0.0f, 0.0f};
+        for (std::size_t k = 0; k < batch; ++k) uv[k * n + std::size_t(j) * s.nx + i] = {t.x, t.y, 0.0f, 0.0f};
       }
   }
   std::vector<sh::Edge> edges(edges_n);
@@ -657,7 +660,16 @@ Result<GpuSolver> GpuSolver::create(Context& context, const ParticleSystem& syst
     destroy_buffer(*ctx, staging);
     VKCLOTH_TRY(r);
   }
-  return GpuSolver(std::move(impl));
+  return impl;
+}
+
+Result<GpuSolver> GpuSolver::create(Context& context, const ParticleSystem& system, SimParams params,
+                                    const GpuSolverOptions& options) {
+  std::vector<SimParams> one;
+  one.push_back(std::move(params));
+  auto impl = Impl::create(context.impl(), system, std::move(one), options);
+  if (!impl) return impl.error();
+  return GpuSolver(std::move(*impl));
 }
 
 GpuSolver::GpuSolver(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -667,13 +679,9 @@ GpuSolver::~GpuSolver() = default;
 
 Result<void> GpuSolver::set_params(SimParams params) {
   VKCLOTH_TRY(params.validate());
-  impl_->params = std::move(params);
-  VKCLOTH_TRY(impl_->upload_colliders());
-  VKCLOTH_TRY(impl_->ensure_implicit());
-  impl_->set_push_constants();
-  return {};
+  return impl_->set_slot_params(0, std::move(params));
 }
-const SimParams& GpuSolver::params() const { return impl_->params; }
+const SimParams& GpuSolver::params() const { return impl_->slots[0].params; }
 
 void GpuSolver::record_steps(VkCommandBuffer cmd, std::uint32_t steps) { impl_->record(cmd, steps); }
 void GpuSolver::record_step(VkCommandBuffer cmd) { impl_->record(cmd, 1); }
@@ -684,7 +692,7 @@ void GpuSolver::record_barrier_to(VkCommandBuffer cmd, VkPipelineStageFlags dst_
 
 Result<void> GpuSolver::simulate(std::uint64_t steps, std::uint32_t steps_per_submit) {
   Impl& s = *impl_;
-  if (s.diverged) return *s.diverged;
+  if (s.slots[0].diverged) return *s.slots[0].diverged;
   if (steps_per_submit == 0) return make_error(ErrorCode::invalid_argument, "steps_per_submit must be > 0");
   const auto& v = s.vk();
   s.last_ms = s.queries ? 0.0 : -1.0;
@@ -710,26 +718,29 @@ Result<void> GpuSolver::simulate(std::uint64_t steps, std::uint32_t steps_per_su
       s.last_ms += double(ticks) * double(s.ctx->properties.limits.timestampPeriod) * 1e-6;
     }
     done += k;
-    VKCLOTH_TRY(s.check_flags());
+    s.refresh_flags();
+    if (s.slots[0].diverged) return *s.slots[0].diverged;
   }
   return {};
 }
 
 Result<void> GpuSolver::check_divergence() {
   Impl& s = *impl_;
-  if (s.diverged) return *s.diverged;
+  if (s.slots[0].diverged) return *s.slots[0].diverged;
   VKCLOTH_TRY(s.submit_and_wait([&](VkCommandBuffer c) { barriers::before_readback(s.vk(), c); }));
-  return s.check_flags();
+  s.refresh_flags();
+  if (s.slots[0].diverged) return *s.slots[0].diverged;
+  return {};
 }
 
-Result<std::vector<glm::vec3>> GpuSolver::positions() { return impl_->read_vec3(impl_->pos[impl_->current()]); }
-Result<std::vector<glm::vec3>> GpuSolver::velocities() { return impl_->read_vec3(impl_->vel); }
-Result<std::vector<glm::vec3>> GpuSolver::normals() { return impl_->read_vec3(impl_->normal); }
-Result<std::vector<glm::vec3>> GpuSolver::forces() { return impl_->read_vec3(impl_->force); }
+Result<std::vector<glm::vec3>> GpuSolver::positions() { return impl_->read_vec3(impl_->pos[impl_->current()], 0); }
+Result<std::vector<glm::vec3>> GpuSolver::velocities() { return impl_->read_vec3(impl_->vel, 0); }
+Result<std::vector<glm::vec3>> GpuSolver::normals() { return impl_->read_vec3(impl_->normal, 0); }
+Result<std::vector<glm::vec3>> GpuSolver::forces() { return impl_->read_vec3(impl_->force, 0); }
 const std::vector<glm::vec2>& GpuSolver::uvs() const { return impl_->uvs; }
 
-std::uint64_t GpuSolver::step_index() const { return impl_->step; }
-double GpuSolver::time() const { return static_cast<double>(impl_->step) * impl_->params.dt; }
+std::uint64_t GpuSolver::step_index() const { return impl_->slots[0].step; }
+double GpuSolver::time() const { return static_cast<double>(impl_->slots[0].step) * impl_->slots[0].params.dt; }
 std::uint32_t GpuSolver::particle_count() const { return impl_->count; }
 std::uint32_t GpuSolver::current_position_index() const { return impl_->current(); }
 VkBuffer GpuSolver::position_buffer(std::uint32_t index) const { return impl_->pos[index & 1u].buffer; }
@@ -740,5 +751,15 @@ VkBuffer GpuSolver::uv_buffer() const { return impl_->uv.buffer; }
 SolveStats GpuSolver::last_solve() const { return impl_->implicit ? impl_->implicit->stats() : SolveStats{}; }
 double GpuSolver::last_gpu_ms() const { return impl_->last_ms; }
 bool GpuSolver::uses_staging() const { return impl_->staging; }
+InstanceBuffers GpuSolver::buffers() const {
+  InstanceBuffers b;
+  b.positions = current_position_buffer();
+  b.normals = normal_buffer();
+  b.uvs = uv_buffer();
+  b.count = impl_->count;
+  b.nx = impl_->nx;
+  b.ny = impl_->ny;
+  return b;
+}
 
 } // namespace vkcloth::gpu

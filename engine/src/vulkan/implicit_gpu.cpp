@@ -21,7 +21,7 @@ namespace {
 constexpr std::uint32_t kBindings[] = {
     VKCLOTH_BINDING_POS_IN,         VKCLOTH_BINDING_FORCE_OUT,     VKCLOTH_BINDING_NORMAL,    VKCLOTH_BINDING_POS_OUT,
     VKCLOTH_BINDING_VEL,            VKCLOTH_BINDING_PARTICLE,      VKCLOTH_BINDING_OFFSETS,   VKCLOTH_BINDING_EDGES,
-    VKCLOTH_BINDING_COLLIDERS,      VKCLOTH_BINDING_FLAGS,         VKCLOTH_BINDING_IMPL_VF,   VKCLOTH_BINDING_IMPL_KS,
+    VKCLOTH_BINDING_COLLIDERS,      VKCLOTH_BINDING_FLAGS,         VKCLOTH_BINDING_INSTANCES, VKCLOTH_BINDING_IMPL_VF,   VKCLOTH_BINDING_IMPL_KS,
     VKCLOTH_BINDING_IMPL_DIAG_INV,  VKCLOTH_BINDING_IMPL_X,        VKCLOTH_BINDING_IMPL_R,    VKCLOTH_BINDING_IMPL_Z,
     VKCLOTH_BINDING_IMPL_D,         VKCLOTH_BINDING_IMPL_Q,        VKCLOTH_BINDING_IMPL_PARTIALS,
     VKCLOTH_BINDING_IMPL_STATE,     VKCLOTH_BINDING_IMPL_ARGS};
@@ -175,6 +175,7 @@ Result<void> ImplicitGpu::write_sets(const ImplicitInputs& in) {
       case VKCLOTH_BINDING_EDGES: b = in.edges; break;
       case VKCLOTH_BINDING_COLLIDERS: b = in.colliders; break;
       case VKCLOTH_BINDING_FLAGS: b = in.flags; break;
+      case VKCLOTH_BINDING_INSTANCES: b = in.instances; break;
       case VKCLOTH_BINDING_IMPL_VF: b = vf_.buffer; break;
       case VKCLOTH_BINDING_IMPL_KS: b = ks_.buffer; break;
       case VKCLOTH_BINDING_IMPL_DIAG_INV: b = diag_inv_.buffer; break;
@@ -197,8 +198,8 @@ Result<void> ImplicitGpu::write_sets(const ImplicitInputs& in) {
   return {};
 }
 
-void ImplicitGpu::record_substep(VkCommandBuffer c, std::uint32_t read, sh::PushConstants pc, const SimParams& params,
-                                 bool first) {
+std::uint32_t ImplicitGpu::record_substep(VkCommandBuffer c, std::uint32_t read, sh::PushConstants pc,
+                                          const SimParams& params, bool first) {
   const auto& v = ctx_->vk;
   const float tol = float(params.cg_tolerance);
   pc.c_next = tol * tol; // as CpuSolver<float>: Real(tol) * Real(tol)
@@ -206,6 +207,7 @@ void ImplicitGpu::record_substep(VkCommandBuffer c, std::uint32_t read, sh::Push
   pc.pad1 = groups_x_ * groups_y_;
   v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &sets_[read], 0, nullptr);
   bool need_barrier = !first;
+  std::uint32_t dispatches = 0;
   VkPipeline bound = VK_NULL_HANDLE;
   auto pass = [&](VkPipeline pipe, std::uint32_t stage, int indirect_offset) {
     if (need_barrier) barriers::implicit_pass(v, c); // previous pass -> this one (RAW, WAR, indirect args)
@@ -215,6 +217,7 @@ void ImplicitGpu::record_substep(VkCommandBuffer c, std::uint32_t read, sh::Push
       bound = pipe;
     }
     pc.stage = stage;
+    ++dispatches;
     v.vkCmdPushConstants(c, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
     if (indirect_offset >= 0)
       v.vkCmdDispatchIndirect(c, args_.buffer, VkDeviceSize(indirect_offset));
@@ -235,6 +238,7 @@ void ImplicitGpu::record_substep(VkCommandBuffer c, std::uint32_t read, sh::Push
     pass(pass_, VKCLOTH_IMPL_DIRECTION, particles);
   }
   pass(pass_, VKCLOTH_IMPL_FINISH, direct);
+  return dispatches;
 }
 
 SolveStats ImplicitGpu::stats() const {

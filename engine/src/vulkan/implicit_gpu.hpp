@@ -21,9 +21,10 @@
 
 namespace vkcloth::gpu {
 
-/// The solver's buffers the implicit passes share (same bindings as the main layout).
+/// The solver's buffers the implicit passes share (same bindings as the main layout). The
+/// implicit passes run batches of one instance (the CG reductions are per instance).
 struct ImplicitInputs {
-  VkBuffer pos[2], vel, force, normal, particle, offsets, edges, colliders, flags;
+  VkBuffer pos[2], vel, force, normal, particle, offsets, edges, colliders, flags, instances;
 };
 
 class ImplicitGpu {
@@ -38,9 +39,10 @@ public:
   /// (Re)writes the two descriptor sets (position parity); call again when an input buffer changes.
   Result<void> write_sets(const ImplicitInputs& in);
   /// Records one substep reading positions[read], writing positions[read ^ 1]. `pc` is the main
-  /// push-constant block with dt = the substep; `first`: no barrier needed before the first pass.
-  void record_substep(VkCommandBuffer cmd, std::uint32_t read, shared::PushConstants pc, const SimParams& params,
-                      bool first);
+  /// push-constant block (the substep's dt is in the InstanceParams); `first`: no barrier needed before the first pass.
+  /// Returns the number of dispatches recorded.
+  std::uint32_t record_substep(VkCommandBuffer cmd, std::uint32_t read, shared::PushConstants pc, const SimParams& params,
+                               bool first);
   /// The last completed solve (host-visible state; valid once the recorded work finished).
   SolveStats stats() const;
 

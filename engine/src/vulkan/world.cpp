@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <map>
+#include <vector>
 
 #include <fmt/format.h>
 
 #include "barriers.hpp"
+#include "solver_batch.hpp"
 #include "vkcloth/gpu/world.hpp"
 
 namespace vkcloth::gpu {
@@ -22,16 +24,37 @@ std::vector<std::uint32_t> grid_triangle_indices(std::uint32_t nx, std::uint32_t
   return idx;
 }
 
+// Instances are grouped into batches (GpuSolver::Impl, solver_batch.hpp) by topology, integrator
+// family and substep count; each batch steps all its instances with one dispatch per pass.
+// Adding, removing or moving an instance rebuilds its batch: new buffers, the surviving
+// instances' state copied over on the GPU (positions, velocities, normals, forces).
 struct ClothWorld::Impl {
+  using Batch = GpuSolver::Impl;
   struct Instance {
     std::shared_ptr<const ParticleSystem> topology;
-    GpuSolver solver;
+    SimParams params;
+    Batch* batch = nullptr;
+    std::uint32_t slot = 0;
   };
+  /// What instances must agree on to share a batch (and so its dispatches).
+  struct BatchKey {
+    const ParticleSystem* topology = nullptr;
+    int family = 0; // 0: explicit / semi-implicit Euler, 1: RK4, 2: implicit Euler (one instance per batch)
+    std::uint32_t substeps = 1;
+    InstanceId only = 0; // implicit Euler: the instance (its CG reductions are per batch)
+    auto operator<=>(const BatchKey&) const = default;
+  };
+  struct BatchEntry {
+    std::unique_ptr<Batch> solver;
+    std::vector<InstanceId> members; // slot order
+  };
+
   std::shared_ptr<Context::Impl> ctx;
-  Context* context = nullptr; // for GpuSolver::create (borrowed; the Impl above keeps the device)
   WorldOptions options;
-  std::map<InstanceId, Instance> instances; // ordered: the recording order
+  std::map<InstanceId, Instance> instances; // ordered by id
+  std::map<BatchKey, BatchEntry> batches;
   InstanceId next = 1;
+  std::uint64_t dispatches = 0; // recorded by record_steps(), all batches
   VkCommandPool cmd_pool = VK_NULL_HANDLE;
   VkCommandBuffer cmd = VK_NULL_HANDLE;
   VkFence fence = VK_NULL_HANDLE;
@@ -40,7 +63,7 @@ struct ClothWorld::Impl {
   Impl(const Impl&) = delete;
   Impl& operator=(const Impl&) = delete;
   ~Impl() {
-    instances.clear();
+    batches.clear();
     if (!ctx || !ctx->device) return;
     const auto& v = ctx->vk;
     if (fence) {
@@ -50,17 +73,106 @@ struct ClothWorld::Impl {
     if (cmd_pool) v.vkDestroyCommandPool(ctx->device, cmd_pool, v.allocator);
   }
 
+  static BatchKey key_of(const Instance& inst, InstanceId id) {
+    BatchKey k;
+    k.topology = inst.topology.get();
+    k.family = inst.params.integrator == Integrator::rk4 ? 1 : inst.params.integrator == Integrator::implicit_euler ? 2 : 0;
+    k.substeps = inst.params.substeps;
+    k.only = k.family == 2 ? id : 0;
+    return k;
+  }
+
   Result<Instance*> find(InstanceId id) {
     const auto it = instances.find(id);
     if (it == instances.end()) return make_error(ErrorCode::invalid_argument, fmt::format("no cloth instance with id {}", id));
     return &it->second;
+  }
+
+  template <typename F> Result<void> submit_and_wait(F&& record_fn) {
+    const auto& v = ctx->vk;
+    VKCLOTH_VK_TRY(v.vkResetFences(ctx->device, 1, &fence), "vkResetFences (world)");
+    VKCLOTH_VK_TRY(v.vkResetCommandBuffer(cmd, 0), "vkResetCommandBuffer (world)");
+    VkCommandBufferBeginInfo bi{};
+    bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+    bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    VKCLOTH_VK_TRY(v.vkBeginCommandBuffer(cmd, &bi), "vkBeginCommandBuffer (world)");
+    record_fn(cmd);
+    VKCLOTH_VK_TRY(v.vkEndCommandBuffer(cmd), "vkEndCommandBuffer (world)");
+    VkSubmitInfo si{};
+    si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
+    si.commandBufferCount = 1;
+    si.pCommandBuffers = &cmd;
+    VKCLOTH_VK_TRY(v.vkQueueSubmit(ctx->queue, 1, &si, fence), "vkQueueSubmit (world)");
+    VKCLOTH_VK_TRY(v.vkWaitForFences(ctx->device, 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences (world)");
+    return {};
+  }
+
+  /// Rebuilds the batch `key` with `members` (slot order; may be empty: the batch goes away).
+  /// Members already in a batch keep their state (copied on the GPU); `fresh` ones start from
+  /// their InitialState. On failure nothing changes.
+  Result<void> rebuild(const BatchKey& key, const std::vector<InstanceId>& members,
+                       const std::map<InstanceId, const InitialState*>& fresh) {
+    if (members.empty()) {
+      batches.erase(key);
+      return {};
+    }
+    std::vector<SimParams> params;
+    std::vector<SlotState> states;
+    for (InstanceId id : members) {
+      params.push_back(instances.at(id).params);
+      const auto f = fresh.find(id);
+      states.push_back(f == fresh.end() ? SlotState{} : SlotState{&f->second->positions, &f->second->velocities});
+    }
+    auto made = Batch::create(ctx, *instances.at(members.front()).topology, std::move(params), options.solver, states);
+    if (!made) return made.error();
+    std::unique_ptr<Batch> batch = std::move(*made);
+    bool copies = false;
+    for (InstanceId id : members) copies = copies || !fresh.count(id);
+    if (copies)
+      VKCLOTH_TRY(submit_and_wait([&](VkCommandBuffer c) {
+        barriers::before_batch_copy(ctx->vk, c);
+        for (std::uint32_t k = 0; k < members.size(); ++k)
+          if (!fresh.count(members[k])) {
+            const Instance& inst = instances.at(members[k]);
+            batch->record_copy_slot(c, *inst.batch, inst.slot, k);
+          }
+        barriers::after_batch_copy(ctx->vk, c);
+      }));
+    for (std::uint32_t k = 0; k < members.size(); ++k) {
+      Instance& inst = instances.at(members[k]);
+      if (!fresh.count(members[k])) {
+        inst.batch->refresh_flags(); // the old batch's flags are current: the copy waited for its work
+        const Batch::Slot& old = inst.batch->slots[inst.slot];
+        Batch::Slot& now = batch->slots[k];
+        now.step = now.epoch_step = old.step;
+        now.diverged = old.diverged;
+        if (now.diverged) batch->freeze_slot(k);
+      }
+    }
+    for (std::uint32_t k = 0; k < members.size(); ++k) {
+      instances.at(members[k]).batch = batch.get();
+      instances.at(members[k]).slot = k;
+    }
+    batches[key] = BatchEntry{std::move(batch), members};
+    return {};
+  }
+
+  /// Reads every batch's flags (their work must be complete and visible to the host).
+  Result<void> divergence() {
+    for (auto& [key, entry] : batches) entry.solver->refresh_flags();
+    for (auto& [id, inst] : instances)
+      if (const auto& d = inst.batch->slots[inst.slot].diverged) {
+        Error e = *d;
+        e.message = fmt::format("cloth instance {}: {}", id, e.message);
+        return e;
+      }
+    return {};
   }
 };
 
 Result<ClothWorld> ClothWorld::create(Context& context, WorldOptions options) {
   auto impl = std::make_unique<Impl>();
   impl->ctx = context.impl();
-  impl->context = &context;
   impl->options = std::move(options);
   const auto& v = impl->ctx->vk;
   const VkDevice d = impl->ctx->device;
@@ -99,44 +211,79 @@ Result<InstanceId> ClothWorld::add(std::shared_ptr<const ParticleSystem> topolog
     return make_error(ErrorCode::invalid_argument,
                       fmt::format("ClothWorld::add: initial velocities has {} entries, the topology {} particles",
                                   initial.velocities.size(), n));
-  Result<GpuSolver> solver = [&]() -> Result<GpuSolver> {
-    if (initial.positions.empty() && initial.velocities.empty())
-      return GpuSolver::create(*impl_->context, *topology, std::move(params), impl_->options.solver);
-    ParticleSystem state = *topology; // the state only: the GPU solver copies what it uploads
-    for (std::size_t p = 0; p < n; ++p) {
-      if (!initial.positions.empty()) state.particles[p].position = initial.positions[p];
-      if (!initial.velocities.empty()) state.particles[p].velocity = initial.velocities[p];
-    }
-    return GpuSolver::create(*impl_->context, state, std::move(params), impl_->options.solver);
-  }();
-  if (!solver) return solver.error();
-  const InstanceId id = impl_->next++;
-  impl_->instances.emplace(id, Impl::Instance{std::move(topology), std::move(solver.value())});
+  VKCLOTH_TRY(params.validate());
+  Impl& s = *impl_;
+  const InstanceId id = s.next;
+  s.instances.emplace(id, Impl::Instance{std::move(topology), std::move(params)});
+  const Impl::BatchKey key = Impl::key_of(s.instances.at(id), id);
+  std::vector<InstanceId> members;
+  if (auto it = s.batches.find(key); it != s.batches.end()) members = it->second.members;
+  members.push_back(id);
+  if (auto r = s.rebuild(key, members, {{id, &initial}}); !r) {
+    s.instances.erase(id);
+    return r.error();
+  }
+  ++s.next;
   return id;
 }
 
 Result<void> ClothWorld::remove(InstanceId id) {
-  VKCLOTH_TRY(impl_->find(id));
-  impl_->instances.erase(id);
+  auto inst = impl_->find(id);
+  if (!inst) return inst.error();
+  Impl& s = *impl_;
+  const Impl::BatchKey key = Impl::key_of(**inst, id);
+  std::vector<InstanceId> members = s.batches.at(key).members;
+  std::erase(members, id);
+  VKCLOTH_TRY(s.rebuild(key, members, {}));
+  s.instances.erase(id);
   return {};
 }
 
 Result<void> ClothWorld::set_params(InstanceId id, SimParams params) {
-  auto inst = impl_->find(id);
-  if (!inst) return inst.error();
-  return (*inst)->solver.set_params(std::move(params));
+  auto found = impl_->find(id);
+  if (!found) return found.error();
+  VKCLOTH_TRY(params.validate());
+  Impl& s = *impl_;
+  Impl::Instance& inst = **found;
+  const Impl::BatchKey old_key = Impl::key_of(inst, id);
+  SimParams previous = std::move(inst.params);
+  inst.params = std::move(params);
+  const Impl::BatchKey new_key = Impl::key_of(inst, id);
+  if (new_key == old_key) {
+    // Same batch: new per-instance parameters and colliders, no pipeline re-created.
+    if (auto r = inst.batch->set_slot_params(inst.slot, inst.params); !r) {
+      inst.params = std::move(previous);
+      return r.error();
+    }
+    return {};
+  }
+  // Another integrator family or substep count: the instance moves to that batch.
+  std::vector<InstanceId> joined;
+  if (auto it = s.batches.find(new_key); it != s.batches.end()) joined = it->second.members;
+  joined.push_back(id);
+  if (auto r = s.rebuild(new_key, joined, {}); !r) {
+    inst.params = std::move(previous);
+    return r.error();
+  }
+  std::vector<InstanceId> left = s.batches.at(old_key).members;
+  std::erase(left, id);
+  return s.rebuild(old_key, left, {});
 }
 
 Result<SimParams> ClothWorld::params(InstanceId id) const {
   auto inst = impl_->find(id);
   if (!inst) return inst.error();
-  return (*inst)->solver.params();
+  return (*inst)->params;
 }
 
 void ClothWorld::record_step(VkCommandBuffer cmd) { record_steps(cmd, 1); }
 
 void ClothWorld::record_steps(VkCommandBuffer cmd, std::uint32_t steps) {
-  for (auto& [id, inst] : impl_->instances) inst.solver.record_steps(cmd, steps);
+  for (auto& [key, entry] : impl_->batches) {
+    const std::uint64_t before = entry.solver->dispatches;
+    entry.solver->record(cmd, steps);
+    impl_->dispatches += entry.solver->dispatches - before;
+  }
 }
 
 void ClothWorld::record_barrier_to(VkCommandBuffer cmd, VkPipelineStageFlags dst_stage, VkAccessFlags dst_access) const {
@@ -146,80 +293,65 @@ void ClothWorld::record_barrier_to(VkCommandBuffer cmd, VkPipelineStageFlags dst
 Result<void> ClothWorld::simulate(std::uint64_t steps, std::uint32_t steps_per_submit) {
   if (steps_per_submit == 0) return make_error(ErrorCode::invalid_argument, "steps_per_submit must be > 0");
   Impl& s = *impl_;
-  const auto& v = s.ctx->vk;
   for (std::uint64_t done = 0; done < steps;) {
     const auto k = static_cast<std::uint32_t>(std::min<std::uint64_t>(steps - done, steps_per_submit));
-    VKCLOTH_VK_TRY(v.vkResetFences(s.ctx->device, 1, &s.fence), "vkResetFences (world)");
-    VKCLOTH_VK_TRY(v.vkResetCommandBuffer(s.cmd, 0), "vkResetCommandBuffer (world)");
-    VkCommandBufferBeginInfo bi{};
-    bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
-    bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-    VKCLOTH_VK_TRY(v.vkBeginCommandBuffer(s.cmd, &bi), "vkBeginCommandBuffer (world)");
-    record_steps(s.cmd, k);
-    barriers::after_steps(v, s.cmd, VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT); // flags read by the host
-    VKCLOTH_VK_TRY(v.vkEndCommandBuffer(s.cmd), "vkEndCommandBuffer (world)");
-    VkSubmitInfo si{};
-    si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
-    si.commandBufferCount = 1;
-    si.pCommandBuffers = &s.cmd;
-    VKCLOTH_VK_TRY(v.vkQueueSubmit(s.ctx->queue, 1, &si, s.fence), "vkQueueSubmit (world)");
-    VKCLOTH_VK_TRY(v.vkWaitForFences(s.ctx->device, 1, &s.fence, VK_TRUE, UINT64_MAX), "vkWaitForFences (world)");
+    VKCLOTH_TRY(s.submit_and_wait([&](VkCommandBuffer c) {
+      record_steps(c, k);
+      barriers::after_steps(s.ctx->vk, c, VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT); // flags read by the host
+    }));
     done += k;
-    VKCLOTH_TRY(check_divergence());
+    VKCLOTH_TRY(s.divergence());
   }
   return {};
 }
 
 Result<void> ClothWorld::check_divergence() {
-  for (auto& [id, inst] : impl_->instances)
-    if (auto r = inst.solver.check_divergence(); !r) {
-      Error e = r.error();
-      e.message = fmt::format("cloth instance {}: {}", id, e.message);
-      return e;
-    }
-  return {};
+  Impl& s = *impl_;
+  VKCLOTH_TRY(s.submit_and_wait([&](VkCommandBuffer c) { barriers::before_readback(s.ctx->vk, c); }));
+  return s.divergence();
 }
 
 Result<std::vector<glm::vec3>> ClothWorld::positions(InstanceId id) {
   auto inst = impl_->find(id);
   if (!inst) return inst.error();
-  return (*inst)->solver.positions();
+  Impl::Batch& b = *(*inst)->batch;
+  return b.read_vec3(b.pos[b.current()], (*inst)->slot);
 }
 Result<std::vector<glm::vec3>> ClothWorld::velocities(InstanceId id) {
   auto inst = impl_->find(id);
   if (!inst) return inst.error();
-  return (*inst)->solver.velocities();
+  return (*inst)->batch->read_vec3((*inst)->batch->vel, (*inst)->slot);
 }
 Result<std::vector<glm::vec3>> ClothWorld::normals(InstanceId id) {
   auto inst = impl_->find(id);
   if (!inst) return inst.error();
-  return (*inst)->solver.normals();
+  return (*inst)->batch->read_vec3((*inst)->batch->normal, (*inst)->slot);
 }
 
 Result<InstanceBuffers> ClothWorld::buffers(InstanceId id) const {
   auto inst = impl_->find(id);
   if (!inst) return inst.error();
-  const GpuSolver& g = (*inst)->solver;
-  InstanceBuffers b;
-  b.positions = g.current_position_buffer();
-  b.normals = g.normal_buffer();
-  b.uvs = g.uv_buffer();
-  b.count = g.particle_count();
-  if ((*inst)->topology->grid) {
-    b.nx = (*inst)->topology->grid->nx;
-    b.ny = (*inst)->topology->grid->ny;
-  }
-  return b;
+  const Impl::Batch& b = *(*inst)->batch;
+  InstanceBuffers out;
+  out.positions = b.pos[b.current()].buffer;
+  out.normals = b.normal.buffer;
+  out.uvs = b.uv.buffer;
+  out.offset = b.slot_offset((*inst)->slot);
+  out.count = b.count;
+  out.nx = b.nx;
+  out.ny = b.ny;
+  return out;
 }
 
-GpuSolver* ClothWorld::solver(InstanceId id) {
+std::uint64_t ClothWorld::step_index(InstanceId id) const {
   auto inst = impl_->find(id);
-  return inst ? &(*inst)->solver : nullptr;
+  return inst ? (*inst)->batch->slots[(*inst)->slot].step : 0;
 }
-const GpuSolver* ClothWorld::solver(InstanceId id) const {
-  auto inst = impl_->find(id);
-  return inst ? &(*inst)->solver : nullptr;
-}
+
+std::size_t ClothWorld::batch_count() const { return impl_->batches.size(); }
+
+std::uint64_t ClothWorld::dispatches_recorded() const { return impl_->dispatches; }
+
 std::shared_ptr<const ParticleSystem> ClothWorld::topology(InstanceId id) const {
   auto inst = impl_->find(id);
   return inst ? (*inst)->topology : nullptr;

@@ -61,6 +61,20 @@ struct GpuSolverOptions {
   std::vector<std::uint32_t> sharing_queue_families;
 };
 
+/// Where an instance's per-particle data lives, for the host's own drawing: vec4 per particle
+/// (w = 1 for positions), `stride` bytes apart, `count` particles from byte `offset` of each buffer.
+/// `positions` is the CURRENT positions buffer: query it again after every record_steps().
+/// Instances of a ClothWorld batch share the buffers at different offsets.
+struct InstanceBuffers {
+  VkBuffer positions = VK_NULL_HANDLE;
+  VkBuffer normals = VK_NULL_HANDLE;
+  VkBuffer uvs = VK_NULL_HANDLE;
+  VkDeviceSize offset = 0;
+  VkDeviceSize stride = 16; ///< GpuSolver::stride
+  std::uint32_t count = 0;
+  std::uint32_t nx = 0, ny = 0; ///< grid size (0 for chains): grid_triangle_indices(nx, ny)
+};
+
 class GpuSolver {
 public:
   /// Validates `params` and `system` as CpuSolver::create does, checks the device limits BEFORE
@@ -137,6 +151,8 @@ public:
   VkBuffer uv_buffer() const;
   /// Byte stride of every per-particle buffer above (vec4).
   static constexpr VkDeviceSize stride = 16;
+  /// The buffers above for drawing (offset 0); query again after every record_steps().
+  InstanceBuffers buffers() const;
 
   /// implicit_euler: CG iterations and relative residual of the last completed substep's solve
   /// (read from host-visible memory: valid once the recorded work has finished).

@@ -3,16 +3,18 @@
 // lengths, CSR gather lists, grid) and instances with their own state (positions, velocities)
 // and parameters (SimParams: integrator, dt, gravity, damping, wind, colliders, ...).
 //
-// Each instance is a GpuSolver (the one physics implementation: same shaders, same bits as a
-// standalone GpuSolver and, on lavapipe, as CpuSolver<float>). record_steps() records every
-// instance's passes into the host's command buffer, one after the other.
-//
-// Known limitations (this version): instances are NOT batched into one dispatch per pass; each
-// instance dispatches its own passes (one fused dispatch per Euler step, two per two-pass step,
-// 8 per RK4 step, the CG passes for implicit Euler), and each keeps its own copy of the topology
-// buffers on the GPU (the CPU-side topology is shared). Pipelines are created per instance at
-// add(); set_params() never re-creates them (except the CG pipelines the first time an instance
-// switches to implicit_euler).
+// Batching: instances that share a topology (the same shared_ptr), an integrator family
+// (explicit and semi-implicit Euler together; RK4) and a substep count form one batch, stepped
+// with ONE dispatch per pass for all of them (instance = gl_WorkGroupID.z): one fused dispatch
+// per Euler step, two per two-pass Euler step, 8 per RK4 step, whatever the number of instances.
+// Their state lives in shared buffers, instance after instance (InstanceBuffers::offset), the
+// topology buffers once per batch; each instance has its own parameters (dt, gravity, damping,
+// wind, colliders, contact mode, divergence limit) and divergence flags. Same shaders, same bits
+// as a standalone GpuSolver and, on lavapipe, as CpuSolver<float> (tested). Implicit-Euler
+// instances are batches of one (their CG reductions are per instance).
+// add() / remove() / an integrator change in set_params() rebuild the batch concerned: new
+// buffers, pipelines and descriptor sets; the other instances' state is copied on the GPU (one
+// submission, waited for). Other set_params() changes only rewrite the instance's parameters.
 //
 // Thread safety: none; one thread drives a world (as a GpuSolver).
 #pragma once
@@ -52,19 +54,6 @@ struct InitialState {
   std::vector<glm::dvec3> velocities;
 };
 
-/// Where an instance's per-particle data lives, for the host's own drawing: vec4 per particle
-/// (w = 1 for positions), `stride` bytes apart, `count` particles from byte `offset` of each buffer.
-/// `positions` is the CURRENT positions buffer: query it again after every record_steps().
-struct InstanceBuffers {
-  VkBuffer positions = VK_NULL_HANDLE;
-  VkBuffer normals = VK_NULL_HANDLE;
-  VkBuffer uvs = VK_NULL_HANDLE;
-  VkDeviceSize offset = 0;
-  VkDeviceSize stride = GpuSolver::stride;
-  std::uint32_t count = 0;
-  std::uint32_t nx = 0, ny = 0; ///< grid size (0 for chains): grid_triangle_indices(nx, ny)
-};
-
 class ClothWorld {
 public:
   /// An empty world on `context` (borrowed: the world keeps its internals alive).
@@ -92,7 +81,7 @@ public:
   /// Records one step of every instance into the host's command buffer (see GpuSolver::record_steps
   /// for the state the buffers are left in: compute writes not yet visible to later stages).
   void record_step(VkCommandBuffer cmd);
-  /// Records `steps` steps of every instance (instance by instance, in id order).
+  /// Records `steps` steps of every instance (batch by batch; one dispatch per pass and batch).
   void record_steps(VkCommandBuffer cmd, std::uint32_t steps);
   /// One barrier making every instance's last writes visible to `dst_stage` / `dst_access`.
   void record_barrier_to(VkCommandBuffer cmd, VkPipelineStageFlags dst_stage, VkAccessFlags dst_access) const;
@@ -108,11 +97,16 @@ public:
   Result<std::vector<glm::vec3>> positions(InstanceId id);
   Result<std::vector<glm::vec3>> velocities(InstanceId id);
   Result<std::vector<glm::vec3>> normals(InstanceId id);
-  /// Buffers for drawing (valid until the instance is removed).
+  /// Buffers for drawing (render::ClothRenderer::record_draw, or the host's own pipeline): valid
+  /// until the next add(), remove() or set_params(); `positions` alternates with every step, so
+  /// query them after the last record_steps().
   Result<InstanceBuffers> buffers(InstanceId id) const;
-  /// The instance's solver, e.g. for render::ClothRenderer (null for an unknown id).
-  GpuSolver* solver(InstanceId id);
-  const GpuSolver* solver(InstanceId id) const;
+  /// Completed steps of the instance since its add() (the bad one when it diverged; 0 for an
+  /// unknown id). Recorded steps count as completed, as GpuSolver::step_index().
+  std::uint64_t step_index(InstanceId id) const;
+  /// Batches (one dispatch per pass each) and the dispatches record_steps() recorded so far.
+  std::size_t batch_count() const;
+  std::uint64_t dispatches_recorded() const;
   /// The instance's shared topology (null for an unknown id).
   std::shared_ptr<const ParticleSystem> topology(InstanceId id) const;
 

@@ -63,6 +63,10 @@ public:
   /// must support graphics (ContextOptions::require_graphics): ErrorCode::unsupported otherwise.
   static Result<ClothRenderer> create(gpu::Context& context, const gpu::GpuSolver& solver,
                                       const ParticleSystem& system, RendererOptions options);
+  /// The same for a ClothWorld instance: `params` gives the colliders to draw (world.params(id)),
+  /// `system` its topology (world.topology(id)).
+  static Result<ClothRenderer> create(gpu::Context& context, const SimParams& params, const ParticleSystem& system,
+                                      RendererOptions options);
 
   ClothRenderer(ClothRenderer&&) noexcept;
   ClothRenderer& operator=(ClothRenderer&&) noexcept;
@@ -75,6 +79,10 @@ public:
   /// with viewport and scissor set to `extent`. The solver's barrier (see the header comment)
   /// must already be recorded.
   void record_draw(VkCommandBuffer cmd, const gpu::GpuSolver& solver, const Camera& camera,
+                   VkExtent2D extent) const;
+  /// The same from an instance's buffers (ClothWorld::buffers(id), or GpuSolver::buffers()):
+  /// query them after the last record_steps() (the current positions buffer alternates).
+  void record_draw(VkCommandBuffer cmd, const gpu::InstanceBuffers& buffers, const Camera& camera,
                    VkExtent2D extent) const;
 
   const Palette& palette() const;

@@ -1,0 +1,119 @@
+// GpuSolver::Impl: the Vulkan solver's engine, a BATCH of instances (cloths) that share one
+// topology and one integrator family, stepped together: one dispatch per pass serves every
+// instance (instance = gl_WorkGroupID.z, vkcloth_shared.h). A GpuSolver is a batch of one;
+// ClothWorld groups its instances into batches (world.cpp). Internal to engine/src/vulkan.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+#include "implicit_gpu.hpp"
+#include "vk_internal.hpp"
+#include "vkcloth/gpu/gpu_solver.hpp"
+#include "vkcloth_shared.h"
+
+namespace vkcloth::gpu {
+
+/// Optional initial state of one instance (empty vectors: the topology's).
+struct SlotState {
+  const std::vector<glm::dvec3>* positions = nullptr;
+  const std::vector<glm::dvec3>* velocities = nullptr;
+};
+
+struct GpuSolver::Impl {
+  /// Host-side state of one instance of the batch.
+  struct Slot {
+    SimParams params;
+    std::uint64_t step = 0;       // completed steps (the bad one when diverged)
+    std::uint64_t epoch_step = 0; // `step` when this batch's flag epoch began (its creation)
+    std::optional<Error> diverged;
+  };
+
+  std::shared_ptr<Context::Impl> ctx;
+  GpuSolverOptions options;
+  std::vector<Slot> slots; // one per instance; slot k's particles are at k * count in the buffers
+  std::uint32_t count = 0; // particles per instance
+  std::uint32_t nx = 0, ny = 0;
+  bool staging = false;
+
+  // Per-particle vec4 buffers (slots() x count entries), then the shared topology, then the small
+  // host-visible ones (per instance).
+  Buffer pos[2], vel, force, force_stage, vel_filt, normal, uv, stage_pos, stage_vel, acc_pos, acc_vel;
+  Buffer particle, offsets, edges;
+  Buffer colliders, flags, instances; // host-visible (written / read by the host)
+  std::uint32_t collider_capacity = 0;
+
+  VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
+  VkDescriptorPool pool = VK_NULL_HANDLE;
+  VkDescriptorSet sets[2][2] = {}; // [positions read index][0: state input, 1: RK4 stage input]
+  VkPipelineLayout layout = VK_NULL_HANDLE;
+  VkPipeline force_pipeline = VK_NULL_HANDLE, integrate_pipeline = VK_NULL_HANDLE, fused_pipeline = VK_NULL_HANDLE;
+  VkCommandPool cmd_pool = VK_NULL_HANDLE;
+  VkCommandBuffer cmd = VK_NULL_HANDLE;
+  VkFence fence = VK_NULL_HANDLE;
+  VkQueryPool queries = VK_NULL_HANDLE;
+  std::uint32_t groups_x = 1, groups_y = 1;
+  // Grid stencil (force_body.glsl's specialisation constants 0..38): constant_id order.
+  struct Stencil {
+    std::uint32_t enabled = 0; // VkBool32
+    std::uint32_t nx = 1, ny = 1;
+    std::int32_t offset[12] = {};
+    float rest[12] = {}, stiffness[12] = {};
+  } stencil;
+  std::uint64_t edges_count = 0;
+
+  shared::PushConstants pc{}; // per dispatch (count, grid, stage, step)
+  std::uint64_t recorded = 0; // recorded steps since the flag epoch: flag step numbers
+  std::uint32_t parity = 0;   // positions[parity] is current; flipped by every recorded substep
+  std::unique_ptr<ImplicitGpu> implicit; // created when the integrator is implicit_euler (batch of one)
+  std::vector<glm::vec2> uvs;
+  double last_ms = -1.0;
+  std::uint64_t dispatches = 0; // recorded so far (ClothWorld::dispatches_recorded)
+
+  /// A batch of `params.size()` instances of `topology` (all of one integrator family and one
+  /// substep count: Euler (explicit and semi-implicit mix), RK4, or implicit Euler (one
+  /// instance)); `states[k]` is instance k's initial state (missing entries: the topology's).
+  static Result<std::unique_ptr<Impl>> create(const std::shared_ptr<Context::Impl>& ctx, const ParticleSystem& topology,
+                                              std::vector<SimParams> params, const GpuSolverOptions& options,
+                                              const std::vector<SlotState>& states = {});
+
+  Impl() = default;
+  Impl(const Impl&) = delete;
+  Impl& operator=(const Impl&) = delete;
+  ~Impl();
+
+  std::uint32_t batch() const { return static_cast<std::uint32_t>(slots.size()); }
+  const SimParams& family() const { return slots.front().params; } // integrator family, substeps
+  const DeviceFns& vk() const { return ctx->vk; }
+  std::uint32_t current() const { return parity; }
+  VkDeviceSize slot_offset(std::uint32_t slot) const { return VkDeviceSize(slot) * count * GpuSolver::stride; }
+  VkDeviceSize slot_bytes() const { return VkDeviceSize(count) * GpuSolver::stride; }
+
+  /// New parameters for one instance (validated by the caller; same family and substeps).
+  Result<void> set_slot_params(std::uint32_t slot, SimParams params);
+  Result<void> ensure_implicit();
+  void record(VkCommandBuffer cmd, std::uint32_t steps);
+  void record_substep(VkCommandBuffer cmd, bool first);
+  /// Copies instance `from_slot` of `from` (current positions, velocities, normals, forces) into
+  /// instance `to_slot` of this batch (both position buffers); the caller records the barriers.
+  void record_copy_slot(VkCommandBuffer cmd, const Impl& from, std::uint32_t from_slot, std::uint32_t to_slot) const;
+  /// Reads the flags of every instance; marks the newly diverged ones (their step, the error).
+  void refresh_flags();
+  /// The flags of an instance that diverged before this batch existed: frozen from step 1 on.
+  void freeze_slot(std::uint32_t slot);
+
+  Result<void> init_pipelines();
+  void detect_stencil(const ParticleSystem& system);
+  Result<void> write_sets();
+  Result<void> upload_colliders();
+  void upload_instance_params();
+  template <typename F> Result<void> submit_and_wait(F&& record);
+  Result<std::vector<glm::vec3>> read_vec3(const Buffer& b, std::uint32_t slot);
+};
+
+} // namespace vkcloth::gpu
