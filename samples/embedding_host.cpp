@@ -1,8 +1,9 @@
 // A minimal "host engine" that embeds vkcloth (docs/embedding.md): it creates ITS OWN Vulkan
 // instance and device (its own volk, not vkcloth::gpu::Context::create), owns its render pass,
-// images, command buffer and queue submission, and adds two cloths through the public API only:
-// a ClothWorld on the adopted device, stepped by record_steps() inside the host's command buffer,
-// then drawn by one render::ClothRenderer per cloth in the host's render pass. Offscreen: writes
+// images, command buffer and queue submission, and adds cloths through the public API only:
+// a ClothWorld on the adopted device (two topologies; the hanging one twice, so those two share
+// one batch and one dispatch per step), stepped by record_steps() inside the host's command
+// buffer, then drawn by one render::ClothRenderer per cloth in the host's render pass. Offscreen: writes
 // a PNG (runs on lavapipe without a display). Exit 0 on success, 1 on failure (or a validation
 // message with --validate), 4 without a Vulkan device.
 //
@@ -207,7 +208,7 @@ int main(int argc, char** argv) {
 
   int status = 0;
   {
-    // ---- vkcloth: adopt the host's device; a world with two cloths; one renderer per cloth. ----
+    // ---- vkcloth: adopt the host's device; a world with three cloths; one renderer per cloth. ----
     using namespace vkcloth;
     gpu::HostHandles h;
     h.instance = instance;
@@ -230,8 +231,11 @@ int main(int argc, char** argv) {
     ClothDesc hanging;
     hanging.nx = 18;
     hanging.ny = 14;
-    hanging.origin = {0.25, 0.2, 0.1};
+    hanging.origin = {0.25, 0.2, 0.4};
     hanging.size = {0.7, 0.55};
+    hanging.stiffness.structural = 300.0; // the default 40 N/m would stretch 252 particles of 0.05 kg into a rope
+    hanging.stiffness.shear = 30.0;
+    hanging.stiffness.bend = 30.0;
     auto falling_sys = make_cloth(falling);
     auto hanging_sys = make_cloth(hanging);
     if (!falling_sys || !hanging_sys) return std::fprintf(stderr, "make_cloth failed\n"), 1;
@@ -242,11 +246,18 @@ int main(int argc, char** argv) {
     on_sphere.colliders = {Collider::plane({0, 0, 1}, 0.0), Collider::sphere({-0.45, 0.0, 0.18}, 0.18)};
     SimParams windy;
     windy.dt = 0.01;
+    windy.substeps = 4; // the stiffer springs need dt / 4 (instances of one batch share the substep count)
     windy.wind.strength = 0.04;
     windy.wind.direction = {0.0, 1.0, 0.2};
     auto a = world->add(falling_topo, on_sphere);
     auto b = world->add(hanging_topo, windy);
-    if (!a || !b) return std::fprintf(stderr, "ClothWorld::add failed\n"), 1;
+    // A second cloth of the same topology, behind the first, with its own start and wind.
+    gpu::InitialState behind;
+    for (const Particle& q : hanging_topo->particles) behind.positions.push_back(q.position + glm::dvec3(-0.15, 0.55, 0.2));
+    SimParams gusty = windy;
+    gusty.wind.strength = 0.12;
+    auto c = world->add(hanging_topo, gusty, behind);
+    if (!a || !b || !c) return std::fprintf(stderr, "ClothWorld::add failed\n"), 1;
 
     render::RendererOptions ro;
     ro.render_pass = render_pass;
@@ -254,7 +265,9 @@ int main(int argc, char** argv) {
     auto ra = render::ClothRenderer::create(*context, on_sphere, *falling_topo, ro);
     ro.floor_half_size = 0.0f;
     auto rb = render::ClothRenderer::create(*context, windy, *hanging_topo, ro);
-    if (!ra || !rb) return std::fprintf(stderr, "ClothRenderer::create: %s\n", (!ra ? ra : rb).error().message.c_str()), 1;
+    auto rc = render::ClothRenderer::create(*context, gusty, *hanging_topo, ro);
+    if (!ra || !rb || !rc)
+      return std::fprintf(stderr, "ClothRenderer::create: %s\n", (!ra ? ra : !rb ? rb : rc).error().message.c_str()), 1;
     render::Camera camera;
     camera.eye = {0.4f, -2.6f, 1.5f};
     camera.target = {0.0f, 0.1f, 0.25f};
@@ -274,6 +287,7 @@ int main(int argc, char** argv) {
       // Each instance's buffers (and offset in them): the current positions alternate every step.
       ra->record_draw(cmd, *world->buffers(*a), camera, {width, height});
       rb->record_draw(cmd, *world->buffers(*b), camera, {width, height});
+      rc->record_draw(cmd, *world->buffers(*c), camera, {width, height}); // same buffers as b, another offset
       vkCmdEndRenderPass(cmd);
       if (frame + 1 == frames) {
         VkBufferImageCopy region{};

@@ -1,6 +1,7 @@
 # `vkcloth bench --json` smoke test: runs at tiny sizes and checks that the JSON parses and carries
 # the documented keys (docs/performance.md). No timing is asserted.
-execute_process(COMMAND "${VKCLOTH}" bench --backend all --sizes 16,32 --steps 20 --warmup 2 --reps 1 --json "${OUT}"
+execute_process(COMMAND "${VKCLOTH}" bench --backend all --sizes 16,32 --steps 20 --warmup 2 --reps 1 --instances 3
+                        --json "${OUT}"
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "vkcloth bench exited ${rc}: ${err}")
@@ -25,7 +26,7 @@ endif()
 math(EXPR last "${n} - 1")
 set(vulkan_rows 0)
 foreach(i RANGE ${last})
-  foreach(key backend variant size particles springs threads steps reps wall_ms gpu_ms ms_per_step gpu_ms_per_step
+  foreach(key backend variant size instances particles springs threads steps reps wall_ms gpu_ms ms_per_step gpu_ms_per_step
               particle_steps_per_s bytes_per_particle_step flops_per_particle_step achieved_gbps memory_fraction
               achieved_gflops compute_fraction)
     string(JSON type ERROR_VARIABLE e TYPE "${doc}" results ${i} ${key})
@@ -37,8 +38,19 @@ foreach(i RANGE ${last})
   if(backend STREQUAL "vulkan")
     math(EXPR vulkan_rows "${vulkan_rows} + 1")
   endif()
+  string(JSON variant GET "${doc}" results ${i} variant)
+  string(JSON size GET "${doc}" results ${i} size)
+  string(JSON instances GET "${doc}" results ${i} instances)
+  string(JSON particles GET "${doc}" results ${i} particles)
+  math(EXPR expected "${size} * ${size} * ${instances}")
+  if(NOT particles EQUAL expected)
+    message(FATAL_ERROR "bench JSON: results[${i}] (${variant}) has ${particles} particles, expected ${expected}")
+  endif()
+  if(variant MATCHES "batched" AND NOT instances EQUAL 3)
+    message(FATAL_ERROR "bench JSON: results[${i}] (${variant}) has ${instances} instances, expected 3 (--instances)")
+  endif()
 endforeach()
-# On CI a Vulkan device is required (lavapipe): the fused and two-pass rows must be there.
-if("$ENV{CI}" STREQUAL "true" AND vulkan_rows LESS 4)
+# On CI a Vulkan device is required (lavapipe): fused, two-pass, batched and unbatched rows per size.
+if("$ENV{CI}" STREQUAL "true" AND vulkan_rows LESS 8)
   message(FATAL_ERROR "bench JSON: CI=true but only ${vulkan_rows} Vulkan rows")
 endif()

@@ -17,6 +17,7 @@
 #include "vkcloth/builders.hpp"
 #include "vkcloth/cpu_solver.hpp"
 #include "vkcloth/gpu/gpu_solver.hpp"
+#include "vkcloth/gpu/world.hpp"
 
 namespace vkcloth::cli {
 namespace {
@@ -30,6 +31,7 @@ struct BenchOptions {
   std::string integrator = "semi_implicit_euler";
   unsigned threads = 0;
   std::uint32_t steps_per_submit = 100;
+  std::uint32_t instances = 1;
   std::optional<double> dt;
   double memory_gbps = 39.0;
   double compute_gflops = 192.0;
@@ -87,7 +89,7 @@ Cost cost_of(const std::string& variant, Integrator integrator, double s, bool g
     // float vec3 (12 B): read pos, vel; write pos_next, vel, force, normal; mass 4 + pinned 1.
     const double euler = 6 * 12.0 + 5.0 + csr;
     c.bytes = rk4 ? 4.0 * (4 * 12.0 + 5.0 + csr + 6 * 12.0) + 4 * 12.0 : euler;
-  } else if (variant == "fused") {
+  } else if (variant == "fused" || variant == "batched" || variant == "unbatched") {
     // vec4 (16 B): read pos, vel, particle 8; write pos, vel, force, normal.
     c.bytes = 16.0 * 2 + 8.0 + csr + 16.0 * 4;
   } else {
@@ -112,6 +114,7 @@ struct Row {
   double gpu_ms = -1;          // median GPU (timestamp) time of `steps` steps; -1 for the CPU
   std::string integrator;      // the scheme timed (implicit runs add a semi-implicit baseline row)
   std::uint32_t cg_iterations = 0; // implicit_euler: CG iterations of the last step
+  std::uint32_t instances = 1;     // cloths stepped together (ClothWorld rows)
   Cost cost;
 };
 
@@ -173,6 +176,33 @@ Result<Row> bench_vulkan(gpu::Context& ctx, const BenchScene& sc, std::uint32_t 
   return row;
 }
 
+/// `instances` cloths of the scene in one ClothWorld, one submission per `steps_per_submit` steps:
+/// batched (one shared topology: one dispatch per pass for all) or not (a topology copy each:
+/// every cloth its own dispatches, as separate solvers recorded into one command buffer).
+Result<Row> bench_world(gpu::Context& ctx, const BenchScene& sc, std::uint32_t n, bool batched, const BenchOptions& o) {
+  gpu::WorldOptions wo;
+  auto w = gpu::ClothWorld::create(ctx, wo);
+  if (!w) return w.error();
+  const auto shared = std::make_shared<const ParticleSystem>(sc.system);
+  for (std::uint32_t k = 0; k < o.instances; ++k)
+    VKCLOTH_TRY(w->add(batched ? shared : std::make_shared<const ParticleSystem>(sc.system), sc.params));
+  VKCLOTH_TRY(w->simulate(o.warmup, o.steps_per_submit));
+  std::vector<double> wall;
+  for (unsigned r = 0; r < o.reps; ++r) {
+    const auto t0 = Clock::now();
+    VKCLOTH_TRY(w->simulate(o.steps, o.steps_per_submit));
+    wall.push_back(ms_since(t0));
+  }
+  Row row;
+  row.backend = "vulkan";
+  row.variant = batched ? "batched" : "unbatched";
+  row.integrator = to_string(sc.params.integrator);
+  row.size = n;
+  row.instances = o.instances;
+  row.wall_ms = median(wall);
+  return row;
+}
+
 Result<std::vector<std::uint32_t>> parse_sizes(const std::string& text) {
   std::vector<std::uint32_t> out;
   std::stringstream ss(text);
@@ -207,6 +237,9 @@ int bench_command(const BenchOptions& o) {
   if (!sizes) return report(sizes.error());
   if (o.steps == 0 || o.reps == 0 || o.steps_per_submit == 0)
     return report(make_error(ErrorCode::invalid_argument, "--steps, --reps and --steps-per-submit must be > 0"));
+  if (o.instances == 0 || o.instances > 4096)
+    return report(make_error(ErrorCode::invalid_argument,
+                             fmt::format("--instances must be in 1..4096, got {}", o.instances)));
   if (!(o.memory_gbps > 0) || !(o.compute_gflops > 0))
     return report(make_error(ErrorCode::invalid_argument, "--memory-gbps and --compute-gflops must be > 0"));
   const double dt = o.dt.value_or(5e-4);
@@ -231,7 +264,7 @@ int bench_command(const BenchOptions& o) {
         return exit_ok;
       }
       if (!r) return report(r.error());
-      r->particles = sc->system.size();
+      r->particles = sc->system.size() * r->instances;
       r->springs = sc->system.springs.size();
       r->steps = o.steps;
       r->reps = o.reps;
@@ -246,6 +279,10 @@ int bench_command(const BenchOptions& o) {
       if (int e = add(bench_vulkan(*ctx, *sc, n, true, o))) return e;
       if (*integrator != Integrator::rk4 && !implicit)
         if (int e = add(bench_vulkan(*ctx, *sc, n, false, o))) return e;
+      if (o.instances > 1) { // many cloths: one batch vs one dispatch chain per cloth, same submission
+        if (int e = add(bench_world(*ctx, *sc, n, true, o))) return e;
+        if (int e = add(bench_world(*ctx, *sc, n, false, o))) return e;
+      }
     }
     if (implicit) { // the explicit baseline at the same size and dt, for the cost ratio
       auto base = bench_scene(n, Integrator::semi_implicit_euler, dt);
@@ -265,6 +302,9 @@ int bench_command(const BenchOptions& o) {
              o.compute_gflops);
   if (ctx) fmt::print("vulkan device: {}\n", ctx->device_name());
   if (!vulkan_note.empty()) fmt::print("vulkan: skipped ({})\n", vulkan_note);
+  if (o.instances > 1)
+    fmt::print("batched / unbatched rows: {} cloths of n x n in one ClothWorld (particles = all of them)\n",
+               o.instances);
   fmt::print("{:<7} {:<9} {:>5} {:>8} {:>3} {:>9} {:>9} {:>9} {:>6} {:>7} {:>5} {:>6} {:>8} {:>5}\n", "backend", "variant",
              "n", "particles", "thr", "ms/step", "gpu ms", "M p-st/s", "B/p-st", "GB/s", "%mem", "fl/pst", "GFLOP/s",
              "%cmp");
@@ -291,6 +331,7 @@ int bench_command(const BenchOptions& o) {
           j["implicit_over_explicit"] = r.wall_ms / e.wall_ms;
     }
     j["size"] = r.size;
+    j["instances"] = r.instances;
     j["particles"] = r.particles;
     j["springs"] = r.springs;
     j["threads"] = r.backend == "cpu" ? nlohmann::json(r.threads) : nlohmann::json(nullptr);
@@ -356,6 +397,10 @@ void add_bench_command(CLI::App& app, int* exit) {
   cmd->add_option("--integrator", opt->integrator, "explicit_euler | semi_implicit_euler | rk4 | implicit_euler (adds a semi-implicit baseline row and the cost ratio)")->capture_default_str();
   cmd->add_option("--threads", opt->threads, "CPU solver threads (0: the host's hardware threads)")->capture_default_str();
   cmd->add_option("--steps-per-submit", opt->steps_per_submit, "Vulkan: steps recorded per command buffer")
+      ->capture_default_str();
+  cmd->add_option("--instances", opt->instances,
+                  "Vulkan: also time this many cloths in one ClothWorld, batched (one dispatch per pass) and "
+                  "unbatched (one per cloth)")
       ->capture_default_str();
   cmd->add_option("--dt", opt->dt, "Time step in seconds (default 5e-4, stable at every size)");
   cmd->add_option("--memory-gbps", opt->memory_gbps, "Memory bandwidth ceiling in GB/s")->capture_default_str();
