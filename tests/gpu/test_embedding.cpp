@@ -341,6 +341,8 @@ TEST_CASE("ClothWorld batches: one dispatch per pass for every instance of a top
   REQUIRE(b3.ok());
   CHECK(b0->positions == b3->positions);
   CHECK(b3->offset == 3 * VkDeviceSize(topo->size()) * GpuSolver::stride);
+  CHECK(b3->indices != VK_NULL_HANDLE);
+  CHECK(b3->index_count == grid_triangle_indices(12, 9).size());
 
   // Remove one from the middle, add one: the batch is rebuilt, the others go on bit for bit.
   REQUIRE(world->remove(ids[2]).ok());

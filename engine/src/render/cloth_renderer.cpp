@@ -12,6 +12,7 @@
 #include <glm/vec4.hpp>
 
 #include "vkcloth/render/cloth_renderer.hpp"
+#include "vkcloth/gpu/world.hpp"
 #include "vkcloth/shaders/render/cloth_frag_spv.hpp"
 #include "vkcloth/shaders/render/cloth_vert_spv.hpp"
 #include "vkcloth/shaders/render/line_frag_spv.hpp"
@@ -137,12 +138,7 @@ Result<void> ClothRenderer::Impl::build_geometry(const ParticleSystem& system, c
   // The cloth: two triangles per grid quad, (i, j) = j * nx + i; or a chain's springs as lines.
   std::vector<std::uint32_t> idx;
   if (system.grid) {
-    const std::uint32_t nx = system.grid->nx, ny = system.grid->ny;
-    for (std::uint32_t j = 0; j + 1 < ny; ++j)
-      for (std::uint32_t i = 0; i + 1 < nx; ++i) {
-        const std::uint32_t a = j * nx + i, b = a + 1, c = a + nx, d = c + 1;
-        idx.insert(idx.end(), {a, b, d, a, d, c});
-      }
+    idx = gpu::grid_triangle_indices(system.grid->nx, system.grid->ny);
   } else {
     for (const Spring& s : system.springs)
       idx.insert(idx.end(), {s.a, s.b});
@@ -562,7 +558,10 @@ void ClothRenderer::record_draw(VkCommandBuffer cmd, const gpu::InstanceBuffers&
     const VkBuffer bufs[3] = {positions, buffers.normals, buffers.uvs};
     const VkDeviceSize offs[3] = {at, at, at};
     v.vkCmdBindVertexBuffers(cmd, 0, 3, bufs, offs);
-    v.vkCmdBindIndexBuffer(cmd, s.cloth_index.buffer, 0, VK_INDEX_TYPE_UINT32);
+    // The solver's own copy of the same triangle list when it has one (it does; hosts that fill
+    // InstanceBuffers themselves may leave it out).
+    const bool solver_indices = buffers.indices && buffers.index_count == s.cloth_index_count;
+    v.vkCmdBindIndexBuffer(cmd, solver_indices ? buffers.indices : s.cloth_index.buffer, 0, VK_INDEX_TYPE_UINT32);
     pc.color = glm::vec4(s.palette.back_tint, 1.0f);
     pc.params = glm::vec4(0.0f, 1.0f, 1.0f, 0.0f);
     v.vkCmdPushConstants(cmd, s.layout, stages, 0, sizeof(pc), &pc);

@@ -13,6 +13,7 @@
 #include "implicit_gpu.hpp"
 #include "solver_batch.hpp"
 #include "vkcloth/gpu/gpu_solver.hpp"
+#include "vkcloth/gpu/world.hpp"
 #include "vkcloth/shaders/force_comp_spv.hpp"
 #include "vkcloth/shaders/integrate_comp_spv.hpp"
 #include "vkcloth/shaders/fused_comp_spv.hpp"
@@ -39,7 +40,7 @@ GpuSolver::Impl::~Impl() {
   if (pool) v.vkDestroyDescriptorPool(d, pool, v.allocator);
   if (set_layout) v.vkDestroyDescriptorSetLayout(d, set_layout, v.allocator);
   for (Buffer* b : {&pos[0], &pos[1], &vel, &force, &force_stage, &vel_filt, &normal, &uv, &stage_pos, &stage_vel, &acc_pos,
-                    &acc_vel, &particle, &offsets, &edges, &colliders, &flags, &instances})
+                    &acc_vel, &particle, &offsets, &edges, &indices, &colliders, &flags, &instances})
     destroy_buffer(*ctx, *b);
 }
 
@@ -532,6 +533,17 @@ Result<std::unique_ptr<GpuSolver::Impl>> GpuSolver::Impl::create(const std::shar
     if (!r) return r.error();
     *b = *r;
   }
+  // The grid's triangle list for the host's drawing (instance-local indices; empty for chains).
+  const std::vector<std::uint32_t> triangles =
+      system.grid ? grid_triangle_indices(system.grid->nx, system.grid->ny) : std::vector<std::uint32_t>{};
+  s.index_count = static_cast<std::uint32_t>(triangles.size());
+  {
+    auto r = create_buffer(*ctx, std::max<VkDeviceSize>(triangles.size() * sizeof(std::uint32_t), 16),
+                           VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUse::device,
+                           allow_map, "triangle indices", families);
+    if (!r) return r.error();
+    s.indices = *r;
+  }
   s.staging = s.pos[0].mapped == nullptr;
   {
     auto r = create_buffer(*ctx, batch * sizeof(sh::Flags), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::host_readback,
@@ -620,6 +632,7 @@ Result<std::unique_ptr<GpuSolver::Impl>> GpuSolver::Impl::create(const std::shar
                             {&s.particle, info.data(), n * sizeof(sh::ParticleInfo)},
                             {&s.offsets, system.adjacency.offsets.data(), (n + 1) * sizeof(std::uint32_t)},
                             {&s.edges, edges.data(), edges_n * sizeof(sh::Edge)},
+                            {&s.indices, triangles.data(), triangles.size() * sizeof(std::uint32_t)},
                             {&s.force, nullptr, 0},
                             {&s.force_stage, nullptr, 0},
                             {&s.vel_filt, nullptr, 0},
@@ -756,6 +769,8 @@ InstanceBuffers GpuSolver::buffers() const {
   b.positions = current_position_buffer();
   b.normals = normal_buffer();
   b.uvs = uv_buffer();
+  b.indices = impl_->indices.buffer;
+  b.index_count = impl_->index_count;
   b.count = impl_->count;
   b.nx = impl_->nx;
   b.ny = impl_->ny;

@@ -44,7 +44,8 @@ struct GpuSolver::Impl {
   // Per-particle vec4 buffers (slots() x count entries), then the shared topology, then the small
   // host-visible ones (per instance).
   Buffer pos[2], vel, force, force_stage, vel_filt, normal, uv, stage_pos, stage_vel, acc_pos, acc_vel;
-  Buffer particle, offsets, edges;
+  Buffer particle, offsets, edges, indices; // indices: grid_triangle_indices (drawing)
+  std::uint32_t index_count = 0;
   Buffer colliders, flags, instances; // host-visible (written / read by the host)
   std::uint32_t collider_capacity = 0;
 

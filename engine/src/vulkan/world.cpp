@@ -336,6 +336,8 @@ Result<InstanceBuffers> ClothWorld::buffers(InstanceId id) const {
   out.positions = b.pos[b.current()].buffer;
   out.normals = b.normal.buffer;
   out.uvs = b.uv.buffer;
+  out.indices = b.indices.buffer;
+  out.index_count = b.index_count;
   out.offset = b.slot_offset((*inst)->slot);
   out.count = b.count;
   out.nx = b.nx;

@@ -73,6 +73,11 @@ struct InstanceBuffers {
   VkDeviceSize stride = 16; ///< GpuSolver::stride
   std::uint32_t count = 0;
   std::uint32_t nx = 0, ny = 0; ///< grid size (0 for chains): grid_triangle_indices(nx, ny)
+  /// grid_triangle_indices(nx, ny) on the device (VK_INDEX_TYPE_UINT32, index_count entries,
+  /// indices relative to the instance's first particle: bind the vertex buffers at `offset`).
+  /// Empty (index_count 0) for chains.
+  VkBuffer indices = VK_NULL_HANDLE;
+  std::uint32_t index_count = 0;
 };
 
 class GpuSolver {
