@@ -11,7 +11,9 @@
 //
 // Buffers (device-local storage buffers, vec4 per particle, w unused; positions have w = 1):
 // positions[2] (ping-pong), velocities, forces, normals (unit, rebuilt every force pass, zero for
-// chains), uvs (i/(nx-1), j/(ny-1) for grids, zero for chains), plus internal scratch.
+// chains), uvs (i/(nx-1), j/(ny-1) for grids, zero for chains), the grid's triangle indices,
+// plus internal scratch. A GpuSolver is a batch of one instance: gpu::ClothWorld steps many
+// cloths of one topology with the same shaders and one dispatch per pass (world.hpp).
 //
 // Thread safety: none; one thread drives a solver. Known limitations: the step counter of the
 // divergence flags is 32-bit (about 4e9 steps per solver); set_params() must not be called while
