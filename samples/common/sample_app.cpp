@@ -163,7 +163,7 @@ int run_window(const vkcloth::Scene& scene, const Options& o) {
     solver->record_barrier_to(f.cmd, VK_PIPELINE_STAGE_VERTEX_INPUT_BIT, VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT);
     w.begin_render_pass(f, renderer->palette().background);
     renderer->record_draw(f.cmd, *solver, cam, f.extent);
-    if (!w.submit(f)) return fail(make_error(ErrorCode::vulkan, "vkQueueSubmit failed"));
+    if (!w.end_render_pass_and_submit(f)) return fail(make_error(ErrorCode::vulkan, "vkQueueSubmit failed"));
     if (auto r = w.present(f); !r) return fail(r.error());
     ++frame;
   }

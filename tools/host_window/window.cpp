@@ -385,7 +385,7 @@ void Window::begin_render_pass(const Frame& f, const glm::vec3& background) {
   vkCmdBeginRenderPass(f.cmd, &rb, VK_SUBPASS_CONTENTS_INLINE);
 }
 
-Result<void> Window::submit(const Frame& f) {
+Result<void> Window::end_render_pass_and_submit(const Frame& f) {
   vkCmdEndRenderPass(f.cmd);
   if (VkResult e = vkEndCommandBuffer(f.cmd); e != VK_SUCCESS)
     return vk_fail(e, "vkEndCommandBuffer");
@@ -407,7 +407,7 @@ Result<void> Window::submit(const Frame& f) {
 }
 
 Result<void> Window::present(const Frame& f) {
-  // Presentation waits for the image's render-done semaphore, signalled by submit().
+  // Presentation waits for the image's render-done semaphore, signalled by end_render_pass_and_submit().
   VkPresentInfoKHR pi{};
   pi.sType = VK_STRUCTURE_TYPE_PRESENT_INFO_KHR;
   pi.waitSemaphoreCount = 1;

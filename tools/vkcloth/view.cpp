@@ -138,7 +138,7 @@ Result<void> Viewer::draw_frame() {
   solver_->record_barrier_to(f.cmd, VK_PIPELINE_STAGE_VERTEX_INPUT_BIT, VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT);
   window_.begin_render_pass(f, renderer_->palette().background);
   renderer_->record_draw(f.cmd, *solver_, orbit_.camera(), f.extent);
-  VKCLOTH_TRY(window_.submit(f));
+  VKCLOTH_TRY(window_.end_render_pass_and_submit(f));
   return window_.present(f);
 }
 

@@ -26,7 +26,7 @@
 namespace vkcloth::host {
 
 /// The frame being recorded: the host records its compute work into `cmd`, then draws between
-/// Window::begin_render_pass and Window::submit.
+/// Window::begin_render_pass and Window::end_render_pass_and_submit.
 struct Frame {
   VkCommandBuffer cmd = VK_NULL_HANDLE;
   std::uint32_t image = 0; ///< the acquired swapchain image
@@ -35,7 +35,8 @@ struct Frame {
 
 /// Set up in this order: open, add_presentation, create_context, create_render_pass (then the
 /// host creates its pipelines for render_pass()), create_frame_resources. Each frame:
-/// wait_last_frame, ensure_swapchain, begin_frame, begin_render_pass, submit, present.
+/// wait_last_frame, ensure_swapchain, begin_frame, begin_render_pass, end_render_pass_and_submit,
+/// present.
 class Window {
 public:
   /// Why open() failed; each host words its own message (its messages are its contract).
@@ -87,7 +88,7 @@ public:
   void begin_render_pass(const Frame& f, const glm::vec3& background);
   /// Ends the render pass and the command buffer and submits it: it waits for the image's
   /// acquisition and signals the image's render-done semaphore and the frame fence.
-  Result<void> submit(const Frame& f);
+  Result<void> end_render_pass_and_submit(const Frame& f);
   /// Presents the frame's image once rendered; out of date or suboptimal: recreated next frame.
   Result<void> present(const Frame& f);
 
