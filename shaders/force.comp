@@ -5,6 +5,7 @@
 // Reads POS_IN (all particles) and VEL_IN (own); writes FORCE_OUT, VEL_FILT, NORMAL (own).
 #include "vkcloth_shared.h"
 #include "common.glsl"
+#define VKCLOTH_POS_TEXEL
 #include "force_body.glsl"
 
 layout(std430, set = 0, binding = VKCLOTH_BINDING_VEL_IN) readonly buffer VelIn { vec4 vel_in[]; };

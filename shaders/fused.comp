@@ -10,6 +10,7 @@
 // Reads POS_IN (all), VEL (own); writes POS_OUT, VEL, FORCE_OUT, NORMAL (own).
 #include "vkcloth_shared.h"
 #include "common.glsl"
+#define VKCLOTH_POS_TEXEL
 #include "force_body.glsl"
 
 layout(std430, set = 0, binding = VKCLOTH_BINDING_FORCE_OUT) writeonly buffer ForceOut { vec4 force_out[]; };
@@ -34,7 +35,7 @@ void main() {
 
   const bool pinned = particle[p].pinned != 0u;
   const float m = particle[p].mass;
-  precise vec3 x = pos_in[p].xyz;
+  precise vec3 x = pos_at(p);
   precise vec3 v = vf;
   if (!pinned) {
     precise vec3 a = f / m;

@@ -6,6 +6,17 @@
 #define VKCLOTH_FORCE_BODY_GLSL
 
 layout(std430, set = 0, binding = VKCLOTH_BINDING_POS_IN) readonly buffer PosIn { vec4 pos_in[]; };
+
+// pos_at(q) = pos_in[q].xyz. With VKCLOTH_POS_TEXEL (force.comp, fused.comp) it reads the same
+// buffer through an RGBA32F uniform texel buffer view (set 1): llvmpipe (Mesa 22.x) turns an SSBO
+// load into a per-lane loop with a bounds check and a branch per component, a texel fetch into one
+// vectorised gather of the 8 lanes' texels. A float texel fetch is a copy: same bits.
+#ifdef VKCLOTH_POS_TEXEL
+layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_POS_IN) uniform samplerBuffer pos_in_texel;
+vec3 pos_at(uint q) { return texelFetch(pos_in_texel, int(q)).xyz; }
+#else
+vec3 pos_at(uint q) { return pos_in[q].xyz; }
+#endif
 layout(std430, set = 0, binding = VKCLOTH_BINDING_OFFSETS) readonly buffer OffsetBuf { uint offsets[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_EDGES) readonly buffer EdgeBuf { Edge edges[]; };
 
@@ -55,7 +66,7 @@ layout(constant_id = 38) const float SC_K11 = 0.0;
 
 // One spring term of report eq. 2, exactly as the CSR loop below.
 void spring_term(inout precise vec3 f, vec3 x, uint q, float rest, float k) {
-  precise vec3 u = pos_in[q].xyz - x;
+  precise vec3 u = pos_at(q) - x;
   precise float len = sqrt(dot3(u, u));
   if (len > 0.0) f = f + u * (k * (len - rest) / len);
 }
@@ -66,13 +77,13 @@ void spring_term(inout precise vec3 f, vec3 x, uint q, float rest, float k) {
 vec3 grid_normal(uint p) {
   const uint nx = SC_STENCIL ? SC_NX : pc.nx; // a constant divisor when specialised
   const uint i = p % nx, j = p / nx;
-  const vec3 x = pos_in[p].xyz;
+  const vec3 x = pos_at(p);
   const bool h0 = i + 1u < nx, h1 = j + 1u < (SC_STENCIL ? SC_NY : pc.ny), h2 = i > 0u, h3 = j > 0u;
   precise vec3 e0 = vec3(0.0), e1 = vec3(0.0), e2 = vec3(0.0), e3 = vec3(0.0);
-  if (h0) e0 = pos_in[p + 1u].xyz - x;
-  if (h1) e1 = pos_in[p + nx].xyz - x;
-  if (h2) e2 = pos_in[p - 1u].xyz - x;
-  if (h3) e3 = pos_in[p - nx].xyz - x;
+  if (h0) e0 = pos_at(p + 1u) - x;
+  if (h1) e1 = pos_at(p + nx) - x;
+  if (h2) e2 = pos_at(p - 1u) - x;
+  if (h3) e3 = pos_at(p - nx) - x;
   precise vec3 sum = vec3(0.0);
   if (h0 && h1) sum = sum + cross3(e0, e1);
   if (h1 && h2) sum = sum + cross3(e1, e2);
@@ -89,7 +100,7 @@ void particle_force(uint p, inout vec3 v_io, out vec3 f_out, out vec3 nrm_out) {
   precise vec3 nrm = vec3(0.0);
   if ((pc.flags & VKCLOTH_FLAG_HAS_GRID) != 0u) nrm = grid_normal(p);
 
-  const vec3 x = pos_in[p].xyz;
+  const vec3 x = pos_at(p);
   precise vec3 f = vec3(0.0);
   bool interior = false;
   if (SC_STENCIL) {

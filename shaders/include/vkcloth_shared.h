@@ -39,6 +39,9 @@ struct vec4 {
 #define VKCLOTH_BINDING_FLAGS 16     // Flags (divergence detection)
 #define VKCLOTH_BINDING_COUNT 17
 
+// Set 1 (force.comp, fused.comp): POS_IN again, as an RGBA32F uniform texel buffer view.
+#define VKCLOTH_TEXEL_BINDING_POS_IN 0
+
 // PushConstants::flags bits.
 #define VKCLOTH_FLAG_HAS_GRID 1u // the system is a cloth grid: rebuild normals
 #define VKCLOTH_FLAG_WIND 2u     // wind strength != 0

@@ -38,6 +38,11 @@ struct GpuSolver::Impl {
   VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
   VkDescriptorPool pool = VK_NULL_HANDLE;
   VkDescriptorSet sets[2][2] = {}; // [positions read index][0: state input, 1: RK4 stage input]
+  // Set 1 of force.comp / fused.comp: POS_IN as an RGBA32F uniform texel buffer (force_body.glsl
+  // pos_at). [0], [1]: positions[0], positions[1]; [2]: RK4 stage positions.
+  VkDescriptorSetLayout texel_layout = VK_NULL_HANDLE;
+  VkBufferView pos_views[3] = {};
+  VkDescriptorSet texel_sets[3] = {};
   VkPipelineLayout layout = VK_NULL_HANDLE;
   VkPipeline force_pipeline = VK_NULL_HANDLE, integrate_pipeline = VK_NULL_HANDLE, fused_pipeline = VK_NULL_HANDLE;
   VkCommandPool cmd_pool = VK_NULL_HANDLE;
@@ -100,6 +105,9 @@ GpuSolver::Impl::~Impl() {
   if (layout) v.vkDestroyPipelineLayout(d, layout, v.allocator);
   if (pool) v.vkDestroyDescriptorPool(d, pool, v.allocator);
   if (set_layout) v.vkDestroyDescriptorSetLayout(d, set_layout, v.allocator);
+  if (texel_layout) v.vkDestroyDescriptorSetLayout(d, texel_layout, v.allocator);
+  for (VkBufferView view : pos_views)
+    if (view) v.vkDestroyBufferView(d, view, v.allocator);
   for (Buffer* b : {&pos[0], &pos[1], &vel, &force, &force_stage, &vel_filt, &normal, &uv, &stage_pos, &stage_vel, &acc_pos,
                     &acc_vel, &particle, &offsets, &edges, &colliders, &flags})
     destroy_buffer(*ctx, *b);
@@ -133,22 +141,29 @@ Result<void> GpuSolver::Impl::init_pipelines() {
   li.bindingCount = static_cast<std::uint32_t>(bindings.size());
   li.pBindings = bindings.data();
   VKCLOTH_VK_TRY(v.vkCreateDescriptorSetLayout(d, &li, v.allocator, &set_layout), "vkCreateDescriptorSetLayout");
+  const VkDescriptorSetLayoutBinding texel_binding{VKCLOTH_TEXEL_BINDING_POS_IN, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1,
+                                                   VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+  li.bindingCount = 1;
+  li.pBindings = &texel_binding;
+  VKCLOTH_VK_TRY(v.vkCreateDescriptorSetLayout(d, &li, v.allocator, &texel_layout), "vkCreateDescriptorSetLayout (texel)");
 
   const VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(sh::PushConstants)};
   VkPipelineLayoutCreateInfo pi{};
   pi.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
-  pi.setLayoutCount = 1;
-  pi.pSetLayouts = &set_layout;
+  const VkDescriptorSetLayout set_layouts[2] = {set_layout, texel_layout};
+  pi.setLayoutCount = 2;
+  pi.pSetLayouts = set_layouts;
   pi.pushConstantRangeCount = 1;
   pi.pPushConstantRanges = &range;
   VKCLOTH_VK_TRY(v.vkCreatePipelineLayout(d, &pi, v.allocator, &layout), "vkCreatePipelineLayout");
 
-  const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 4 * VKCLOTH_BINDING_COUNT};
+  const VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 4 * VKCLOTH_BINDING_COUNT},
+                                         {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 3}};
   VkDescriptorPoolCreateInfo dp{};
   dp.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
-  dp.maxSets = 4;
-  dp.poolSizeCount = 1;
-  dp.pPoolSizes = &size;
+  dp.maxSets = 4 + 3;
+  dp.poolSizeCount = 2;
+  dp.pPoolSizes = sizes;
   VKCLOTH_VK_TRY(v.vkCreateDescriptorPool(d, &dp, v.allocator, &pool), "vkCreateDescriptorPool");
   const VkDescriptorSetLayout layouts[4] = {set_layout, set_layout, set_layout, set_layout};
   VkDescriptorSetAllocateInfo ai{};
@@ -157,6 +172,29 @@ Result<void> GpuSolver::Impl::init_pipelines() {
   ai.descriptorSetCount = 4;
   ai.pSetLayouts = layouts;
   VKCLOTH_VK_TRY(v.vkAllocateDescriptorSets(d, &ai, &sets[0][0]), "vkAllocateDescriptorSets");
+  // The texel sets never change: positions[0/1] and the stage positions live as long as the solver.
+  const VkDescriptorSetLayout texel_layouts[3] = {texel_layout, texel_layout, texel_layout};
+  ai.descriptorSetCount = 3;
+  ai.pSetLayouts = texel_layouts;
+  VKCLOTH_VK_TRY(v.vkAllocateDescriptorSets(d, &ai, texel_sets), "vkAllocateDescriptorSets (texel)");
+  const Buffer* viewed[3] = {&pos[0], &pos[1], &stage_pos};
+  VkWriteDescriptorSet texel_writes[3]{};
+  for (int k = 0; k < 3; ++k) {
+    VkBufferViewCreateInfo vi{};
+    vi.sType = VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO;
+    vi.buffer = viewed[k]->buffer;
+    vi.format = VK_FORMAT_R32G32B32A32_SFLOAT; // uniform texel buffer support is mandatory for it
+    vi.offset = 0;
+    vi.range = VK_WHOLE_SIZE;
+    VKCLOTH_VK_TRY(v.vkCreateBufferView(d, &vi, v.allocator, &pos_views[k]), "vkCreateBufferView (positions)");
+    texel_writes[k].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+    texel_writes[k].dstSet = texel_sets[k];
+    texel_writes[k].dstBinding = VKCLOTH_TEXEL_BINDING_POS_IN;
+    texel_writes[k].descriptorCount = 1;
+    texel_writes[k].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+    texel_writes[k].pTexelBufferView = &pos_views[k];
+  }
+  v.vkUpdateDescriptorSets(d, 3, texel_writes, 0, nullptr);
 
   VkShaderModule modules[3] = {};
   auto destroy_modules = [&] {
@@ -427,8 +465,8 @@ void GpuSolver::Impl::record_substep(VkCommandBuffer c, bool first) {
     // One dispatch per (sub)step (fused.comp); the descriptor set alternates with the parity.
     v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, fused_pipeline);
     pc.stage = 0;
-    const VkDescriptorSet set = sets[read][0];
-    v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &set, 0, nullptr);
+    const VkDescriptorSet bound_sets[2] = {sets[read][0], texel_sets[read]};
+    v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 2, bound_sets, 0, nullptr);
     v.vkCmdPushConstants(c, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
     if (!first) barriers::dispatch_to_dispatch(v, c); // previous step -> this step
     v.vkCmdDispatch(c, groups_x, groups_y, 1);
@@ -443,7 +481,8 @@ void GpuSolver::Impl::record_substep(VkCommandBuffer c, bool first) {
     pc.c_next = c_next[k];
     const VkDescriptorSet set = sets[read][k == 0 ? 0 : 1];
     if (set != bound) {
-      v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &set, 0, nullptr);
+      const VkDescriptorSet bound_sets[2] = {set, texel_sets[k == 0 ? read : 2]};
+      v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 2, bound_sets, 0, nullptr);
       bound = set;
     }
     v.vkCmdPushConstants(c, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
@@ -516,7 +555,8 @@ Result<GpuSolver> GpuSolver::create(Context& context, const ParticleSystem& syst
   // Buffers. Bulk ones prefer device-local + host-visible (mapped) unless staging is forced.
   // VERTEX_BUFFER: a renderer binds positions, normals and uvs as vertex buffers (render/).
   const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
-                                   VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT;
+                                   VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT |
+                                   VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT; // positions: force_body.glsl pos_at
   const VkDeviceSize vec4_bytes = VkDeviceSize(n) * 16;
   const bool allow_map = !options.force_staging;
   std::vector<std::uint32_t> families;
