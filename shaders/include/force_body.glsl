@@ -63,6 +63,25 @@ layout(constant_id = 35) const float SC_K8 = 0.0;
 layout(constant_id = 36) const float SC_K9 = 0.0;
 layout(constant_id = 37) const float SC_K10 = 0.0;
 layout(constant_id = 38) const float SC_K11 = 0.0;
+// Border particles too: every particle's gather list is the stencil's entries whose neighbour lies
+// inside the grid, in stencil order (GpuSolver detect_stencil checks it). Then no particle takes
+// the CSR loop, which llvmpipe runs for every 8-lane group holding a border particle (and whose
+// per-lane loads it pays, masked, for every group).
+layout(constant_id = 39) const bool SC_BORDER = false;
+
+// Bit `bit` when stencil neighbour `off` of grid particle (i, j) lies inside the grid
+// (off = dj nx + di with |di|, |dj| <= 2; compile-time constants after specialisation).
+uint stencil_bit(uint i, uint j, int off, uint bit) {
+  const int dj = (off + 2 * int(SC_NX) + 2) / int(SC_NX) - 2;
+  const int di = off - dj * int(SC_NX);
+  return uint(int(i) + di) < SC_NX && uint(int(j) + dj) < SC_NY ? bit : 0u;
+}
+uint stencil_present(uint i, uint j) {
+  return stencil_bit(i, j, SC_OFF0, 1u) | stencil_bit(i, j, SC_OFF1, 2u) | stencil_bit(i, j, SC_OFF2, 4u) |
+         stencil_bit(i, j, SC_OFF3, 8u) | stencil_bit(i, j, SC_OFF4, 16u) | stencil_bit(i, j, SC_OFF5, 32u) |
+         stencil_bit(i, j, SC_OFF6, 64u) | stencil_bit(i, j, SC_OFF7, 128u) | stencil_bit(i, j, SC_OFF8, 256u) |
+         stencil_bit(i, j, SC_OFF9, 512u) | stencil_bit(i, j, SC_OFF10, 1024u) | stencil_bit(i, j, SC_OFF11, 2048u);
+}
 
 // One spring term of report eq. 2, exactly as the CSR loop below.
 void spring_term(inout precise vec3 f, vec3 x, uint q, float rest, float k) {
@@ -103,24 +122,29 @@ void particle_force(uint p, inout vec3 v_io, out vec3 f_out, out vec3 nrm_out) {
   const vec3 x = pos_at(p);
   precise vec3 f = vec3(0.0);
   bool interior = false;
+  uint has = 0xfffu; // bit k: stencil neighbour k exists (all of them inside)
   if (SC_STENCIL) {
     const uint i = p % SC_NX, j = p / SC_NX;
     interior = i >= 2u && i + 2u < SC_NX && j >= 2u && j + 2u < SC_NY;
+    if (SC_BORDER) {
+      interior = true;
+      has = stencil_present(i, j);
+    }
   }
   if (interior) {
     const int q = int(p);
-    spring_term(f, x, uint(q + SC_OFF0), SC_L0, SC_K0);
-    spring_term(f, x, uint(q + SC_OFF1), SC_L1, SC_K1);
-    spring_term(f, x, uint(q + SC_OFF2), SC_L2, SC_K2);
-    spring_term(f, x, uint(q + SC_OFF3), SC_L3, SC_K3);
-    spring_term(f, x, uint(q + SC_OFF4), SC_L4, SC_K4);
-    spring_term(f, x, uint(q + SC_OFF5), SC_L5, SC_K5);
-    spring_term(f, x, uint(q + SC_OFF6), SC_L6, SC_K6);
-    spring_term(f, x, uint(q + SC_OFF7), SC_L7, SC_K7);
-    spring_term(f, x, uint(q + SC_OFF8), SC_L8, SC_K8);
-    spring_term(f, x, uint(q + SC_OFF9), SC_L9, SC_K9);
-    spring_term(f, x, uint(q + SC_OFF10), SC_L10, SC_K10);
-    spring_term(f, x, uint(q + SC_OFF11), SC_L11, SC_K11);
+    if ((has & 1u) != 0u) spring_term(f, x, uint(q + SC_OFF0), SC_L0, SC_K0);
+    if ((has & 2u) != 0u) spring_term(f, x, uint(q + SC_OFF1), SC_L1, SC_K1);
+    if ((has & 4u) != 0u) spring_term(f, x, uint(q + SC_OFF2), SC_L2, SC_K2);
+    if ((has & 8u) != 0u) spring_term(f, x, uint(q + SC_OFF3), SC_L3, SC_K3);
+    if ((has & 16u) != 0u) spring_term(f, x, uint(q + SC_OFF4), SC_L4, SC_K4);
+    if ((has & 32u) != 0u) spring_term(f, x, uint(q + SC_OFF5), SC_L5, SC_K5);
+    if ((has & 64u) != 0u) spring_term(f, x, uint(q + SC_OFF6), SC_L6, SC_K6);
+    if ((has & 128u) != 0u) spring_term(f, x, uint(q + SC_OFF7), SC_L7, SC_K7);
+    if ((has & 256u) != 0u) spring_term(f, x, uint(q + SC_OFF8), SC_L8, SC_K8);
+    if ((has & 512u) != 0u) spring_term(f, x, uint(q + SC_OFF9), SC_L9, SC_K9);
+    if ((has & 1024u) != 0u) spring_term(f, x, uint(q + SC_OFF10), SC_L10, SC_K10);
+    if ((has & 2048u) != 0u) spring_term(f, x, uint(q + SC_OFF11), SC_L11, SC_K11);
   } else {
     const uint end = offsets[p + 1];
     for (uint e = offsets[p]; e < end; ++e) {

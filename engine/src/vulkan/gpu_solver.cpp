@@ -50,12 +50,13 @@ struct GpuSolver::Impl {
   VkFence fence = VK_NULL_HANDLE;
   VkQueryPool queries = VK_NULL_HANDLE;
   std::uint32_t groups_x = 1, groups_y = 1;
-  // Grid stencil (force_body.glsl's specialisation constants 0..38): constant_id order.
+  // Grid stencil (force_body.glsl's specialisation constants 0..39): constant_id order.
   struct Stencil {
     std::uint32_t enabled = 0; // VkBool32
     std::uint32_t nx = 1, ny = 1;
     std::int32_t offset[12] = {};
     float rest[12] = {}, stiffness[12] = {};
+    std::uint32_t border = 0; // VkBool32: border particles use the stencil too (SC_BORDER)
   } stencil;
   std::uint64_t edges_count = 0;
 
@@ -219,8 +220,8 @@ Result<void> GpuSolver::Impl::init_pipelines() {
     modules[2] = *um;
   }
   // Specialisation constants of force_body.glsl (force.comp, fused.comp): the grid stencil.
-  static_assert(sizeof(Stencil) == 39 * 4);
-  std::array<VkSpecializationMapEntry, 39> entries{};
+  static_assert(sizeof(Stencil) == 40 * 4);
+  std::array<VkSpecializationMapEntry, 40> entries{};
   for (std::uint32_t k = 0; k < entries.size(); ++k) entries[k] = VkSpecializationMapEntry{k, k * 4, 4};
   const VkSpecializationInfo spec{static_cast<std::uint32_t>(entries.size()), entries.data(), sizeof(Stencil), &stencil};
   VkComputePipelineCreateInfo ci[3]{};
@@ -276,6 +277,31 @@ void GpuSolver::Impl::detect_stencil(const ParticleSystem& system) {
       }
     }
   stencil = st;
+  // Border particles (SC_BORDER): their lists must be the stencil entries whose neighbour lies in
+  // the grid, in stencil order, with the same constants; offsets must be (di, dj) in [-2, 2]^2.
+  std::int64_t di[12], dj[12];
+  for (int k = 0; k < 12; ++k) {
+    dj[k] = (st.offset[k] + 2 * gx + 2) / gx - 2;
+    di[k] = st.offset[k] - dj[k] * gx;
+    if (st.offset[k] + 2 * gx + 2 < 0 || dj[k] < -2 || dj[k] > 2 || di[k] < -2 || di[k] > 2) return;
+  }
+  for (std::int64_t j = 0; j < gy; ++j)
+    for (std::int64_t i = 0; i < gx; ++i) {
+      if (i >= 2 && i < gx - 2 && j >= 2 && j < gy - 2) continue; // checked above
+      const std::int64_t p = j * gx + i;
+      std::int64_t e = off[p];
+      for (int k = 0; k < 12; ++k) {
+        if (i + di[k] < 0 || i + di[k] >= gx || j + dj[k] < 0 || j + dj[k] >= gy) continue;
+        if (e >= off[p + 1]) return;
+        const SpringRef& r = refs[e++];
+        const Spring& sp = system.springs[r.spring];
+        if (std::int64_t(r.other) - p != st.offset[k] || float(sp.rest_length) != st.rest[k] ||
+            float(sp.stiffness) != st.stiffness[k])
+          return;
+      }
+      if (e != off[p + 1]) return;
+    }
+  stencil.border = 1;
 }
 
 Result<void> GpuSolver::Impl::write_sets() {
