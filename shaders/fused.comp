@@ -7,7 +7,8 @@
 // writes only its own POS_OUT = positions[write]) and the velocity is read and written only by its
 // own invocation. Removes the force / filtered-velocity round trip through memory and one barrier
 // per step. Same float expressions, in the same order, as force.comp + integrate.comp.
-// Reads POS_IN (all), VEL (own); writes POS_OUT, VEL, FORCE_OUT, NORMAL (own).
+// Reads POS_IN (all), VEL (own); writes POS_OUT, VEL (own), and FORCE_OUT, NORMAL (own) in the
+// last substep of a recorded batch (SC_WRITE_AUX).
 #include "vkcloth_shared.h"
 #include "common.glsl"
 #define VKCLOTH_POS_TEXEL
@@ -20,6 +21,11 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_VEL) buffer VelBuf { vec4 vel[
 
 #include "finish.glsl"
 
+// False for every substep of a recorded batch but the last (GpuSolver fused_noaux_pipeline): the
+// forces and normals of the other substeps are overwritten before anyone can read them, and
+// llvmpipe pays a per-lane scalar loop for each of these stores.
+layout(constant_id = 40) const bool SC_WRITE_AUX = true;
+
 void main() {
   const uint p = particle_index();
   if (p >= pc.count) return;
@@ -30,8 +36,10 @@ void main() {
   vec3 vf = vel[p].xyz;
   vec3 f, nrm;
   particle_force(p, vf, f, nrm);
-  force_out[p] = vec4(f, 0.0);
-  normal_out[p] = vec4(nrm, 0.0);
+  if (SC_WRITE_AUX) {
+    force_out[p] = vec4(f, 0.0);
+    normal_out[p] = vec4(nrm, 0.0);
+  }
 
   const bool pinned = particle[p].pinned != 0u;
   const float m = particle[p].mass;

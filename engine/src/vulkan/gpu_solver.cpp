@@ -45,6 +45,9 @@ struct GpuSolver::Impl {
   VkDescriptorSet texel_sets[3] = {};
   VkPipelineLayout layout = VK_NULL_HANDLE;
   VkPipeline force_pipeline = VK_NULL_HANDLE, integrate_pipeline = VK_NULL_HANDLE, fused_pipeline = VK_NULL_HANDLE;
+  // fused.comp without the force and normal stores (SC_WRITE_AUX = false): every fused substep of
+  // a recorded batch but the last, since only the last one's forces and normals can be observed.
+  VkPipeline fused_noaux_pipeline = VK_NULL_HANDLE;
   VkCommandPool cmd_pool = VK_NULL_HANDLE;
   VkCommandBuffer cmd = VK_NULL_HANDLE;
   VkFence fence = VK_NULL_HANDLE;
@@ -77,7 +80,7 @@ struct GpuSolver::Impl {
   const DeviceFns& vk() const { return ctx->vk; }
   std::uint32_t current() const { return parity; }
   Result<void> ensure_implicit();
-  void record_substep(VkCommandBuffer cmd, bool first);
+  void record_substep(VkCommandBuffer cmd, bool first, bool last);
 
   Result<void> init_pipelines();
   void detect_stencil(const ParticleSystem& system);
@@ -103,6 +106,7 @@ GpuSolver::Impl::~Impl() {
   if (force_pipeline) v.vkDestroyPipeline(d, force_pipeline, v.allocator);
   if (integrate_pipeline) v.vkDestroyPipeline(d, integrate_pipeline, v.allocator);
   if (fused_pipeline) v.vkDestroyPipeline(d, fused_pipeline, v.allocator);
+  if (fused_noaux_pipeline) v.vkDestroyPipeline(d, fused_noaux_pipeline, v.allocator);
   if (layout) v.vkDestroyPipelineLayout(d, layout, v.allocator);
   if (pool) v.vkDestroyDescriptorPool(d, pool, v.allocator);
   if (set_layout) v.vkDestroyDescriptorSetLayout(d, set_layout, v.allocator);
@@ -224,21 +228,32 @@ Result<void> GpuSolver::Impl::init_pipelines() {
   std::array<VkSpecializationMapEntry, 40> entries{};
   for (std::uint32_t k = 0; k < entries.size(); ++k) entries[k] = VkSpecializationMapEntry{k, k * 4, 4};
   const VkSpecializationInfo spec{static_cast<std::uint32_t>(entries.size()), entries.data(), sizeof(Stencil), &stencil};
-  VkComputePipelineCreateInfo ci[3]{};
-  for (int k = 0; k < 3; ++k) {
+  // fused.comp's SC_WRITE_AUX (constant_id 40) = false for fused_noaux_pipeline.
+  struct {
+    Stencil st;
+    std::uint32_t write_aux = 0; // VkBool32
+  } noaux_data{stencil};
+  static_assert(sizeof(noaux_data) == 41 * 4);
+  std::array<VkSpecializationMapEntry, 41> noaux_entries{};
+  for (std::uint32_t k = 0; k < noaux_entries.size(); ++k) noaux_entries[k] = VkSpecializationMapEntry{k, k * 4, 4};
+  const VkSpecializationInfo noaux_spec{static_cast<std::uint32_t>(noaux_entries.size()), noaux_entries.data(),
+                                        sizeof(noaux_data), &noaux_data};
+  VkComputePipelineCreateInfo ci[4]{};
+  for (int k = 0; k < 4; ++k) {
     ci[k].sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
     ci[k].stage = VkPipelineShaderStageCreateInfo{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0,
-                                                  VK_SHADER_STAGE_COMPUTE_BIT, modules[k], "main",
-                                                  k == 1 ? nullptr : &spec};
+                                                  VK_SHADER_STAGE_COMPUTE_BIT, modules[k == 3 ? 2 : k], "main",
+                                                  k == 1 ? nullptr : k == 3 ? &noaux_spec : &spec};
     ci[k].layout = layout;
   }
-  VkPipeline pipes[3] = {};
-  const VkResult r = v.vkCreateComputePipelines(d, VK_NULL_HANDLE, 3, ci, v.allocator, pipes);
+  VkPipeline pipes[4] = {};
+  const VkResult r = v.vkCreateComputePipelines(d, VK_NULL_HANDLE, 4, ci, v.allocator, pipes);
   destroy_modules();
   if (r != VK_SUCCESS) return vk_error(r, "vkCreateComputePipelines (force.comp, integrate.comp, fused.comp)");
   force_pipeline = pipes[0];
   integrate_pipeline = pipes[1];
   fused_pipeline = pipes[2];
+  fused_noaux_pipeline = pipes[3];
   return {};
 }
 
@@ -470,7 +485,7 @@ void GpuSolver::Impl::record(VkCommandBuffer c, std::uint32_t steps) {
   for (std::uint32_t s = 0; s < steps; ++s) {
     pc.step = static_cast<std::uint32_t>(recorded + 1); // 1-based number of the step being computed
     for (std::uint32_t k = 0; k < params.substeps; ++k) {
-      record_substep(c, first);
+      record_substep(c, first, s + 1 == steps && k + 1 == params.substeps);
       first = false;
       parity ^= 1u; // positions[read ^ 1] now holds the new state
     }
@@ -479,7 +494,7 @@ void GpuSolver::Impl::record(VkCommandBuffer c, std::uint32_t steps) {
   }
 }
 
-void GpuSolver::Impl::record_substep(VkCommandBuffer c, bool first) {
+void GpuSolver::Impl::record_substep(VkCommandBuffer c, bool first, bool last) {
   const auto& v = vk();
   const std::uint32_t read = current();
   if (params.integrator == Integrator::implicit_euler) {
@@ -489,7 +504,7 @@ void GpuSolver::Impl::record_substep(VkCommandBuffer c, bool first) {
   const bool rk4 = params.integrator == Integrator::rk4;
   if (options.fused && !rk4) {
     // One dispatch per (sub)step (fused.comp); the descriptor set alternates with the parity.
-    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, fused_pipeline);
+    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, last ? fused_pipeline : fused_noaux_pipeline);
     pc.stage = 0;
     const VkDescriptorSet bound_sets[2] = {sets[read][0], texel_sets[read]};
     v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 2, bound_sets, 0, nullptr);
