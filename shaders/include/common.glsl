@@ -8,6 +8,11 @@ layout(local_size_x = VKCLOTH_WORKGROUP_SIZE) in;
 
 layout(push_constant) uniform PushBlock { PushConstants pc; };
 
+// False: no colliders (pc.collider_count == 0), the contact loops compiled out. llvmpipe runs a
+// loop body once even when no invocation enters it, per-lane collider loads included (GpuSolver
+// creates fused.comp with and without; the other shaders keep the default).
+layout(constant_id = 41) const bool SC_COLLIDERS = true;
+
 layout(std430, set = 0, binding = VKCLOTH_BINDING_PARTICLE) readonly buffer ParticleBuf { ParticleInfo particle[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_COLLIDERS) readonly buffer ColliderBuf { Collider colliders[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_FLAGS) buffer FlagBuf { Flags flags; };

@@ -164,7 +164,7 @@ void particle_force(uint p, inout vec3 v_io, out vec3 f_out, out vec3 nrm_out) {
 
   // Contacts: inside the 2 eps band, remove only the parts of v and F pointing into the collider.
   if (particle[p].pinned == 0u) {
-    for (uint c = 0u; c < pc.collider_count; ++c) {
+    for (uint c = 0u; c < (SC_COLLIDERS ? pc.collider_count : 0u); ++c) {
       float dist;
       vec3 n;
       collider_contact(c, x, dist, n);

@@ -44,10 +44,12 @@ struct GpuSolver::Impl {
   VkBufferView pos_views[3] = {};
   VkDescriptorSet texel_sets[3] = {};
   VkPipelineLayout layout = VK_NULL_HANDLE;
-  VkPipeline force_pipeline = VK_NULL_HANDLE, integrate_pipeline = VK_NULL_HANDLE, fused_pipeline = VK_NULL_HANDLE;
-  // fused.comp without the force and normal stores (SC_WRITE_AUX = false): every fused substep of
-  // a recorded batch but the last, since only the last one's forces and normals can be observed.
-  VkPipeline fused_noaux_pipeline = VK_NULL_HANDLE;
+  VkPipeline force_pipeline = VK_NULL_HANDLE, integrate_pipeline = VK_NULL_HANDLE;
+  // fused.comp variants, created when first needed (ensure_fused): [write_aux][colliders].
+  // write_aux = 0 (SC_WRITE_AUX false: no force and normal stores) for every fused substep of a
+  // recorded batch but the last, since only the last one's forces and normals can be observed;
+  // colliders = 0 (SC_COLLIDERS false: no contact loops) while params.colliders is empty.
+  VkPipeline fused_pipes[2][2] = {};
   VkCommandPool cmd_pool = VK_NULL_HANDLE;
   VkCommandBuffer cmd = VK_NULL_HANDLE;
   VkFence fence = VK_NULL_HANDLE;
@@ -80,6 +82,7 @@ struct GpuSolver::Impl {
   const DeviceFns& vk() const { return ctx->vk; }
   std::uint32_t current() const { return parity; }
   Result<void> ensure_implicit();
+  Result<void> ensure_fused();
   void record_substep(VkCommandBuffer cmd, bool first, bool last);
 
   Result<void> init_pipelines();
@@ -105,8 +108,9 @@ GpuSolver::Impl::~Impl() {
   if (cmd_pool) v.vkDestroyCommandPool(d, cmd_pool, v.allocator);
   if (force_pipeline) v.vkDestroyPipeline(d, force_pipeline, v.allocator);
   if (integrate_pipeline) v.vkDestroyPipeline(d, integrate_pipeline, v.allocator);
-  if (fused_pipeline) v.vkDestroyPipeline(d, fused_pipeline, v.allocator);
-  if (fused_noaux_pipeline) v.vkDestroyPipeline(d, fused_noaux_pipeline, v.allocator);
+  for (auto& row : fused_pipes)
+    for (VkPipeline p : row)
+      if (p) v.vkDestroyPipeline(d, p, v.allocator);
   if (layout) v.vkDestroyPipelineLayout(d, layout, v.allocator);
   if (pool) v.vkDestroyDescriptorPool(d, pool, v.allocator);
   if (set_layout) v.vkDestroyDescriptorSetLayout(d, set_layout, v.allocator);
@@ -201,7 +205,7 @@ Result<void> GpuSolver::Impl::init_pipelines() {
   }
   v.vkUpdateDescriptorSets(d, 3, texel_writes, 0, nullptr);
 
-  VkShaderModule modules[3] = {};
+  VkShaderModule modules[2] = {};
   auto destroy_modules = [&] {
     for (VkShaderModule m : modules)
       if (m) v.vkDestroyShaderModule(d, m, v.allocator);
@@ -216,44 +220,62 @@ Result<void> GpuSolver::Impl::init_pipelines() {
       return im.error();
     }
     modules[1] = *im;
-    auto um = make_module(v, d, spirv::fused_comp_spv, "fused.comp");
-    if (!um) {
-      destroy_modules();
-      return um.error();
-    }
-    modules[2] = *um;
   }
   // Specialisation constants of force_body.glsl (force.comp, fused.comp): the grid stencil.
   static_assert(sizeof(Stencil) == 40 * 4);
   std::array<VkSpecializationMapEntry, 40> entries{};
   for (std::uint32_t k = 0; k < entries.size(); ++k) entries[k] = VkSpecializationMapEntry{k, k * 4, 4};
   const VkSpecializationInfo spec{static_cast<std::uint32_t>(entries.size()), entries.data(), sizeof(Stencil), &stencil};
-  // fused.comp's SC_WRITE_AUX (constant_id 40) = false for fused_noaux_pipeline.
-  struct {
-    Stencil st;
-    std::uint32_t write_aux = 0; // VkBool32
-  } noaux_data{stencil};
-  static_assert(sizeof(noaux_data) == 41 * 4);
-  std::array<VkSpecializationMapEntry, 41> noaux_entries{};
-  for (std::uint32_t k = 0; k < noaux_entries.size(); ++k) noaux_entries[k] = VkSpecializationMapEntry{k, k * 4, 4};
-  const VkSpecializationInfo noaux_spec{static_cast<std::uint32_t>(noaux_entries.size()), noaux_entries.data(),
-                                        sizeof(noaux_data), &noaux_data};
-  VkComputePipelineCreateInfo ci[4]{};
-  for (int k = 0; k < 4; ++k) {
+  VkComputePipelineCreateInfo ci[2]{};
+  for (int k = 0; k < 2; ++k) {
     ci[k].sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
     ci[k].stage = VkPipelineShaderStageCreateInfo{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0,
-                                                  VK_SHADER_STAGE_COMPUTE_BIT, modules[k == 3 ? 2 : k], "main",
-                                                  k == 1 ? nullptr : k == 3 ? &noaux_spec : &spec};
+                                                  VK_SHADER_STAGE_COMPUTE_BIT, modules[k], "main",
+                                                  k == 1 ? nullptr : &spec};
     ci[k].layout = layout;
   }
-  VkPipeline pipes[4] = {};
-  const VkResult r = v.vkCreateComputePipelines(d, VK_NULL_HANDLE, 4, ci, v.allocator, pipes);
+  VkPipeline pipes[2] = {};
+  const VkResult r = v.vkCreateComputePipelines(d, VK_NULL_HANDLE, 2, ci, v.allocator, pipes);
   destroy_modules();
-  if (r != VK_SUCCESS) return vk_error(r, "vkCreateComputePipelines (force.comp, integrate.comp, fused.comp)");
+  if (r != VK_SUCCESS) return vk_error(r, "vkCreateComputePipelines (force.comp, integrate.comp)");
   force_pipeline = pipes[0];
   integrate_pipeline = pipes[1];
-  fused_pipeline = pipes[2];
-  fused_noaux_pipeline = pipes[3];
+  return {};
+}
+
+// The fused.comp variants the current parameters need ([0] and [1] x colliders or not).
+Result<void> GpuSolver::Impl::ensure_fused() {
+  const std::uint32_t col = params.colliders.empty() ? 0u : 1u;
+  if (!options.fused || (fused_pipes[0][col] && fused_pipes[1][col])) return {};
+  const auto& v = vk();
+  const VkDevice d = ctx->device;
+  auto m = make_module(v, d, spirv::fused_comp_spv, "fused.comp");
+  if (!m) return m.error();
+  // Constant ids 0..39: the stencil; 40: SC_WRITE_AUX; 41: SC_COLLIDERS (fused.comp, common.glsl).
+  struct Data {
+    Stencil st;
+    std::uint32_t write_aux, colliders; // VkBool32
+  } data[2] = {{stencil, 0u, col}, {stencil, 1u, col}};
+  static_assert(sizeof(Data) == 42 * 4);
+  std::array<VkSpecializationMapEntry, 42> entries{};
+  for (std::uint32_t k = 0; k < entries.size(); ++k) entries[k] = VkSpecializationMapEntry{k, k * 4, 4};
+  VkSpecializationInfo spec[2];
+  VkComputePipelineCreateInfo ci[2]{};
+  for (int k = 0; k < 2; ++k) {
+    spec[k] = VkSpecializationInfo{static_cast<std::uint32_t>(entries.size()), entries.data(), sizeof(Data), &data[k]};
+    ci[k].sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
+    ci[k].stage = VkPipelineShaderStageCreateInfo{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0,
+                                                  VK_SHADER_STAGE_COMPUTE_BIT, *m, "main", &spec[k]};
+    ci[k].layout = layout;
+  }
+  VkPipeline pipes[2] = {};
+  const VkResult r = v.vkCreateComputePipelines(d, VK_NULL_HANDLE, 2, ci, v.allocator, pipes);
+  v.vkDestroyShaderModule(d, *m, v.allocator);
+  if (r != VK_SUCCESS) return vk_error(r, "vkCreateComputePipelines (fused.comp)");
+  for (int k = 0; k < 2; ++k) {
+    if (fused_pipes[k][col]) v.vkDestroyPipeline(d, fused_pipes[k][col], v.allocator);
+    fused_pipes[k][col] = pipes[k];
+  }
   return {};
 }
 
@@ -504,7 +526,7 @@ void GpuSolver::Impl::record_substep(VkCommandBuffer c, bool first, bool last) {
   const bool rk4 = params.integrator == Integrator::rk4;
   if (options.fused && !rk4) {
     // One dispatch per (sub)step (fused.comp); the descriptor set alternates with the parity.
-    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, last ? fused_pipeline : fused_noaux_pipeline);
+    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, fused_pipes[last ? 1 : 0][pc.collider_count > 0 ? 1 : 0]);
     pc.stage = 0;
     const VkDescriptorSet bound_sets[2] = {sets[read][0], texel_sets[read]};
     v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 2, bound_sets, 0, nullptr);
@@ -660,6 +682,7 @@ Result<GpuSolver> GpuSolver::create(Context& context, const ParticleSystem& syst
   VKCLOTH_TRY(s.init_pipelines());
   VKCLOTH_TRY(s.write_sets());
   VKCLOTH_TRY(s.ensure_implicit());
+  VKCLOTH_TRY(s.ensure_fused());
   s.set_push_constants();
 
   // Initial state, converted as CpuSolver<float>::create converts it.
@@ -751,6 +774,7 @@ Result<void> GpuSolver::set_params(SimParams params) {
   impl_->params = std::move(params);
   VKCLOTH_TRY(impl_->upload_colliders());
   VKCLOTH_TRY(impl_->ensure_implicit());
+  VKCLOTH_TRY(impl_->ensure_fused());
   impl_->set_push_constants();
   return {};
 }
