@@ -29,14 +29,16 @@ layout(constant_id = 40) const bool SC_WRITE_AUX = true;
 void main() {
   const uint p = particle_index();
   if (p >= pc.count) return;
-  if (frozen()) {
-    pos_out[p] = pos_in[p]; // keep the frozen state in the buffer that becomes current
-    return;
-  }
-  vec3 vf = vel[p].xyz;
+  // A frozen step (after a divergence) writes back the state it read through the same stores as a
+  // live step (keeps it in the buffer that becomes current): llvmpipe runs every branch, so a
+  // separate copy cost a masked per-lane load and store loop in every step. finish() re-checks the
+  // frozen state, which is the bad step's output: the same particles, no flag changes.
+  const bool fr = frozen();
+  const vec3 v0 = vel[p].xyz;
+  vec3 vf = v0;
   vec3 f, nrm;
   particle_force(p, vf, f, nrm);
-  if (SC_WRITE_AUX) {
+  if (SC_WRITE_AUX && !fr) {
     force_out[p] = vec4(f, 0.0);
     normal_out[p] = vec4(nrm, 0.0);
   }
@@ -45,7 +47,7 @@ void main() {
   const float m = particle[p].mass;
   precise vec3 x = pos_at(p);
   precise vec3 v = vf;
-  if (!pinned) {
+  if (!pinned && !fr) {
     precise vec3 a = f / m;
     if (pc.integrator == VKCLOTH_INTEGRATOR_SEMI_IMPLICIT_EULER) {
       v = v + a * pc.dt;
@@ -55,5 +57,6 @@ void main() {
       v = v + a * pc.dt;
     }
   }
-  finish(p, pinned, x, v);
+  if (fr) v = v0;
+  finish(p, pinned || fr, x, v);
 }
