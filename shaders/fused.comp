@@ -43,8 +43,8 @@ void main() {
     normal_out[p] = vec4(nrm, 0.0);
   }
 
-  const bool pinned = particle[p].pinned != 0u;
-  const float m = particle[p].mass;
+  const bool pinned = pinned_at(p);
+  const float m = mass_at(p);
   precise vec3 x = pos_at(p);
   precise vec3 v = vf;
   if (!pinned && !fr) {

@@ -7,15 +7,21 @@
 
 layout(std430, set = 0, binding = VKCLOTH_BINDING_POS_IN) readonly buffer PosIn { vec4 pos_in[]; };
 
-// pos_at(q) = pos_in[q].xyz. With VKCLOTH_POS_TEXEL (force.comp, fused.comp) it reads the same
-// buffer through an RGBA32F uniform texel buffer view (set 1): llvmpipe (Mesa 22.x) turns an SSBO
-// load into a per-lane loop with a bounds check and a branch per component, a texel fetch into one
-// vectorised gather of the 8 lanes' texels. A float texel fetch is a copy: same bits.
+// pos_at(q) = pos_in[q].xyz, mass_at(p) = particle[p].mass, pinned_at(p) = particle[p].pinned != 0.
+// With VKCLOTH_POS_TEXEL (force.comp, fused.comp) they read the same buffers through uniform
+// texel buffer views (set 1): llvmpipe (Mesa 22.x) turns an SSBO load into a per-lane loop with a
+// bounds check and a branch per component, a texel fetch into one vectorised gather of the 8
+// lanes' texels. A 32-bit texel fetch is a copy: same bits.
 #ifdef VKCLOTH_POS_TEXEL
 layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_POS_IN) uniform samplerBuffer pos_in_texel;
+layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_PARTICLE) uniform usamplerBuffer particle_texel;
 vec3 pos_at(uint q) { return texelFetch(pos_in_texel, int(q)).xyz; }
+float mass_at(uint p) { return uintBitsToFloat(texelFetch(particle_texel, int(p)).x); }
+bool pinned_at(uint p) { return texelFetch(particle_texel, int(p)).y != 0u; }
 #else
 vec3 pos_at(uint q) { return pos_in[q].xyz; }
+float mass_at(uint p) { return particle[p].mass; }
+bool pinned_at(uint p) { return particle[p].pinned != 0u; }
 #endif
 layout(std430, set = 0, binding = VKCLOTH_BINDING_OFFSETS) readonly buffer OffsetBuf { uint offsets[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_EDGES) readonly buffer EdgeBuf { Edge edges[]; };
@@ -152,7 +158,7 @@ void particle_force(uint p, inout vec3 v_io, out vec3 f_out, out vec3 nrm_out) {
       spring_term(f, x, s.other, s.rest_length, s.stiffness); // report eq. 2
     }
   }
-  const float m = particle[p].mass;
+  const float m = mass_at(p);
   f = f + pc.gravity_damping.xyz * m;
   precise float mu_m = pc.gravity_damping.w * m;
   precise vec3 v = v_io;
@@ -163,7 +169,7 @@ void particle_force(uint p, inout vec3 v_io, out vec3 f_out, out vec3 nrm_out) {
   }
 
   // Contacts: inside the 2 eps band, remove only the parts of v and F pointing into the collider.
-  if (particle[p].pinned == 0u) {
+  if (!pinned_at(p)) {
     for (uint c = 0u; c < (SC_COLLIDERS ? pc.collider_count : 0u); ++c) {
       float dist;
       vec3 n;

@@ -39,9 +39,11 @@ struct GpuSolver::Impl {
   VkDescriptorPool pool = VK_NULL_HANDLE;
   VkDescriptorSet sets[2][2] = {}; // [positions read index][0: state input, 1: RK4 stage input]
   // Set 1 of force.comp / fused.comp: POS_IN as an RGBA32F uniform texel buffer (force_body.glsl
-  // pos_at). [0], [1]: positions[0], positions[1]; [2]: RK4 stage positions.
+  // pos_at) and the particle constants as an RG32UI one. [0], [1]: positions[0], positions[1];
+  // [2]: RK4 stage positions.
   VkDescriptorSetLayout texel_layout = VK_NULL_HANDLE;
   VkBufferView pos_views[3] = {};
+  VkBufferView particle_view = VK_NULL_HANDLE;
   VkDescriptorSet texel_sets[3] = {};
   VkPipelineLayout layout = VK_NULL_HANDLE;
   VkPipeline force_pipeline = VK_NULL_HANDLE, integrate_pipeline = VK_NULL_HANDLE;
@@ -117,6 +119,7 @@ GpuSolver::Impl::~Impl() {
   if (texel_layout) v.vkDestroyDescriptorSetLayout(d, texel_layout, v.allocator);
   for (VkBufferView view : pos_views)
     if (view) v.vkDestroyBufferView(d, view, v.allocator);
+  if (particle_view) v.vkDestroyBufferView(d, particle_view, v.allocator);
   for (Buffer* b : {&pos[0], &pos[1], &vel, &force, &force_stage, &vel_filt, &normal, &uv, &stage_pos, &stage_vel, &acc_pos,
                     &acc_vel, &particle, &offsets, &edges, &colliders, &flags})
     destroy_buffer(*ctx, *b);
@@ -150,10 +153,11 @@ Result<void> GpuSolver::Impl::init_pipelines() {
   li.bindingCount = static_cast<std::uint32_t>(bindings.size());
   li.pBindings = bindings.data();
   VKCLOTH_VK_TRY(v.vkCreateDescriptorSetLayout(d, &li, v.allocator, &set_layout), "vkCreateDescriptorSetLayout");
-  const VkDescriptorSetLayoutBinding texel_binding{VKCLOTH_TEXEL_BINDING_POS_IN, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1,
-                                                   VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
-  li.bindingCount = 1;
-  li.pBindings = &texel_binding;
+  const VkDescriptorSetLayoutBinding texel_bindings[2] = {
+      {VKCLOTH_TEXEL_BINDING_POS_IN, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+      {VKCLOTH_TEXEL_BINDING_PARTICLE, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr}};
+  li.bindingCount = 2;
+  li.pBindings = texel_bindings;
   VKCLOTH_VK_TRY(v.vkCreateDescriptorSetLayout(d, &li, v.allocator, &texel_layout), "vkCreateDescriptorSetLayout (texel)");
 
   const VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(sh::PushConstants)};
@@ -167,7 +171,7 @@ Result<void> GpuSolver::Impl::init_pipelines() {
   VKCLOTH_VK_TRY(v.vkCreatePipelineLayout(d, &pi, v.allocator, &layout), "vkCreatePipelineLayout");
 
   const VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 4 * VKCLOTH_BINDING_COUNT},
-                                         {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 3}};
+                                         {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 2 * 3}};
   VkDescriptorPoolCreateInfo dp{};
   dp.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
   dp.maxSets = 4 + 3;
@@ -187,7 +191,22 @@ Result<void> GpuSolver::Impl::init_pipelines() {
   ai.pSetLayouts = texel_layouts;
   VKCLOTH_VK_TRY(v.vkAllocateDescriptorSets(d, &ai, texel_sets), "vkAllocateDescriptorSets (texel)");
   const Buffer* viewed[3] = {&pos[0], &pos[1], &stage_pos};
-  VkWriteDescriptorSet texel_writes[3]{};
+  VkWriteDescriptorSet texel_writes[6]{};
+  VkBufferViewCreateInfo pvi{};
+  pvi.sType = VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO;
+  pvi.buffer = particle.buffer;
+  pvi.format = VK_FORMAT_R32G32_UINT; // sh::ParticleInfo; uniform texel buffer support is mandatory
+  pvi.offset = 0;
+  pvi.range = VK_WHOLE_SIZE;
+  VKCLOTH_VK_TRY(v.vkCreateBufferView(d, &pvi, v.allocator, &particle_view), "vkCreateBufferView (particle constants)");
+  for (int k = 0; k < 3; ++k) {
+    texel_writes[3 + k].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+    texel_writes[3 + k].dstSet = texel_sets[k];
+    texel_writes[3 + k].dstBinding = VKCLOTH_TEXEL_BINDING_PARTICLE;
+    texel_writes[3 + k].descriptorCount = 1;
+    texel_writes[3 + k].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+    texel_writes[3 + k].pTexelBufferView = &particle_view;
+  }
   for (int k = 0; k < 3; ++k) {
     VkBufferViewCreateInfo vi{};
     vi.sType = VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO;
@@ -203,7 +222,7 @@ Result<void> GpuSolver::Impl::init_pipelines() {
     texel_writes[k].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
     texel_writes[k].pTexelBufferView = &pos_views[k];
   }
-  v.vkUpdateDescriptorSets(d, 3, texel_writes, 0, nullptr);
+  v.vkUpdateDescriptorSets(d, 6, texel_writes, 0, nullptr);
 
   VkShaderModule modules[2] = {};
   auto destroy_modules = [&] {
