@@ -4,6 +4,7 @@
 // and contact_at for one particle; the body is in force_body.glsl, shared with fused.comp).
 // Reads POS_IN (all particles) and VEL_IN (own); writes FORCE_OUT, VEL_FILT, NORMAL (own).
 #include "vkcloth_shared.h"
+#define VKCLOTH_PC_COPY
 #include "common.glsl"
 #define VKCLOTH_POS_TEXEL
 #include "force_body.glsl"
@@ -14,6 +15,7 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_VEL_FILT) writeonly buffer Vel
 layout(std430, set = 0, binding = VKCLOTH_BINDING_NORMAL) writeonly buffer NormalOut { vec4 normal_out[]; };
 
 void main() {
+  pc = pc_block; // before any branch (common.glsl)
   const uint p = particle_index();
   if (p >= pc.count || frozen()) return;
   vec3 v = vel_in[p].xyz;

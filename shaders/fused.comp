@@ -10,6 +10,7 @@
 // Reads POS_IN (all), VEL (own); writes POS_OUT, VEL (own), and FORCE_OUT, NORMAL (own) in the
 // last substep of a recorded batch (SC_WRITE_AUX).
 #include "vkcloth_shared.h"
+#define VKCLOTH_PC_COPY
 #include "common.glsl"
 #define VKCLOTH_POS_TEXEL
 #include "force_body.glsl"
@@ -27,6 +28,7 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_VEL) buffer VelBuf { vec4 vel[
 layout(constant_id = 40) const bool SC_WRITE_AUX = true;
 
 void main() {
+  pc = pc_block; // before any branch (common.glsl)
   const uint p = particle_index();
   if (p >= pc.count) return;
   // A frozen step (after a divergence) writes back the state it read through the same stores as a

@@ -5,6 +5,7 @@
 // stages 0..2 write the next stage's (STAGE_POS, STAGE_VEL) and the running sums, stage 3
 // writes the new state. Reads FORCE_OUT, VEL_FILT (own), POS_BASE, VEL; writes POS_OUT, VEL.
 #include "vkcloth_shared.h"
+#define VKCLOTH_PC_COPY
 #include "common.glsl"
 
 layout(std430, set = 0, binding = VKCLOTH_BINDING_FORCE_OUT) readonly buffer ForceIn { vec4 force_in[]; };
@@ -20,6 +21,7 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_ACC_VEL) buffer AccVel { vec4 
 #include "finish.glsl"
 
 void main() {
+  pc = pc_block; // before any branch (common.glsl)
   const uint p = particle_index();
   if (p >= pc.count) return;
   const bool last = pc.integrator != VKCLOTH_INTEGRATOR_RK4 || pc.stage == 3u;

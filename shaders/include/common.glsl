@@ -6,7 +6,15 @@
 
 layout(local_size_x = VKCLOTH_WORKGROUP_SIZE) in;
 
+#ifdef VKCLOTH_PC_COPY
+// The shader copies the push constants into `pc` before any branch (main: pc = pc_block): llvmpipe
+// (Mesa 22.x) loads a push constant once and broadcasts it only outside control flow; inside a
+// branch (everything after `if (p >= pc.count) return;`) it gathers it lane by lane.
+layout(push_constant) uniform PushBlock { PushConstants pc_block; };
+PushConstants pc;
+#else
 layout(push_constant) uniform PushBlock { PushConstants pc; };
+#endif
 
 // False: no colliders (pc.collider_count == 0), the contact loops compiled out. llvmpipe runs a
 // loop body once even when no invocation enters it, per-lane collider loads included (GpuSolver
