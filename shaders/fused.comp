@@ -27,6 +27,14 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_VEL) buffer VelBuf { vec4 vel[
 // llvmpipe pays a per-lane scalar loop for each of these stores.
 layout(constant_id = 40) const bool SC_WRITE_AUX = true;
 
+// The state velocity and the flags word read through texel views of VEL and FLAGS (set 1), like
+// the positions (force_body.glsl pos_at): on llvmpipe an SSBO load is a per-lane loop even at a
+// constant offset. Each invocation reads its own velocity before it stores it, and any flags value
+// this dispatch can see gives the same frozen() answer (older steps' values are visible through
+// the barrier; this step's own writes are >= pc.step).
+layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_VEL) uniform samplerBuffer vel_texel;
+layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_FLAGS) uniform usamplerBuffer flags_texel;
+
 void main() {
   pc = pc_block; // before any branch (common.glsl)
   const uint p = particle_index();
@@ -35,8 +43,8 @@ void main() {
   // live step (keeps it in the buffer that becomes current): llvmpipe runs every branch, so a
   // separate copy cost a masked per-lane load and store loop in every step. finish() re-checks the
   // frozen state, which is the bad step's output: the same particles, no flag changes.
-  const bool fr = frozen();
-  const vec3 v0 = vel[p].xyz;
+  const bool fr = texelFetch(flags_texel, 1).x < pc.step; // frozen(): Flags::first_bad_step
+  const vec3 v0 = texelFetch(vel_texel, int(p)).xyz;
   vec3 vf = v0;
   vec3 f, nrm;
   particle_force(p, vf, f, nrm);

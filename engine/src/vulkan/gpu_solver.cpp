@@ -43,7 +43,7 @@ struct GpuSolver::Impl {
   // [2]: RK4 stage positions.
   VkDescriptorSetLayout texel_layout = VK_NULL_HANDLE;
   VkBufferView pos_views[3] = {};
-  VkBufferView particle_view = VK_NULL_HANDLE;
+  VkBufferView particle_view = VK_NULL_HANDLE, vel_view = VK_NULL_HANDLE, flags_view = VK_NULL_HANDLE;
   VkDescriptorSet texel_sets[3] = {};
   VkPipelineLayout layout = VK_NULL_HANDLE;
   VkPipeline force_pipeline = VK_NULL_HANDLE, integrate_pipeline = VK_NULL_HANDLE;
@@ -119,7 +119,8 @@ GpuSolver::Impl::~Impl() {
   if (texel_layout) v.vkDestroyDescriptorSetLayout(d, texel_layout, v.allocator);
   for (VkBufferView view : pos_views)
     if (view) v.vkDestroyBufferView(d, view, v.allocator);
-  if (particle_view) v.vkDestroyBufferView(d, particle_view, v.allocator);
+  for (VkBufferView view : {particle_view, vel_view, flags_view})
+    if (view) v.vkDestroyBufferView(d, view, v.allocator);
   for (Buffer* b : {&pos[0], &pos[1], &vel, &force, &force_stage, &vel_filt, &normal, &uv, &stage_pos, &stage_vel, &acc_pos,
                     &acc_vel, &particle, &offsets, &edges, &colliders, &flags})
     destroy_buffer(*ctx, *b);
@@ -153,10 +154,12 @@ Result<void> GpuSolver::Impl::init_pipelines() {
   li.bindingCount = static_cast<std::uint32_t>(bindings.size());
   li.pBindings = bindings.data();
   VKCLOTH_VK_TRY(v.vkCreateDescriptorSetLayout(d, &li, v.allocator, &set_layout), "vkCreateDescriptorSetLayout");
-  const VkDescriptorSetLayoutBinding texel_bindings[2] = {
+  const VkDescriptorSetLayoutBinding texel_bindings[4] = {
       {VKCLOTH_TEXEL_BINDING_POS_IN, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
-      {VKCLOTH_TEXEL_BINDING_PARTICLE, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr}};
-  li.bindingCount = 2;
+      {VKCLOTH_TEXEL_BINDING_PARTICLE, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+      {VKCLOTH_TEXEL_BINDING_VEL, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+      {VKCLOTH_TEXEL_BINDING_FLAGS, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr}};
+  li.bindingCount = 4;
   li.pBindings = texel_bindings;
   VKCLOTH_VK_TRY(v.vkCreateDescriptorSetLayout(d, &li, v.allocator, &texel_layout), "vkCreateDescriptorSetLayout (texel)");
 
@@ -171,7 +174,7 @@ Result<void> GpuSolver::Impl::init_pipelines() {
   VKCLOTH_VK_TRY(v.vkCreatePipelineLayout(d, &pi, v.allocator, &layout), "vkCreatePipelineLayout");
 
   const VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 4 * VKCLOTH_BINDING_COUNT},
-                                         {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 2 * 3}};
+                                         {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 4 * 3}};
   VkDescriptorPoolCreateInfo dp{};
   dp.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
   dp.maxSets = 4 + 3;
@@ -191,21 +194,36 @@ Result<void> GpuSolver::Impl::init_pipelines() {
   ai.pSetLayouts = texel_layouts;
   VKCLOTH_VK_TRY(v.vkAllocateDescriptorSets(d, &ai, texel_sets), "vkAllocateDescriptorSets (texel)");
   const Buffer* viewed[3] = {&pos[0], &pos[1], &stage_pos};
-  VkWriteDescriptorSet texel_writes[6]{};
-  VkBufferViewCreateInfo pvi{};
-  pvi.sType = VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO;
-  pvi.buffer = particle.buffer;
-  pvi.format = VK_FORMAT_R32G32_UINT; // sh::ParticleInfo; uniform texel buffer support is mandatory
-  pvi.offset = 0;
-  pvi.range = VK_WHOLE_SIZE;
-  VKCLOTH_VK_TRY(v.vkCreateBufferView(d, &pvi, v.allocator, &particle_view), "vkCreateBufferView (particle constants)");
-  for (int k = 0; k < 3; ++k) {
-    texel_writes[3 + k].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-    texel_writes[3 + k].dstSet = texel_sets[k];
-    texel_writes[3 + k].dstBinding = VKCLOTH_TEXEL_BINDING_PARTICLE;
-    texel_writes[3 + k].descriptorCount = 1;
-    texel_writes[3 + k].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
-    texel_writes[3 + k].pTexelBufferView = &particle_view;
+  VkWriteDescriptorSet texel_writes[12]{};
+  // The same views in all three sets: particle constants (sh::ParticleInfo), velocities, flags.
+  // Uniform texel buffer support is mandatory for these formats.
+  const struct {
+    const Buffer* buffer;
+    VkFormat format;
+    VkBufferView* view;
+    std::uint32_t binding;
+    const char* what;
+  } shared_views[3] = {
+      {&particle, VK_FORMAT_R32G32_UINT, &particle_view, VKCLOTH_TEXEL_BINDING_PARTICLE, "vkCreateBufferView (particle constants)"},
+      {&vel, VK_FORMAT_R32G32B32A32_SFLOAT, &vel_view, VKCLOTH_TEXEL_BINDING_VEL, "vkCreateBufferView (velocities)"},
+      {&flags, VK_FORMAT_R32_UINT, &flags_view, VKCLOTH_TEXEL_BINDING_FLAGS, "vkCreateBufferView (flags)"}};
+  for (int b = 0; b < 3; ++b) {
+    VkBufferViewCreateInfo bvi{};
+    bvi.sType = VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO;
+    bvi.buffer = shared_views[b].buffer->buffer;
+    bvi.format = shared_views[b].format;
+    bvi.offset = 0;
+    bvi.range = VK_WHOLE_SIZE;
+    VKCLOTH_VK_TRY(v.vkCreateBufferView(d, &bvi, v.allocator, shared_views[b].view), shared_views[b].what);
+    for (int k = 0; k < 3; ++k) {
+      VkWriteDescriptorSet& w = texel_writes[3 + 3 * b + k];
+      w.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+      w.dstSet = texel_sets[k];
+      w.dstBinding = shared_views[b].binding;
+      w.descriptorCount = 1;
+      w.descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+      w.pTexelBufferView = shared_views[b].view;
+    }
   }
   for (int k = 0; k < 3; ++k) {
     VkBufferViewCreateInfo vi{};
@@ -222,7 +240,7 @@ Result<void> GpuSolver::Impl::init_pipelines() {
     texel_writes[k].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
     texel_writes[k].pTexelBufferView = &pos_views[k];
   }
-  v.vkUpdateDescriptorSets(d, 6, texel_writes, 0, nullptr);
+  v.vkUpdateDescriptorSets(d, 12, texel_writes, 0, nullptr);
 
   VkShaderModule modules[2] = {};
   auto destroy_modules = [&] {
@@ -667,7 +685,8 @@ Result<GpuSolver> GpuSolver::create(Context& context, const ParticleSystem& syst
   }
   s.staging = s.pos[0].mapped == nullptr;
   {
-    auto r = create_buffer(*ctx, sizeof(sh::Flags), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::host_readback, true, "flags");
+    auto r = create_buffer(*ctx, sizeof(sh::Flags), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT,
+                           MemoryUse::host_readback, true, "flags"); // texel view: fused.comp
     if (!r) return r.error();
     s.flags = *r;
     *static_cast<sh::Flags*>(s.flags.mapped) = sh::Flags{0, VKCLOTH_NO_BAD_STEP, VKCLOTH_NO_BAD_STEP, 0};
