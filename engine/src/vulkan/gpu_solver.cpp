@@ -624,6 +624,13 @@ Result<GpuSolver> GpuSolver::create(Context& context, const ParticleSystem& syst
                                     ctx->name, need.what, need.bytes, need.items, need.per, max_bytes,
                                     overridden ? "GpuSolverOptions::max_storage_buffer_bytes"
                                                : "maxStorageBufferRange"));
+  // Positions, velocities and particle constants are also read through texel buffer views (one
+  // texel per particle).
+  if (std::uint64_t(n) > lim.maxTexelBufferElements)
+    return make_error(ErrorCode::unsupported,
+                      fmt::format("the system is too large for device '{}': {} particles need {} texels per texel "
+                                  "buffer view but the device allows {} (maxTexelBufferElements); use fewer particles",
+                                  ctx->name, n, n, lim.maxTexelBufferElements));
   const std::uint64_t groups = (std::uint64_t(n) + VKCLOTH_WORKGROUP_SIZE - 1) / VKCLOTH_WORKGROUP_SIZE;
   std::uint64_t row = lim.maxComputeWorkGroupCount[0];
   if (options.max_workgroups_x) row = std::min<std::uint64_t>(row, options.max_workgroups_x);
