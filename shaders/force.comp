@@ -4,7 +4,9 @@
 // and contact_at for one particle; the body is in force_body.glsl, shared with fused.comp).
 // Reads POS_IN (all particles) and VEL_IN (own); writes FORCE_OUT, VEL_FILT, NORMAL (own).
 #include "vkcloth_shared.h"
+#define VKCLOTH_PC_COPY
 #include "common.glsl"
+#define VKCLOTH_POS_TEXEL
 #include "force_body.glsl"
 
 layout(std430, set = 0, binding = VKCLOTH_BINDING_VEL_IN) readonly buffer VelIn { vec4 vel_in[]; };

@@ -7,9 +7,12 @@
 // writes only its own POS_OUT = positions[write]) and the velocity is read and written only by its
 // own invocation. Removes the force / filtered-velocity round trip through memory and one barrier
 // per step. Same float expressions, in the same order, as force.comp + integrate.comp.
-// Reads POS_IN (all), VEL (own); writes POS_OUT, VEL, FORCE_OUT, NORMAL (own).
+// Reads POS_IN (all), VEL (own); writes POS_OUT, VEL (own), and FORCE_OUT, NORMAL (own) in the
+// last substep of a recorded batch (SC_WRITE_AUX).
 #include "vkcloth_shared.h"
+#define VKCLOTH_PC_COPY
 #include "common.glsl"
+#define VKCLOTH_POS_TEXEL
 #include "force_body.glsl"
 
 layout(std430, set = 0, binding = VKCLOTH_BINDING_FORCE_OUT) writeonly buffer ForceOut { vec4 force_out[]; };
@@ -19,26 +22,43 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_VEL) buffer VelBuf { vec4 vel[
 
 #include "finish.glsl"
 
+// False for every substep of a recorded batch but the last (GpuSolver fused_noaux_pipeline): the
+// forces and normals of the other substeps are overwritten before anyone can read them, and
+// llvmpipe pays a per-lane scalar loop for each of these stores.
+layout(constant_id = 40) const bool SC_WRITE_AUX = true;
+
+// The state velocity and the flags word read through texel views of VEL and FLAGS (set 1), like
+// the positions (force_body.glsl pos_at): on llvmpipe an SSBO load is a per-lane loop even at a
+// constant offset. Each invocation reads its own velocity before it stores it, and any flags value
+// this dispatch can see gives the same frozen() answer (older steps' values are visible through
+// the barrier; this step's own writes are >= pc.step).
+layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_VEL) uniform samplerBuffer vel_texel;
+layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_FLAGS) uniform usamplerBuffer flags_texel;
+
 void main() {
   begin_instance();
   const uint p = particle_index();
   if (p >= pc.count) return;
   const uint g = base + p; // this particle's entry in the state buffers
-  if (frozen()) {
-    pos_out[g] = pos_in[g]; // keep the frozen state in the buffer that becomes current
-    return;
-  }
-  vec3 vf = vel[g].xyz;
+  // A frozen step (after a divergence) writes back the state it read through the same stores as a
+  // live step (keeps it in the buffer that becomes current): llvmpipe runs every branch, so a
+  // separate copy cost a masked per-lane load and store loop in every step. finish() re-checks the
+  // frozen state, which is the bad step's output: the same particles, no flag changes.
+  const bool fr = texelFetch(flags_texel, int(inst * 4u + 1u)).x < pc.step; // frozen(): Flags[inst].first_bad_step
+  const vec3 v0 = texelFetch(vel_texel, int(g)).xyz;
+  vec3 vf = v0;
   vec3 f, nrm;
   particle_force(p, vf, f, nrm);
-  force_out[g] = vec4(f, 0.0);
-  normal_out[g] = vec4(nrm, 0.0);
+  if (SC_WRITE_AUX && !fr) {
+    force_out[g] = vec4(f, 0.0);
+    normal_out[g] = vec4(nrm, 0.0);
+  }
 
-  const bool pinned = particle[p].pinned != 0u;
-  const float m = particle[p].mass;
-  precise vec3 x = pos_in[g].xyz;
+  const bool pinned = pinned_at(p);
+  const float m = mass_at(p);
+  precise vec3 x = pos_at(p);
   precise vec3 v = vf;
-  if (!pinned) {
+  if (!pinned && !fr) {
     precise vec3 a = f / m;
     if (ip.integrator == VKCLOTH_INTEGRATOR_SEMI_IMPLICIT_EULER) {
       v = v + a * ip.dt;
@@ -48,5 +68,6 @@ void main() {
       v = v + a * ip.dt;
     }
   }
-  finish(p, pinned, x, v);
+  if (fr) v = v0;
+  finish(p, pinned || fr, x, v);
 }

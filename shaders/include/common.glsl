@@ -6,7 +6,21 @@
 
 layout(local_size_x = VKCLOTH_WORKGROUP_SIZE) in;
 
+#ifdef VKCLOTH_PC_COPY
+// The shader copies the push constants into `pc` before any branch (main: pc = pc_block): llvmpipe
+// (Mesa 22.x) loads a push constant once and broadcasts it only outside control flow; inside a
+// branch (everything after `if (p >= pc.count) return;`) it gathers it lane by lane.
+layout(push_constant) uniform PushBlock { PushConstants pc_block; };
+PushConstants pc;
+#else
 layout(push_constant) uniform PushBlock { PushConstants pc; };
+#endif
+
+// False: no instance of the batch has colliders (every ip.collider_count == 0), the contact loops
+// compiled out. llvmpipe runs a
+// loop body once even when no invocation enters it, per-lane collider loads included (GpuSolver
+// creates fused.comp with and without; the other shaders keep the default).
+layout(constant_id = 41) const bool SC_COLLIDERS = true;
 
 layout(std430, set = 0, binding = VKCLOTH_BINDING_PARTICLE) readonly buffer ParticleBuf { ParticleInfo particle[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_COLLIDERS) readonly buffer ColliderBuf { Collider colliders[]; };
@@ -20,6 +34,9 @@ uint base;
 InstanceParams ip;
 
 void begin_instance() {
+#ifdef VKCLOTH_PC_COPY
+  pc = pc_block; // before any branch (see above)
+#endif
   inst = gl_WorkGroupID.z;
   base = inst * pc.count;
   ip = instances[inst];

@@ -13,7 +13,7 @@ void finish(uint p, bool pinned, vec3 x_in, vec3 v_in) {
   precise vec3 x = x_in;
   precise vec3 v = v_in;
   if (!pinned) {
-    for (uint c = 0u; c < ip.collider_count; ++c) {
+    for (uint c = 0u; c < (SC_COLLIDERS ? ip.collider_count : 0u); ++c) {
       float dist;
       vec3 n;
       collider_contact(c, x, dist, n);

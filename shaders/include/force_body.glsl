@@ -6,6 +6,24 @@
 #define VKCLOTH_FORCE_BODY_GLSL
 
 layout(std430, set = 0, binding = VKCLOTH_BINDING_POS_IN) readonly buffer PosIn { vec4 pos_in[]; };
+
+// pos_at(q) = pos_in[base + q].xyz (this instance's particle q; q indexes the shared topology),
+// mass_at(p) = particle[p].mass, pinned_at(p) = particle[p].pinned != 0.
+// With VKCLOTH_POS_TEXEL (force.comp, fused.comp) they read the same buffers through uniform
+// texel buffer views (set 1): llvmpipe (Mesa 22.x) turns an SSBO load into a per-lane loop with a
+// bounds check and a branch per component, a texel fetch into one vectorised gather of the 8
+// lanes' texels. A 32-bit texel fetch is a copy: same bits.
+#ifdef VKCLOTH_POS_TEXEL
+layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_POS_IN) uniform samplerBuffer pos_in_texel;
+layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_PARTICLE) uniform usamplerBuffer particle_texel;
+vec3 pos_at(uint q) { return texelFetch(pos_in_texel, int(base + q)).xyz; }
+float mass_at(uint p) { return uintBitsToFloat(texelFetch(particle_texel, int(p)).x); }
+bool pinned_at(uint p) { return texelFetch(particle_texel, int(p)).y != 0u; }
+#else
+vec3 pos_at(uint q) { return pos_in[base + q].xyz; }
+float mass_at(uint p) { return particle[p].mass; }
+bool pinned_at(uint p) { return particle[p].pinned != 0u; }
+#endif
 layout(std430, set = 0, binding = VKCLOTH_BINDING_OFFSETS) readonly buffer OffsetBuf { uint offsets[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_EDGES) readonly buffer EdgeBuf { Edge edges[]; };
 
@@ -52,13 +70,29 @@ layout(constant_id = 35) const float SC_K8 = 0.0;
 layout(constant_id = 36) const float SC_K9 = 0.0;
 layout(constant_id = 37) const float SC_K10 = 0.0;
 layout(constant_id = 38) const float SC_K11 = 0.0;
+// Border particles too: every particle's gather list is the stencil's entries whose neighbour lies
+// inside the grid, in stencil order (GpuSolver detect_stencil checks it). Then no particle takes
+// the CSR loop, which llvmpipe runs for every 8-lane group holding a border particle (and whose
+// per-lane loads it pays, masked, for every group).
+layout(constant_id = 39) const bool SC_BORDER = false;
 
-// Position of this instance's particle q (q indexes the shared topology).
-vec3 pos_of(uint q) { return pos_in[base + q].xyz; }
+// Bit `bit` when stencil neighbour `off` of grid particle (i, j) lies inside the grid
+// (off = dj nx + di with |di|, |dj| <= 2; compile-time constants after specialisation).
+uint stencil_bit(uint i, uint j, int off, uint bit) {
+  const int dj = (off + 2 * int(SC_NX) + 2) / int(SC_NX) - 2;
+  const int di = off - dj * int(SC_NX);
+  return uint(int(i) + di) < SC_NX && uint(int(j) + dj) < SC_NY ? bit : 0u;
+}
+uint stencil_present(uint i, uint j) {
+  return stencil_bit(i, j, SC_OFF0, 1u) | stencil_bit(i, j, SC_OFF1, 2u) | stencil_bit(i, j, SC_OFF2, 4u) |
+         stencil_bit(i, j, SC_OFF3, 8u) | stencil_bit(i, j, SC_OFF4, 16u) | stencil_bit(i, j, SC_OFF5, 32u) |
+         stencil_bit(i, j, SC_OFF6, 64u) | stencil_bit(i, j, SC_OFF7, 128u) | stencil_bit(i, j, SC_OFF8, 256u) |
+         stencil_bit(i, j, SC_OFF9, 512u) | stencil_bit(i, j, SC_OFF10, 1024u) | stencil_bit(i, j, SC_OFF11, 2048u);
+}
 
 // One spring term of report eq. 2, exactly as the CSR loop below.
 void spring_term(inout precise vec3 f, vec3 x, uint q, float rest, float k) {
-  precise vec3 u = pos_of(q) - x;
+  precise vec3 u = pos_at(q) - x;
   precise float len = sqrt(dot3(u, u));
   if (len > 0.0) f = f + u * (k * (len - rest) / len);
 }
@@ -69,13 +103,13 @@ void spring_term(inout precise vec3 f, vec3 x, uint q, float rest, float k) {
 vec3 grid_normal(uint p) {
   const uint nx = SC_STENCIL ? SC_NX : pc.nx; // a constant divisor when specialised
   const uint i = p % nx, j = p / nx;
-  const vec3 x = pos_of(p);
+  const vec3 x = pos_at(p);
   const bool h0 = i + 1u < nx, h1 = j + 1u < (SC_STENCIL ? SC_NY : pc.ny), h2 = i > 0u, h3 = j > 0u;
   precise vec3 e0 = vec3(0.0), e1 = vec3(0.0), e2 = vec3(0.0), e3 = vec3(0.0);
-  if (h0) e0 = pos_of(p + 1u) - x;
-  if (h1) e1 = pos_of(p + nx) - x;
-  if (h2) e2 = pos_of(p - 1u) - x;
-  if (h3) e3 = pos_of(p - nx) - x;
+  if (h0) e0 = pos_at(p + 1u) - x;
+  if (h1) e1 = pos_at(p + nx) - x;
+  if (h2) e2 = pos_at(p - 1u) - x;
+  if (h3) e3 = pos_at(p - nx) - x;
   precise vec3 sum = vec3(0.0);
   if (h0 && h1) sum = sum + cross3(e0, e1);
   if (h1 && h2) sum = sum + cross3(e1, e2);
@@ -92,27 +126,32 @@ void particle_force(uint p, inout vec3 v_io, out vec3 f_out, out vec3 nrm_out) {
   precise vec3 nrm = vec3(0.0);
   if ((ip.flags & VKCLOTH_FLAG_HAS_GRID) != 0u) nrm = grid_normal(p);
 
-  const vec3 x = pos_of(p);
+  const vec3 x = pos_at(p);
   precise vec3 f = vec3(0.0);
   bool interior = false;
+  uint has = 0xfffu; // bit k: stencil neighbour k exists (all of them inside)
   if (SC_STENCIL) {
     const uint i = p % SC_NX, j = p / SC_NX;
     interior = i >= 2u && i + 2u < SC_NX && j >= 2u && j + 2u < SC_NY;
+    if (SC_BORDER) {
+      interior = true;
+      has = stencil_present(i, j);
+    }
   }
   if (interior) {
     const int q = int(p);
-    spring_term(f, x, uint(q + SC_OFF0), SC_L0, SC_K0);
-    spring_term(f, x, uint(q + SC_OFF1), SC_L1, SC_K1);
-    spring_term(f, x, uint(q + SC_OFF2), SC_L2, SC_K2);
-    spring_term(f, x, uint(q + SC_OFF3), SC_L3, SC_K3);
-    spring_term(f, x, uint(q + SC_OFF4), SC_L4, SC_K4);
-    spring_term(f, x, uint(q + SC_OFF5), SC_L5, SC_K5);
-    spring_term(f, x, uint(q + SC_OFF6), SC_L6, SC_K6);
-    spring_term(f, x, uint(q + SC_OFF7), SC_L7, SC_K7);
-    spring_term(f, x, uint(q + SC_OFF8), SC_L8, SC_K8);
-    spring_term(f, x, uint(q + SC_OFF9), SC_L9, SC_K9);
-    spring_term(f, x, uint(q + SC_OFF10), SC_L10, SC_K10);
-    spring_term(f, x, uint(q + SC_OFF11), SC_L11, SC_K11);
+    if ((has & 1u) != 0u) spring_term(f, x, uint(q + SC_OFF0), SC_L0, SC_K0);
+    if ((has & 2u) != 0u) spring_term(f, x, uint(q + SC_OFF1), SC_L1, SC_K1);
+    if ((has & 4u) != 0u) spring_term(f, x, uint(q + SC_OFF2), SC_L2, SC_K2);
+    if ((has & 8u) != 0u) spring_term(f, x, uint(q + SC_OFF3), SC_L3, SC_K3);
+    if ((has & 16u) != 0u) spring_term(f, x, uint(q + SC_OFF4), SC_L4, SC_K4);
+    if ((has & 32u) != 0u) spring_term(f, x, uint(q + SC_OFF5), SC_L5, SC_K5);
+    if ((has & 64u) != 0u) spring_term(f, x, uint(q + SC_OFF6), SC_L6, SC_K6);
+    if ((has & 128u) != 0u) spring_term(f, x, uint(q + SC_OFF7), SC_L7, SC_K7);
+    if ((has & 256u) != 0u) spring_term(f, x, uint(q + SC_OFF8), SC_L8, SC_K8);
+    if ((has & 512u) != 0u) spring_term(f, x, uint(q + SC_OFF9), SC_L9, SC_K9);
+    if ((has & 1024u) != 0u) spring_term(f, x, uint(q + SC_OFF10), SC_L10, SC_K10);
+    if ((has & 2048u) != 0u) spring_term(f, x, uint(q + SC_OFF11), SC_L11, SC_K11);
   } else {
     const uint end = offsets[p + 1];
     for (uint e = offsets[p]; e < end; ++e) {
@@ -120,7 +159,7 @@ void particle_force(uint p, inout vec3 v_io, out vec3 f_out, out vec3 nrm_out) {
       spring_term(f, x, s.other, s.rest_length, s.stiffness); // report eq. 2
     }
   }
-  const float m = particle[p].mass;
+  const float m = mass_at(p);
   f = f + ip.gravity_damping.xyz * m;
   precise float mu_m = ip.gravity_damping.w * m;
   precise vec3 v = v_io;
@@ -131,8 +170,8 @@ void particle_force(uint p, inout vec3 v_io, out vec3 f_out, out vec3 nrm_out) {
   }
 
   // Contacts: inside the 2 eps band, remove only the parts of v and F pointing into the collider.
-  if (particle[p].pinned == 0u) {
-    for (uint c = 0u; c < ip.collider_count; ++c) {
+  if (!pinned_at(p)) {
+    for (uint c = 0u; c < (SC_COLLIDERS ? ip.collider_count : 0u); ++c) {
       float dist;
       vec3 n;
       collider_contact(c, x, dist, n);

@@ -46,6 +46,14 @@ struct vec4 {
 #define VKCLOTH_BINDING_INSTANCES 17 // InstanceParams per instance
 #define VKCLOTH_BINDING_COUNT 18
 
+// Set 1 (force.comp, fused.comp): POS_IN again, as an RGBA32F uniform texel buffer view,
+// PARTICLE as an RG32UI one (x: the mass's bits, y: pinned), and (fused.comp) VEL as RGBA32F and
+// FLAGS as R32UI.
+#define VKCLOTH_TEXEL_BINDING_POS_IN 0
+#define VKCLOTH_TEXEL_BINDING_PARTICLE 1
+#define VKCLOTH_TEXEL_BINDING_VEL 2
+#define VKCLOTH_TEXEL_BINDING_FLAGS 3
+
 // PushConstants::flags bits.
 #define VKCLOTH_FLAG_HAS_GRID 1u // the system is a cloth grid: rebuild normals
 #define VKCLOTH_FLAG_WIND 2u     // wind strength != 0

@@ -36,6 +36,7 @@ struct BenchOptions {
   double memory_gbps = 39.0;
   double compute_gflops = 192.0;
   std::string json;
+  std::string variants = "fused,two_pass"; // Vulkan layouts to time (RK4 and implicit: always one)
 };
 
 /// The benchmark scene at n x n: a 1 m x 1 m vertical cloth hanging from its two top corners, in
@@ -276,8 +277,11 @@ int bench_command(const BenchOptions& o) {
     if (o.backend != "vulkan")
       if (int e = add(bench_cpu(*sc, n, o))) return e;
     if (ctx) {
-      if (int e = add(bench_vulkan(*ctx, *sc, n, true, o))) return e;
-      if (*integrator != Integrator::rk4 && !implicit)
+      const bool fused = o.variants.find("fused") != std::string::npos;
+      const bool two_pass = o.variants.find("two_pass") != std::string::npos;
+      if (fused || *integrator == Integrator::rk4 || implicit)
+        if (int e = add(bench_vulkan(*ctx, *sc, n, true, o))) return e;
+      if (two_pass && *integrator != Integrator::rk4 && !implicit)
         if (int e = add(bench_vulkan(*ctx, *sc, n, false, o))) return e;
       if (o.instances > 1) { // many cloths: one batch vs one dispatch chain per cloth, same submission
         if (int e = add(bench_world(*ctx, *sc, n, true, o))) return e;
@@ -405,6 +409,13 @@ void add_bench_command(CLI::App& app, int* exit) {
   cmd->add_option("--dt", opt->dt, "Time step in seconds (default 5e-4, stable at every size)");
   cmd->add_option("--memory-gbps", opt->memory_gbps, "Memory bandwidth ceiling in GB/s")->capture_default_str();
   cmd->add_option("--compute-gflops", opt->compute_gflops, "Compute ceiling in GFLOP/s")->capture_default_str();
+  cmd->add_option("--variants", opt->variants, "Vulkan: fused | two_pass | fused,two_pass (semi-implicit and explicit Euler)")
+      ->capture_default_str()
+      ->check([](const std::string& v) {
+        return v == "fused" || v == "two_pass" || v == "fused,two_pass" || v == "two_pass,fused"
+                   ? std::string()
+                   : std::string("expected fused, two_pass or fused,two_pass");
+      });
   cmd->add_option("--json", opt->json, "Also write the results as JSON to FILE (keys: docs/performance.md)");
   cmd->footer(exit_codes_footer);
   cmd->callback([opt, exit] { *exit = bench_command(*opt); });

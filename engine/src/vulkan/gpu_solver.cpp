@@ -35,10 +35,17 @@ GpuSolver::Impl::~Impl() {
   if (cmd_pool) v.vkDestroyCommandPool(d, cmd_pool, v.allocator);
   if (force_pipeline) v.vkDestroyPipeline(d, force_pipeline, v.allocator);
   if (integrate_pipeline) v.vkDestroyPipeline(d, integrate_pipeline, v.allocator);
-  if (fused_pipeline) v.vkDestroyPipeline(d, fused_pipeline, v.allocator);
+  for (auto& row : fused_pipes)
+    for (VkPipeline p : row)
+      if (p) v.vkDestroyPipeline(d, p, v.allocator);
   if (layout) v.vkDestroyPipelineLayout(d, layout, v.allocator);
   if (pool) v.vkDestroyDescriptorPool(d, pool, v.allocator);
   if (set_layout) v.vkDestroyDescriptorSetLayout(d, set_layout, v.allocator);
+  if (texel_layout) v.vkDestroyDescriptorSetLayout(d, texel_layout, v.allocator);
+  for (VkBufferView view : pos_views)
+    if (view) v.vkDestroyBufferView(d, view, v.allocator);
+  for (VkBufferView view : {particle_view, vel_view, flags_view})
+    if (view) v.vkDestroyBufferView(d, view, v.allocator);
   for (Buffer* b : {&pos[0], &pos[1], &vel, &force, &force_stage, &vel_filt, &normal, &uv, &stage_pos, &stage_vel, &acc_pos,
                     &acc_vel, &particle, &offsets, &edges, &indices, &colliders, &flags, &instances})
     destroy_buffer(*ctx, *b);
@@ -72,22 +79,32 @@ Result<void> GpuSolver::Impl::init_pipelines() {
   li.bindingCount = static_cast<std::uint32_t>(bindings.size());
   li.pBindings = bindings.data();
   VKCLOTH_VK_TRY(v.vkCreateDescriptorSetLayout(d, &li, v.allocator, &set_layout), "vkCreateDescriptorSetLayout");
+  const VkDescriptorSetLayoutBinding texel_bindings[4] = {
+      {VKCLOTH_TEXEL_BINDING_POS_IN, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+      {VKCLOTH_TEXEL_BINDING_PARTICLE, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+      {VKCLOTH_TEXEL_BINDING_VEL, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+      {VKCLOTH_TEXEL_BINDING_FLAGS, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr}};
+  li.bindingCount = 4;
+  li.pBindings = texel_bindings;
+  VKCLOTH_VK_TRY(v.vkCreateDescriptorSetLayout(d, &li, v.allocator, &texel_layout), "vkCreateDescriptorSetLayout (texel)");
 
   const VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(sh::PushConstants)};
   VkPipelineLayoutCreateInfo pi{};
   pi.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
-  pi.setLayoutCount = 1;
-  pi.pSetLayouts = &set_layout;
+  const VkDescriptorSetLayout set_layouts[2] = {set_layout, texel_layout};
+  pi.setLayoutCount = 2;
+  pi.pSetLayouts = set_layouts;
   pi.pushConstantRangeCount = 1;
   pi.pPushConstantRanges = &range;
   VKCLOTH_VK_TRY(v.vkCreatePipelineLayout(d, &pi, v.allocator, &layout), "vkCreatePipelineLayout");
 
-  const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 4 * VKCLOTH_BINDING_COUNT};
+  const VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 4 * VKCLOTH_BINDING_COUNT},
+                                         {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 4 * 3}};
   VkDescriptorPoolCreateInfo dp{};
   dp.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
-  dp.maxSets = 4;
-  dp.poolSizeCount = 1;
-  dp.pPoolSizes = &size;
+  dp.maxSets = 4 + 3;
+  dp.poolSizeCount = 2;
+  dp.pPoolSizes = sizes;
   VKCLOTH_VK_TRY(v.vkCreateDescriptorPool(d, &dp, v.allocator, &pool), "vkCreateDescriptorPool");
   const VkDescriptorSetLayout layouts[4] = {set_layout, set_layout, set_layout, set_layout};
   VkDescriptorSetAllocateInfo ai{};
@@ -96,8 +113,61 @@ Result<void> GpuSolver::Impl::init_pipelines() {
   ai.descriptorSetCount = 4;
   ai.pSetLayouts = layouts;
   VKCLOTH_VK_TRY(v.vkAllocateDescriptorSets(d, &ai, &sets[0][0]), "vkAllocateDescriptorSets");
+  // The texel sets never change: positions[0/1] and the stage positions live as long as the solver.
+  const VkDescriptorSetLayout texel_layouts[3] = {texel_layout, texel_layout, texel_layout};
+  ai.descriptorSetCount = 3;
+  ai.pSetLayouts = texel_layouts;
+  VKCLOTH_VK_TRY(v.vkAllocateDescriptorSets(d, &ai, texel_sets), "vkAllocateDescriptorSets (texel)");
+  const Buffer* viewed[3] = {&pos[0], &pos[1], &stage_pos};
+  VkWriteDescriptorSet texel_writes[12]{};
+  // The same views in all three sets: particle constants (sh::ParticleInfo), velocities, flags.
+  // Uniform texel buffer support is mandatory for these formats.
+  const struct {
+    const Buffer* buffer;
+    VkFormat format;
+    VkBufferView* view;
+    std::uint32_t binding;
+    const char* what;
+  } shared_views[3] = {
+      {&particle, VK_FORMAT_R32G32_UINT, &particle_view, VKCLOTH_TEXEL_BINDING_PARTICLE, "vkCreateBufferView (particle constants)"},
+      {&vel, VK_FORMAT_R32G32B32A32_SFLOAT, &vel_view, VKCLOTH_TEXEL_BINDING_VEL, "vkCreateBufferView (velocities)"},
+      {&flags, VK_FORMAT_R32_UINT, &flags_view, VKCLOTH_TEXEL_BINDING_FLAGS, "vkCreateBufferView (flags)"}};
+  for (int b = 0; b < 3; ++b) {
+    VkBufferViewCreateInfo bvi{};
+    bvi.sType = VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO;
+    bvi.buffer = shared_views[b].buffer->buffer;
+    bvi.format = shared_views[b].format;
+    bvi.offset = 0;
+    bvi.range = VK_WHOLE_SIZE;
+    VKCLOTH_VK_TRY(v.vkCreateBufferView(d, &bvi, v.allocator, shared_views[b].view), shared_views[b].what);
+    for (int k = 0; k < 3; ++k) {
+      VkWriteDescriptorSet& w = texel_writes[3 + 3 * b + k];
+      w.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+      w.dstSet = texel_sets[k];
+      w.dstBinding = shared_views[b].binding;
+      w.descriptorCount = 1;
+      w.descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+      w.pTexelBufferView = shared_views[b].view;
+    }
+  }
+  for (int k = 0; k < 3; ++k) {
+    VkBufferViewCreateInfo vi{};
+    vi.sType = VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO;
+    vi.buffer = viewed[k]->buffer;
+    vi.format = VK_FORMAT_R32G32B32A32_SFLOAT; // uniform texel buffer support is mandatory for it
+    vi.offset = 0;
+    vi.range = VK_WHOLE_SIZE;
+    VKCLOTH_VK_TRY(v.vkCreateBufferView(d, &vi, v.allocator, &pos_views[k]), "vkCreateBufferView (positions)");
+    texel_writes[k].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+    texel_writes[k].dstSet = texel_sets[k];
+    texel_writes[k].dstBinding = VKCLOTH_TEXEL_BINDING_POS_IN;
+    texel_writes[k].descriptorCount = 1;
+    texel_writes[k].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+    texel_writes[k].pTexelBufferView = &pos_views[k];
+  }
+  v.vkUpdateDescriptorSets(d, 12, texel_writes, 0, nullptr);
 
-  VkShaderModule modules[3] = {};
+  VkShaderModule modules[2] = {};
   auto destroy_modules = [&] {
     for (VkShaderModule m : modules)
       if (m) v.vkDestroyShaderModule(d, m, v.allocator);
@@ -112,33 +182,62 @@ Result<void> GpuSolver::Impl::init_pipelines() {
       return im.error();
     }
     modules[1] = *im;
-    auto um = make_module(v, d, spirv::fused_comp_spv, "fused.comp");
-    if (!um) {
-      destroy_modules();
-      return um.error();
-    }
-    modules[2] = *um;
   }
   // Specialisation constants of force_body.glsl (force.comp, fused.comp): the grid stencil.
-  static_assert(sizeof(Stencil) == 39 * 4);
-  std::array<VkSpecializationMapEntry, 39> entries{};
+  static_assert(sizeof(Stencil) == 40 * 4);
+  std::array<VkSpecializationMapEntry, 40> entries{};
   for (std::uint32_t k = 0; k < entries.size(); ++k) entries[k] = VkSpecializationMapEntry{k, k * 4, 4};
   const VkSpecializationInfo spec{static_cast<std::uint32_t>(entries.size()), entries.data(), sizeof(Stencil), &stencil};
-  VkComputePipelineCreateInfo ci[3]{};
-  for (int k = 0; k < 3; ++k) {
+  VkComputePipelineCreateInfo ci[2]{};
+  for (int k = 0; k < 2; ++k) {
     ci[k].sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
     ci[k].stage = VkPipelineShaderStageCreateInfo{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0,
                                                   VK_SHADER_STAGE_COMPUTE_BIT, modules[k], "main",
                                                   k == 1 ? nullptr : &spec};
     ci[k].layout = layout;
   }
-  VkPipeline pipes[3] = {};
-  const VkResult r = v.vkCreateComputePipelines(d, VK_NULL_HANDLE, 3, ci, v.allocator, pipes);
+  VkPipeline pipes[2] = {};
+  const VkResult r = v.vkCreateComputePipelines(d, VK_NULL_HANDLE, 2, ci, v.allocator, pipes);
   destroy_modules();
-  if (r != VK_SUCCESS) return vk_error(r, "vkCreateComputePipelines (force.comp, integrate.comp, fused.comp)");
+  if (r != VK_SUCCESS) return vk_error(r, "vkCreateComputePipelines (force.comp, integrate.comp)");
   force_pipeline = pipes[0];
   integrate_pipeline = pipes[1];
-  fused_pipeline = pipes[2];
+  return {};
+}
+
+// The fused.comp variants the current parameters need ([0] and [1] x colliders in the batch or not).
+Result<void> GpuSolver::Impl::ensure_fused() {
+  const std::uint32_t col = any_colliders() ? 1u : 0u;
+  if (!options.fused || (fused_pipes[0][col] && fused_pipes[1][col])) return {};
+  const auto& v = vk();
+  const VkDevice d = ctx->device;
+  auto m = make_module(v, d, spirv::fused_comp_spv, "fused.comp");
+  if (!m) return m.error();
+  // Constant ids 0..39: the stencil; 40: SC_WRITE_AUX; 41: SC_COLLIDERS (fused.comp, common.glsl).
+  struct Data {
+    Stencil st;
+    std::uint32_t write_aux, colliders; // VkBool32
+  } data[2] = {{stencil, 0u, col}, {stencil, 1u, col}};
+  static_assert(sizeof(Data) == 42 * 4);
+  std::array<VkSpecializationMapEntry, 42> entries{};
+  for (std::uint32_t k = 0; k < entries.size(); ++k) entries[k] = VkSpecializationMapEntry{k, k * 4, 4};
+  VkSpecializationInfo spec[2];
+  VkComputePipelineCreateInfo ci[2]{};
+  for (int k = 0; k < 2; ++k) {
+    spec[k] = VkSpecializationInfo{static_cast<std::uint32_t>(entries.size()), entries.data(), sizeof(Data), &data[k]};
+    ci[k].sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
+    ci[k].stage = VkPipelineShaderStageCreateInfo{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0,
+                                                  VK_SHADER_STAGE_COMPUTE_BIT, *m, "main", &spec[k]};
+    ci[k].layout = layout;
+  }
+  VkPipeline pipes[2] = {};
+  const VkResult r = v.vkCreateComputePipelines(d, VK_NULL_HANDLE, 2, ci, v.allocator, pipes);
+  v.vkDestroyShaderModule(d, *m, v.allocator);
+  if (r != VK_SUCCESS) return vk_error(r, "vkCreateComputePipelines (fused.comp)");
+  for (int k = 0; k < 2; ++k) {
+    if (fused_pipes[k][col]) v.vkDestroyPipeline(d, fused_pipes[k][col], v.allocator);
+    fused_pipes[k][col] = pipes[k];
+  }
   return {};
 }
 
@@ -177,6 +276,31 @@ void GpuSolver::Impl::detect_stencil(const ParticleSystem& system) {
       }
     }
   stencil = st;
+  // Border particles (SC_BORDER): their lists must be the stencil entries whose neighbour lies in
+  // the grid, in stencil order, with the same constants; offsets must be (di, dj) in [-2, 2]^2.
+  std::int64_t di[12], dj[12];
+  for (int k = 0; k < 12; ++k) {
+    dj[k] = (st.offset[k] + 2 * gx + 2) / gx - 2;
+    di[k] = st.offset[k] - dj[k] * gx;
+    if (st.offset[k] + 2 * gx + 2 < 0 || dj[k] < -2 || dj[k] > 2 || di[k] < -2 || di[k] > 2) return;
+  }
+  for (std::int64_t j = 0; j < gy; ++j)
+    for (std::int64_t i = 0; i < gx; ++i) {
+      if (i >= 2 && i < gx - 2 && j >= 2 && j < gy - 2) continue; // checked above
+      const std::int64_t p = j * gx + i;
+      std::int64_t e = off[p];
+      for (int k = 0; k < 12; ++k) {
+        if (i + di[k] < 0 || i + di[k] >= gx || j + dj[k] < 0 || j + dj[k] >= gy) continue;
+        if (e >= off[p + 1]) return;
+        const SpringRef& r = refs[e++];
+        const Spring& sp = system.springs[r.spring];
+        if (std::int64_t(r.other) - p != st.offset[k] || float(sp.rest_length) != st.rest[k] ||
+            float(sp.stiffness) != st.stiffness[k])
+          return;
+      }
+      if (e != off[p + 1]) return;
+    }
+  stencil.border = 1;
 }
 
 Result<void> GpuSolver::Impl::write_sets() {
@@ -356,6 +480,7 @@ Result<void> GpuSolver::Impl::set_slot_params(std::uint32_t slot, SimParams para
   slots[slot].params = std::move(params);
   VKCLOTH_TRY(upload_colliders());
   VKCLOTH_TRY(ensure_implicit());
+  VKCLOTH_TRY(ensure_fused());
   upload_instance_params();
   return {};
 }
@@ -375,7 +500,7 @@ void GpuSolver::Impl::record(VkCommandBuffer c, std::uint32_t steps) {
   for (std::uint32_t s = 0; s < steps; ++s) {
     pc.step = static_cast<std::uint32_t>(recorded + 1); // 1-based number of the step being computed
     for (std::uint32_t k = 0; k < family().substeps; ++k) {
-      record_substep(c, first);
+      record_substep(c, first, s + 1 == steps && k + 1 == family().substeps);
       first = false;
       parity ^= 1u; // positions[read ^ 1] now holds the new state
     }
@@ -396,7 +521,7 @@ void GpuSolver::Impl::record_copy_slot(VkCommandBuffer c, const Impl& from, std:
   for (auto [src, dst] : copies) vk().vkCmdCopyBuffer(c, src->buffer, dst->buffer, 1, &region);
 }
 
-void GpuSolver::Impl::record_substep(VkCommandBuffer c, bool first) {
+void GpuSolver::Impl::record_substep(VkCommandBuffer c, bool first, bool last) {
   const auto& v = vk();
   const std::uint32_t read = current();
   if (family().integrator == Integrator::implicit_euler) {
@@ -407,10 +532,10 @@ void GpuSolver::Impl::record_substep(VkCommandBuffer c, bool first) {
   const bool rk4 = family().integrator == Integrator::rk4;
   if (options.fused && !rk4) {
     // One dispatch per (sub)step (fused.comp); the descriptor set alternates with the parity.
-    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, fused_pipeline);
+    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, fused_pipes[last ? 1 : 0][any_colliders() ? 1 : 0]);
     pc.stage = 0;
-    const VkDescriptorSet set = sets[read][0];
-    v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &set, 0, nullptr);
+    const VkDescriptorSet bound_sets[2] = {sets[read][0], texel_sets[read]};
+    v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 2, bound_sets, 0, nullptr);
     v.vkCmdPushConstants(c, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
     if (!first) barriers::dispatch_to_dispatch(v, c); // previous step -> this step
     v.vkCmdDispatch(c, groups_x, groups_y, instances_z);
@@ -423,7 +548,8 @@ void GpuSolver::Impl::record_substep(VkCommandBuffer c, bool first) {
     pc.stage = k;
     const VkDescriptorSet set = sets[read][k == 0 ? 0 : 1];
     if (set != bound) {
-      v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &set, 0, nullptr);
+      const VkDescriptorSet bound_sets[2] = {set, texel_sets[k == 0 ? read : 2]};
+      v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 2, bound_sets, 0, nullptr);
       bound = set;
     }
     v.vkCmdPushConstants(c, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
@@ -470,6 +596,14 @@ Result<std::unique_ptr<GpuSolver::Impl>> GpuSolver::Impl::create(const std::shar
                                     ctx->name, need.what, need.bytes, need.items, need.per, max_bytes,
                                     overridden ? "GpuSolverOptions::max_storage_buffer_bytes"
                                                : "maxStorageBufferRange"));
+  // Positions, velocities and particle constants are also read through texel buffer views (one
+  // texel per particle of every instance).
+  if (batch * n > lim.maxTexelBufferElements)
+    return make_error(ErrorCode::unsupported,
+                      fmt::format("the system is too large for device '{}': {} particles ({} instances of {}) need "
+                                  "{} texels per texel buffer view but the device allows {} (maxTexelBufferElements); "
+                                  "use fewer particles or fewer instances of one topology",
+                                  ctx->name, batch * n, batch, n, batch * n, lim.maxTexelBufferElements));
   const std::uint64_t groups = (std::uint64_t(n) + VKCLOTH_WORKGROUP_SIZE - 1) / VKCLOTH_WORKGROUP_SIZE;
   std::uint64_t row = lim.maxComputeWorkGroupCount[0];
   if (options.max_workgroups_x) row = std::min<std::uint64_t>(row, options.max_workgroups_x);
@@ -506,7 +640,8 @@ Result<std::unique_ptr<GpuSolver::Impl>> GpuSolver::Impl::create(const std::shar
   // Buffers. Bulk ones prefer device-local + host-visible (mapped) unless staging is forced.
   // VERTEX_BUFFER: a renderer binds positions, normals and uvs as vertex buffers (render/).
   const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
-                                   VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT;
+                                   VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT |
+                                   VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT; // positions: force_body.glsl pos_at
   const VkDeviceSize vec4_bytes = VkDeviceSize(batch) * n * 16;
   const bool allow_map = !options.force_staging;
   std::vector<std::uint32_t> families;
@@ -546,8 +681,9 @@ Result<std::unique_ptr<GpuSolver::Impl>> GpuSolver::Impl::create(const std::shar
   }
   s.staging = s.pos[0].mapped == nullptr;
   {
-    auto r = create_buffer(*ctx, batch * sizeof(sh::Flags), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::host_readback,
-                           true, "flags");
+    auto r = create_buffer(*ctx, batch * sizeof(sh::Flags),
+                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT,
+                           MemoryUse::host_readback, true, "flags"); // texel view: fused.comp
     if (!r) return r.error();
     s.flags = *r;
     for (std::uint64_t k = 0; k < batch; ++k)
@@ -588,6 +724,7 @@ Result<std::unique_ptr<GpuSolver::Impl>> GpuSolver::Impl::create(const std::shar
   VKCLOTH_TRY(s.init_pipelines());
   VKCLOTH_TRY(s.write_sets());
   VKCLOTH_TRY(s.ensure_implicit());
+  VKCLOTH_TRY(s.ensure_fused());
   s.upload_instance_params();
 
   // Initial state of every instance, converted as CpuSolver<float>::create converts it.

@@ -52,19 +52,32 @@ struct GpuSolver::Impl {
   VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
   VkDescriptorPool pool = VK_NULL_HANDLE;
   VkDescriptorSet sets[2][2] = {}; // [positions read index][0: state input, 1: RK4 stage input]
+  // Set 1 of force.comp / fused.comp: POS_IN as an RGBA32F uniform texel buffer (force_body.glsl
+  // pos_at) and the particle constants as an RG32UI one. [0], [1]: positions[0], positions[1];
+  // [2]: RK4 stage positions.
+  VkDescriptorSetLayout texel_layout = VK_NULL_HANDLE;
+  VkBufferView pos_views[3] = {};
+  VkBufferView particle_view = VK_NULL_HANDLE, vel_view = VK_NULL_HANDLE, flags_view = VK_NULL_HANDLE;
+  VkDescriptorSet texel_sets[3] = {};
   VkPipelineLayout layout = VK_NULL_HANDLE;
-  VkPipeline force_pipeline = VK_NULL_HANDLE, integrate_pipeline = VK_NULL_HANDLE, fused_pipeline = VK_NULL_HANDLE;
+  VkPipeline force_pipeline = VK_NULL_HANDLE, integrate_pipeline = VK_NULL_HANDLE;
+  // fused.comp variants, created when first needed (ensure_fused): [write_aux][colliders].
+  // write_aux = 0 (SC_WRITE_AUX false: no force and normal stores) for every fused substep of a
+  // recorded batch of steps but the last, since only the last one's forces and normals can be
+  // observed; colliders = 0 (SC_COLLIDERS false: no contact loops) while no instance has colliders.
+  VkPipeline fused_pipes[2][2] = {};
   VkCommandPool cmd_pool = VK_NULL_HANDLE;
   VkCommandBuffer cmd = VK_NULL_HANDLE;
   VkFence fence = VK_NULL_HANDLE;
   VkQueryPool queries = VK_NULL_HANDLE;
   std::uint32_t groups_x = 1, groups_y = 1;
-  // Grid stencil (force_body.glsl's specialisation constants 0..38): constant_id order.
+  // Grid stencil (force_body.glsl's specialisation constants 0..39): constant_id order.
   struct Stencil {
     std::uint32_t enabled = 0; // VkBool32
     std::uint32_t nx = 1, ny = 1;
     std::int32_t offset[12] = {};
     float rest[12] = {}, stiffness[12] = {};
+    std::uint32_t border = 0; // VkBool32: border particles use the stencil too (SC_BORDER)
   } stencil;
   std::uint64_t edges_count = 0;
 
@@ -90,6 +103,11 @@ struct GpuSolver::Impl {
 
   std::uint32_t batch() const { return static_cast<std::uint32_t>(slots.size()); }
   const SimParams& family() const { return slots.front().params; } // integrator family, substeps
+  bool any_colliders() const {
+    for (const Slot& slot : slots)
+      if (!slot.params.colliders.empty()) return true;
+    return false;
+  }
   const DeviceFns& vk() const { return ctx->vk; }
   std::uint32_t current() const { return parity; }
   VkDeviceSize slot_offset(std::uint32_t slot) const { return VkDeviceSize(slot) * count * GpuSolver::stride; }
@@ -98,8 +116,10 @@ struct GpuSolver::Impl {
   /// New parameters for one instance (validated by the caller; same family and substeps).
   Result<void> set_slot_params(std::uint32_t slot, SimParams params);
   Result<void> ensure_implicit();
+  Result<void> ensure_fused();
   void record(VkCommandBuffer cmd, std::uint32_t steps);
-  void record_substep(VkCommandBuffer cmd, bool first);
+  /// `last`: the last substep of this recording (the fused variant that stores forces and normals).
+  void record_substep(VkCommandBuffer cmd, bool first, bool last);
   /// Copies instance `from_slot` of `from` (current positions, velocities, normals, forces) into
   /// instance `to_slot` of this batch (both position buffers); the caller records the barriers.
   void record_copy_slot(VkCommandBuffer cmd, const Impl& from, std::uint32_t from_slot, std::uint32_t to_slot) const;

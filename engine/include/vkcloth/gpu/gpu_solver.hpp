@@ -138,6 +138,9 @@ public:
   Result<std::vector<glm::vec3>> positions();
   Result<std::vector<glm::vec3>> velocities();
   /// Unit normals of the last force evaluation (zero for chains and degenerate fans).
+  /// Fused Euler (the default) writes forces and normals only in the last substep of each recorded
+  /// batch (each submission of simulate(), each record_steps() call), so after a divergence inside
+  /// a batch they are those of the last batch end before it, not the bad step's.
   Result<std::vector<glm::vec3>> normals();
   /// Forces of the last evaluation after contacts (for RK4 the first stage's), as on the CPU.
   Result<std::vector<glm::vec3>> forces();
