@@ -33,13 +33,37 @@ uint inst;
 uint base;
 InstanceParams ip;
 
+#ifdef VKCLOTH_PC_COPY
+// The same shaders (force.comp, fused.comp, integrate.comp) read the instance parameters through
+// an RGBA32UI texel view (set 1): on llvmpipe an SSBO load is a per-lane loop even at an index
+// that is the same for the whole workgroup; a texel fetch is one vectorised call.
+layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_INSTANCES) uniform usamplerBuffer instances_texel;
+#endif
+
 void begin_instance() {
+  inst = gl_WorkGroupID.z;
 #ifdef VKCLOTH_PC_COPY
   pc = pc_block; // before any branch (see above)
-#endif
-  inst = gl_WorkGroupID.z;
+  base = inst * pc.count;
+  const int t = int(inst) * 5; // sizeof(InstanceParams) / 16
+  const uvec4 a = texelFetch(instances_texel, t), g = texelFetch(instances_texel, t + 1),
+              w = texelFetch(instances_texel, t + 2), d = texelFetch(instances_texel, t + 3),
+              e = texelFetch(instances_texel, t + 4);
+  ip.flags = a.x;
+  ip.integrator = a.y;
+  ip.collider_first = a.z;
+  ip.collider_count = a.w;
+  ip.gravity_damping = uintBitsToFloat(g);
+  ip.wind = uintBitsToFloat(w);
+  ip.dt = uintBitsToFloat(d.x);
+  ip.w6 = uintBitsToFloat(d.y);
+  ip.band = uintBitsToFloat(d.z);
+  ip.eps = uintBitsToFloat(d.w);
+  ip.limit = uintBitsToFloat(e.x);
+#else
   base = inst * pc.count;
   ip = instances[inst];
+#endif
 }
 
 // Particle index within the instance: 1-D, with a second grid dimension when one row of workgroups is not enough.

@@ -48,11 +48,12 @@ struct vec4 {
 
 // Set 1 (force.comp, fused.comp): POS_IN again, as an RGBA32F uniform texel buffer view,
 // PARTICLE as an RG32UI one (x: the mass's bits, y: pinned), and (fused.comp) VEL as RGBA32F and
-// FLAGS as R32UI.
+// FLAGS as R32UI; INSTANCES as RGBA32UI (common.glsl begin_instance).
 #define VKCLOTH_TEXEL_BINDING_POS_IN 0
 #define VKCLOTH_TEXEL_BINDING_PARTICLE 1
 #define VKCLOTH_TEXEL_BINDING_VEL 2
 #define VKCLOTH_TEXEL_BINDING_FLAGS 3
+#define VKCLOTH_TEXEL_BINDING_INSTANCES 4 // InstanceParams as RGBA32UI, 5 texels per instance
 
 // PushConstants::flags bits.
 #define VKCLOTH_FLAG_HAS_GRID 1u // the system is a cloth grid: rebuild normals

@@ -44,7 +44,7 @@ GpuSolver::Impl::~Impl() {
   if (texel_layout) v.vkDestroyDescriptorSetLayout(d, texel_layout, v.allocator);
   for (VkBufferView view : pos_views)
     if (view) v.vkDestroyBufferView(d, view, v.allocator);
-  for (VkBufferView view : {particle_view, vel_view, flags_view})
+  for (VkBufferView view : {particle_view, vel_view, flags_view, instances_view})
     if (view) v.vkDestroyBufferView(d, view, v.allocator);
   for (Buffer* b : {&pos[0], &pos[1], &vel, &force, &force_stage, &vel_filt, &normal, &uv, &stage_pos, &stage_vel, &acc_pos,
                     &acc_vel, &particle, &offsets, &edges, &indices, &colliders, &flags, &instances})
@@ -79,12 +79,13 @@ Result<void> GpuSolver::Impl::init_pipelines() {
   li.bindingCount = static_cast<std::uint32_t>(bindings.size());
   li.pBindings = bindings.data();
   VKCLOTH_VK_TRY(v.vkCreateDescriptorSetLayout(d, &li, v.allocator, &set_layout), "vkCreateDescriptorSetLayout");
-  const VkDescriptorSetLayoutBinding texel_bindings[4] = {
+  const VkDescriptorSetLayoutBinding texel_bindings[5] = {
       {VKCLOTH_TEXEL_BINDING_POS_IN, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
       {VKCLOTH_TEXEL_BINDING_PARTICLE, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
       {VKCLOTH_TEXEL_BINDING_VEL, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
-      {VKCLOTH_TEXEL_BINDING_FLAGS, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr}};
-  li.bindingCount = 4;
+      {VKCLOTH_TEXEL_BINDING_FLAGS, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+      {VKCLOTH_TEXEL_BINDING_INSTANCES, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr}};
+  li.bindingCount = 5;
   li.pBindings = texel_bindings;
   VKCLOTH_VK_TRY(v.vkCreateDescriptorSetLayout(d, &li, v.allocator, &texel_layout), "vkCreateDescriptorSetLayout (texel)");
 
@@ -99,7 +100,7 @@ Result<void> GpuSolver::Impl::init_pipelines() {
   VKCLOTH_VK_TRY(v.vkCreatePipelineLayout(d, &pi, v.allocator, &layout), "vkCreatePipelineLayout");
 
   const VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 4 * VKCLOTH_BINDING_COUNT},
-                                         {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 4 * 3}};
+                                         {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 5 * 3}};
   VkDescriptorPoolCreateInfo dp{};
   dp.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
   dp.maxSets = 4 + 3;
@@ -119,8 +120,9 @@ Result<void> GpuSolver::Impl::init_pipelines() {
   ai.pSetLayouts = texel_layouts;
   VKCLOTH_VK_TRY(v.vkAllocateDescriptorSets(d, &ai, texel_sets), "vkAllocateDescriptorSets (texel)");
   const Buffer* viewed[3] = {&pos[0], &pos[1], &stage_pos};
-  VkWriteDescriptorSet texel_writes[12]{};
-  // The same views in all three sets: particle constants (sh::ParticleInfo), velocities, flags.
+  VkWriteDescriptorSet texel_writes[15]{};
+  // The same views in all three sets: particle constants (sh::ParticleInfo), velocities, flags,
+  // instance parameters.
   // Uniform texel buffer support is mandatory for these formats.
   const struct {
     const Buffer* buffer;
@@ -128,11 +130,13 @@ Result<void> GpuSolver::Impl::init_pipelines() {
     VkBufferView* view;
     std::uint32_t binding;
     const char* what;
-  } shared_views[3] = {
+  } shared_views[4] = {
       {&particle, VK_FORMAT_R32G32_UINT, &particle_view, VKCLOTH_TEXEL_BINDING_PARTICLE, "vkCreateBufferView (particle constants)"},
       {&vel, VK_FORMAT_R32G32B32A32_SFLOAT, &vel_view, VKCLOTH_TEXEL_BINDING_VEL, "vkCreateBufferView (velocities)"},
-      {&flags, VK_FORMAT_R32_UINT, &flags_view, VKCLOTH_TEXEL_BINDING_FLAGS, "vkCreateBufferView (flags)"}};
-  for (int b = 0; b < 3; ++b) {
+      {&flags, VK_FORMAT_R32_UINT, &flags_view, VKCLOTH_TEXEL_BINDING_FLAGS, "vkCreateBufferView (flags)"},
+      {&instances, VK_FORMAT_R32G32B32A32_UINT, &instances_view, VKCLOTH_TEXEL_BINDING_INSTANCES,
+       "vkCreateBufferView (instance parameters)"}};
+  for (int b = 0; b < 4; ++b) {
     VkBufferViewCreateInfo bvi{};
     bvi.sType = VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO;
     bvi.buffer = shared_views[b].buffer->buffer;
@@ -165,7 +169,7 @@ Result<void> GpuSolver::Impl::init_pipelines() {
     texel_writes[k].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
     texel_writes[k].pTexelBufferView = &pos_views[k];
   }
-  v.vkUpdateDescriptorSets(d, 12, texel_writes, 0, nullptr);
+  v.vkUpdateDescriptorSets(d, 15, texel_writes, 0, nullptr);
 
   VkShaderModule modules[2] = {};
   auto destroy_modules = [&] {
@@ -690,8 +694,9 @@ Result<std::unique_ptr<GpuSolver::Impl>> GpuSolver::Impl::create(const std::shar
       static_cast<sh::Flags*>(s.flags.mapped)[k] = sh::Flags{0, VKCLOTH_NO_BAD_STEP, VKCLOTH_NO_BAD_STEP, 0};
   }
   {
-    auto r = create_buffer(*ctx, batch * sizeof(sh::InstanceParams), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                           MemoryUse::host_upload, true, "instance parameters");
+    auto r = create_buffer(*ctx, batch * sizeof(sh::InstanceParams),
+                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT,
+                           MemoryUse::host_upload, true, "instance parameters"); // texel view: common.glsl
     if (!r) return r.error();
     s.instances = *r;
   }

@@ -53,11 +53,12 @@ struct GpuSolver::Impl {
   VkDescriptorPool pool = VK_NULL_HANDLE;
   VkDescriptorSet sets[2][2] = {}; // [positions read index][0: state input, 1: RK4 stage input]
   // Set 1 of force.comp / fused.comp: POS_IN as an RGBA32F uniform texel buffer (force_body.glsl
-  // pos_at) and the particle constants as an RG32UI one. [0], [1]: positions[0], positions[1];
+  // pos_at), the particle constants as an RG32UI one, velocities, flags, instance parameters. [0], [1]: positions[0], positions[1];
   // [2]: RK4 stage positions.
   VkDescriptorSetLayout texel_layout = VK_NULL_HANDLE;
   VkBufferView pos_views[3] = {};
-  VkBufferView particle_view = VK_NULL_HANDLE, vel_view = VK_NULL_HANDLE, flags_view = VK_NULL_HANDLE;
+  VkBufferView particle_view = VK_NULL_HANDLE, vel_view = VK_NULL_HANDLE, flags_view = VK_NULL_HANDLE,
+               instances_view = VK_NULL_HANDLE;
   VkDescriptorSet texel_sets[3] = {};
   VkPipelineLayout layout = VK_NULL_HANDLE;
   VkPipeline force_pipeline = VK_NULL_HANDLE, integrate_pipeline = VK_NULL_HANDLE;
