@@ -375,6 +375,77 @@ TEST_CASE("the CPU grid stencil gives the same results as the CSR gather lists")
   }
 }
 
+TEST_CASE("the CPU row sweep: masked border rows and the per-particle border give the CSR lists' bits") {
+  // Three solvers on one jittered cloth: `masked` (make_cloth's lists: every particle takes the
+  // row kernel, border particles with their stencil masks), `border` (a zero-stiffness spring
+  // between two border particles makes their lists irregular: no masks, the border particles
+  // take the per-particle code) and `csr` (the same between interior particles: no stencil, the
+  // CSR lists everywhere). A zero-stiffness spring adds u * 0 = 0 last, which changes no value.
+  // Midway, set_particle and a few RK4 steps change the positions outside the row sweep: the
+  // sweep's SoA copy must be rebuilt from them.
+  ClothDesc d;
+  d.nx = 41;
+  d.ny = 19;
+  d.particle_mass = 0.3;
+  d.origin = {-0.5, 0.0, 0.5};
+  ParticleSystem masked = cloth(d);
+  masked.particles[std::size_t(1 * d.nx + 20)].pinned = true; // a pinned border particle
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> jitter(-0.004, 0.004);
+  for (Particle& q : masked.particles) {
+    q.position += glm::dvec3{jitter(rng), jitter(rng), jitter(rng)};
+    if (!q.pinned) q.velocity = glm::dvec3{jitter(rng), jitter(rng), jitter(rng)} * 10.0;
+  }
+  ParticleSystem border = masked;
+  border.springs.push_back(Spring{0, d.nx + 3, 0.1, 0.0, SpringKind::plain});
+  border.finalize();
+  ParticleSystem csr = masked;
+  csr.springs.push_back(Spring{5 * d.nx + 5, 6 * d.nx + 7, 0.1, 0.0, SpringKind::plain});
+  csr.finalize();
+  SimParams p;
+  p.wind = {0.07, {0.2, 1, 0.1}};
+  for (int colliders = 0; colliders < 2; ++colliders)
+    for (Integrator integ : {Integrator::explicit_euler, Integrator::semi_implicit_euler})
+      for (unsigned threads : {1u, 2u}) {
+        CAPTURE(colliders);
+        CAPTURE(to_string(integ));
+        CAPTURE(threads);
+        p.integrator = integ;
+        p.dt = integ == Integrator::explicit_euler ? 0.004 : 0.02;
+        if (colliders == 0) p.colliders.clear();
+        else p.colliders = {Collider::sphere({0, 0.2, 0.2}, 0.3)};
+        std::vector<CpuSolver<float>> s;
+        for (const ParticleSystem* sys : {&masked, &border, &csr}) {
+          auto c = CpuSolver<float>::create(*sys, p, {threads});
+          REQUIRE(c.ok());
+          s.push_back(std::move(*c));
+        }
+        for (CpuSolver<float>& c : s) {
+          REQUIRE(c.run(15).ok());
+          // A border and an interior particle moved by a "hand".
+          REQUIRE(c.set_particle(std::uint32_t(d.nx + 7), glm::vec3(-0.3f, 0.01f, 0.45f), glm::vec3(0.1f, 0, 0)).ok());
+          REQUIRE(c.set_particle(std::uint32_t(9 * d.nx + 20), glm::vec3(0.02f, 0.05f, 0.2f), glm::vec3(0)).ok());
+          REQUIRE(c.run(10).ok());
+          SimParams rk = p;
+          rk.integrator = Integrator::rk4;
+          REQUIRE(c.set_params(rk).ok());
+          REQUIRE(c.run(3).ok());
+          REQUIRE(c.set_params(p).ok());
+          REQUIRE(c.run(10).ok());
+        }
+        for (std::size_t k = 1; k < s.size(); ++k) {
+          CAPTURE(k);
+          std::size_t differ = 0;
+          for (std::size_t q = 0; q < s[0].positions().size(); ++q)
+            differ += std::memcmp(&s[0].positions()[q], &s[k].positions()[q], sizeof(glm::vec3)) != 0 ||
+                      std::memcmp(&s[0].velocities()[q], &s[k].velocities()[q], sizeof(glm::vec3)) != 0 ||
+                      std::memcmp(&s[0].forces()[q], &s[k].forces()[q], sizeof(glm::vec3)) != 0 ||
+                      std::memcmp(&s[0].normals()[q], &s[k].normals()[q], sizeof(glm::vec3)) != 0;
+          CHECK(differ == 0);
+        }
+      }
+}
+
 namespace {
 /// Runs `steps` steps of a CpuSolver<Real> created while VKCLOTH_CPU_SIMD = `isa` (the row kernel's
 /// ISA is chosen at creation), returning positions, velocities, forces and normals end to end.

@@ -17,8 +17,13 @@ template <typename Real> struct RowArgs {
   const std::uint8_t* pinned;
   Real* force_out;             // AoS
   Real* normal_out;            // AoS
-  const Real* pos_aos;         // current positions, AoS (pinned particles copy theirs)
   Real* pos_next;              // AoS, written when integrating
+  Real *sx_next, *sy_next, *sz_next; // next positions, SoA, written when integrating
+  // Per-particle masks (null: every particle in [q0, q1) is interior): bit k (0..11) = stencil
+  // spring k is in the particle's gather list, bit 12 + k (0..3) = normal fan term k is present.
+  // Absent terms are skipped by the same select as `len > 0`, so a border particle gets the CSR
+  // path's bits; its absent neighbours may lie outside [0, n): px, py, pz are padded.
+  const std::uint16_t* mask;
   std::int64_t nx;
   const std::int64_t* off;     // 12 stencil offsets
   const Real* rest;            // 12
