@@ -598,41 +598,49 @@ template <typename Real> void CpuSolver<Real>::substep(const Real dt) {
       }
     };
     if (rows) {
-      // Whole vectors in SIMD, a remainder shorter than one vector through the scalar kernel.
-      auto kernel = [&](std::int64_t q0, std::int64_t q1) {
+      // Whole vectors in SIMD, a remainder shorter than one vector through the scalar kernel;
+      // then the finite check of what was written that the SIMD kernel did not check already.
+      const Real limit = Real(params_.divergence_limit);
+      ra.limit = limit;
+      Real* const pn = &pos_next_[0].x;
+      Real* const vn = &vel_[0].x;
+      auto kernel = [&](std::int64_t q0, std::int64_t q1, unsigned& bad_here) {
         std::int64_t done = q0;
+        bool simd_bad = false;
 #if VKCLOTH_ROW_SIMD
-        if (simd_ == 2) done = detail::row_kernel_avx512(ra, done, q1);
-        else if (simd_ == 1) done = detail::row_kernel_avx2(ra, done, q1);
+        if (simd_ == 2) done = detail::row_kernel_avx512(ra, done, q1, simd_bad);
+        else if (simd_ == 1) done = detail::row_kernel_avx2(ra, done, q1, simd_bad);
 #endif
         if (done < q1) row_kernel(ra, done, q1);
-        if (!kernel_integrates)
+        if (!kernel_integrates) {
           for (std::int64_t q = q0; q < q1; ++q) finish(std::size_t(q), force_[std::size_t(q)]);
+          done = q0;
+        }
+        bad_here |= unsigned(simd_bad) | bad_components(pn + 3 * done, vn + 3 * done, std::size_t(3 * (q1 - done)), limit);
       };
-      const Real limit = Real(params_.divergence_limit);
       std::atomic<bool> bad{false};
       pool_->parallel_for(pos_.size(), [&](std::size_t b, std::size_t e) {
-        // Blocks of ~1024 particles: the finite check reads what the block just wrote (in cache).
+        // Blocks of ~1024 particles: finish() and the check read what the kernel just wrote.
         constexpr std::size_t block = 1024;
         unsigned bad_here = 0;
         for (std::size_t b0 = b; b0 < e;) {
           const std::size_t b1 = e - b0 < 2 * block ? e : b0 + block;
           if (ra.mask) {
-            kernel(std::int64_t(b0), std::int64_t(b1));
+            kernel(std::int64_t(b0), std::int64_t(b1), bad_here);
           } else {
             for (std::size_t p = b0; p < b1;) {
               const std::int64_t j = std::int64_t(p) / gnx, i = std::int64_t(p) % gnx;
               if (j >= 2 && j + 2 < gny && i >= 2 && i + 2 < gnx) {
                 const std::size_t run_end = std::min<std::size_t>(b1, std::size_t(j * gnx + gnx - 2));
-                kernel(std::int64_t(p), std::int64_t(run_end));
+                kernel(std::int64_t(p), std::int64_t(run_end), bad_here);
                 p = run_end;
                 continue;
               }
               finish(p, normal_force_at(pos_, vel_, p));
+              bad_here |= bad_components(pn + 3 * p, vn + 3 * p, 3, limit);
               ++p;
             }
           }
-          bad_here |= bad_components(&pos_next_[b0].x, &vel_[b0].x, 3 * (b1 - b0), limit);
           b0 = b1;
         }
         if (bad_here) bad.store(true, std::memory_order_relaxed);

@@ -29,14 +29,17 @@ template <typename Real> struct RowArgs {
   const Real* rest;            // 12
   const Real* stiff;           // 12
   Real gx, gy, gz, damping, kw, wx, wy, wz, dt;
+  Real limit;                  // divergence limit (the SIMD kernels' finite check)
   bool wind, integrate, semi;
 };
 
 // Each processes whole vectors from q0 and returns where it stopped (q1 minus the remainder,
-// fewer than one vector, which the caller runs through the scalar kernel).
-std::int64_t row_kernel_avx512(const RowArgs<float>& a, std::int64_t q0, std::int64_t q1);
-std::int64_t row_kernel_avx512(const RowArgs<double>& a, std::int64_t q0, std::int64_t q1);
-std::int64_t row_kernel_avx2(const RowArgs<float>& a, std::int64_t q0, std::int64_t q1);
-std::int64_t row_kernel_avx2(const RowArgs<double>& a, std::int64_t q0, std::int64_t q1);
+// fewer than one vector, which the caller runs through the scalar kernel). When integrating, each
+// also applies check_finite's test to the positions and velocities it wrote and sets `bad` if one
+// fails (it never clears it); without integrating the caller checks after finishing the particles.
+std::int64_t row_kernel_avx512(const RowArgs<float>& a, std::int64_t q0, std::int64_t q1, bool& bad);
+std::int64_t row_kernel_avx512(const RowArgs<double>& a, std::int64_t q0, std::int64_t q1, bool& bad);
+std::int64_t row_kernel_avx2(const RowArgs<float>& a, std::int64_t q0, std::int64_t q1, bool& bad);
+std::int64_t row_kernel_avx2(const RowArgs<double>& a, std::int64_t q0, std::int64_t q1, bool& bad);
 
 } // namespace vkcloth::detail

@@ -88,10 +88,10 @@ struct IsaD : IsaGeneric<double, vd4, vl4, 4> {
 } // namespace
 
 namespace vkcloth::detail {
-std::int64_t row_kernel_avx2(const RowArgs<float>& a, std::int64_t q0, std::int64_t q1) {
-  return simd_dispatch<IsaF>(a, q0, q1);
+std::int64_t row_kernel_avx2(const RowArgs<float>& a, std::int64_t q0, std::int64_t q1, bool& bad) {
+  return simd_dispatch<IsaF>(a, q0, q1, bad);
 }
-std::int64_t row_kernel_avx2(const RowArgs<double>& a, std::int64_t q0, std::int64_t q1) {
-  return simd_dispatch<IsaD>(a, q0, q1);
+std::int64_t row_kernel_avx2(const RowArgs<double>& a, std::int64_t q0, std::int64_t q1, bool& bad) {
+  return simd_dispatch<IsaD>(a, q0, q1, bad);
 }
 } // namespace vkcloth::detail

@@ -23,7 +23,8 @@ template <bool B> struct Flag {
 };
 
 template <typename T, bool wind, bool integrate, bool semi>
-std::int64_t simd_body(const vkcloth::detail::RowArgs<typename T::Real>& a, std::int64_t q0, std::int64_t q1) {
+std::int64_t simd_body(const vkcloth::detail::RowArgs<typename T::Real>& a, std::int64_t q0, std::int64_t q1,
+                       bool& bad) {
   using Real = typename T::Real;
   using V = typename T::V;
   using M = typename T::M;
@@ -44,6 +45,10 @@ std::int64_t simd_body(const vkcloth::detail::RowArgs<typename T::Real>& a, std:
   const V zero = V{};
   const V gx = bc<T>(a.gx), gy = bc<T>(a.gy), gz = bc<T>(a.gz), damping = bc<T>(a.damping), kw = bc<T>(a.kw),
           wx = bc<T>(a.wx), wy = bc<T>(a.wy), wz = bc<T>(a.wz), dt = bc<T>(a.dt);
+  const V lim = bc<T>(a.limit), nlim = bc<T>(-a.limit);
+  M lane{}; // lane index, to leave a tail vector's skipped lanes out of the finite check
+  for (int l = 0; l < W; ++l) lane[l] = l;
+  M ok = lane == lane; // all lanes true: every value written so far passed the finite check
   const std::int64_t nx = a.nx;
   std::int64_t O[12];
   V L[12], K[12];
@@ -163,15 +168,26 @@ std::int64_t simd_body(const vkcloth::detail::RowArgs<typename T::Real>& a, std:
       put(sxn + q, ox);
       put(syn + q, oy);
       put(szn + q, oz);
-      put3(vel + 3 * q, pin ? vx : nvx, pin ? vy : nvy, pin ? vz : nvz);
+      const V ux = pin ? vx : nvx, uy = pin ? vy : nvy, uz = pin ? vz : nvz;
+      put3(vel + 3 * q, ux, uy, uz);
+      // check_finite's test (bad_components), lane by lane: |x| <= limit (false for NaN) is
+      // x <= limit and -limit <= x; c - c == 0 fails for inf and NaN.
+      M good = (ox <= lim) & (nlim <= ox) & (ox - ox == zero) & (oy <= lim) & (nlim <= oy) & (oy - oy == zero) &
+               (oz <= lim) & (nlim <= oz) & (oz - oz == zero) & (ux - ux == zero) & (uy - uy == zero) &
+               (uz - uz == zero);
+      if constexpr (Tail) good = good | (lane < skip);
+      ok = ok & good;
     }
   };
   // Interior vectors (all W masks full) take the unmasked code; with no mask array, all do.
   auto full = [&](std::int64_t q) {
     if (!mask) return true;
-    unsigned acc = 0xFFFFu;
-    for (int l = 0; l < W; ++l) acc &= mask[q + l];
-    return acc == 0xFFFFu;
+    constexpr int words = W / 4; // 4 masks per 64-bit word (W is a multiple of 4)
+    std::uint64_t w[words];
+    __builtin_memcpy(w, mask + q, sizeof w);
+    std::uint64_t acc = ~std::uint64_t(0);
+    for (int l = 0; l < words; ++l) acc &= w[l];
+    return acc == ~std::uint64_t(0);
   };
   std::int64_t done = q0;
   for (; done + W <= q1; done += W) {
@@ -184,21 +200,27 @@ std::int64_t simd_body(const vkcloth::detail::RowArgs<typename T::Real>& a, std:
     else vec(q, int(W - (q1 - done)), Flag<true>{}, Flag<true>{});
     done = q1;
   }
+  if constexpr (integrate) {
+    bool all = true;
+    for (int l = 0; l < W; ++l) all = all && ok[l] != 0;
+    if (!all) bad = true;
+  }
   return done;
 }
 
 template <typename T>
-std::int64_t simd_dispatch(const vkcloth::detail::RowArgs<typename T::Real>& a, std::int64_t q0, std::int64_t q1) {
+std::int64_t simd_dispatch(const vkcloth::detail::RowArgs<typename T::Real>& a, std::int64_t q0, std::int64_t q1,
+                           bool& bad) {
   const int v = (a.wind ? 4 : 0) | (a.integrate ? 2 : 0) | (a.semi ? 1 : 0);
   switch (v) {
-  case 0: return simd_body<T, false, false, false>(a, q0, q1);
-  case 1: return simd_body<T, false, false, true>(a, q0, q1);
-  case 2: return simd_body<T, false, true, false>(a, q0, q1);
-  case 3: return simd_body<T, false, true, true>(a, q0, q1);
-  case 4: return simd_body<T, true, false, false>(a, q0, q1);
-  case 5: return simd_body<T, true, false, true>(a, q0, q1);
-  case 6: return simd_body<T, true, true, false>(a, q0, q1);
-  default: return simd_body<T, true, true, true>(a, q0, q1);
+  case 0: return simd_body<T, false, false, false>(a, q0, q1, bad);
+  case 1: return simd_body<T, false, false, true>(a, q0, q1, bad);
+  case 2: return simd_body<T, false, true, false>(a, q0, q1, bad);
+  case 3: return simd_body<T, false, true, true>(a, q0, q1, bad);
+  case 4: return simd_body<T, true, false, false>(a, q0, q1, bad);
+  case 5: return simd_body<T, true, false, true>(a, q0, q1, bad);
+  case 6: return simd_body<T, true, true, false>(a, q0, q1, bad);
+  default: return simd_body<T, true, true, true>(a, q0, q1, bad);
   }
 }
 
