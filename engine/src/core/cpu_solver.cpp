@@ -619,8 +619,10 @@ template <typename Real> void CpuSolver<Real>::substep(const Real dt) {
         bad_here |= unsigned(simd_bad) | bad_components(pn + 3 * done, vn + 3 * done, std::size_t(3 * (q1 - done)), limit);
       };
       std::atomic<bool> bad{false};
-      pool_->parallel_for(pos_.size(), [&](std::size_t b, std::size_t e) {
-        // Blocks of ~1024 particles: finish() and the check read what the kernel just wrote.
+      // Claimed in blocks of ~2048 particles by whichever thread is free (a thread the OS delays
+      // holds up at most one block); within one, pieces of ~1024: finish() and the check read
+      // what the kernel just wrote.
+      pool_->parallel_blocks(pos_.size(), 2048, [&](std::size_t b, std::size_t e) {
         constexpr std::size_t block = 1024;
         unsigned bad_here = 0;
         for (std::size_t b0 = b; b0 < e;) {
