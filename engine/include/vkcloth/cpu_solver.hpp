@@ -129,7 +129,18 @@ private:
   std::array<std::int64_t, 12> stencil_offset_{};
   std::array<Edge, 12> stencil_edge_{};
   std::array<Real, 12> stencil_rest_{}, stencil_stiff_{};
-  std::vector<Real> soa_; // positions as x[n], y[n], z[n] for the row kernel
+  // Positions as SoA for the row kernel: x, y, z blocks of n + 2 soa_pad_ each, particle p of a
+  // block at soa_pad_ + p (the pads let masked border lanes read absent neighbours). The row sweep
+  // writes the next step's copy (soa_next_) as it integrates; soa_valid_ is false after anything
+  // else changed pos_ (set_particle, RK4, implicit Euler), and the next row sweep transposes.
+  std::vector<Real> soa_, soa_next_;
+  std::size_t soa_pad_ = 0;
+  bool soa_valid_ = false;
+  // Per-particle stencil masks (row_kernel.hpp RowArgs::mask) when every particle's gather list is
+  // a subsequence of the stencil (make_cloth's grids): then all particles take the row kernel.
+  // Empty otherwise: border particles take the per-particle code.
+  std::vector<std::uint16_t> mask_;
+  bool swept_finite_ = false; // the last substep's row sweep found every position/velocity finite
   int simd_ = 0;           // row kernel ISA: 0 scalar, 1 AVX2, 2 AVX-512F (cpu_solver.cpp)
   std::uint64_t step_ = 0;
   std::unique_ptr<detail::ThreadPool> pool_;

@@ -1,6 +1,7 @@
 #include "vkcloth/cpu_solver.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -63,8 +64,11 @@ inline void row_kernel_body(const RowArgs<Real>& a, std::int64_t q0, std::int64_
   Real* __restrict fo = a.force_out;
   Real* __restrict no = a.normal_out;
   Real* __restrict vel = a.vel_out; // read and written in place (own particle only)
-  const Real* __restrict pos_aos = a.pos_aos;
   Real* __restrict pos_next = a.pos_next;
+  Real* __restrict sxn = a.sx_next;
+  Real* __restrict syn = a.sy_next;
+  Real* __restrict szn = a.sz_next;
+  const std::uint16_t* __restrict mask = a.mask;
   const Real gx = a.gx, gy = a.gy, gz = a.gz, damping = a.damping, kw = a.kw, wx = a.wx, wy = a.wy, wz = a.wz,
              dt = a.dt;
   const std::int64_t nx = a.nx;
@@ -76,6 +80,8 @@ inline void row_kernel_body(const RowArgs<Real>& a, std::int64_t q0, std::int64_
                       a.stiff[6], a.stiff[7], a.stiff[8], a.stiff[9], a.stiff[10], a.stiff[11]};
   const std::int64_t O[12] = {o0, o1, o2, o3, o4, o5, o6, o7, o8, o9, o10, o11};
   for (std::int64_t q = q0; q < q1; ++q) {
+    // Border particles (mask): absent spring and fan terms are skipped, as the CSR path does.
+    const unsigned mk = mask ? unsigned(mask[q]) : 0xFFFFu;
     const Real x0 = px[q], y0 = py[q], z0 = pz[q];
     // normal_at: fan right (e0), up (e1), left (e2), down (e3); all present inside.
     const Real e0x = px[q + 1] - x0, e0y = py[q + 1] - y0, e0z = pz[q + 1] - z0;
@@ -84,14 +90,16 @@ inline void row_kernel_body(const RowArgs<Real>& a, std::int64_t q0, std::int64_
     const Real e3x = px[q - nx] - x0, e3y = py[q - nx] - y0, e3z = pz[q - nx] - z0;
     // sum = 0; sum += cross(e_k, e_k+1) (glm::cross order), k = 0..3
     Real sx = Real(0), sy = Real(0), sz = Real(0);
-#define VKCLOTH_CROSS_ADD(ax, ay, az, bx, by, bz)                                                                       \
-  sx = sx + (ay * bz - by * az);                                                                                       \
-  sy = sy + (az * bx - bz * ax);                                                                                       \
-  sz = sz + (ax * by - bx * ay);
-    VKCLOTH_CROSS_ADD(e0x, e0y, e0z, e1x, e1y, e1z)
-    VKCLOTH_CROSS_ADD(e1x, e1y, e1z, e2x, e2y, e2z)
-    VKCLOTH_CROSS_ADD(e2x, e2y, e2z, e3x, e3y, e3z)
-    VKCLOTH_CROSS_ADD(e3x, e3y, e3z, e0x, e0y, e0z)
+#define VKCLOTH_CROSS_ADD(bit, ax, ay, az, bx, by, bz)                                                                  \
+  if (mk >> (bit) & 1u) {                                                                                              \
+    sx = sx + (ay * bz - by * az);                                                                                     \
+    sy = sy + (az * bx - bz * ax);                                                                                     \
+    sz = sz + (ax * by - bx * ay);                                                                                     \
+  }
+    VKCLOTH_CROSS_ADD(12, e0x, e0y, e0z, e1x, e1y, e1z)
+    VKCLOTH_CROSS_ADD(13, e1x, e1y, e1z, e2x, e2y, e2z)
+    VKCLOTH_CROSS_ADD(14, e2x, e2y, e2z, e3x, e3y, e3z)
+    VKCLOTH_CROSS_ADD(15, e3x, e3y, e3z, e0x, e0y, e0z)
 #undef VKCLOTH_CROSS_ADD
     const Real nlen = std::sqrt(sx * sx + sy * sy + sz * sz);
     const bool npos = nlen > Real(0);
@@ -106,7 +114,7 @@ inline void row_kernel_body(const RowArgs<Real>& a, std::int64_t q0, std::int64_
     const Real ux = px[r] - x0, uy = py[r] - y0, uz = pz[r] - z0;                                                      \
     const Real len = std::sqrt(ux * ux + uy * uy + uz * uz);                                                           \
     const Real c = K[k] * (len - L[k]) / len;                                                                          \
-    const bool pos = len > Real(0);                                                                                    \
+    const bool pos = len > Real(0) && (mk >> (k) & 1u);                                                                \
     const Real tx = fx + ux * c, ty = fy + uy * c, tz = fz + uz * c;                                                   \
     fx = pos ? tx : fx;                                                                                                \
     fy = pos ? ty : fy;                                                                                                \
@@ -138,7 +146,7 @@ inline void row_kernel_body(const RowArgs<Real>& a, std::int64_t q0, std::int64_
     fo[3 * q + 2] = fz;
     if constexpr (integrate) { // no colliders: contact_at and project_at do nothing
       const Real ax = fx / m, ay = fy / m, az = fz / m;
-      const Real xx = pos_aos[3 * q], xy = pos_aos[3 * q + 1], xz = pos_aos[3 * q + 2];
+      const Real xx = x0, xy = y0, xz = z0; // the SoA copy holds the AoS positions' values
       Real nvx, nvy, nvz, nxx, nxy, nxz;
       if constexpr (semi) {
         nvx = vx + ax * dt;
@@ -156,9 +164,9 @@ inline void row_kernel_body(const RowArgs<Real>& a, std::int64_t q0, std::int64_
         nvz = vz + az * dt;
       }
       const bool pin = pinned[q] != 0;
-      pos_next[3 * q] = pin ? xx : nxx;
-      pos_next[3 * q + 1] = pin ? xy : nxy;
-      pos_next[3 * q + 2] = pin ? xz : nxz;
+      pos_next[3 * q] = sxn[q] = pin ? xx : nxx;
+      pos_next[3 * q + 1] = syn[q] = pin ? xy : nxy;
+      pos_next[3 * q + 2] = szn[q] = pin ? xz : nxz;
       vel[3 * q] = pin ? vx : nvx;
       vel[3 * q + 1] = pin ? vy : nvy;
       vel[3 * q + 2] = pin ? vz : nvz;
@@ -199,6 +207,17 @@ VKCLOTH_ROW_CLONES void row_kernel_d(const RowArgs<double>& a, std::int64_t q0, 
 }
 inline void row_kernel(const RowArgs<float>& a, std::int64_t q0, std::int64_t q1) { row_kernel_f(a, q0, q1); }
 inline void row_kernel(const RowArgs<double>& a, std::int64_t q0, std::int64_t q1) { row_kernel_d(a, q0, q1); }
+
+/// check_finite's test, branch-free (vectorisable OR-reduction over flat arrays of n3 components):
+/// nonzero when a component is not finite (c - c != 0 for inf and NaN) or a position has |x| > limit
+/// (or is NaN). The row sweep runs it on each block it wrote, check_finite on the whole state.
+template <typename Real> unsigned bad_components(const Real* x, const Real* v, std::size_t n3, Real limit) {
+  unsigned bad = 0;
+  for (std::size_t i = 0; i < n3; ++i)
+    bad |= unsigned(!(std::abs(x[i]) <= limit)) | unsigned(!(x[i] - x[i] == Real(0))) |
+           unsigned(!(v[i] - v[i] == Real(0)));
+  return bad;
+}
 
 /// Row kernel ISA: 2 = AVX-512F, 1 = AVX2, 0 = scalar; the widest the CPU has, capped by the
 /// environment variable VKCLOTH_CPU_SIMD = scalar | avx2 | avx512 (tests compare them bitwise).
@@ -283,6 +302,7 @@ Result<void> CpuSolver<Real>::set_particle(std::uint32_t index, Vec3 position, V
                                     index, position.x, position.y, position.z, velocity.x, velocity.y, velocity.z));
   pos_[index] = position;
   vel_[index] = pinned_[index] ? Vec3(0) : velocity;
+  soa_valid_ = false;
   return {};
 }
 
@@ -330,6 +350,34 @@ template <typename Real> void CpuSolver<Real>::detect_stencil() {
       }
     }
   stencil_ = true;
+  // Pad of the SoA copies: the farthest neighbour a (masked) lane may read.
+  std::int64_t reach = nx + 1;
+  for (std::int64_t o : stencil_offset_) reach = std::max(reach, o < 0 ? -o : o);
+  soa_pad_ = std::size_t(reach);
+  // Masks: every particle's gather list must be the stencil's, in order, with some springs left
+  // out (make_cloth's border particles are); the fan terms follow normal_at's `has`.
+  const std::size_t n = pos_.size();
+  mask_.assign(n, 0);
+  for (std::size_t p = 0; p < n; ++p) {
+    const std::int64_t i = std::int64_t(p) % nx, j = std::int64_t(p) / nx;
+    const bool has[4] = {i + 1 < nx, j + 1 < ny, i > 0, j > 0};
+    unsigned m = 0;
+    for (int k = 0; k < 4; ++k)
+      if (has[k] && has[(k + 1) & 3]) m |= 1u << (12 + k);
+    int k = 0;
+    for (std::uint32_t e = edge_offsets_[p]; e < edge_offsets_[p + 1]; ++e, ++k) {
+      const Edge& ed = edges_[e];
+      while (k < 12 && (std::int64_t(ed.other) - std::int64_t(p) != stencil_offset_[k] ||
+                        ed.rest_length != stencil_edge_[k].rest_length || ed.stiffness != stencil_edge_[k].stiffness))
+        ++k;
+      if (k == 12) {
+        mask_.clear(); // irregular: border particles take the per-particle code
+        return;
+      }
+      m |= 1u << k;
+    }
+    mask_[p] = std::uint16_t(m);
+  }
 }
 
 template <typename Real>
@@ -417,16 +465,7 @@ template <typename Real> Result<void> CpuSolver<Real>::check_finite() const {
   // Fast pass without early exit (vectorisable OR-reduction over the flat arrays): a component
   // is bad when not finite (c - c != 0 for inf and NaN) or, for positions, |x| > limit (or NaN).
   // Only when something is bad does the loop below look for the first particle, for the message.
-  {
-    const Real* x = pos_.empty() ? nullptr : &pos_[0].x;
-    const Real* v = vel_.empty() ? nullptr : &vel_[0].x;
-    const std::size_t n3 = 3 * pos_.size();
-    unsigned bad = 0;
-    for (std::size_t i = 0; i < n3; ++i)
-      bad |= unsigned(!(std::abs(x[i]) <= limit)) | unsigned(!(x[i] - x[i] == Real(0))) |
-             unsigned(!(v[i] - v[i] == Real(0)));
-    if (!bad) return {};
-  }
+  if (pos_.empty() || !bad_components(&pos_[0].x, &vel_[0].x, 3 * pos_.size(), limit)) return {};
   for (std::size_t p = 0; p < pos_.size(); ++p) {
     const Vec3 x = pos_[p], v = vel_[p];
     const bool finite = std::isfinite(x.x) && std::isfinite(x.y) && std::isfinite(x.z) && std::isfinite(v.x) &&
@@ -448,36 +487,51 @@ template <typename Real> Result<void> CpuSolver<Real>::step() {
   const Real h = Real(k == 1 ? params_.dt : params_.dt / double(k));
   for (std::uint32_t s = 0; s < k; ++s) substep(h);
   ++step_;
+  if (swept_finite_) return {}; // the last substep's row sweep already checked every particle
   return check_finite();
 }
 
 template <typename Real> void CpuSolver<Real>::substep(const Real dt) {
+  swept_finite_ = false;
   switch (params_.integrator) {
   case Integrator::implicit_euler:
+    soa_valid_ = false;
     implicit_substep(dt);
     break;
   case Integrator::explicit_euler:
   case Integrator::semi_implicit_euler: {
     const bool semi = params_.integrator == Integrator::semi_implicit_euler;
-    // Grid stencil: interior runs of each row go through the vectorised row kernel (positions
-    // transposed to SoA first); the border particles through the per-particle code below.
+    // Grid stencil: the vectorised row kernel takes every particle (masks for the border), or,
+    // when some gather list is irregular (no masks), the interior runs of each row while the
+    // border particles take the per-particle code below. It reads positions from the SoA copy
+    // and writes the next one; one fork-join per substep (sweep + finite check).
     const bool rows = stencil_;
     const bool kernel_integrates = params_.colliders.empty();
     RowArgs<Real> ra{};
     std::int64_t gnx = 0, gny = 0;
+    Real *nsx = nullptr, *nsy = nullptr, *nsz = nullptr;
     if (rows) {
-      const std::size_t n = pos_.size();
-      if (soa_.size() != 3 * n) soa_.resize(3 * n);
-      Real* sx = soa_.data();
-      Real* sy = sx + n;
-      Real* sz = sy + n;
-      pool_->parallel_for(n, [&](std::size_t b, std::size_t e) {
-        for (std::size_t p = b; p < e; ++p) {
-          sx[p] = pos_[p].x;
-          sy[p] = pos_[p].y;
-          sz[p] = pos_[p].z;
-        }
-      });
+      const std::size_t n = pos_.size(), pad = soa_pad_, stride = n + 2 * pad;
+      if (soa_.size() != 3 * stride) {
+        soa_.assign(3 * stride, Real(0));
+        soa_next_.assign(3 * stride, Real(0));
+        soa_valid_ = false;
+      }
+      Real* sx = soa_.data() + pad;
+      Real* sy = sx + stride;
+      Real* sz = sy + stride;
+      if (!soa_valid_) { // first step, or pos_ changed outside the row sweep
+        pool_->parallel_for(n, [&](std::size_t b, std::size_t e) {
+          for (std::size_t p = b; p < e; ++p) {
+            sx[p] = pos_[p].x;
+            sy[p] = pos_[p].y;
+            sz[p] = pos_[p].z;
+          }
+        });
+      }
+      nsx = soa_next_.data() + pad;
+      nsy = nsx + stride;
+      nsz = nsy + stride;
       gnx = system_->grid->nx;
       gny = system_->grid->ny;
       ra.px = sx;
@@ -489,8 +543,11 @@ template <typename Real> void CpuSolver<Real>::substep(const Real dt) {
       ra.pinned = pinned_.data();
       ra.force_out = &force_[0].x;
       ra.normal_out = &normal_[0].x;
-      ra.pos_aos = &pos_[0].x;
       ra.pos_next = &pos_next_[0].x;
+      ra.sx_next = nsx;
+      ra.sy_next = nsy;
+      ra.sz_next = nsz;
+      ra.mask = mask_.empty() ? nullptr : mask_.data();
       ra.nx = gnx;
       ra.off = stencil_offset_.data();
       for (int k = 0; k < 12; ++k) {
@@ -517,46 +574,83 @@ template <typename Real> void CpuSolver<Real>::substep(const Real dt) {
       if (pinned_[p]) {
         force_[p] = f;
         pos_next_[p] = pos_[p];
-        return;
-      }
-      Vec3 v = vel_[p];
-      contact_at(pos_[p], v, f);
-      force_[p] = f;
-      const Vec3 a = f / mass_[p];
-      Vec3 x = pos_[p];
-      if (semi) {
-        v += a * dt;
-        x += v * dt;
       } else {
-        x += v * dt;
-        v += a * dt;
+        Vec3 v = vel_[p];
+        contact_at(pos_[p], v, f);
+        force_[p] = f;
+        const Vec3 a = f / mass_[p];
+        Vec3 x = pos_[p];
+        if (semi) {
+          v += a * dt;
+          x += v * dt;
+        } else {
+          x += v * dt;
+          v += a * dt;
+        }
+        project_at(x, v);
+        pos_next_[p] = x;
+        vel_[p] = v; // only particle p reads its own velocity: updating in place is safe
       }
-      project_at(x, v);
-      pos_next_[p] = x;
-      vel_[p] = v; // only particle p reads its own velocity: updating in place is safe
+      if (nsx) {
+        nsx[p] = pos_next_[p].x;
+        nsy[p] = pos_next_[p].y;
+        nsz[p] = pos_next_[p].z;
+      }
     };
     if (rows) {
-      pool_->parallel_for(pos_.size(), [&](std::size_t b, std::size_t e) {
-        for (std::size_t p = b; p < e;) {
-          const std::int64_t j = std::int64_t(p) / gnx, i = std::int64_t(p) % gnx;
-          if (j >= 2 && j + 2 < gny && i >= 2 && i + 2 < gnx) {
-            const std::size_t run_end = std::min<std::size_t>(e, std::size_t(j * gnx + gnx - 2));
-            std::int64_t done = std::int64_t(p); // whole vectors in SIMD, the remainder scalar
+      // Whole vectors in SIMD, a remainder shorter than one vector through the scalar kernel;
+      // then the finite check of what was written that the SIMD kernel did not check already.
+      const Real limit = Real(params_.divergence_limit);
+      ra.limit = limit;
+      Real* const pn = &pos_next_[0].x;
+      Real* const vn = &vel_[0].x;
+      auto kernel = [&](std::int64_t q0, std::int64_t q1, unsigned& bad_here) {
+        std::int64_t done = q0;
+        bool simd_bad = false;
 #if VKCLOTH_ROW_SIMD
-            if (simd_ == 2) done = detail::row_kernel_avx512(ra, done, std::int64_t(run_end));
-            else if (simd_ == 1) done = detail::row_kernel_avx2(ra, done, std::int64_t(run_end));
+        if (simd_ == 2) done = detail::row_kernel_avx512(ra, done, q1, simd_bad);
+        else if (simd_ == 1) done = detail::row_kernel_avx2(ra, done, q1, simd_bad);
 #endif
-            if (done < std::int64_t(run_end)) row_kernel(ra, done, std::int64_t(run_end));
-            if (!kernel_integrates)
-              for (std::size_t q = p; q < run_end; ++q) finish(q, force_[q]);
-            p = run_end;
-            continue;
-          }
-          finish(p, normal_force_at(pos_, vel_, p));
-          ++p;
+        if (done < q1) row_kernel(ra, done, q1);
+        if (!kernel_integrates) {
+          for (std::int64_t q = q0; q < q1; ++q) finish(std::size_t(q), force_[std::size_t(q)]);
+          done = q0;
         }
+        bad_here |= unsigned(simd_bad) | bad_components(pn + 3 * done, vn + 3 * done, std::size_t(3 * (q1 - done)), limit);
+      };
+      std::atomic<bool> bad{false};
+      // Claimed in blocks of ~2048 particles by whichever thread is free (a thread the OS delays
+      // holds up at most one block); within one, pieces of ~1024: finish() and the check read
+      // what the kernel just wrote.
+      pool_->parallel_blocks(pos_.size(), 2048, [&](std::size_t b, std::size_t e) {
+        constexpr std::size_t block = 1024;
+        unsigned bad_here = 0;
+        for (std::size_t b0 = b; b0 < e;) {
+          const std::size_t b1 = e - b0 < 2 * block ? e : b0 + block;
+          if (ra.mask) {
+            kernel(std::int64_t(b0), std::int64_t(b1), bad_here);
+          } else {
+            for (std::size_t p = b0; p < b1;) {
+              const std::int64_t j = std::int64_t(p) / gnx, i = std::int64_t(p) % gnx;
+              if (j >= 2 && j + 2 < gny && i >= 2 && i + 2 < gnx) {
+                const std::size_t run_end = std::min<std::size_t>(b1, std::size_t(j * gnx + gnx - 2));
+                kernel(std::int64_t(p), std::int64_t(run_end), bad_here);
+                p = run_end;
+                continue;
+              }
+              finish(p, normal_force_at(pos_, vel_, p));
+              bad_here |= bad_components(pn + 3 * p, vn + 3 * p, 3, limit);
+              ++p;
+            }
+          }
+          b0 = b1;
+        }
+        if (bad_here) bad.store(true, std::memory_order_relaxed);
       });
       std::swap(pos_, pos_next_);
+      std::swap(soa_, soa_next_);
+      soa_valid_ = true;
+      swept_finite_ = !bad.load(std::memory_order_relaxed);
       break;
     }
     // One sweep: p's normal needs only positions (read-only here), and force_at reads p's own.
@@ -565,6 +659,7 @@ template <typename Real> void CpuSolver<Real>::substep(const Real dt) {
     break;
   }
   case Integrator::rk4: {
+    soa_valid_ = false;
     // Stage s evaluates (v, F/m) at y_s = y0 + c_s dt k_{s-1}; contacts filter each stage.
     const std::size_t n = pos_.size();
     if (stage_pos_.size() != n) {

@@ -72,6 +72,9 @@ struct IsaF : IsaGeneric<float, vf8, vi8, 8> {
     const vi8 v = (vi8)_mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p)));
     return v != 0;
   }
+  static M loadmask(const std::uint16_t* p) {
+    return (vi8)_mm256_cvtepu16_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)));
+  }
 };
 
 struct IsaD : IsaGeneric<double, vd4, vl4, 4> {
@@ -85,10 +88,10 @@ struct IsaD : IsaGeneric<double, vd4, vl4, 4> {
 } // namespace
 
 namespace vkcloth::detail {
-std::int64_t row_kernel_avx2(const RowArgs<float>& a, std::int64_t q0, std::int64_t q1) {
-  return simd_dispatch<IsaF>(a, q0, q1);
+std::int64_t row_kernel_avx2(const RowArgs<float>& a, std::int64_t q0, std::int64_t q1, bool& bad) {
+  return simd_dispatch<IsaF>(a, q0, q1, bad);
 }
-std::int64_t row_kernel_avx2(const RowArgs<double>& a, std::int64_t q0, std::int64_t q1) {
-  return simd_dispatch<IsaD>(a, q0, q1);
+std::int64_t row_kernel_avx2(const RowArgs<double>& a, std::int64_t q0, std::int64_t q1, bool& bad) {
+  return simd_dispatch<IsaD>(a, q0, q1, bad);
 }
 } // namespace vkcloth::detail

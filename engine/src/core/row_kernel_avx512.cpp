@@ -64,6 +64,9 @@ struct IsaF : IsaGeneric<float, vf16, vi16, 16> {
     const vi16 v = (vi16)_mm512_maskz_cvtepu8_epi32(__mmask16(0xFFFF), _mm_loadu_si128(reinterpret_cast<const __m128i*>(p)));
     return v != 0;
   }
+  static M loadmask(const std::uint16_t* p) {
+    return (vi16)_mm512_maskz_cvtepu16_epi32(__mmask16(0xFFFF), _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)));
+  }
 };
 
 struct IsaD : IsaGeneric<double, vd8, vl8, 8> {
@@ -89,10 +92,10 @@ struct IsaD : IsaGeneric<double, vd8, vl8, 8> {
 } // namespace
 
 namespace vkcloth::detail {
-std::int64_t row_kernel_avx512(const RowArgs<float>& a, std::int64_t q0, std::int64_t q1) {
-  return simd_dispatch<IsaF>(a, q0, q1);
+std::int64_t row_kernel_avx512(const RowArgs<float>& a, std::int64_t q0, std::int64_t q1, bool& bad) {
+  return simd_dispatch<IsaF>(a, q0, q1, bad);
 }
-std::int64_t row_kernel_avx512(const RowArgs<double>& a, std::int64_t q0, std::int64_t q1) {
-  return simd_dispatch<IsaD>(a, q0, q1);
+std::int64_t row_kernel_avx512(const RowArgs<double>& a, std::int64_t q0, std::int64_t q1, bool& bad) {
+  return simd_dispatch<IsaD>(a, q0, q1, bad);
 }
 } // namespace vkcloth::detail

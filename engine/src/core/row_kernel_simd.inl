@@ -23,7 +23,8 @@ template <bool B> struct Flag {
 };
 
 template <typename T, bool wind, bool integrate, bool semi>
-std::int64_t simd_body(const vkcloth::detail::RowArgs<typename T::Real>& a, std::int64_t q0, std::int64_t q1) {
+std::int64_t simd_body(const vkcloth::detail::RowArgs<typename T::Real>& a, std::int64_t q0, std::int64_t q1,
+                       bool& bad) {
   using Real = typename T::Real;
   using V = typename T::V;
   using M = typename T::M;
@@ -33,14 +34,21 @@ std::int64_t simd_body(const vkcloth::detail::RowArgs<typename T::Real>& a, std:
   const Real* __restrict pz = a.pz;
   const Real* __restrict mass = a.mass;
   const std::uint8_t* __restrict pinned = a.pinned;
+  const std::uint16_t* __restrict mask = a.mask;
   Real* __restrict fo = a.force_out;
   Real* __restrict no = a.normal_out;
   Real* __restrict vel = a.vel_out;
-  const Real* __restrict pos_aos = a.pos_aos;
   Real* __restrict pos_next = a.pos_next;
+  Real* __restrict sxn = a.sx_next;
+  Real* __restrict syn = a.sy_next;
+  Real* __restrict szn = a.sz_next;
   const V zero = V{};
   const V gx = bc<T>(a.gx), gy = bc<T>(a.gy), gz = bc<T>(a.gz), damping = bc<T>(a.damping), kw = bc<T>(a.kw),
           wx = bc<T>(a.wx), wy = bc<T>(a.wy), wz = bc<T>(a.wz), dt = bc<T>(a.dt);
+  const V lim = bc<T>(a.limit), nlim = bc<T>(-a.limit);
+  M lane{}; // lane index, to leave a tail vector's skipped lanes out of the finite check
+  for (int l = 0; l < W; ++l) lane[l] = l;
+  M ok = lane == lane; // all lanes true: every value written so far passed the finite check
   const std::int64_t nx = a.nx;
   std::int64_t O[12];
   V L[12], K[12];
@@ -52,8 +60,10 @@ std::int64_t simd_body(const vkcloth::detail::RowArgs<typename T::Real>& a, std:
   // One vector of W particles from q; with Tail, the first `skip` lanes were done already and only
   // the others are stored (the overlapped last vector of a run: the skipped lanes read velocities
   // updated in place, but their results are thrown away; the stored lanes read only their own).
-  auto vec = [&](std::int64_t q, int skip, auto tail) {
+  // With Masked, each lane's spring and fan terms are selected by its mask (border particles).
+  auto vec = [&](std::int64_t q, int skip, auto tail, auto masked) {
     constexpr bool Tail = decltype(tail)::value;
+    constexpr bool Masked = decltype(masked)::value;
     auto put3 = [&](Real* p, V x, V y, V z) {
       if constexpr (!Tail) {
         T::store3(p, x, y, z);
@@ -63,20 +73,39 @@ std::int64_t simd_body(const vkcloth::detail::RowArgs<typename T::Real>& a, std:
         __builtin_memcpy(p + 3 * skip, buf + 3 * skip, sizeof(Real) * std::size_t(3 * (W - skip)));
       }
     };
+    auto put = [&](Real* p, V x) {
+      if constexpr (!Tail) {
+        __builtin_memcpy(p, &x, sizeof x);
+      } else {
+        Real buf[W];
+        __builtin_memcpy(buf, &x, sizeof x);
+        __builtin_memcpy(p + skip, buf + skip, sizeof(Real) * std::size_t(W - skip));
+      }
+    };
+    M mk{};
+    if constexpr (Masked) mk = T::loadmask(mask + q);
+    auto has = [&](int bit) -> M { return (mk & (1 << bit)) != 0; }; // only used when Masked
     const V x0 = ld<T>(px + q), y0 = ld<T>(py + q), z0 = ld<T>(pz + q);
     const V e0x = ld<T>(px + q + 1) - x0, e0y = ld<T>(py + q + 1) - y0, e0z = ld<T>(pz + q + 1) - z0;
     const V e1x = ld<T>(px + q + nx) - x0, e1y = ld<T>(py + q + nx) - y0, e1z = ld<T>(pz + q + nx) - z0;
     const V e2x = ld<T>(px + q - 1) - x0, e2y = ld<T>(py + q - 1) - y0, e2z = ld<T>(pz + q - 1) - z0;
     const V e3x = ld<T>(px + q - nx) - x0, e3y = ld<T>(py + q - nx) - y0, e3z = ld<T>(pz + q - nx) - z0;
     V sx = zero, sy = zero, sz = zero;
-#define VKCLOTH_CROSS_ADD(ax, ay, az, bx, by, bz)                                                                       \
-  sx = sx + (ay * bz - by * az);                                                                                       \
-  sy = sy + (az * bx - bz * ax);                                                                                       \
-  sz = sz + (ax * by - bx * ay);
-    VKCLOTH_CROSS_ADD(e0x, e0y, e0z, e1x, e1y, e1z)
-    VKCLOTH_CROSS_ADD(e1x, e1y, e1z, e2x, e2y, e2z)
-    VKCLOTH_CROSS_ADD(e2x, e2y, e2z, e3x, e3y, e3z)
-    VKCLOTH_CROSS_ADD(e3x, e3y, e3z, e0x, e0y, e0z)
+#define VKCLOTH_CROSS_ADD(bit, ax, ay, az, bx, by, bz)                                                                  \
+  if constexpr (Masked) {                                                                                              \
+    const M h = has(bit);                                                                                              \
+    sx = h ? sx + (ay * bz - by * az) : sx;                                                                            \
+    sy = h ? sy + (az * bx - bz * ax) : sy;                                                                            \
+    sz = h ? sz + (ax * by - bx * ay) : sz;                                                                            \
+  } else {                                                                                                             \
+    sx = sx + (ay * bz - by * az);                                                                                     \
+    sy = sy + (az * bx - bz * ax);                                                                                     \
+    sz = sz + (ax * by - bx * ay);                                                                                     \
+  }
+    VKCLOTH_CROSS_ADD(12, e0x, e0y, e0z, e1x, e1y, e1z)
+    VKCLOTH_CROSS_ADD(13, e1x, e1y, e1z, e2x, e2y, e2z)
+    VKCLOTH_CROSS_ADD(14, e2x, e2y, e2z, e3x, e3y, e3z)
+    VKCLOTH_CROSS_ADD(15, e3x, e3y, e3z, e0x, e0y, e0z)
 #undef VKCLOTH_CROSS_ADD
     const V nlen = T::sqrt(sx * sx + sy * sy + sz * sz);
     const M npos = nlen > zero;
@@ -89,7 +118,8 @@ std::int64_t simd_body(const vkcloth::detail::RowArgs<typename T::Real>& a, std:
       const V ux = ld<T>(px + r) - x0, uy = ld<T>(py + r) - y0, uz = ld<T>(pz + r) - z0;
       const V len = T::sqrt(ux * ux + uy * uy + uz * uz);
       const V c = K[k] * (len - L[k]) / len;
-      const M pos = len > zero;
+      M pos = len > zero;
+      if constexpr (Masked) pos = pos & has(k);
       const V tx = fx + ux * c, ty = fy + uy * c, tz = fz + uz * c;
       fx = pos ? tx : fx;
       fy = pos ? ty : fy;
@@ -115,50 +145,82 @@ std::int64_t simd_body(const vkcloth::detail::RowArgs<typename T::Real>& a, std:
     put3(fo + 3 * q, fx, fy, fz);
     if constexpr (integrate) {
       const V ax = fx / m, ay = fy / m, az = fz / m;
-      V xx, xy, xz;
-      T::load3(pos_aos + 3 * q, xx, xy, xz);
+      // The current position is x0, y0, z0 (the SoA copy holds the AoS positions' values).
       V nvx, nvy, nvz, nxx, nxy, nxz;
       if constexpr (semi) {
         nvx = vx + ax * dt;
         nvy = vy + ay * dt;
         nvz = vz + az * dt;
-        nxx = xx + nvx * dt;
-        nxy = xy + nvy * dt;
-        nxz = xz + nvz * dt;
+        nxx = x0 + nvx * dt;
+        nxy = y0 + nvy * dt;
+        nxz = z0 + nvz * dt;
       } else {
-        nxx = xx + vx * dt;
-        nxy = xy + vy * dt;
-        nxz = xz + vz * dt;
+        nxx = x0 + vx * dt;
+        nxy = y0 + vy * dt;
+        nxz = z0 + vz * dt;
         nvx = vx + ax * dt;
         nvy = vy + ay * dt;
         nvz = vz + az * dt;
       }
       const M pin = T::pinmask(pinned + q);
-      put3(pos_next + 3 * q, pin ? xx : nxx, pin ? xy : nxy, pin ? xz : nxz);
-      put3(vel + 3 * q, pin ? vx : nvx, pin ? vy : nvy, pin ? vz : nvz);
+      const V ox = pin ? x0 : nxx, oy = pin ? y0 : nxy, oz = pin ? z0 : nxz;
+      put3(pos_next + 3 * q, ox, oy, oz);
+      put(sxn + q, ox);
+      put(syn + q, oy);
+      put(szn + q, oz);
+      const V ux = pin ? vx : nvx, uy = pin ? vy : nvy, uz = pin ? vz : nvz;
+      put3(vel + 3 * q, ux, uy, uz);
+      // check_finite's test (bad_components), lane by lane: |x| <= limit (false for NaN) is
+      // x <= limit and -limit <= x; c - c == 0 fails for inf and NaN.
+      M good = (ox <= lim) & (nlim <= ox) & (ox - ox == zero) & (oy <= lim) & (nlim <= oy) & (oy - oy == zero) &
+               (oz <= lim) & (nlim <= oz) & (oz - oz == zero) & (ux - ux == zero) & (uy - uy == zero) &
+               (uz - uz == zero);
+      if constexpr (Tail) good = good | (lane < skip);
+      ok = ok & good;
     }
   };
+  // Interior vectors (all W masks full) take the unmasked code; with no mask array, all do.
+  auto full = [&](std::int64_t q) {
+    if (!mask) return true;
+    constexpr int words = W / 4; // 4 masks per 64-bit word (W is a multiple of 4)
+    std::uint64_t w[words];
+    __builtin_memcpy(w, mask + q, sizeof w);
+    std::uint64_t acc = ~std::uint64_t(0);
+    for (int l = 0; l < words; ++l) acc &= w[l];
+    return acc == ~std::uint64_t(0);
+  };
   std::int64_t done = q0;
-  for (; done + W <= q1; done += W) vec(done, 0, Flag<false>{});
+  for (; done + W <= q1; done += W) {
+    if (full(done)) vec(done, 0, Flag<false>{}, Flag<false>{});
+    else vec(done, 0, Flag<false>{}, Flag<true>{});
+  }
   if (done < q1 && q1 - q0 >= W) { // the remainder as one vector overlapping the previous one
-    vec(q1 - W, int(W - (q1 - done)), Flag<true>{});
+    const std::int64_t q = q1 - W;
+    if (full(q)) vec(q, int(W - (q1 - done)), Flag<true>{}, Flag<false>{});
+    else vec(q, int(W - (q1 - done)), Flag<true>{}, Flag<true>{});
     done = q1;
+  }
+  if constexpr (integrate) {
+    bool all = true;
+    for (int l = 0; l < W; ++l) all = all && ok[l] != 0;
+    if (!all) bad = true;
   }
   return done;
 }
 
 template <typename T>
-std::int64_t simd_dispatch(const vkcloth::detail::RowArgs<typename T::Real>& a, std::int64_t q0, std::int64_t q1) {
+std::int64_t simd_dispatch(const vkcloth::detail::RowArgs<typename T::Real>& a, std::int64_t q0, std::int64_t q1,
+                           bool& bad) {
   const int v = (a.wind ? 4 : 0) | (a.integrate ? 2 : 0) | (a.semi ? 1 : 0);
   switch (v) {
-  case 0: return simd_body<T, false, false, false>(a, q0, q1);
-  case 1: return simd_body<T, false, false, true>(a, q0, q1);
-  case 2: return simd_body<T, false, true, false>(a, q0, q1);
-  case 3: return simd_body<T, false, true, true>(a, q0, q1);
-  case 4: return simd_body<T, true, false, false>(a, q0, q1);
-  case 5: return simd_body<T, true, false, true>(a, q0, q1);
-  case 6: return simd_body<T, true, true, false>(a, q0, q1);
-  default: return simd_body<T, true, true, true>(a, q0, q1);
+  case 0: return simd_body<T, false, false, false>(a, q0, q1, bad);
+  case 1: return simd_body<T, false, false, true>(a, q0, q1, bad);
+  case 2: return simd_body<T, false, true, false>(a, q0, q1, bad);
+  case 3: return simd_body<T, false, true, true>(a, q0, q1, bad);
+  case 4: return simd_body<T, true, false, false>(a, q0, q1, bad);
+  case 5: return simd_body<T, true, false, true>(a, q0, q1, bad);
+  case 6: return simd_body<T, true, true, false>(a, q0, q1, bad);
+  default: return simd_body<T, true, true, true>(a, q0, q1, bad);
   }
 }
 
@@ -181,6 +243,11 @@ template <typename Real, typename V, typename M, int W> struct IsaGeneric {
   static M pinmask(const std::uint8_t* p) {
     M m;
     for (int l = 0; l < W; ++l) m[l] = p[l] ? -1 : 0;
+    return m;
+  }
+  static M loadmask(const std::uint16_t* p) {
+    M m;
+    for (int l = 0; l < W; ++l) m[l] = p[l];
     return m;
   }
 };

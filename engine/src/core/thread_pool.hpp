@@ -1,11 +1,14 @@
-// A small fork-join pool for the CPU solver: parallel_for splits [0, n) into one contiguous chunk
-// per thread. Work items are independent per particle, so results do not depend on the thread count.
+// A small fork-join pool for the CPU solver. A job is [0, n) cut into blocks; the caller and the
+// workers claim blocks one at a time (an atomic counter), so a thread the OS delays does not hold
+// the others up: whoever runs takes the next block, and the caller waits only for blocks already
+// claimed. Work items are independent per particle and the blocks do not depend on which thread
+// runs them, so results do not depend on the thread count or on scheduling.
 #pragma once
 
-#include <condition_variable>
+#include <atomic>
 #include <cstddef>
+#include <cstdint>
 #include <functional>
-#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -13,6 +16,8 @@ namespace vkcloth::detail {
 
 class ThreadPool {
 public:
+  using Fn = std::function<void(std::size_t, std::size_t)>;
+
   /// `threads` = total threads including the caller's (1 = run everything inline).
   explicit ThreadPool(unsigned threads);
   ~ThreadPool();
@@ -21,20 +26,29 @@ public:
 
   unsigned size() const { return static_cast<unsigned>(workers_.size()) + 1; }
 
-  /// Calls fn(begin, end) over [0, n) split across the threads; returns when all are done.
-  void parallel_for(std::size_t n, const std::function<void(std::size_t, std::size_t)>& fn);
+  /// Calls fn(begin, end) over [0, n) split into one contiguous chunk per thread; returns when
+  /// all are done.
+  void parallel_for(std::size_t n, const Fn& fn);
+  /// The same with chunks of about `block` items (at least `block`, at most 2 x `block` - 1), so
+  /// that the threads share the work by what each actually gets done.
+  void parallel_blocks(std::size_t n, std::size_t block, const Fn& fn);
 
 private:
-  void worker(unsigned index);
+  void run(std::size_t n, std::uint32_t blocks, const Fn& fn);
+  void claim_loop(std::uint32_t generation);
+  void worker();
 
   std::vector<std::thread> workers_;
-  std::mutex mutex_;
-  std::condition_variable wake_, done_;
-  const std::function<void(std::size_t, std::size_t)>* job_ = nullptr;
-  std::size_t n_ = 0;
-  std::uint64_t generation_ = 0;
-  unsigned pending_ = 0;
-  bool stop_ = false;
+  // The job: valid for the generation stored in claim_'s high 32 bits; claim_'s low 32 bits are
+  // the next unclaimed block. Workers read the job after seeing the generation and only run a
+  // block after claiming it with a compare-exchange that also checks the generation.
+  std::atomic<const Fn*> fn_{nullptr};
+  std::atomic<std::size_t> n_{0};
+  std::atomic<std::uint32_t> blocks_{0};
+  std::atomic<std::uint64_t> claim_{0};
+  std::atomic<std::uint32_t> finished_{0}; // blocks of the current job done
+  std::atomic<std::uint32_t> generation_{0}; // wakes the workers (spin, then atomic wait)
+  std::atomic<bool> stop_{false};
 };
 
 } // namespace vkcloth::detail
