@@ -79,20 +79,25 @@ double kernel_flops(double s, bool grid, bool wind) {
   return normal + springs + external;
 }
 
-Cost cost_of(const std::string& variant, Integrator integrator, double s, bool grid, bool wind) {
+// `grid`: the bench's regular cloth, whose springs both solvers sum from the grid stencil (no
+// CSR reads since round 4); `steps_per_submit`: fused Vulkan steps store forces and normals only
+// in the last step of a submission.
+Cost cost_of(const std::string& variant, Integrator integrator, double s, bool grid, bool wind,
+             std::uint32_t steps_per_submit) {
   Cost c;
   const double eval = kernel_flops(s, grid, wind);
   const bool rk4 = integrator == Integrator::rk4;
   // Euler update: a = f/m 3, two axpys 12. RK4: 4 stages (eval + k sums 6 + next stage 12), final 12.
   c.flops = rk4 ? 4.0 * (eval + 18.0) + 12.0 : eval + 15.0;
-  const double csr = 4.0 + 12.0 * s; // offsets + 12-byte edges
+  const double csr = grid ? 0.0 : 4.0 + 12.0 * s; // offsets + 12-byte edges
   if (variant == "cpu") {
-    // float vec3 (12 B): read pos, vel; write pos_next, vel, force, normal; mass 4 + pinned 1.
-    const double euler = 6 * 12.0 + 5.0 + csr;
+    // float vec3 (12 B): read pos, vel; write pos_next, vel, force, normal (and, on grids, the
+    // next step's SoA position copy); mass 4 + pinned 1.
+    const double euler = 6 * 12.0 + 5.0 + csr + (grid ? 12.0 : 0.0);
     c.bytes = rk4 ? 4.0 * (4 * 12.0 + 5.0 + csr + 6 * 12.0) + 4 * 12.0 : euler;
   } else if (variant == "fused" || variant == "batched" || variant == "unbatched") {
-    // vec4 (16 B): read pos, vel, particle 8; write pos, vel, force, normal.
-    c.bytes = 16.0 * 2 + 8.0 + csr + 16.0 * 4;
+    // vec4 (16 B): read pos, vel, particle 8; write pos, vel; force, normal once per submission.
+    c.bytes = 16.0 * 2 + 8.0 + csr + 16.0 * 2 + 16.0 * 2 / double(std::max(steps_per_submit, 1u));
   } else {
     // two-pass: force reads pos, vel, particle, CSR; writes force, vel_filt, normal.
     //           integrate reads particle, force, vel_filt, pos; writes pos, vel.
@@ -269,7 +274,7 @@ int bench_command(const BenchOptions& o) {
       r->springs = sc->system.springs.size();
       r->steps = o.steps;
       r->reps = o.reps;
-      r->cost = cost_of(r->variant, *integrator, s, true, true);
+      r->cost = cost_of(r->variant, *integrator, s, true, true, o.steps_per_submit);
       rows.push_back(*r);
       return exit_ok;
     };
