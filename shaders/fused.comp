@@ -1,7 +1,7 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// Fused Euler step, one invocation per particle of every instance of the batch, one dispatch per step (GpuSolverOptions::fused):
-// the force pass (force_body.glsl: normal rebuilt from the neighbours' POS_IN, spring gather,
+// Fused Euler step, one invocation per particle of every instance of the batch, one dispatch per
+// step (GpuSolverOptions::fused): the force pass (force_body.glsl: normal rebuilt from the neighbours' POS_IN, spring gather,
 // contacts) followed by the Euler update and projection (finish.glsl) in registers. Valid in one
 // dispatch because positions are ping-ponged (every invocation reads POS_IN = positions[read] and
 // writes only its own POS_OUT = positions[write]) and the velocity is read and written only by its
@@ -22,7 +22,7 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_VEL) buffer VelBuf { vec4 vel[
 
 #include "finish.glsl"
 
-// False for every substep of a recorded batch but the last (GpuSolver fused_noaux_pipeline): the
+// False for every substep of a recorded batch but the last (GpuSolver fused_pipes[0][*]): the
 // forces and normals of the other substeps are overwritten before anyone can read them, and
 // llvmpipe pays a per-lane scalar loop for each of these stores.
 layout(constant_id = 40) const bool SC_WRITE_AUX = true;
@@ -44,7 +44,8 @@ void main() {
   // live step (keeps it in the buffer that becomes current): llvmpipe runs every branch, so a
   // separate copy cost a masked per-lane load and store loop in every step. finish() re-checks the
   // frozen state, which is the bad step's output: the same particles, no flag changes.
-  const bool fr = texelFetch(flags_texel, int(inst * 4u + 1u)).x < pc.step; // frozen(): Flags[inst].first_bad_step
+  // frozen(): Flags[inst].first_bad_step (4 words per Flags) < this step
+  const bool fr = texelFetch(flags_texel, int(inst * 4u + 1u)).x < pc.step;
   const vec3 v0 = texelFetch(vel_texel, int(g)).xyz;
   vec3 vf = v0;
   vec3 f, nrm;

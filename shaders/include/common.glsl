@@ -17,9 +17,8 @@ layout(push_constant) uniform PushBlock { PushConstants pc; };
 #endif
 
 // False: no instance of the batch has colliders (every ip.collider_count == 0), the contact loops
-// compiled out. llvmpipe runs a
-// loop body once even when no invocation enters it, per-lane collider loads included (GpuSolver
-// creates fused.comp with and without; the other shaders keep the default).
+// compiled out. llvmpipe runs a loop body once even when no invocation enters it, per-lane collider
+// loads included (GpuSolver creates fused.comp with and without; the other shaders keep the default).
 layout(constant_id = 41) const bool SC_COLLIDERS = true;
 
 layout(std430, set = 0, binding = VKCLOTH_BINDING_PARTICLE) readonly buffer ParticleBuf { ParticleInfo particle[]; };
