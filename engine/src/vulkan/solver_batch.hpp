@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include <glm/vec2.hpp>
@@ -134,7 +135,9 @@ struct GpuSolver::Impl {
   Result<void> write_sets();
   Result<void> upload_colliders();
   void upload_instance_params();
-  template <typename F> Result<void> submit_and_wait(F&& record);
+  template <typename F> Result<void> submit_and_wait(F&& record_fn) {
+    return gpu::submit_and_wait(*ctx, cmd, fence, std::forward<F>(record_fn));
+  }
   Result<std::vector<glm::vec3>> read_vec3(const Buffer& b, std::uint32_t slot);
 };
 

@@ -107,4 +107,26 @@ Result<Buffer> create_buffer(Context::Impl& ctx, VkDeviceSize size, VkBufferUsag
                              bool allow_map, const char* what, const std::vector<std::uint32_t>& sharing_families = {});
 void destroy_buffer(Context::Impl& ctx, Buffer& b);
 
+/// The convenience path of solvers and worlds: resets `cmd`, records `record_fn(cmd)` into it
+/// (one-time submit), submits it on the Context's queue signalling `fence` and waits for it.
+template <typename F>
+Result<void> submit_and_wait(const Context::Impl& ctx, VkCommandBuffer cmd, VkFence fence, F&& record_fn) {
+  const auto& v = ctx.vk;
+  VKCLOTH_VK_TRY(v.vkResetCommandBuffer(cmd, 0), "vkResetCommandBuffer");
+  VkCommandBufferBeginInfo bi{};
+  bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+  bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  VKCLOTH_VK_TRY(v.vkBeginCommandBuffer(cmd, &bi), "vkBeginCommandBuffer");
+  record_fn(cmd);
+  VKCLOTH_VK_TRY(v.vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
+  VkSubmitInfo si{};
+  si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
+  si.commandBufferCount = 1;
+  si.pCommandBuffers = &cmd;
+  VKCLOTH_VK_TRY(v.vkResetFences(ctx.device, 1, &fence), "vkResetFences");
+  VKCLOTH_VK_TRY(v.vkQueueSubmit(ctx.queue, 1, &si, fence), "vkQueueSubmit");
+  VKCLOTH_VK_TRY(v.vkWaitForFences(ctx.device, 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+  return {};
+}
+
 } // namespace vkcloth::gpu

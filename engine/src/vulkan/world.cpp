@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <map>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -89,22 +90,7 @@ struct ClothWorld::Impl {
   }
 
   template <typename F> Result<void> submit_and_wait(F&& record_fn) {
-    const auto& v = ctx->vk;
-    VKCLOTH_VK_TRY(v.vkResetFences(ctx->device, 1, &fence), "vkResetFences (world)");
-    VKCLOTH_VK_TRY(v.vkResetCommandBuffer(cmd, 0), "vkResetCommandBuffer (world)");
-    VkCommandBufferBeginInfo bi{};
-    bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
-    bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-    VKCLOTH_VK_TRY(v.vkBeginCommandBuffer(cmd, &bi), "vkBeginCommandBuffer (world)");
-    record_fn(cmd);
-    VKCLOTH_VK_TRY(v.vkEndCommandBuffer(cmd), "vkEndCommandBuffer (world)");
-    VkSubmitInfo si{};
-    si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
-    si.commandBufferCount = 1;
-    si.pCommandBuffers = &cmd;
-    VKCLOTH_VK_TRY(v.vkQueueSubmit(ctx->queue, 1, &si, fence), "vkQueueSubmit (world)");
-    VKCLOTH_VK_TRY(v.vkWaitForFences(ctx->device, 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences (world)");
-    return {};
+    return gpu::submit_and_wait(*ctx, cmd, fence, std::forward<F>(record_fn));
   }
 
   /// Rebuilds the batch `key` with `members` (slot order; may be empty: the batch goes away).
