@@ -10,9 +10,9 @@
 //                        (implicit_gpu.hpp); every scheme repeats its passes `substeps` times per step
 //
 // Buffers (device-local storage buffers, vec4 per particle, w unused; positions have w = 1):
-// positions[2] (ping-pong), velocities, forces, normals (unit, zero for
-// chains; fused Euler stores forces and normals in the last step of a recording), uvs (i/(nx-1), j/(ny-1) for grids, zero for chains), the grid's triangle indices,
-// plus internal scratch. A GpuSolver is a batch of one instance: gpu::ClothWorld steps many
+// positions[2] (ping-pong), velocities, forces, normals (unit, zero for chains; fused Euler
+// stores forces and normals in the last step of a recording), uvs (i/(nx-1), j/(ny-1) for grids,
+// zero for chains), the grid's triangle indices, plus internal scratch. A GpuSolver is a batch of one instance: gpu::ClothWorld steps many
 // cloths of one topology with the same shaders and one dispatch per pass (world.hpp).
 //
 // Thread safety: none; one thread drives a solver. Known limitations: the step counter of the
