@@ -186,8 +186,7 @@ Result<Row> bench_vulkan(gpu::Context& ctx, const BenchScene& sc, std::uint32_t 
 /// batched (one shared topology: one dispatch per pass for all) or not (a topology copy each:
 /// every cloth its own dispatches, as separate solvers recorded into one command buffer).
 Result<Row> bench_world(gpu::Context& ctx, const BenchScene& sc, std::uint32_t n, bool batched, const BenchOptions& o) {
-  gpu::WorldOptions wo;
-  auto w = gpu::ClothWorld::create(ctx, wo);
+  auto w = gpu::ClothWorld::create(ctx);
   if (!w) return w.error();
   const auto shared = std::make_shared<const ParticleSystem>(sc.system);
   for (std::uint32_t k = 0; k < o.instances; ++k)

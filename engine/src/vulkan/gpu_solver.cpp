@@ -106,9 +106,6 @@ void GpuSolver::Impl::upload_instance_params() {
     ip.limit = float(params.divergence_limit);
     *out++ = ip;
   }
-  pc.count = count;
-  pc.nx = nx;
-  pc.ny = ny;
 }
 
 // One instance's entries of a per-particle buffer.
@@ -201,8 +198,8 @@ void GpuSolver::Impl::record(VkCommandBuffer c, std::uint32_t steps) {
 void GpuSolver::Impl::record_copy_slot(VkCommandBuffer c, const Impl& from, std::uint32_t from_slot,
                                        std::uint32_t to_slot) const {
   const VkBufferCopy region{from.slot_offset(from_slot), slot_offset(to_slot), slot_bytes()};
+  // Into positions[0], the new batch's current buffer; every step rewrites all of positions[1].
   const std::pair<const Buffer*, const Buffer*> copies[] = {{&from.pos[from.current()], &pos[0]},
-                                                            {&from.pos[from.current()], &pos[1]},
                                                             {&from.vel, &vel},
                                                             {&from.normal, &normal},
                                                             {&from.force, &force}};
@@ -316,12 +313,13 @@ Result<std::unique_ptr<GpuSolver::Impl>> GpuSolver::Impl::create(const std::shar
   for (std::size_t k = 0; k < params.size(); ++k) s.slots[k].params = std::move(params[k]);
   s.options = options;
   s.count = static_cast<std::uint32_t>(n);
+  s.pc.count = s.count;
   s.edges_count = edges_n;
   s.groups_x = static_cast<std::uint32_t>(gx);
   s.groups_y = static_cast<std::uint32_t>(gy);
   if (system.grid) {
-    s.nx = system.grid->nx;
-    s.ny = system.grid->ny;
+    s.nx = s.pc.nx = system.grid->nx;
+    s.ny = s.pc.ny = system.grid->ny;
   }
   const auto& v = ctx->vk;
   const VkDevice d = ctx->device;

@@ -123,7 +123,8 @@ struct GpuSolver::Impl {
   /// `last`: the last substep of this recording (the fused variant that stores forces and normals).
   void record_substep(VkCommandBuffer cmd, bool first, bool last);
   /// Copies instance `from_slot` of `from` (current positions, velocities, normals, forces) into
-  /// instance `to_slot` of this batch (both position buffers); the caller records the barriers.
+  /// instance `to_slot` of this batch (positions[0]: current at creation); the caller records the
+  /// barriers.
   void record_copy_slot(VkCommandBuffer cmd, const Impl& from, std::uint32_t from_slot, std::uint32_t to_slot) const;
   /// Reads the flags of every instance; marks the newly diverged ones (their step, the error).
   void refresh_flags();

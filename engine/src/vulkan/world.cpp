@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <map>
+#include <set>
 #include <utility>
 #include <vector>
 
@@ -112,9 +113,10 @@ struct ClothWorld::Impl {
     auto made = Batch::create(ctx, *instances.at(members.front()).topology, std::move(params), options.solver, states);
     if (!made) return made.error();
     std::unique_ptr<Batch> batch = std::move(*made);
-    bool copies = false;
-    for (InstanceId id : members) copies = copies || !fresh.count(id);
-    if (copies)
+    std::set<Batch*> sources; // the batches the surviving members come from
+    for (InstanceId id : members)
+      if (!fresh.count(id)) sources.insert(instances.at(id).batch);
+    if (!sources.empty())
       VKCLOTH_TRY(submit_and_wait([&](VkCommandBuffer c) {
         barriers::before_batch_copy(ctx->vk, c);
         for (std::uint32_t k = 0; k < members.size(); ++k)
@@ -124,20 +126,19 @@ struct ClothWorld::Impl {
           }
         barriers::after_batch_copy(ctx->vk, c);
       }));
+    // Their flags are current (the copy waited for their work): read each batch's once.
+    for (Batch* source : sources) source->refresh_flags();
     for (std::uint32_t k = 0; k < members.size(); ++k) {
       Instance& inst = instances.at(members[k]);
-      if (!fresh.count(members[k])) {
-        inst.batch->refresh_flags(); // the old batch's flags are current: the copy waited for its work
+      if (!fresh.count(members[k])) { // carry its step count and divergence over
         const Batch::Slot& old = inst.batch->slots[inst.slot];
         Batch::Slot& now = batch->slots[k];
         now.step = now.epoch_step = old.step;
         now.diverged = old.diverged;
         if (now.diverged) batch->freeze_slot(k);
       }
-    }
-    for (std::uint32_t k = 0; k < members.size(); ++k) {
-      instances.at(members[k]).batch = batch.get();
-      instances.at(members[k]).slot = k;
+      inst.batch = batch.get();
+      inst.slot = k;
     }
     batches[key] = BatchEntry{std::move(batch), members};
     return {};
