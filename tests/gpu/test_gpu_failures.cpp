@@ -1,19 +1,26 @@
 // Vulkan failure paths (issue #9): an allocation failing at any point of a solver's life is a clear
 // error, everything allocated before it is released, and the Context stays usable.
-#include <cstdlib>
 #include <string>
 
 #include "gpu_test_util.hpp"
+#include "vkcloth/gpu/testing.hpp"
 
 using namespace vkcloth;
 using namespace vkcloth::gpu;
 
 namespace {
 
-/// Sets VKCLOTH_TEST_FAIL_ALLOCATION for the scope (see engine/src/vulkan/buffer.cpp).
+/// Makes the nth device memory allocation on `ctx` fail for the scope (testing.hpp).
 struct FailAllocation {
-  explicit FailAllocation(unsigned n) { ::setenv("VKCLOTH_TEST_FAIL_ALLOCATION", std::to_string(n).c_str(), 1); }
-  ~FailAllocation() { ::unsetenv("VKCLOTH_TEST_FAIL_ALLOCATION"); }
+  FailAllocation(Context& ctx, unsigned n) : ctx_(ctx) {
+    testing::set_allocation_failure_hook(ctx, [n, count = 0u]() mutable { return ++count == n; });
+  }
+  ~FailAllocation() { testing::set_allocation_failure_hook(ctx_, {}); }
+  FailAllocation(const FailAllocation&) = delete;
+  FailAllocation& operator=(const FailAllocation&) = delete;
+
+private:
+  Context& ctx_;
 };
 
 bool is_injected_oom(const Error& e) {
@@ -41,7 +48,7 @@ TEST_CASE("GpuSolver: out of device memory at every allocation is reported, leak
       CAPTURE(n);
       bool failed = false;
       {
-        FailAllocation hook(n);
+        FailAllocation hook(ctx, n);
         auto gpu = GpuSolver::create(ctx, *cloth, params, o);
         if (!gpu.ok()) {
           CHECK_MESSAGE(is_injected_oom(gpu.error()), gpu.error().message);

@@ -11,6 +11,7 @@
 #include <glm/mat4x4.hpp>
 #include <glm/vec4.hpp>
 
+#include "../vulkan/barriers.hpp"
 #include "vkcloth/render/cloth_renderer.hpp"
 #include "vkcloth/gpu/world.hpp"
 #include "vkcloth/shaders/render/cloth_frag_spv.hpp"
@@ -71,7 +72,7 @@ void add_sphere(std::vector<MeshVertex>& v, std::vector<std::uint32_t>& idx, glm
 } // namespace
 
 struct ClothRenderer::Impl {
-  std::shared_ptr<gpu::Context::Impl> ctx;
+  std::shared_ptr<gpu::Context::Impl> ctx; // first: outlives the objects below
   Palette palette;
   bool grid = false;
   std::uint32_t particle_count = 0;
@@ -83,37 +84,13 @@ struct ClothRenderer::Impl {
   std::vector<MeshRange> colliders;
   MeshRange unit_sphere; // chain masses (instanced at the solver's positions)
 
-  detail::ImageResource texture;
-  VkSampler sampler = VK_NULL_HANDLE;
-  VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
-  VkDescriptorPool pool = VK_NULL_HANDLE;
-  VkDescriptorSet set = VK_NULL_HANDLE;
-  VkPipelineLayout layout = VK_NULL_HANDLE;
-  VkPipeline cloth_pipeline = VK_NULL_HANDLE, mesh_pipeline = VK_NULL_HANDLE, line_pipeline = VK_NULL_HANDLE;
-
-  Impl() = default;
-  Impl(const Impl&) = delete;
-  Impl& operator=(const Impl&) = delete;
-  ~Impl() {
-    if (!ctx || !ctx->device)
-      return;
-    const auto& v = ctx->vk;
-    const VkDevice d = ctx->device;
-    for (VkPipeline p : {cloth_pipeline, mesh_pipeline, line_pipeline})
-      if (p)
-        v.vkDestroyPipeline(d, p, v.allocator);
-    if (layout)
-      v.vkDestroyPipelineLayout(d, layout, v.allocator);
-    if (pool)
-      v.vkDestroyDescriptorPool(d, pool, v.allocator);
-    if (set_layout)
-      v.vkDestroyDescriptorSetLayout(d, set_layout, v.allocator);
-    if (sampler)
-      v.vkDestroySampler(d, sampler, v.allocator);
-    detail::destroy_image(*ctx, texture);
-    for (Buffer* b : {&cloth_index, &mesh_vertices, &mesh_index, &zero_instance})
-      gpu::destroy_buffer(*ctx, *b);
-  }
+  gpu::ImageResource texture;
+  gpu::Sampler sampler;
+  gpu::DescriptorSetLayout set_layout;
+  gpu::DescriptorPool pool;
+  VkDescriptorSet set = VK_NULL_HANDLE; // freed with pool
+  gpu::PipelineLayout layout;
+  gpu::Pipeline cloth_pipeline, mesh_pipeline, line_pipeline;
 
   Result<Buffer> host_buffer(const void* data, VkDeviceSize bytes, VkBufferUsageFlags usage,
                              const char* what) {
@@ -148,7 +125,7 @@ Result<void> ClothRenderer::Impl::build_geometry(const ParticleSystem& system, c
                         "cloth indices");
   if (!ci)
     return ci.error();
-  cloth_index = *ci;
+  cloth_index = std::move(*ci);
 
   // Colliders, in world space; the floor is a square around the scene's centre.
   const Bounds b = scene_bounds(system, params);
@@ -200,99 +177,42 @@ Result<void> ClothRenderer::Impl::build_geometry(const ParticleSystem& system, c
                         "mesh vertices");
   if (!mv)
     return mv.error();
-  mesh_vertices = *mv;
+  mesh_vertices = std::move(*mv);
   auto mi = host_buffer(midx.data(), midx.size() * sizeof(std::uint32_t), VK_BUFFER_USAGE_INDEX_BUFFER_BIT,
                         "mesh indices");
   if (!mi)
     return mi.error();
-  mesh_index = *mi;
+  mesh_index = std::move(*mi);
   const glm::vec4 zero(0.0f);
   auto zi = host_buffer(&zero, sizeof(zero), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, "zero instance offset");
   if (!zi)
     return zi.error();
-  zero_instance = *zi;
+  zero_instance = std::move(*zi);
   return {};
 }
 
 Result<void> ClothRenderer::Impl::upload_texture(const Image& img) {
   const auto& v = ctx->vk;
   const VkDevice d = ctx->device;
-  auto t = detail::create_image(*ctx, VK_FORMAT_R8G8B8A8_UNORM,
-                                VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
-                                VK_IMAGE_ASPECT_COLOR_BIT, img.width, img.height, "texture");
+  auto t = gpu::create_image(*ctx, VK_FORMAT_R8G8B8A8_UNORM, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+                             VK_IMAGE_ASPECT_COLOR_BIT, img.width, img.height, "texture");
   if (!t)
     return t.error();
-  texture = *t;
-  auto st =
-      host_buffer(img.rgba.data(), img.rgba.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, "texture staging");
-  if (!st)
-    return st.error();
-  Buffer staging = *st;
-
-  VkCommandPool cmd_pool = VK_NULL_HANDLE;
-  VkCommandBuffer cmd = VK_NULL_HANDLE;
-  VkFence fence = VK_NULL_HANDLE;
-  auto cleanup = [&] {
-    if (fence)
-      v.vkDestroyFence(d, fence, v.allocator);
-    if (cmd_pool)
-      v.vkDestroyCommandPool(d, cmd_pool, v.allocator);
-    gpu::destroy_buffer(*ctx, staging);
-  };
-  auto run = [&]() -> Result<void> {
-    VkCommandPoolCreateInfo cp{};
-    cp.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
-    cp.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;
-    cp.queueFamilyIndex = ctx->queue_family;
-    VKCLOTH_VK_TRY(v.vkCreateCommandPool(d, &cp, v.allocator, &cmd_pool), "vkCreateCommandPool (texture upload)");
-    VkCommandBufferAllocateInfo ca{};
-    ca.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
-    ca.commandPool = cmd_pool;
-    ca.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-    ca.commandBufferCount = 1;
-    VKCLOTH_VK_TRY(v.vkAllocateCommandBuffers(d, &ca, &cmd), "vkAllocateCommandBuffers (texture upload)");
-    VkFenceCreateInfo fi{};
-    fi.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
-    VKCLOTH_VK_TRY(v.vkCreateFence(d, &fi, v.allocator, &fence), "vkCreateFence (texture upload)");
-    VkCommandBufferBeginInfo bi{};
-    bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
-    bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-    VKCLOTH_VK_TRY(v.vkBeginCommandBuffer(cmd, &bi), "vkBeginCommandBuffer (texture upload)");
-    VkImageMemoryBarrier ib{};
-    ib.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
-    ib.srcQueueFamilyIndex = ib.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    ib.image = texture.image;
-    ib.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-    // Undefined -> transfer destination (nothing to wait for: the image is new).
-    ib.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-    ib.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
-    ib.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-    v.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0,
-                           nullptr, 0, nullptr, 1, &ib);
+  texture = std::move(*t);
+  auto staging = host_buffer(img.rgba.data(), img.rgba.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, "texture staging");
+  if (!staging)
+    return staging.error();
+  auto commands = gpu::CommandContext::create(*ctx, "texture upload");
+  if (!commands)
+    return commands.error();
+  VKCLOTH_TRY(commands->submit_and_wait([&](VkCommandBuffer cmd) {
+    gpu::barriers::texture_before_upload(v, cmd, texture.image);
     VkBufferImageCopy region{};
     region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
     region.imageExtent = {img.width, img.height, 1};
-    v.vkCmdCopyBufferToImage(cmd, staging.buffer, texture.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
-                             &region);
-    // The copy's writes -> visible to the fragment shader's sampling, in the sampled layout.
-    ib.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
-    ib.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
-    ib.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-    ib.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
-    v.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, 0, 0,
-                           nullptr, 0, nullptr, 1, &ib);
-    VKCLOTH_VK_TRY(v.vkEndCommandBuffer(cmd), "vkEndCommandBuffer (texture upload)");
-    VkSubmitInfo si{};
-    si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
-    si.commandBufferCount = 1;
-    si.pCommandBuffers = &cmd;
-    VKCLOTH_VK_TRY(v.vkQueueSubmit(ctx->queue, 1, &si, fence), "vkQueueSubmit (texture upload)");
-    VKCLOTH_VK_TRY(v.vkWaitForFences(d, 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences (texture upload)");
-    return {};
-  };
-  auto r = run();
-  cleanup();
-  VKCLOTH_TRY(r);
+    v.vkCmdCopyBufferToImage(cmd, staging->buffer, texture.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+    gpu::barriers::texture_after_upload(v, cmd, texture.image);
+  }));
 
   VkSamplerCreateInfo si{};
   si.sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO;
@@ -300,7 +220,7 @@ Result<void> ClothRenderer::Impl::upload_texture(const Image& img) {
   si.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST;
   si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_REPEAT;
   si.maxLod = 0.0f;
-  VKCLOTH_VK_TRY(v.vkCreateSampler(d, &si, v.allocator, &sampler), "vkCreateSampler");
+  VKCLOTH_VK_TRY(v.vkCreateSampler(d, &si, v.allocator, sampler.init(*ctx)), "vkCreateSampler");
   return {};
 }
 
@@ -313,7 +233,7 @@ Result<void> ClothRenderer::Impl::build_pipelines(const RendererOptions& o) {
   li.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
   li.bindingCount = 1;
   li.pBindings = &binding;
-  VKCLOTH_VK_TRY(v.vkCreateDescriptorSetLayout(d, &li, v.allocator, &set_layout),
+  VKCLOTH_VK_TRY(v.vkCreateDescriptorSetLayout(d, &li, v.allocator, set_layout.init(*ctx)),
                  "vkCreateDescriptorSetLayout (renderer)");
   const VkDescriptorPoolSize ps{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1};
   VkDescriptorPoolCreateInfo dp{};
@@ -321,12 +241,12 @@ Result<void> ClothRenderer::Impl::build_pipelines(const RendererOptions& o) {
   dp.maxSets = 1;
   dp.poolSizeCount = 1;
   dp.pPoolSizes = &ps;
-  VKCLOTH_VK_TRY(v.vkCreateDescriptorPool(d, &dp, v.allocator, &pool), "vkCreateDescriptorPool (renderer)");
+  VKCLOTH_VK_TRY(v.vkCreateDescriptorPool(d, &dp, v.allocator, pool.init(*ctx)), "vkCreateDescriptorPool (renderer)");
   VkDescriptorSetAllocateInfo ai{};
   ai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
   ai.descriptorPool = pool;
   ai.descriptorSetCount = 1;
-  ai.pSetLayouts = &set_layout;
+  ai.pSetLayouts = set_layout.ptr();
   VKCLOTH_VK_TRY(v.vkAllocateDescriptorSets(d, &ai, &set), "vkAllocateDescriptorSets (renderer)");
   const VkDescriptorImageInfo ii{sampler, texture.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
   VkWriteDescriptorSet w{};
@@ -342,10 +262,10 @@ Result<void> ClothRenderer::Impl::build_pipelines(const RendererOptions& o) {
   VkPipelineLayoutCreateInfo pl{};
   pl.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
   pl.setLayoutCount = 1;
-  pl.pSetLayouts = &set_layout;
+  pl.pSetLayouts = set_layout.ptr();
   pl.pushConstantRangeCount = 1;
   pl.pPushConstantRanges = &range;
-  VKCLOTH_VK_TRY(v.vkCreatePipelineLayout(d, &pl, v.allocator, &layout), "vkCreatePipelineLayout (renderer)");
+  VKCLOTH_VK_TRY(v.vkCreatePipelineLayout(d, &pl, v.allocator, layout.init(*ctx)), "vkCreatePipelineLayout (renderer)");
 
   struct Shaders {
     const std::uint32_t* vs;
@@ -356,15 +276,13 @@ Result<void> ClothRenderer::Impl::build_pipelines(const RendererOptions& o) {
   };
   auto make = [&](const Shaders& sh, const std::vector<VkVertexInputBindingDescription>& bindings,
                   const std::vector<VkVertexInputAttributeDescription>& attrs, VkPrimitiveTopology topology,
-                  VkPipeline* out) -> Result<void> {
-    auto vm = detail::create_shader(*ctx, sh.vs, sh.vs_words, sh.name);
+                  gpu::Pipeline* out) -> Result<void> {
+    auto vm = gpu::create_shader_module(*ctx, {sh.vs, sh.vs_words}, sh.name);
     if (!vm)
       return vm.error();
-    auto fm = detail::create_shader(*ctx, sh.fs, sh.fs_words, sh.name);
-    if (!fm) {
-      v.vkDestroyShaderModule(d, *vm, v.allocator);
+    auto fm = gpu::create_shader_module(*ctx, {sh.fs, sh.fs_words}, sh.name);
+    if (!fm)
       return fm.error();
-    }
     VkPipelineShaderStageCreateInfo stages[2]{};
     stages[0] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
                  nullptr,
@@ -434,11 +352,8 @@ Result<void> ClothRenderer::Impl::build_pipelines(const RendererOptions& o) {
     gi.layout = layout;
     gi.renderPass = o.render_pass;
     gi.subpass = o.subpass;
-    const VkResult r = v.vkCreateGraphicsPipelines(d, VK_NULL_HANDLE, 1, &gi, v.allocator, out);
-    v.vkDestroyShaderModule(d, *vm, v.allocator);
-    v.vkDestroyShaderModule(d, *fm, v.allocator);
-    if (r != VK_SUCCESS)
-      return gpu::vk_error(r, fmt::format("vkCreateGraphicsPipelines ({})", sh.name));
+    VKCLOTH_VK_TRY(v.vkCreateGraphicsPipelines(d, ctx->pipeline_cache, 1, &gi, v.allocator, out->init(*ctx)),
+                   fmt::format("vkCreateGraphicsPipelines ({})", sh.name));
     return {};
   };
   namespace sp = gpu::spirv;

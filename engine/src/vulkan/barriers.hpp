@@ -1,10 +1,15 @@
-// Every pipeline barrier the Vulkan solver records lives here, each saying what it orders.
-// Classic vkCmdPipelineBarrier with global memory barriers (core 1.0, so an adopted device needs
-// no synchronization2 feature); a global barrier costs the same as a buffer barrier on current
-// drivers and covers all of the solver's buffers at once.
+// Every pipeline barrier vkcloth records (solver, world, renderer, offscreen target) lives here,
+// each saying why it is needed and what it orders. Classic vkCmdPipelineBarrier (core 1.0, so an
+// adopted device needs no synchronization2 feature). The solver uses global memory barriers: one
+// costs the same as a buffer barrier on current drivers and covers all of its buffers at once.
+// Image layout transitions and queue-family ownership transfers need per-resource barriers:
+// image() / buffer() build them, pipeline() records them (as niagara's resources.h).
 #pragma once
 
 #include "vk_internal.hpp"
+
+#include <array>
+#include <span>
 
 namespace vkcloth::gpu::barriers {
 
@@ -47,7 +52,8 @@ inline void before_readback(const VolkDeviceTable& vk, VkCommandBuffer cmd) {
          VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_HOST_READ_BIT);
 }
 
-/// After a staging copy (readback): the copy's writes are visible to host reads.
+/// After a staging copy (solver readbacks, the offscreen target's frame copy): the copy's writes
+/// are visible to host reads of the mapped memory.
 inline void transfer_to_host(const VolkDeviceTable& vk, VkCommandBuffer cmd) {
   memory(vk, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
          VK_ACCESS_HOST_READ_BIT);
@@ -108,6 +114,122 @@ inline void implicit_pass(const VolkDeviceTable& vk, VkCommandBuffer cmd) {
   memory(vk, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
          VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
          VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+}
+
+} // namespace vkcloth::gpu::barriers
+
+namespace vkcloth::gpu::barriers {
+
+/// A whole-image (one mip, one layer) barrier of `aspect`, no queue-family transfer.
+inline VkImageMemoryBarrier image(VkImage img, VkAccessFlags src_access, VkAccessFlags dst_access,
+                                  VkImageLayout old_layout, VkImageLayout new_layout,
+                                  VkImageAspectFlags aspect = VK_IMAGE_ASPECT_COLOR_BIT) {
+  VkImageMemoryBarrier b{};
+  b.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
+  b.srcAccessMask = src_access;
+  b.dstAccessMask = dst_access;
+  b.oldLayout = old_layout;
+  b.newLayout = new_layout;
+  b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  b.image = img;
+  b.subresourceRange = {aspect, 0, 1, 0, 1};
+  return b;
+}
+
+/// A whole-buffer barrier; `src_family` != `dst_family` makes it a queue-family ownership transfer.
+inline VkBufferMemoryBarrier buffer(VkBuffer buf, VkAccessFlags src_access, VkAccessFlags dst_access,
+                                    std::uint32_t src_family = VK_QUEUE_FAMILY_IGNORED,
+                                    std::uint32_t dst_family = VK_QUEUE_FAMILY_IGNORED) {
+  VkBufferMemoryBarrier b{};
+  b.sType = VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER;
+  b.srcAccessMask = src_access;
+  b.dstAccessMask = dst_access;
+  b.srcQueueFamilyIndex = src_family;
+  b.dstQueueFamilyIndex = dst_family;
+  b.buffer = buf;
+  b.offset = 0;
+  b.size = VK_WHOLE_SIZE;
+  return b;
+}
+
+/// Records per-resource barriers between `src_stage` and `dst_stage`.
+inline void pipeline(const VolkDeviceTable& vk, VkCommandBuffer cmd, VkPipelineStageFlags src_stage,
+                     VkPipelineStageFlags dst_stage, std::span<const VkBufferMemoryBarrier> buffers,
+                     std::span<const VkImageMemoryBarrier> images) {
+  vk.vkCmdPipelineBarrier(cmd, src_stage, dst_stage, 0, 0, nullptr, static_cast<std::uint32_t>(buffers.size()),
+                          buffers.data(), static_cast<std::uint32_t>(images.size()), images.data());
+}
+
+/// Texture upload, before the copy: UNDEFINED -> TRANSFER_DST_OPTIMAL for the copy's writes. A
+/// fresh image: nothing earlier to wait for (TOP_OF_PIPE, no source access); old contents dropped.
+inline void texture_before_upload(const VolkDeviceTable& vk, VkCommandBuffer cmd, VkImage img) {
+  const VkImageMemoryBarrier b = image(img, 0, VK_ACCESS_TRANSFER_WRITE_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                                       VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+  pipeline(vk, cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, {}, {&b, 1});
+}
+
+/// Texture upload, after the copy: TRANSFER_DST -> SHADER_READ_ONLY_OPTIMAL; the copy's writes
+/// become visible to the fragment shader's sampling (every later draw of the renderer).
+inline void texture_after_upload(const VolkDeviceTable& vk, VkCommandBuffer cmd, VkImage img) {
+  const VkImageMemoryBarrier b = image(img, VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT,
+                                       VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  pipeline(vk, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, {}, {&b, 1});
+}
+
+/// The offscreen target's render pass does its image layout transitions itself: colour
+/// UNDEFINED -> COLOR_ATTACHMENT_OPTIMAL at the start (contents cleared) and -> TRANSFER_SRC_OPTIMAL
+/// at the end (for the readback copy); depth UNDEFINED -> DEPTH_STENCIL_ATTACHMENT_OPTIMAL. These
+/// two subpass dependencies order those transitions:
+/// [0] external -> subpass: the previous frame's readback copy (transfer read of the colour image)
+///     and its attachment writes finish before this frame's transition, clears and writes (WAR, WAW);
+/// [1] subpass -> external: the colour writes and the final transition happen before the readback
+///     copy's transfer read (RAW).
+inline std::array<VkSubpassDependency, 2> offscreen_subpass_dependencies() {
+  constexpr VkPipelineStageFlags attachments = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT |
+                                               VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT |
+                                               VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT;
+  std::array<VkSubpassDependency, 2> dep{};
+  dep[0].srcSubpass = VK_SUBPASS_EXTERNAL;
+  dep[0].dstSubpass = 0;
+  dep[0].srcStageMask = VK_PIPELINE_STAGE_TRANSFER_BIT | attachments;
+  dep[0].srcAccessMask = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
+  dep[0].dstStageMask = attachments;
+  dep[0].dstAccessMask = VK_ACCESS_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT |
+                         VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
+  dep[1].srcSubpass = 0;
+  dep[1].dstSubpass = VK_SUBPASS_EXTERNAL;
+  dep[1].srcStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
+  dep[1].srcAccessMask = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT;
+  dep[1].dstStageMask = VK_PIPELINE_STAGE_TRANSFER_BIT;
+  dep[1].dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
+  return dep;
+}
+
+/// Queue-family ownership transfer, RELEASE half (gpu_solver.hpp, record_steps(): separate compute
+/// and graphics families with EXCLUSIVE buffers). Recorded on the compute queue after the steps:
+/// the compute shader writes of `buffers` are made available and ownership leaves `compute_family`
+/// for `graphics_family`. The destination access is ignored for a release (BOTTOM_OF_PIPE, 0); the
+/// host signals a semaphore with this submission.
+inline void release_to_family(const VolkDeviceTable& vk, VkCommandBuffer cmd, std::span<const VkBuffer> buffers,
+                              std::uint32_t compute_family, std::uint32_t graphics_family) {
+  std::array<VkBufferMemoryBarrier, 8> b{};
+  std::uint32_t n = 0;
+  for (VkBuffer buf : buffers)
+    if (n < b.size()) b[n++] = buffer(buf, VK_ACCESS_SHADER_WRITE_BIT, 0, compute_family, graphics_family);
+  pipeline(vk, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, {b.data(), n}, {});
+}
+
+/// The ACQUIRE half, recorded on the graphics queue after waiting on that semaphore (wait stage
+/// VERTEX_INPUT): the same buffers and families, the writes made visible to vertex fetch. The
+/// source access is ignored for an acquire (TOP_OF_PIPE, 0): the semaphore orders the release.
+inline void acquire_from_family(const VolkDeviceTable& vk, VkCommandBuffer cmd, std::span<const VkBuffer> buffers,
+                                std::uint32_t compute_family, std::uint32_t graphics_family) {
+  std::array<VkBufferMemoryBarrier, 8> b{};
+  std::uint32_t n = 0;
+  for (VkBuffer buf : buffers)
+    if (n < b.size())
+      b[n++] = buffer(buf, 0, VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT, compute_family, graphics_family);
+  pipeline(vk, cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_VERTEX_INPUT_BIT, {b.data(), n}, {});
 }
 
 } // namespace vkcloth::gpu::barriers

@@ -1,4 +1,4 @@
-#include "vk_internal.hpp"
+#include "resources.hpp"
 
 #include <algorithm>
 #include <array>
@@ -6,6 +6,7 @@
 #include <cstring>
 #include <limits>
 #include <optional>
+#include <tuple>
 
 #include <fmt/format.h>
 
@@ -19,34 +20,6 @@
 namespace vkcloth::gpu {
 
 namespace sh = shared;
-
-GpuSolver::Impl::~Impl() {
-  if (!ctx || !ctx->device) return;
-  const auto& v = ctx->vk;
-  const VkDevice d = ctx->device;
-  if (fence) {
-    v.vkWaitForFences(d, 1, &fence, VK_TRUE, UINT64_MAX); // our own submissions (always waited already)
-    v.vkDestroyFence(d, fence, v.allocator);
-  }
-  if (queries) v.vkDestroyQueryPool(d, queries, v.allocator);
-  if (cmd_pool) v.vkDestroyCommandPool(d, cmd_pool, v.allocator);
-  if (force_pipeline) v.vkDestroyPipeline(d, force_pipeline, v.allocator);
-  if (integrate_pipeline) v.vkDestroyPipeline(d, integrate_pipeline, v.allocator);
-  for (auto& row : fused_pipes)
-    for (VkPipeline p : row)
-      if (p) v.vkDestroyPipeline(d, p, v.allocator);
-  if (layout) v.vkDestroyPipelineLayout(d, layout, v.allocator);
-  if (pool) v.vkDestroyDescriptorPool(d, pool, v.allocator);
-  if (set_layout) v.vkDestroyDescriptorSetLayout(d, set_layout, v.allocator);
-  if (texel_layout) v.vkDestroyDescriptorSetLayout(d, texel_layout, v.allocator);
-  for (VkBufferView view : pos_views)
-    if (view) v.vkDestroyBufferView(d, view, v.allocator);
-  for (VkBufferView view : {particle_view, vel_view, flags_view, instances_view})
-    if (view) v.vkDestroyBufferView(d, view, v.allocator);
-  for (Buffer* b : {&pos[0], &pos[1], &vel, &force, &force_stage, &vel_filt, &normal, &uv, &stage_pos, &stage_vel, &acc_pos,
-                    &acc_vel, &particle, &offsets, &edges, &indices, &colliders, &flags, &instances})
-    destroy_buffer(*ctx, *b);
-}
 
 namespace {
 
@@ -63,8 +36,7 @@ Result<void> GpuSolver::Impl::upload_colliders() {
     auto b = create_buffer(*ctx, cap * sizeof(sh::Collider), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::host_upload, true,
                            "colliders");
     if (!b) return b.error();
-    destroy_buffer(*ctx, colliders);
-    colliders = *b;
+    colliders = std::move(*b);
     collider_capacity = cap;
     if (sets[0][0]) VKCLOTH_TRY(write_sets());
   }
@@ -110,29 +82,25 @@ void GpuSolver::Impl::upload_instance_params() {
 
 // One instance's entries of a per-particle buffer.
 Result<std::vector<glm::vec3>> GpuSolver::Impl::read_vec3(const Buffer& b, std::uint32_t slot) {
-  std::optional<Buffer> tmp;
+  Buffer tmp; // staging, when `b` is not mapped
   if (!b.mapped) {
     auto s = create_buffer(*ctx, slot_bytes(), VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUse::host_readback, true,
                            "readback staging");
     if (!s) return s.error();
-    tmp = *s;
+    tmp = std::move(*s);
   }
-  auto r = submit_and_wait([&](VkCommandBuffer c) {
+  VKCLOTH_TRY(submit_and_wait([&](VkCommandBuffer c) {
     barriers::before_readback(vk(), c);
-    if (tmp) {
+    if (tmp.buffer) {
       const VkBufferCopy region{slot_offset(slot), 0, slot_bytes()};
-      vk().vkCmdCopyBuffer(c, b.buffer, tmp->buffer, 1, &region);
+      vk().vkCmdCopyBuffer(c, b.buffer, tmp.buffer, 1, &region);
       barriers::transfer_to_host(vk(), c);
     }
-  });
-  std::vector<glm::vec3> out;
-  if (r) {
-    const auto* src = static_cast<const sh::vec4*>(tmp ? tmp->mapped : b.mapped) + (tmp ? 0 : std::size_t(slot) * count);
-    out.resize(count);
-    for (std::uint32_t i = 0; i < count; ++i) out[i] = glm::vec3(src[i].x, src[i].y, src[i].z);
-  }
-  if (tmp) destroy_buffer(*ctx, *tmp);
-  if (!r) return r.error();
+  }));
+  const auto* src = tmp.buffer ? static_cast<const sh::vec4*>(tmp.mapped)
+                               : static_cast<const sh::vec4*>(b.mapped) + std::size_t(slot) * count;
+  std::vector<glm::vec3> out(count);
+  for (std::uint32_t i = 0; i < count; ++i) out[i] = glm::vec3(src[i].x, src[i].y, src[i].z);
   return out;
 }
 
@@ -248,18 +216,19 @@ void GpuSolver::Impl::record_substep(VkCommandBuffer c, bool first, bool last) {
   }
 }
 
-Result<std::unique_ptr<GpuSolver::Impl>> GpuSolver::Impl::create(const std::shared_ptr<Context::Impl>& ctx,
-                                                                  const ParticleSystem& system,
-                                                                  std::vector<SimParams> params,
-                                                                  const GpuSolverOptions& options,
-                                                                  const std::vector<SlotState>& states) {
-  for (SimParams& p : params) VKCLOTH_TRY(p.validate());
-  VKCLOTH_TRY(system.validate());
-  const std::size_t n = system.size();
-  const std::uint64_t batch = params.size();
+namespace {
 
-  // Device limits, checked before any allocation.
-  const VkPhysicalDeviceLimits& lim = ctx->properties.limits;
+/// Workgroups per dispatch: gx x gy (x instances in z).
+struct DispatchGrid {
+  std::uint32_t x = 1, y = 1;
+};
+
+/// The device limits a batch of `batch` instances of `system` must fit, checked before any
+/// allocation; errors name the buffer or dispatch and the limit.
+Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ParticleSystem& system, std::uint64_t batch,
+                                  const GpuSolverOptions& options) {
+  const std::uint64_t n = system.size();
+  const VkPhysicalDeviceLimits& lim = ctx.properties.limits;
   std::uint64_t max_bytes = lim.maxStorageBufferRange;
   const bool overridden = options.max_storage_buffer_bytes && options.max_storage_buffer_bytes < max_bytes;
   if (overridden) max_bytes = options.max_storage_buffer_bytes;
@@ -271,14 +240,14 @@ Result<std::unique_ptr<GpuSolver::Impl>> GpuSolver::Impl::create(const std::shar
     std::uint64_t items;
   } needs[] = {{"per-particle (vec4)", batch * n * 16, 16, batch * n},
                {"spring adjacency", edges_n * sizeof(sh::Edge), sizeof(sh::Edge), edges_n},
-               {"particle constants", std::uint64_t(n) * sizeof(sh::ParticleInfo), sizeof(sh::ParticleInfo), n}};
+               {"particle constants", n * sizeof(sh::ParticleInfo), sizeof(sh::ParticleInfo), n}};
   for (const auto& need : needs)
     if (need.bytes > max_bytes)
       return make_error(ErrorCode::unsupported,
                         fmt::format("the system is too large for device '{}': its {} buffer needs {} bytes ({} x {} "
                                     "bytes) but a storage buffer may hold at most {} bytes ({}); use fewer particles "
                                     "or fewer instances of one topology",
-                                    ctx->name, need.what, need.bytes, need.items, need.per, max_bytes,
+                                    ctx.name, need.what, need.bytes, need.items, need.per, max_bytes,
                                     overridden ? "GpuSolverOptions::max_storage_buffer_bytes"
                                                : "maxStorageBufferRange"));
   // Positions, velocities and particle constants are also read through texel buffer views (one
@@ -288,8 +257,8 @@ Result<std::unique_ptr<GpuSolver::Impl>> GpuSolver::Impl::create(const std::shar
                       fmt::format("the system is too large for device '{}': {} particles ({} instances of {}) need "
                                   "{} texels per texel buffer view but the device allows {} (maxTexelBufferElements); "
                                   "use fewer particles or fewer instances of one topology",
-                                  ctx->name, batch * n, batch, n, batch * n, lim.maxTexelBufferElements));
-  const std::uint64_t groups = (std::uint64_t(n) + VKCLOTH_WORKGROUP_SIZE - 1) / VKCLOTH_WORKGROUP_SIZE;
+                                  ctx.name, batch * n, batch, n, batch * n, lim.maxTexelBufferElements));
+  const std::uint64_t groups = (n + VKCLOTH_WORKGROUP_SIZE - 1) / VKCLOTH_WORKGROUP_SIZE;
   std::uint64_t row = lim.maxComputeWorkGroupCount[0];
   if (options.max_workgroups_x) row = std::min<std::uint64_t>(row, options.max_workgroups_x);
   const std::uint64_t gx = std::min<std::uint64_t>(groups, row);
@@ -298,13 +267,192 @@ Result<std::unique_ptr<GpuSolver::Impl>> GpuSolver::Impl::create(const std::shar
     return make_error(ErrorCode::unsupported,
                       fmt::format("the system is too large for device '{}': {} particles need {} workgroups of {} but "
                                   "the device dispatches at most {} x {}",
-                                  ctx->name, n, groups, VKCLOTH_WORKGROUP_SIZE, lim.maxComputeWorkGroupCount[0],
+                                  ctx.name, n, groups, VKCLOTH_WORKGROUP_SIZE, lim.maxComputeWorkGroupCount[0],
                                   lim.maxComputeWorkGroupCount[1]));
   if (batch == 0 || batch > lim.maxComputeWorkGroupCount[2])
     return make_error(ErrorCode::unsupported,
                       fmt::format("a batch of {} instances of one topology does not fit device '{}' (at most {} per "
                                   "dispatch: maxComputeWorkGroupCount[2])",
-                                  batch, ctx->name, lim.maxComputeWorkGroupCount[2]));
+                                  batch, ctx.name, lim.maxComputeWorkGroupCount[2]));
+  return DispatchGrid{static_cast<std::uint32_t>(gx), static_cast<std::uint32_t>(gy)};
+}
+
+} // namespace
+
+// Buffers. Bulk ones prefer device-local + host-visible (mapped) unless staging is forced.
+Result<void> GpuSolver::Impl::create_buffers() {
+  const std::size_t n = count;
+  // VERTEX_BUFFER: a renderer binds positions, normals and uvs as vertex buffers (render/);
+  // UNIFORM_TEXEL_BUFFER: positions are read through texel views (force_body.glsl pos_at).
+  const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                                   VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT |
+                                   VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
+  const VkDeviceSize vec4_bytes = VkDeviceSize(batch()) * n * 16;
+  const bool allow_map = !options.force_staging;
+  std::vector<std::uint32_t> families;
+  if (!options.sharing_queue_families.empty()) {
+    families = options.sharing_queue_families;
+    families.push_back(ctx->queue_family); // the solver's own queue always uses them
+  }
+  const std::tuple<Buffer*, VkDeviceSize, const char*> device_buffers[] = {
+      {&pos[0], vec4_bytes, "positions[0]"},
+      {&pos[1], vec4_bytes, "positions[1]"},
+      {&vel, vec4_bytes, "velocities"},
+      {&force, vec4_bytes, "forces"},
+      {&force_stage, vec4_bytes, "stage forces"},
+      {&vel_filt, vec4_bytes, "contact velocities"},
+      {&normal, vec4_bytes, "normals"},
+      {&uv, vec4_bytes, "uvs"},
+      {&stage_pos, vec4_bytes, "stage positions"},
+      {&stage_vel, vec4_bytes, "stage velocities"},
+      {&acc_pos, vec4_bytes, "rk4 sums (positions)"},
+      {&acc_vel, vec4_bytes, "rk4 sums (velocities)"},
+      {&particle, std::max<VkDeviceSize>(n * sizeof(sh::ParticleInfo), 16), "particle constants"},
+      {&offsets, std::max<VkDeviceSize>((n + 1) * sizeof(std::uint32_t), 16), "adjacency offsets"},
+      {&edges, std::max<VkDeviceSize>(edges_count * sizeof(sh::Edge), 16), "adjacency"}};
+  for (auto [b, bytes, what] : device_buffers) {
+    auto r = create_buffer(*ctx, bytes, usage, MemoryUse::device, allow_map, what, families);
+    if (!r) return r.error();
+    *b = std::move(*r);
+  }
+  // The grid's triangle list for the host's drawing (instance-local indices; empty for chains).
+  index_count = nx >= 2 && ny >= 2 ? (nx - 1) * (ny - 1) * 6 : 0; // grid_triangle_indices(nx, ny).size()
+  {
+    auto r = create_buffer(*ctx, std::max<VkDeviceSize>(VkDeviceSize(index_count) * sizeof(std::uint32_t), 16),
+                           VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUse::device,
+                           allow_map, "triangle indices", families);
+    if (!r) return r.error();
+    indices = std::move(*r);
+  }
+  staging = pos[0].mapped == nullptr;
+  // Texel views of both: fused.comp (flags), common.glsl (instance parameters).
+  constexpr VkBufferUsageFlags small = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
+  {
+    auto r = create_buffer(*ctx, batch() * sizeof(sh::Flags), small, MemoryUse::host_readback, true, "flags");
+    if (!r) return r.error();
+    flags = std::move(*r);
+    for (std::uint32_t k = 0; k < batch(); ++k)
+      static_cast<sh::Flags*>(flags.mapped)[k] = sh::Flags{0, VKCLOTH_NO_BAD_STEP, VKCLOTH_NO_BAD_STEP, 0};
+  }
+  {
+    auto r = create_buffer(*ctx, batch() * sizeof(sh::InstanceParams), small, MemoryUse::host_upload, true,
+                           "instance parameters");
+    if (!r) return r.error();
+    instances = std::move(*r);
+  }
+  return upload_colliders();
+}
+
+// The command buffer of the convenience path and the timestamp queries of simulate().
+Result<void> GpuSolver::Impl::create_commands() {
+  auto c = CommandContext::create(*ctx, "solver");
+  if (!c) return c.error();
+  commands = std::move(*c);
+  if (ctx->timestamp_valid_bits == 0) return {};
+  VkQueryPoolCreateInfo qi{};
+  qi.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
+  qi.queryType = VK_QUERY_TYPE_TIMESTAMP;
+  qi.queryCount = 2;
+  VKCLOTH_VK_TRY(vk().vkCreateQueryPool(ctx->device, &qi, vk().allocator, queries.init(*ctx)), "vkCreateQueryPool");
+  return {};
+}
+
+// Initial state of every instance, converted as CpuSolver<float>::create converts it, and the
+// topology: copied into mapped memory, or through one staging buffer (one submission).
+Result<void> GpuSolver::Impl::upload_initial_state(const ParticleSystem& system, const std::vector<SlotState>& states) {
+  const std::size_t n = count;
+  const std::size_t entries = std::size_t(batch()) * n;
+  const VkDeviceSize vec4_bytes = entries * 16;
+  std::vector<sh::vec4> x0(entries), v0(entries), uv0(entries);
+  std::vector<sh::ParticleInfo> info(n);
+  uvs.assign(n, glm::vec2(0.0f));
+  for (std::size_t k = 0; k < batch(); ++k) {
+    const SlotState state = k < states.size() ? states[k] : SlotState{};
+    for (std::size_t p = 0; p < n; ++p) {
+      const Particle& q = system.particles[p];
+      const glm::dvec3 x = state.positions && !state.positions->empty() ? (*state.positions)[p] : q.position;
+      const glm::dvec3 u = state.velocities && !state.velocities->empty() ? (*state.velocities)[p] : q.velocity;
+      x0[k * n + p] = {float(x.x), float(x.y), float(x.z), 1.0f};
+      v0[k * n + p] = q.pinned ? sh::vec4{0, 0, 0, 0} : sh::vec4{float(u.x), float(u.y), float(u.z), 0.0f};
+      info[p] = {float(q.mass), q.pinned ? 1u : 0u};
+    }
+  }
+  for (std::uint32_t j = 0; j < ny; ++j)
+    for (std::uint32_t i = 0; i < nx; ++i) {
+      const glm::vec2 t(nx > 1 ? float(i) / float(nx - 1) : 0.0f, ny > 1 ? float(j) / float(ny - 1) : 0.0f);
+      uvs[std::size_t(j) * nx + i] = t;
+      for (std::size_t k = 0; k < batch(); ++k) uv0[k * n + std::size_t(j) * nx + i] = {t.x, t.y, 0.0f, 0.0f};
+    }
+  std::vector<sh::Edge> edge_data(edges_count);
+  for (std::size_t e = 0; e < edges_count; ++e) {
+    const SpringRef& r = system.adjacency.refs[e];
+    const Spring& sp = system.springs[r.spring];
+    edge_data[e] = {r.other, float(sp.rest_length), float(sp.stiffness)};
+  }
+  const std::vector<std::uint32_t> triangles = grid_triangle_indices(nx, ny);
+  struct Upload {
+    Buffer* dst;
+    const void* data; // null: zero fill
+    VkDeviceSize bytes;
+  };
+  const Upload uploads[] = {{&pos[0], x0.data(), vec4_bytes},
+                            {&pos[1], x0.data(), vec4_bytes},
+                            {&vel, v0.data(), vec4_bytes},
+                            {&uv, uv0.data(), vec4_bytes},
+                            {&particle, info.data(), n * sizeof(sh::ParticleInfo)},
+                            {&offsets, system.adjacency.offsets.data(), (n + 1) * sizeof(std::uint32_t)},
+                            {&edges, edge_data.data(), edges_count * sizeof(sh::Edge)},
+                            {&indices, triangles.data(), triangles.size() * sizeof(std::uint32_t)},
+                            {&force, nullptr, 0},
+                            {&force_stage, nullptr, 0},
+                            {&vel_filt, nullptr, 0},
+                            {&normal, nullptr, 0},
+                            {&stage_pos, nullptr, 0},
+                            {&stage_vel, nullptr, 0},
+                            {&acc_pos, nullptr, 0},
+                            {&acc_vel, nullptr, 0}};
+  if (!staging) {
+    for (const Upload& u : uploads) {
+      if (u.data)
+        std::memcpy(u.dst->mapped, u.data, u.bytes);
+      else
+        std::memset(u.dst->mapped, 0, u.dst->size);
+    }
+    return {};
+  }
+  VkDeviceSize total = 0;
+  for (const Upload& u : uploads) total += u.data ? u.bytes : 0;
+  auto st = create_buffer(*ctx, std::max<VkDeviceSize>(total, 16), VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                          MemoryUse::host_upload, true, "upload staging");
+  if (!st) return st.error();
+  const Buffer& stage = *st;
+  const auto& v = vk();
+  VkDeviceSize at = 0;
+  return submit_and_wait([&](VkCommandBuffer c) {
+    for (const Upload& u : uploads) {
+      if (!u.data) {
+        v.vkCmdFillBuffer(c, u.dst->buffer, 0, VK_WHOLE_SIZE, 0);
+        continue;
+      }
+      if (u.bytes == 0) continue;
+      std::memcpy(static_cast<char*>(stage.mapped) + at, u.data, u.bytes);
+      const VkBufferCopy region{at, 0, u.bytes};
+      v.vkCmdCopyBuffer(c, stage.buffer, u.dst->buffer, 1, &region);
+      at += u.bytes;
+    }
+    barriers::transfer_to_compute(v, c);
+  });
+}
+
+Result<std::unique_ptr<GpuSolver::Impl>> GpuSolver::Impl::create(const std::shared_ptr<Context::Impl>& ctx,
+                                                                  const ParticleSystem& system,
+                                                                  std::vector<SimParams> params,
+                                                                  const GpuSolverOptions& options,
+                                                                  const std::vector<SlotState>& states) {
+  for (SimParams& p : params) VKCLOTH_TRY(p.validate());
+  VKCLOTH_TRY(system.validate());
+  auto grid = check_limits(*ctx, system, params.size(), options);
+  if (!grid) return grid.error();
 
   auto impl = std::make_unique<Impl>();
   Impl& s = *impl;
@@ -312,192 +460,24 @@ Result<std::unique_ptr<GpuSolver::Impl>> GpuSolver::Impl::create(const std::shar
   s.slots.resize(params.size());
   for (std::size_t k = 0; k < params.size(); ++k) s.slots[k].params = std::move(params[k]);
   s.options = options;
-  s.count = static_cast<std::uint32_t>(n);
-  s.pc.count = s.count;
-  s.edges_count = edges_n;
-  s.groups_x = static_cast<std::uint32_t>(gx);
-  s.groups_y = static_cast<std::uint32_t>(gy);
+  s.count = s.pc.count = static_cast<std::uint32_t>(system.size());
+  s.edges_count = system.adjacency.refs.size();
+  s.groups_x = grid->x;
+  s.groups_y = grid->y;
   if (system.grid) {
     s.nx = s.pc.nx = system.grid->nx;
     s.ny = s.pc.ny = system.grid->ny;
   }
-  const auto& v = ctx->vk;
-  const VkDevice d = ctx->device;
-
-  // Buffers. Bulk ones prefer device-local + host-visible (mapped) unless staging is forced.
-  // VERTEX_BUFFER: a renderer binds positions, normals and uvs as vertex buffers (render/).
-  const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
-                                   VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT |
-                                   VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT; // positions: force_body.glsl pos_at
-  const VkDeviceSize vec4_bytes = VkDeviceSize(batch) * n * 16;
-  const bool allow_map = !options.force_staging;
-  std::vector<std::uint32_t> families;
-  if (!options.sharing_queue_families.empty()) {
-    families = options.sharing_queue_families;
-    families.push_back(ctx->queue_family); // the solver's own queue always uses them
-  }
-  const std::pair<Buffer*, const char*> vec4_buffers[] = {
-      {&s.pos[0], "positions[0]"}, {&s.pos[1], "positions[1]"}, {&s.vel, "velocities"},     {&s.force, "forces"},
-      {&s.force_stage, "stage forces"}, {&s.vel_filt, "contact velocities"}, {&s.normal, "normals"}, {&s.uv, "uvs"},
-      {&s.stage_pos, "stage positions"}, {&s.stage_vel, "stage velocities"}, {&s.acc_pos, "rk4 sums (positions)"},
-      {&s.acc_vel, "rk4 sums (velocities)"}};
-  for (auto [b, what] : vec4_buffers) {
-    auto r = create_buffer(*ctx, vec4_bytes, usage, MemoryUse::device, allow_map, what, families);
-    if (!r) return r.error();
-    *b = *r;
-  }
-  const std::tuple<Buffer*, VkDeviceSize, const char*> const_buffers[] = {
-      {&s.particle, std::max<VkDeviceSize>(n * sizeof(sh::ParticleInfo), 16), "particle constants"},
-      {&s.offsets, std::max<VkDeviceSize>((n + 1) * sizeof(std::uint32_t), 16), "adjacency offsets"},
-      {&s.edges, std::max<VkDeviceSize>(edges_n * sizeof(sh::Edge), 16), "adjacency"}};
-  for (auto [b, bytes, what] : const_buffers) {
-    auto r = create_buffer(*ctx, bytes, usage, MemoryUse::device, allow_map, what, families);
-    if (!r) return r.error();
-    *b = *r;
-  }
-  // The grid's triangle list for the host's drawing (instance-local indices; empty for chains).
-  const std::vector<std::uint32_t> triangles =
-      system.grid ? grid_triangle_indices(system.grid->nx, system.grid->ny) : std::vector<std::uint32_t>{};
-  s.index_count = static_cast<std::uint32_t>(triangles.size());
-  {
-    auto r = create_buffer(*ctx, std::max<VkDeviceSize>(triangles.size() * sizeof(std::uint32_t), 16),
-                           VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUse::device,
-                           allow_map, "triangle indices", families);
-    if (!r) return r.error();
-    s.indices = *r;
-  }
-  s.staging = s.pos[0].mapped == nullptr;
-  {
-    auto r = create_buffer(*ctx, batch * sizeof(sh::Flags),
-                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT,
-                           MemoryUse::host_readback, true, "flags"); // texel view: fused.comp
-    if (!r) return r.error();
-    s.flags = *r;
-    for (std::uint64_t k = 0; k < batch; ++k)
-      static_cast<sh::Flags*>(s.flags.mapped)[k] = sh::Flags{0, VKCLOTH_NO_BAD_STEP, VKCLOTH_NO_BAD_STEP, 0};
-  }
-  {
-    auto r = create_buffer(*ctx, batch * sizeof(sh::InstanceParams),
-                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT,
-                           MemoryUse::host_upload, true, "instance parameters"); // texel view: common.glsl
-    if (!r) return r.error();
-    s.instances = *r;
-  }
-  VKCLOTH_TRY(s.upload_colliders());
-
-  // Command pool, command buffer, fence, timestamps.
-  VkCommandPoolCreateInfo cp{};
-  cp.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
-  cp.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-  cp.queueFamilyIndex = ctx->queue_family;
-  VKCLOTH_VK_TRY(v.vkCreateCommandPool(d, &cp, v.allocator, &s.cmd_pool), "vkCreateCommandPool");
-  VkCommandBufferAllocateInfo ca{};
-  ca.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
-  ca.commandPool = s.cmd_pool;
-  ca.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  ca.commandBufferCount = 1;
-  VKCLOTH_VK_TRY(v.vkAllocateCommandBuffers(d, &ca, &s.cmd), "vkAllocateCommandBuffers");
-  VkFenceCreateInfo fi{};
-  fi.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
-  fi.flags = VK_FENCE_CREATE_SIGNALED_BIT;
-  VKCLOTH_VK_TRY(v.vkCreateFence(d, &fi, v.allocator, &s.fence), "vkCreateFence");
-  if (ctx->timestamp_valid_bits > 0) {
-    VkQueryPoolCreateInfo qi{};
-    qi.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
-    qi.queryType = VK_QUERY_TYPE_TIMESTAMP;
-    qi.queryCount = 2;
-    VKCLOTH_VK_TRY(v.vkCreateQueryPool(d, &qi, v.allocator, &s.queries), "vkCreateQueryPool");
-  }
+  // On failure `impl` frees whatever the phases created so far.
+  VKCLOTH_TRY(s.create_buffers());
+  VKCLOTH_TRY(s.create_commands());
   if (!options.csr_only) s.detect_stencil(system);
   VKCLOTH_TRY(s.init_pipelines());
   VKCLOTH_TRY(s.write_sets());
   VKCLOTH_TRY(s.ensure_implicit());
   VKCLOTH_TRY(s.ensure_fused());
   s.upload_instance_params();
-
-  // Initial state of every instance, converted as CpuSolver<float>::create converts it.
-  const std::size_t entries = std::size_t(batch) * n;
-  std::vector<sh::vec4> pos(entries), vel(entries), uv(entries);
-  std::vector<sh::ParticleInfo> info(n);
-  s.uvs.assign(n, glm::vec2(0.0f));
-  for (std::size_t k = 0; k < batch; ++k) {
-    const SlotState state = k < states.size() ? states[k] : SlotState{};
-    for (std::size_t p = 0; p < n; ++p) {
-      const Particle& q = system.particles[p];
-      const glm::dvec3 x = state.positions && !state.positions->empty() ? (*state.positions)[p] : q.position;
-      const glm::dvec3 u = state.velocities && !state.velocities->empty() ? (*state.velocities)[p] : q.velocity;
-      pos[k * n + p] = {float(x.x), float(x.y), float(x.z), 1.0f};
-      vel[k * n + p] = q.pinned ? sh::vec4{0, 0, 0, 0} : sh::vec4{float(u.x), float(u.y), float(u.z), 0.0f};
-      info[p] = {float(q.mass), q.pinned ? 1u : 0u};
-    }
-  }
-  if (system.grid) {
-    for (std::uint32_t j = 0; j < s.ny; ++j)
-      for (std::uint32_t i = 0; i < s.nx; ++i) {
-        const glm::vec2 t(s.nx > 1 ? float(i) / float(s.nx - 1) : 0.0f, s.ny > 1 ? float(j) / float(s.ny - 1) : 0.0f);
-        s.uvs[std::size_t(j) * s.nx + i] = t;
-        for (std::size_t k = 0; k < batch; ++k) uv[k * n + std::size_t(j) * s.nx + i] = {t.x, t.y, 0.0f, 0.0f};
-      }
-  }
-  std::vector<sh::Edge> edges(edges_n);
-  for (std::size_t e = 0; e < edges_n; ++e) {
-    const SpringRef& r = system.adjacency.refs[e];
-    const Spring& sp = system.springs[r.spring];
-    edges[e] = {r.other, float(sp.rest_length), float(sp.stiffness)};
-  }
-  struct Upload {
-    Buffer* dst;
-    const void* data; // null: zero fill
-    VkDeviceSize bytes;
-  };
-  const Upload uploads[] = {{&s.pos[0], pos.data(), vec4_bytes},
-                            {&s.pos[1], pos.data(), vec4_bytes},
-                            {&s.vel, vel.data(), vec4_bytes},
-                            {&s.uv, uv.data(), vec4_bytes},
-                            {&s.particle, info.data(), n * sizeof(sh::ParticleInfo)},
-                            {&s.offsets, system.adjacency.offsets.data(), (n + 1) * sizeof(std::uint32_t)},
-                            {&s.edges, edges.data(), edges_n * sizeof(sh::Edge)},
-                            {&s.indices, triangles.data(), triangles.size() * sizeof(std::uint32_t)},
-                            {&s.force, nullptr, 0},
-                            {&s.force_stage, nullptr, 0},
-                            {&s.vel_filt, nullptr, 0},
-                            {&s.normal, nullptr, 0},
-                            {&s.stage_pos, nullptr, 0},
-                            {&s.stage_vel, nullptr, 0},
-                            {&s.acc_pos, nullptr, 0},
-                            {&s.acc_vel, nullptr, 0}};
-  if (!s.staging) {
-    for (const Upload& u : uploads) {
-      if (u.data)
-        std::memcpy(u.dst->mapped, u.data, u.bytes);
-      else
-        std::memset(u.dst->mapped, 0, u.dst->size);
-    }
-  } else {
-    VkDeviceSize total = 0;
-    for (const Upload& u : uploads) total += u.data ? u.bytes : 0;
-    auto st = create_buffer(*ctx, std::max<VkDeviceSize>(total, 16), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryUse::host_upload,
-                            true, "upload staging");
-    if (!st) return st.error();
-    Buffer staging = *st;
-    VkDeviceSize at = 0;
-    auto r = s.submit_and_wait([&](VkCommandBuffer c) {
-      for (const Upload& u : uploads) {
-        if (!u.data) {
-          v.vkCmdFillBuffer(c, u.dst->buffer, 0, VK_WHOLE_SIZE, 0);
-          continue;
-        }
-        if (u.bytes == 0) continue;
-        std::memcpy(static_cast<char*>(staging.mapped) + at, u.data, u.bytes);
-        const VkBufferCopy region{at, 0, u.bytes};
-        v.vkCmdCopyBuffer(c, staging.buffer, u.dst->buffer, 1, &region);
-        at += u.bytes;
-      }
-      barriers::transfer_to_compute(v, c);
-    });
-    destroy_buffer(*ctx, staging);
-    VKCLOTH_TRY(r);
-  }
+  VKCLOTH_TRY(s.upload_initial_state(system, states));
   return impl;
 }
 

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <tuple>
 
 #include <fmt/format.h>
 
@@ -27,30 +28,7 @@ constexpr std::uint32_t kBindings[] = {
     VKCLOTH_BINDING_IMPL_STATE,     VKCLOTH_BINDING_IMPL_ARGS};
 constexpr std::uint32_t kBindingCount = sizeof(kBindings) / sizeof(kBindings[0]);
 
-template <std::size_t N>
-Result<VkShaderModule> module(const DeviceFns& vk, VkDevice d, const std::uint32_t (&code)[N], const char* name) {
-  VkShaderModuleCreateInfo ci{};
-  ci.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
-  ci.codeSize = N * sizeof(std::uint32_t);
-  ci.pCode = code;
-  VkShaderModule m = VK_NULL_HANDLE;
-  VKCLOTH_VK_TRY(vk.vkCreateShaderModule(d, &ci, vk.allocator, &m), fmt::format("vkCreateShaderModule ({})", name));
-  return m;
-}
-
 } // namespace
-
-ImplicitGpu::~ImplicitGpu() {
-  if (!ctx_ || !ctx_->device) return;
-  const auto& v = ctx_->vk;
-  const VkDevice d = ctx_->device;
-  if (pass_) v.vkDestroyPipeline(d, pass_, v.allocator);
-  if (reduce_) v.vkDestroyPipeline(d, reduce_, v.allocator);
-  if (layout_) v.vkDestroyPipelineLayout(d, layout_, v.allocator);
-  if (pool_) v.vkDestroyDescriptorPool(d, pool_, v.allocator);
-  if (set_layout_) v.vkDestroyDescriptorSetLayout(d, set_layout_, v.allocator);
-  for (Buffer* b : {&vf_, &ks_, &diag_inv_, &x_, &r_, &z_, &d_, &q_, &partials_, &state_, &args_}) destroy_buffer(*ctx_, *b);
-}
 
 Result<std::unique_ptr<ImplicitGpu>> ImplicitGpu::create(const std::shared_ptr<Context::Impl>& ctx, std::uint32_t count,
                                                          std::uint64_t entries, std::uint32_t groups_x,
@@ -60,101 +38,83 @@ Result<std::unique_ptr<ImplicitGpu>> ImplicitGpu::create(const std::shared_ptr<C
   s->count_ = count;
   s->groups_x_ = groups_x;
   s->groups_y_ = groups_y;
-  const auto& v = ctx->vk;
-  const VkDevice d = ctx->device;
-  const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-  const VkDeviceSize vec4_bytes = std::max<VkDeviceSize>(VkDeviceSize(count) * 16, 16);
-  const std::pair<Buffer*, const char*> vec4s[] = {{&s->vf_, "implicit: filtered velocities"},
-                                                   {&s->diag_inv_, "implicit: Jacobi diagonal"},
-                                                   {&s->x_, "implicit: CG x"},
-                                                   {&s->r_, "implicit: CG r"},
-                                                   {&s->z_, "implicit: CG z"},
-                                                   {&s->d_, "implicit: CG d"},
-                                                   {&s->q_, "implicit: CG q"}};
-  for (auto [b, what] : vec4s) {
-    auto r = create_buffer(*ctx, vec4_bytes, usage, MemoryUse::device, allow_map, what);
-    if (!r) return r.error();
-    *b = *r;
-  }
-  {
-    auto r = create_buffer(*ctx, std::max<VkDeviceSize>(entries * 32, 32), usage, MemoryUse::device, allow_map,
-                           "implicit: spring blocks");
-    if (!r) return r.error();
-    s->ks_ = *r;
-    const std::uint64_t groups = std::uint64_t(groups_x) * groups_y;
-    auto p = create_buffer(*ctx, std::max<VkDeviceSize>(groups * 8, 16), usage, MemoryUse::device, allow_map,
-                           "implicit: partial sums");
-    if (!p) return p.error();
-    s->partials_ = *p;
-    auto st = create_buffer(*ctx, sizeof(sh::CgState), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::host_readback, true,
-                            "implicit: CG state");
-    if (!st) return st.error();
-    s->state_ = *st;
-    sh::CgState init{};
-    init.done = 1;
-    init.groups_x = groups_x;
-    init.groups_y = groups_y;
-    std::memcpy(s->state_.mapped, &init, sizeof(init));
-    auto a = create_buffer(*ctx, sizeof(sh::CgArgs), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT,
-                           MemoryUse::device, false, "implicit: indirect arguments");
-    if (!a) return a.error();
-    s->args_ = *a;
-  }
+  VKCLOTH_TRY(s->create_buffers(entries, allow_map));
+  VKCLOTH_TRY(s->create_pipelines());
+  return s;
+}
 
-  std::array<VkDescriptorSetLayoutBinding, kBindingCount> bindings{};
-  for (std::uint32_t i = 0; i < kBindingCount; ++i)
-    bindings[i] = {kBindings[i], VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
-  VkDescriptorSetLayoutCreateInfo li{};
-  li.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
-  li.bindingCount = kBindingCount;
-  li.pBindings = bindings.data();
-  VKCLOTH_VK_TRY(v.vkCreateDescriptorSetLayout(d, &li, v.allocator, &s->set_layout_), "vkCreateDescriptorSetLayout (implicit)");
-  const VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(sh::PushConstants)};
-  VkPipelineLayoutCreateInfo pi{};
-  pi.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
-  pi.setLayoutCount = 1;
-  pi.pSetLayouts = &s->set_layout_;
-  pi.pushConstantRangeCount = 1;
-  pi.pPushConstantRanges = &range;
-  VKCLOTH_VK_TRY(v.vkCreatePipelineLayout(d, &pi, v.allocator, &s->layout_), "vkCreatePipelineLayout (implicit)");
+Result<void> ImplicitGpu::create_buffers(std::uint64_t entries, bool allow_map) {
+  Context::Impl& ctx = *ctx_;
+  const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  const VkDeviceSize vec4_bytes = std::max<VkDeviceSize>(VkDeviceSize(count_) * 16, 16);
+  const std::uint64_t groups = std::uint64_t(groups_x_) * groups_y_;
+  const std::tuple<Buffer*, VkDeviceSize, const char*> device_buffers[] = {
+      {&vf_, vec4_bytes, "implicit: filtered velocities"},
+      {&diag_inv_, vec4_bytes, "implicit: Jacobi diagonal"},
+      {&x_, vec4_bytes, "implicit: CG x"},
+      {&r_, vec4_bytes, "implicit: CG r"},
+      {&z_, vec4_bytes, "implicit: CG z"},
+      {&d_, vec4_bytes, "implicit: CG d"},
+      {&q_, vec4_bytes, "implicit: CG q"},
+      {&ks_, std::max<VkDeviceSize>(entries * 32, 32), "implicit: spring blocks"},
+      {&partials_, std::max<VkDeviceSize>(groups * 8, 16), "implicit: partial sums"}};
+  for (auto [b, bytes, what] : device_buffers) {
+    auto r = create_buffer(ctx, bytes, usage, MemoryUse::device, allow_map, what);
+    if (!r) return r.error();
+    *b = std::move(*r);
+  }
+  auto st = create_buffer(ctx, sizeof(sh::CgState), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::host_readback, true,
+                          "implicit: CG state");
+  if (!st) return st.error();
+  state_ = std::move(*st);
+  sh::CgState init{};
+  init.done = 1;
+  init.groups_x = groups_x_;
+  init.groups_y = groups_y_;
+  std::memcpy(state_.mapped, &init, sizeof(init));
+  auto a = create_buffer(ctx, sizeof(sh::CgArgs), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT,
+                         MemoryUse::device, false, "implicit: indirect arguments");
+  if (!a) return a.error();
+  args_ = std::move(*a);
+  return {};
+}
+
+Result<void> ImplicitGpu::create_pipelines() {
+  Context::Impl& ctx = *ctx_;
+  const auto& v = ctx.vk;
+  auto sl = create_compute_set_layout(ctx, kBindings, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, "implicit");
+  if (!sl) return sl.error();
+  set_layout_ = std::move(*sl);
+  const VkDescriptorSetLayout set_layouts[1] = {set_layout_};
+  auto pl = create_pipeline_layout(ctx, set_layouts, VK_SHADER_STAGE_COMPUTE_BIT, sizeof(sh::PushConstants), "implicit");
+  if (!pl) return pl.error();
+  layout_ = std::move(*pl);
   const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2 * kBindingCount};
   VkDescriptorPoolCreateInfo dp{};
   dp.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
   dp.maxSets = 2;
   dp.poolSizeCount = 1;
   dp.pPoolSizes = &size;
-  VKCLOTH_VK_TRY(v.vkCreateDescriptorPool(d, &dp, v.allocator, &s->pool_), "vkCreateDescriptorPool (implicit)");
-  const VkDescriptorSetLayout layouts[2] = {s->set_layout_, s->set_layout_};
+  VKCLOTH_VK_TRY(v.vkCreateDescriptorPool(ctx.device, &dp, v.allocator, pool_.init(ctx)),
+                 "vkCreateDescriptorPool (implicit)");
+  const VkDescriptorSetLayout layouts[2] = {set_layout_, set_layout_};
   VkDescriptorSetAllocateInfo ai{};
   ai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
-  ai.descriptorPool = s->pool_;
+  ai.descriptorPool = pool_;
   ai.descriptorSetCount = 2;
   ai.pSetLayouts = layouts;
-  VKCLOTH_VK_TRY(v.vkAllocateDescriptorSets(d, &ai, s->sets_), "vkAllocateDescriptorSets (implicit)");
-
-  auto pm = module(v, d, spirv::implicit_comp_spv, "implicit.comp");
+  VKCLOTH_VK_TRY(v.vkAllocateDescriptorSets(ctx.device, &ai, sets_), "vkAllocateDescriptorSets (implicit)");
+  auto pm = create_shader_module(ctx, spirv::implicit_comp_spv, "implicit.comp");
   if (!pm) return pm.error();
-  auto rm = module(v, d, spirv::implicit_reduce_comp_spv, "implicit_reduce.comp");
-  if (!rm) {
-    v.vkDestroyShaderModule(d, *pm, v.allocator);
-    return rm.error();
-  }
-  VkComputePipelineCreateInfo ci[2]{};
-  const VkShaderModule mods[2] = {*pm, *rm};
-  for (int k = 0; k < 2; ++k) {
-    ci[k].sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
-    ci[k].stage = VkPipelineShaderStageCreateInfo{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0,
-                                                  VK_SHADER_STAGE_COMPUTE_BIT, mods[k], "main", nullptr};
-    ci[k].layout = s->layout_;
-  }
-  VkPipeline pipes[2] = {};
-  const VkResult res = v.vkCreateComputePipelines(d, VK_NULL_HANDLE, 2, ci, v.allocator, pipes);
-  v.vkDestroyShaderModule(d, *pm, v.allocator);
-  v.vkDestroyShaderModule(d, *rm, v.allocator);
-  if (res != VK_SUCCESS) return vk_error(res, "vkCreateComputePipelines (implicit.comp, implicit_reduce.comp)");
-  s->pass_ = pipes[0];
-  s->reduce_ = pipes[1];
-  return s;
+  auto pp = create_compute_pipeline(ctx, layout_, *pm, nullptr, "implicit.comp");
+  if (!pp) return pp.error();
+  pass_ = std::move(*pp);
+  auto rm = create_shader_module(ctx, spirv::implicit_reduce_comp_spv, "implicit_reduce.comp");
+  if (!rm) return rm.error();
+  auto rp = create_compute_pipeline(ctx, layout_, *rm, nullptr, "implicit_reduce.comp");
+  if (!rp) return rp.error();
+  reduce_ = std::move(*rp);
+  return {};
 }
 
 Result<void> ImplicitGpu::write_sets(const ImplicitInputs& in) {
@@ -205,10 +165,11 @@ std::uint32_t ImplicitGpu::record_substep(VkCommandBuffer c, std::uint32_t read,
   pc.c_next = tol * tol; // as CpuSolver<float>: Real(tol) * Real(tol)
   pc.pad0 = params.cg_max_iterations;
   pc.pad1 = groups_x_ * groups_y_;
-  v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &sets_[read], 0, nullptr);
+  v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout_.get(), 0, 1, &sets_[read], 0, nullptr);
   bool need_barrier = !first;
   std::uint32_t dispatches = 0;
   VkPipeline bound = VK_NULL_HANDLE;
+  const VkPipeline pass_pipe = pass_, reduce_pipe = reduce_;
   auto pass = [&](VkPipeline pipe, std::uint32_t stage, int indirect_offset) {
     if (need_barrier) barriers::implicit_pass(v, c); // previous pass -> this one (RAW, WAR, indirect args)
     need_barrier = true;
@@ -221,23 +182,23 @@ std::uint32_t ImplicitGpu::record_substep(VkCommandBuffer c, std::uint32_t read,
     v.vkCmdPushConstants(c, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
     if (indirect_offset >= 0)
       v.vkCmdDispatchIndirect(c, args_.buffer, VkDeviceSize(indirect_offset));
-    else if (pipe == reduce_)
+    else if (pipe == reduce_pipe)
       v.vkCmdDispatch(c, 1, 1, 1);
     else
       v.vkCmdDispatch(c, groups_x_, groups_y_, 1);
   };
   constexpr int direct = -1, particles = offsetof(sh::CgArgs, particle_x), reduce = offsetof(sh::CgArgs, reduce_x);
-  pass(pass_, VKCLOTH_IMPL_FORCE, direct);
-  pass(pass_, VKCLOTH_IMPL_SYSTEM, direct);
-  pass(reduce_, VKCLOTH_REDUCE_INIT, direct);
+  pass(pass_pipe, VKCLOTH_IMPL_FORCE, direct);
+  pass(pass_pipe, VKCLOTH_IMPL_SYSTEM, direct);
+  pass(reduce_pipe, VKCLOTH_REDUCE_INIT, direct);
   for (std::uint32_t it = 0; it < params.cg_max_iterations; ++it) {
-    pass(pass_, VKCLOTH_IMPL_MATVEC, particles);
-    pass(reduce_, VKCLOTH_REDUCE_ALPHA, reduce);
-    pass(pass_, VKCLOTH_IMPL_UPDATE, particles);
-    pass(reduce_, VKCLOTH_REDUCE_BETA, reduce);
-    pass(pass_, VKCLOTH_IMPL_DIRECTION, particles);
+    pass(pass_pipe, VKCLOTH_IMPL_MATVEC, particles);
+    pass(reduce_pipe, VKCLOTH_REDUCE_ALPHA, reduce);
+    pass(pass_pipe, VKCLOTH_IMPL_UPDATE, particles);
+    pass(reduce_pipe, VKCLOTH_REDUCE_BETA, reduce);
+    pass(pass_pipe, VKCLOTH_IMPL_DIRECTION, particles);
   }
-  pass(pass_, VKCLOTH_IMPL_FINISH, direct);
+  pass(pass_pipe, VKCLOTH_IMPL_FINISH, direct);
   return dispatches;
 }
 

@@ -15,7 +15,7 @@
 #include <cstdint>
 #include <memory>
 
-#include "vk_internal.hpp"
+#include "resources.hpp"
 #include "vkcloth/params.hpp"
 #include "vkcloth_shared.h"
 
@@ -32,7 +32,6 @@ public:
   static Result<std::unique_ptr<ImplicitGpu>> create(const std::shared_ptr<Context::Impl>& ctx, std::uint32_t count,
                                                      std::uint64_t entries, std::uint32_t groups_x, std::uint32_t groups_y,
                                                      bool allow_map);
-  ~ImplicitGpu();
   ImplicitGpu(const ImplicitGpu&) = delete;
   ImplicitGpu& operator=(const ImplicitGpu&) = delete;
 
@@ -51,11 +50,14 @@ private:
   std::shared_ptr<Context::Impl> ctx_;
   std::uint32_t count_ = 0, groups_x_ = 1, groups_y_ = 1;
   Buffer vf_, ks_, diag_inv_, x_, r_, z_, d_, q_, partials_, state_, args_;
-  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
-  VkDescriptorPool pool_ = VK_NULL_HANDLE;
+  DescriptorSetLayout set_layout_;
+  DescriptorPool pool_;
   VkDescriptorSet sets_[2] = {};
-  VkPipelineLayout layout_ = VK_NULL_HANDLE;
-  VkPipeline pass_ = VK_NULL_HANDLE, reduce_ = VK_NULL_HANDLE;
+  PipelineLayout layout_;
+  Pipeline pass_, reduce_;
+
+  Result<void> create_buffers(std::uint64_t entries, bool allow_map);
+  Result<void> create_pipelines();
 };
 
 } // namespace vkcloth::gpu

@@ -14,7 +14,7 @@
 #include <glm/vec3.hpp>
 
 #include "implicit_gpu.hpp"
-#include "vk_internal.hpp"
+#include "resources.hpp"
 #include "vkcloth/gpu/gpu_solver.hpp"
 #include "vkcloth_shared.h"
 
@@ -43,35 +43,33 @@ struct GpuSolver::Impl {
   bool staging = false;
 
   // Per-particle vec4 buffers (slots() x count entries), then the shared topology, then the small
-  // host-visible ones (per instance).
+  // host-visible ones (per instance). Every object below is owned (resources.hpp): a new buffer
+  // is one member here plus its creation.
   Buffer pos[2], vel, force, force_stage, vel_filt, normal, uv, stage_pos, stage_vel, acc_pos, acc_vel;
   Buffer particle, offsets, edges, indices; // indices: grid_triangle_indices (drawing)
   std::uint32_t index_count = 0;
   Buffer colliders, flags, instances; // host-visible (written / read by the host)
   std::uint32_t collider_capacity = 0;
 
-  VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
-  VkDescriptorPool pool = VK_NULL_HANDLE;
+  DescriptorSetLayout set_layout;
+  DescriptorPool pool;
   VkDescriptorSet sets[2][2] = {}; // [positions read index][0: state input, 1: RK4 stage input]
   // Set 1 of force.comp / fused.comp: POS_IN as an RGBA32F uniform texel buffer (force_body.glsl
-  // pos_at), the particle constants as an RG32UI one, velocities, flags, instance parameters. [0], [1]: positions[0], positions[1];
-  // [2]: RK4 stage positions.
-  VkDescriptorSetLayout texel_layout = VK_NULL_HANDLE;
-  VkBufferView pos_views[3] = {};
-  VkBufferView particle_view = VK_NULL_HANDLE, vel_view = VK_NULL_HANDLE, flags_view = VK_NULL_HANDLE,
-               instances_view = VK_NULL_HANDLE;
+  // pos_at), the particle constants as an RG32UI one, velocities, flags, instance parameters.
+  // pos_views [0], [1]: positions[0], positions[1]; [2]: RK4 stage positions.
+  DescriptorSetLayout texel_layout;
+  BufferView pos_views[3];
+  BufferView particle_view, vel_view, flags_view, instances_view;
   VkDescriptorSet texel_sets[3] = {};
-  VkPipelineLayout layout = VK_NULL_HANDLE;
-  VkPipeline force_pipeline = VK_NULL_HANDLE, integrate_pipeline = VK_NULL_HANDLE;
+  PipelineLayout layout;
+  Pipeline force_pipeline, integrate_pipeline;
   // fused.comp variants, created when first needed (ensure_fused): [write_aux][colliders].
   // write_aux = 0 (SC_WRITE_AUX false: no force and normal stores) for every fused substep of a
   // recorded batch of steps but the last, since only the last one's forces and normals can be
   // observed; colliders = 0 (SC_COLLIDERS false: no contact loops) while no instance has colliders.
-  VkPipeline fused_pipes[2][2] = {};
-  VkCommandPool cmd_pool = VK_NULL_HANDLE;
-  VkCommandBuffer cmd = VK_NULL_HANDLE;
-  VkFence fence = VK_NULL_HANDLE;
-  VkQueryPool queries = VK_NULL_HANDLE;
+  Pipeline fused_pipes[2][2];
+  CommandContext commands; // readbacks, uploads, simulate()
+  QueryPool queries;       // two timestamps around each simulate() submission
   std::uint32_t groups_x = 1, groups_y = 1;
   // Grid stencil (force_body.glsl's specialisation constants 0..39): constant_id order.
   struct Stencil {
@@ -101,7 +99,6 @@ struct GpuSolver::Impl {
   Impl() = default;
   Impl(const Impl&) = delete;
   Impl& operator=(const Impl&) = delete;
-  ~Impl();
 
   std::uint32_t batch() const { return static_cast<std::uint32_t>(slots.size()); }
   const SimParams& family() const { return slots.front().params; } // integrator family, substeps
@@ -131,13 +128,21 @@ struct GpuSolver::Impl {
   /// The flags of an instance that diverged before this batch existed: frozen from step 1 on.
   void freeze_slot(std::uint32_t slot);
 
-  Result<void> init_pipelines();
+  // Creation phases (create()), in order.
+  Result<void> create_buffers();
+  Result<void> create_commands();
   void detect_stencil(const ParticleSystem& system);
+  Result<void> init_pipelines();
+  Result<void> create_descriptor_sets();
+  Result<void> create_texel_views();
+  Result<void> create_pipelines();
   Result<void> write_sets();
   Result<void> upload_colliders();
   void upload_instance_params();
+  Result<void> upload_initial_state(const ParticleSystem& system, const std::vector<SlotState>& states);
+
   template <typename F> Result<void> submit_and_wait(F&& record_fn) {
-    return gpu::submit_and_wait(*ctx, cmd, fence, std::forward<F>(record_fn));
+    return commands.submit_and_wait(std::forward<F>(record_fn));
   }
   Result<std::vector<glm::vec3>> read_vec3(const Buffer& b, std::uint32_t slot);
 };

@@ -1,10 +1,11 @@
 // GpuSolver::Impl (solver_batch.hpp): descriptor set layouts, sets and texel views, the compute
 // pipelines (force, integrate, the fused variants) and their specialisation constants (the grid
 // stencil). The stepping, buffers and readbacks are in gpu_solver.cpp.
-#include "vk_internal.hpp"
+#include "resources.hpp"
 
 #include <array>
 #include <cstdint>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -20,51 +21,40 @@ namespace sh = shared;
 
 namespace {
 
-template <std::size_t N> Result<VkShaderModule> make_module(const DeviceFns& vk, VkDevice d, const std::uint32_t (&code)[N],
-                                                            const char* name) {
-  VkShaderModuleCreateInfo ci{};
-  ci.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
-  ci.codeSize = N * sizeof(std::uint32_t);
-  ci.pCode = code;
-  VkShaderModule m = VK_NULL_HANDLE;
-  VKCLOTH_VK_TRY(vk.vkCreateShaderModule(d, &ci, vk.allocator, &m), fmt::format("vkCreateShaderModule ({})", name));
-  return m;
+/// Specialisation map of `N` consecutive 32-bit constants, ids 0..N-1 (force_body.glsl: 0..39 the
+/// stencil; fused.comp adds 40 SC_WRITE_AUX and 41 SC_COLLIDERS).
+template <std::uint32_t N> std::array<VkSpecializationMapEntry, N> constant_entries() {
+  std::array<VkSpecializationMapEntry, N> entries{};
+  for (std::uint32_t k = 0; k < N; ++k) entries[k] = VkSpecializationMapEntry{k, k * 4, 4};
+  return entries;
 }
-
 
 } // namespace
 
+// Layouts (set 0: storage buffers, set 1: texel buffers), then the sets, views and pipelines.
 Result<void> GpuSolver::Impl::init_pipelines() {
-  const auto& v = vk();
-  const VkDevice d = ctx->device;
-  std::array<VkDescriptorSetLayoutBinding, VKCLOTH_BINDING_COUNT> bindings{};
-  for (std::uint32_t i = 0; i < bindings.size(); ++i)
-    bindings[i] = VkDescriptorSetLayoutBinding{i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
-  VkDescriptorSetLayoutCreateInfo li{};
-  li.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
-  li.bindingCount = static_cast<std::uint32_t>(bindings.size());
-  li.pBindings = bindings.data();
-  VKCLOTH_VK_TRY(v.vkCreateDescriptorSetLayout(d, &li, v.allocator, &set_layout), "vkCreateDescriptorSetLayout");
-  const VkDescriptorSetLayoutBinding texel_bindings[5] = {
-      {VKCLOTH_TEXEL_BINDING_POS_IN, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
-      {VKCLOTH_TEXEL_BINDING_PARTICLE, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
-      {VKCLOTH_TEXEL_BINDING_VEL, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
-      {VKCLOTH_TEXEL_BINDING_FLAGS, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
-      {VKCLOTH_TEXEL_BINDING_INSTANCES, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr}};
-  li.bindingCount = 5;
-  li.pBindings = texel_bindings;
-  VKCLOTH_VK_TRY(v.vkCreateDescriptorSetLayout(d, &li, v.allocator, &texel_layout), "vkCreateDescriptorSetLayout (texel)");
-
-  const VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(sh::PushConstants)};
-  VkPipelineLayoutCreateInfo pi{};
-  pi.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
+  std::array<std::uint32_t, VKCLOTH_BINDING_COUNT> storage{};
+  for (std::uint32_t i = 0; i < storage.size(); ++i) storage[i] = i;
+  auto sl = create_compute_set_layout(*ctx, storage, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, "solver");
+  if (!sl) return sl.error();
+  set_layout = std::move(*sl);
+  const std::uint32_t texel[] = {VKCLOTH_TEXEL_BINDING_POS_IN, VKCLOTH_TEXEL_BINDING_PARTICLE, VKCLOTH_TEXEL_BINDING_VEL,
+                                 VKCLOTH_TEXEL_BINDING_FLAGS, VKCLOTH_TEXEL_BINDING_INSTANCES};
+  auto tl = create_compute_set_layout(*ctx, texel, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, "solver texel views");
+  if (!tl) return tl.error();
+  texel_layout = std::move(*tl);
   const VkDescriptorSetLayout set_layouts[2] = {set_layout, texel_layout};
-  pi.setLayoutCount = 2;
-  pi.pSetLayouts = set_layouts;
-  pi.pushConstantRangeCount = 1;
-  pi.pPushConstantRanges = &range;
-  VKCLOTH_VK_TRY(v.vkCreatePipelineLayout(d, &pi, v.allocator, &layout), "vkCreatePipelineLayout");
+  auto pl = create_pipeline_layout(*ctx, set_layouts, VK_SHADER_STAGE_COMPUTE_BIT, sizeof(sh::PushConstants), "solver");
+  if (!pl) return pl.error();
+  layout = std::move(*pl);
+  VKCLOTH_TRY(create_descriptor_sets());
+  VKCLOTH_TRY(create_texel_views());
+  return create_pipelines();
+}
 
+// Four storage sets ([read][state / RK4 stage input], written by write_sets()) and three texel sets.
+Result<void> GpuSolver::Impl::create_descriptor_sets() {
+  const auto& v = vk();
   const VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 4 * VKCLOTH_BINDING_COUNT},
                                          {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 5 * 3}};
   VkDescriptorPoolCreateInfo dp{};
@@ -72,106 +62,82 @@ Result<void> GpuSolver::Impl::init_pipelines() {
   dp.maxSets = 4 + 3;
   dp.poolSizeCount = 2;
   dp.pPoolSizes = sizes;
-  VKCLOTH_VK_TRY(v.vkCreateDescriptorPool(d, &dp, v.allocator, &pool), "vkCreateDescriptorPool");
+  VKCLOTH_VK_TRY(v.vkCreateDescriptorPool(ctx->device, &dp, v.allocator, pool.init(*ctx)), "vkCreateDescriptorPool");
   const VkDescriptorSetLayout layouts[4] = {set_layout, set_layout, set_layout, set_layout};
   VkDescriptorSetAllocateInfo ai{};
   ai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
   ai.descriptorPool = pool;
   ai.descriptorSetCount = 4;
   ai.pSetLayouts = layouts;
-  VKCLOTH_VK_TRY(v.vkAllocateDescriptorSets(d, &ai, &sets[0][0]), "vkAllocateDescriptorSets");
-  // The texel sets never change: positions[0/1] and the stage positions live as long as the solver.
+  VKCLOTH_VK_TRY(v.vkAllocateDescriptorSets(ctx->device, &ai, &sets[0][0]), "vkAllocateDescriptorSets");
   const VkDescriptorSetLayout texel_layouts[3] = {texel_layout, texel_layout, texel_layout};
   ai.descriptorSetCount = 3;
   ai.pSetLayouts = texel_layouts;
-  VKCLOTH_VK_TRY(v.vkAllocateDescriptorSets(d, &ai, texel_sets), "vkAllocateDescriptorSets (texel)");
-  const Buffer* viewed[3] = {&pos[0], &pos[1], &stage_pos};
-  VkWriteDescriptorSet texel_writes[15]{};
-  // The same views in all three sets: particle constants (sh::ParticleInfo), velocities, flags,
-  // instance parameters.
-  // Uniform texel buffer support is mandatory for these formats.
+  VKCLOTH_VK_TRY(v.vkAllocateDescriptorSets(ctx->device, &ai, texel_sets), "vkAllocateDescriptorSets (texel)");
+  return {};
+}
+
+// The texel sets never change: positions[0/1] and the stage positions live as long as the batch.
+// Set k: its positions view (k = 0, 1: positions[k]; 2: stage positions) and the same four shared
+// views. Uniform texel buffer support is mandatory for these formats.
+Result<void> GpuSolver::Impl::create_texel_views() {
   const struct {
     const Buffer* buffer;
     VkFormat format;
-    VkBufferView* view;
-    std::uint32_t binding;
+    BufferView* view;
     const char* what;
-  } shared_views[4] = {
-      {&particle, VK_FORMAT_R32G32_UINT, &particle_view, VKCLOTH_TEXEL_BINDING_PARTICLE, "vkCreateBufferView (particle constants)"},
-      {&vel, VK_FORMAT_R32G32B32A32_SFLOAT, &vel_view, VKCLOTH_TEXEL_BINDING_VEL, "vkCreateBufferView (velocities)"},
-      {&flags, VK_FORMAT_R32_UINT, &flags_view, VKCLOTH_TEXEL_BINDING_FLAGS, "vkCreateBufferView (flags)"},
-      {&instances, VK_FORMAT_R32G32B32A32_UINT, &instances_view, VKCLOTH_TEXEL_BINDING_INSTANCES,
-       "vkCreateBufferView (instance parameters)"}};
-  for (int b = 0; b < 4; ++b) {
-    VkBufferViewCreateInfo bvi{};
-    bvi.sType = VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO;
-    bvi.buffer = shared_views[b].buffer->buffer;
-    bvi.format = shared_views[b].format;
-    bvi.offset = 0;
-    bvi.range = VK_WHOLE_SIZE;
-    VKCLOTH_VK_TRY(v.vkCreateBufferView(d, &bvi, v.allocator, shared_views[b].view), shared_views[b].what);
-    for (int k = 0; k < 3; ++k) {
-      VkWriteDescriptorSet& w = texel_writes[3 + 3 * b + k];
-      w.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-      w.dstSet = texel_sets[k];
-      w.dstBinding = shared_views[b].binding;
-      w.descriptorCount = 1;
-      w.descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
-      w.pTexelBufferView = shared_views[b].view;
-    }
+  } views[7] = {{&pos[0], VK_FORMAT_R32G32B32A32_SFLOAT, &pos_views[0], "positions[0]"},
+                {&pos[1], VK_FORMAT_R32G32B32A32_SFLOAT, &pos_views[1], "positions[1]"},
+                {&stage_pos, VK_FORMAT_R32G32B32A32_SFLOAT, &pos_views[2], "stage positions"},
+                {&particle, VK_FORMAT_R32G32_UINT, &particle_view, "particle constants"},
+                {&vel, VK_FORMAT_R32G32B32A32_SFLOAT, &vel_view, "velocities"},
+                {&flags, VK_FORMAT_R32_UINT, &flags_view, "flags"},
+                {&instances, VK_FORMAT_R32G32B32A32_UINT, &instances_view, "instance parameters"}};
+  for (const auto& view : views) {
+    auto r = create_buffer_view(*ctx, view.buffer->buffer, view.format, view.what);
+    if (!r) return r.error();
+    *view.view = std::move(*r);
   }
-  for (int k = 0; k < 3; ++k) {
-    VkBufferViewCreateInfo vi{};
-    vi.sType = VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO;
-    vi.buffer = viewed[k]->buffer;
-    vi.format = VK_FORMAT_R32G32B32A32_SFLOAT; // uniform texel buffer support is mandatory for it
-    vi.offset = 0;
-    vi.range = VK_WHOLE_SIZE;
-    VKCLOTH_VK_TRY(v.vkCreateBufferView(d, &vi, v.allocator, &pos_views[k]), "vkCreateBufferView (positions)");
-    texel_writes[k].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-    texel_writes[k].dstSet = texel_sets[k];
-    texel_writes[k].dstBinding = VKCLOTH_TEXEL_BINDING_POS_IN;
-    texel_writes[k].descriptorCount = 1;
-    texel_writes[k].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
-    texel_writes[k].pTexelBufferView = &pos_views[k];
-  }
-  v.vkUpdateDescriptorSets(d, 15, texel_writes, 0, nullptr);
-
-  VkShaderModule modules[2] = {};
-  auto destroy_modules = [&] {
-    for (VkShaderModule m : modules)
-      if (m) v.vkDestroyShaderModule(d, m, v.allocator);
+  const std::pair<const BufferView*, std::uint32_t> shared_views[4] = {
+      {&particle_view, VKCLOTH_TEXEL_BINDING_PARTICLE},
+      {&vel_view, VKCLOTH_TEXEL_BINDING_VEL},
+      {&flags_view, VKCLOTH_TEXEL_BINDING_FLAGS},
+      {&instances_view, VKCLOTH_TEXEL_BINDING_INSTANCES}};
+  std::array<VkWriteDescriptorSet, 15> writes{};
+  std::size_t w = 0;
+  auto write = [&](VkDescriptorSet set, std::uint32_t binding, const BufferView& view) {
+    writes[w] = VkWriteDescriptorSet{};
+    writes[w].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+    writes[w].dstSet = set;
+    writes[w].dstBinding = binding;
+    writes[w].descriptorCount = 1;
+    writes[w].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+    writes[w].pTexelBufferView = view.ptr();
+    ++w;
   };
-  {
-    auto fm = make_module(v, d, spirv::force_comp_spv, "force.comp");
-    if (!fm) return fm.error();
-    modules[0] = *fm;
-    auto im = make_module(v, d, spirv::integrate_comp_spv, "integrate.comp");
-    if (!im) {
-      destroy_modules();
-      return im.error();
-    }
-    modules[1] = *im;
+  for (std::uint32_t k = 0; k < 3; ++k) {
+    write(texel_sets[k], VKCLOTH_TEXEL_BINDING_POS_IN, pos_views[k]);
+    for (auto [view, binding] : shared_views) write(texel_sets[k], binding, *view);
   }
-  // Specialisation constants of force_body.glsl (force.comp, fused.comp): the grid stencil.
+  vk().vkUpdateDescriptorSets(ctx->device, static_cast<std::uint32_t>(w), writes.data(), 0, nullptr);
+  return {};
+}
+
+// force.comp (specialised with the grid stencil) and integrate.comp.
+Result<void> GpuSolver::Impl::create_pipelines() {
   static_assert(sizeof(Stencil) == 40 * 4);
-  std::array<VkSpecializationMapEntry, 40> entries{};
-  for (std::uint32_t k = 0; k < entries.size(); ++k) entries[k] = VkSpecializationMapEntry{k, k * 4, 4};
+  const auto entries = constant_entries<40>();
   const VkSpecializationInfo spec{static_cast<std::uint32_t>(entries.size()), entries.data(), sizeof(Stencil), &stencil};
-  VkComputePipelineCreateInfo ci[2]{};
-  for (int k = 0; k < 2; ++k) {
-    ci[k].sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
-    ci[k].stage = VkPipelineShaderStageCreateInfo{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0,
-                                                  VK_SHADER_STAGE_COMPUTE_BIT, modules[k], "main",
-                                                  k == 1 ? nullptr : &spec};
-    ci[k].layout = layout;
-  }
-  VkPipeline pipes[2] = {};
-  const VkResult r = v.vkCreateComputePipelines(d, VK_NULL_HANDLE, 2, ci, v.allocator, pipes);
-  destroy_modules();
-  if (r != VK_SUCCESS) return vk_error(r, "vkCreateComputePipelines (force.comp, integrate.comp)");
-  force_pipeline = pipes[0];
-  integrate_pipeline = pipes[1];
+  auto fm = create_shader_module(*ctx, spirv::force_comp_spv, "force.comp");
+  if (!fm) return fm.error();
+  auto fp = create_compute_pipeline(*ctx, layout, *fm, &spec, "force.comp");
+  if (!fp) return fp.error();
+  force_pipeline = std::move(*fp);
+  auto im = create_shader_module(*ctx, spirv::integrate_comp_spv, "integrate.comp");
+  if (!im) return im.error();
+  auto ip = create_compute_pipeline(*ctx, layout, *im, nullptr, "integrate.comp");
+  if (!ip) return ip.error();
+  integrate_pipeline = std::move(*ip);
   return {};
 }
 
@@ -179,34 +145,20 @@ Result<void> GpuSolver::Impl::init_pipelines() {
 Result<void> GpuSolver::Impl::ensure_fused() {
   const std::uint32_t col = any_colliders() ? 1u : 0u;
   if (!options.fused || (fused_pipes[0][col] && fused_pipes[1][col])) return {};
-  const auto& v = vk();
-  const VkDevice d = ctx->device;
-  auto m = make_module(v, d, spirv::fused_comp_spv, "fused.comp");
+  auto m = create_shader_module(*ctx, spirv::fused_comp_spv, "fused.comp");
   if (!m) return m.error();
-  // Constant ids 0..39: the stencil; 40: SC_WRITE_AUX; 41: SC_COLLIDERS (fused.comp, common.glsl).
   struct Data {
     Stencil st;
     std::uint32_t write_aux, colliders; // VkBool32
-  } data[2] = {{stencil, 0u, col}, {stencil, 1u, col}};
+  };
   static_assert(sizeof(Data) == 42 * 4);
-  std::array<VkSpecializationMapEntry, 42> entries{};
-  for (std::uint32_t k = 0; k < entries.size(); ++k) entries[k] = VkSpecializationMapEntry{k, k * 4, 4};
-  VkSpecializationInfo spec[2];
-  VkComputePipelineCreateInfo ci[2]{};
-  for (int k = 0; k < 2; ++k) {
-    spec[k] = VkSpecializationInfo{static_cast<std::uint32_t>(entries.size()), entries.data(), sizeof(Data), &data[k]};
-    ci[k].sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
-    ci[k].stage = VkPipelineShaderStageCreateInfo{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0,
-                                                  VK_SHADER_STAGE_COMPUTE_BIT, *m, "main", &spec[k]};
-    ci[k].layout = layout;
-  }
-  VkPipeline pipes[2] = {};
-  const VkResult r = v.vkCreateComputePipelines(d, VK_NULL_HANDLE, 2, ci, v.allocator, pipes);
-  v.vkDestroyShaderModule(d, *m, v.allocator);
-  if (r != VK_SUCCESS) return vk_error(r, "vkCreateComputePipelines (fused.comp)");
-  for (int k = 0; k < 2; ++k) {
-    if (fused_pipes[k][col]) v.vkDestroyPipeline(d, fused_pipes[k][col], v.allocator);
-    fused_pipes[k][col] = pipes[k];
+  const auto entries = constant_entries<42>();
+  for (std::uint32_t aux = 0; aux < 2; ++aux) {
+    const Data data{stencil, aux, col};
+    const VkSpecializationInfo spec{static_cast<std::uint32_t>(entries.size()), entries.data(), sizeof(Data), &data};
+    auto p = create_compute_pipeline(*ctx, layout, *m, &spec, "fused.comp");
+    if (!p) return p.error();
+    fused_pipes[aux][col] = std::move(*p);
   }
   return {};
 }

@@ -1,4 +1,4 @@
-// Internal to engine/src/vulkan: volk, the Context internals, errors and buffers.
+// Internal to engine/src/vulkan: volk, the Context internals and errors (objects: resources.hpp).
 // Include this FIRST in every .cpp here: volk.h must precede any other Vulkan header.
 #pragma once
 
@@ -9,6 +9,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -72,7 +73,12 @@ struct Context::Impl {
   bool print_messages = true;
   VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
   std::atomic<std::uint64_t> messages{0};
-  std::atomic<std::int64_t> live_allocations{0}; ///< create_buffer() allocations not yet freed
+  std::atomic<std::int64_t> live_allocations{0}; ///< allocate_memory() allocations not yet freed
+  /// Test hook (testing::set_allocation_failure_hook): true fails the allocation. Empty: no cost
+  /// beyond one branch per allocation.
+  std::function<bool()> fail_allocation;
+  /// Every compute pipeline of this device goes through it (resources.cpp).
+  VkPipelineCache pipeline_cache = VK_NULL_HANDLE;
 
   Impl() = default;
   Impl(const Impl&) = delete;
@@ -85,48 +91,5 @@ struct Context::Impl {
   /// all of `preferred`); -1 if none.
   int find_memory_type(std::uint32_t type_bits, VkMemoryPropertyFlags required, VkMemoryPropertyFlags preferred) const;
 };
-
-/// A buffer with its own memory allocation; `mapped` is set when the memory is host-visible and
-/// mapped persistently (always host-coherent).
-struct Buffer {
-  VkBuffer buffer = VK_NULL_HANDLE;
-  VkDeviceMemory memory = VK_NULL_HANDLE;
-  VkDeviceSize size = 0;
-  void* mapped = nullptr;
-};
-
-enum class MemoryUse {
-  device,         ///< device-local; mapped only if also host-visible+coherent and `allow_map`
-  host_upload,    ///< host-visible+coherent staging for uploads
-  host_readback,  ///< host-visible+coherent, cached if possible, for readbacks and flags
-};
-
-/// `sharing_families`: queue families that use the buffer without ownership transfers; two or more
-/// distinct ones make it VK_SHARING_MODE_CONCURRENT, otherwise it is EXCLUSIVE.
-Result<Buffer> create_buffer(Context::Impl& ctx, VkDeviceSize size, VkBufferUsageFlags usage, MemoryUse use,
-                             bool allow_map, const char* what, const std::vector<std::uint32_t>& sharing_families = {});
-void destroy_buffer(Context::Impl& ctx, Buffer& b);
-
-/// The convenience path of solvers and worlds: resets `cmd`, records `record_fn(cmd)` into it
-/// (one-time submit), submits it on the Context's queue signalling `fence` and waits for it.
-template <typename F>
-Result<void> submit_and_wait(const Context::Impl& ctx, VkCommandBuffer cmd, VkFence fence, F&& record_fn) {
-  const auto& v = ctx.vk;
-  VKCLOTH_VK_TRY(v.vkResetCommandBuffer(cmd, 0), "vkResetCommandBuffer");
-  VkCommandBufferBeginInfo bi{};
-  bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
-  bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  VKCLOTH_VK_TRY(v.vkBeginCommandBuffer(cmd, &bi), "vkBeginCommandBuffer");
-  record_fn(cmd);
-  VKCLOTH_VK_TRY(v.vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
-  VkSubmitInfo si{};
-  si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
-  si.commandBufferCount = 1;
-  si.pCommandBuffers = &cmd;
-  VKCLOTH_VK_TRY(v.vkResetFences(ctx.device, 1, &fence), "vkResetFences");
-  VKCLOTH_VK_TRY(v.vkQueueSubmit(ctx.queue, 1, &si, fence), "vkQueueSubmit");
-  VKCLOTH_VK_TRY(v.vkWaitForFences(ctx.device, 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
-  return {};
-}
 
 } // namespace vkcloth::gpu

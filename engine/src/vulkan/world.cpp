@@ -1,4 +1,4 @@
-#include "vk_internal.hpp"
+#include "resources.hpp"
 
 #include <algorithm>
 #include <map>
@@ -57,23 +57,11 @@ struct ClothWorld::Impl {
   std::map<BatchKey, BatchEntry> batches;
   InstanceId next = 1;
   std::uint64_t dispatches = 0; // recorded by record_steps(), all batches
-  VkCommandPool cmd_pool = VK_NULL_HANDLE;
-  VkCommandBuffer cmd = VK_NULL_HANDLE;
-  VkFence fence = VK_NULL_HANDLE;
+  CommandContext commands;      // batch rebuilds (copies), simulate(), check_divergence()
 
   Impl() = default;
   Impl(const Impl&) = delete;
   Impl& operator=(const Impl&) = delete;
-  ~Impl() {
-    batches.clear();
-    if (!ctx || !ctx->device) return;
-    const auto& v = ctx->vk;
-    if (fence) {
-      v.vkWaitForFences(ctx->device, 1, &fence, VK_TRUE, UINT64_MAX);
-      v.vkDestroyFence(ctx->device, fence, v.allocator);
-    }
-    if (cmd_pool) v.vkDestroyCommandPool(ctx->device, cmd_pool, v.allocator);
-  }
 
   static BatchKey key_of(const Instance& inst, InstanceId id) {
     BatchKey k;
@@ -91,7 +79,7 @@ struct ClothWorld::Impl {
   }
 
   template <typename F> Result<void> submit_and_wait(F&& record_fn) {
-    return gpu::submit_and_wait(*ctx, cmd, fence, std::forward<F>(record_fn));
+    return commands.submit_and_wait(std::forward<F>(record_fn));
   }
 
   /// Rebuilds the batch `key` with `members` (slot order; may be empty: the batch goes away).
@@ -161,23 +149,9 @@ Result<ClothWorld> ClothWorld::create(Context& context, WorldOptions options) {
   auto impl = std::make_unique<Impl>();
   impl->ctx = context.impl();
   impl->options = std::move(options);
-  const auto& v = impl->ctx->vk;
-  const VkDevice d = impl->ctx->device;
-  VkCommandPoolCreateInfo cp{};
-  cp.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
-  cp.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-  cp.queueFamilyIndex = impl->ctx->queue_family;
-  VKCLOTH_VK_TRY(v.vkCreateCommandPool(d, &cp, v.allocator, &impl->cmd_pool), "vkCreateCommandPool (world)");
-  VkCommandBufferAllocateInfo ca{};
-  ca.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
-  ca.commandPool = impl->cmd_pool;
-  ca.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  ca.commandBufferCount = 1;
-  VKCLOTH_VK_TRY(v.vkAllocateCommandBuffers(d, &ca, &impl->cmd), "vkAllocateCommandBuffers (world)");
-  VkFenceCreateInfo fi{};
-  fi.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
-  fi.flags = VK_FENCE_CREATE_SIGNALED_BIT;
-  VKCLOTH_VK_TRY(v.vkCreateFence(d, &fi, v.allocator, &impl->fence), "vkCreateFence (world)");
+  auto commands = CommandContext::create(*impl->ctx, "world");
+  if (!commands) return commands.error();
+  impl->commands = std::move(*commands);
   return ClothWorld(std::move(impl));
 }
 

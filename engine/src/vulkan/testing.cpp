@@ -1,0 +1,11 @@
+#include "vk_internal.hpp"
+
+#include "vkcloth/gpu/testing.hpp"
+
+namespace vkcloth::gpu::testing {
+
+void set_allocation_failure_hook(Context& context, std::function<bool()> hook) {
+  context.impl()->fail_allocation = std::move(hook);
+}
+
+} // namespace vkcloth::gpu::testing
