@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian packages vkcloth needs. Idempotent; prints nothing when all is present.
-# Usage: tools/setup.sh [fuzz]   (fuzz: also clang and its libFuzzer runtime, for tools/fuzz.sh)
+# Usage: tools/setup.sh [fuzz|format]   (fuzz: also clang and its libFuzzer runtime, for tools/fuzz.sh;
+#                                       format: clang-format, for tools/format.sh)
 set -euo pipefail
 packages=(
   cmake ninja-build g++ pkg-config
@@ -10,6 +11,7 @@ packages=(
   libglfw3-dev libstb-dev xvfb xauth
 )
 [[ ${1:-} == fuzz ]] && packages+=(clang libclang-rt-14-dev)
+[[ ${1:-} == format ]] && packages+=(clang-format)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
