@@ -1,5 +1,6 @@
 // Context and error paths: device filters, adopting a host's handles, size limits, bad input.
 #include "gpu_test_util.hpp"
+#include "vkcloth/gpu/testing.hpp"
 
 using namespace vkcloth;
 using namespace vkcloth::gpu;
@@ -70,9 +71,9 @@ TEST_CASE("GpuSolver: a system too large for the device is refused before alloca
   VKCLOTH_GPU_TEST_BEGIN(ctx);
   auto cloth = make_cloth(ClothDesc{});
   REQUIRE(cloth.ok());
-  GpuSolverOptions o;
+  testing::SolverKnobs o;
   o.max_storage_buffer_bytes = 1024; // 100 particles x 16 bytes = 1600 > 1024
-  auto gpu = GpuSolver::create(ctx, *cloth, SimParams{}, o);
+  auto gpu = testing::create_solver(ctx, *cloth, SimParams{}, {}, o);
   REQUIRE(!gpu.ok());
   CHECK(gpu.error().code == ErrorCode::unsupported);
   CHECK(gpu.error().message.find("too large") != std::string::npos);

@@ -40,7 +40,7 @@ TEST_CASE("GpuSolver: out of device memory at every allocation is reported, leak
   params.colliders.push_back(Collider::sphere({0.5, 0.5, -1.0}, 0.3));
   for (bool staging : {false, true}) {
     CAPTURE(staging);
-    GpuSolverOptions o;
+    testing::SolverKnobs o;
     o.force_staging = staging;
     REQUIRE(ctx.live_allocation_count() == 0);
     unsigned failures = 0;
@@ -49,7 +49,7 @@ TEST_CASE("GpuSolver: out of device memory at every allocation is reported, leak
       bool failed = false;
       {
         FailAllocation hook(ctx, n);
-        auto gpu = GpuSolver::create(ctx, *cloth, params, o);
+        auto gpu = testing::create_solver(ctx, *cloth, params, {}, o);
         if (!gpu.ok()) {
           CHECK_MESSAGE(is_injected_oom(gpu.error()), gpu.error().message);
           CHECK(gpu.error().message.find("vkAllocateMemory") != std::string::npos);
@@ -75,7 +75,7 @@ TEST_CASE("GpuSolver: out of device memory at every allocation is reported, leak
     CHECK(failures >= 5); // the walk really went through the solver's buffers
     MESSAGE("staging=" << staging << ": " << failures << " allocation points failed cleanly");
     // The Context works as before.
-    auto gpu = GpuSolver::create(ctx, *cloth, params, o);
+    auto gpu = testing::create_solver(ctx, *cloth, params, {}, o);
     REQUIRE(gpu.ok());
     REQUIRE(gpu->simulate(20).ok());
     CHECK(gpu->positions().ok());
@@ -88,9 +88,9 @@ TEST_CASE("GpuSolver: the max_storage_buffer_bytes limit refuses before allocati
   VKCLOTH_GPU_TEST_BEGIN(ctx);
   auto cloth = make_cloth(ClothDesc{});
   REQUIRE(cloth.ok());
-  GpuSolverOptions o;
+  testing::SolverKnobs o;
   o.max_storage_buffer_bytes = 16;
-  auto gpu = GpuSolver::create(ctx, *cloth, SimParams{}, o);
+  auto gpu = testing::create_solver(ctx, *cloth, SimParams{}, {}, o);
   REQUIRE(!gpu.ok());
   CHECK(gpu.error().code == ErrorCode::unsupported);
   CHECK(ctx.live_allocation_count() == 0);

@@ -9,6 +9,7 @@
 // steps of a stiff system) while still catching any formula or ordering mistake (those show up
 // at 1e-3 or more).
 #include "gpu_test_util.hpp"
+#include "vkcloth/gpu/testing.hpp"
 
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
@@ -61,7 +62,7 @@ TestScene falling_cloth() {
 
 /// Runs `steps` steps on both solvers with `integrator`; checks positions, velocities, normals.
 void check_against_cpu(Context& ctx, const std::string& name, TestScene scene, std::uint64_t steps = 100,
-                       GpuSolverOptions options = {}) {
+                       GpuSolverOptions options = {}, testing::SolverKnobs knobs = {}) {
   const double base_dt = scene.params.dt;
   for (Integrator integrator : integrators) {
     const std::string method = to_string(integrator);
@@ -74,7 +75,7 @@ void check_against_cpu(Context& ctx, const std::string& name, TestScene scene, s
     else scene.params.dt = base_dt;
     auto cpu = CpuSolver<float>::create(scene.system, scene.params);
     REQUIRE(cpu.ok());
-    auto gpu = GpuSolver::create(ctx, scene.system, scene.params, options);
+    auto gpu = testing::create_solver(ctx, scene.system, scene.params, options, knobs);
     REQUIRE_MESSAGE(gpu.ok(), (gpu.ok() ? "" : gpu.error().message));
     const auto cr = cpu->run(steps);
     REQUIRE_MESSAGE(cr.ok(), (cr.ok() ? "" : cr.error().message));
@@ -155,26 +156,26 @@ TEST_CASE("GPU matches CPU: horizontal cloth falling on a plane and a sphere") {
 
 TEST_CASE("GPU staging path (forced) matches CPU") {
   VKCLOTH_GPU_TEST_BEGIN(ctx);
-  GpuSolverOptions o;
-  o.force_staging = true;
+  testing::SolverKnobs staging;
+  staging.force_staging = true;
   TestScene s = cloth(13, 7);
-  auto gpu = GpuSolver::create(ctx, s.system, s.params, o);
+  auto gpu = testing::create_solver(ctx, s.system, s.params, {}, staging);
   REQUIRE(gpu.ok());
   CHECK(gpu->uses_staging());
-  check_against_cpu(ctx, "cloth 13x7 (staging)", cloth(13, 7), 100, o);
+  check_against_cpu(ctx, "cloth 13x7 (staging)", cloth(13, 7), 100, {}, staging);
   // Wind so that the normals are used, with staging too.
   TestScene w = cloth(13, 7);
   w.params.wind.strength = 0.5;
-  check_against_cpu(ctx, "cloth 13x7 + wind (staging)", std::move(w), 40, o);
+  check_against_cpu(ctx, "cloth 13x7 + wind (staging)", std::move(w), 40, {}, staging);
 }
 
 TEST_CASE("GPU two-dimensional dispatch (rows of workgroups) matches CPU") {
   VKCLOTH_GPU_TEST_BEGIN(ctx);
-  GpuSolverOptions o;
-  o.max_workgroups_x = 3; // 851 particles = 14 groups of 64 -> 3 x 5 groups, the last row partly idle
+  testing::SolverKnobs k;
+  k.max_workgroups_x = 3; // 851 particles = 14 groups of 64 -> 3 x 5 groups, the last row partly idle
   TestScene w = cloth(37, 23);
   w.params.wind.strength = 0.8;
-  check_against_cpu(ctx, "cloth 37x23 + wind (3x5 groups)", std::move(w), 50, o);
+  check_against_cpu(ctx, "cloth 37x23 + wind (3x5 groups)", std::move(w), 50, {}, k);
 }
 
 TEST_CASE("GPU runs are deterministic (bit-identical)") {
@@ -357,10 +358,11 @@ TEST_CASE("GPU fused step and two-pass layout agree with each other and with the
   check_against_cpu(ctx, "falling cloth (two-pass)", falling_cloth(), 100, two_pass);
   check_against_cpu(ctx, "double spring (two-pass)", chain({1.0, 1.0}, {{0.1, 0.0, -0.4}, {0.3, 0.1, -0.9}}), 100,
                     two_pass);
-  GpuSolverOptions fused_2d;
-  fused_2d.fused = true;
-  fused_2d.max_workgroups_x = 3;
-  check_against_cpu(ctx, "falling cloth (fused, 2-D dispatch)", falling_cloth(), 100, fused_2d);
+  GpuSolverOptions fused;
+  fused.fused = true;
+  testing::SolverKnobs rows;
+  rows.max_workgroups_x = 3;
+  check_against_cpu(ctx, "falling cloth (fused, 2-D dispatch)", falling_cloth(), 100, fused, rows);
 
   // Fused vs two-pass directly: every state buffer bit for bit, for both Euler integrators.
   for (Integrator integrator : {Integrator::explicit_euler, Integrator::semi_implicit_euler}) {
@@ -408,8 +410,9 @@ TEST_CASE("GPU grid stencil (specialisation constants) gives the CSR gather's bi
         for (int k = 0; k < 2; ++k) {
           GpuSolverOptions o;
           o.fused = fused;
-          o.csr_only = k == 1;
-          auto gpu = GpuSolver::create(ctx, s.system, s.params, o);
+          testing::SolverKnobs knobs;
+          knobs.csr_only = k == 1;
+          auto gpu = testing::create_solver(ctx, s.system, s.params, o, knobs);
           REQUIRE(gpu.ok());
           REQUIRE(gpu->simulate(60, 25).ok());
           out[k][0] = gpu->positions().value();

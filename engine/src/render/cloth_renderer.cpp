@@ -398,7 +398,7 @@ Result<ClothRenderer> ClothRenderer::create(gpu::Context& context, const SimPara
   if (!options.render_pass)
     return make_error(ErrorCode::invalid_argument, "RendererOptions::render_pass is required");
   auto impl = std::make_unique<Impl>();
-  impl->ctx = context.impl();
+  impl->ctx = gpu::context_impl(context);
   if (!detail::queue_has_graphics(*impl->ctx))
     return make_error(
         ErrorCode::unsupported,

@@ -11,7 +11,7 @@ void record_hold_particle(const gpu::Context& context, VkCommandBuffer cmd, cons
                           std::uint32_t particle, glm::vec3 position) {
   if (particle >= solver.particle_count())
     return;
-  const auto& v = context.impl()->vk;
+  const auto& v = gpu::context_impl(context)->vk;
   gpu::barriers::before_host_edit(v, cmd);
   const glm::vec4 p(position, 1.0f), zero(0.0f);
   const VkDeviceSize at = VkDeviceSize(particle) * gpu::GpuSolver::stride;

@@ -29,7 +29,7 @@ Result<OffscreenTarget> OffscreenTarget::create(gpu::Context& context, std::uint
                       fmt::format("image size {}x{} is out of range (1..4096 a side)", width, height));
   auto impl = std::make_unique<Impl>();
   Impl& s = *impl;
-  s.ctx = context.impl();
+  s.ctx = gpu::context_impl(context);
   s.width = width;
   s.height = height;
   if (!detail::queue_has_graphics(*s.ctx))

@@ -140,7 +140,7 @@ Result<void> GpuSolver::Impl::set_slot_params(std::uint32_t slot, SimParams para
 
 Result<void> GpuSolver::Impl::ensure_implicit() {
   if (family().integrator != Integrator::implicit_euler || implicit) return {};
-  auto r = ImplicitGpu::create(ctx, count, edges_count, groups_x, groups_y, !options.force_staging);
+  auto r = ImplicitGpu::create(ctx, count, edges_count, groups_x, groups_y, !knobs.force_staging);
   if (!r) return r.error();
   implicit = std::move(*r);
   return write_sets();
@@ -226,12 +226,12 @@ struct DispatchGrid {
 /// The device limits a batch of `batch` instances of `system` must fit, checked before any
 /// allocation; errors name the buffer or dispatch and the limit.
 Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ParticleSystem& system, std::uint64_t batch,
-                                  const GpuSolverOptions& options) {
+                                  const testing::SolverKnobs& knobs) {
   const std::uint64_t n = system.size();
   const VkPhysicalDeviceLimits& lim = ctx.properties.limits;
   std::uint64_t max_bytes = lim.maxStorageBufferRange;
-  const bool overridden = options.max_storage_buffer_bytes && options.max_storage_buffer_bytes < max_bytes;
-  if (overridden) max_bytes = options.max_storage_buffer_bytes;
+  const bool overridden = knobs.max_storage_buffer_bytes && knobs.max_storage_buffer_bytes < max_bytes;
+  if (overridden) max_bytes = knobs.max_storage_buffer_bytes;
   const std::uint64_t edges_n = system.adjacency.refs.size();
   const struct {
     const char* what;
@@ -248,7 +248,7 @@ Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ParticleSystem
                                     "bytes) but a storage buffer may hold at most {} bytes ({}); use fewer particles "
                                     "or fewer instances of one topology",
                                     ctx.name, need.what, need.bytes, need.items, need.per, max_bytes,
-                                    overridden ? "GpuSolverOptions::max_storage_buffer_bytes"
+                                    overridden ? "testing::SolverKnobs::max_storage_buffer_bytes"
                                                : "maxStorageBufferRange"));
   // Positions, velocities and particle constants are also read through texel buffer views (one
   // texel per particle of every instance).
@@ -260,7 +260,7 @@ Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ParticleSystem
                                   ctx.name, batch * n, batch, n, batch * n, lim.maxTexelBufferElements));
   const std::uint64_t groups = (n + VKCLOTH_WORKGROUP_SIZE - 1) / VKCLOTH_WORKGROUP_SIZE;
   std::uint64_t row = lim.maxComputeWorkGroupCount[0];
-  if (options.max_workgroups_x) row = std::min<std::uint64_t>(row, options.max_workgroups_x);
+  if (knobs.max_workgroups_x) row = std::min<std::uint64_t>(row, knobs.max_workgroups_x);
   const std::uint64_t gx = std::min<std::uint64_t>(groups, row);
   const std::uint64_t gy = (groups + gx - 1) / gx;
   if (gy > lim.maxComputeWorkGroupCount[1] || n >= std::numeric_limits<std::uint32_t>::max())
@@ -288,7 +288,7 @@ Result<void> GpuSolver::Impl::create_buffers() {
                                    VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT |
                                    VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
   const VkDeviceSize vec4_bytes = VkDeviceSize(batch()) * n * 16;
-  const bool allow_map = !options.force_staging;
+  const bool allow_map = !knobs.force_staging;
   std::vector<std::uint32_t> families;
   if (!options.sharing_queue_families.empty()) {
     families = options.sharing_queue_families;
@@ -448,10 +448,11 @@ Result<std::unique_ptr<GpuSolver::Impl>> GpuSolver::Impl::create(const std::shar
                                                                   const ParticleSystem& system,
                                                                   std::vector<SimParams> params,
                                                                   const GpuSolverOptions& options,
+                                                                  const testing::SolverKnobs& knobs,
                                                                   const std::vector<SlotState>& states) {
   for (SimParams& p : params) VKCLOTH_TRY(p.validate());
   VKCLOTH_TRY(system.validate());
-  auto grid = check_limits(*ctx, system, params.size(), options);
+  auto grid = check_limits(*ctx, system, params.size(), knobs);
   if (!grid) return grid.error();
 
   auto impl = std::make_unique<Impl>();
@@ -460,6 +461,7 @@ Result<std::unique_ptr<GpuSolver::Impl>> GpuSolver::Impl::create(const std::shar
   s.slots.resize(params.size());
   for (std::size_t k = 0; k < params.size(); ++k) s.slots[k].params = std::move(params[k]);
   s.options = options;
+  s.knobs = knobs;
   s.count = s.pc.count = static_cast<std::uint32_t>(system.size());
   s.edges_count = system.adjacency.refs.size();
   s.groups_x = grid->x;
@@ -471,7 +473,7 @@ Result<std::unique_ptr<GpuSolver::Impl>> GpuSolver::Impl::create(const std::shar
   // On failure `impl` frees whatever the phases created so far.
   VKCLOTH_TRY(s.create_buffers());
   VKCLOTH_TRY(s.create_commands());
-  if (!options.csr_only) s.detect_stencil(system);
+  if (!knobs.csr_only) s.detect_stencil(system);
   VKCLOTH_TRY(s.init_pipelines());
   VKCLOTH_TRY(s.write_sets());
   VKCLOTH_TRY(s.ensure_implicit());
@@ -483,11 +485,16 @@ Result<std::unique_ptr<GpuSolver::Impl>> GpuSolver::Impl::create(const std::shar
 
 Result<GpuSolver> GpuSolver::create(Context& context, const ParticleSystem& system, SimParams params,
                                     const GpuSolverOptions& options) {
+  return testing::create_solver(context, system, std::move(params), options);
+}
+
+Result<GpuSolver> testing::create_solver(Context& context, const ParticleSystem& system, SimParams params,
+                                         const GpuSolverOptions& options, const SolverKnobs& knobs) {
   std::vector<SimParams> one;
   one.push_back(std::move(params));
-  auto impl = Impl::create(context.impl(), system, std::move(one), options);
+  auto impl = GpuSolver::Impl::create(context_impl(context), system, std::move(one), options, knobs);
   if (!impl) return impl.error();
-  return GpuSolver(std::move(*impl));
+  return detail::Access::wrap<GpuSolver>(std::move(*impl));
 }
 
 GpuSolver::GpuSolver(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}

@@ -16,6 +16,7 @@
 #include "implicit_gpu.hpp"
 #include "resources.hpp"
 #include "vkcloth/gpu/gpu_solver.hpp"
+#include "vkcloth/gpu/testing.hpp"
 #include "vkcloth_shared.h"
 
 namespace vkcloth::gpu {
@@ -37,6 +38,7 @@ struct GpuSolver::Impl {
 
   std::shared_ptr<Context::Impl> ctx;
   GpuSolverOptions options;
+  testing::SolverKnobs knobs;
   std::vector<Slot> slots; // one per instance; slot k's particles are at k * count in the buffers
   std::uint32_t count = 0; // particles per instance
   std::uint32_t nx = 0, ny = 0;
@@ -94,6 +96,7 @@ struct GpuSolver::Impl {
   /// instance)); `states[k]` is instance k's initial state (missing entries: the topology's).
   static Result<std::unique_ptr<Impl>> create(const std::shared_ptr<Context::Impl>& ctx, const ParticleSystem& topology,
                                               std::vector<SimParams> params, const GpuSolverOptions& options,
+                                              const testing::SolverKnobs& knobs,
                                               const std::vector<SlotState>& states = {});
 
   Impl() = default;

@@ -5,7 +5,7 @@
 namespace vkcloth::gpu::testing {
 
 void set_allocation_failure_hook(Context& context, std::function<bool()> hook) {
-  context.impl()->fail_allocation = std::move(hook);
+  context_impl(context)->fail_allocation = std::move(hook);
 }
 
 } // namespace vkcloth::gpu::testing

@@ -10,6 +10,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,20 @@ Error vk_error(VkResult r, const std::string& what);
     if (const VkResult vkcloth_vk_r_ = (call); vkcloth_vk_r_ != VK_SUCCESS)                             \
       return ::vkcloth::gpu::vk_error(vkcloth_vk_r_, (what));                                           \
   } while (0)
+
+namespace detail {
+/// The engine's way past the public objects' private members (friend of Context, GpuSolver and
+/// ClothWorld), so no Impl accessor appears in a public header.
+struct Access {
+  static const std::shared_ptr<Context::Impl>& context(const Context& c) { return c.impl_; }
+  /// Wraps an Impl in its public object (their constructors are private).
+  template <typename T, typename I> static T wrap(std::unique_ptr<I> impl) { return T(std::move(impl)); }
+  template <typename T> static auto& impl(T& object) { return *object.impl_; }
+};
+} // namespace detail
+
+/// The internals of a Context (kept alive by every object created from it).
+inline const std::shared_ptr<Context::Impl>& context_impl(const Context& c) { return detail::Access::context(c); }
 
 /// Instance-level functions of one instance (loaded from its own vkGetInstanceProcAddr, so
 /// several Contexts on different instances never share function pointers).

@@ -10,6 +10,7 @@
 
 #include "barriers.hpp"
 #include "solver_batch.hpp"
+#include "vkcloth/gpu/testing.hpp"
 #include "vkcloth/gpu/world.hpp"
 
 namespace vkcloth::gpu {
@@ -53,6 +54,7 @@ struct ClothWorld::Impl {
 
   std::shared_ptr<Context::Impl> ctx;
   WorldOptions options;
+  testing::SolverKnobs knobs;
   std::map<InstanceId, Instance> instances; // ordered by id
   std::map<BatchKey, BatchEntry> batches;
   InstanceId next = 1;
@@ -98,7 +100,7 @@ struct ClothWorld::Impl {
       const auto f = fresh.find(id);
       states.push_back(f == fresh.end() ? SlotState{} : SlotState{&f->second->positions, &f->second->velocities});
     }
-    auto made = Batch::create(ctx, *instances.at(members.front()).topology, std::move(params), options.solver, states);
+    auto made = Batch::create(ctx, *instances.at(members.front()).topology, std::move(params), options.solver, knobs, states);
     if (!made) return made.error();
     std::unique_ptr<Batch> batch = std::move(*made);
     std::set<Batch*> sources; // the batches the surviving members come from
@@ -146,13 +148,18 @@ struct ClothWorld::Impl {
 };
 
 Result<ClothWorld> ClothWorld::create(Context& context, WorldOptions options) {
-  auto impl = std::make_unique<Impl>();
-  impl->ctx = context.impl();
+  return testing::create_world(context, std::move(options), {});
+}
+
+Result<ClothWorld> testing::create_world(Context& context, WorldOptions options, const SolverKnobs& knobs) {
+  auto impl = std::make_unique<ClothWorld::Impl>();
+  impl->ctx = context_impl(context);
   impl->options = std::move(options);
+  impl->knobs = knobs;
   auto commands = CommandContext::create(*impl->ctx, "world");
   if (!commands) return commands.error();
   impl->commands = std::move(*commands);
-  return ClothWorld(std::move(impl));
+  return detail::Access::wrap<ClothWorld>(std::move(impl));
 }
 
 ClothWorld::ClothWorld(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}

@@ -20,6 +20,10 @@
 
 namespace vkcloth::gpu {
 
+namespace detail {
+struct Access; // engine internals: reach the Impl of a Context, GpuSolver or ClothWorld
+} // namespace detail
+
 /// Options for a Context that creates its own instance and device.
 struct ContextOptions {
   /// Device choice: a decimal index into the device list, or a case-insensitive substring of the
@@ -113,9 +117,9 @@ public:
   Result<void> wait_idle() const;
 
   struct Impl; ///< internal (engine/src/vulkan)
-  const std::shared_ptr<Impl>& impl() const { return impl_; }
 
 private:
+  friend struct detail::Access;
   explicit Context(std::shared_ptr<Impl> impl);
   std::shared_ptr<Impl> impl_;
 };

@@ -42,19 +42,6 @@ struct GpuSolverOptions {
   /// per step instead of two. RK4 always uses the two-pass layout (its stages need every
   /// particle's stage state before the next force evaluation).
   bool fused = true;
-  /// Keep every bulk buffer in device-local memory and go through staging buffers for uploads
-  /// and readbacks even when the device-local memory is host-visible (as on lavapipe or UMA).
-  bool force_staging = false;
-  /// Lower the per-buffer size limit below the device's maxStorageBufferRange (0: the device's).
-  std::uint64_t max_storage_buffer_bytes = 0;
-  /// Lower the workgroups per dispatch row below maxComputeWorkGroupCount[0] (0: the device's);
-  /// larger systems then dispatch a second grid dimension (tests use it to exercise that path).
-  std::uint32_t max_workgroups_x = 0;
-  /// Cloth grids: interior particles whose gather lists are all the same up to translation sum
-  /// their springs from a compile-time stencil (specialisation constants) instead of the CSR
-  /// lists; same terms in the same order, so the same bits. `true` keeps the CSR gather for every
-  /// particle (tests, comparison).
-  bool csr_only = false;
   /// Queue families (besides the Context's, which is always added) that use the per-particle and
   /// topology buffers, e.g. the host's graphics family when it differs from the compute family.
   /// Two or more distinct families create the buffers VK_SHARING_MODE_CONCURRENT, so the host
@@ -171,12 +158,13 @@ public:
   /// GPU time of the last simulate() (sum over its submissions, timestamps), in milliseconds;
   /// negative when the queue has no timestamp support.
   double last_gpu_ms() const;
-  /// True when bulk buffers go through staging (not host-visible or force_staging).
+  /// True when bulk buffers go through staging (not host-visible, or testing::SolverKnobs::force_staging).
   bool uses_staging() const;
 
   struct Impl; ///< internal (engine/src/vulkan)
 
 private:
+  friend struct detail::Access;
   explicit GpuSolver(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };

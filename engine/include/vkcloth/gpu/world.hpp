@@ -117,6 +117,7 @@ public:
   struct Impl; ///< internal (engine/src/vulkan/world.cpp)
 
 private:
+  friend struct detail::Access;
   explicit ClothWorld(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };
