@@ -12,6 +12,7 @@
 #include <glm/vec4.hpp>
 
 #include "../vulkan/barriers.hpp"
+#include "../vulkan/pipelines.hpp"
 #include "vkcloth/render/cloth_renderer.hpp"
 #include "vkcloth/gpu/world.hpp"
 #include "vkcloth/shaders/render/cloth_frag_spv.hpp"
@@ -352,7 +353,7 @@ Result<void> ClothRenderer::Impl::build_pipelines(const RendererOptions& o) {
     gi.layout = layout;
     gi.renderPass = o.render_pass;
     gi.subpass = o.subpass;
-    VKCLOTH_VK_TRY(v.vkCreateGraphicsPipelines(d, ctx->pipeline_cache, 1, &gi, v.allocator, out->init(*ctx)),
+    VKCLOTH_VK_TRY(v.vkCreateGraphicsPipelines(d, ctx->pipelines->cache(), 1, &gi, v.allocator, out->init(*ctx)),
                    fmt::format("vkCreateGraphicsPipelines ({})", sh.name));
     return {};
   };

@@ -1,5 +1,7 @@
 #include "vk_internal.hpp"
 
+#include "pipelines.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
@@ -282,6 +284,7 @@ Error vk_error(VkResult r, const std::string& what) {
 }
 
 Context::Impl::~Impl() {
+  pipelines.reset(); // before the device goes, whoever owns it
   if (!owns) return;
   if (device) {
     if (vk.vkDeviceWaitIdle) vk.vkDeviceWaitIdle(device);
@@ -318,6 +321,7 @@ Result<void> Context::Impl::load(std::uint32_t required_api) {
   }
   if (!vk.vkCmdDispatch || !vk.vkQueueSubmit)
     return make_error(ErrorCode::vulkan, "vkGetDeviceProcAddr returned no core device functions");
+  pipelines = std::make_unique<PipelineRegistry>(*this); // creates nothing yet
   return {};
 }
 

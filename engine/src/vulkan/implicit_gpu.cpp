@@ -4,31 +4,18 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <vector>
 #include <tuple>
 
 #include <fmt/format.h>
 
 #include "barriers.hpp"
+#include "pipelines.hpp"
 #include "implicit_shared.h"
-#include "vkcloth/shaders/implicit_comp_spv.hpp"
-#include "vkcloth/shaders/implicit_reduce_comp_spv.hpp"
 
 namespace vkcloth::gpu {
 
 namespace sh = shared;
-
-namespace {
-
-constexpr std::uint32_t kBindings[] = {
-    VKCLOTH_BINDING_POS_IN,         VKCLOTH_BINDING_FORCE_OUT,     VKCLOTH_BINDING_NORMAL,    VKCLOTH_BINDING_POS_OUT,
-    VKCLOTH_BINDING_VEL,            VKCLOTH_BINDING_PARTICLE,      VKCLOTH_BINDING_OFFSETS,   VKCLOTH_BINDING_EDGES,
-    VKCLOTH_BINDING_COLLIDERS,      VKCLOTH_BINDING_FLAGS,         VKCLOTH_BINDING_INSTANCES, VKCLOTH_BINDING_IMPL_VF,   VKCLOTH_BINDING_IMPL_KS,
-    VKCLOTH_BINDING_IMPL_DIAG_INV,  VKCLOTH_BINDING_IMPL_X,        VKCLOTH_BINDING_IMPL_R,    VKCLOTH_BINDING_IMPL_Z,
-    VKCLOTH_BINDING_IMPL_D,         VKCLOTH_BINDING_IMPL_Q,        VKCLOTH_BINDING_IMPL_PARTIALS,
-    VKCLOTH_BINDING_IMPL_STATE,     VKCLOTH_BINDING_IMPL_ARGS};
-constexpr std::uint32_t kBindingCount = sizeof(kBindings) / sizeof(kBindings[0]);
-
-} // namespace
 
 Result<std::unique_ptr<ImplicitGpu>> ImplicitGpu::create(const std::shared_ptr<Context::Impl>& ctx, std::uint32_t count,
                                                          std::uint64_t entries, std::uint32_t groups_x,
@@ -79,17 +66,16 @@ Result<void> ImplicitGpu::create_buffers(std::uint64_t entries, bool allow_map) 
   return {};
 }
 
+// The Context's layouts and pipelines; this batch's pool and two sets (position parity).
 Result<void> ImplicitGpu::create_pipelines() {
   Context::Impl& ctx = *ctx_;
   const auto& v = ctx.vk;
-  auto sl = create_compute_set_layout(ctx, kBindings, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, "implicit");
-  if (!sl) return sl.error();
-  set_layout_ = std::move(*sl);
-  const VkDescriptorSetLayout set_layouts[1] = {set_layout_};
-  auto pl = create_pipeline_layout(ctx, set_layouts, VK_SHADER_STAGE_COMPUTE_BIT, sizeof(sh::PushConstants), "implicit");
-  if (!pl) return pl.error();
-  layout_ = std::move(*pl);
-  const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2 * kBindingCount};
+  auto layouts = ctx.pipelines->implicit_layouts();
+  if (!layouts) return layouts.error();
+  set_layout_ = layouts->set;
+  layout_ = layouts->layout;
+  const auto bindings = implicit_bindings();
+  const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2 * static_cast<std::uint32_t>(bindings.size())};
   VkDescriptorPoolCreateInfo dp{};
   dp.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
   dp.maxSets = 2;
@@ -97,32 +83,29 @@ Result<void> ImplicitGpu::create_pipelines() {
   dp.pPoolSizes = &size;
   VKCLOTH_VK_TRY(v.vkCreateDescriptorPool(ctx.device, &dp, v.allocator, pool_.init(ctx)),
                  "vkCreateDescriptorPool (implicit)");
-  const VkDescriptorSetLayout layouts[2] = {set_layout_, set_layout_};
+  const VkDescriptorSetLayout layouts2[2] = {set_layout_, set_layout_};
   VkDescriptorSetAllocateInfo ai{};
   ai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
   ai.descriptorPool = pool_;
   ai.descriptorSetCount = 2;
-  ai.pSetLayouts = layouts;
+  ai.pSetLayouts = layouts2;
   VKCLOTH_VK_TRY(v.vkAllocateDescriptorSets(ctx.device, &ai, sets_), "vkAllocateDescriptorSets (implicit)");
-  auto pm = create_shader_module(ctx, spirv::implicit_comp_spv, "implicit.comp");
-  if (!pm) return pm.error();
-  auto pp = create_compute_pipeline(ctx, layout_, *pm, nullptr, "implicit.comp");
+  auto pp = ctx.pipelines->pipeline(PipelineRegistry::Shader::implicit, {});
   if (!pp) return pp.error();
-  pass_ = std::move(*pp);
-  auto rm = create_shader_module(ctx, spirv::implicit_reduce_comp_spv, "implicit_reduce.comp");
-  if (!rm) return rm.error();
-  auto rp = create_compute_pipeline(ctx, layout_, *rm, nullptr, "implicit_reduce.comp");
+  pass_ = *pp;
+  auto rp = ctx.pipelines->pipeline(PipelineRegistry::Shader::implicit_reduce, {});
   if (!rp) return rp.error();
-  reduce_ = std::move(*rp);
+  reduce_ = *rp;
   return {};
 }
 
 Result<void> ImplicitGpu::write_sets(const ImplicitInputs& in) {
-  std::array<VkDescriptorBufferInfo, 2 * kBindingCount> infos{};
-  std::array<VkWriteDescriptorSet, 2 * kBindingCount> writes{};
+  const auto bindings = implicit_bindings();
+  std::vector<VkDescriptorBufferInfo> infos(2 * bindings.size()); // creation only: not the hot path
+  std::vector<VkWriteDescriptorSet> writes(2 * bindings.size());
   std::size_t k = 0;
   for (std::uint32_t read = 0; read < 2; ++read)
-    for (std::uint32_t binding : kBindings) {
+    for (std::uint32_t binding : bindings) {
       VkBuffer b = VK_NULL_HANDLE;
       switch (binding) {
       case VKCLOTH_BINDING_POS_IN: b = in.pos[read]; break;
@@ -165,11 +148,11 @@ std::uint32_t ImplicitGpu::record_substep(VkCommandBuffer c, std::uint32_t read,
   pc.c_next = tol * tol; // as CpuSolver<float>: Real(tol) * Real(tol)
   pc.pad0 = params.cg_max_iterations;
   pc.pad1 = groups_x_ * groups_y_;
-  v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout_.get(), 0, 1, &sets_[read], 0, nullptr);
+  v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &sets_[read], 0, nullptr);
   bool need_barrier = !first;
   std::uint32_t dispatches = 0;
   VkPipeline bound = VK_NULL_HANDLE;
-  const VkPipeline pass_pipe = pass_, reduce_pipe = reduce_;
+  const VkPipeline pass_pipe = pass_, reduce_pipe = reduce_; // raw handles, for the lambda's comparisons
   auto pass = [&](VkPipeline pipe, std::uint32_t stage, int indirect_offset) {
     if (need_barrier) barriers::implicit_pass(v, c); // previous pass -> this one (RAW, WAR, indirect args)
     need_barrier = true;

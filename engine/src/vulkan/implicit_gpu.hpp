@@ -50,11 +50,12 @@ private:
   std::shared_ptr<Context::Impl> ctx_;
   std::uint32_t count_ = 0, groups_x_ = 1, groups_y_ = 1;
   Buffer vf_, ks_, diag_inv_, x_, r_, z_, d_, q_, partials_, state_, args_;
-  DescriptorSetLayout set_layout_;
   DescriptorPool pool_;
   VkDescriptorSet sets_[2] = {};
-  PipelineLayout layout_;
-  Pipeline pass_, reduce_;
+  // The Context's (PipelineRegistry), shared by every implicit batch.
+  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
+  VkPipelineLayout layout_ = VK_NULL_HANDLE;
+  VkPipeline pass_ = VK_NULL_HANDLE, reduce_ = VK_NULL_HANDLE;
 
   Result<void> create_buffers(std::uint64_t entries, bool allow_map);
   Result<void> create_pipelines();

@@ -183,25 +183,6 @@ Result<ShaderModule> create_shader_module(Context::Impl& ctx, std::span<const st
   return m;
 }
 
-Result<Pipeline> create_compute_pipeline(Context::Impl& ctx, VkPipelineLayout layout, VkShaderModule module,
-                                         const VkSpecializationInfo* spec, const char* name) {
-  VkComputePipelineCreateInfo ci{};
-  ci.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
-  ci.stage = VkPipelineShaderStageCreateInfo{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
-                                             nullptr,
-                                             0,
-                                             VK_SHADER_STAGE_COMPUTE_BIT,
-                                             module,
-                                             "main",
-                                             spec};
-  ci.layout = layout;
-  Pipeline p;
-  VKCLOTH_VK_TRY(
-      ctx.vk.vkCreateComputePipelines(ctx.device, ctx.pipeline_cache, 1, &ci, ctx.vk.allocator, p.init(ctx)),
-      fmt::format("vkCreateComputePipelines ({})", name));
-  return p;
-}
-
 Result<DescriptorSetLayout> create_compute_set_layout(Context::Impl& ctx,
                                                       std::span<const std::uint32_t> bindings,
                                                       VkDescriptorType type, const char* name) {

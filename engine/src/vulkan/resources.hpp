@@ -156,11 +156,6 @@ void free_memory(Context::Impl& ctx, VkDeviceMemory memory);
 Result<ShaderModule> create_shader_module(Context::Impl& ctx, std::span<const std::uint32_t> code,
                                           const char* name);
 
-/// A compute pipeline of `module`'s "main" with optional specialisation constants, through the
-/// Context's pipeline cache.
-Result<Pipeline> create_compute_pipeline(Context::Impl& ctx, VkPipelineLayout layout, VkShaderModule module,
-                                         const VkSpecializationInfo* spec, const char* name);
-
 /// A descriptor set layout of `bindings`, each one descriptor of `type` for the compute stage.
 Result<DescriptorSetLayout> create_compute_set_layout(Context::Impl& ctx,
                                                       std::span<const std::uint32_t> bindings,

@@ -53,23 +53,23 @@ struct GpuSolver::Impl {
   Buffer colliders, flags, instances; // host-visible (written / read by the host)
   std::uint32_t collider_capacity = 0;
 
-  DescriptorSetLayout set_layout;
+  // Layouts and pipelines: the Context's (PipelineRegistry, pipelines.hpp), shared by every batch.
+  VkDescriptorSetLayout set_layout = VK_NULL_HANDLE, texel_layout = VK_NULL_HANDLE;
+  VkPipelineLayout layout = VK_NULL_HANDLE;
+  VkPipeline force_pipeline = VK_NULL_HANDLE, integrate_pipeline = VK_NULL_HANDLE;
+  // fused.comp variants, looked up when first needed (ensure_fused): [write_aux][colliders].
+  // write_aux = 0 (SC_WRITE_AUX false: no force and normal stores) for every fused substep of a
+  // recorded batch of steps but the last, since only the last one's forces and normals can be
+  // observed; colliders = 0 (SC_COLLIDERS false: no contact loops) while no instance has colliders.
+  VkPipeline fused_pipes[2][2] = {};
   DescriptorPool pool;
   VkDescriptorSet sets[2][2] = {}; // [positions read index][0: state input, 1: RK4 stage input]
   // Set 1 of force.comp / fused.comp: POS_IN as an RGBA32F uniform texel buffer (force_body.glsl
   // pos_at), the particle constants as an RG32UI one, velocities, flags, instance parameters.
   // pos_views [0], [1]: positions[0], positions[1]; [2]: RK4 stage positions.
-  DescriptorSetLayout texel_layout;
   BufferView pos_views[3];
   BufferView particle_view, vel_view, flags_view, instances_view;
   VkDescriptorSet texel_sets[3] = {};
-  PipelineLayout layout;
-  Pipeline force_pipeline, integrate_pipeline;
-  // fused.comp variants, created when first needed (ensure_fused): [write_aux][colliders].
-  // write_aux = 0 (SC_WRITE_AUX false: no force and normal stores) for every fused substep of a
-  // recorded batch of steps but the last, since only the last one's forces and normals can be
-  // observed; colliders = 0 (SC_COLLIDERS false: no contact loops) while no instance has colliders.
-  Pipeline fused_pipes[2][2];
   CommandContext commands; // readbacks, uploads, simulate()
   QueryPool queries;       // two timestamps around each simulate() submission
   std::uint32_t groups_x = 1, groups_y = 1;

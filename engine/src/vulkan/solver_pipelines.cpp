@@ -5,14 +5,13 @@
 
 #include <array>
 #include <cstdint>
+#include <cstring>
 #include <utility>
 
 #include <fmt/format.h>
 
+#include "pipelines.hpp"
 #include "solver_batch.hpp"
-#include "vkcloth/shaders/force_comp_spv.hpp"
-#include "vkcloth/shaders/fused_comp_spv.hpp"
-#include "vkcloth/shaders/integrate_comp_spv.hpp"
 #include "vkcloth_shared.h"
 
 namespace vkcloth::gpu {
@@ -21,32 +20,28 @@ namespace sh = shared;
 
 namespace {
 
-/// Specialisation map of `N` consecutive 32-bit constants, ids 0..N-1 (force_body.glsl: 0..39 the
-/// stencil; fused.comp adds 40 SC_WRITE_AUX and 41 SC_COLLIDERS).
-template <std::uint32_t N> std::array<VkSpecializationMapEntry, N> constant_entries() {
-  std::array<VkSpecializationMapEntry, N> entries{};
-  for (std::uint32_t k = 0; k < N; ++k) entries[k] = VkSpecializationMapEntry{k, k * 4, 4};
-  return entries;
+/// The specialisation constants of force_body.glsl (ids 0..39: the grid stencil) followed by
+/// `extra` (fused.comp: 40 SC_WRITE_AUX, 41 SC_COLLIDERS), as 32-bit words.
+template <std::size_t N>
+std::array<std::uint32_t, 40 + N> stencil_constants(const GpuSolver::Impl::Stencil& st,
+                                                    const std::array<std::uint32_t, N>& extra) {
+  static_assert(sizeof(GpuSolver::Impl::Stencil) == 40 * 4);
+  std::array<std::uint32_t, 40 + N> words{};
+  std::memcpy(words.data(), &st, sizeof(st));
+  for (std::size_t k = 0; k < N; ++k) words[40 + k] = extra[k];
+  return words;
 }
 
 } // namespace
 
-// Layouts (set 0: storage buffers, set 1: texel buffers), then the sets, views and pipelines.
+// The Context's layouts (set 0: storage buffers, set 1: texel views), then this batch's sets and
+// views, then the Context's pipelines for this batch's stencil.
 Result<void> GpuSolver::Impl::init_pipelines() {
-  std::array<std::uint32_t, VKCLOTH_BINDING_COUNT> storage{};
-  for (std::uint32_t i = 0; i < storage.size(); ++i) storage[i] = i;
-  auto sl = create_compute_set_layout(*ctx, storage, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, "solver");
-  if (!sl) return sl.error();
-  set_layout = std::move(*sl);
-  const std::uint32_t texel[] = {VKCLOTH_TEXEL_BINDING_POS_IN, VKCLOTH_TEXEL_BINDING_PARTICLE, VKCLOTH_TEXEL_BINDING_VEL,
-                                 VKCLOTH_TEXEL_BINDING_FLAGS, VKCLOTH_TEXEL_BINDING_INSTANCES};
-  auto tl = create_compute_set_layout(*ctx, texel, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, "solver texel views");
-  if (!tl) return tl.error();
-  texel_layout = std::move(*tl);
-  const VkDescriptorSetLayout set_layouts[2] = {set_layout, texel_layout};
-  auto pl = create_pipeline_layout(*ctx, set_layouts, VK_SHADER_STAGE_COMPUTE_BIT, sizeof(sh::PushConstants), "solver");
-  if (!pl) return pl.error();
-  layout = std::move(*pl);
+  auto layouts = ctx->pipelines->solver_layouts();
+  if (!layouts) return layouts.error();
+  set_layout = layouts->storage;
+  texel_layout = layouts->texel;
+  layout = layouts->layout;
   VKCLOTH_TRY(create_descriptor_sets());
   VKCLOTH_TRY(create_texel_views());
   return create_pipelines();
@@ -123,42 +118,29 @@ Result<void> GpuSolver::Impl::create_texel_views() {
   return {};
 }
 
-// force.comp (specialised with the grid stencil) and integrate.comp.
+// force.comp (specialised with the grid stencil) and integrate.comp, from the Context's registry.
 Result<void> GpuSolver::Impl::create_pipelines() {
-  static_assert(sizeof(Stencil) == 40 * 4);
-  const auto entries = constant_entries<40>();
-  const VkSpecializationInfo spec{static_cast<std::uint32_t>(entries.size()), entries.data(), sizeof(Stencil), &stencil};
-  auto fm = create_shader_module(*ctx, spirv::force_comp_spv, "force.comp");
-  if (!fm) return fm.error();
-  auto fp = create_compute_pipeline(*ctx, layout, *fm, &spec, "force.comp");
+  using Shader = PipelineRegistry::Shader;
+  const auto constants = stencil_constants<0>(stencil, {});
+  auto fp = ctx->pipelines->pipeline(Shader::force, constants);
   if (!fp) return fp.error();
-  force_pipeline = std::move(*fp);
-  auto im = create_shader_module(*ctx, spirv::integrate_comp_spv, "integrate.comp");
-  if (!im) return im.error();
-  auto ip = create_compute_pipeline(*ctx, layout, *im, nullptr, "integrate.comp");
+  force_pipeline = *fp;
+  auto ip = ctx->pipelines->pipeline(Shader::integrate, {});
   if (!ip) return ip.error();
-  integrate_pipeline = std::move(*ip);
+  integrate_pipeline = *ip;
   return {};
 }
 
-// The fused.comp variants the current parameters need ([0] and [1] x colliders in the batch or not).
+// The fused.comp variants the current parameters need ([0] and [1] x colliders in the batch or
+// not); the registry makes each variant once per Context.
 Result<void> GpuSolver::Impl::ensure_fused() {
   const std::uint32_t col = any_colliders() ? 1u : 0u;
   if (!options.fused || (fused_pipes[0][col] && fused_pipes[1][col])) return {};
-  auto m = create_shader_module(*ctx, spirv::fused_comp_spv, "fused.comp");
-  if (!m) return m.error();
-  struct Data {
-    Stencil st;
-    std::uint32_t write_aux, colliders; // VkBool32
-  };
-  static_assert(sizeof(Data) == 42 * 4);
-  const auto entries = constant_entries<42>();
   for (std::uint32_t aux = 0; aux < 2; ++aux) {
-    const Data data{stencil, aux, col};
-    const VkSpecializationInfo spec{static_cast<std::uint32_t>(entries.size()), entries.data(), sizeof(Data), &data};
-    auto p = create_compute_pipeline(*ctx, layout, *m, &spec, "fused.comp");
+    const auto constants = stencil_constants<2>(stencil, {aux, col}); // VkBool32 SC_WRITE_AUX, SC_COLLIDERS
+    auto p = ctx->pipelines->pipeline(PipelineRegistry::Shader::fused, constants);
     if (!p) return p.error();
-    fused_pipes[aux][col] = std::move(*p);
+    fused_pipes[aux][col] = *p;
   }
   return {};
 }

@@ -32,6 +32,8 @@ Error vk_error(VkResult r, const std::string& what);
       return ::vkcloth::gpu::vk_error(vkcloth_vk_r_, (what));                                           \
   } while (0)
 
+class PipelineRegistry;
+
 namespace detail {
 /// The engine's way past the public objects' private members (friend of Context, GpuSolver and
 /// ClothWorld), so no Impl accessor appears in a public header.
@@ -92,8 +94,9 @@ struct Context::Impl {
   /// Test hook (testing::set_allocation_failure_hook): true fails the allocation. Empty: no cost
   /// beyond one branch per allocation.
   std::function<bool()> fail_allocation;
-  /// Every compute pipeline of this device goes through it (resources.cpp).
-  VkPipelineCache pipeline_cache = VK_NULL_HANDLE;
+  /// Shader modules, layouts, the pipeline cache and the compute pipelines, shared by every
+  /// batch on this Context (pipelines.hpp); made in load(), destroyed first in ~Impl().
+  std::unique_ptr<PipelineRegistry> pipelines;
 
   Impl() = default;
   Impl(const Impl&) = delete;

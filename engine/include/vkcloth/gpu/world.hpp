@@ -13,8 +13,10 @@
 // as a standalone GpuSolver and, on lavapipe, as CpuSolver<float> (tested). Implicit-Euler
 // instances are batches of one (their CG reductions are per instance).
 // add() / remove() / an integrator change in set_params() rebuild the batch concerned: new
-// buffers, pipelines and descriptor sets; the other instances' state is copied on the GPU (one
-// submission, waited for). Other set_params() changes only rewrite the instance's parameters.
+// buffers and descriptor sets; the other instances' state is copied on the GPU (one submission,
+// waited for). Other set_params() changes only rewrite the instance's parameters. No call
+// re-creates a pipeline: every pipeline (per shader and specialisation: grid stencil, fused
+// variants) is made once per Context, when a batch first needs it, and shared by all batches.
 //
 // Thread safety: none; one thread drives a world (as a GpuSolver).
 #pragma once
@@ -74,7 +76,8 @@ public:
   /// Removes an instance (its buffers are freed now: no recorded work of the world may be
   /// pending); the others keep their state. ErrorCode::invalid_argument for an unknown id.
   Result<void> remove(InstanceId id);
-  /// New parameters from the next recorded step (no pipeline is re-created; see the header note).
+  /// New parameters from the next recorded step; an integrator family or substep change moves the
+  /// instance to another batch (a rebuild, see the header note). No pipeline is re-created.
   Result<void> set_params(InstanceId id, SimParams params);
   Result<SimParams> params(InstanceId id) const;
 

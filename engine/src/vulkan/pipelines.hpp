@@ -1,0 +1,67 @@
+// The compute pipelines of one Context, made once and shared by every batch (GpuSolver,
+// ClothWorld) on it: shader modules, descriptor set layouts, pipeline layouts, a VkPipelineCache,
+// and the pipelines keyed by (shader, specialisation constants), e.g. force.comp per grid stencil,
+// fused.comp per stencil x SC_WRITE_AUX x SC_COLLIDERS. Lookups happen when a batch is created or
+// its parameters change, never per dispatch: batches keep the raw handles, which live as long as
+// the Context's internals (each batch holds them). Internal to engine/src/vulkan.
+#pragma once
+
+#include "resources.hpp"
+
+#include <map>
+#include <mutex>
+#include <span>
+#include <utility>
+#include <vector>
+
+namespace vkcloth::gpu {
+
+/// The storage bindings of implicit.comp / implicit_reduce.comp, in descriptor-write order.
+std::span<const std::uint32_t> implicit_bindings();
+
+class PipelineRegistry {
+public:
+  enum class Shader { force, integrate, fused, implicit, implicit_reduce };
+
+  /// Set 0 (storage buffers) and set 1 (texel views) of force/integrate/fused.comp and their layout.
+  struct SolverLayouts {
+    VkDescriptorSetLayout storage = VK_NULL_HANDLE, texel = VK_NULL_HANDLE;
+    VkPipelineLayout layout = VK_NULL_HANDLE;
+  };
+  /// The one set of implicit.comp / implicit_reduce.comp and its layout.
+  struct ImplicitLayouts {
+    VkDescriptorSetLayout set = VK_NULL_HANDLE;
+    VkPipelineLayout layout = VK_NULL_HANDLE;
+  };
+
+  /// Makes nothing yet (the Context's allocation callbacks may still be unset): every object is
+  /// created when first asked for.
+  explicit PipelineRegistry(Context::Impl& ctx) : ctx_(ctx) {}
+  PipelineRegistry(const PipelineRegistry&) = delete;
+  PipelineRegistry& operator=(const PipelineRegistry&) = delete;
+
+  Result<SolverLayouts> solver_layouts();
+  Result<ImplicitLayouts> implicit_layouts();
+  /// The pipeline of `shader` specialised with `constants` (ids 0..size-1, 32 bits each; empty:
+  /// none), created on first request; its layout is solver_layouts() or implicit_layouts().
+  Result<VkPipeline> pipeline(Shader shader, std::span<const std::uint32_t> constants);
+  /// The Context's pipeline cache (VK_NULL_HANDLE when it could not be made: caching is optional).
+  VkPipelineCache cache();
+
+private:
+  Result<SolverLayouts> solver_layouts_locked();
+  Result<ImplicitLayouts> implicit_layouts_locked();
+  VkPipelineCache cache_locked();
+  Result<VkShaderModule> module_locked(Shader shader);
+
+  Context::Impl& ctx_;
+  std::mutex mutex_; // several solvers may be created on one Context from different threads
+  PipelineCache cache_;
+  bool cache_tried_ = false;
+  DescriptorSetLayout solver_storage_, solver_texel_, implicit_set_;
+  PipelineLayout solver_layout_, implicit_layout_;
+  std::map<Shader, ShaderModule> modules_;
+  std::map<std::pair<Shader, std::vector<std::uint32_t>>, Pipeline> pipelines_;
+};
+
+} // namespace vkcloth::gpu
