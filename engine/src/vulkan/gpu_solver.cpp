@@ -1,487 +1,34 @@
+// GpuSolver: a ClothWorld of one instance (world_impl.hpp). Every step, readback and rebuild is
+// the world's and its batch's (solver_batch.cpp); this file only maps the single-cloth API onto
+// them: the instance's own divergence error (without the world's "cloth instance N" prefix),
+// its buffers by index, the forces and timings the world does not expose.
 #include "resources.hpp"
 
-#include <algorithm>
-#include <array>
-#include <cmath>
-#include <cstring>
-#include <limits>
-#include <optional>
-#include <tuple>
-
-#include <fmt/format.h>
+#include <memory>
+#include <utility>
 
 #include "barriers.hpp"
-#include "implicit_gpu.hpp"
-#include "solver_batch.hpp"
 #include "vkcloth/gpu/gpu_solver.hpp"
-#include "vkcloth/gpu/world.hpp"
-#include "vkcloth_shared.h"
+#include "vkcloth/gpu/testing.hpp"
+#include "world_impl.hpp"
 
 namespace vkcloth::gpu {
 
-namespace sh = shared;
+struct GpuSolver::Impl {
+  ClothWorld world;
+  InstanceId id = 0;
 
-namespace {
-
-std::string vec_str(glm::vec3 v) { return fmt::format("({:.4g}, {:.4g}, {:.4g})", double(v.x), double(v.y), double(v.z)); }
-
-} // namespace
-
-// Every instance's colliders, one after the other (InstanceParams::collider_first).
-Result<void> GpuSolver::Impl::upload_colliders() {
-  std::uint32_t n = 0;
-  for (const Slot& slot : slots) n += static_cast<std::uint32_t>(slot.params.colliders.size());
-  if (n > collider_capacity || !colliders.buffer) {
-    const std::uint32_t cap = std::max<std::uint32_t>(n, 4);
-    auto b = create_buffer(*ctx, cap * sizeof(sh::Collider), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::host_upload, true,
-                           "colliders");
-    if (!b) return b.error();
-    colliders = std::move(*b);
-    collider_capacity = cap;
-    if (sets[0][0]) VKCLOTH_TRY(write_sets());
+  ClothWorld::Impl& w() const { return detail::Access::impl(world); }
+  const ClothWorld::Impl::Instance& instance() const { return w().instances.at(id); }
+  SolverBatch& batch() const { return *instance().batch; }
+  std::uint32_t slot() const { return instance().slot; }
+  const std::optional<Error>& diverged() const { return batch().slot(slot()).diverged; }
+  /// `r`, or the instance's own divergence error when it diverged.
+  Result<void> own_error(Result<void> r) const {
+    if (const auto& d = diverged()) return *d;
+    return r;
   }
-  auto* out = static_cast<sh::Collider*>(colliders.mapped);
-  for (const Slot& slot : slots)
-    for (const Collider& c : slot.params.colliders) {
-      sh::Collider g{};
-      g.type = static_cast<std::uint32_t>(c.type);
-      if (c.type == Collider::Type::plane)
-        g.shape = {float(c.normal.x), float(c.normal.y), float(c.normal.z), float(c.offset)};
-      else
-        g.shape = {float(c.center.x), float(c.center.y), float(c.center.z), float(c.radius)};
-      *out++ = g;
-    }
-  return {};
-}
-
-void GpuSolver::Impl::upload_instance_params() {
-  auto* out = static_cast<sh::InstanceParams*>(instances.mapped);
-  std::uint32_t first_collider = 0;
-  for (const Slot& slot : slots) {
-    const SimParams& params = slot.params;
-    // Conversions exactly as CpuSolver<float>: each double field cast to float, then float math.
-    const float dt = float(params.substeps == 1 ? params.dt : params.dt / double(params.substeps)); // as the CPU
-    sh::InstanceParams ip{};
-    ip.flags = (nx ? VKCLOTH_FLAG_HAS_GRID : 0u) | (float(params.wind.strength) != 0.0f ? VKCLOTH_FLAG_WIND : 0u) |
-               (params.contact_inward_only ? 0u : VKCLOTH_FLAG_CONTACT_BOTH);
-    ip.integrator = static_cast<std::uint32_t>(params.integrator);
-    ip.collider_first = first_collider;
-    ip.collider_count = static_cast<std::uint32_t>(params.colliders.size());
-    first_collider += ip.collider_count;
-    ip.gravity_damping = {float(params.gravity.x), float(params.gravity.y), float(params.gravity.z), float(params.damping)};
-    ip.wind = {float(params.wind.direction.x), float(params.wind.direction.y), float(params.wind.direction.z),
-               float(params.wind.strength)};
-    ip.dt = dt;
-    ip.w6 = dt / 6.0f;
-    ip.eps = float(params.contact_epsilon);
-    ip.band = 2.0f * ip.eps;
-    ip.limit = float(params.divergence_limit);
-    *out++ = ip;
-  }
-}
-
-// One instance's entries of a per-particle buffer.
-Result<std::vector<glm::vec3>> GpuSolver::Impl::read_vec3(const Buffer& b, std::uint32_t slot) {
-  Buffer tmp; // staging, when `b` is not mapped
-  if (!b.mapped) {
-    auto s = create_buffer(*ctx, slot_bytes(), VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUse::host_readback, true,
-                           "readback staging");
-    if (!s) return s.error();
-    tmp = std::move(*s);
-  }
-  VKCLOTH_TRY(submit_and_wait([&](VkCommandBuffer c) {
-    barriers::before_readback(vk(), c);
-    if (tmp.buffer) {
-      const VkBufferCopy region{slot_offset(slot), 0, slot_bytes()};
-      vk().vkCmdCopyBuffer(c, b.buffer, tmp.buffer, 1, &region);
-      barriers::transfer_to_host(vk(), c);
-    }
-  }));
-  const auto* src = tmp.buffer ? static_cast<const sh::vec4*>(tmp.mapped)
-                               : static_cast<const sh::vec4*>(b.mapped) + std::size_t(slot) * count;
-  std::vector<glm::vec3> out(count);
-  for (std::uint32_t i = 0; i < count; ++i) out[i] = glm::vec3(src[i].x, src[i].y, src[i].z);
-  return out;
-}
-
-void GpuSolver::Impl::refresh_flags() {
-  const auto* f = static_cast<const sh::Flags*>(flags.mapped);
-  for (std::uint32_t k = 0; k < batch(); ++k) {
-    Slot& slot = slots[k];
-    if (slot.diverged || !f[k].diverged) continue;
-    slot.step = slot.epoch_step + f[k].first_bad_step; // flag steps count from the batch's creation
-    const std::uint32_t p = std::min(f[k].bad_particle, count - 1);
-    std::string where;
-    auto x = read_vec3(pos[current()], k);
-    auto v = read_vec3(vel, k);
-    if (x && v) where = fmt::format(": particle {} is at {} with velocity {}", p, vec_str((*x)[p]), vec_str((*v)[p]));
-    slot.diverged = make_error(ErrorCode::diverged,
-                               fmt::format("simulation diverged at step {} (t = {:.4g} s) on the GPU{} (limit {:g}); the "
-                                           "state is left as after that step; try a smaller integrator.dt, lower "
-                                           "stiffness or more damping",
-                                           slot.step, double(slot.step) * slot.params.dt, where,
-                                           slot.params.divergence_limit));
-  }
-}
-
-void GpuSolver::Impl::freeze_slot(std::uint32_t slot) {
-  // first_bad_step 0 is before every recorded step (1-based): frozen() holds from the first one.
-  static_cast<sh::Flags*>(flags.mapped)[slot] = sh::Flags{1, 0, 0, 0};
-}
-
-Result<void> GpuSolver::Impl::set_slot_params(std::uint32_t slot, SimParams params) {
-  slots[slot].params = std::move(params);
-  VKCLOTH_TRY(upload_colliders());
-  VKCLOTH_TRY(ensure_implicit());
-  VKCLOTH_TRY(ensure_fused());
-  upload_instance_params();
-  return {};
-}
-
-Result<void> GpuSolver::Impl::ensure_implicit() {
-  if (family().integrator != Integrator::implicit_euler || implicit) return {};
-  auto r = ImplicitGpu::create(ctx, count, edges_count, groups_x, groups_y, !knobs.force_staging);
-  if (!r) return r.error();
-  implicit = std::move(*r);
-  return write_sets();
-}
-
-void GpuSolver::Impl::record(VkCommandBuffer c, std::uint32_t steps) {
-  if (steps == 0) return;
-  barriers::before_steps(vk(), c);
-  bool first = true;
-  for (std::uint32_t s = 0; s < steps; ++s) {
-    pc.step = static_cast<std::uint32_t>(recorded + 1); // 1-based number of the step being computed
-    for (std::uint32_t k = 0; k < family().substeps; ++k) {
-      record_substep(c, first, s + 1 == steps && k + 1 == family().substeps);
-      first = false;
-      parity ^= 1u; // positions[read ^ 1] now holds the new state
-    }
-    ++recorded;
-    for (Slot& slot : slots)
-      if (!slot.diverged) ++slot.step;
-  }
-}
-
-void GpuSolver::Impl::record_copy_slot(VkCommandBuffer c, const Impl& from, std::uint32_t from_slot,
-                                       std::uint32_t to_slot) const {
-  const VkBufferCopy region{from.slot_offset(from_slot), slot_offset(to_slot), slot_bytes()};
-  // Into positions[0], the new batch's current buffer; every step rewrites all of positions[1].
-  const std::pair<const Buffer*, const Buffer*> copies[] = {{&from.pos[from.current()], &pos[0]},
-                                                            {&from.vel, &vel},
-                                                            {&from.normal, &normal},
-                                                            {&from.force, &force}};
-  for (auto [src, dst] : copies) vk().vkCmdCopyBuffer(c, src->buffer, dst->buffer, 1, &region);
-}
-
-void GpuSolver::Impl::record_substep(VkCommandBuffer c, bool first, bool last) {
-  const auto& v = vk();
-  const std::uint32_t read = current();
-  if (family().integrator == Integrator::implicit_euler) {
-    dispatches += implicit->record_substep(c, read, pc, family(), first);
-    return;
-  }
-  const std::uint32_t instances_z = batch(); // one dispatch serves every instance (gl_WorkGroupID.z)
-  const bool rk4 = family().integrator == Integrator::rk4;
-  if (options.fused && !rk4) {
-    // One dispatch per (sub)step (fused.comp); the descriptor set alternates with the parity.
-    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, fused_pipes[last ? 1 : 0][any_colliders() ? 1 : 0]);
-    pc.stage = 0;
-    const VkDescriptorSet bound_sets[2] = {sets[read][0], texel_sets[read]};
-    v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 2, bound_sets, 0, nullptr);
-    v.vkCmdPushConstants(c, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
-    if (!first) barriers::dispatch_to_dispatch(v, c); // previous step -> this step
-    v.vkCmdDispatch(c, groups_x, groups_y, instances_z);
-    ++dispatches;
-    return;
-  }
-  const std::uint32_t stages = rk4 ? 4 : 1;
-  VkDescriptorSet bound = VK_NULL_HANDLE;
-  for (std::uint32_t k = 0; k < stages; ++k) {
-    pc.stage = k;
-    const VkDescriptorSet set = sets[read][k == 0 ? 0 : 1];
-    if (set != bound) {
-      const VkDescriptorSet bound_sets[2] = {set, texel_sets[k == 0 ? read : 2]};
-      v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 2, bound_sets, 0, nullptr);
-      bound = set;
-    }
-    v.vkCmdPushConstants(c, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
-    if (!first || k > 0) barriers::dispatch_to_dispatch(v, c); // integrate (previous stage/step) -> force
-    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, force_pipeline);
-    v.vkCmdDispatch(c, groups_x, groups_y, instances_z);
-    barriers::dispatch_to_dispatch(v, c); // force -> integrate
-    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, integrate_pipeline);
-    v.vkCmdDispatch(c, groups_x, groups_y, instances_z);
-    dispatches += 2;
-  }
-}
-
-namespace {
-
-/// Workgroups per dispatch: gx x gy (x instances in z).
-struct DispatchGrid {
-  std::uint32_t x = 1, y = 1;
 };
-
-/// The device limits a batch of `batch` instances of `system` must fit, checked before any
-/// allocation; errors name the buffer or dispatch and the limit.
-Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ParticleSystem& system, std::uint64_t batch,
-                                  const testing::SolverKnobs& knobs) {
-  const std::uint64_t n = system.size();
-  const VkPhysicalDeviceLimits& lim = ctx.properties.limits;
-  std::uint64_t max_bytes = lim.maxStorageBufferRange;
-  const bool overridden = knobs.max_storage_buffer_bytes && knobs.max_storage_buffer_bytes < max_bytes;
-  if (overridden) max_bytes = knobs.max_storage_buffer_bytes;
-  const std::uint64_t edges_n = system.adjacency.refs.size();
-  const struct {
-    const char* what;
-    std::uint64_t bytes;
-    std::uint64_t per;
-    std::uint64_t items;
-  } needs[] = {{"per-particle (vec4)", batch * n * 16, 16, batch * n},
-               {"spring adjacency", edges_n * sizeof(sh::Edge), sizeof(sh::Edge), edges_n},
-               {"particle constants", n * sizeof(sh::ParticleInfo), sizeof(sh::ParticleInfo), n}};
-  for (const auto& need : needs)
-    if (need.bytes > max_bytes)
-      return make_error(ErrorCode::unsupported,
-                        fmt::format("the system is too large for device '{}': its {} buffer needs {} bytes ({} x {} "
-                                    "bytes) but a storage buffer may hold at most {} bytes ({}); use fewer particles "
-                                    "or fewer instances of one topology",
-                                    ctx.name, need.what, need.bytes, need.items, need.per, max_bytes,
-                                    overridden ? "testing::SolverKnobs::max_storage_buffer_bytes"
-                                               : "maxStorageBufferRange"));
-  // Positions, velocities and particle constants are also read through texel buffer views (one
-  // texel per particle of every instance).
-  if (batch * n > lim.maxTexelBufferElements)
-    return make_error(ErrorCode::unsupported,
-                      fmt::format("the system is too large for device '{}': {} particles ({} instances of {}) need "
-                                  "{} texels per texel buffer view but the device allows {} (maxTexelBufferElements); "
-                                  "use fewer particles or fewer instances of one topology",
-                                  ctx.name, batch * n, batch, n, batch * n, lim.maxTexelBufferElements));
-  const std::uint64_t groups = (n + VKCLOTH_WORKGROUP_SIZE - 1) / VKCLOTH_WORKGROUP_SIZE;
-  std::uint64_t row = lim.maxComputeWorkGroupCount[0];
-  if (knobs.max_workgroups_x) row = std::min<std::uint64_t>(row, knobs.max_workgroups_x);
-  const std::uint64_t gx = std::min<std::uint64_t>(groups, row);
-  const std::uint64_t gy = (groups + gx - 1) / gx;
-  if (gy > lim.maxComputeWorkGroupCount[1] || n >= std::numeric_limits<std::uint32_t>::max())
-    return make_error(ErrorCode::unsupported,
-                      fmt::format("the system is too large for device '{}': {} particles need {} workgroups of {} but "
-                                  "the device dispatches at most {} x {}",
-                                  ctx.name, n, groups, VKCLOTH_WORKGROUP_SIZE, lim.maxComputeWorkGroupCount[0],
-                                  lim.maxComputeWorkGroupCount[1]));
-  if (batch == 0 || batch > lim.maxComputeWorkGroupCount[2])
-    return make_error(ErrorCode::unsupported,
-                      fmt::format("a batch of {} instances of one topology does not fit device '{}' (at most {} per "
-                                  "dispatch: maxComputeWorkGroupCount[2])",
-                                  batch, ctx.name, lim.maxComputeWorkGroupCount[2]));
-  return DispatchGrid{static_cast<std::uint32_t>(gx), static_cast<std::uint32_t>(gy)};
-}
-
-} // namespace
-
-// Buffers. Bulk ones prefer device-local + host-visible (mapped) unless staging is forced.
-Result<void> GpuSolver::Impl::create_buffers() {
-  const std::size_t n = count;
-  // VERTEX_BUFFER: a renderer binds positions, normals and uvs as vertex buffers (render/);
-  // UNIFORM_TEXEL_BUFFER: positions are read through texel views (force_body.glsl pos_at).
-  const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
-                                   VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT |
-                                   VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
-  const VkDeviceSize vec4_bytes = VkDeviceSize(batch()) * n * 16;
-  const bool allow_map = !knobs.force_staging;
-  std::vector<std::uint32_t> families;
-  if (!options.sharing_queue_families.empty()) {
-    families = options.sharing_queue_families;
-    families.push_back(ctx->queue_family); // the solver's own queue always uses them
-  }
-  const std::tuple<Buffer*, VkDeviceSize, const char*> device_buffers[] = {
-      {&pos[0], vec4_bytes, "positions[0]"},
-      {&pos[1], vec4_bytes, "positions[1]"},
-      {&vel, vec4_bytes, "velocities"},
-      {&force, vec4_bytes, "forces"},
-      {&force_stage, vec4_bytes, "stage forces"},
-      {&vel_filt, vec4_bytes, "contact velocities"},
-      {&normal, vec4_bytes, "normals"},
-      {&uv, vec4_bytes, "uvs"},
-      {&stage_pos, vec4_bytes, "stage positions"},
-      {&stage_vel, vec4_bytes, "stage velocities"},
-      {&acc_pos, vec4_bytes, "rk4 sums (positions)"},
-      {&acc_vel, vec4_bytes, "rk4 sums (velocities)"},
-      {&particle, std::max<VkDeviceSize>(n * sizeof(sh::ParticleInfo), 16), "particle constants"},
-      {&offsets, std::max<VkDeviceSize>((n + 1) * sizeof(std::uint32_t), 16), "adjacency offsets"},
-      {&edges, std::max<VkDeviceSize>(edges_count * sizeof(sh::Edge), 16), "adjacency"}};
-  for (auto [b, bytes, what] : device_buffers) {
-    auto r = create_buffer(*ctx, bytes, usage, MemoryUse::device, allow_map, what, families);
-    if (!r) return r.error();
-    *b = std::move(*r);
-  }
-  // The grid's triangle list for the host's drawing (instance-local indices; empty for chains).
-  index_count = nx >= 2 && ny >= 2 ? (nx - 1) * (ny - 1) * 6 : 0; // grid_triangle_indices(nx, ny).size()
-  {
-    auto r = create_buffer(*ctx, std::max<VkDeviceSize>(VkDeviceSize(index_count) * sizeof(std::uint32_t), 16),
-                           VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUse::device,
-                           allow_map, "triangle indices", families);
-    if (!r) return r.error();
-    indices = std::move(*r);
-  }
-  staging = pos[0].mapped == nullptr;
-  // Texel views of both: fused.comp (flags), common.glsl (instance parameters).
-  constexpr VkBufferUsageFlags small = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
-  {
-    auto r = create_buffer(*ctx, batch() * sizeof(sh::Flags), small, MemoryUse::host_readback, true, "flags");
-    if (!r) return r.error();
-    flags = std::move(*r);
-    for (std::uint32_t k = 0; k < batch(); ++k)
-      static_cast<sh::Flags*>(flags.mapped)[k] = sh::Flags{0, VKCLOTH_NO_BAD_STEP, VKCLOTH_NO_BAD_STEP, 0};
-  }
-  {
-    auto r = create_buffer(*ctx, batch() * sizeof(sh::InstanceParams), small, MemoryUse::host_upload, true,
-                           "instance parameters");
-    if (!r) return r.error();
-    instances = std::move(*r);
-  }
-  return upload_colliders();
-}
-
-// The command buffer of the convenience path and the timestamp queries of simulate().
-Result<void> GpuSolver::Impl::create_commands() {
-  auto c = CommandContext::create(*ctx, "solver");
-  if (!c) return c.error();
-  commands = std::move(*c);
-  if (ctx->timestamp_valid_bits == 0) return {};
-  VkQueryPoolCreateInfo qi{};
-  qi.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
-  qi.queryType = VK_QUERY_TYPE_TIMESTAMP;
-  qi.queryCount = 2;
-  VKCLOTH_VK_TRY(vk().vkCreateQueryPool(ctx->device, &qi, vk().allocator, queries.init(*ctx)), "vkCreateQueryPool");
-  return {};
-}
-
-// Initial state of every instance, converted as CpuSolver<float>::create converts it, and the
-// topology: copied into mapped memory, or through one staging buffer (one submission).
-Result<void> GpuSolver::Impl::upload_initial_state(const ParticleSystem& system, const std::vector<SlotState>& states) {
-  const std::size_t n = count;
-  const std::size_t entries = std::size_t(batch()) * n;
-  const VkDeviceSize vec4_bytes = entries * 16;
-  std::vector<sh::vec4> x0(entries), v0(entries), uv0(entries);
-  std::vector<sh::ParticleInfo> info(n);
-  uvs.assign(n, glm::vec2(0.0f));
-  for (std::size_t k = 0; k < batch(); ++k) {
-    const SlotState state = k < states.size() ? states[k] : SlotState{};
-    for (std::size_t p = 0; p < n; ++p) {
-      const Particle& q = system.particles[p];
-      const glm::dvec3 x = state.positions && !state.positions->empty() ? (*state.positions)[p] : q.position;
-      const glm::dvec3 u = state.velocities && !state.velocities->empty() ? (*state.velocities)[p] : q.velocity;
-      x0[k * n + p] = {float(x.x), float(x.y), float(x.z), 1.0f};
-      v0[k * n + p] = q.pinned ? sh::vec4{0, 0, 0, 0} : sh::vec4{float(u.x), float(u.y), float(u.z), 0.0f};
-      info[p] = {float(q.mass), q.pinned ? 1u : 0u};
-    }
-  }
-  for (std::uint32_t j = 0; j < ny; ++j)
-    for (std::uint32_t i = 0; i < nx; ++i) {
-      const glm::vec2 t(nx > 1 ? float(i) / float(nx - 1) : 0.0f, ny > 1 ? float(j) / float(ny - 1) : 0.0f);
-      uvs[std::size_t(j) * nx + i] = t;
-      for (std::size_t k = 0; k < batch(); ++k) uv0[k * n + std::size_t(j) * nx + i] = {t.x, t.y, 0.0f, 0.0f};
-    }
-  std::vector<sh::Edge> edge_data(edges_count);
-  for (std::size_t e = 0; e < edges_count; ++e) {
-    const SpringRef& r = system.adjacency.refs[e];
-    const Spring& sp = system.springs[r.spring];
-    edge_data[e] = {r.other, float(sp.rest_length), float(sp.stiffness)};
-  }
-  const std::vector<std::uint32_t> triangles = grid_triangle_indices(nx, ny);
-  struct Upload {
-    Buffer* dst;
-    const void* data; // null: zero fill
-    VkDeviceSize bytes;
-  };
-  const Upload uploads[] = {{&pos[0], x0.data(), vec4_bytes},
-                            {&pos[1], x0.data(), vec4_bytes},
-                            {&vel, v0.data(), vec4_bytes},
-                            {&uv, uv0.data(), vec4_bytes},
-                            {&particle, info.data(), n * sizeof(sh::ParticleInfo)},
-                            {&offsets, system.adjacency.offsets.data(), (n + 1) * sizeof(std::uint32_t)},
-                            {&edges, edge_data.data(), edges_count * sizeof(sh::Edge)},
-                            {&indices, triangles.data(), triangles.size() * sizeof(std::uint32_t)},
-                            {&force, nullptr, 0},
-                            {&force_stage, nullptr, 0},
-                            {&vel_filt, nullptr, 0},
-                            {&normal, nullptr, 0},
-                            {&stage_pos, nullptr, 0},
-                            {&stage_vel, nullptr, 0},
-                            {&acc_pos, nullptr, 0},
-                            {&acc_vel, nullptr, 0}};
-  if (!staging) {
-    for (const Upload& u : uploads) {
-      if (u.data)
-        std::memcpy(u.dst->mapped, u.data, u.bytes);
-      else
-        std::memset(u.dst->mapped, 0, u.dst->size);
-    }
-    return {};
-  }
-  VkDeviceSize total = 0;
-  for (const Upload& u : uploads) total += u.data ? u.bytes : 0;
-  auto st = create_buffer(*ctx, std::max<VkDeviceSize>(total, 16), VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
-                          MemoryUse::host_upload, true, "upload staging");
-  if (!st) return st.error();
-  const Buffer& stage = *st;
-  const auto& v = vk();
-  VkDeviceSize at = 0;
-  return submit_and_wait([&](VkCommandBuffer c) {
-    for (const Upload& u : uploads) {
-      if (!u.data) {
-        v.vkCmdFillBuffer(c, u.dst->buffer, 0, VK_WHOLE_SIZE, 0);
-        continue;
-      }
-      if (u.bytes == 0) continue;
-      std::memcpy(static_cast<char*>(stage.mapped) + at, u.data, u.bytes);
-      const VkBufferCopy region{at, 0, u.bytes};
-      v.vkCmdCopyBuffer(c, stage.buffer, u.dst->buffer, 1, &region);
-      at += u.bytes;
-    }
-    barriers::transfer_to_compute(v, c);
-  });
-}
-
-Result<std::unique_ptr<GpuSolver::Impl>> GpuSolver::Impl::create(const std::shared_ptr<Context::Impl>& ctx,
-                                                                  const ParticleSystem& system,
-                                                                  std::vector<SimParams> params,
-                                                                  const GpuSolverOptions& options,
-                                                                  const testing::SolverKnobs& knobs,
-                                                                  const std::vector<SlotState>& states) {
-  for (SimParams& p : params) VKCLOTH_TRY(p.validate());
-  VKCLOTH_TRY(system.validate());
-  auto grid = check_limits(*ctx, system, params.size(), knobs);
-  if (!grid) return grid.error();
-
-  auto impl = std::make_unique<Impl>();
-  Impl& s = *impl;
-  s.ctx = ctx;
-  s.slots.resize(params.size());
-  for (std::size_t k = 0; k < params.size(); ++k) s.slots[k].params = std::move(params[k]);
-  s.options = options;
-  s.knobs = knobs;
-  s.count = s.pc.count = static_cast<std::uint32_t>(system.size());
-  s.edges_count = system.adjacency.refs.size();
-  s.groups_x = grid->x;
-  s.groups_y = grid->y;
-  if (system.grid) {
-    s.nx = s.pc.nx = system.grid->nx;
-    s.ny = s.pc.ny = system.grid->ny;
-  }
-  // On failure `impl` frees whatever the phases created so far.
-  VKCLOTH_TRY(s.create_buffers());
-  VKCLOTH_TRY(s.create_commands());
-  if (!knobs.csr_only) s.detect_stencil(system);
-  VKCLOTH_TRY(s.init_pipelines());
-  VKCLOTH_TRY(s.write_sets());
-  VKCLOTH_TRY(s.ensure_implicit());
-  VKCLOTH_TRY(s.ensure_fused());
-  s.upload_instance_params();
-  VKCLOTH_TRY(s.upload_initial_state(system, states));
-  return impl;
-}
 
 Result<GpuSolver> GpuSolver::create(Context& context, const ParticleSystem& system, SimParams params,
                                     const GpuSolverOptions& options) {
@@ -490,11 +37,16 @@ Result<GpuSolver> GpuSolver::create(Context& context, const ParticleSystem& syst
 
 Result<GpuSolver> testing::create_solver(Context& context, const ParticleSystem& system, SimParams params,
                                          const GpuSolverOptions& options, const SolverKnobs& knobs) {
-  std::vector<SimParams> one;
-  one.push_back(std::move(params));
-  auto impl = GpuSolver::Impl::create(context_impl(context), system, std::move(one), options, knobs);
-  if (!impl) return impl.error();
-  return detail::Access::wrap<GpuSolver>(std::move(*impl));
+  WorldOptions wo;
+  wo.solver = options;
+  auto world = create_world(context, std::move(wo), knobs);
+  if (!world) return world.error();
+  // The world keeps its topology (for rebuilds when the integrator changes): a copy, since the
+  // caller's system need not outlive the solver.
+  auto id = world->add(std::make_shared<const ParticleSystem>(system), std::move(params));
+  if (!id) return id.error();
+  auto impl = std::make_unique<GpuSolver::Impl>(GpuSolver::Impl{std::move(*world), *id});
+  return detail::Access::wrap<GpuSolver>(std::move(impl));
 }
 
 GpuSolver::GpuSolver(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -502,91 +54,46 @@ GpuSolver::GpuSolver(GpuSolver&&) noexcept = default;
 GpuSolver& GpuSolver::operator=(GpuSolver&&) noexcept = default;
 GpuSolver::~GpuSolver() = default;
 
-Result<void> GpuSolver::set_params(SimParams params) {
-  VKCLOTH_TRY(params.validate());
-  return impl_->set_slot_params(0, std::move(params));
-}
-const SimParams& GpuSolver::params() const { return impl_->slots[0].params; }
+Result<void> GpuSolver::set_params(SimParams params) { return impl_->world.set_params(impl_->id, std::move(params)); }
+const SimParams& GpuSolver::params() const { return impl_->instance().params; }
 
-void GpuSolver::record_steps(VkCommandBuffer cmd, std::uint32_t steps) { impl_->record(cmd, steps); }
-void GpuSolver::record_step(VkCommandBuffer cmd) { impl_->record(cmd, 1); }
+void GpuSolver::record_steps(VkCommandBuffer cmd, std::uint32_t steps) { impl_->world.record_steps(cmd, steps); }
+void GpuSolver::record_step(VkCommandBuffer cmd) { impl_->world.record_steps(cmd, 1); }
 
 void GpuSolver::record_barrier_to(VkCommandBuffer cmd, VkPipelineStageFlags dst_stage, VkAccessFlags dst_access) const {
-  barriers::after_steps(impl_->vk(), cmd, dst_stage, dst_access);
+  impl_->world.record_barrier_to(cmd, dst_stage, dst_access);
 }
 
 Result<void> GpuSolver::simulate(std::uint64_t steps, std::uint32_t steps_per_submit) {
-  Impl& s = *impl_;
-  if (s.slots[0].diverged) return *s.slots[0].diverged;
-  if (steps_per_submit == 0) return make_error(ErrorCode::invalid_argument, "steps_per_submit must be > 0");
-  const auto& v = s.vk();
-  s.last_ms = s.queries ? 0.0 : -1.0;
-  for (std::uint64_t done = 0; done < steps;) {
-    const auto k = static_cast<std::uint32_t>(std::min<std::uint64_t>(steps - done, steps_per_submit));
-    VKCLOTH_TRY(s.submit_and_wait([&](VkCommandBuffer c) {
-      if (s.queries) {
-        v.vkCmdResetQueryPool(c, s.queries, 0, 2);
-        v.vkCmdWriteTimestamp(c, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, s.queries, 0);
-      }
-      s.record(c, k);
-      if (s.queries) v.vkCmdWriteTimestamp(c, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, s.queries, 1);
-      barriers::after_steps(v, c, VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT); // flags read by the host
-    }));
-    if (s.queries) {
-      std::uint64_t ts[2] = {};
-      VKCLOTH_VK_TRY(v.vkGetQueryPoolResults(s.ctx->device, s.queries, 0, 2, sizeof(ts), ts, sizeof(std::uint64_t),
-                                             VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
-                     "vkGetQueryPoolResults");
-      const std::uint32_t bits = s.ctx->timestamp_valid_bits;
-      const std::uint64_t mask = bits >= 64 ? ~0ull : ((1ull << bits) - 1);
-      const std::uint64_t ticks = ((ts[1] & mask) - (ts[0] & mask)) & mask;
-      s.last_ms += double(ticks) * double(s.ctx->properties.limits.timestampPeriod) * 1e-6;
-    }
-    done += k;
-    s.refresh_flags();
-    if (s.slots[0].diverged) return *s.slots[0].diverged;
-  }
-  return {};
+  if (const auto& d = impl_->diverged()) return *d;
+  return impl_->own_error(impl_->w().simulate(steps, steps_per_submit));
 }
 
 Result<void> GpuSolver::check_divergence() {
-  Impl& s = *impl_;
-  if (s.slots[0].diverged) return *s.slots[0].diverged;
-  VKCLOTH_TRY(s.submit_and_wait([&](VkCommandBuffer c) { barriers::before_readback(s.vk(), c); }));
-  s.refresh_flags();
-  if (s.slots[0].diverged) return *s.slots[0].diverged;
-  return {};
+  if (const auto& d = impl_->diverged()) return *d;
+  return impl_->own_error(impl_->w().check_divergence());
 }
 
-Result<std::vector<glm::vec3>> GpuSolver::positions() { return impl_->read_vec3(impl_->pos[impl_->current()], 0); }
-Result<std::vector<glm::vec3>> GpuSolver::velocities() { return impl_->read_vec3(impl_->vel, 0); }
-Result<std::vector<glm::vec3>> GpuSolver::normals() { return impl_->read_vec3(impl_->normal, 0); }
-Result<std::vector<glm::vec3>> GpuSolver::forces() { return impl_->read_vec3(impl_->force, 0); }
-const std::vector<glm::vec2>& GpuSolver::uvs() const { return impl_->uvs; }
-
-std::uint64_t GpuSolver::step_index() const { return impl_->slots[0].step; }
-double GpuSolver::time() const { return static_cast<double>(impl_->slots[0].step) * impl_->slots[0].params.dt; }
-std::uint32_t GpuSolver::particle_count() const { return impl_->count; }
-std::uint32_t GpuSolver::current_position_index() const { return impl_->current(); }
-VkBuffer GpuSolver::position_buffer(std::uint32_t index) const { return impl_->pos[index & 1u].buffer; }
-VkBuffer GpuSolver::current_position_buffer() const { return impl_->pos[impl_->current()].buffer; }
-VkBuffer GpuSolver::velocity_buffer() const { return impl_->vel.buffer; }
-VkBuffer GpuSolver::normal_buffer() const { return impl_->normal.buffer; }
-VkBuffer GpuSolver::uv_buffer() const { return impl_->uv.buffer; }
-SolveStats GpuSolver::last_solve() const { return impl_->implicit ? impl_->implicit->stats() : SolveStats{}; }
-double GpuSolver::last_gpu_ms() const { return impl_->last_ms; }
-bool GpuSolver::uses_staging() const { return impl_->staging; }
-InstanceBuffers GpuSolver::buffers() const {
-  InstanceBuffers b;
-  b.positions = current_position_buffer();
-  b.normals = normal_buffer();
-  b.uvs = uv_buffer();
-  b.indices = impl_->indices.buffer;
-  b.index_count = impl_->index_count;
-  b.count = impl_->count;
-  b.nx = impl_->nx;
-  b.ny = impl_->ny;
-  return b;
+Result<std::vector<glm::vec3>> GpuSolver::positions() { return impl_->world.positions(impl_->id); }
+Result<std::vector<glm::vec3>> GpuSolver::velocities() { return impl_->world.velocities(impl_->id); }
+Result<std::vector<glm::vec3>> GpuSolver::normals() { return impl_->world.normals(impl_->id); }
+Result<std::vector<glm::vec3>> GpuSolver::forces() {
+  return impl_->batch().read(SolverBatch::Field::forces, impl_->slot());
 }
+const std::vector<glm::vec2>& GpuSolver::uvs() const { return impl_->batch().uvs(); }
+
+std::uint64_t GpuSolver::step_index() const { return impl_->world.step_index(impl_->id); }
+double GpuSolver::time() const { return static_cast<double>(step_index()) * params().dt; }
+std::uint32_t GpuSolver::particle_count() const { return impl_->batch().particle_count(); }
+std::uint32_t GpuSolver::current_position_index() const { return impl_->batch().current_position_index(); }
+VkBuffer GpuSolver::position_buffer(std::uint32_t index) const { return impl_->batch().position_buffer(index); }
+VkBuffer GpuSolver::current_position_buffer() const { return buffers().positions; }
+VkBuffer GpuSolver::velocity_buffer() const { return impl_->batch().velocity_buffer(); }
+VkBuffer GpuSolver::normal_buffer() const { return buffers().normals; }
+VkBuffer GpuSolver::uv_buffer() const { return buffers().uvs; }
+SolveStats GpuSolver::last_solve() const { return impl_->batch().last_solve(); }
+double GpuSolver::last_gpu_ms() const { return impl_->w().last_ms; }
+bool GpuSolver::uses_staging() const { return impl_->batch().uses_staging(); }
+InstanceBuffers GpuSolver::buffers() const { return impl_->batch().buffers(impl_->slot()); }
 
 } // namespace vkcloth::gpu

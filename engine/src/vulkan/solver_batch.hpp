@@ -1,7 +1,13 @@
-// GpuSolver::Impl: the Vulkan solver's engine, a BATCH of instances (cloths) that share one
-// topology and one integrator family, stepped together: one dispatch per pass serves every
-// instance (instance = gl_WorkGroupID.z, vkcloth_shared.h). A GpuSolver is a batch of one;
-// ClothWorld groups its instances into batches (world.cpp). Internal to engine/src/vulkan.
+// SolverBatch: the Vulkan solver's engine, a BATCH of instances (cloths) that share one topology
+// and one integrator family, stepped together: one dispatch per pass serves every instance
+// (instance = gl_WorkGroupID.z, vkcloth_shared.h). ClothWorld owns its batches and groups its
+// instances into them (world.cpp); a GpuSolver is a world of one instance (gpu_solver.cpp).
+// Buffers, descriptor sets and texel views are the batch's; layouts and pipelines the Context's
+// (pipelines.hpp). Internal to engine/src/vulkan.
+//
+// Topology: create() reads a ParticleSystem (its CSR gather lists, grid, particles) once; the
+// world keys batches by the shared topology object, so switching to a shared, prepared topology
+// (std::shared_ptr<const ClothTopology>) only changes create()'s parameter and the key's type.
 #pragma once
 
 #include <cstdint>
@@ -27,7 +33,8 @@ struct SlotState {
   const std::vector<glm::dvec3>* velocities = nullptr;
 };
 
-struct GpuSolver::Impl {
+class SolverBatch {
+public:
   /// Host-side state of one instance of the batch.
   struct Slot {
     SimParams params;
@@ -35,6 +42,65 @@ struct GpuSolver::Impl {
     std::uint64_t epoch_step = 0; // `step` when this batch's flag epoch began (its creation)
     std::optional<Error> diverged;
   };
+  /// The per-particle buffers a readback can copy.
+  enum class Field { positions, velocities, normals, forces };
+
+  /// A batch of `params.size()` instances of `topology` (all of one integrator family and one
+  /// substep count: Euler (explicit and semi-implicit mix), RK4, or implicit Euler (one
+  /// instance)); `states[k]` is instance k's initial state (missing entries: the topology's).
+  /// `commands` (the owner's) serves the uploads and readbacks and must outlive the batch.
+  static Result<std::unique_ptr<SolverBatch>> create(const std::shared_ptr<Context::Impl>& ctx,
+                                                     CommandContext& commands, const ParticleSystem& topology,
+                                                     std::vector<SimParams> params, const GpuSolverOptions& options,
+                                                     const testing::SolverKnobs& knobs,
+                                                     const std::vector<SlotState>& states = {});
+  SolverBatch(const SolverBatch&) = delete;
+  SolverBatch& operator=(const SolverBatch&) = delete;
+
+  std::uint32_t size() const { return static_cast<std::uint32_t>(slots.size()); }
+  std::uint32_t particle_count() const { return count; }
+  const Slot& slot(std::uint32_t k) const { return slots[k]; }
+  /// New parameters for one instance (validated by the caller; same family and substeps). Uploads
+  /// its colliders and parameters; looks up (never re-creates) the pipelines they need.
+  Result<void> set_params(std::uint32_t slot, SimParams params);
+
+  /// Records `steps` steps of every instance; advances the host-side counters now.
+  void record(VkCommandBuffer cmd, std::uint32_t steps);
+  std::uint64_t dispatches() const { return dispatches_; }
+  /// Copies instance `from_slot` of `from` (current positions, velocities, normals, forces) into
+  /// instance `to_slot` of this batch (positions[0]: current at creation); the caller records the
+  /// barriers.
+  void record_copy_slot(VkCommandBuffer cmd, const SolverBatch& from, std::uint32_t from_slot,
+                        std::uint32_t to_slot) const;
+  /// Instance `slot` continues `old` (an instance of an older batch): its step count and
+  /// divergence (a diverged instance stays frozen).
+  void carry_over(std::uint32_t slot, const Slot& old);
+
+  /// Reads the flags of every instance (their work complete and visible to the host); marks the
+  /// newly diverged ones (their step, the error).
+  void refresh_flags();
+  /// One instance's entries of a per-particle buffer (submits, waits, copies).
+  Result<std::vector<glm::vec3>> read(Field field, std::uint32_t slot);
+  /// Instance `slot`'s buffers for drawing (the current positions: query after recording).
+  InstanceBuffers buffers(std::uint32_t slot) const;
+  std::uint32_t current_position_index() const { return parity; }
+  VkBuffer position_buffer(std::uint32_t index) const { return pos[index & 1u].buffer; }
+  VkBuffer velocity_buffer() const { return vel.buffer; }
+  const std::vector<glm::vec2>& uvs() const { return uvs_; }
+  SolveStats last_solve() const { return implicit ? implicit->stats() : SolveStats{}; }
+  bool uses_staging() const { return staging; }
+
+  /// Grid stencil (force_body.glsl's specialisation constants 0..39): constant_id order.
+  struct Stencil {
+    std::uint32_t enabled = 0; // VkBool32
+    std::uint32_t nx = 1, ny = 1;
+    std::int32_t offset[12] = {};
+    float rest[12] = {}, stiffness[12] = {};
+    std::uint32_t border = 0; // VkBool32: border particles use the stencil too (SC_BORDER)
+  };
+
+private:
+  SolverBatch() = default;
 
   std::shared_ptr<Context::Impl> ctx;
   GpuSolverOptions options;
@@ -70,84 +136,46 @@ struct GpuSolver::Impl {
   BufferView pos_views[3];
   BufferView particle_view, vel_view, flags_view, instances_view;
   VkDescriptorSet texel_sets[3] = {};
-  CommandContext commands; // readbacks, uploads, simulate()
-  QueryPool queries;       // two timestamps around each simulate() submission
+  CommandContext* commands = nullptr; // the owner's (ClothWorld): uploads, readbacks
   std::uint32_t groups_x = 1, groups_y = 1;
-  // Grid stencil (force_body.glsl's specialisation constants 0..39): constant_id order.
-  struct Stencil {
-    std::uint32_t enabled = 0; // VkBool32
-    std::uint32_t nx = 1, ny = 1;
-    std::int32_t offset[12] = {};
-    float rest[12] = {}, stiffness[12] = {};
-    std::uint32_t border = 0; // VkBool32: border particles use the stencil too (SC_BORDER)
-  } stencil;
+  Stencil stencil;
   std::uint64_t edges_count = 0;
 
   shared::PushConstants pc{}; // per dispatch (count, grid, stage, step)
   std::uint64_t recorded = 0; // recorded steps since the flag epoch: flag step numbers
   std::uint32_t parity = 0;   // positions[parity] is current; flipped by every recorded substep
   std::unique_ptr<ImplicitGpu> implicit; // created when the integrator is implicit_euler (batch of one)
-  std::vector<glm::vec2> uvs;
-  double last_ms = -1.0;
-  std::uint64_t dispatches = 0; // recorded so far (ClothWorld::dispatches_recorded)
+  std::vector<glm::vec2> uvs_; // per particle of one instance (as uploaded)
+  std::uint64_t dispatches_ = 0; // recorded so far (ClothWorld::dispatches_recorded)
 
-  /// A batch of `params.size()` instances of `topology` (all of one integrator family and one
-  /// substep count: Euler (explicit and semi-implicit mix), RK4, or implicit Euler (one
-  /// instance)); `states[k]` is instance k's initial state (missing entries: the topology's).
-  static Result<std::unique_ptr<Impl>> create(const std::shared_ptr<Context::Impl>& ctx, const ParticleSystem& topology,
-                                              std::vector<SimParams> params, const GpuSolverOptions& options,
-                                              const testing::SolverKnobs& knobs,
-                                              const std::vector<SlotState>& states = {});
 
-  Impl() = default;
-  Impl(const Impl&) = delete;
-  Impl& operator=(const Impl&) = delete;
-
-  std::uint32_t batch() const { return static_cast<std::uint32_t>(slots.size()); }
   const SimParams& family() const { return slots.front().params; } // integrator family, substeps
   bool any_colliders() const {
-    for (const Slot& slot : slots)
-      if (!slot.params.colliders.empty()) return true;
+    for (const Slot& s : slots)
+      if (!s.params.colliders.empty()) return true;
     return false;
   }
   const DeviceFns& vk() const { return ctx->vk; }
-  std::uint32_t current() const { return parity; }
   VkDeviceSize slot_offset(std::uint32_t slot) const { return VkDeviceSize(slot) * count * GpuSolver::stride; }
   VkDeviceSize slot_bytes() const { return VkDeviceSize(count) * GpuSolver::stride; }
-
-  /// New parameters for one instance (validated by the caller; same family and substeps).
-  Result<void> set_slot_params(std::uint32_t slot, SimParams params);
-  Result<void> ensure_implicit();
-  Result<void> ensure_fused();
-  void record(VkCommandBuffer cmd, std::uint32_t steps);
-  /// `last`: the last substep of this recording (the fused variant that stores forces and normals).
-  void record_substep(VkCommandBuffer cmd, bool first, bool last);
-  /// Copies instance `from_slot` of `from` (current positions, velocities, normals, forces) into
-  /// instance `to_slot` of this batch (positions[0]: current at creation); the caller records the
-  /// barriers.
-  void record_copy_slot(VkCommandBuffer cmd, const Impl& from, std::uint32_t from_slot, std::uint32_t to_slot) const;
-  /// Reads the flags of every instance; marks the newly diverged ones (their step, the error).
-  void refresh_flags();
-  /// The flags of an instance that diverged before this batch existed: frozen from step 1 on.
-  void freeze_slot(std::uint32_t slot);
+  const Buffer& buffer_of(Field field) const;
 
   // Creation phases (create()), in order.
   Result<void> create_buffers();
-  Result<void> create_commands();
   void detect_stencil(const ParticleSystem& system);
   Result<void> init_pipelines();
   Result<void> create_descriptor_sets();
   Result<void> create_texel_views();
   Result<void> create_pipelines();
   Result<void> write_sets();
+  Result<void> ensure_implicit();
+  Result<void> ensure_fused();
   Result<void> upload_colliders();
   void upload_instance_params();
   Result<void> upload_initial_state(const ParticleSystem& system, const std::vector<SlotState>& states);
 
-  template <typename F> Result<void> submit_and_wait(F&& record_fn) {
-    return commands.submit_and_wait(std::forward<F>(record_fn));
-  }
-  Result<std::vector<glm::vec3>> read_vec3(const Buffer& b, std::uint32_t slot);
+  /// `last`: the last substep of this recording (the fused variant that stores forces and normals).
+  void record_substep(VkCommandBuffer cmd, bool first, bool last);
 };
 
 } // namespace vkcloth::gpu

@@ -1,6 +1,6 @@
-// GpuSolver::Impl (solver_batch.hpp): descriptor set layouts, sets and texel views, the compute
+// SolverBatch (solver_batch.hpp): descriptor set layouts, sets and texel views, the compute
 // pipelines (force, integrate, the fused variants) and their specialisation constants (the grid
-// stencil). The stepping, buffers and readbacks are in gpu_solver.cpp.
+// stencil). The stepping, buffers and readbacks are in solver_batch.cpp.
 #include "resources.hpp"
 
 #include <array>
@@ -23,9 +23,9 @@ namespace {
 /// The specialisation constants of force_body.glsl (ids 0..39: the grid stencil) followed by
 /// `extra` (fused.comp: 40 SC_WRITE_AUX, 41 SC_COLLIDERS), as 32-bit words.
 template <std::size_t N>
-std::array<std::uint32_t, 40 + N> stencil_constants(const GpuSolver::Impl::Stencil& st,
+std::array<std::uint32_t, 40 + N> stencil_constants(const SolverBatch::Stencil& st,
                                                     const std::array<std::uint32_t, N>& extra) {
-  static_assert(sizeof(GpuSolver::Impl::Stencil) == 40 * 4);
+  static_assert(sizeof(SolverBatch::Stencil) == 40 * 4);
   std::array<std::uint32_t, 40 + N> words{};
   std::memcpy(words.data(), &st, sizeof(st));
   for (std::size_t k = 0; k < N; ++k) words[40 + k] = extra[k];
@@ -36,7 +36,7 @@ std::array<std::uint32_t, 40 + N> stencil_constants(const GpuSolver::Impl::Stenc
 
 // The Context's layouts (set 0: storage buffers, set 1: texel views), then this batch's sets and
 // views, then the Context's pipelines for this batch's stencil.
-Result<void> GpuSolver::Impl::init_pipelines() {
+Result<void> SolverBatch::init_pipelines() {
   auto layouts = ctx->pipelines->solver_layouts();
   if (!layouts) return layouts.error();
   set_layout = layouts->storage;
@@ -48,7 +48,7 @@ Result<void> GpuSolver::Impl::init_pipelines() {
 }
 
 // Four storage sets ([read][state / RK4 stage input], written by write_sets()) and three texel sets.
-Result<void> GpuSolver::Impl::create_descriptor_sets() {
+Result<void> SolverBatch::create_descriptor_sets() {
   const auto& v = vk();
   const VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 4 * VKCLOTH_BINDING_COUNT},
                                          {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 5 * 3}};
@@ -75,7 +75,7 @@ Result<void> GpuSolver::Impl::create_descriptor_sets() {
 // The texel sets never change: positions[0/1] and the stage positions live as long as the batch.
 // Set k: its positions view (k = 0, 1: positions[k]; 2: stage positions) and the same four shared
 // views. Uniform texel buffer support is mandatory for these formats.
-Result<void> GpuSolver::Impl::create_texel_views() {
+Result<void> SolverBatch::create_texel_views() {
   const struct {
     const Buffer* buffer;
     VkFormat format;
@@ -119,7 +119,7 @@ Result<void> GpuSolver::Impl::create_texel_views() {
 }
 
 // force.comp (specialised with the grid stencil) and integrate.comp, from the Context's registry.
-Result<void> GpuSolver::Impl::create_pipelines() {
+Result<void> SolverBatch::create_pipelines() {
   using Shader = PipelineRegistry::Shader;
   const auto constants = stencil_constants<0>(stencil, {});
   auto fp = ctx->pipelines->pipeline(Shader::force, constants);
@@ -133,7 +133,7 @@ Result<void> GpuSolver::Impl::create_pipelines() {
 
 // The fused.comp variants the current parameters need ([0] and [1] x colliders in the batch or
 // not); the registry makes each variant once per Context.
-Result<void> GpuSolver::Impl::ensure_fused() {
+Result<void> SolverBatch::ensure_fused() {
   const std::uint32_t col = any_colliders() ? 1u : 0u;
   if (!options.fused || (fused_pipes[0][col] && fused_pipes[1][col])) return {};
   for (std::uint32_t aux = 0; aux < 2; ++aux) {
@@ -148,7 +148,7 @@ Result<void> GpuSolver::Impl::ensure_fused() {
 // Like CpuSolver::detect_stencil: the stencil applies when every interior particle's gather list
 // (2 <= i < nx-2, 2 <= j < ny-2) is the same up to translation, in the same order, with the same
 // float constants. Then the shaders' interior branch sums exactly the CSR terms in CSR order.
-void GpuSolver::Impl::detect_stencil(const ParticleSystem& system) {
+void SolverBatch::detect_stencil(const ParticleSystem& system) {
   stencil = Stencil{};
   if (!system.grid) return;
   const std::int64_t gx = system.grid->nx, gy = system.grid->ny;
@@ -207,7 +207,7 @@ void GpuSolver::Impl::detect_stencil(const ParticleSystem& system) {
   stencil.border = 1;
 }
 
-Result<void> GpuSolver::Impl::write_sets() {
+Result<void> SolverBatch::write_sets() {
   std::array<VkDescriptorBufferInfo, 4 * VKCLOTH_BINDING_COUNT> infos{};
   std::array<VkWriteDescriptorSet, 4 * VKCLOTH_BINDING_COUNT> writes{};
   std::size_t k = 0;

@@ -1,0 +1,500 @@
+// SolverBatch: buffers, uploads, stepping, readbacks and divergence flags of one batch (the
+// descriptor sets and pipelines: solver_pipelines.cpp).
+#include "solver_batch.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <optional>
+#include <tuple>
+
+#include <fmt/format.h>
+
+#include "barriers.hpp"
+#include "implicit_gpu.hpp"
+#include "vkcloth/gpu/world.hpp"
+#include "vkcloth_shared.h"
+
+namespace vkcloth::gpu {
+
+namespace sh = shared;
+
+namespace {
+
+std::string vec_str(glm::vec3 v) { return fmt::format("({:.4g}, {:.4g}, {:.4g})", double(v.x), double(v.y), double(v.z)); }
+
+} // namespace
+
+// Every instance's colliders, one after the other (InstanceParams::collider_first).
+Result<void> SolverBatch::upload_colliders() {
+  std::uint32_t n = 0;
+  for (const Slot& slot : slots) n += static_cast<std::uint32_t>(slot.params.colliders.size());
+  if (n > collider_capacity || !colliders.buffer) {
+    const std::uint32_t cap = std::max<std::uint32_t>(n, 4);
+    auto b = create_buffer(*ctx, cap * sizeof(sh::Collider), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::host_upload, true,
+                           "colliders");
+    if (!b) return b.error();
+    colliders = std::move(*b);
+    collider_capacity = cap;
+    if (sets[0][0]) VKCLOTH_TRY(write_sets());
+  }
+  auto* out = static_cast<sh::Collider*>(colliders.mapped);
+  for (const Slot& slot : slots)
+    for (const Collider& c : slot.params.colliders) {
+      sh::Collider g{};
+      g.type = static_cast<std::uint32_t>(c.type);
+      if (c.type == Collider::Type::plane)
+        g.shape = {float(c.normal.x), float(c.normal.y), float(c.normal.z), float(c.offset)};
+      else
+        g.shape = {float(c.center.x), float(c.center.y), float(c.center.z), float(c.radius)};
+      *out++ = g;
+    }
+  return {};
+}
+
+void SolverBatch::upload_instance_params() {
+  auto* out = static_cast<sh::InstanceParams*>(instances.mapped);
+  std::uint32_t first_collider = 0;
+  for (const Slot& slot : slots) {
+    const SimParams& params = slot.params;
+    // Conversions exactly as CpuSolver<float>: each double field cast to float, then float math.
+    const float dt = float(params.substeps == 1 ? params.dt : params.dt / double(params.substeps)); // as the CPU
+    sh::InstanceParams ip{};
+    ip.flags = (nx ? VKCLOTH_FLAG_HAS_GRID : 0u) | (float(params.wind.strength) != 0.0f ? VKCLOTH_FLAG_WIND : 0u) |
+               (params.contact_inward_only ? 0u : VKCLOTH_FLAG_CONTACT_BOTH);
+    ip.integrator = static_cast<std::uint32_t>(params.integrator);
+    ip.collider_first = first_collider;
+    ip.collider_count = static_cast<std::uint32_t>(params.colliders.size());
+    first_collider += ip.collider_count;
+    ip.gravity_damping = {float(params.gravity.x), float(params.gravity.y), float(params.gravity.z), float(params.damping)};
+    ip.wind = {float(params.wind.direction.x), float(params.wind.direction.y), float(params.wind.direction.z),
+               float(params.wind.strength)};
+    ip.dt = dt;
+    ip.w6 = dt / 6.0f;
+    ip.eps = float(params.contact_epsilon);
+    ip.band = 2.0f * ip.eps;
+    ip.limit = float(params.divergence_limit);
+    *out++ = ip;
+  }
+}
+
+const Buffer& SolverBatch::buffer_of(Field field) const {
+  switch (field) {
+  case Field::positions: return pos[parity];
+  case Field::velocities: return vel;
+  case Field::normals: return normal;
+  case Field::forces: return force;
+  }
+  return pos[parity];
+}
+
+Result<std::vector<glm::vec3>> SolverBatch::read(Field field, std::uint32_t slot) {
+  const Buffer& b = buffer_of(field);
+  Buffer tmp; // staging, when `b` is not mapped
+  if (!b.mapped) {
+    auto s = create_buffer(*ctx, slot_bytes(), VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUse::host_readback, true,
+                           "readback staging");
+    if (!s) return s.error();
+    tmp = std::move(*s);
+  }
+  VKCLOTH_TRY(commands->submit_and_wait([&](VkCommandBuffer c) {
+    barriers::before_readback(vk(), c);
+    if (tmp.buffer) {
+      const VkBufferCopy region{slot_offset(slot), 0, slot_bytes()};
+      vk().vkCmdCopyBuffer(c, b.buffer, tmp.buffer, 1, &region);
+      barriers::transfer_to_host(vk(), c);
+    }
+  }));
+  const auto* src = tmp.buffer ? static_cast<const sh::vec4*>(tmp.mapped)
+                               : static_cast<const sh::vec4*>(b.mapped) + std::size_t(slot) * count;
+  std::vector<glm::vec3> out(count);
+  for (std::uint32_t i = 0; i < count; ++i) out[i] = glm::vec3(src[i].x, src[i].y, src[i].z);
+  return out;
+}
+
+void SolverBatch::refresh_flags() {
+  const auto* f = static_cast<const sh::Flags*>(flags.mapped);
+  for (std::uint32_t k = 0; k < size(); ++k) {
+    Slot& slot = slots[k];
+    if (slot.diverged || !f[k].diverged) continue;
+    slot.step = slot.epoch_step + f[k].first_bad_step; // flag steps count from the batch's creation
+    const std::uint32_t p = std::min(f[k].bad_particle, count - 1);
+    std::string where;
+    auto x = read(Field::positions, k);
+    auto v = read(Field::velocities, k);
+    if (x && v) where = fmt::format(": particle {} is at {} with velocity {}", p, vec_str((*x)[p]), vec_str((*v)[p]));
+    slot.diverged = make_error(ErrorCode::diverged,
+                               fmt::format("simulation diverged at step {} (t = {:.4g} s) on the GPU{} (limit {:g}); the "
+                                           "state is left as after that step; try a smaller integrator.dt, lower "
+                                           "stiffness or more damping",
+                                           slot.step, double(slot.step) * slot.params.dt, where,
+                                           slot.params.divergence_limit));
+  }
+}
+
+void SolverBatch::carry_over(std::uint32_t slot, const Slot& old) {
+  Slot& now = slots[slot];
+  now.step = now.epoch_step = old.step; // flag steps count from this batch's creation
+  now.diverged = old.diverged;
+  // first_bad_step 0 is before every recorded step (1-based): frozen() holds from the first one.
+  if (now.diverged) static_cast<sh::Flags*>(flags.mapped)[slot] = sh::Flags{1, 0, 0, 0};
+}
+
+InstanceBuffers SolverBatch::buffers(std::uint32_t slot) const {
+  InstanceBuffers b;
+  b.positions = pos[parity].buffer;
+  b.normals = normal.buffer;
+  b.uvs = uv.buffer;
+  b.indices = indices.buffer;
+  b.index_count = index_count;
+  b.offset = slot_offset(slot);
+  b.count = count;
+  b.nx = nx;
+  b.ny = ny;
+  return b;
+}
+
+Result<void> SolverBatch::set_params(std::uint32_t slot, SimParams params) {
+  slots[slot].params = std::move(params);
+  VKCLOTH_TRY(upload_colliders());
+  VKCLOTH_TRY(ensure_implicit());
+  VKCLOTH_TRY(ensure_fused());
+  upload_instance_params();
+  return {};
+}
+
+Result<void> SolverBatch::ensure_implicit() {
+  if (family().integrator != Integrator::implicit_euler || implicit) return {};
+  auto r = ImplicitGpu::create(ctx, count, edges_count, groups_x, groups_y, !knobs.force_staging);
+  if (!r) return r.error();
+  implicit = std::move(*r);
+  return write_sets();
+}
+
+void SolverBatch::record(VkCommandBuffer c, std::uint32_t steps) {
+  if (steps == 0) return;
+  barriers::before_steps(vk(), c);
+  bool first = true;
+  for (std::uint32_t s = 0; s < steps; ++s) {
+    pc.step = static_cast<std::uint32_t>(recorded + 1); // 1-based number of the step being computed
+    for (std::uint32_t k = 0; k < family().substeps; ++k) {
+      record_substep(c, first, s + 1 == steps && k + 1 == family().substeps);
+      first = false;
+      parity ^= 1u; // positions[read ^ 1] now holds the new state
+    }
+    ++recorded;
+    for (Slot& slot : slots)
+      if (!slot.diverged) ++slot.step;
+  }
+}
+
+void SolverBatch::record_copy_slot(VkCommandBuffer c, const SolverBatch& from, std::uint32_t from_slot,
+                                       std::uint32_t to_slot) const {
+  const VkBufferCopy region{from.slot_offset(from_slot), slot_offset(to_slot), slot_bytes()};
+  // Into positions[0], the new batch's current buffer; every step rewrites all of positions[1].
+  const std::pair<const Buffer*, const Buffer*> copies[] = {{&from.pos[from.parity], &pos[0]},
+                                                            {&from.vel, &vel},
+                                                            {&from.normal, &normal},
+                                                            {&from.force, &force}};
+  for (auto [src, dst] : copies) vk().vkCmdCopyBuffer(c, src->buffer, dst->buffer, 1, &region);
+}
+
+void SolverBatch::record_substep(VkCommandBuffer c, bool first, bool last) {
+  const auto& v = vk();
+  const std::uint32_t read = parity;
+  if (family().integrator == Integrator::implicit_euler) {
+    dispatches_ += implicit->record_substep(c, read, pc, family(), first);
+    return;
+  }
+  const std::uint32_t instances_z = size(); // one dispatch serves every instance (gl_WorkGroupID.z)
+  const bool rk4 = family().integrator == Integrator::rk4;
+  if (options.fused && !rk4) {
+    // One dispatch per (sub)step (fused.comp); the descriptor set alternates with the parity.
+    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, fused_pipes[last ? 1 : 0][any_colliders() ? 1 : 0]);
+    pc.stage = 0;
+    const VkDescriptorSet bound_sets[2] = {sets[read][0], texel_sets[read]};
+    v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 2, bound_sets, 0, nullptr);
+    v.vkCmdPushConstants(c, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
+    if (!first) barriers::dispatch_to_dispatch(v, c); // previous step -> this step
+    v.vkCmdDispatch(c, groups_x, groups_y, instances_z);
+    ++dispatches_;
+    return;
+  }
+  const std::uint32_t stages = rk4 ? 4 : 1;
+  VkDescriptorSet bound = VK_NULL_HANDLE;
+  for (std::uint32_t k = 0; k < stages; ++k) {
+    pc.stage = k;
+    const VkDescriptorSet set = sets[read][k == 0 ? 0 : 1];
+    if (set != bound) {
+      const VkDescriptorSet bound_sets[2] = {set, texel_sets[k == 0 ? read : 2]};
+      v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 2, bound_sets, 0, nullptr);
+      bound = set;
+    }
+    v.vkCmdPushConstants(c, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
+    if (!first || k > 0) barriers::dispatch_to_dispatch(v, c); // integrate (previous stage/step) -> force
+    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, force_pipeline);
+    v.vkCmdDispatch(c, groups_x, groups_y, instances_z);
+    barriers::dispatch_to_dispatch(v, c); // force -> integrate
+    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, integrate_pipeline);
+    v.vkCmdDispatch(c, groups_x, groups_y, instances_z);
+    dispatches_ += 2;
+  }
+}
+
+namespace {
+
+/// Workgroups per dispatch: gx x gy (x instances in z).
+struct DispatchGrid {
+  std::uint32_t x = 1, y = 1;
+};
+
+/// The device limits a batch of `batch` instances of `system` must fit, checked before any
+/// allocation; errors name the buffer or dispatch and the limit.
+Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ParticleSystem& system, std::uint64_t batch,
+                                  const testing::SolverKnobs& knobs) {
+  const std::uint64_t n = system.size();
+  const VkPhysicalDeviceLimits& lim = ctx.properties.limits;
+  std::uint64_t max_bytes = lim.maxStorageBufferRange;
+  const bool overridden = knobs.max_storage_buffer_bytes && knobs.max_storage_buffer_bytes < max_bytes;
+  if (overridden) max_bytes = knobs.max_storage_buffer_bytes;
+  const std::uint64_t edges_n = system.adjacency.refs.size();
+  const struct {
+    const char* what;
+    std::uint64_t bytes;
+    std::uint64_t per;
+    std::uint64_t items;
+  } needs[] = {{"per-particle (vec4)", batch * n * 16, 16, batch * n},
+               {"spring adjacency", edges_n * sizeof(sh::Edge), sizeof(sh::Edge), edges_n},
+               {"particle constants", n * sizeof(sh::ParticleInfo), sizeof(sh::ParticleInfo), n}};
+  for (const auto& need : needs)
+    if (need.bytes > max_bytes)
+      return make_error(ErrorCode::unsupported,
+                        fmt::format("the system is too large for device '{}': its {} buffer needs {} bytes ({} x {} "
+                                    "bytes) but a storage buffer may hold at most {} bytes ({}); use fewer particles "
+                                    "or fewer instances of one topology",
+                                    ctx.name, need.what, need.bytes, need.items, need.per, max_bytes,
+                                    overridden ? "testing::SolverKnobs::max_storage_buffer_bytes"
+                                               : "maxStorageBufferRange"));
+  // Positions, velocities and particle constants are also read through texel buffer views (one
+  // texel per particle of every instance).
+  if (batch * n > lim.maxTexelBufferElements)
+    return make_error(ErrorCode::unsupported,
+                      fmt::format("the system is too large for device '{}': {} particles ({} instances of {}) need "
+                                  "{} texels per texel buffer view but the device allows {} (maxTexelBufferElements); "
+                                  "use fewer particles or fewer instances of one topology",
+                                  ctx.name, batch * n, batch, n, batch * n, lim.maxTexelBufferElements));
+  const std::uint64_t groups = (n + VKCLOTH_WORKGROUP_SIZE - 1) / VKCLOTH_WORKGROUP_SIZE;
+  std::uint64_t row = lim.maxComputeWorkGroupCount[0];
+  if (knobs.max_workgroups_x) row = std::min<std::uint64_t>(row, knobs.max_workgroups_x);
+  const std::uint64_t gx = std::min<std::uint64_t>(groups, row);
+  const std::uint64_t gy = (groups + gx - 1) / gx;
+  if (gy > lim.maxComputeWorkGroupCount[1] || n >= std::numeric_limits<std::uint32_t>::max())
+    return make_error(ErrorCode::unsupported,
+                      fmt::format("the system is too large for device '{}': {} particles need {} workgroups of {} but "
+                                  "the device dispatches at most {} x {}",
+                                  ctx.name, n, groups, VKCLOTH_WORKGROUP_SIZE, lim.maxComputeWorkGroupCount[0],
+                                  lim.maxComputeWorkGroupCount[1]));
+  if (batch == 0 || batch > lim.maxComputeWorkGroupCount[2])
+    return make_error(ErrorCode::unsupported,
+                      fmt::format("a batch of {} instances of one topology does not fit device '{}' (at most {} per "
+                                  "dispatch: maxComputeWorkGroupCount[2])",
+                                  batch, ctx.name, lim.maxComputeWorkGroupCount[2]));
+  return DispatchGrid{static_cast<std::uint32_t>(gx), static_cast<std::uint32_t>(gy)};
+}
+
+} // namespace
+
+// Buffers. Bulk ones prefer device-local + host-visible (mapped) unless staging is forced.
+Result<void> SolverBatch::create_buffers() {
+  const std::size_t n = count;
+  // VERTEX_BUFFER: a renderer binds positions, normals and uvs as vertex buffers (render/);
+  // UNIFORM_TEXEL_BUFFER: positions are read through texel views (force_body.glsl pos_at).
+  const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                                   VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT |
+                                   VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
+  const VkDeviceSize vec4_bytes = VkDeviceSize(size()) * n * 16;
+  const bool allow_map = !knobs.force_staging;
+  std::vector<std::uint32_t> families;
+  if (!options.sharing_queue_families.empty()) {
+    families = options.sharing_queue_families;
+    families.push_back(ctx->queue_family); // the solver's own queue always uses them
+  }
+  const std::tuple<Buffer*, VkDeviceSize, const char*> device_buffers[] = {
+      {&pos[0], vec4_bytes, "positions[0]"},
+      {&pos[1], vec4_bytes, "positions[1]"},
+      {&vel, vec4_bytes, "velocities"},
+      {&force, vec4_bytes, "forces"},
+      {&force_stage, vec4_bytes, "stage forces"},
+      {&vel_filt, vec4_bytes, "contact velocities"},
+      {&normal, vec4_bytes, "normals"},
+      {&uv, vec4_bytes, "uvs"},
+      {&stage_pos, vec4_bytes, "stage positions"},
+      {&stage_vel, vec4_bytes, "stage velocities"},
+      {&acc_pos, vec4_bytes, "rk4 sums (positions)"},
+      {&acc_vel, vec4_bytes, "rk4 sums (velocities)"},
+      {&particle, std::max<VkDeviceSize>(n * sizeof(sh::ParticleInfo), 16), "particle constants"},
+      {&offsets, std::max<VkDeviceSize>((n + 1) * sizeof(std::uint32_t), 16), "adjacency offsets"},
+      {&edges, std::max<VkDeviceSize>(edges_count * sizeof(sh::Edge), 16), "adjacency"}};
+  for (auto [b, bytes, what] : device_buffers) {
+    auto r = create_buffer(*ctx, bytes, usage, MemoryUse::device, allow_map, what, families);
+    if (!r) return r.error();
+    *b = std::move(*r);
+  }
+  // The grid's triangle list for the host's drawing (instance-local indices; empty for chains).
+  index_count = nx >= 2 && ny >= 2 ? (nx - 1) * (ny - 1) * 6 : 0; // grid_triangle_indices(nx, ny).size()
+  {
+    auto r = create_buffer(*ctx, std::max<VkDeviceSize>(VkDeviceSize(index_count) * sizeof(std::uint32_t), 16),
+                           VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUse::device,
+                           allow_map, "triangle indices", families);
+    if (!r) return r.error();
+    indices = std::move(*r);
+  }
+  staging = pos[0].mapped == nullptr;
+  // Texel views of both: fused.comp (flags), common.glsl (instance parameters).
+  constexpr VkBufferUsageFlags small = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
+  {
+    auto r = create_buffer(*ctx, size() * sizeof(sh::Flags), small, MemoryUse::host_readback, true, "flags");
+    if (!r) return r.error();
+    flags = std::move(*r);
+    for (std::uint32_t k = 0; k < size(); ++k)
+      static_cast<sh::Flags*>(flags.mapped)[k] = sh::Flags{0, VKCLOTH_NO_BAD_STEP, VKCLOTH_NO_BAD_STEP, 0};
+  }
+  {
+    auto r = create_buffer(*ctx, size() * sizeof(sh::InstanceParams), small, MemoryUse::host_upload, true,
+                           "instance parameters");
+    if (!r) return r.error();
+    instances = std::move(*r);
+  }
+  return upload_colliders();
+}
+
+// Initial state of every instance, converted as CpuSolver<float>::create converts it, and the
+// topology: copied into mapped memory, or through one staging buffer (one submission).
+Result<void> SolverBatch::upload_initial_state(const ParticleSystem& system, const std::vector<SlotState>& states) {
+  const std::size_t n = count;
+  const std::size_t entries = std::size_t(size()) * n;
+  const VkDeviceSize vec4_bytes = entries * 16;
+  std::vector<sh::vec4> x0(entries), v0(entries), uv0(entries);
+  std::vector<sh::ParticleInfo> info(n);
+  uvs_.assign(n, glm::vec2(0.0f));
+  for (std::size_t k = 0; k < size(); ++k) {
+    const SlotState state = k < states.size() ? states[k] : SlotState{};
+    for (std::size_t p = 0; p < n; ++p) {
+      const Particle& q = system.particles[p];
+      const glm::dvec3 x = state.positions && !state.positions->empty() ? (*state.positions)[p] : q.position;
+      const glm::dvec3 u = state.velocities && !state.velocities->empty() ? (*state.velocities)[p] : q.velocity;
+      x0[k * n + p] = {float(x.x), float(x.y), float(x.z), 1.0f};
+      v0[k * n + p] = q.pinned ? sh::vec4{0, 0, 0, 0} : sh::vec4{float(u.x), float(u.y), float(u.z), 0.0f};
+      info[p] = {float(q.mass), q.pinned ? 1u : 0u};
+    }
+  }
+  for (std::uint32_t j = 0; j < ny; ++j)
+    for (std::uint32_t i = 0; i < nx; ++i) {
+      const glm::vec2 t(nx > 1 ? float(i) / float(nx - 1) : 0.0f, ny > 1 ? float(j) / float(ny - 1) : 0.0f);
+      uvs_[std::size_t(j) * nx + i] = t;
+      for (std::size_t k = 0; k < size(); ++k) uv0[k * n + std::size_t(j) * nx + i] = {t.x, t.y, 0.0f, 0.0f};
+    }
+  std::vector<sh::Edge> edge_data(edges_count);
+  for (std::size_t e = 0; e < edges_count; ++e) {
+    const SpringRef& r = system.adjacency.refs[e];
+    const Spring& sp = system.springs[r.spring];
+    edge_data[e] = {r.other, float(sp.rest_length), float(sp.stiffness)};
+  }
+  const std::vector<std::uint32_t> triangles = grid_triangle_indices(nx, ny);
+  struct Upload {
+    Buffer* dst;
+    const void* data; // null: zero fill
+    VkDeviceSize bytes;
+  };
+  const Upload uploads[] = {{&pos[0], x0.data(), vec4_bytes},
+                            {&pos[1], x0.data(), vec4_bytes},
+                            {&vel, v0.data(), vec4_bytes},
+                            {&uv, uv0.data(), vec4_bytes},
+                            {&particle, info.data(), n * sizeof(sh::ParticleInfo)},
+                            {&offsets, system.adjacency.offsets.data(), (n + 1) * sizeof(std::uint32_t)},
+                            {&edges, edge_data.data(), edges_count * sizeof(sh::Edge)},
+                            {&indices, triangles.data(), triangles.size() * sizeof(std::uint32_t)},
+                            {&force, nullptr, 0},
+                            {&force_stage, nullptr, 0},
+                            {&vel_filt, nullptr, 0},
+                            {&normal, nullptr, 0},
+                            {&stage_pos, nullptr, 0},
+                            {&stage_vel, nullptr, 0},
+                            {&acc_pos, nullptr, 0},
+                            {&acc_vel, nullptr, 0}};
+  if (!staging) {
+    for (const Upload& u : uploads) {
+      if (u.data)
+        std::memcpy(u.dst->mapped, u.data, u.bytes);
+      else
+        std::memset(u.dst->mapped, 0, u.dst->size);
+    }
+    return {};
+  }
+  VkDeviceSize total = 0;
+  for (const Upload& u : uploads) total += u.data ? u.bytes : 0;
+  auto st = create_buffer(*ctx, std::max<VkDeviceSize>(total, 16), VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                          MemoryUse::host_upload, true, "upload staging");
+  if (!st) return st.error();
+  const Buffer& stage = *st;
+  const auto& v = vk();
+  VkDeviceSize at = 0;
+  return commands->submit_and_wait([&](VkCommandBuffer c) {
+    for (const Upload& u : uploads) {
+      if (!u.data) {
+        v.vkCmdFillBuffer(c, u.dst->buffer, 0, VK_WHOLE_SIZE, 0);
+        continue;
+      }
+      if (u.bytes == 0) continue;
+      std::memcpy(static_cast<char*>(stage.mapped) + at, u.data, u.bytes);
+      const VkBufferCopy region{at, 0, u.bytes};
+      v.vkCmdCopyBuffer(c, stage.buffer, u.dst->buffer, 1, &region);
+      at += u.bytes;
+    }
+    barriers::transfer_to_compute(v, c);
+  });
+}
+
+Result<std::unique_ptr<SolverBatch>> SolverBatch::create(const std::shared_ptr<Context::Impl>& ctx,
+                                                          CommandContext& commands, const ParticleSystem& system,
+                                                                  std::vector<SimParams> params,
+                                                                  const GpuSolverOptions& options,
+                                                                  const testing::SolverKnobs& knobs,
+                                                                  const std::vector<SlotState>& states) {
+  for (SimParams& p : params) VKCLOTH_TRY(p.validate());
+  VKCLOTH_TRY(system.validate());
+  auto grid = check_limits(*ctx, system, params.size(), knobs);
+  if (!grid) return grid.error();
+
+  std::unique_ptr<SolverBatch> impl(new SolverBatch());
+  SolverBatch& s = *impl;
+  s.ctx = ctx;
+  s.commands = &commands;
+  s.slots.resize(params.size());
+  for (std::size_t k = 0; k < params.size(); ++k) s.slots[k].params = std::move(params[k]);
+  s.options = options;
+  s.knobs = knobs;
+  s.count = s.pc.count = static_cast<std::uint32_t>(system.size());
+  s.edges_count = system.adjacency.refs.size();
+  s.groups_x = grid->x;
+  s.groups_y = grid->y;
+  if (system.grid) {
+    s.nx = s.pc.nx = system.grid->nx;
+    s.ny = s.pc.ny = system.grid->ny;
+  }
+  // On failure `impl` frees whatever the phases created so far.
+  VKCLOTH_TRY(s.create_buffers());
+  if (!knobs.csr_only) s.detect_stencil(system);
+  VKCLOTH_TRY(s.init_pipelines());
+  VKCLOTH_TRY(s.write_sets());
+  VKCLOTH_TRY(s.ensure_implicit());
+  VKCLOTH_TRY(s.ensure_fused());
+  s.upload_instance_params();
+  VKCLOTH_TRY(s.upload_initial_state(system, states));
+  return impl;
+}
+
+
+} // namespace vkcloth::gpu
