@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <span>
 #include <vector>
 
 #include <fmt/format.h>
@@ -108,6 +109,7 @@ struct ClothRenderer::Impl {
   Result<void> build_geometry(const ParticleSystem& system, const SimParams& params,
                               const RendererOptions& o);
   Result<void> upload_texture(const Image& img);
+  Result<void> create_texture_set();
   Result<void> build_pipelines(const RendererOptions& o);
 };
 
@@ -225,7 +227,98 @@ Result<void> ClothRenderer::Impl::upload_texture(const Image& img) {
   return {};
 }
 
-Result<void> ClothRenderer::Impl::build_pipelines(const RendererOptions& o) {
+namespace {
+
+struct Shaders {
+  std::span<const std::uint32_t> vs, fs;
+  const char* name;
+};
+
+/// One graphics pipeline of the renderer: `sh` with the given vertex input and topology; no
+/// culling (both sides are drawn), depth test and write, dynamic viewport and scissor.
+Result<gpu::Pipeline> create_graphics_pipeline(gpu::Context::Impl& ctx, VkPipelineLayout layout,
+                                               const RendererOptions& o, const Shaders& sh,
+                                               std::span<const VkVertexInputBindingDescription> bindings,
+                                               std::span<const VkVertexInputAttributeDescription> attrs,
+                                               VkPrimitiveTopology topology) {
+  auto vm = gpu::create_shader_module(ctx, sh.vs, sh.name);
+  if (!vm)
+    return vm.error();
+  auto fm = gpu::create_shader_module(ctx, sh.fs, sh.name);
+  if (!fm)
+    return fm.error();
+  VkPipelineShaderStageCreateInfo stages[2]{};
+  for (int k = 0; k < 2; ++k) {
+    stages[k].sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+    stages[k].stage = k == 0 ? VK_SHADER_STAGE_VERTEX_BIT : VK_SHADER_STAGE_FRAGMENT_BIT;
+    stages[k].module = k == 0 ? vm->get() : fm->get();
+    stages[k].pName = "main";
+  }
+  VkPipelineVertexInputStateCreateInfo vi{};
+  vi.sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO;
+  vi.vertexBindingDescriptionCount = static_cast<std::uint32_t>(bindings.size());
+  vi.pVertexBindingDescriptions = bindings.data();
+  vi.vertexAttributeDescriptionCount = static_cast<std::uint32_t>(attrs.size());
+  vi.pVertexAttributeDescriptions = attrs.data();
+  VkPipelineInputAssemblyStateCreateInfo ia{};
+  ia.sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO;
+  ia.topology = topology;
+  VkPipelineViewportStateCreateInfo vp{};
+  vp.sType = VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO;
+  vp.viewportCount = 1;
+  vp.scissorCount = 1;
+  VkPipelineRasterizationStateCreateInfo rs{};
+  rs.sType = VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO;
+  rs.polygonMode = VK_POLYGON_MODE_FILL;
+  rs.cullMode = VK_CULL_MODE_NONE; // the cloth is seen from both sides; the shaders pick the side
+  rs.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
+  rs.lineWidth = 1.0f;
+  VkPipelineMultisampleStateCreateInfo ms{};
+  ms.sType = VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO;
+  ms.rasterizationSamples = o.samples;
+  VkPipelineDepthStencilStateCreateInfo ds{};
+  ds.sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO;
+  ds.depthTestEnable = VK_TRUE;
+  ds.depthWriteEnable = VK_TRUE;
+  ds.depthCompareOp = VK_COMPARE_OP_LESS_OR_EQUAL;
+  VkPipelineColorBlendAttachmentState att{};
+  att.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT |
+                       VK_COLOR_COMPONENT_A_BIT;
+  VkPipelineColorBlendStateCreateInfo cb{};
+  cb.sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO;
+  cb.attachmentCount = 1;
+  cb.pAttachments = &att;
+  const VkDynamicState dyn[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+  VkPipelineDynamicStateCreateInfo dy{};
+  dy.sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO;
+  dy.dynamicStateCount = 2;
+  dy.pDynamicStates = dyn;
+  VkGraphicsPipelineCreateInfo gi{};
+  gi.sType = VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO;
+  gi.stageCount = 2;
+  gi.pStages = stages;
+  gi.pVertexInputState = &vi;
+  gi.pInputAssemblyState = &ia;
+  gi.pViewportState = &vp;
+  gi.pRasterizationState = &rs;
+  gi.pMultisampleState = &ms;
+  gi.pDepthStencilState = &ds;
+  gi.pColorBlendState = &cb;
+  gi.pDynamicState = &dy;
+  gi.layout = layout;
+  gi.renderPass = o.render_pass;
+  gi.subpass = o.subpass;
+  gpu::Pipeline out;
+  VKCLOTH_VK_TRY(ctx.vk.vkCreateGraphicsPipelines(ctx.device, ctx.pipelines->cache(), 1, &gi, ctx.vk.allocator,
+                                                  out.init(ctx)),
+                 fmt::format("vkCreateGraphicsPipelines ({})", sh.name));
+  return out;
+}
+
+} // namespace
+
+// The fabric texture's combined image sampler (set 0 of cloth.frag).
+Result<void> ClothRenderer::Impl::create_texture_set() {
   const auto& v = ctx->vk;
   const VkDevice d = ctx->device;
   const VkDescriptorSetLayoutBinding binding{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1,
@@ -257,7 +350,14 @@ Result<void> ClothRenderer::Impl::build_pipelines(const RendererOptions& o) {
   w.descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
   w.pImageInfo = &ii;
   v.vkUpdateDescriptorSets(d, 1, &w, 0, nullptr);
+  return {};
+}
 
+// The pipeline layout (texture set, push constants) and the cloth, mesh and line pipelines.
+Result<void> ClothRenderer::Impl::build_pipelines(const RendererOptions& o) {
+  const auto& v = ctx->vk;
+  const VkDevice d = ctx->device;
+  VKCLOTH_TRY(create_texture_set());
   const VkPushConstantRange range{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
                                   sizeof(DrawConstants)};
   VkPipelineLayoutCreateInfo pl{};
@@ -267,100 +367,18 @@ Result<void> ClothRenderer::Impl::build_pipelines(const RendererOptions& o) {
   pl.pushConstantRangeCount = 1;
   pl.pPushConstantRanges = &range;
   VKCLOTH_VK_TRY(v.vkCreatePipelineLayout(d, &pl, v.allocator, layout.init(*ctx)), "vkCreatePipelineLayout (renderer)");
-
-  struct Shaders {
-    const std::uint32_t* vs;
-    std::size_t vs_words;
-    const std::uint32_t* fs;
-    std::size_t fs_words;
-    const char* name;
-  };
   auto make = [&](const Shaders& sh, const std::vector<VkVertexInputBindingDescription>& bindings,
                   const std::vector<VkVertexInputAttributeDescription>& attrs, VkPrimitiveTopology topology,
                   gpu::Pipeline* out) -> Result<void> {
-    auto vm = gpu::create_shader_module(*ctx, {sh.vs, sh.vs_words}, sh.name);
-    if (!vm)
-      return vm.error();
-    auto fm = gpu::create_shader_module(*ctx, {sh.fs, sh.fs_words}, sh.name);
-    if (!fm)
-      return fm.error();
-    VkPipelineShaderStageCreateInfo stages[2]{};
-    stages[0] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
-                 nullptr,
-                 0,
-                 VK_SHADER_STAGE_VERTEX_BIT,
-                 *vm,
-                 "main",
-                 nullptr};
-    stages[1] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
-                 nullptr,
-                 0,
-                 VK_SHADER_STAGE_FRAGMENT_BIT,
-                 *fm,
-                 "main",
-                 nullptr};
-    VkPipelineVertexInputStateCreateInfo vi{};
-    vi.sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO;
-    vi.vertexBindingDescriptionCount = static_cast<std::uint32_t>(bindings.size());
-    vi.pVertexBindingDescriptions = bindings.data();
-    vi.vertexAttributeDescriptionCount = static_cast<std::uint32_t>(attrs.size());
-    vi.pVertexAttributeDescriptions = attrs.data();
-    VkPipelineInputAssemblyStateCreateInfo ia{};
-    ia.sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO;
-    ia.topology = topology;
-    VkPipelineViewportStateCreateInfo vp{};
-    vp.sType = VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO;
-    vp.viewportCount = 1;
-    vp.scissorCount = 1;
-    VkPipelineRasterizationStateCreateInfo rs{};
-    rs.sType = VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO;
-    rs.polygonMode = VK_POLYGON_MODE_FILL;
-    rs.cullMode = VK_CULL_MODE_NONE; // the cloth is seen from both sides; the shaders pick the side
-    rs.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
-    rs.lineWidth = 1.0f;
-    VkPipelineMultisampleStateCreateInfo ms{};
-    ms.sType = VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO;
-    ms.rasterizationSamples = o.samples;
-    VkPipelineDepthStencilStateCreateInfo ds{};
-    ds.sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO;
-    ds.depthTestEnable = VK_TRUE;
-    ds.depthWriteEnable = VK_TRUE;
-    ds.depthCompareOp = VK_COMPARE_OP_LESS_OR_EQUAL;
-    VkPipelineColorBlendAttachmentState att{};
-    att.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT |
-                         VK_COLOR_COMPONENT_A_BIT;
-    VkPipelineColorBlendStateCreateInfo cb{};
-    cb.sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO;
-    cb.attachmentCount = 1;
-    cb.pAttachments = &att;
-    const VkDynamicState dyn[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
-    VkPipelineDynamicStateCreateInfo dy{};
-    dy.sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO;
-    dy.dynamicStateCount = 2;
-    dy.pDynamicStates = dyn;
-    VkGraphicsPipelineCreateInfo gi{};
-    gi.sType = VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO;
-    gi.stageCount = 2;
-    gi.pStages = stages;
-    gi.pVertexInputState = &vi;
-    gi.pInputAssemblyState = &ia;
-    gi.pViewportState = &vp;
-    gi.pRasterizationState = &rs;
-    gi.pMultisampleState = &ms;
-    gi.pDepthStencilState = &ds;
-    gi.pColorBlendState = &cb;
-    gi.pDynamicState = &dy;
-    gi.layout = layout;
-    gi.renderPass = o.render_pass;
-    gi.subpass = o.subpass;
-    VKCLOTH_VK_TRY(v.vkCreateGraphicsPipelines(d, ctx->pipelines->cache(), 1, &gi, v.allocator, out->init(*ctx)),
-                   fmt::format("vkCreateGraphicsPipelines ({})", sh.name));
+    auto p = create_graphics_pipeline(*ctx, layout, o, sh, bindings, attrs, topology);
+    if (!p)
+      return p.error();
+    *out = std::move(*p);
     return {};
   };
   namespace sp = gpu::spirv;
   constexpr std::uint32_t vec4 = 16;
-  VKCLOTH_TRY(make({sp::cloth_vert_spv, std::size(sp::cloth_vert_spv), sp::cloth_frag_spv,
-                    std::size(sp::cloth_frag_spv), "cloth"},
+  VKCLOTH_TRY(make({sp::cloth_vert_spv, sp::cloth_frag_spv, "cloth"},
                    {{0, vec4, VK_VERTEX_INPUT_RATE_VERTEX},
                     {1, vec4, VK_VERTEX_INPUT_RATE_VERTEX},
                     {2, vec4, VK_VERTEX_INPUT_RATE_VERTEX}},
@@ -369,15 +387,13 @@ Result<void> ClothRenderer::Impl::build_pipelines(const RendererOptions& o) {
                     {2, 2, VK_FORMAT_R32G32B32A32_SFLOAT, 0}},
                    VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST, &cloth_pipeline));
   VKCLOTH_TRY(
-      make({sp::mesh_vert_spv, std::size(sp::mesh_vert_spv), sp::mesh_frag_spv, std::size(sp::mesh_frag_spv),
-            "mesh"},
+      make({sp::mesh_vert_spv, sp::mesh_frag_spv, "mesh"},
            {{0, sizeof(MeshVertex), VK_VERTEX_INPUT_RATE_VERTEX}, {1, vec4, VK_VERTEX_INPUT_RATE_INSTANCE}},
            {{0, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 0},
             {1, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 16},
             {2, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 0}},
            VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST, &mesh_pipeline));
-  VKCLOTH_TRY(make({sp::line_vert_spv, std::size(sp::line_vert_spv), sp::line_frag_spv,
-                    std::size(sp::line_frag_spv), "line"},
+  VKCLOTH_TRY(make({sp::line_vert_spv, sp::line_frag_spv, "line"},
                    {{0, vec4, VK_VERTEX_INPUT_RATE_VERTEX}}, {{0, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 0}},
                    VK_PRIMITIVE_TOPOLOGY_LINE_LIST, &line_pipeline));
   return {};

@@ -366,6 +366,106 @@ Result<std::vector<DeviceInfo>> Context::list_devices() {
   return out;
 }
 
+namespace {
+
+/// The debug messenger that counts (and prints) validation warnings and errors.
+Result<void> create_messenger(Context::Impl& impl) {
+  VkDebugUtilsMessengerCreateInfoEXT mi{};
+  mi.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT;
+  mi.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+  mi.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                   VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+  mi.pfnUserCallback = debug_callback;
+  mi.pUserData = &impl;
+  if (!impl.fi.vkCreateDebugUtilsMessengerEXT)
+    return make_error(ErrorCode::unsupported, "vkCreateDebugUtilsMessengerEXT is missing although VK_EXT_debug_utils is enabled");
+  VKCLOTH_VK_TRY(impl.fi.vkCreateDebugUtilsMessengerEXT(impl.instance, &mi, nullptr, &impl.messenger),
+                 "vkCreateDebugUtilsMessengerEXT");
+  return {};
+}
+
+/// A physical device that offers what the options need: `family` is its queue family, or
+/// UINT32_MAX when none fits (or a requested device extension is missing).
+struct Candidate {
+  std::uint32_t index;
+  VkPhysicalDeviceProperties props;
+  std::uint32_t family;
+};
+
+struct Candidates {
+  std::vector<VkPhysicalDevice> devices;
+  std::vector<Candidate> usable; // Vulkan 1.2 and a fitting queue family
+  std::string listing;           // every device, for error messages
+};
+
+/// Every physical device of the instance, and those usable with `options`.
+Result<Candidates> list_candidates(Context::Impl& impl, PFN_vkGetInstanceProcAddr gipa, const ContextOptions& options) {
+  Candidates out;
+  std::uint32_t n = 0;
+  VKCLOTH_VK_TRY(impl.fi.vkEnumeratePhysicalDevices(impl.instance, &n, nullptr), "vkEnumeratePhysicalDevices");
+  if (n == 0)
+    return make_error(ErrorCode::no_device, "the Vulkan loader found no physical device (install a driver, e.g. "
+                                            "mesa-vulkan-drivers for the lavapipe CPU device)");
+  out.devices.resize(n);
+  VKCLOTH_VK_TRY(impl.fi.vkEnumeratePhysicalDevices(impl.instance, &n, out.devices.data()), "vkEnumeratePhysicalDevices");
+  keep_vulkan_libraries_loaded_for_lsan(); // the drivers are loaded now
+
+  for (std::uint32_t i = 0; i < n; ++i) {
+    Candidate c{i, {}, pick_queue_family(impl.fi, out.devices[i], &options, impl.instance)};
+    if (c.family != UINT32_MAX && !options.device_extensions.empty()) {
+      auto enumerate = reinterpret_cast<PFN_vkEnumerateDeviceExtensionProperties>(
+          gipa(impl.instance, "vkEnumerateDeviceExtensionProperties"));
+      std::uint32_t ne = 0;
+      enumerate(out.devices[i], nullptr, &ne, nullptr);
+      std::vector<VkExtensionProperties> de(ne);
+      enumerate(out.devices[i], nullptr, &ne, de.data());
+      for (const char* e : options.device_extensions)
+        if (std::none_of(de.begin(), de.end(), [&](const VkExtensionProperties& p) { return std::strcmp(p.extensionName, e) == 0; }))
+          c.family = UINT32_MAX;
+    }
+    impl.fi.vkGetPhysicalDeviceProperties(out.devices[i], &c.props);
+    out.listing += fmt::format("{}[{}] {} ({}, Vulkan {})", i ? ", " : "", i, c.props.deviceName, type_name(c.props.deviceType),
+                           version_string(c.props.apiVersion));
+    if (c.family != UINT32_MAX && c.props.apiVersion >= VK_API_VERSION_1_2) out.usable.push_back(c);
+  }
+  if (out.usable.empty())
+    return make_error(ErrorCode::no_device,
+                      fmt::format("no device offers Vulkan 1.2 and a compute queue{}{}; devices: {}",
+                                  options.require_graphics ? " with graphics" : "",
+                                  options.queue_family_filter ? " (and presentation)" : "", out.listing));
+
+  return out;
+}
+
+/// The device `filter` names (an index or a name substring), else the best type (discrete first).
+Result<const Candidate*> choose_device(const Candidates& c, const std::string& filter) {
+  const Candidate* chosen = nullptr;
+  if (!filter.empty()) {
+    const bool numeric = std::all_of(filter.begin(), filter.end(), [](unsigned char ch) { return std::isdigit(ch); });
+    for (const Candidate& d : c.usable) {
+      const bool match = numeric ? std::to_string(d.index) == filter
+                                 : lower(d.props.deviceName).find(lower(filter)) != std::string::npos;
+      if (match) {
+        chosen = &d;
+        break;
+      }
+    }
+    if (!chosen)
+      return make_error(ErrorCode::no_device,
+                        fmt::format("no usable Vulkan device matches '{}' (VKCLOTH_DEVICE or the device option: an index "
+                                    "or a name substring); devices: {}",
+                                    filter, c.listing));
+  } else {
+    chosen = &*std::min_element(c.usable.begin(), c.usable.end(), [](const Candidate& a, const Candidate& b) {
+      return type_rank(a.props.deviceType) < type_rank(b.props.deviceType);
+    });
+  }
+
+  return chosen;
+}
+
+} // namespace
+
 Result<Context> Context::create(const ContextOptions& options) {
   const bool validation = options.validation ? *options.validation : env_flag("VKCLOTH_VALIDATION");
   std::string filter = options.device_filter;
@@ -384,85 +484,14 @@ Result<Context> Context::create(const ContextOptions& options) {
   auto fi = load_instance_fns(inst->gipa, inst->instance);
   if (!fi) return fi.error();
   impl->fi = *fi;
+  if (validation) VKCLOTH_TRY(create_messenger(*impl));
 
-  if (validation) {
-    VkDebugUtilsMessengerCreateInfoEXT mi{};
-    mi.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT;
-    mi.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-    mi.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
-                     VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
-    mi.pfnUserCallback = debug_callback;
-    mi.pUserData = impl.get();
-    if (!impl->fi.vkCreateDebugUtilsMessengerEXT)
-      return make_error(ErrorCode::unsupported, "vkCreateDebugUtilsMessengerEXT is missing although VK_EXT_debug_utils is enabled");
-    VKCLOTH_VK_TRY(impl->fi.vkCreateDebugUtilsMessengerEXT(impl->instance, &mi, nullptr, &impl->messenger),
-                   "vkCreateDebugUtilsMessengerEXT");
-  }
-
-  std::uint32_t n = 0;
-  VKCLOTH_VK_TRY(impl->fi.vkEnumeratePhysicalDevices(impl->instance, &n, nullptr), "vkEnumeratePhysicalDevices");
-  if (n == 0)
-    return make_error(ErrorCode::no_device, "the Vulkan loader found no physical device (install a driver, e.g. "
-                                            "mesa-vulkan-drivers for the lavapipe CPU device)");
-  std::vector<VkPhysicalDevice> pds(n);
-  VKCLOTH_VK_TRY(impl->fi.vkEnumeratePhysicalDevices(impl->instance, &n, pds.data()), "vkEnumeratePhysicalDevices");
-  keep_vulkan_libraries_loaded_for_lsan(); // the drivers are loaded now
-
-  struct Candidate {
-    std::uint32_t index;
-    VkPhysicalDeviceProperties props;
-    std::uint32_t family;
-  };
-  std::vector<Candidate> all, usable;
-  std::string listing;
-  for (std::uint32_t i = 0; i < n; ++i) {
-    Candidate c{i, {}, pick_queue_family(impl->fi, pds[i], &options, impl->instance)};
-    if (c.family != UINT32_MAX && !options.device_extensions.empty()) {
-      auto enumerate = reinterpret_cast<PFN_vkEnumerateDeviceExtensionProperties>(
-          inst->gipa(impl->instance, "vkEnumerateDeviceExtensionProperties"));
-      std::uint32_t ne = 0;
-      enumerate(pds[i], nullptr, &ne, nullptr);
-      std::vector<VkExtensionProperties> de(ne);
-      enumerate(pds[i], nullptr, &ne, de.data());
-      for (const char* e : options.device_extensions)
-        if (std::none_of(de.begin(), de.end(), [&](const VkExtensionProperties& p) { return std::strcmp(p.extensionName, e) == 0; }))
-          c.family = UINT32_MAX;
-    }
-    impl->fi.vkGetPhysicalDeviceProperties(pds[i], &c.props);
-    listing += fmt::format("{}[{}] {} ({}, Vulkan {})", i ? ", " : "", i, c.props.deviceName, type_name(c.props.deviceType),
-                           version_string(c.props.apiVersion));
-    all.push_back(c);
-    if (c.family != UINT32_MAX && c.props.apiVersion >= VK_API_VERSION_1_2) usable.push_back(c);
-  }
-  if (usable.empty())
-    return make_error(ErrorCode::no_device,
-                      fmt::format("no device offers Vulkan 1.2 and a compute queue{}{}; devices: {}",
-                                  options.require_graphics ? " with graphics" : "",
-                                  options.queue_family_filter ? " (and presentation)" : "", listing));
-
-  const Candidate* chosen = nullptr;
-  if (!filter.empty()) {
-    const bool numeric = std::all_of(filter.begin(), filter.end(), [](unsigned char c) { return std::isdigit(c); });
-    for (const Candidate& c : usable) {
-      const bool match = numeric ? std::to_string(c.index) == filter
-                                 : lower(c.props.deviceName).find(lower(filter)) != std::string::npos;
-      if (match) {
-        chosen = &c;
-        break;
-      }
-    }
-    if (!chosen)
-      return make_error(ErrorCode::no_device,
-                        fmt::format("no usable Vulkan device matches '{}' (VKCLOTH_DEVICE or the device option: an index "
-                                    "or a name substring); devices: {}",
-                                    filter, listing));
-  } else {
-    chosen = &*std::min_element(usable.begin(), usable.end(), [](const Candidate& a, const Candidate& b) {
-      return type_rank(a.props.deviceType) < type_rank(b.props.deviceType);
-    });
-  }
-
-  impl->physical_device = pds[chosen->index];
+  auto candidates = list_candidates(*impl, inst->gipa, options);
+  if (!candidates) return candidates.error();
+  auto picked = choose_device(*candidates, filter);
+  if (!picked) return picked.error();
+  const Candidate* chosen = *picked;
+  impl->physical_device = candidates->devices[chosen->index];
   impl->queue_family = chosen->family;
   const float priority = 1.0f;
   VkDeviceQueueCreateInfo qi{};

@@ -371,7 +371,7 @@ Result<void> SolverBatch::create_buffers() {
 }
 
 // Initial state of every instance, converted as CpuSolver<float>::create converts it, and the
-// topology: copied into mapped memory, or through one staging buffer (one submission).
+// topology's constants; the scratch buffers zeroed.
 Result<void> SolverBatch::upload_initial_state(const ParticleSystem& system, const std::vector<SlotState>& states) {
   const std::size_t n = count;
   const std::size_t entries = std::size_t(size()) * n;
@@ -403,11 +403,6 @@ Result<void> SolverBatch::upload_initial_state(const ParticleSystem& system, con
     edge_data[e] = {r.other, float(sp.rest_length), float(sp.stiffness)};
   }
   const std::vector<std::uint32_t> triangles = grid_triangle_indices(nx, ny);
-  struct Upload {
-    Buffer* dst;
-    const void* data; // null: zero fill
-    VkDeviceSize bytes;
-  };
   const Upload uploads[] = {{&pos[0], x0.data(), vec4_bytes},
                             {&pos[1], x0.data(), vec4_bytes},
                             {&vel, v0.data(), vec4_bytes},
@@ -424,6 +419,11 @@ Result<void> SolverBatch::upload_initial_state(const ParticleSystem& system, con
                             {&stage_vel, nullptr, 0},
                             {&acc_pos, nullptr, 0},
                             {&acc_vel, nullptr, 0}};
+  return upload(uploads);
+}
+
+// Into mapped memory directly, or through one staging buffer (one submission, waited for).
+Result<void> SolverBatch::upload(std::span<const Upload> uploads) {
   if (!staging) {
     for (const Upload& u : uploads) {
       if (u.data)

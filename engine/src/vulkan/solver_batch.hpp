@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -173,6 +174,12 @@ private:
   Result<void> upload_colliders();
   void upload_instance_params();
   Result<void> upload_initial_state(const ParticleSystem& system, const std::vector<SlotState>& states);
+  struct Upload {
+    Buffer* dst;
+    const void* data; // null: zero fill
+    VkDeviceSize bytes;
+  };
+  Result<void> upload(std::span<const Upload> uploads);
 
   /// `last`: the last substep of this recording (the fused variant that stores forces and normals).
   void record_substep(VkCommandBuffer cmd, bool first, bool last);
