@@ -71,6 +71,22 @@ void add_sphere(std::vector<MeshVertex>& v, std::vector<std::uint32_t>& idx, glm
     }
 }
 
+/// A plane collider drawn as a square of half side `half` around the point of the plane nearest
+/// to `around`; checker coordinates in the w components (mesh.vert).
+void add_plane(std::vector<MeshVertex>& v, std::vector<std::uint32_t>& idx, glm::vec3 n, float offset,
+               glm::vec3 around, float half) {
+  // Drawn a hair below the surface: cloth resting at offset + eps never z-fights with it.
+  const glm::vec3 centre = around - (glm::dot(n, around) - offset + 1e-3f) * n;
+  const glm::vec3 t = glm::normalize(glm::cross(n, std::abs(n.z) < 0.9f ? glm::vec3(0, 0, 1) : glm::vec3(1, 0, 0)));
+  const glm::vec3 s = glm::cross(n, t);
+  const auto base = static_cast<std::uint32_t>(v.size());
+  for (int q = 0; q < 4; ++q) {
+    const float u = (q == 1 || q == 2) ? half : -half, w = q >= 2 ? half : -half;
+    v.push_back({glm::vec4(centre + u * t + w * s, u + half), glm::vec4(n, w + half)});
+  }
+  idx.insert(idx.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+}
+
 } // namespace
 
 struct ClothRenderer::Impl {
@@ -145,18 +161,7 @@ Result<void> ClothRenderer::Impl::build_geometry(const ParticleSystem& system, c
       add_sphere(verts, midx, glm::vec3(k.center), float(k.radius) * 0.95f, 48, 24);
       r.color = palette.sphere;
     } else {
-      const glm::vec3 n = glm::normalize(glm::vec3(k.normal));
-      // Drawn a hair below the surface: cloth resting at offset + eps never z-fights with it.
-      const glm::vec3 centre = b.center() - (glm::dot(n, b.center()) - float(k.offset) + 1e-3f) * n;
-      const glm::vec3 t =
-          glm::normalize(glm::cross(n, std::abs(n.z) < 0.9f ? glm::vec3(0, 0, 1) : glm::vec3(1, 0, 0)));
-      const glm::vec3 s = glm::cross(n, t);
-      const auto base = static_cast<std::uint32_t>(verts.size());
-      for (int q = 0; q < 4; ++q) {
-        const float u = (q == 1 || q == 2) ? half : -half, w = q >= 2 ? half : -half;
-        verts.push_back({glm::vec4(centre + u * t + w * s, u + half), glm::vec4(n, w + half)});
-      }
-      midx.insert(midx.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+      add_plane(verts, midx, glm::normalize(glm::vec3(k.normal)), float(k.offset), b.center(), half);
       r.mode = 1.0f;
       r.cell = half / 5.0f;
       r.color = palette.floor;

@@ -160,6 +160,45 @@ struct OwnedInstance {
   PFN_vkGetInstanceProcAddr gipa = nullptr;
 };
 
+/// The validation layer and the two instance extensions validation needs (volk mutex held).
+Result<void> check_validation_support(const char* layer) {
+  std::uint32_t n = 0;
+  vkEnumerateInstanceLayerProperties(&n, nullptr);
+  std::vector<VkLayerProperties> lp(n);
+  vkEnumerateInstanceLayerProperties(&n, lp.data());
+  if (std::none_of(lp.begin(), lp.end(), [&](const VkLayerProperties& p) { return std::strcmp(p.layerName, layer) == 0; }))
+    return make_error(ErrorCode::unsupported,
+                      "validation was requested (VKCLOTH_VALIDATION=1 or ContextOptions::validation) but "
+                      "VK_LAYER_KHRONOS_validation is not installed (package vulkan-validationlayers)");
+  std::uint32_t ne = 0;
+  vkEnumerateInstanceExtensionProperties(layer, &ne, nullptr);
+  std::vector<VkExtensionProperties> le(ne);
+  vkEnumerateInstanceExtensionProperties(layer, &ne, le.data());
+  std::uint32_t ng = 0;
+  vkEnumerateInstanceExtensionProperties(nullptr, &ng, nullptr);
+  le.resize(ne + ng);
+  vkEnumerateInstanceExtensionProperties(nullptr, &ng, le.data() + ne);
+  auto has = [&](const char* e) {
+    return std::any_of(le.begin(), le.end(), [&](const VkExtensionProperties& p) { return std::strcmp(p.extensionName, e) == 0; });
+  };
+  if (!has(VK_EXT_DEBUG_UTILS_EXTENSION_NAME) || !has(VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME))
+    return make_error(ErrorCode::unsupported, "validation needs VK_EXT_debug_utils and VK_EXT_validation_features, "
+                                              "which this Vulkan installation does not offer");
+  return {};
+}
+
+/// What the debug messenger reports (warnings and errors), to `impl`'s counter.
+VkDebugUtilsMessengerCreateInfoEXT messenger_info(Context::Impl* impl) {
+  VkDebugUtilsMessengerCreateInfoEXT mi{};
+  mi.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT;
+  mi.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+  mi.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                   VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+  mi.pfnUserCallback = debug_callback;
+  mi.pUserData = impl;
+  return mi;
+}
+
 /// Creates an instance (validation optional; `impl` receives messages from creation on).
 Result<OwnedInstance> create_instance(Context::Impl* impl, bool validation,
                                       const std::vector<const char*>& extra_extensions = {}) {
@@ -176,41 +215,14 @@ Result<OwnedInstance> create_instance(Context::Impl* impl, bool validation,
   VkValidationFeaturesEXT features{};
   features.sType = VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT;
   const VkValidationFeatureEnableEXT enables[] = {VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT};
-  VkDebugUtilsMessengerCreateInfoEXT messenger{};
-  messenger.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT;
+  VkDebugUtilsMessengerCreateInfoEXT messenger = messenger_info(impl);
   const void* next = nullptr;
   if (validation) {
-    std::uint32_t n = 0;
-    vkEnumerateInstanceLayerProperties(&n, nullptr);
-    std::vector<VkLayerProperties> lp(n);
-    vkEnumerateInstanceLayerProperties(&n, lp.data());
     const char* layer = "VK_LAYER_KHRONOS_validation";
-    if (std::none_of(lp.begin(), lp.end(), [&](const VkLayerProperties& p) { return std::strcmp(p.layerName, layer) == 0; }))
-      return make_error(ErrorCode::unsupported,
-                        "validation was requested (VKCLOTH_VALIDATION=1 or ContextOptions::validation) but "
-                        "VK_LAYER_KHRONOS_validation is not installed (package vulkan-validationlayers)");
+    VKCLOTH_TRY(check_validation_support(layer));
     layers.push_back(layer);
-    std::uint32_t ne = 0;
-    vkEnumerateInstanceExtensionProperties(layer, &ne, nullptr);
-    std::vector<VkExtensionProperties> le(ne);
-    vkEnumerateInstanceExtensionProperties(layer, &ne, le.data());
-    std::uint32_t ng = 0;
-    vkEnumerateInstanceExtensionProperties(nullptr, &ng, nullptr);
-    le.resize(ne + ng);
-    vkEnumerateInstanceExtensionProperties(nullptr, &ng, le.data() + ne);
-    auto has = [&](const char* e) {
-      return std::any_of(le.begin(), le.end(), [&](const VkExtensionProperties& p) { return std::strcmp(p.extensionName, e) == 0; });
-    };
-    if (!has(VK_EXT_DEBUG_UTILS_EXTENSION_NAME) || !has(VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME))
-      return make_error(ErrorCode::unsupported, "validation needs VK_EXT_debug_utils and VK_EXT_validation_features, "
-                                                "which this Vulkan installation does not offer");
     extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
     extensions.push_back(VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME);
-    messenger.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-    messenger.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
-                            VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
-    messenger.pfnUserCallback = debug_callback;
-    messenger.pUserData = impl;
     features.enabledValidationFeatureCount = 1;
     features.pEnabledValidationFeatures = enables;
     features.pNext = &messenger; // also reports messages of vkCreateInstance / vkDestroyInstance
@@ -370,13 +382,7 @@ namespace {
 
 /// The debug messenger that counts (and prints) validation warnings and errors.
 Result<void> create_messenger(Context::Impl& impl) {
-  VkDebugUtilsMessengerCreateInfoEXT mi{};
-  mi.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT;
-  mi.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-  mi.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
-                   VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
-  mi.pfnUserCallback = debug_callback;
-  mi.pUserData = &impl;
+  const VkDebugUtilsMessengerCreateInfoEXT mi = messenger_info(&impl);
   if (!impl.fi.vkCreateDebugUtilsMessengerEXT)
     return make_error(ErrorCode::unsupported, "vkCreateDebugUtilsMessengerEXT is missing although VK_EXT_debug_utils is enabled");
   VKCLOTH_VK_TRY(impl.fi.vkCreateDebugUtilsMessengerEXT(impl.instance, &mi, nullptr, &impl.messenger),
