@@ -12,8 +12,9 @@
 // Buffers (device-local storage buffers, vec4 per particle, w unused; positions have w = 1):
 // positions[2] (ping-pong), velocities, forces, normals (unit, zero for chains; fused Euler
 // stores forces and normals in the last step of a recording), uvs (i/(nx-1), j/(ny-1) for grids,
-// zero for chains), the grid's triangle indices, plus internal scratch. A GpuSolver is a batch of one instance: gpu::ClothWorld steps many
-// cloths of one topology with the same shaders and one dispatch per pass (world.hpp).
+// zero for chains), the grid's triangle indices, plus internal scratch. A GpuSolver is a
+// gpu::ClothWorld of one instance (world.hpp: many cloths of one topology, same shaders, one
+// dispatch per pass), with the single-cloth conveniences below.
 //
 // Thread safety: none; one thread drives a solver. Known limitations: the step counter of the
 // divergence flags is 32-bit (about 4e9 steps per solver); set_params() must not be called while
@@ -84,7 +85,9 @@ public:
   /// caller recorded with record_steps() must have finished executing (or never be submitted).
   ~GpuSolver();
 
-  /// Replaces the parameters (validated). No recorded work of this solver may be pending.
+  /// Replaces the parameters (validated). No recorded work of this solver may be pending. A new
+  /// integrator family or substep count rebuilds the solver's buffers (the state is copied on the
+  /// GPU, bit for bit; current_position_index() restarts at 0); no pipeline is re-created.
   Result<void> set_params(SimParams params);
   const SimParams& params() const;
 
@@ -138,8 +141,9 @@ public:
   double time() const;
   std::uint32_t particle_count() const;
 
-  /// Index (0 or 1) of the positions buffer holding the current positions: 0 at creation,
-  /// flipped by every recorded substep (so (step_index() * substeps) % 2, unless a step diverged).
+  /// Index (0 or 1) of the positions buffer holding the current positions: 0 at creation (and
+  /// after a set_params() that changed the integrator family or substeps), flipped by every
+  /// recorded substep (so (step_index() * substeps) % 2, unless a step diverged).
   std::uint32_t current_position_index() const;
   VkBuffer position_buffer(std::uint32_t index) const;
   VkBuffer current_position_buffer() const;

@@ -117,7 +117,7 @@ public:
   std::vector<InstanceId> instances() const;
   std::size_t size() const;
 
-  struct Impl; ///< internal (engine/src/vulkan/world.cpp)
+  struct Impl; ///< internal (engine/src/vulkan/world_impl.hpp)
 
 private:
   friend struct detail::Access;
