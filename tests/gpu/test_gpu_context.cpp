@@ -201,3 +201,40 @@ TEST_CASE("Context: the validation messenger counts real errors, sync validation
   vkDestroyCommandPool(h.device, pool, nullptr);
   MESSAGE("deliberate hazard: " << ctx.validation_message_count() << " validation message(s)");
 }
+
+TEST_CASE("Context: pipelines are made once per Context and shared by every solver and world batch") {
+  VKCLOTH_GPU_TEST_BEGIN(ctx);
+  ClothDesc d;
+  d.nx = 11;
+  d.ny = 9;
+  auto cloth = make_cloth(d);
+  REQUIRE(cloth.ok());
+  SimParams params;
+  auto first = GpuSolver::create(ctx, *cloth, params);
+  REQUIRE(first.ok());
+  const std::size_t made = testing::pipeline_count(ctx);
+  CHECK(made > 0);
+  // A second solver of the same cloth (same stencil) and a world with two of them make none.
+  auto second = GpuSolver::create(ctx, *cloth, params);
+  REQUIRE(second.ok());
+  CHECK(testing::pipeline_count(ctx) == made);
+  auto world = ClothWorld::create(ctx);
+  REQUIRE(world.ok());
+  auto topology = std::make_shared<const ParticleSystem>(*cloth);
+  auto a = world->add(topology, params);
+  auto b = world->add(topology, params);
+  REQUIRE(a.ok());
+  REQUIRE(b.ok());
+  REQUIRE(world->remove(*a).ok());
+  CHECK(testing::pipeline_count(ctx) == made);
+  // Colliders need the fused variants with contacts: made once, then shared.
+  SimParams with_sphere = params;
+  with_sphere.colliders.push_back(Collider::sphere({0.5, 0.5, -1.0}, 0.3));
+  REQUIRE(first->set_params(with_sphere).ok());
+  const std::size_t with_contacts = testing::pipeline_count(ctx);
+  REQUIRE(second->set_params(with_sphere).ok());
+  REQUIRE(world->set_params(*b, with_sphere).ok());
+  CHECK(testing::pipeline_count(ctx) == with_contacts);
+  REQUIRE(first->simulate(3).ok());
+  REQUIRE(world->simulate(3).ok());
+}

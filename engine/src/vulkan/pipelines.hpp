@@ -47,6 +47,11 @@ public:
   Result<VkPipeline> pipeline(Shader shader, std::span<const std::uint32_t> constants);
   /// The Context's pipeline cache (VK_NULL_HANDLE when it could not be made: caching is optional).
   VkPipelineCache cache();
+  /// Compute pipelines made so far (testing::pipeline_count).
+  std::size_t size() {
+    const std::lock_guard lock(mutex_);
+    return pipelines_.size();
+  }
 
 private:
   Result<SolverLayouts> solver_layouts_locked();

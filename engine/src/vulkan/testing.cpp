@@ -1,5 +1,6 @@
 #include "vk_internal.hpp"
 
+#include "pipelines.hpp"
 #include "vkcloth/gpu/testing.hpp"
 
 namespace vkcloth::gpu::testing {
@@ -7,5 +8,7 @@ namespace vkcloth::gpu::testing {
 void set_allocation_failure_hook(Context& context, std::function<bool()> hook) {
   context_impl(context)->fail_allocation = std::move(hook);
 }
+
+std::size_t pipeline_count(const Context& context) { return context_impl(context)->pipelines->size(); }
 
 } // namespace vkcloth::gpu::testing

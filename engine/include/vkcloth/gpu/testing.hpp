@@ -2,6 +2,7 @@
 // and diagnostics include this header; applications have no reason to.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 
@@ -36,6 +37,10 @@ Result<GpuSolver> create_solver(Context& context, const ParticleSystem& system, 
                                 const GpuSolverOptions& options = {}, const SolverKnobs& knobs = {});
 /// ClothWorld::create with knobs for every batch of the world.
 Result<ClothWorld> create_world(Context& context, WorldOptions options, const SolverKnobs& knobs);
+
+/// Compute pipelines made so far on `context`: one per shader and specialisation (grid stencil,
+/// fused variant), shared by every solver and world batch of the Context.
+std::size_t pipeline_count(const Context& context);
 
 /// Called before every device memory allocation vkcloth makes on `context` (solvers, worlds,
 /// renderers, offscreen targets); returning true makes that allocation fail with
