@@ -17,9 +17,12 @@ namespace vkcloth::gpu {
 struct GpuSolver::Impl {
   ClothWorld world;
   InstanceId id = 0;
+  // The world's entry of the one instance: std::map nodes never move, and the instance is never
+  // removed, so no lookup per call (record_draw, hold, readbacks query it every frame).
+  const ClothWorld::Impl::Instance* inst = nullptr;
 
   ClothWorld::Impl& w() const { return detail::Access::impl(world); }
-  const ClothWorld::Impl::Instance& instance() const { return w().instances.at(id); }
+  const ClothWorld::Impl::Instance& instance() const { return *inst; }
   SolverBatch& batch() const { return *instance().batch; }
   std::uint32_t slot() const { return instance().slot; }
   const std::optional<Error>& diverged() const { return batch().slot(slot()).diverged; }
@@ -45,7 +48,8 @@ Result<GpuSolver> testing::create_solver(Context& context, const ParticleSystem&
   // caller's system need not outlive the solver.
   auto id = world->add(std::make_shared<const ParticleSystem>(system), std::move(params));
   if (!id) return id.error();
-  auto impl = std::make_unique<GpuSolver::Impl>(GpuSolver::Impl{std::move(*world), *id});
+  auto impl = std::make_unique<GpuSolver::Impl>(GpuSolver::Impl{std::move(*world), *id, nullptr});
+  impl->inst = &impl->w().instances.at(*id);
   return detail::Access::wrap<GpuSolver>(std::move(impl));
 }
 
@@ -82,7 +86,7 @@ Result<std::vector<glm::vec3>> GpuSolver::forces() {
 }
 const std::vector<glm::vec2>& GpuSolver::uvs() const { return impl_->batch().uvs(); }
 
-std::uint64_t GpuSolver::step_index() const { return impl_->world.step_index(impl_->id); }
+std::uint64_t GpuSolver::step_index() const { return impl_->batch().slot(impl_->slot()).step; }
 double GpuSolver::time() const { return static_cast<double>(step_index()) * params().dt; }
 std::uint32_t GpuSolver::particle_count() const { return impl_->batch().particle_count(); }
 std::uint32_t GpuSolver::current_position_index() const { return impl_->batch().current_position_index(); }
