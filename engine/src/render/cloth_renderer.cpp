@@ -77,7 +77,8 @@ void add_plane(std::vector<MeshVertex>& v, std::vector<std::uint32_t>& idx, glm:
                glm::vec3 around, float half) {
   // Drawn a hair below the surface: cloth resting at offset + eps never z-fights with it.
   const glm::vec3 centre = around - (glm::dot(n, around) - offset + 1e-3f) * n;
-  const glm::vec3 t = glm::normalize(glm::cross(n, std::abs(n.z) < 0.9f ? glm::vec3(0, 0, 1) : glm::vec3(1, 0, 0)));
+  const glm::vec3 t =
+      glm::normalize(glm::cross(n, std::abs(n.z) < 0.9f ? glm::vec3(0, 0, 1) : glm::vec3(1, 0, 0)));
   const glm::vec3 s = glm::cross(n, t);
   const auto base = static_cast<std::uint32_t>(v.size());
   for (int q = 0; q < 4; ++q) {
@@ -202,12 +203,14 @@ Result<void> ClothRenderer::Impl::build_geometry(const ParticleSystem& system, c
 Result<void> ClothRenderer::Impl::upload_texture(const Image& img) {
   const auto& v = ctx->vk;
   const VkDevice d = ctx->device;
-  auto t = gpu::create_image(*ctx, VK_FORMAT_R8G8B8A8_UNORM, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+  auto t = gpu::create_image(*ctx, VK_FORMAT_R8G8B8A8_UNORM,
+                             VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
                              VK_IMAGE_ASPECT_COLOR_BIT, img.width, img.height, "texture");
   if (!t)
     return t.error();
   texture = std::move(*t);
-  auto staging = host_buffer(img.rgba.data(), img.rgba.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, "texture staging");
+  auto staging =
+      host_buffer(img.rgba.data(), img.rgba.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, "texture staging");
   if (!staging)
     return staging.error();
   auto commands = gpu::CommandContext::create(*ctx, "texture upload");
@@ -218,7 +221,8 @@ Result<void> ClothRenderer::Impl::upload_texture(const Image& img) {
     VkBufferImageCopy region{};
     region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
     region.imageExtent = {img.width, img.height, 1};
-    v.vkCmdCopyBufferToImage(cmd, staging->buffer, texture.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+    v.vkCmdCopyBufferToImage(cmd, staging->buffer, texture.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
+                             &region);
     gpu::barriers::texture_after_upload(v, cmd, texture.image);
   }));
 
@@ -314,8 +318,8 @@ Result<gpu::Pipeline> create_graphics_pipeline(gpu::Context::Impl& ctx, VkPipeli
   gi.renderPass = o.render_pass;
   gi.subpass = o.subpass;
   gpu::Pipeline out;
-  VKCLOTH_VK_TRY(ctx.vk.vkCreateGraphicsPipelines(ctx.device, ctx.pipelines->cache(), 1, &gi, ctx.vk.allocator,
-                                                  out.init(ctx)),
+  VKCLOTH_VK_TRY(ctx.vk.vkCreateGraphicsPipelines(ctx.device, ctx.pipelines->cache(), 1, &gi,
+                                                  ctx.vk.allocator, out.init(ctx)),
                  fmt::format("vkCreateGraphicsPipelines ({})", sh.name));
   return out;
 }
@@ -340,7 +344,8 @@ Result<void> ClothRenderer::Impl::create_texture_set() {
   dp.maxSets = 1;
   dp.poolSizeCount = 1;
   dp.pPoolSizes = &ps;
-  VKCLOTH_VK_TRY(v.vkCreateDescriptorPool(d, &dp, v.allocator, pool.init(*ctx)), "vkCreateDescriptorPool (renderer)");
+  VKCLOTH_VK_TRY(v.vkCreateDescriptorPool(d, &dp, v.allocator, pool.init(*ctx)),
+                 "vkCreateDescriptorPool (renderer)");
   VkDescriptorSetAllocateInfo ai{};
   ai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
   ai.descriptorPool = pool;
@@ -371,7 +376,8 @@ Result<void> ClothRenderer::Impl::build_pipelines(const RendererOptions& o) {
   pl.pSetLayouts = set_layout.ptr();
   pl.pushConstantRangeCount = 1;
   pl.pPushConstantRanges = &range;
-  VKCLOTH_VK_TRY(v.vkCreatePipelineLayout(d, &pl, v.allocator, layout.init(*ctx)), "vkCreatePipelineLayout (renderer)");
+  VKCLOTH_VK_TRY(v.vkCreatePipelineLayout(d, &pl, v.allocator, layout.init(*ctx)),
+                 "vkCreatePipelineLayout (renderer)");
   auto make = [&](const Shaders& sh, const std::vector<VkVertexInputBindingDescription>& bindings,
                   const std::vector<VkVertexInputAttributeDescription>& attrs, VkPrimitiveTopology topology,
                   gpu::Pipeline* out) -> Result<void> {
@@ -398,9 +404,9 @@ Result<void> ClothRenderer::Impl::build_pipelines(const RendererOptions& o) {
             {1, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 16},
             {2, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 0}},
            VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST, &mesh_pipeline));
-  VKCLOTH_TRY(make({sp::line_vert_spv, sp::line_frag_spv, "line"},
-                   {{0, vec4, VK_VERTEX_INPUT_RATE_VERTEX}}, {{0, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 0}},
-                   VK_PRIMITIVE_TOPOLOGY_LINE_LIST, &line_pipeline));
+  VKCLOTH_TRY(make({sp::line_vert_spv, sp::line_frag_spv, "line"}, {{0, vec4, VK_VERTEX_INPUT_RATE_VERTEX}},
+                   {{0, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 0}}, VK_PRIMITIVE_TOPOLOGY_LINE_LIST,
+                   &line_pipeline));
   return {};
 }
 
@@ -415,8 +421,8 @@ Result<ClothRenderer> ClothRenderer::create(gpu::Context& context, const gpu::Gp
   return create(context, solver.params(), system, std::move(options));
 }
 
-Result<ClothRenderer> ClothRenderer::create(gpu::Context& context, const SimParams& params, const ParticleSystem& system,
-                                            RendererOptions options) {
+Result<ClothRenderer> ClothRenderer::create(gpu::Context& context, const SimParams& params,
+                                            const ParticleSystem& system, RendererOptions options) {
   if (!options.render_pass)
     return make_error(ErrorCode::invalid_argument, "RendererOptions::render_pass is required");
   auto impl = std::make_unique<Impl>();
@@ -457,8 +463,8 @@ void ClothRenderer::record_draw(VkCommandBuffer cmd, const gpu::GpuSolver& solve
   record_draw(cmd, solver.buffers(), camera, extent);
 }
 
-void ClothRenderer::record_draw(VkCommandBuffer cmd, const gpu::InstanceBuffers& buffers, const Camera& camera,
-                                VkExtent2D extent) const {
+void ClothRenderer::record_draw(VkCommandBuffer cmd, const gpu::InstanceBuffers& buffers,
+                                const Camera& camera, VkExtent2D extent) const {
   const Impl& s = *impl_;
   const auto& v = s.ctx->vk;
   const VkViewport viewport{0.0f, 0.0f, float(extent.width), float(extent.height), 0.0f, 1.0f};
@@ -498,7 +504,8 @@ void ClothRenderer::record_draw(VkCommandBuffer cmd, const gpu::InstanceBuffers&
     // The solver's own copy of the same triangle list when it has one (it does; hosts that fill
     // InstanceBuffers themselves may leave it out).
     const bool solver_indices = buffers.indices && buffers.index_count == s.cloth_index_count;
-    v.vkCmdBindIndexBuffer(cmd, solver_indices ? buffers.indices : s.cloth_index.buffer, 0, VK_INDEX_TYPE_UINT32);
+    v.vkCmdBindIndexBuffer(cmd, solver_indices ? buffers.indices : s.cloth_index.buffer, 0,
+                           VK_INDEX_TYPE_UINT32);
     pc.color = glm::vec4(s.palette.back_tint, 1.0f);
     pc.params = glm::vec4(0.0f, 1.0f, 1.0f, 0.0f);
     v.vkCmdPushConstants(cmd, s.layout, stages, 0, sizeof(pc), &pc);

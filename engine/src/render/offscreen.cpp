@@ -54,13 +54,13 @@ Result<OffscreenTarget> OffscreenTarget::create(gpu::Context& context, std::uint
     return make_error(ErrorCode::unsupported, "no depth attachment format");
   constexpr VkFormat color_format = VK_FORMAT_R8G8B8A8_UNORM;
   auto c = gpu::create_image(*s.ctx, color_format,
-                                VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
-                                VK_IMAGE_ASPECT_COLOR_BIT, width, height, "offscreen colour");
+                             VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                             VK_IMAGE_ASPECT_COLOR_BIT, width, height, "offscreen colour");
   if (!c)
     return c.error();
   s.color = std::move(*c);
   auto dd = gpu::create_image(*s.ctx, s.depth_format, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT,
-                                 VK_IMAGE_ASPECT_DEPTH_BIT, width, height, "offscreen depth");
+                              VK_IMAGE_ASPECT_DEPTH_BIT, width, height, "offscreen depth");
   if (!dd)
     return dd.error();
   s.depth = std::move(*dd);
@@ -75,7 +75,8 @@ Result<OffscreenTarget> OffscreenTarget::create(gpu::Context& context, std::uint
   fb.width = width;
   fb.height = height;
   fb.layers = 1;
-  VKCLOTH_VK_TRY(v.vkCreateFramebuffer(d, &fb, v.allocator, s.framebuffer.init(*s.ctx)), "vkCreateFramebuffer (offscreen)");
+  VKCLOTH_VK_TRY(v.vkCreateFramebuffer(d, &fb, v.allocator, s.framebuffer.init(*s.ctx)),
+                 "vkCreateFramebuffer (offscreen)");
   auto rb = gpu::create_buffer(*s.ctx, VkDeviceSize(width) * height * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                gpu::MemoryUse::host_readback, true, "frame readback");
   if (!rb)
@@ -119,7 +120,8 @@ Result<void> OffscreenTarget::Impl::create_render_pass(VkFormat color_format) {
   rp.pSubpasses = &sub;
   rp.dependencyCount = static_cast<std::uint32_t>(dep.size());
   rp.pDependencies = dep.data();
-  VKCLOTH_VK_TRY(ctx->vk.vkCreateRenderPass(ctx->device, &rp, ctx->vk.allocator, render_pass.init(*ctx)), "vkCreateRenderPass (offscreen)");
+  VKCLOTH_VK_TRY(ctx->vk.vkCreateRenderPass(ctx->device, &rp, ctx->vk.allocator, render_pass.init(*ctx)),
+                 "vkCreateRenderPass (offscreen)");
   return {};
 }
 

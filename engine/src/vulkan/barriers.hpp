@@ -13,8 +13,8 @@
 
 namespace vkcloth::gpu::barriers {
 
-inline void memory(const VolkDeviceTable& vk, VkCommandBuffer cmd, VkPipelineStageFlags src_stage, VkAccessFlags src_access,
-                   VkPipelineStageFlags dst_stage, VkAccessFlags dst_access) {
+inline void memory(const VolkDeviceTable& vk, VkCommandBuffer cmd, VkPipelineStageFlags src_stage,
+                   VkAccessFlags src_access, VkPipelineStageFlags dst_stage, VkAccessFlags dst_access) {
   VkMemoryBarrier b{};
   b.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
   b.srcAccessMask = src_access;
@@ -26,8 +26,8 @@ inline void memory(const VolkDeviceTable& vk, VkCommandBuffer cmd, VkPipelineSta
 /// fills, copies, the previous batch's dispatches, a renderer's reads of the buffers) completes,
 /// and its writes become visible, before the first dispatch reads or writes any buffer.
 inline void before_steps(const VolkDeviceTable& vk, VkCommandBuffer cmd) {
-  memory(vk, cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-         VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+  memory(vk, cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_WRITE_BIT,
+         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
 }
 
 /// Between two dispatches (force -> integrate, integrate -> next force, RK4 stage -> stage):
@@ -35,13 +35,14 @@ inline void before_steps(const VolkDeviceTable& vk, VkCommandBuffer cmd) {
 /// stage buffers, flags) are visible to the next pass's reads; WAR: the previous pass's reads
 /// finish before the next pass overwrites what it read (execution dependency).
 inline void dispatch_to_dispatch(const VolkDeviceTable& vk, VkCommandBuffer cmd) {
-  memory(vk, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-         VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+  memory(vk, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
 }
 
 /// After the last dispatch: its writes become visible to a consumer (`dst`), e.g. vertex input
 /// for drawing, transfer for copies, host for mapped reads.
-inline void after_steps(const VolkDeviceTable& vk, VkCommandBuffer cmd, VkPipelineStageFlags dst_stage, VkAccessFlags dst_access) {
+inline void after_steps(const VolkDeviceTable& vk, VkCommandBuffer cmd, VkPipelineStageFlags dst_stage,
+                        VkAccessFlags dst_access) {
   memory(vk, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, dst_stage, dst_access);
 }
 
@@ -49,7 +50,8 @@ inline void after_steps(const VolkDeviceTable& vk, VkCommandBuffer cmd, VkPipeli
 /// the copy into the staging buffer and to host reads of mapped memory.
 inline void before_readback(const VolkDeviceTable& vk, VkCommandBuffer cmd) {
   memory(vk, cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_WRITE_BIT,
-         VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_HOST_READ_BIT);
+         VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_HOST_BIT,
+         VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_HOST_READ_BIT);
 }
 
 /// After a staging copy (solver readbacks, the offscreen target's frame copy): the copy's writes
@@ -61,25 +63,27 @@ inline void transfer_to_host(const VolkDeviceTable& vk, VkCommandBuffer cmd) {
 
 /// After uploads (fills and staging copies): their writes are visible to the dispatches.
 inline void transfer_to_compute(const VolkDeviceTable& vk, VkCommandBuffer cmd) {
-  memory(vk, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-         VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+  memory(vk, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
 }
 
 /// ClothWorld moving instances into a rebuilt batch: every earlier command's writes (the old
 /// batch's dispatches, the new batch's fills and uploads) are visible to the copies, which also
 /// wait for earlier reads of the destination (a fresh buffer: none, but cheap to state).
 inline void before_batch_copy(const VolkDeviceTable& vk, VkCommandBuffer cmd) {
-  memory(vk, cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-         VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT);
+  memory(vk, cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_WRITE_BIT,
+         VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT);
 }
 
 /// After those copies: visible to the next steps, to a renderer's vertex reads and to the host
 /// (the old batch's divergence flags are read right after this submission).
 inline void after_batch_copy(const VolkDeviceTable& vk, VkCommandBuffer cmd) {
-  memory(vk, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT |
-         VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_VERTEX_INPUT_BIT |
-         VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT |
-         VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT | VK_ACCESS_HOST_READ_BIT);
+  memory(vk, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+         VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT,
+         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_VERTEX_INPUT_BIT |
+             VK_PIPELINE_STAGE_HOST_BIT,
+         VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT |
+             VK_ACCESS_HOST_READ_BIT);
 }
 
 } // namespace vkcloth::gpu::barriers
@@ -90,8 +94,8 @@ namespace vkcloth::gpu::barriers {
 /// every earlier access (dispatches' writes, the renderer's vertex reads) completes and earlier
 /// writes are visible before the transfer writes.
 inline void before_host_edit(const VolkDeviceTable& vk, VkCommandBuffer cmd) {
-  memory(vk, cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-         VK_ACCESS_TRANSFER_WRITE_BIT);
+  memory(vk, cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_WRITE_BIT,
+         VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
 }
 
 /// After those edits: the transfer writes are visible to the next steps and to vertex reads.
@@ -156,8 +160,9 @@ inline VkBufferMemoryBarrier buffer(VkBuffer buf, VkAccessFlags src_access, VkAc
 inline void pipeline(const VolkDeviceTable& vk, VkCommandBuffer cmd, VkPipelineStageFlags src_stage,
                      VkPipelineStageFlags dst_stage, std::span<const VkBufferMemoryBarrier> buffers,
                      std::span<const VkImageMemoryBarrier> images) {
-  vk.vkCmdPipelineBarrier(cmd, src_stage, dst_stage, 0, 0, nullptr, static_cast<std::uint32_t>(buffers.size()),
-                          buffers.data(), static_cast<std::uint32_t>(images.size()), images.data());
+  vk.vkCmdPipelineBarrier(cmd, src_stage, dst_stage, 0, 0, nullptr,
+                          static_cast<std::uint32_t>(buffers.size()), buffers.data(),
+                          static_cast<std::uint32_t>(images.size()), images.data());
 }
 
 /// Texture upload, before the copy: UNDEFINED -> TRANSFER_DST_OPTIMAL for the copy's writes. A
@@ -171,8 +176,9 @@ inline void texture_before_upload(const VolkDeviceTable& vk, VkCommandBuffer cmd
 /// Texture upload, after the copy: TRANSFER_DST -> SHADER_READ_ONLY_OPTIMAL; the copy's writes
 /// become visible to the fragment shader's sampling (every later draw of the renderer).
 inline void texture_after_upload(const VolkDeviceTable& vk, VkCommandBuffer cmd, VkImage img) {
-  const VkImageMemoryBarrier b = image(img, VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT,
-                                       VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  const VkImageMemoryBarrier b =
+      image(img, VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT,
+            VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
   pipeline(vk, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, {}, {&b, 1});
 }
 
@@ -195,7 +201,8 @@ inline std::array<VkSubpassDependency, 2> offscreen_subpass_dependencies() {
   dep[0].srcAccessMask = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
   dep[0].dstStageMask = attachments;
   dep[0].dstAccessMask = VK_ACCESS_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT |
-                         VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
+                         VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
+                         VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
   dep[1].srcSubpass = 0;
   dep[1].dstSubpass = VK_SUBPASS_EXTERNAL;
   dep[1].srcStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
@@ -210,20 +217,24 @@ inline std::array<VkSubpassDependency, 2> offscreen_subpass_dependencies() {
 /// the compute shader writes of `buffers` are made available and ownership leaves `compute_family`
 /// for `graphics_family`. The destination access is ignored for a release (BOTTOM_OF_PIPE, 0); the
 /// host signals a semaphore with this submission.
-inline void release_to_family(const VolkDeviceTable& vk, VkCommandBuffer cmd, std::span<const VkBuffer> buffers,
-                              std::uint32_t compute_family, std::uint32_t graphics_family) {
+inline void release_to_family(const VolkDeviceTable& vk, VkCommandBuffer cmd,
+                              std::span<const VkBuffer> buffers, std::uint32_t compute_family,
+                              std::uint32_t graphics_family) {
   std::array<VkBufferMemoryBarrier, 8> b{};
   std::uint32_t n = 0;
   for (VkBuffer buf : buffers)
-    if (n < b.size()) b[n++] = buffer(buf, VK_ACCESS_SHADER_WRITE_BIT, 0, compute_family, graphics_family);
-  pipeline(vk, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, {b.data(), n}, {});
+    if (n < b.size())
+      b[n++] = buffer(buf, VK_ACCESS_SHADER_WRITE_BIT, 0, compute_family, graphics_family);
+  pipeline(vk, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, {b.data(), n},
+           {});
 }
 
 /// The ACQUIRE half, recorded on the graphics queue after waiting on that semaphore (wait stage
 /// VERTEX_INPUT): the same buffers and families, the writes made visible to vertex fetch. The
 /// source access is ignored for an acquire (TOP_OF_PIPE, 0): the semaphore orders the release.
-inline void acquire_from_family(const VolkDeviceTable& vk, VkCommandBuffer cmd, std::span<const VkBuffer> buffers,
-                                std::uint32_t compute_family, std::uint32_t graphics_family) {
+inline void acquire_from_family(const VolkDeviceTable& vk, VkCommandBuffer cmd,
+                                std::span<const VkBuffer> buffers, std::uint32_t compute_family,
+                                std::uint32_t graphics_family) {
   std::array<VkBufferMemoryBarrier, 8> b{};
   std::uint32_t n = 0;
   for (VkBuffer buf : buffers)

@@ -28,7 +28,8 @@ struct GpuSolver::Impl {
   const std::optional<Error>& diverged() const { return batch().slot(slot()).diverged; }
   /// `r`, or the instance's own divergence error when it diverged.
   Result<void> own_error(Result<void> r) const {
-    if (const auto& d = diverged()) return *d;
+    if (const auto& d = diverged())
+      return *d;
     return r;
   }
 };
@@ -43,11 +44,13 @@ Result<GpuSolver> testing::create_solver(Context& context, const ParticleSystem&
   WorldOptions wo;
   wo.solver = options;
   auto world = create_world(context, std::move(wo), knobs);
-  if (!world) return world.error();
+  if (!world)
+    return world.error();
   // The world keeps its topology (for rebuilds when the integrator changes): a copy, since the
   // caller's system need not outlive the solver.
   auto id = world->add(std::make_shared<const ParticleSystem>(system), std::move(params));
-  if (!id) return id.error();
+  if (!id)
+    return id.error();
   auto impl = std::make_unique<GpuSolver::Impl>(GpuSolver::Impl{std::move(*world), *id, nullptr});
   impl->inst = &impl->w().instances.at(*id);
   return detail::Access::wrap<GpuSolver>(std::move(impl));
@@ -58,46 +61,91 @@ GpuSolver::GpuSolver(GpuSolver&&) noexcept = default;
 GpuSolver& GpuSolver::operator=(GpuSolver&&) noexcept = default;
 GpuSolver::~GpuSolver() = default;
 
-Result<void> GpuSolver::set_params(SimParams params) { return impl_->world.set_params(impl_->id, std::move(params)); }
-const SimParams& GpuSolver::params() const { return impl_->instance().params; }
+Result<void> GpuSolver::set_params(SimParams params) {
+  return impl_->world.set_params(impl_->id, std::move(params));
+}
+const SimParams& GpuSolver::params() const {
+  return impl_->instance().params;
+}
 
-void GpuSolver::record_steps(VkCommandBuffer cmd, std::uint32_t steps) { impl_->world.record_steps(cmd, steps); }
-void GpuSolver::record_step(VkCommandBuffer cmd) { impl_->world.record_steps(cmd, 1); }
+void GpuSolver::record_steps(VkCommandBuffer cmd, std::uint32_t steps) {
+  impl_->world.record_steps(cmd, steps);
+}
+void GpuSolver::record_step(VkCommandBuffer cmd) {
+  impl_->world.record_steps(cmd, 1);
+}
 
-void GpuSolver::record_barrier_to(VkCommandBuffer cmd, VkPipelineStageFlags dst_stage, VkAccessFlags dst_access) const {
+void GpuSolver::record_barrier_to(VkCommandBuffer cmd, VkPipelineStageFlags dst_stage,
+                                  VkAccessFlags dst_access) const {
   impl_->world.record_barrier_to(cmd, dst_stage, dst_access);
 }
 
 Result<void> GpuSolver::simulate(std::uint64_t steps, std::uint32_t steps_per_submit) {
-  if (const auto& d = impl_->diverged()) return *d;
+  if (const auto& d = impl_->diverged())
+    return *d;
   return impl_->own_error(impl_->w().simulate(steps, steps_per_submit));
 }
 
 Result<void> GpuSolver::check_divergence() {
-  if (const auto& d = impl_->diverged()) return *d;
+  if (const auto& d = impl_->diverged())
+    return *d;
   return impl_->own_error(impl_->w().check_divergence());
 }
 
-Result<std::vector<glm::vec3>> GpuSolver::positions() { return impl_->world.positions(impl_->id); }
-Result<std::vector<glm::vec3>> GpuSolver::velocities() { return impl_->world.velocities(impl_->id); }
-Result<std::vector<glm::vec3>> GpuSolver::normals() { return impl_->world.normals(impl_->id); }
+Result<std::vector<glm::vec3>> GpuSolver::positions() {
+  return impl_->world.positions(impl_->id);
+}
+Result<std::vector<glm::vec3>> GpuSolver::velocities() {
+  return impl_->world.velocities(impl_->id);
+}
+Result<std::vector<glm::vec3>> GpuSolver::normals() {
+  return impl_->world.normals(impl_->id);
+}
 Result<std::vector<glm::vec3>> GpuSolver::forces() {
   return impl_->batch().read(SolverBatch::Field::forces, impl_->slot());
 }
-const std::vector<glm::vec2>& GpuSolver::uvs() const { return impl_->batch().uvs(); }
+const std::vector<glm::vec2>& GpuSolver::uvs() const {
+  return impl_->batch().uvs();
+}
 
-std::uint64_t GpuSolver::step_index() const { return impl_->batch().slot(impl_->slot()).step; }
-double GpuSolver::time() const { return static_cast<double>(step_index()) * params().dt; }
-std::uint32_t GpuSolver::particle_count() const { return impl_->batch().particle_count(); }
-std::uint32_t GpuSolver::current_position_index() const { return impl_->batch().current_position_index(); }
-VkBuffer GpuSolver::position_buffer(std::uint32_t index) const { return impl_->batch().position_buffer(index); }
-VkBuffer GpuSolver::current_position_buffer() const { return buffers().positions; }
-VkBuffer GpuSolver::velocity_buffer() const { return impl_->batch().velocity_buffer(); }
-VkBuffer GpuSolver::normal_buffer() const { return buffers().normals; }
-VkBuffer GpuSolver::uv_buffer() const { return buffers().uvs; }
-SolveStats GpuSolver::last_solve() const { return impl_->batch().last_solve(); }
-double GpuSolver::last_gpu_ms() const { return impl_->w().last_ms; }
-bool GpuSolver::uses_staging() const { return impl_->batch().uses_staging(); }
-InstanceBuffers GpuSolver::buffers() const { return impl_->batch().buffers(impl_->slot()); }
+std::uint64_t GpuSolver::step_index() const {
+  return impl_->batch().slot(impl_->slot()).step;
+}
+double GpuSolver::time() const {
+  return static_cast<double>(step_index()) * params().dt;
+}
+std::uint32_t GpuSolver::particle_count() const {
+  return impl_->batch().particle_count();
+}
+std::uint32_t GpuSolver::current_position_index() const {
+  return impl_->batch().current_position_index();
+}
+VkBuffer GpuSolver::position_buffer(std::uint32_t index) const {
+  return impl_->batch().position_buffer(index);
+}
+VkBuffer GpuSolver::current_position_buffer() const {
+  return buffers().positions;
+}
+VkBuffer GpuSolver::velocity_buffer() const {
+  return impl_->batch().velocity_buffer();
+}
+VkBuffer GpuSolver::normal_buffer() const {
+  return buffers().normals;
+}
+VkBuffer GpuSolver::uv_buffer() const {
+  return buffers().uvs;
+}
+SolveStats GpuSolver::last_solve() const {
+  return impl_->batch().last_solve();
+}
+double GpuSolver::last_gpu_ms() const {
+  return impl_->w().last_ms;
+}
+bool GpuSolver::uses_staging() const {
+  return impl_->batch().uses_staging();
+}
+InstanceBuffers GpuSolver::buffers() const {
+  return impl_->batch().buffers(impl_->slot());
+}
 
 } // namespace vkcloth::gpu

@@ -17,9 +17,10 @@ namespace vkcloth::gpu {
 
 namespace sh = shared;
 
-Result<std::unique_ptr<ImplicitGpu>> ImplicitGpu::create(const std::shared_ptr<Context::Impl>& ctx, std::uint32_t count,
-                                                         std::uint64_t entries, std::uint32_t groups_x,
-                                                         std::uint32_t groups_y, bool allow_map) {
+Result<std::unique_ptr<ImplicitGpu>> ImplicitGpu::create(const std::shared_ptr<Context::Impl>& ctx,
+                                                         std::uint32_t count, std::uint64_t entries,
+                                                         std::uint32_t groups_x, std::uint32_t groups_y,
+                                                         bool allow_map) {
   std::unique_ptr<ImplicitGpu> s(new ImplicitGpu());
   s->ctx_ = ctx;
   s->count_ = count;
@@ -47,21 +48,25 @@ Result<void> ImplicitGpu::create_buffers(std::uint64_t entries, bool allow_map) 
       {&partials_, std::max<VkDeviceSize>(groups * 8, 16), "implicit: partial sums"}};
   for (auto [b, bytes, what] : device_buffers) {
     auto r = create_buffer(ctx, bytes, usage, MemoryUse::device, allow_map, what);
-    if (!r) return r.error();
+    if (!r)
+      return r.error();
     *b = std::move(*r);
   }
-  auto st = create_buffer(ctx, sizeof(sh::CgState), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::host_readback, true,
-                          "implicit: CG state");
-  if (!st) return st.error();
+  auto st = create_buffer(ctx, sizeof(sh::CgState), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                          MemoryUse::host_readback, true, "implicit: CG state");
+  if (!st)
+    return st.error();
   state_ = std::move(*st);
   sh::CgState init{};
   init.done = 1;
   init.groups_x = groups_x_;
   init.groups_y = groups_y_;
   std::memcpy(state_.mapped, &init, sizeof(init));
-  auto a = create_buffer(ctx, sizeof(sh::CgArgs), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT,
+  auto a = create_buffer(ctx, sizeof(sh::CgArgs),
+                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT,
                          MemoryUse::device, false, "implicit: indirect arguments");
-  if (!a) return a.error();
+  if (!a)
+    return a.error();
   args_ = std::move(*a);
   return {};
 }
@@ -71,11 +76,13 @@ Result<void> ImplicitGpu::create_pipelines() {
   Context::Impl& ctx = *ctx_;
   const auto& v = ctx.vk;
   auto layouts = ctx.pipelines->implicit_layouts();
-  if (!layouts) return layouts.error();
+  if (!layouts)
+    return layouts.error();
   set_layout_ = layouts->set;
   layout_ = layouts->layout;
   const auto bindings = implicit_bindings();
-  const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2 * static_cast<std::uint32_t>(bindings.size())};
+  const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                  2 * static_cast<std::uint32_t>(bindings.size())};
   VkDescriptorPoolCreateInfo dp{};
   dp.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
   dp.maxSets = 2;
@@ -91,10 +98,12 @@ Result<void> ImplicitGpu::create_pipelines() {
   ai.pSetLayouts = layouts2;
   VKCLOTH_VK_TRY(v.vkAllocateDescriptorSets(ctx.device, &ai, sets_), "vkAllocateDescriptorSets (implicit)");
   auto pp = ctx.pipelines->pipeline(PipelineRegistry::Shader::implicit, {});
-  if (!pp) return pp.error();
+  if (!pp)
+    return pp.error();
   pass_ = *pp;
   auto rp = ctx.pipelines->pipeline(PipelineRegistry::Shader::implicit_reduce, {});
-  if (!rp) return rp.error();
+  if (!rp)
+    return rp.error();
   reduce_ = *rp;
   return {};
 }
@@ -108,33 +117,79 @@ Result<void> ImplicitGpu::write_sets(const ImplicitInputs& in) {
     for (std::uint32_t binding : bindings) {
       VkBuffer b = VK_NULL_HANDLE;
       switch (binding) {
-      case VKCLOTH_BINDING_POS_IN: b = in.pos[read]; break;
-      case VKCLOTH_BINDING_POS_OUT: b = in.pos[read ^ 1u]; break;
-      case VKCLOTH_BINDING_FORCE_OUT: b = in.force; break;
-      case VKCLOTH_BINDING_NORMAL: b = in.normal; break;
-      case VKCLOTH_BINDING_VEL: b = in.vel; break;
-      case VKCLOTH_BINDING_PARTICLE: b = in.particle; break;
-      case VKCLOTH_BINDING_OFFSETS: b = in.offsets; break;
-      case VKCLOTH_BINDING_EDGES: b = in.edges; break;
-      case VKCLOTH_BINDING_COLLIDERS: b = in.colliders; break;
-      case VKCLOTH_BINDING_FLAGS: b = in.flags; break;
-      case VKCLOTH_BINDING_INSTANCES: b = in.instances; break;
-      case VKCLOTH_BINDING_IMPL_VF: b = vf_.buffer; break;
-      case VKCLOTH_BINDING_IMPL_KS: b = ks_.buffer; break;
-      case VKCLOTH_BINDING_IMPL_DIAG_INV: b = diag_inv_.buffer; break;
-      case VKCLOTH_BINDING_IMPL_X: b = x_.buffer; break;
-      case VKCLOTH_BINDING_IMPL_R: b = r_.buffer; break;
-      case VKCLOTH_BINDING_IMPL_Z: b = z_.buffer; break;
-      case VKCLOTH_BINDING_IMPL_D: b = d_.buffer; break;
-      case VKCLOTH_BINDING_IMPL_Q: b = q_.buffer; break;
-      case VKCLOTH_BINDING_IMPL_PARTIALS: b = partials_.buffer; break;
-      case VKCLOTH_BINDING_IMPL_STATE: b = state_.buffer; break;
-      case VKCLOTH_BINDING_IMPL_ARGS: b = args_.buffer; break;
-      default: break;
+      case VKCLOTH_BINDING_POS_IN:
+        b = in.pos[read];
+        break;
+      case VKCLOTH_BINDING_POS_OUT:
+        b = in.pos[read ^ 1u];
+        break;
+      case VKCLOTH_BINDING_FORCE_OUT:
+        b = in.force;
+        break;
+      case VKCLOTH_BINDING_NORMAL:
+        b = in.normal;
+        break;
+      case VKCLOTH_BINDING_VEL:
+        b = in.vel;
+        break;
+      case VKCLOTH_BINDING_PARTICLE:
+        b = in.particle;
+        break;
+      case VKCLOTH_BINDING_OFFSETS:
+        b = in.offsets;
+        break;
+      case VKCLOTH_BINDING_EDGES:
+        b = in.edges;
+        break;
+      case VKCLOTH_BINDING_COLLIDERS:
+        b = in.colliders;
+        break;
+      case VKCLOTH_BINDING_FLAGS:
+        b = in.flags;
+        break;
+      case VKCLOTH_BINDING_INSTANCES:
+        b = in.instances;
+        break;
+      case VKCLOTH_BINDING_IMPL_VF:
+        b = vf_.buffer;
+        break;
+      case VKCLOTH_BINDING_IMPL_KS:
+        b = ks_.buffer;
+        break;
+      case VKCLOTH_BINDING_IMPL_DIAG_INV:
+        b = diag_inv_.buffer;
+        break;
+      case VKCLOTH_BINDING_IMPL_X:
+        b = x_.buffer;
+        break;
+      case VKCLOTH_BINDING_IMPL_R:
+        b = r_.buffer;
+        break;
+      case VKCLOTH_BINDING_IMPL_Z:
+        b = z_.buffer;
+        break;
+      case VKCLOTH_BINDING_IMPL_D:
+        b = d_.buffer;
+        break;
+      case VKCLOTH_BINDING_IMPL_Q:
+        b = q_.buffer;
+        break;
+      case VKCLOTH_BINDING_IMPL_PARTIALS:
+        b = partials_.buffer;
+        break;
+      case VKCLOTH_BINDING_IMPL_STATE:
+        b = state_.buffer;
+        break;
+      case VKCLOTH_BINDING_IMPL_ARGS:
+        b = args_.buffer;
+        break;
+      default:
+        break;
       }
       infos[k] = {b, 0, VK_WHOLE_SIZE};
-      writes[k] = VkWriteDescriptorSet{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, nullptr, sets_[read], binding, 0, 1,
-                                       VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, nullptr, &infos[k], nullptr};
+      writes[k] =
+          VkWriteDescriptorSet{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, nullptr, sets_[read], binding, 0, 1,
+                               VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,      nullptr, &infos[k],   nullptr};
       ++k;
     }
   ctx_->vk.vkUpdateDescriptorSets(ctx_->device, static_cast<std::uint32_t>(k), writes.data(), 0, nullptr);
@@ -154,7 +209,8 @@ std::uint32_t ImplicitGpu::record_substep(VkCommandBuffer c, std::uint32_t read,
   VkPipeline bound = VK_NULL_HANDLE;
   const VkPipeline pass_pipe = pass_, reduce_pipe = reduce_; // raw handles, for the lambda's comparisons
   auto pass = [&](VkPipeline pipe, std::uint32_t stage, int indirect_offset) {
-    if (need_barrier) barriers::implicit_pass(v, c); // previous pass -> this one (RAW, WAR, indirect args)
+    if (need_barrier)
+      barriers::implicit_pass(v, c); // previous pass -> this one (RAW, WAR, indirect args)
     need_barrier = true;
     if (pipe != bound) {
       v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, pipe);
@@ -170,7 +226,8 @@ std::uint32_t ImplicitGpu::record_substep(VkCommandBuffer c, std::uint32_t read,
     else
       v.vkCmdDispatch(c, groups_x_, groups_y_, 1);
   };
-  constexpr int direct = -1, particles = offsetof(sh::CgArgs, particle_x), reduce = offsetof(sh::CgArgs, reduce_x);
+  constexpr int direct = -1, particles = offsetof(sh::CgArgs, particle_x),
+                reduce = offsetof(sh::CgArgs, reduce_x);
   pass(pass_pipe, VKCLOTH_IMPL_FORCE, direct);
   pass(pass_pipe, VKCLOTH_IMPL_SYSTEM, direct);
   pass(reduce_pipe, VKCLOTH_REDUCE_INIT, direct);

@@ -29,8 +29,9 @@ struct ImplicitInputs {
 
 class ImplicitGpu {
 public:
-  static Result<std::unique_ptr<ImplicitGpu>> create(const std::shared_ptr<Context::Impl>& ctx, std::uint32_t count,
-                                                     std::uint64_t entries, std::uint32_t groups_x, std::uint32_t groups_y,
+  static Result<std::unique_ptr<ImplicitGpu>> create(const std::shared_ptr<Context::Impl>& ctx,
+                                                     std::uint32_t count, std::uint64_t entries,
+                                                     std::uint32_t groups_x, std::uint32_t groups_y,
                                                      bool allow_map);
   ImplicitGpu(const ImplicitGpu&) = delete;
   ImplicitGpu& operator=(const ImplicitGpu&) = delete;
@@ -38,10 +39,10 @@ public:
   /// (Re)writes the two descriptor sets (position parity); call again when an input buffer changes.
   Result<void> write_sets(const ImplicitInputs& in);
   /// Records one substep reading positions[read], writing positions[read ^ 1]. `pc` is the main
-  /// push-constant block (the substep's dt is in the InstanceParams); `first`: no barrier needed before the first pass.
-  /// Returns the number of dispatches recorded.
-  std::uint32_t record_substep(VkCommandBuffer cmd, std::uint32_t read, shared::PushConstants pc, const SimParams& params,
-                               bool first);
+  /// push-constant block (the substep's dt is in the InstanceParams); `first`: no barrier needed before the
+  /// first pass. Returns the number of dispatches recorded.
+  std::uint32_t record_substep(VkCommandBuffer cmd, std::uint32_t read, shared::PushConstants pc,
+                               const SimParams& params, bool first);
   /// The last completed solve (host-visible state; valid once the recorded work finished).
   SolveStats stats() const;
 

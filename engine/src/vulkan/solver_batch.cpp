@@ -23,22 +23,27 @@ namespace sh = shared;
 
 namespace {
 
-std::string vec_str(glm::vec3 v) { return fmt::format("({:.4g}, {:.4g}, {:.4g})", double(v.x), double(v.y), double(v.z)); }
+std::string vec_str(glm::vec3 v) {
+  return fmt::format("({:.4g}, {:.4g}, {:.4g})", double(v.x), double(v.y), double(v.z));
+}
 
 } // namespace
 
 // Every instance's colliders, one after the other (InstanceParams::collider_first).
 Result<void> SolverBatch::upload_colliders() {
   std::uint32_t n = 0;
-  for (const Slot& slot : slots) n += static_cast<std::uint32_t>(slot.params.colliders.size());
+  for (const Slot& slot : slots)
+    n += static_cast<std::uint32_t>(slot.params.colliders.size());
   if (n > collider_capacity || !colliders.buffer) {
     const std::uint32_t cap = std::max<std::uint32_t>(n, 4);
-    auto b = create_buffer(*ctx, cap * sizeof(sh::Collider), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::host_upload, true,
-                           "colliders");
-    if (!b) return b.error();
+    auto b = create_buffer(*ctx, cap * sizeof(sh::Collider), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                           MemoryUse::host_upload, true, "colliders");
+    if (!b)
+      return b.error();
     colliders = std::move(*b);
     collider_capacity = cap;
-    if (sets[0][0]) VKCLOTH_TRY(write_sets());
+    if (sets[0][0])
+      VKCLOTH_TRY(write_sets());
   }
   auto* out = static_cast<sh::Collider*>(colliders.mapped);
   for (const Slot& slot : slots)
@@ -60,15 +65,18 @@ void SolverBatch::upload_instance_params() {
   for (const Slot& slot : slots) {
     const SimParams& params = slot.params;
     // Conversions exactly as CpuSolver<float>: each double field cast to float, then float math.
-    const float dt = float(params.substeps == 1 ? params.dt : params.dt / double(params.substeps)); // as the CPU
+    const float dt =
+        float(params.substeps == 1 ? params.dt : params.dt / double(params.substeps)); // as the CPU
     sh::InstanceParams ip{};
-    ip.flags = (nx ? VKCLOTH_FLAG_HAS_GRID : 0u) | (float(params.wind.strength) != 0.0f ? VKCLOTH_FLAG_WIND : 0u) |
+    ip.flags = (nx ? VKCLOTH_FLAG_HAS_GRID : 0u) |
+               (float(params.wind.strength) != 0.0f ? VKCLOTH_FLAG_WIND : 0u) |
                (params.contact_inward_only ? 0u : VKCLOTH_FLAG_CONTACT_BOTH);
     ip.integrator = static_cast<std::uint32_t>(params.integrator);
     ip.collider_first = first_collider;
     ip.collider_count = static_cast<std::uint32_t>(params.colliders.size());
     first_collider += ip.collider_count;
-    ip.gravity_damping = {float(params.gravity.x), float(params.gravity.y), float(params.gravity.z), float(params.damping)};
+    ip.gravity_damping = {float(params.gravity.x), float(params.gravity.y), float(params.gravity.z),
+                          float(params.damping)};
     ip.wind = {float(params.wind.direction.x), float(params.wind.direction.y), float(params.wind.direction.z),
                float(params.wind.strength)};
     ip.dt = dt;
@@ -82,10 +90,14 @@ void SolverBatch::upload_instance_params() {
 
 const Buffer& SolverBatch::buffer_of(Field field) const {
   switch (field) {
-  case Field::positions: return pos[parity];
-  case Field::velocities: return vel;
-  case Field::normals: return normal;
-  case Field::forces: return force;
+  case Field::positions:
+    return pos[parity];
+  case Field::velocities:
+    return vel;
+  case Field::normals:
+    return normal;
+  case Field::forces:
+    return force;
   }
   return pos[parity];
 }
@@ -94,9 +106,10 @@ Result<std::vector<glm::vec3>> SolverBatch::read(Field field, std::uint32_t slot
   const Buffer& b = buffer_of(field);
   Buffer tmp; // staging, when `b` is not mapped
   if (!b.mapped) {
-    auto s = create_buffer(*ctx, slot_bytes(), VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUse::host_readback, true,
-                           "readback staging");
-    if (!s) return s.error();
+    auto s = create_buffer(*ctx, slot_bytes(), VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUse::host_readback,
+                           true, "readback staging");
+    if (!s)
+      return s.error();
     tmp = std::move(*s);
   }
   VKCLOTH_TRY(commands->submit_and_wait([&](VkCommandBuffer c) {
@@ -110,7 +123,8 @@ Result<std::vector<glm::vec3>> SolverBatch::read(Field field, std::uint32_t slot
   const auto* src = tmp.buffer ? static_cast<const sh::vec4*>(tmp.mapped)
                                : static_cast<const sh::vec4*>(b.mapped) + std::size_t(slot) * count;
   std::vector<glm::vec3> out(count);
-  for (std::uint32_t i = 0; i < count; ++i) out[i] = glm::vec3(src[i].x, src[i].y, src[i].z);
+  for (std::uint32_t i = 0; i < count; ++i)
+    out[i] = glm::vec3(src[i].x, src[i].y, src[i].z);
   return out;
 }
 
@@ -118,19 +132,21 @@ void SolverBatch::refresh_flags() {
   const auto* f = static_cast<const sh::Flags*>(flags.mapped);
   for (std::uint32_t k = 0; k < size(); ++k) {
     Slot& slot = slots[k];
-    if (slot.diverged || !f[k].diverged) continue;
+    if (slot.diverged || !f[k].diverged)
+      continue;
     slot.step = slot.epoch_step + f[k].first_bad_step; // flag steps count from the batch's creation
     const std::uint32_t p = std::min(f[k].bad_particle, count - 1);
     std::string where;
     auto x = read(Field::positions, k);
     auto v = read(Field::velocities, k);
-    if (x && v) where = fmt::format(": particle {} is at {} with velocity {}", p, vec_str((*x)[p]), vec_str((*v)[p]));
-    slot.diverged = make_error(ErrorCode::diverged,
-                               fmt::format("simulation diverged at step {} (t = {:.4g} s) on the GPU{} (limit {:g}); the "
-                                           "state is left as after that step; try a smaller integrator.dt, lower "
-                                           "stiffness or more damping",
-                                           slot.step, double(slot.step) * slot.params.dt, where,
-                                           slot.params.divergence_limit));
+    if (x && v)
+      where = fmt::format(": particle {} is at {} with velocity {}", p, vec_str((*x)[p]), vec_str((*v)[p]));
+    slot.diverged = make_error(
+        ErrorCode::diverged,
+        fmt::format("simulation diverged at step {} (t = {:.4g} s) on the GPU{} (limit {:g}); the "
+                    "state is left as after that step; try a smaller integrator.dt, lower "
+                    "stiffness or more damping",
+                    slot.step, double(slot.step) * slot.params.dt, where, slot.params.divergence_limit));
   }
 }
 
@@ -139,7 +155,8 @@ void SolverBatch::carry_over(std::uint32_t slot, const Slot& old) {
   now.step = now.epoch_step = old.step; // flag steps count from this batch's creation
   now.diverged = old.diverged;
   // first_bad_step 0 is before every recorded step (1-based): frozen() holds from the first one.
-  if (now.diverged) static_cast<sh::Flags*>(flags.mapped)[slot] = sh::Flags{1, 0, 0, 0};
+  if (now.diverged)
+    static_cast<sh::Flags*>(flags.mapped)[slot] = sh::Flags{1, 0, 0, 0};
 }
 
 InstanceBuffers SolverBatch::buffers(std::uint32_t slot) const {
@@ -166,15 +183,18 @@ Result<void> SolverBatch::set_params(std::uint32_t slot, SimParams params) {
 }
 
 Result<void> SolverBatch::ensure_implicit() {
-  if (family().integrator != Integrator::implicit_euler || implicit) return {};
+  if (family().integrator != Integrator::implicit_euler || implicit)
+    return {};
   auto r = ImplicitGpu::create(ctx, count, edges_count, groups_x, groups_y, !knobs.force_staging);
-  if (!r) return r.error();
+  if (!r)
+    return r.error();
   implicit = std::move(*r);
   return write_sets();
 }
 
 void SolverBatch::record(VkCommandBuffer c, std::uint32_t steps) {
-  if (steps == 0) return;
+  if (steps == 0)
+    return;
   barriers::before_steps(vk(), c);
   bool first = true;
   for (std::uint32_t s = 0; s < steps; ++s) {
@@ -186,19 +206,19 @@ void SolverBatch::record(VkCommandBuffer c, std::uint32_t steps) {
     }
     ++recorded;
     for (Slot& slot : slots)
-      if (!slot.diverged) ++slot.step;
+      if (!slot.diverged)
+        ++slot.step;
   }
 }
 
 void SolverBatch::record_copy_slot(VkCommandBuffer c, const SolverBatch& from, std::uint32_t from_slot,
-                                       std::uint32_t to_slot) const {
+                                   std::uint32_t to_slot) const {
   const VkBufferCopy region{from.slot_offset(from_slot), slot_offset(to_slot), slot_bytes()};
   // Into positions[0], the new batch's current buffer; every step rewrites all of positions[1].
-  const std::pair<const Buffer*, const Buffer*> copies[] = {{&from.pos[from.parity], &pos[0]},
-                                                            {&from.vel, &vel},
-                                                            {&from.normal, &normal},
-                                                            {&from.force, &force}};
-  for (auto [src, dst] : copies) vk().vkCmdCopyBuffer(c, src->buffer, dst->buffer, 1, &region);
+  const std::pair<const Buffer*, const Buffer*> copies[] = {
+      {&from.pos[from.parity], &pos[0]}, {&from.vel, &vel}, {&from.normal, &normal}, {&from.force, &force}};
+  for (auto [src, dst] : copies)
+    vk().vkCmdCopyBuffer(c, src->buffer, dst->buffer, 1, &region);
 }
 
 void SolverBatch::record_substep(VkCommandBuffer c, bool first, bool last) {
@@ -212,12 +232,14 @@ void SolverBatch::record_substep(VkCommandBuffer c, bool first, bool last) {
   const bool rk4 = family().integrator == Integrator::rk4;
   if (options.fused && !rk4) {
     // One dispatch per (sub)step (fused.comp); the descriptor set alternates with the parity.
-    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, fused_pipes[last ? 1 : 0][any_colliders() ? 1 : 0]);
+    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE,
+                        fused_pipes[last ? 1 : 0][any_colliders() ? 1 : 0]);
     pc.stage = 0;
     const VkDescriptorSet bound_sets[2] = {sets[read][0], texel_sets[read]};
     v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 2, bound_sets, 0, nullptr);
     v.vkCmdPushConstants(c, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
-    if (!first) barriers::dispatch_to_dispatch(v, c); // previous step -> this step
+    if (!first)
+      barriers::dispatch_to_dispatch(v, c); // previous step -> this step
     v.vkCmdDispatch(c, groups_x, groups_y, instances_z);
     ++dispatches_;
     return;
@@ -233,7 +255,8 @@ void SolverBatch::record_substep(VkCommandBuffer c, bool first, bool last) {
       bound = set;
     }
     v.vkCmdPushConstants(c, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
-    if (!first || k > 0) barriers::dispatch_to_dispatch(v, c); // integrate (previous stage/step) -> force
+    if (!first || k > 0)
+      barriers::dispatch_to_dispatch(v, c); // integrate (previous stage/step) -> force
     v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, force_pipeline);
     v.vkCmdDispatch(c, groups_x, groups_y, instances_z);
     barriers::dispatch_to_dispatch(v, c); // force -> integrate
@@ -258,7 +281,8 @@ Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ParticleSystem
   const VkPhysicalDeviceLimits& lim = ctx.properties.limits;
   std::uint64_t max_bytes = lim.maxStorageBufferRange;
   const bool overridden = knobs.max_storage_buffer_bytes && knobs.max_storage_buffer_bytes < max_bytes;
-  if (overridden) max_bytes = knobs.max_storage_buffer_bytes;
+  if (overridden)
+    max_bytes = knobs.max_storage_buffer_bytes;
   const std::uint64_t edges_n = system.adjacency.refs.size();
   const struct {
     const char* what;
@@ -270,37 +294,42 @@ Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ParticleSystem
                {"particle constants", n * sizeof(sh::ParticleInfo), sizeof(sh::ParticleInfo), n}};
   for (const auto& need : needs)
     if (need.bytes > max_bytes)
-      return make_error(ErrorCode::unsupported,
-                        fmt::format("the system is too large for device '{}': its {} buffer needs {} bytes ({} x {} "
-                                    "bytes) but a storage buffer may hold at most {} bytes ({}); use fewer particles "
-                                    "or fewer instances of one topology",
-                                    ctx.name, need.what, need.bytes, need.items, need.per, max_bytes,
-                                    overridden ? "testing::SolverKnobs::max_storage_buffer_bytes"
-                                               : "maxStorageBufferRange"));
+      return make_error(
+          ErrorCode::unsupported,
+          fmt::format("the system is too large for device '{}': its {} buffer needs {} bytes ({} x {} "
+                      "bytes) but a storage buffer may hold at most {} bytes ({}); use fewer particles "
+                      "or fewer instances of one topology",
+                      ctx.name, need.what, need.bytes, need.items, need.per, max_bytes,
+                      overridden ? "testing::SolverKnobs::max_storage_buffer_bytes"
+                                 : "maxStorageBufferRange"));
   // Positions, velocities and particle constants are also read through texel buffer views (one
   // texel per particle of every instance).
   if (batch * n > lim.maxTexelBufferElements)
-    return make_error(ErrorCode::unsupported,
-                      fmt::format("the system is too large for device '{}': {} particles ({} instances of {}) need "
-                                  "{} texels per texel buffer view but the device allows {} (maxTexelBufferElements); "
-                                  "use fewer particles or fewer instances of one topology",
-                                  ctx.name, batch * n, batch, n, batch * n, lim.maxTexelBufferElements));
+    return make_error(
+        ErrorCode::unsupported,
+        fmt::format("the system is too large for device '{}': {} particles ({} instances of {}) need "
+                    "{} texels per texel buffer view but the device allows {} (maxTexelBufferElements); "
+                    "use fewer particles or fewer instances of one topology",
+                    ctx.name, batch * n, batch, n, batch * n, lim.maxTexelBufferElements));
   const std::uint64_t groups = (n + VKCLOTH_WORKGROUP_SIZE - 1) / VKCLOTH_WORKGROUP_SIZE;
   std::uint64_t row = lim.maxComputeWorkGroupCount[0];
-  if (knobs.max_workgroups_x) row = std::min<std::uint64_t>(row, knobs.max_workgroups_x);
+  if (knobs.max_workgroups_x)
+    row = std::min<std::uint64_t>(row, knobs.max_workgroups_x);
   const std::uint64_t gx = std::min<std::uint64_t>(groups, row);
   const std::uint64_t gy = (groups + gx - 1) / gx;
   if (gy > lim.maxComputeWorkGroupCount[1] || n >= std::numeric_limits<std::uint32_t>::max())
-    return make_error(ErrorCode::unsupported,
-                      fmt::format("the system is too large for device '{}': {} particles need {} workgroups of {} but "
-                                  "the device dispatches at most {} x {}",
-                                  ctx.name, n, groups, VKCLOTH_WORKGROUP_SIZE, lim.maxComputeWorkGroupCount[0],
-                                  lim.maxComputeWorkGroupCount[1]));
+    return make_error(
+        ErrorCode::unsupported,
+        fmt::format("the system is too large for device '{}': {} particles need {} workgroups of {} but "
+                    "the device dispatches at most {} x {}",
+                    ctx.name, n, groups, VKCLOTH_WORKGROUP_SIZE, lim.maxComputeWorkGroupCount[0],
+                    lim.maxComputeWorkGroupCount[1]));
   if (batch == 0 || batch > lim.maxComputeWorkGroupCount[2])
-    return make_error(ErrorCode::unsupported,
-                      fmt::format("a batch of {} instances of one topology does not fit device '{}' (at most {} per "
-                                  "dispatch: maxComputeWorkGroupCount[2])",
-                                  batch, ctx.name, lim.maxComputeWorkGroupCount[2]));
+    return make_error(
+        ErrorCode::unsupported,
+        fmt::format("a batch of {} instances of one topology does not fit device '{}' (at most {} per "
+                    "dispatch: maxComputeWorkGroupCount[2])",
+                    batch, ctx.name, lim.maxComputeWorkGroupCount[2]));
   return DispatchGrid{static_cast<std::uint32_t>(gx), static_cast<std::uint32_t>(gy)};
 }
 
@@ -339,24 +368,29 @@ Result<void> SolverBatch::create_buffers() {
       {&edges, std::max<VkDeviceSize>(edges_count * sizeof(sh::Edge), 16), "adjacency"}};
   for (auto [b, bytes, what] : device_buffers) {
     auto r = create_buffer(*ctx, bytes, usage, MemoryUse::device, allow_map, what, families);
-    if (!r) return r.error();
+    if (!r)
+      return r.error();
     *b = std::move(*r);
   }
   // The grid's triangle list for the host's drawing (instance-local indices; empty for chains).
   index_count = nx >= 2 && ny >= 2 ? (nx - 1) * (ny - 1) * 6 : 0; // grid_triangle_indices(nx, ny).size()
   {
-    auto r = create_buffer(*ctx, std::max<VkDeviceSize>(VkDeviceSize(index_count) * sizeof(std::uint32_t), 16),
-                           VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUse::device,
-                           allow_map, "triangle indices", families);
-    if (!r) return r.error();
+    auto r =
+        create_buffer(*ctx, std::max<VkDeviceSize>(VkDeviceSize(index_count) * sizeof(std::uint32_t), 16),
+                      VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUse::device,
+                      allow_map, "triangle indices", families);
+    if (!r)
+      return r.error();
     indices = std::move(*r);
   }
   staging = pos[0].mapped == nullptr;
   // Texel views of both: fused.comp (flags), common.glsl (instance parameters).
-  constexpr VkBufferUsageFlags small = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
+  constexpr VkBufferUsageFlags small =
+      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
   {
     auto r = create_buffer(*ctx, size() * sizeof(sh::Flags), small, MemoryUse::host_readback, true, "flags");
-    if (!r) return r.error();
+    if (!r)
+      return r.error();
     flags = std::move(*r);
     for (std::uint32_t k = 0; k < size(); ++k)
       static_cast<sh::Flags*>(flags.mapped)[k] = sh::Flags{0, VKCLOTH_NO_BAD_STEP, VKCLOTH_NO_BAD_STEP, 0};
@@ -364,7 +398,8 @@ Result<void> SolverBatch::create_buffers() {
   {
     auto r = create_buffer(*ctx, size() * sizeof(sh::InstanceParams), small, MemoryUse::host_upload, true,
                            "instance parameters");
-    if (!r) return r.error();
+    if (!r)
+      return r.error();
     instances = std::move(*r);
   }
   return upload_colliders();
@@ -372,7 +407,8 @@ Result<void> SolverBatch::create_buffers() {
 
 // Initial state of every instance, converted as CpuSolver<float>::create converts it, and the
 // topology's constants; the scratch buffers zeroed.
-Result<void> SolverBatch::upload_initial_state(const ParticleSystem& system, const std::vector<SlotState>& states) {
+Result<void> SolverBatch::upload_initial_state(const ParticleSystem& system,
+                                               const std::vector<SlotState>& states) {
   const std::size_t n = count;
   const std::size_t entries = std::size_t(size()) * n;
   const VkDeviceSize vec4_bytes = entries * 16;
@@ -384,7 +420,8 @@ Result<void> SolverBatch::upload_initial_state(const ParticleSystem& system, con
     for (std::size_t p = 0; p < n; ++p) {
       const Particle& q = system.particles[p];
       const glm::dvec3 x = state.positions && !state.positions->empty() ? (*state.positions)[p] : q.position;
-      const glm::dvec3 u = state.velocities && !state.velocities->empty() ? (*state.velocities)[p] : q.velocity;
+      const glm::dvec3 u =
+          state.velocities && !state.velocities->empty() ? (*state.velocities)[p] : q.velocity;
       x0[k * n + p] = {float(x.x), float(x.y), float(x.z), 1.0f};
       v0[k * n + p] = q.pinned ? sh::vec4{0, 0, 0, 0} : sh::vec4{float(u.x), float(u.y), float(u.z), 0.0f};
       info[p] = {float(q.mass), q.pinned ? 1u : 0u};
@@ -394,7 +431,8 @@ Result<void> SolverBatch::upload_initial_state(const ParticleSystem& system, con
     for (std::uint32_t i = 0; i < nx; ++i) {
       const glm::vec2 t(nx > 1 ? float(i) / float(nx - 1) : 0.0f, ny > 1 ? float(j) / float(ny - 1) : 0.0f);
       uvs_[std::size_t(j) * nx + i] = t;
-      for (std::size_t k = 0; k < size(); ++k) uv0[k * n + std::size_t(j) * nx + i] = {t.x, t.y, 0.0f, 0.0f};
+      for (std::size_t k = 0; k < size(); ++k)
+        uv0[k * n + std::size_t(j) * nx + i] = {t.x, t.y, 0.0f, 0.0f};
     }
   std::vector<sh::Edge> edge_data(edges_count);
   for (std::size_t e = 0; e < edges_count; ++e) {
@@ -434,10 +472,12 @@ Result<void> SolverBatch::upload(std::span<const Upload> uploads) {
     return {};
   }
   VkDeviceSize total = 0;
-  for (const Upload& u : uploads) total += u.data ? u.bytes : 0;
+  for (const Upload& u : uploads)
+    total += u.data ? u.bytes : 0;
   auto st = create_buffer(*ctx, std::max<VkDeviceSize>(total, 16), VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                           MemoryUse::host_upload, true, "upload staging");
-  if (!st) return st.error();
+  if (!st)
+    return st.error();
   const Buffer& stage = *st;
   const auto& v = vk();
   VkDeviceSize at = 0;
@@ -447,7 +487,8 @@ Result<void> SolverBatch::upload(std::span<const Upload> uploads) {
         v.vkCmdFillBuffer(c, u.dst->buffer, 0, VK_WHOLE_SIZE, 0);
         continue;
       }
-      if (u.bytes == 0) continue;
+      if (u.bytes == 0)
+        continue;
       std::memcpy(static_cast<char*>(stage.mapped) + at, u.data, u.bytes);
       const VkBufferCopy region{at, 0, u.bytes};
       v.vkCmdCopyBuffer(c, stage.buffer, u.dst->buffer, 1, &region);
@@ -457,23 +498,25 @@ Result<void> SolverBatch::upload(std::span<const Upload> uploads) {
   });
 }
 
-Result<std::unique_ptr<SolverBatch>> SolverBatch::create(const std::shared_ptr<Context::Impl>& ctx,
-                                                          CommandContext& commands, const ParticleSystem& system,
-                                                                  std::vector<SimParams> params,
-                                                                  const GpuSolverOptions& options,
-                                                                  const testing::SolverKnobs& knobs,
-                                                                  const std::vector<SlotState>& states) {
-  for (SimParams& p : params) VKCLOTH_TRY(p.validate());
+Result<std::unique_ptr<SolverBatch>>
+SolverBatch::create(const std::shared_ptr<Context::Impl>& ctx, CommandContext& commands,
+                    const ParticleSystem& system, std::vector<SimParams> params,
+                    const GpuSolverOptions& options, const testing::SolverKnobs& knobs,
+                    const std::vector<SlotState>& states) {
+  for (SimParams& p : params)
+    VKCLOTH_TRY(p.validate());
   VKCLOTH_TRY(system.validate());
   auto grid = check_limits(*ctx, system, params.size(), knobs);
-  if (!grid) return grid.error();
+  if (!grid)
+    return grid.error();
 
   std::unique_ptr<SolverBatch> impl(new SolverBatch());
   SolverBatch& s = *impl;
   s.ctx = ctx;
   s.commands = &commands;
   s.slots.resize(params.size());
-  for (std::size_t k = 0; k < params.size(); ++k) s.slots[k].params = std::move(params[k]);
+  for (std::size_t k = 0; k < params.size(); ++k)
+    s.slots[k].params = std::move(params[k]);
   s.options = options;
   s.knobs = knobs;
   s.count = s.pc.count = static_cast<std::uint32_t>(system.size());
@@ -486,7 +529,8 @@ Result<std::unique_ptr<SolverBatch>> SolverBatch::create(const std::shared_ptr<C
   }
   // On failure `impl` frees whatever the phases created so far.
   VKCLOTH_TRY(s.create_buffers());
-  if (!knobs.csr_only) s.detect_stencil(system);
+  if (!knobs.csr_only)
+    s.detect_stencil(system);
   VKCLOTH_TRY(s.init_pipelines());
   VKCLOTH_TRY(s.write_sets());
   VKCLOTH_TRY(s.ensure_implicit());
@@ -495,6 +539,5 @@ Result<std::unique_ptr<SolverBatch>> SolverBatch::create(const std::shared_ptr<C
   VKCLOTH_TRY(s.upload_initial_state(system, states));
   return impl;
 }
-
 
 } // namespace vkcloth::gpu

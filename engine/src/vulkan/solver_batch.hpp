@@ -50,11 +50,10 @@ public:
   /// substep count: Euler (explicit and semi-implicit mix), RK4, or implicit Euler (one
   /// instance)); `states[k]` is instance k's initial state (missing entries: the topology's).
   /// `commands` (the owner's) serves the uploads and readbacks and must outlive the batch.
-  static Result<std::unique_ptr<SolverBatch>> create(const std::shared_ptr<Context::Impl>& ctx,
-                                                     CommandContext& commands, const ParticleSystem& topology,
-                                                     std::vector<SimParams> params, const GpuSolverOptions& options,
-                                                     const testing::SolverKnobs& knobs,
-                                                     const std::vector<SlotState>& states = {});
+  static Result<std::unique_ptr<SolverBatch>>
+  create(const std::shared_ptr<Context::Impl>& ctx, CommandContext& commands, const ParticleSystem& topology,
+         std::vector<SimParams> params, const GpuSolverOptions& options, const testing::SolverKnobs& knobs,
+         const std::vector<SlotState>& states = {});
   SolverBatch(const SolverBatch&) = delete;
   SolverBatch& operator=(const SolverBatch&) = delete;
 
@@ -142,22 +141,24 @@ private:
   Stencil stencil;
   std::uint64_t edges_count = 0;
 
-  shared::PushConstants pc{}; // per dispatch (count, grid, stage, step)
-  std::uint64_t recorded = 0; // recorded steps since the flag epoch: flag step numbers
-  std::uint32_t parity = 0;   // positions[parity] is current; flipped by every recorded substep
+  shared::PushConstants pc{};            // per dispatch (count, grid, stage, step)
+  std::uint64_t recorded = 0;            // recorded steps since the flag epoch: flag step numbers
+  std::uint32_t parity = 0;              // positions[parity] is current; flipped by every recorded substep
   std::unique_ptr<ImplicitGpu> implicit; // created when the integrator is implicit_euler (batch of one)
-  std::vector<glm::vec2> uvs_; // per particle of one instance (as uploaded)
-  std::uint64_t dispatches_ = 0; // recorded so far (ClothWorld::dispatches_recorded)
-
+  std::vector<glm::vec2> uvs_;           // per particle of one instance (as uploaded)
+  std::uint64_t dispatches_ = 0;         // recorded so far (ClothWorld::dispatches_recorded)
 
   const SimParams& family() const { return slots.front().params; } // integrator family, substeps
   bool any_colliders() const {
     for (const Slot& s : slots)
-      if (!s.params.colliders.empty()) return true;
+      if (!s.params.colliders.empty())
+        return true;
     return false;
   }
   const DeviceFns& vk() const { return ctx->vk; }
-  VkDeviceSize slot_offset(std::uint32_t slot) const { return VkDeviceSize(slot) * count * GpuSolver::stride; }
+  VkDeviceSize slot_offset(std::uint32_t slot) const {
+    return VkDeviceSize(slot) * count * GpuSolver::stride;
+  }
   VkDeviceSize slot_bytes() const { return VkDeviceSize(count) * GpuSolver::stride; }
   const Buffer& buffer_of(Field field) const;
 

@@ -28,7 +28,8 @@ std::array<std::uint32_t, 40 + N> stencil_constants(const SolverBatch::Stencil& 
   static_assert(sizeof(SolverBatch::Stencil) == 40 * 4);
   std::array<std::uint32_t, 40 + N> words{};
   std::memcpy(words.data(), &st, sizeof(st));
-  for (std::size_t k = 0; k < N; ++k) words[40 + k] = extra[k];
+  for (std::size_t k = 0; k < N; ++k)
+    words[40 + k] = extra[k];
   return words;
 }
 
@@ -38,7 +39,8 @@ std::array<std::uint32_t, 40 + N> stencil_constants(const SolverBatch::Stencil& 
 // views, then the Context's pipelines for this batch's stencil.
 Result<void> SolverBatch::init_pipelines() {
   auto layouts = ctx->pipelines->solver_layouts();
-  if (!layouts) return layouts.error();
+  if (!layouts)
+    return layouts.error();
   set_layout = layouts->storage;
   texel_layout = layouts->texel;
   layout = layouts->layout;
@@ -57,7 +59,8 @@ Result<void> SolverBatch::create_descriptor_sets() {
   dp.maxSets = 4 + 3;
   dp.poolSizeCount = 2;
   dp.pPoolSizes = sizes;
-  VKCLOTH_VK_TRY(v.vkCreateDescriptorPool(ctx->device, &dp, v.allocator, pool.init(*ctx)), "vkCreateDescriptorPool");
+  VKCLOTH_VK_TRY(v.vkCreateDescriptorPool(ctx->device, &dp, v.allocator, pool.init(*ctx)),
+                 "vkCreateDescriptorPool");
   const VkDescriptorSetLayout layouts[4] = {set_layout, set_layout, set_layout, set_layout};
   VkDescriptorSetAllocateInfo ai{};
   ai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
@@ -68,7 +71,8 @@ Result<void> SolverBatch::create_descriptor_sets() {
   const VkDescriptorSetLayout texel_layouts[3] = {texel_layout, texel_layout, texel_layout};
   ai.descriptorSetCount = 3;
   ai.pSetLayouts = texel_layouts;
-  VKCLOTH_VK_TRY(v.vkAllocateDescriptorSets(ctx->device, &ai, texel_sets), "vkAllocateDescriptorSets (texel)");
+  VKCLOTH_VK_TRY(v.vkAllocateDescriptorSets(ctx->device, &ai, texel_sets),
+                 "vkAllocateDescriptorSets (texel)");
   return {};
 }
 
@@ -90,7 +94,8 @@ Result<void> SolverBatch::create_texel_views() {
                 {&instances, VK_FORMAT_R32G32B32A32_UINT, &instances_view, "instance parameters"}};
   for (const auto& view : views) {
     auto r = create_buffer_view(*ctx, view.buffer->buffer, view.format, view.what);
-    if (!r) return r.error();
+    if (!r)
+      return r.error();
     *view.view = std::move(*r);
   }
   const std::pair<const BufferView*, std::uint32_t> shared_views[4] = {
@@ -112,7 +117,8 @@ Result<void> SolverBatch::create_texel_views() {
   };
   for (std::uint32_t k = 0; k < 3; ++k) {
     write(texel_sets[k], VKCLOTH_TEXEL_BINDING_POS_IN, pos_views[k]);
-    for (auto [view, binding] : shared_views) write(texel_sets[k], binding, *view);
+    for (auto [view, binding] : shared_views)
+      write(texel_sets[k], binding, *view);
   }
   vk().vkUpdateDescriptorSets(ctx->device, static_cast<std::uint32_t>(w), writes.data(), 0, nullptr);
   return {};
@@ -123,10 +129,12 @@ Result<void> SolverBatch::create_pipelines() {
   using Shader = PipelineRegistry::Shader;
   const auto constants = stencil_constants<0>(stencil, {});
   auto fp = ctx->pipelines->pipeline(Shader::force, constants);
-  if (!fp) return fp.error();
+  if (!fp)
+    return fp.error();
   force_pipeline = *fp;
   auto ip = ctx->pipelines->pipeline(Shader::integrate, {});
-  if (!ip) return ip.error();
+  if (!ip)
+    return ip.error();
   integrate_pipeline = *ip;
   return {};
 }
@@ -135,11 +143,13 @@ Result<void> SolverBatch::create_pipelines() {
 // not); the registry makes each variant once per Context.
 Result<void> SolverBatch::ensure_fused() {
   const std::uint32_t col = any_colliders() ? 1u : 0u;
-  if (!options.fused || (fused_pipes[0][col] && fused_pipes[1][col])) return {};
+  if (!options.fused || (fused_pipes[0][col] && fused_pipes[1][col]))
+    return {};
   for (std::uint32_t aux = 0; aux < 2; ++aux) {
     const auto constants = stencil_constants<2>(stencil, {aux, col}); // VkBool32 SC_WRITE_AUX, SC_COLLIDERS
     auto p = ctx->pipelines->pipeline(PipelineRegistry::Shader::fused, constants);
-    if (!p) return p.error();
+    if (!p)
+      return p.error();
     fused_pipes[aux][col] = *p;
   }
   return {};
@@ -150,13 +160,16 @@ Result<void> SolverBatch::ensure_fused() {
 // float constants. Then the shaders' interior branch sums exactly the CSR terms in CSR order.
 void SolverBatch::detect_stencil(const ParticleSystem& system) {
   stencil = Stencil{};
-  if (!system.grid) return;
+  if (!system.grid)
+    return;
   const std::int64_t gx = system.grid->nx, gy = system.grid->ny;
-  if (gx < 5 || gy < 5) return;
+  if (gx < 5 || gy < 5)
+    return;
   const auto& off = system.adjacency.offsets;
   const auto& refs = system.adjacency.refs;
   const std::int64_t first = 2 * gx + 2;
-  if (off[first + 1] - off[first] != 12) return;
+  if (off[first + 1] - off[first] != 12)
+    return;
   Stencil st;
   st.enabled = 1;
   st.nx = static_cast<std::uint32_t>(gx);
@@ -170,7 +183,8 @@ void SolverBatch::detect_stencil(const ParticleSystem& system) {
   for (std::int64_t j = 2; j < gy - 2; ++j)
     for (std::int64_t i = 2; i < gx - 2; ++i) {
       const std::int64_t p = j * gx + i;
-      if (off[p + 1] - off[p] != 12) return;
+      if (off[p + 1] - off[p] != 12)
+        return;
       for (int k = 0; k < 12; ++k) {
         const SpringRef& r = refs[off[p] + k];
         const Spring& sp = system.springs[r.spring];
@@ -186,23 +200,28 @@ void SolverBatch::detect_stencil(const ParticleSystem& system) {
   for (int k = 0; k < 12; ++k) {
     dj[k] = (st.offset[k] + 2 * gx + 2) / gx - 2;
     di[k] = st.offset[k] - dj[k] * gx;
-    if (st.offset[k] + 2 * gx + 2 < 0 || dj[k] < -2 || dj[k] > 2 || di[k] < -2 || di[k] > 2) return;
+    if (st.offset[k] + 2 * gx + 2 < 0 || dj[k] < -2 || dj[k] > 2 || di[k] < -2 || di[k] > 2)
+      return;
   }
   for (std::int64_t j = 0; j < gy; ++j)
     for (std::int64_t i = 0; i < gx; ++i) {
-      if (i >= 2 && i < gx - 2 && j >= 2 && j < gy - 2) continue; // checked above
+      if (i >= 2 && i < gx - 2 && j >= 2 && j < gy - 2)
+        continue; // checked above
       const std::int64_t p = j * gx + i;
       std::int64_t e = off[p];
       for (int k = 0; k < 12; ++k) {
-        if (i + di[k] < 0 || i + di[k] >= gx || j + dj[k] < 0 || j + dj[k] >= gy) continue;
-        if (e >= off[p + 1]) return;
+        if (i + di[k] < 0 || i + di[k] >= gx || j + dj[k] < 0 || j + dj[k] >= gy)
+          continue;
+        if (e >= off[p + 1])
+          return;
         const SpringRef& r = refs[e++];
         const Spring& sp = system.springs[r.spring];
         if (std::int64_t(r.other) - p != st.offset[k] || float(sp.rest_length) != st.rest[k] ||
             float(sp.stiffness) != st.stiffness[k])
           return;
       }
-      if (e != off[p + 1]) return;
+      if (e != off[p + 1])
+        return;
     }
   stencil.border = 1;
 }
@@ -243,10 +262,18 @@ Result<void> SolverBatch::write_sets() {
         writes[k].pBufferInfo = &infos[k];
       }
     }
-  vk().vkUpdateDescriptorSets(ctx->device, static_cast<std::uint32_t>(writes.size()), writes.data(), 0, nullptr);
+  vk().vkUpdateDescriptorSets(ctx->device, static_cast<std::uint32_t>(writes.size()), writes.data(), 0,
+                              nullptr);
   if (implicit)
-    return implicit->write_sets({{pos[0].buffer, pos[1].buffer}, vel.buffer, force.buffer, normal.buffer, particle.buffer,
-                                 offsets.buffer, edges.buffer, colliders.buffer, flags.buffer,
+    return implicit->write_sets({{pos[0].buffer, pos[1].buffer},
+                                 vel.buffer,
+                                 force.buffer,
+                                 normal.buffer,
+                                 particle.buffer,
+                                 offsets.buffer,
+                                 edges.buffer,
+                                 colliders.buffer,
+                                 flags.buffer,
                                  instances.buffer});
   return {};
 }

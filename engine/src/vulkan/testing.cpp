@@ -9,6 +9,8 @@ void set_allocation_failure_hook(Context& context, std::function<bool()> hook) {
   context_impl(context)->fail_allocation = std::move(hook);
 }
 
-std::size_t pipeline_count(const Context& context) { return context_impl(context)->pipelines->size(); }
+std::size_t pipeline_count(const Context& context) {
+  return context_impl(context)->pipelines->size();
+}
 
 } // namespace vkcloth::gpu::testing

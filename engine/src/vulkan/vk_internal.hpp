@@ -26,10 +26,10 @@ const char* vk_result_name(VkResult r);
 /// ErrorCode::vulkan otherwise; the message names the call and the VkResult.
 Error vk_error(VkResult r, const std::string& what);
 
-#define VKCLOTH_VK_TRY(call, what)                                                                      \
-  do {                                                                                                  \
-    if (const VkResult vkcloth_vk_r_ = (call); vkcloth_vk_r_ != VK_SUCCESS)                             \
-      return ::vkcloth::gpu::vk_error(vkcloth_vk_r_, (what));                                           \
+#define VKCLOTH_VK_TRY(call, what)                                                                           \
+  do {                                                                                                       \
+    if (const VkResult vkcloth_vk_r_ = (call); vkcloth_vk_r_ != VK_SUCCESS)                                  \
+      return ::vkcloth::gpu::vk_error(vkcloth_vk_r_, (what));                                                \
   } while (0)
 
 class PipelineRegistry;
@@ -46,7 +46,9 @@ struct Access {
 } // namespace detail
 
 /// The internals of a Context (kept alive by every object created from it).
-inline const std::shared_ptr<Context::Impl>& context_impl(const Context& c) { return detail::Access::context(c); }
+inline const std::shared_ptr<Context::Impl>& context_impl(const Context& c) {
+  return detail::Access::context(c);
+}
 
 /// Instance-level functions of one instance (loaded from its own vkGetInstanceProcAddr, so
 /// several Contexts on different instances never share function pointers).
@@ -107,7 +109,8 @@ struct Context::Impl {
   Result<void> load(std::uint32_t required_api);
   /// Index of a memory type allowed by `type_bits` having all of `required` (and, when possible,
   /// all of `preferred`); -1 if none.
-  int find_memory_type(std::uint32_t type_bits, VkMemoryPropertyFlags required, VkMemoryPropertyFlags preferred) const;
+  int find_memory_type(std::uint32_t type_bits, VkMemoryPropertyFlags required,
+                       VkMemoryPropertyFlags preferred) const;
 };
 
 } // namespace vkcloth::gpu

@@ -15,7 +15,8 @@ namespace vkcloth::gpu {
 
 std::vector<std::uint32_t> grid_triangle_indices(std::uint32_t nx, std::uint32_t ny) {
   std::vector<std::uint32_t> idx;
-  if (nx < 2 || ny < 2) return idx;
+  if (nx < 2 || ny < 2)
+    return idx;
   idx.reserve(std::size_t(nx - 1) * (ny - 1) * 6);
   for (std::uint32_t j = 0; j + 1 < ny; ++j)
     for (std::uint32_t i = 0; i + 1 < nx; ++i) {
@@ -26,14 +27,15 @@ std::vector<std::uint32_t> grid_triangle_indices(std::uint32_t nx, std::uint32_t
 }
 
 Result<std::unique_ptr<ClothWorld::Impl>> ClothWorld::Impl::create(const std::shared_ptr<Context::Impl>& ctx,
-                                                                    WorldOptions options,
-                                                                    const testing::SolverKnobs& knobs) {
+                                                                   WorldOptions options,
+                                                                   const testing::SolverKnobs& knobs) {
   auto impl = std::make_unique<Impl>();
   impl->ctx = ctx;
   impl->options = std::move(options);
   impl->knobs = knobs;
   auto commands = CommandContext::create(*ctx, "world");
-  if (!commands) return commands.error();
+  if (!commands)
+    return commands.error();
   impl->commands = std::move(*commands);
   if (ctx->timestamp_valid_bits > 0) {
     VkQueryPoolCreateInfo qi{};
@@ -49,7 +51,9 @@ Result<std::unique_ptr<ClothWorld::Impl>> ClothWorld::Impl::create(const std::sh
 ClothWorld::Impl::BatchKey ClothWorld::Impl::key_of(const Instance& inst, InstanceId id) {
   BatchKey k;
   k.topology = inst.topology.get();
-  k.family = inst.params.integrator == Integrator::rk4 ? 1 : inst.params.integrator == Integrator::implicit_euler ? 2 : 0;
+  k.family = inst.params.integrator == Integrator::rk4              ? 1
+             : inst.params.integrator == Integrator::implicit_euler ? 2
+                                                                    : 0;
   k.substeps = inst.params.substeps;
   k.only = k.family == 2 ? id : 0;
   return k;
@@ -57,7 +61,8 @@ ClothWorld::Impl::BatchKey ClothWorld::Impl::key_of(const Instance& inst, Instan
 
 Result<ClothWorld::Impl::Instance*> ClothWorld::Impl::find(InstanceId id) {
   const auto it = instances.find(id);
-  if (it == instances.end()) return make_error(ErrorCode::invalid_argument, fmt::format("no cloth instance with id {}", id));
+  if (it == instances.end())
+    return make_error(ErrorCode::invalid_argument, fmt::format("no cloth instance with id {}", id));
   return &it->second;
 }
 
@@ -72,15 +77,18 @@ Result<void> ClothWorld::Impl::rebuild(const BatchKey& key, const std::vector<In
   for (InstanceId id : members) {
     params.push_back(instances.at(id).params);
     const auto f = fresh.find(id);
-    states.push_back(f == fresh.end() ? SlotState{} : SlotState{&f->second->positions, &f->second->velocities});
+    states.push_back(f == fresh.end() ? SlotState{}
+                                      : SlotState{&f->second->positions, &f->second->velocities});
   }
-  auto made = Batch::create(ctx, commands, *instances.at(members.front()).topology, std::move(params), options.solver,
-                            knobs, states);
-  if (!made) return made.error();
+  auto made = Batch::create(ctx, commands, *instances.at(members.front()).topology, std::move(params),
+                            options.solver, knobs, states);
+  if (!made)
+    return made.error();
   std::unique_ptr<Batch> batch = std::move(*made);
   std::set<Batch*> sources; // the batches the surviving members come from
   for (InstanceId id : members)
-    if (!fresh.count(id)) sources.insert(instances.at(id).batch);
+    if (!fresh.count(id))
+      sources.insert(instances.at(id).batch);
   if (!sources.empty())
     VKCLOTH_TRY(commands.submit_and_wait([&](VkCommandBuffer c) {
       barriers::before_batch_copy(ctx->vk, c);
@@ -92,10 +100,12 @@ Result<void> ClothWorld::Impl::rebuild(const BatchKey& key, const std::vector<In
       barriers::after_batch_copy(ctx->vk, c);
     }));
   // Their flags are current (the copy waited for their work): read each batch's once.
-  for (Batch* source : sources) source->refresh_flags();
+  for (Batch* source : sources)
+    source->refresh_flags();
   for (std::uint32_t k = 0; k < members.size(); ++k) {
     Instance& inst = instances.at(members[k]);
-    if (!fresh.count(members[k])) batch->carry_over(k, inst.batch->slot(inst.slot)); // step count, divergence
+    if (!fresh.count(members[k]))
+      batch->carry_over(k, inst.batch->slot(inst.slot)); // step count, divergence
     inst.batch = batch.get();
     inst.slot = k;
   }
@@ -112,7 +122,8 @@ void ClothWorld::Impl::record_steps(VkCommandBuffer cmd, std::uint32_t steps) {
 }
 
 Result<void> ClothWorld::Impl::simulate(std::uint64_t steps, std::uint32_t steps_per_submit) {
-  if (steps_per_submit == 0) return make_error(ErrorCode::invalid_argument, "steps_per_submit must be > 0");
+  if (steps_per_submit == 0)
+    return make_error(ErrorCode::invalid_argument, "steps_per_submit must be > 0");
   const auto& v = ctx->vk;
   last_ms = queries ? 0.0 : -1.0;
   for (std::uint64_t done = 0; done < steps;) {
@@ -123,12 +134,15 @@ Result<void> ClothWorld::Impl::simulate(std::uint64_t steps, std::uint32_t steps
         v.vkCmdWriteTimestamp(c, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, queries, 0);
       }
       record_steps(c, k);
-      if (queries) v.vkCmdWriteTimestamp(c, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries, 1);
-      barriers::after_steps(v, c, VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT); // flags read by the host
+      if (queries)
+        v.vkCmdWriteTimestamp(c, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries, 1);
+      barriers::after_steps(v, c, VK_PIPELINE_STAGE_HOST_BIT,
+                            VK_ACCESS_HOST_READ_BIT); // flags read by the host
     }));
     if (queries) {
       std::uint64_t ts[2] = {};
-      VKCLOTH_VK_TRY(v.vkGetQueryPoolResults(ctx->device, queries, 0, 2, sizeof(ts), ts, sizeof(std::uint64_t),
+      VKCLOTH_VK_TRY(v.vkGetQueryPoolResults(ctx->device, queries, 0, 2, sizeof(ts), ts,
+                                             sizeof(std::uint64_t),
                                              VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
                      "vkGetQueryPoolResults");
       const std::uint32_t bits = ctx->timestamp_valid_bits;
@@ -148,7 +162,8 @@ Result<void> ClothWorld::Impl::check_divergence() {
 }
 
 Result<void> ClothWorld::Impl::divergence() {
-  for (auto& [key, entry] : batches) entry.solver->refresh_flags();
+  for (auto& [key, entry] : batches)
+    entry.solver->refresh_flags();
   for (auto& [id, inst] : instances)
     if (const auto& d = inst.batch->slot(inst.slot).diverged) {
       Error e = *d;
@@ -164,7 +179,8 @@ Result<ClothWorld> ClothWorld::create(Context& context, WorldOptions options) {
 
 Result<ClothWorld> testing::create_world(Context& context, WorldOptions options, const SolverKnobs& knobs) {
   auto impl = ClothWorld::Impl::create(context_impl(context), std::move(options), knobs);
-  if (!impl) return impl.error();
+  if (!impl)
+    return impl.error();
   return detail::Access::wrap<ClothWorld>(std::move(*impl));
 }
 
@@ -175,23 +191,27 @@ ClothWorld::~ClothWorld() = default;
 
 Result<InstanceId> ClothWorld::add(std::shared_ptr<const ParticleSystem> topology, SimParams params,
                                    const InitialState& initial) {
-  if (!topology) return make_error(ErrorCode::invalid_argument, "ClothWorld::add: the topology is null");
+  if (!topology)
+    return make_error(ErrorCode::invalid_argument, "ClothWorld::add: the topology is null");
   const std::size_t n = topology->size();
   if (!initial.positions.empty() && initial.positions.size() != n)
-    return make_error(ErrorCode::invalid_argument,
-                      fmt::format("ClothWorld::add: initial positions has {} entries, the topology {} particles",
-                                  initial.positions.size(), n));
+    return make_error(
+        ErrorCode::invalid_argument,
+        fmt::format("ClothWorld::add: initial positions has {} entries, the topology {} particles",
+                    initial.positions.size(), n));
   if (!initial.velocities.empty() && initial.velocities.size() != n)
-    return make_error(ErrorCode::invalid_argument,
-                      fmt::format("ClothWorld::add: initial velocities has {} entries, the topology {} particles",
-                                  initial.velocities.size(), n));
+    return make_error(
+        ErrorCode::invalid_argument,
+        fmt::format("ClothWorld::add: initial velocities has {} entries, the topology {} particles",
+                    initial.velocities.size(), n));
   VKCLOTH_TRY(params.validate());
   Impl& s = *impl_;
   const InstanceId id = s.next;
   s.instances.emplace(id, Impl::Instance{std::move(topology), std::move(params)});
   const Impl::BatchKey key = Impl::key_of(s.instances.at(id), id);
   std::vector<InstanceId> members;
-  if (auto it = s.batches.find(key); it != s.batches.end()) members = it->second.members;
+  if (auto it = s.batches.find(key); it != s.batches.end())
+    members = it->second.members;
   members.push_back(id);
   if (auto r = s.rebuild(key, members, {{id, &initial}}); !r) {
     s.instances.erase(id);
@@ -203,7 +223,8 @@ Result<InstanceId> ClothWorld::add(std::shared_ptr<const ParticleSystem> topolog
 
 Result<void> ClothWorld::remove(InstanceId id) {
   auto inst = impl_->find(id);
-  if (!inst) return inst.error();
+  if (!inst)
+    return inst.error();
   Impl& s = *impl_;
   const Impl::BatchKey key = Impl::key_of(**inst, id);
   std::vector<InstanceId> members = s.batches.at(key).members;
@@ -215,7 +236,8 @@ Result<void> ClothWorld::remove(InstanceId id) {
 
 Result<void> ClothWorld::set_params(InstanceId id, SimParams params) {
   auto found = impl_->find(id);
-  if (!found) return found.error();
+  if (!found)
+    return found.error();
   VKCLOTH_TRY(params.validate());
   Impl& s = *impl_;
   Impl::Instance& inst = **found;
@@ -233,7 +255,8 @@ Result<void> ClothWorld::set_params(InstanceId id, SimParams params) {
   }
   // Another integrator family or substep count: the instance moves to that batch.
   std::vector<InstanceId> joined;
-  if (auto it = s.batches.find(new_key); it != s.batches.end()) joined = it->second.members;
+  if (auto it = s.batches.find(new_key); it != s.batches.end())
+    joined = it->second.members;
   joined.push_back(id);
   if (auto r = s.rebuild(new_key, joined, {}); !r) {
     inst.params = std::move(previous);
@@ -246,15 +269,21 @@ Result<void> ClothWorld::set_params(InstanceId id, SimParams params) {
 
 Result<SimParams> ClothWorld::params(InstanceId id) const {
   auto inst = impl_->find(id);
-  if (!inst) return inst.error();
+  if (!inst)
+    return inst.error();
   return (*inst)->params;
 }
 
-void ClothWorld::record_step(VkCommandBuffer cmd) { record_steps(cmd, 1); }
+void ClothWorld::record_step(VkCommandBuffer cmd) {
+  record_steps(cmd, 1);
+}
 
-void ClothWorld::record_steps(VkCommandBuffer cmd, std::uint32_t steps) { impl_->record_steps(cmd, steps); }
+void ClothWorld::record_steps(VkCommandBuffer cmd, std::uint32_t steps) {
+  impl_->record_steps(cmd, steps);
+}
 
-void ClothWorld::record_barrier_to(VkCommandBuffer cmd, VkPipelineStageFlags dst_stage, VkAccessFlags dst_access) const {
+void ClothWorld::record_barrier_to(VkCommandBuffer cmd, VkPipelineStageFlags dst_stage,
+                                   VkAccessFlags dst_access) const {
   barriers::after_steps(impl_->ctx->vk, cmd, dst_stage, dst_access);
 }
 
@@ -262,13 +291,16 @@ Result<void> ClothWorld::simulate(std::uint64_t steps, std::uint32_t steps_per_s
   return impl_->simulate(steps, steps_per_submit);
 }
 
-Result<void> ClothWorld::check_divergence() { return impl_->check_divergence(); }
+Result<void> ClothWorld::check_divergence() {
+  return impl_->check_divergence();
+}
 
 namespace {
 
 Result<std::vector<glm::vec3>> read(ClothWorld::Impl& w, InstanceId id, SolverBatch::Field field) {
   auto inst = w.find(id);
-  if (!inst) return inst.error();
+  if (!inst)
+    return inst.error();
   return (*inst)->batch->read(field, (*inst)->slot);
 }
 
@@ -280,11 +312,14 @@ Result<std::vector<glm::vec3>> ClothWorld::positions(InstanceId id) {
 Result<std::vector<glm::vec3>> ClothWorld::velocities(InstanceId id) {
   return read(*impl_, id, SolverBatch::Field::velocities);
 }
-Result<std::vector<glm::vec3>> ClothWorld::normals(InstanceId id) { return read(*impl_, id, SolverBatch::Field::normals); }
+Result<std::vector<glm::vec3>> ClothWorld::normals(InstanceId id) {
+  return read(*impl_, id, SolverBatch::Field::normals);
+}
 
 Result<InstanceBuffers> ClothWorld::buffers(InstanceId id) const {
   auto inst = impl_->find(id);
-  if (!inst) return inst.error();
+  if (!inst)
+    return inst.error();
   return (*inst)->batch->buffers((*inst)->slot);
 }
 
@@ -293,9 +328,13 @@ std::uint64_t ClothWorld::step_index(InstanceId id) const {
   return inst ? (*inst)->batch->slot((*inst)->slot).step : 0;
 }
 
-std::size_t ClothWorld::batch_count() const { return impl_->batches.size(); }
+std::size_t ClothWorld::batch_count() const {
+  return impl_->batches.size();
+}
 
-std::uint64_t ClothWorld::dispatches_recorded() const { return impl_->dispatches; }
+std::uint64_t ClothWorld::dispatches_recorded() const {
+  return impl_->dispatches;
+}
 
 std::shared_ptr<const ParticleSystem> ClothWorld::topology(InstanceId id) const {
   auto inst = impl_->find(id);
@@ -304,9 +343,12 @@ std::shared_ptr<const ParticleSystem> ClothWorld::topology(InstanceId id) const 
 
 std::vector<InstanceId> ClothWorld::instances() const {
   std::vector<InstanceId> ids;
-  for (const auto& [id, inst] : impl_->instances) ids.push_back(id);
+  for (const auto& [id, inst] : impl_->instances)
+    ids.push_back(id);
   return ids;
 }
-std::size_t ClothWorld::size() const { return impl_->instances.size(); }
+std::size_t ClothWorld::size() const {
+  return impl_->instances.size();
+}
 
 } // namespace vkcloth::gpu

@@ -65,8 +65,8 @@ public:
                                       const ParticleSystem& system, RendererOptions options);
   /// The same for a ClothWorld instance: `params` gives the colliders to draw (world.params(id)),
   /// `system` its topology (world.topology(id)).
-  static Result<ClothRenderer> create(gpu::Context& context, const SimParams& params, const ParticleSystem& system,
-                                      RendererOptions options);
+  static Result<ClothRenderer> create(gpu::Context& context, const SimParams& params,
+                                      const ParticleSystem& system, RendererOptions options);
 
   ClothRenderer(ClothRenderer&&) noexcept;
   ClothRenderer& operator=(ClothRenderer&&) noexcept;
