@@ -1,4 +1,4 @@
-// Single and coupled springs (report §2) against closed forms and the integrators' stability theory.
+// Single and coupled springs (docs/model.md "Springs", "Integrators") against closed forms and the integrators' stability theory.
 // The observations of the report run on every backend; the convergence-order and energy studies
 // need double precision and run on the CPU double solver.
 #include <doctest/doctest.h>

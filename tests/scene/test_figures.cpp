@@ -39,7 +39,7 @@ void check_spring_physics(const nlohmann::json& m) {
   CHECK(m["spring"]["double_spring"]["energy_end"].get<double>() < m["spring"]["double_spring"]["energy_start"].get<double>());
 }
 
-/// The cloth figures' numbers (report §3-4): each parameter study moves the way the report says.
+/// The cloth figures' numbers (docs/model.md "The report's observations"): each parameter study moves the way the report says.
 void check_cloth_physics(const nlohmann::json& m) {
   const auto& c = m["cloth"];
   auto num = [](const nlohmann::json& j) { return j.get<double>(); };

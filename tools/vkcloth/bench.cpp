@@ -40,8 +40,8 @@ struct BenchOptions {
 };
 
 /// The benchmark scene at n x n: a 1 m x 1 m vertical cloth hanging from its two top corners, in
-/// the wind. The total mass stays that of the report's 64 x 64-ish cloth scaled to the grid
-/// (m = 0.05 kg * 4096 / n^2, the particle mass 0.05 kg of the report at 64 x 64), and the wind
+/// the wind. The total mass stays that of a 64 x 64 cloth of 0.05 kg particles scaled to the grid
+/// (m = 0.05 kg * 4096 / n^2), and the wind
 /// force scales with m, so the accelerations are the same at every size; dt = 5e-4 s keeps the
 /// stiffest size (1024: sqrt(k/m) ~ 450 1/s per spring) well inside the Euler stability limit.
 struct BenchScene {

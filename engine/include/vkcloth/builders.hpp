@@ -1,4 +1,4 @@
-// Builders for the report's systems: a chain of springs (§2) and a cloth grid (§3).
+// Builders for the report's systems: a chain of springs and a cloth grid (docs/model.md "Springs").
 #pragma once
 
 #include <array>
@@ -16,7 +16,7 @@ namespace vkcloth {
 /// A fixed anchor (particle 0, pinned) followed by masses joined in a line: spring k joins
 /// particle k and k+1. Coordinates: z is up and the anchor is the ceiling; the report's
 /// mass position (0, 0, 0.4) is a distance BELOW the ceiling, so here it is anchor + (0, 0, -0.4).
-/// Defaults are the report's single spring (§2.1): K = 20, L0 = 0.4, m = 1, started at rest length.
+/// Defaults: the report's single spring K = 20, with vkcloth's L0 = 0.4, m = 1, started at rest length.
 struct ChainDesc {
   glm::dvec3 anchor{0.0, 0.0, 0.0};
   std::vector<double> masses{1.0};
@@ -46,7 +46,7 @@ struct ClothDesc {
   glm::dvec2 size{1.0, 1.0};
   glm::dvec3 origin{0.0, 0.0, 0.0};
   ClothOrientation orientation = ClothOrientation::vertical;
-  double particle_mass = 0.05; ///< with 40/8/8 at dt 0.02 a 10 x 10 cloth diverges past K_struct ~ 50, as in the report
+  double particle_mass = 0.05; ///< vkcloth's choice (the report gives no mass); docs/model.md "The report's observations"
   ClothStiffness stiffness;
   /// Pinned (i, j) cells; empty means the two top corners (0, ny-1) and (nx-1, ny-1).
   std::vector<std::array<std::uint32_t, 2>> pins;

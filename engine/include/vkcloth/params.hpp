@@ -15,7 +15,7 @@ namespace vkcloth {
 
 /// Time integrators, each named for what it is (see docs/scene-format.md).
 enum class Integrator : std::uint32_t {
-  explicit_euler = 0,      ///< p += dt v_old; v += dt a   (report eq. 3 as written)
+  explicit_euler = 0,      ///< p += dt v_old; v += dt a   (the report's update as written; docs/model.md "Integrators")
   semi_implicit_euler = 1, ///< v += dt a; p += dt v_new   (what the report observed; the default)
   rk4 = 2,                 ///< classic 4-stage Runge-Kutta on (p, v)
   implicit_euler = 3,      ///< backward Euler (Baraff & Witkin 1998), linearised, solved by PCG
@@ -61,18 +61,19 @@ struct SimParams {
   /// ... or after this many iterations (then the step uses the last iterate).
   std::uint32_t cg_max_iterations = 200;
   glm::dvec3 gravity{0.0, 0.0, -9.81};
-  /// Fluid damping mu (1/s): the force -mu m v. With m = 1 it is the report's -mu v (§2);
-  /// on a cloth it is eq. 4's (1 - dt mu) velocity factor.
+  /// Fluid damping mu (1/s): the force -mu m v. With m = 1 it is the report's -mu v; on a cloth
+  /// it is the (1 - dt mu) velocity factor (docs/model.md "Forces").
   double damping = 0.5;
   Wind wind;
   std::vector<Collider> colliders;
   /// Projection distance eps: a particle found inside a collider is put back at surface + eps.
   /// A particle closer than 2 eps to a surface is "in contact" (its inward v and F are removed).
   double contact_epsilon = 1e-3;
-  /// Remove only the parts of v and F that point INTO a collider (report §4, the default). False
+  /// Remove only the parts of v and F that point INTO a collider (the default; docs/model.md "Collisions"). False
   /// removes the whole normal part, the variant of the report's Figure 12 where the cloth sticks.
   bool contact_inward_only = true;
-  /// A position farther than this from the origin (or non-finite) counts as a blow-up.
+  /// A position with a coordinate |x_i| > this, or a non-finite position or velocity, is a blow-up
+  /// (docs/model.md "Divergence").
   double divergence_limit = 1e4;
 
   /// Checks every field (finite, in range) and normalises directions. The message names the field.

@@ -13,12 +13,12 @@
 
 namespace vkcloth {
 
-/// The report's spring families (Figure 4); `plain` is a chain spring (§2).
+/// The report's spring families (docs/model.md "Springs"); `plain` is a chain spring.
 enum class SpringKind : std::uint32_t { plain = 0, structural = 1, shear = 2, bend = 3 };
 
 const char* to_string(SpringKind kind);
 
-/// Hooke spring between particles a and b (report eq. 2): F_a = K (|u| - L0) u/|u|, u = p_b - p_a.
+/// Hooke spring between particles a and b (docs/model.md "Springs"): F_a = K (|u| - L0) u/|u|, u = p_b - p_a.
 struct Spring {
   std::uint32_t a = 0;
   std::uint32_t b = 0;
