@@ -56,19 +56,10 @@ void main() {
   }
 
   const bool pinned = pinned_at(p);
-  const float m = mass_at(p);
-  precise vec3 x = pos_at(p);
-  precise vec3 v = vf;
-  if (!pinned && !fr) {
-    precise vec3 a = f / m;
-    if (ip.integrator == VKCLOTH_INTEGRATOR_SEMI_IMPLICIT_EULER) {
-      v = v + a * ip.dt;
-      x = x + v * ip.dt;
-    } else {
-      x = x + v * ip.dt;
-      v = v + a * ip.dt;
-    }
-  }
+  vec3 x = pos_at(p);
+  vec3 v = vf;
+  if (!pinned && !fr)
+    euler_update(ip.integrator == VKCLOTH_INTEGRATOR_SEMI_IMPLICIT_EULER, x, v, f, mass_at(p), ip.dt);
   if (fr) v = v0;
   finish(p, pinned || fr, x, v);
 }

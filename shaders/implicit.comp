@@ -42,15 +42,13 @@ void workgroup_partial(vec2 value) {
   if (l == 0u) partials[gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x] = red[0];
 }
 
-precise vec3 apply_ks(uint e, vec3 w) {
-  const vec4 a = ks[2u * e], b = ks[2u * e + 1u]; // (xx yy zz xy), (xz yz)
-  precise float x = a.x * w.x + a.w * w.y;
-  x = x + b.x * w.z;
-  precise float y = a.w * w.x + a.y * w.y;
-  y = y + b.y * w.z;
-  precise float z = b.x * w.x + b.y * w.y;
-  z = z + a.z * w.z;
-  return vec3(x, y, z);
+// Edge e's stiffness block, stored as two vec4: (xx yy zz xy), (xz yz 0 0).
+SpringBlock block_at(uint e) {
+  const vec4 a = ks[2u * e], b = ks[2u * e + 1u];
+  SpringBlock s;
+  s.diag = a.xyz;
+  s.off = vec3(a.w, b.x, b.y);
+  return s;
 }
 
 void main() {
@@ -84,30 +82,19 @@ void main() {
       const uint end = offsets[p + 1];
       for (uint e = offsets[p]; e < end; ++e) {
         const Edge s = edges[e];
-        precise vec3 u = pos_in[s.other].xyz - x;
-        precise float len = sqrt(dot3(u, u));
-        vec4 a = vec4(0.0), b = vec4(0.0);
-        if (len > 0.0) {
-          precise vec3 n = u / len;
-          precise float c = s.stiffness * max(0.0, 1.0 - s.rest_length / len);
-          precise float al = s.stiffness - c;
-          precise float xx = al * n.x * n.x + c, yy = al * n.y * n.y + c, zz = al * n.z * n.z + c;
-          precise float xy = al * n.x * n.y, xz = al * n.x * n.z, yz = al * n.y * n.z;
-          a = vec4(xx, yy, zz, xy);
-          b = vec4(xz, yz, 0.0, 0.0);
-        }
-        ks[2u * e] = a;
-        ks[2u * e + 1u] = b;
-        lv = lv + apply_ks(e, vp - vf[s.other].xyz);
-        ksum = ksum + a.xyz;
+        const SpringBlock k = spring_block(pos_in[s.other].xyz - x, s.rest_length, s.stiffness);
+        ks[2u * e] = vec4(k.diag, k.off.x);
+        ks[2u * e + 1u] = vec4(k.off.y, k.off.z, 0.0, 0.0);
+        lv = lv + apply_block(k, vp - vf[s.other].xyz);
+        ksum = ksum + k.diag;
       }
-      precise vec3 diag = vec3(mu_h * particle[p].mass) + ksum * h2;
+      const vec3 diag = implicit_diagonal(mu_h, particle[p].mass, ksum, h2);
       cx[p] = vec4(0.0);
       if (pinned) {
         diag_inv[p] = cr[p] = cz[p] = cd[p] = vec4(0.0);
       } else {
         precise vec3 di = vec3(1.0) / diag;
-        precise vec3 r = (force_out[p].xyz - lv * h) * h;
+        const vec3 r = implicit_rhs(force_out[p].xyz, lv, h);
         precise vec3 z = r * di;
         diag_inv[p] = vec4(di, 0.0);
         cr[p] = vec4(r, 0.0);
@@ -127,8 +114,8 @@ void main() {
       if (!pinned) {
         precise vec3 s = vec3(0.0);
         const uint end = offsets[p + 1];
-        for (uint e = offsets[p]; e < end; ++e) s = s + apply_ks(e, dp - cd[edges[e].other].xyz);
-        q = dp * (mu_h * particle[p].mass) + s * h2;
+        for (uint e = offsets[p]; e < end; ++e) s = s + apply_block(block_at(e), dp - cd[edges[e].other].xyz);
+        q = implicit_row(dp, mu_h, particle[p].mass, s, h2);
       }
       cq[p] = vec4(q, 0.0);
       part = vec2(dot3(dp, q), 0.0);
@@ -168,14 +155,12 @@ void main() {
     return;
   }
   precise vec3 v = vf[p].xyz + cx[p].xyz;
-  for (uint c = 0u; c < ip.collider_count; ++c) { // CpuSolver::contact_at on the new velocity
+  const bool both = (ip.flags & VKCLOTH_FLAG_CONTACT_BOTH) != 0u;
+  for (uint c = 0u; c < ip.collider_count; ++c) { // the contact filter on the new velocity only
     float dist;
     vec3 n;
-    collider_contact(c, x0, dist, n);
-    if (!(dist < ip.band)) continue;
-    const bool both = (ip.flags & VKCLOTH_FLAG_CONTACT_BOTH) != 0u;
-    precise float vn = dot3(v, n);
-    if (vn < 0.0 || (both && vn != 0.0)) v = v - n * vn;
+    collider_at(c, x0, dist, n);
+    if (dist < ip.band) remove_inward(v, n, both);
   }
   precise vec3 x = x0 + v * h;
   finish(p, false, x, v);

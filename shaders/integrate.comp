@@ -1,7 +1,7 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// Integration pass, one invocation per particle (CpuSolver::step after the forces, then
-// CpuSolver::project and check_finite). Euler: one pass per step. RK4: one pass per stage;
+// Integration pass, one invocation per particle (the CPU reference's update after the forces,
+// then projection and the divergence check; formulas from cloth_kernel.h). Euler: one pass per step. RK4: one pass per stage;
 // stages 0..2 write the next stage's (STAGE_POS, STAGE_VEL) and the running sums, stage 3
 // writes the new state. Reads FORCE_OUT, VEL_FILT (own), POS_BASE, VEL; writes POS_OUT, VEL.
 #include "vkcloth_shared.h"
@@ -37,18 +37,9 @@ void main() {
   const vec3 vf = vel_filt[g].xyz;
 
   if (ip.integrator != VKCLOTH_INTEGRATOR_RK4) {
-    precise vec3 x = x0;
-    precise vec3 v = vf;
-    if (!pinned) {
-      precise vec3 a = f / m;
-      if (ip.integrator == VKCLOTH_INTEGRATOR_SEMI_IMPLICIT_EULER) {
-        v = v + a * ip.dt;
-        x = x + v * ip.dt;
-      } else {
-        x = x + v * ip.dt;
-        v = v + a * ip.dt;
-      }
-    }
+    vec3 x = x0;
+    vec3 v = vf;
+    if (!pinned) euler_update(ip.integrator == VKCLOTH_INTEGRATOR_SEMI_IMPLICIT_EULER, x, v, f, m, ip.dt);
     finish(p, pinned, x, v);
     return;
   }
@@ -56,33 +47,22 @@ void main() {
   // RK4 stage k: k_pos = stage velocity (after contacts), k_vel = F / m; zero when pinned.
   precise vec3 kp = pinned ? vec3(0.0) : vf;
   precise vec3 kv = pinned ? vec3(0.0) : f / m;
-  precise vec3 sp, sv;
-  if (pc.stage == 0u) {
-    sp = kp;
-    sv = kv;
-  } else if (pc.stage < 3u) {
-    sp = acc_pos[g].xyz + kp * 2.0; // CPU: dp = k0 + k1 * 2; dp += k2 * 2
-    sv = acc_vel[g].xyz + kv * 2.0;
-  } else {
-    sp = acc_pos[g].xyz + kp; // dp += k3
-    sv = acc_vel[g].xyz + kv;
-  }
+  const vec3 sp = rk4_accumulate(pc.stage, pc.stage == 0u ? vec3(0.0) : acc_pos[g].xyz, kp);
+  const vec3 sv = rk4_accumulate(pc.stage, pc.stage == 0u ? vec3(0.0) : acc_vel[g].xyz, kv);
   const vec3 v0 = vel[g].xyz;
-  if (pc.stage < 3u) {
-    precise float c_next = pc.stage < 2u ? ip.dt / 2.0 : ip.dt; // CPU: c = {0, dt/2, dt/2, dt}
+  if (pc.stage < 3u) { // the running sums and the next stage's point y0 + c_{k+1} k_k
+    const float c_next = rk4_c(pc.stage + 1u, ip.dt);
     acc_pos[g] = vec4(sp, 0.0);
     acc_vel[g] = vec4(sv, 0.0);
-    precise vec3 y = x0 + kp * c_next; // y_{k+1} = y0 + c_{k+1} k_k
-    precise vec3 w = v0 + kv * c_next;
-    stage_pos[g] = vec4(y, 1.0);
-    stage_vel[g] = vec4(w, 0.0);
+    stage_pos[g] = vec4(rk4_stage_point(x0, kp, c_next), 1.0);
+    stage_vel[g] = vec4(rk4_stage_point(v0, kv, c_next), 0.0);
     return;
   }
-  precise vec3 x = x0;
-  precise vec3 v = v0;
+  vec3 x = x0;
+  vec3 v = v0;
   if (!pinned) {
-    x = x + sp * ip.w6;
-    v = v + sv * ip.w6;
+    x = rk4_finish(x0, sp, ip.w6);
+    v = rk4_finish(v0, sv, ip.w6);
   }
   finish(p, pinned, x, v);
 }

@@ -1,6 +1,6 @@
-// Helpers shared by force.comp and integrate.comp. Every float expression is written in the
-// order engine/src/core/cpu_solver.cpp uses, and `precise` keeps the compiler from fusing or
-// reassociating it (no FMA contraction), so lavapipe reproduces the CPU bit for bit.
+// What every compute shader shares: workgroup size, push constants, the instance's parameters,
+// the topology and collider buffers, and the per-particle physics of cloth_kernel.h (the same
+// source the CPU reference compiles as C++), so lavapipe reproduces the CPU bit for bit.
 #ifndef VKCLOTH_COMMON_GLSL
 #define VKCLOTH_COMMON_GLSL
 
@@ -74,36 +74,23 @@ uint particle_index() {
 // CPU, which stops there). Stable within a dispatch: first_bad_step only takes this step's value.
 bool frozen() { return flags[inst].first_bad_step < pc.step; }
 
-// dot3(a, b) = a.x*b.x + a.y*b.y + a.z*b.z, left to right (CPU dot3).
-precise float dot3(vec3 a, vec3 b) {
-  precise float r = a.x * b.x + a.y * b.y;
-  r = r + a.z * b.z;
-  return r;
+// The per-particle physics shared with the CPU reference (cloth_kernel.h, also compiled as C++
+// by engine/src/core/kernel.hpp): its language prelude for GLSL.
+#define real float
+#define KFN
+#define OUT(T) out T
+#define INOUT(T) inout T
+// No component is NaN or inf, from the bits: a compiler that assumes finite floats cannot fold it.
+bool all_finite(vec3 v) {
+  const uvec3 bits = floatBitsToUint(v) & 0x7f800000u; // exponent all ones: inf or NaN
+  return all(notEqual(bits, uvec3(0x7f800000u)));
 }
+#include "cloth_kernel.h"
 
-// glm::cross order.
-precise vec3 cross3(vec3 x, vec3 y) {
-  precise float cx = x.y * y.z - y.y * x.z;
-  precise float cy = x.z * y.x - y.z * x.x;
-  precise float cz = x.x * y.y - y.x * x.y;
-  return vec3(cx, cy, cz);
-}
-
-// Signed distance to the instance's collider c and its outward unit normal (CPU collider_contact).
-void collider_contact(uint c, vec3 p, out float distance, out vec3 normal) {
-  const vec4 shape = colliders[ip.collider_first + c].shape;
-  if (colliders[ip.collider_first + c].type == VKCLOTH_COLLIDER_PLANE) {
-    normal = shape.xyz;
-    precise float d = dot3(shape.xyz, p) - shape.w;
-    distance = d;
-    return;
-  }
-  precise vec3 r = p - shape.xyz;
-  precise float len = sqrt(dot3(r, r));
-  precise vec3 n = len > 0.0 ? r / len : vec3(0.0, 0.0, 1.0); // at the exact centre, push up
-  precise float d = len - shape.w;
-  normal = n;
-  distance = d;
+// Signed distance to the instance's collider c and its outward unit normal.
+void collider_at(uint c, vec3 p, out float distance, out vec3 normal) {
+  const Collider col = colliders[ip.collider_first + c];
+  collider_contact(col.type, col.shape.xyz, col.shape.w, p, distance, normal);
 }
 
 #endif

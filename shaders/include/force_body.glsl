@@ -1,7 +1,8 @@
-// The force evaluation of one particle (CpuSolver::normal_at, force_at, contact_at), shared by
-// force.comp (two-pass layout) and fused.comp (one pass per Euler step): vertex normal from the
-// grid neighbours, spring gather in SpringAdjacency order, gravity, damping -mu m v, wind
-// Kw <n, u> n, then contact filtering. Reads POS_IN (all particles), OFFSETS, EDGES, PARTICLE.
+// The force evaluation of one particle, shared by force.comp (two-pass layout), fused.comp (one
+// pass per Euler step) and implicit.comp: vertex normal from the grid fan, spring gather in the
+// topology's order, gravity, damping, wind, then contact filtering; each formula from
+// cloth_kernel.h, which the CPU reference compiles too. Reads POS_IN (all particles), OFFSETS,
+// EDGES, PARTICLE.
 #ifndef VKCLOTH_FORCE_BODY_GLSL
 #define VKCLOTH_FORCE_BODY_GLSL
 
@@ -90,16 +91,12 @@ uint stencil_present(uint i, uint j) {
          stencil_bit(i, j, SC_OFF9, 512u) | stencil_bit(i, j, SC_OFF10, 1024u) | stencil_bit(i, j, SC_OFF11, 2048u);
 }
 
-// One spring term of report eq. 2, exactly as the CSR loop below.
-void spring_term(inout precise vec3 f, vec3 x, uint q, float rest, float k) {
-  precise vec3 u = pos_at(q) - x;
-  precise float len = sqrt(dot3(u, u));
-  if (len > 0.0) f = f + u * (k * (len - rest) / len);
-}
+// One spring term (cloth_kernel.h add_spring) towards this instance's particle q.
+void spring_term(inout vec3 f, vec3 x, uint q, float rest, float k) { add_spring(f, x, pos_at(q), rest, k); }
 
-// CpuSolver::normal_at for particle (i, j): fan right, up, left, down; area-weighted sum of the
-// cross products of consecutive present edges, k = 0..3 in that order (the CPU's loop, unrolled:
-// no local arrays, which llvmpipe would keep in memory with per-lane gathers).
+// The grid fan of particle (i, j): right, up, left, down; one triangle per consecutive present
+// pair, k = 0..3 in that order, as the topology's fan lists give it to the CPU (unrolled: no
+// local arrays, which llvmpipe would keep in memory with per-lane gathers).
 vec3 grid_normal(uint p) {
   const uint nx = SC_STENCIL ? SC_NX : pc.nx; // a constant divisor when specialised
   const uint i = p % nx, j = p / nx;
@@ -110,24 +107,22 @@ vec3 grid_normal(uint p) {
   if (h1) e1 = pos_at(p + nx) - x;
   if (h2) e2 = pos_at(p - 1u) - x;
   if (h3) e3 = pos_at(p - nx) - x;
-  precise vec3 sum = vec3(0.0);
-  if (h0 && h1) sum = sum + cross3(e0, e1);
-  if (h1 && h2) sum = sum + cross3(e1, e2);
-  if (h2 && h3) sum = sum + cross3(e2, e3);
-  if (h3 && h0) sum = sum + cross3(e3, e0);
-  precise float len = sqrt(dot3(sum, sum));
-  precise vec3 n = len > 0.0 ? sum / len : vec3(0.0);
-  return n;
+  vec3 sum = vec3(0.0);
+  if (h0 && h1) add_fan_triangle(sum, e0, e1);
+  if (h1 && h2) add_fan_triangle(sum, e1, e2);
+  if (h2 && h3) add_fan_triangle(sum, e2, e3);
+  if (h3 && h0) add_fan_triangle(sum, e3, e0);
+  return unit_or_zero(sum);
 }
 
 // Force on particle p (index within the instance) after contacts (f), its velocity after contacts (v, in: the state velocity)
 // and its unit normal (nrm).
 void particle_force(uint p, inout vec3 v_io, out vec3 f_out, out vec3 nrm_out) {
-  precise vec3 nrm = vec3(0.0);
+  vec3 nrm = vec3(0.0);
   if ((ip.flags & VKCLOTH_FLAG_HAS_GRID) != 0u) nrm = grid_normal(p);
 
   const vec3 x = pos_at(p);
-  precise vec3 f = vec3(0.0);
+  vec3 f = vec3(0.0);
   bool interior = false;
   uint has = 0xfffu; // bit k: stencil neighbour k exists (all of them inside)
   if (SC_STENCIL) {
@@ -156,31 +151,22 @@ void particle_force(uint p, inout vec3 v_io, out vec3 f_out, out vec3 nrm_out) {
     const uint end = offsets[p + 1];
     for (uint e = offsets[p]; e < end; ++e) {
       const Edge s = edges[e];
-      spring_term(f, x, s.other, s.rest_length, s.stiffness); // report eq. 2
+      spring_term(f, x, s.other, s.rest_length, s.stiffness);
     }
   }
   const float m = mass_at(p);
-  f = f + ip.gravity_damping.xyz * m;
-  precise float mu_m = ip.gravity_damping.w * m;
-  precise vec3 v = v_io;
-  f = f - v * mu_m;
-  if ((ip.flags & VKCLOTH_FLAG_WIND) != 0u) {
-    precise float kn = ip.wind.w * dot3(nrm, ip.wind.xyz);
-    f = f + nrm * kn;
-  }
+  vec3 v = v_io;
+  f = add_body_forces(f, m, v, ip.gravity_damping.xyz, ip.gravity_damping.w, (ip.flags & VKCLOTH_FLAG_WIND) != 0u,
+                      nrm, ip.wind.xyz, ip.wind.w);
 
   // Contacts: inside the 2 eps band, remove only the parts of v and F pointing into the collider.
   if (!pinned_at(p)) {
+    const bool both = (ip.flags & VKCLOTH_FLAG_CONTACT_BOTH) != 0u;
     for (uint c = 0u; c < (SC_COLLIDERS ? ip.collider_count : 0u); ++c) {
       float dist;
       vec3 n;
-      collider_contact(c, x, dist, n);
-      if (!(dist < ip.band)) continue;
-      const bool both = (ip.flags & VKCLOTH_FLAG_CONTACT_BOTH) != 0u;
-      precise float vn = dot3(v, n);
-      if (vn < 0.0 || (both && vn != 0.0)) v = v - n * vn;
-      precise float fn = dot3(f, n);
-      if (fn < 0.0 || (both && fn != 0.0)) f = f - n * fn;
+      collider_at(c, x, dist, n);
+      contact_filter(v, f, n, dist, ip.band, both);
     }
   }
 

@@ -11,27 +11,10 @@
 namespace vkcloth {
 namespace {
 
-template <typename V> auto dot3(V a, V b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-
-/// K_s w for K_s stored as (xx, yy, zz, xy, xz, yz).
-template <typename Real, typename V> V apply(const std::array<Real, 6>& k, V w) {
-  return V{k[0] * w.x + k[3] * w.y + k[4] * w.z, k[3] * w.x + k[1] * w.y + k[5] * w.z,
-           k[4] * w.x + k[5] * w.y + k[2] * w.z};
-}
-
-/// The positive semi-definite part of a spring's stiffness matrix (implicit_euler.hpp).
-template <typename Real, typename V> std::array<Real, 6> spring_block(V u, Real rest, Real k) {
-  const Real len = std::sqrt(dot3(u, u));
-  if (!(len > Real(0))) return {};
-  const V n = u / len;
-  const Real c = k * std::max(Real(0), Real(1) - rest / len); // transverse (tension only)
-  const Real a = k - c;                                        // along the spring: a + c = k
-  return {a * n.x * n.x + c, a * n.y * n.y + c, a * n.z * n.z + c, a * n.x * n.y, a * n.x * n.z, a * n.y * n.z};
-}
-
 template <typename Real, typename V> Real dot_all(const std::vector<V>& a, const std::vector<V>& b) {
   Real s = Real(0);
-  for (std::size_t p = 0; p < a.size(); ++p) s += dot3(a[p], b[p]); // particle order: deterministic
+  for (std::size_t p = 0; p < a.size(); ++p)
+    s += kernel::dot3(a[p], b[p]); // particle order: deterministic
   return s;
 }
 
@@ -39,15 +22,18 @@ template <typename Real, typename V> Real dot_all(const std::vector<V>& a, const
 
 template <typename Real> void CpuSolver<Real>::implicit_substep(const Real h) {
   const std::size_t n = pos_.size();
-  if (!implicit_) implicit_ = std::make_unique<detail::ImplicitWorkspace<Real>>();
+  if (!implicit_)
+    implicit_ = std::make_unique<detail::ImplicitWorkspace<Real>>();
   auto& w = *implicit_;
   if (w.x.size() != n) {
     w.ks.assign(edges_.size(), {});
-    for (auto* v : {&w.vf, &w.diag_inv, &w.x, &w.r, &w.z, &w.d, &w.q}) v->assign(n, Vec3(0));
+    for (auto* v : {&w.vf, &w.diag_inv, &w.x, &w.r, &w.z, &w.d, &w.q})
+      v->assign(n, Vec3(0));
   }
   auto parallel = [&](auto&& body) {
     pool_->parallel_for(n, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t p = begin; p < end; ++p) body(p);
+      for (std::size_t p = begin; p < end; ++p)
+        body(p);
     });
   };
   const Real mu_h = Real(1) + h * Real(params_.damping); // M - h D = (1 + h mu) M
@@ -57,7 +43,8 @@ template <typename Real> void CpuSolver<Real>::implicit_substep(const Real h) {
   parallel([&](std::size_t p) {
     Vec3 f = normal_force_at(pos_, vel_, p);
     Vec3 v = vel_[p];
-    if (!pinned_[p]) contact_at(pos_[p], v, f);
+    if (!pinned_[p])
+      contact_at(pos_[p], v, f);
     force_[p] = f;
     w.vf[p] = v;
   });
@@ -66,23 +53,22 @@ template <typename Real> void CpuSolver<Real>::implicit_substep(const Real h) {
     const Vec3 x = pos_[p];
     const Vec3 vp = w.vf[p];
     Vec3 lv(0);
-    Vec3 diag(mu_h * mass_[p]);
     Vec3 ksum(0);
     for (std::uint32_t e = edge_offsets_[p]; e < edge_offsets_[p + 1]; ++e) {
       const Edge& s = edges_[e];
-      const auto k = spring_block<Real>(pos_[s.other] - x, s.rest_length, s.stiffness);
+      const auto k = kernel::spring_block(pos_[s.other] - x, s.rest_length, s.stiffness);
       w.ks[e] = k;
-      lv += apply<Real>(k, vp - w.vf[s.other]);
-      ksum += Vec3{k[0], k[1], k[2]};
+      lv += kernel::apply_block(k, vp - w.vf[s.other]);
+      ksum += k.diag;
     }
-    diag += ksum * h2;
+    const Vec3 diag = kernel::implicit_diagonal(mu_h, mass_[p], ksum, h2);
     w.x[p] = Vec3(0);
     if (pinned_[p]) {
       w.diag_inv[p] = w.r[p] = w.z[p] = w.d[p] = Vec3(0);
       return;
     }
     w.diag_inv[p] = Vec3(1) / diag;
-    w.r[p] = (force_[p] - lv * h) * h;
+    w.r[p] = kernel::implicit_rhs(force_[p], lv, h);
     w.z[p] = w.r[p] * w.diag_inv[p];
     w.d[p] = w.z[p];
   });
@@ -102,11 +88,12 @@ template <typename Real> void CpuSolver<Real>::implicit_substep(const Real h) {
       const Vec3 dp = w.d[p];
       Vec3 s(0);
       for (std::uint32_t e = edge_offsets_[p]; e < edge_offsets_[p + 1]; ++e)
-        s += apply<Real>(w.ks[e], dp - w.d[edges_[e].other]);
-      w.q[p] = dp * (mu_h * mass_[p]) + s * h2;
+        s += kernel::apply_block(w.ks[e], dp - w.d[edges_[e].other]);
+      w.q[p] = kernel::implicit_row(dp, mu_h, mass_[p], s, h2);
     });
     const Real dq = dot_all<Real>(w.d, w.q);
-    if (!(dq > Real(0))) break;
+    if (!(dq > Real(0)))
+      break;
     const Real alpha = rz / dq;
     parallel([&](std::size_t p) {
       w.x[p] += w.d[p] * alpha;
@@ -118,7 +105,8 @@ template <typename Real> void CpuSolver<Real>::implicit_substep(const Real h) {
     const Real beta = rz_new / rz;
     rz = rz_new;
     ++it;
-    if (rr <= tol2 * rr0) break; // converged: d is not needed any more
+    if (rr <= tol2 * rr0)
+      break; // converged: d is not needed any more
     parallel([&](std::size_t p) { w.d[p] = w.z[p] + w.d[p] * beta; });
   }
   solve_.iterations = it;
@@ -127,7 +115,8 @@ template <typename Real> void CpuSolver<Real>::implicit_substep(const Real h) {
   // 4. v' = v + dv, the inward part removed in contact; x' = x + h v', projected.
   // Only particle p's own state is read here, so the update is in place.
   parallel([&](std::size_t p) {
-    if (pinned_[p]) return; // stays put, velocity zero
+    if (pinned_[p])
+      return; // stays put, velocity zero
     Vec3 v = w.vf[p] + w.x[p];
     Vec3 no_force(0);
     contact_at(pos_[p], v, no_force); // inward normal part of v' (the whole part if !inward_only)

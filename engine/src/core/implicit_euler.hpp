@@ -24,6 +24,8 @@
 // kept unless contact_inward_only is false), then x' = x + h v' is projected as usual.
 #pragma once
 
+#include "kernel.hpp"
+
 #include <array>
 #include <vector>
 
@@ -33,8 +35,8 @@ namespace vkcloth::detail {
 
 template <typename Real> struct ImplicitWorkspace {
   using Vec3 = glm::vec<3, Real, glm::defaultp>;
-  /// Per CSR entry: K_s as (xx, yy, zz, xy, xz, yz).
-  std::vector<std::array<Real, 6>> ks;
+  /// Per CSR entry: the spring's stiffness block K_s (cloth_kernel.h spring_block).
+  std::vector<kernel::SpringBlock<Real>> ks;
   std::vector<Vec3> vf;       ///< contact-filtered velocity
   std::vector<Vec3> diag_inv; ///< 1 / diag(A), zero for pinned particles (the filter S)
   std::vector<Vec3> x, r, z, d, q;

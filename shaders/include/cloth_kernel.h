@@ -1,0 +1,237 @@
+// The per-particle physics of vkcloth, written ONCE for both backends: the compute shaders
+// include this file as GLSL (through common.glsl) and the CPU reference solver compiles it as
+// C++ (through engine/src/core/kernel.hpp, with GLM, for float and for double), as Jolt's
+// HairIntegrate.h is shared by its HLSL and its C++ solver. The equations: docs/model.md.
+//
+// Rules that keep CPU and GPU bit-identical (on lavapipe; a real GPU may round sqrt/division
+// differently):
+// - Every expression is written out in one fixed order, and every result lands in a `precise`
+//   variable, so the shader compiler may neither reassociate nor fuse it into an FMA (the C++
+//   side builds with -ffp-contract=off; `precise` is empty there).
+// - Literals are `real(...)`: a bare 2.0 would be a double in C++.
+// - Pure functions of values: no buffer, no loop over particles or colliders. Each caller
+//   gathers its inputs its own way (texel fetches, std::vector) and loops itself.
+//
+// Provided by the including file: real, vec3, uint, KFN (function prefix: `inline` in C++),
+// OUT(T) / INOUT(T) (out / inout parameters: T& in C++), precise, sqrt, abs, max, and
+// all_finite(vec3) (no component is NaN or inf). Constants: vkcloth_shared.h.
+// No include guard: kernel.hpp includes this file once per precision, in two namespaces.
+
+// ---- Vector helpers ----------------------------------------------------------------------------
+
+// a.x b.x + a.y b.y + a.z b.z, left to right.
+KFN precise real dot3(vec3 a, vec3 b) {
+  precise real r = a.x * b.x + a.y * b.y;
+  r = r + a.z * b.z;
+  return r;
+}
+
+// cross(x, y) in glm::cross's order.
+KFN precise vec3 cross3(vec3 x, vec3 y) {
+  precise real cx = x.y * y.z - y.y * x.z;
+  precise real cy = x.z * y.x - y.z * x.x;
+  precise real cz = x.x * y.y - y.x * x.y;
+  return vec3(cx, cy, cz);
+}
+
+// ---- Normals (docs/model.md "Wind") ------------------------------------------------------------
+
+// One triangle of a particle's fan: sum += cross(x_a - x, x_b - x), twice the triangle's area
+// along its normal, so the fan's sum is an area-weighted vertex normal.
+KFN void add_fan_triangle(INOUT(vec3) sum, vec3 ea, vec3 eb) {
+  precise vec3 t = sum + cross3(ea, eb);
+  sum = t;
+}
+
+// The unit normal of a fan sum; zero for a degenerate fan (and for particles without a surface).
+KFN precise vec3 unit_or_zero(vec3 sum) {
+  precise real len = sqrt(dot3(sum, sum));
+  precise vec3 n = len > real(0) ? sum / len : vec3(real(0));
+  return n;
+}
+
+// ---- Forces (docs/model.md "Springs", "Forces", "Wind") -------------------------
+
+// Eq. 2, one spring of particle x towards its neighbour xq: f += K (|u| - L0) u / |u|, u = xq - x.
+// A zero-length spring has no direction and adds nothing.
+KFN void add_spring(INOUT(vec3) f, vec3 x, vec3 xq, real rest, real k) {
+  precise vec3 u = xq - x;
+  precise real len = sqrt(dot3(u, u));
+  if (len > real(0)) {
+    precise vec3 t = f + u * (k * (len - rest) / len);
+    f = t;
+  }
+}
+
+// The springs' sum plus gravity m g, fluid damping -mu m v and (when `wind`) wind Kw <n, u> n.
+KFN precise vec3 add_body_forces(vec3 springs, real m, vec3 v, vec3 gravity, real mu, bool wind, vec3 nrm,
+                                 vec3 wind_dir, real kw) {
+  precise vec3 f = springs + gravity * m;
+  precise real mu_m = mu * m;
+  f = f - v * mu_m;
+  if (wind) {
+    precise real kn = kw * dot3(nrm, wind_dir);
+    f = f + nrm * kn;
+  }
+  return f;
+}
+
+// ---- Contacts (docs/model.md "Collisions") ----------------------------------------------------
+
+// Signed distance of p to a collider and the collider's outward unit normal there. Plane
+// {n.p = offset}: (a, b) = (n, offset); sphere: (a, b) = (centre, radius).
+KFN void collider_contact(uint type, vec3 a, real b, vec3 p, OUT(real) distance, OUT(vec3) normal) {
+  if (type == VKCLOTH_COLLIDER_PLANE) {
+    precise real d = dot3(a, p) - b;
+    distance = d;
+    normal = a;
+    return;
+  }
+  precise vec3 r = p - a;
+  precise real len = sqrt(dot3(r, r));
+  precise vec3 n = len > real(0) ? r / len : vec3(real(0), real(0), real(1)); // at the centre: push up
+  precise real d = len - b;
+  distance = d;
+  normal = n;
+}
+
+// Removes the part of `w` along n that points into the collider (<w, n> < 0); with `both`
+// (Figure 12's variant) the outward part as well.
+KFN void remove_inward(INOUT(vec3) w, vec3 n, bool both) {
+  precise real wn = dot3(w, n);
+  if (wn < real(0) || (both && wn != real(0))) {
+    precise vec3 t = w - n * wn;
+    w = t;
+  }
+}
+
+// Contact filter of one collider: within the band (distance < 2 eps) velocity and force lose
+// their parts pointing into the collider, so a hand lifting the cloth keeps its outward pull.
+KFN void contact_filter(INOUT(vec3) v, INOUT(vec3) f, vec3 n, real distance, real band, bool both) {
+  if (!(distance < band))
+    return;
+  remove_inward(v, n, both);
+  remove_inward(f, n, both);
+}
+
+// Eq. 5 / eq. 6: a point inside a collider goes back to its surface + eps, and loses its
+// inward velocity.
+KFN void project_out(uint type, vec3 a, real b, real eps, INOUT(vec3) x, INOUT(vec3) v) {
+  real distance;
+  vec3 n;
+  collider_contact(type, a, b, x, distance, n);
+  if (!(distance < real(0)))
+    return;
+  if (type == VKCLOTH_COLLIDER_PLANE) {
+    precise real back = eps - distance;
+    precise vec3 t = x + n * back;
+    x = t;
+  } else {
+    precise real r = b + eps;
+    precise vec3 t = a + n * r;
+    x = t;
+  }
+  remove_inward(v, n, false);
+}
+
+// ---- Integrators (docs/model.md "Integrators") ------------------------------------------------
+
+// Eq. 3 (explicit: x with the old v) or semi-implicit Euler (x with the new v); a = F / m.
+KFN void euler_update(bool semi, INOUT(vec3) x, INOUT(vec3) v, vec3 f, real m, real dt) {
+  precise vec3 a = f / m;
+  if (semi) {
+    precise vec3 nv = v + a * dt;
+    precise vec3 nx = x + nv * dt;
+    v = nv;
+    x = nx;
+  } else {
+    precise vec3 nx = x + v * dt;
+    precise vec3 nv = v + a * dt;
+    x = nx;
+    v = nv;
+  }
+}
+
+// RK4 stage s (0..3) is evaluated at y_s = y0 + c_s k_{s-1}, c = (0, dt/2, dt/2, dt).
+KFN precise real rk4_c(uint stage, real dt) {
+  precise real c = stage == 0u ? real(0) : (stage < 3u ? dt / real(2) : dt);
+  return c;
+}
+KFN precise vec3 rk4_stage_point(vec3 y0, vec3 k_prev, real c) {
+  precise vec3 y = y0 + k_prev * c;
+  return y;
+}
+// Running sum k1 + 2 k2 + 2 k3 + k4, one stage at a time (same order as summing at the end).
+KFN precise vec3 rk4_accumulate(uint stage, vec3 sum, vec3 k) {
+  precise vec3 s = stage == 0u ? k : (stage < 3u ? sum + k * real(2) : sum + k);
+  return s;
+}
+// y1 = y0 + (dt / 6) (k1 + 2 k2 + 2 k3 + k4).
+KFN precise vec3 rk4_finish(vec3 y0, vec3 sum, real dt_over_6) {
+  precise vec3 y = y0 + sum * dt_over_6;
+  return y;
+}
+
+// ---- Implicit Euler (docs/model.md "Implicit Euler") ------------------------------------------
+
+// A spring's 3x3 stiffness block, symmetric: diag = (xx, yy, zz), off = (xy, xz, yz).
+struct SpringBlock {
+  vec3 diag;
+  vec3 off;
+};
+
+// The positive semi-definite part of a spring's Jacobian: k along the spring, and the transverse
+// tension term k max(0, 1 - L0 / |u|) across it (the compressive part is dropped).
+KFN SpringBlock spring_block(vec3 u, real rest, real k) {
+  SpringBlock s;
+  s.diag = vec3(real(0));
+  s.off = vec3(real(0));
+  precise real len = sqrt(dot3(u, u));
+  if (len > real(0)) {
+    precise vec3 n = u / len;
+    precise real c = k * max(real(0), real(1) - rest / len);
+    precise real al = k - c;
+    precise real xx = al * n.x * n.x + c, yy = al * n.y * n.y + c, zz = al * n.z * n.z + c;
+    precise real xy = al * n.x * n.y, xz = al * n.x * n.z, yz = al * n.y * n.z;
+    s.diag = vec3(xx, yy, zz);
+    s.off = vec3(xy, xz, yz);
+  }
+  return s;
+}
+
+// K w for a symmetric block.
+KFN precise vec3 apply_block(SpringBlock s, vec3 w) {
+  precise real x = s.diag.x * w.x + s.off.x * w.y;
+  x = x + s.off.y * w.z;
+  precise real y = s.off.x * w.x + s.diag.y * w.y;
+  y = y + s.off.z * w.z;
+  precise real z = s.off.y * w.x + s.off.z * w.y;
+  z = z + s.diag.z * w.z;
+  return vec3(x, y, z);
+}
+
+// The implicit system A = (1 + h mu) M + h^2 K (K: the springs' blocks), row by row.
+// Jacobi diagonal: (1 + h mu) m + h^2 times the sum of the blocks' diagonals.
+KFN precise vec3 implicit_diagonal(real mu_h, real m, vec3 block_diagonals, real h2) {
+  precise real mm = mu_h * m;
+  precise vec3 d = vec3(mm) + block_diagonals * h2;
+  return d;
+}
+// (A w)_p: the mass term plus h^2 times sum_q K_pq (w_p - w_q).
+KFN precise vec3 implicit_row(vec3 w, real mu_h, real m, vec3 springs, real h2) {
+  precise real mm = mu_h * m;
+  precise vec3 q = w * mm + springs * h2;
+  return q;
+}
+// Right-hand side h (f - h K v) (K v: the springs' sum of K_pq (v_p - v_q)).
+KFN precise vec3 implicit_rhs(vec3 f, vec3 kv, real h) {
+  precise vec3 r = (f - kv * h) * h;
+  return r;
+}
+
+// ---- Divergence (docs/model.md "Divergence") -------------------------------------------
+
+// A particle has diverged when a component of x or v is NaN or inf, or |x_i| > limit.
+KFN bool diverged(vec3 x, vec3 v, real limit) {
+  return !all_finite(x) || !all_finite(v) || abs(x.x) > limit || abs(x.y) > limit || abs(x.z) > limit;
+}
