@@ -490,7 +490,8 @@ TEST_CASE("the CPU row sweep's finite check catches a bad particle in any lane, 
 
 namespace {
 /// Runs `steps` steps of a CpuSolver<Real> created while VKCLOTH_CPU_SIMD = `isa` (the row kernel's
-/// ISA is chosen at creation), returning positions, velocities, forces and normals end to end.
+/// ISA is chosen at creation; "scalar": every particle through the shared kernel, cloth_kernel.h),
+/// returning positions, velocities, forces and normals end to end.
 template <typename Real>
 std::vector<glm::vec<3, Real>> run_with_isa(const char* isa, const ParticleSystem& sys, const SimParams& p,
                                             unsigned threads, int steps) {
@@ -515,7 +516,7 @@ template <typename Real> std::size_t bitwise_differences(const std::vector<glm::
 }
 } // namespace
 
-TEST_CASE_TEMPLATE("the SIMD row kernels (AVX2, AVX-512) give the scalar kernel's bits", Real, float, double) {
+TEST_CASE_TEMPLATE("the SIMD row kernels (AVX2, AVX-512) give the shared reference's bits", Real, float, double) {
   // Odd sizes: interior runs of 33 particles = whole vectors plus a scalar remainder, and chunk
   // boundaries of the 2-thread split fall mid-row. Wind on, an interior pinned particle (the
   // kernel's pin select), a perturbed start so no lane sees a symmetric configuration. On a CPU

@@ -429,8 +429,8 @@ template <typename Real> void CpuSolver<Real>::substep(const Real dt) {
       }
     };
     if (rows) {
-      // Whole vectors in SIMD, a remainder shorter than one vector through the scalar kernel;
-      // then the finite check of what was written that the SIMD kernel did not check already.
+      // Whole vectors in SIMD, a remainder shorter than one vector through the per-particle
+      // reference; then the finite check of what was written that the SIMD kernel did not check.
       const Real limit = Real(params_.divergence_limit);
       ra.limit = limit;
       Real* const pn = &pos_next_[0].x;

@@ -1,7 +1,8 @@
-// The CPU solver's interior row kernel: its arguments and the per-ISA SIMD entry points.
-// cpu_solver.cpp holds the scalar kernel (the reference); row_kernel_avx2.cpp and
-// row_kernel_avx512.cpp hold the same arithmetic with 8 / 16 particles per vector, each file
-// compiled with its own -m flags and only called after __builtin_cpu_supports said yes.
+// The CPU solver's grid row kernel: its arguments and the per-ISA SIMD entry points.
+// The reference is the shared kernel (shaders/include/cloth_kernel.h, per particle in
+// cpu_solver.cpp); row_kernel_avx2.cpp and row_kernel_avx512.cpp hold the same arithmetic with
+// 8 / 16 (float) particles per vector, each file compiled with its own -m flags and only called
+// after __builtin_cpu_supports said yes.
 #pragma once
 
 #include <cstddef>
@@ -34,7 +35,7 @@ template <typename Real> struct RowArgs {
 };
 
 // Each processes whole vectors from q0 and returns where it stopped (q1 minus the remainder,
-// fewer than one vector, which the caller runs through the scalar kernel). When integrating, each
+// fewer than one vector, which the caller runs through the per-particle reference). When integrating, each
 // also applies check_finite's test to the positions and velocities it wrote and sets `bad` if one
 // fails (it never clears it); without integrating the caller checks after finishing the particles.
 std::int64_t row_kernel_avx512(const RowArgs<float>& a, std::int64_t q0, std::int64_t q1, bool& bad);

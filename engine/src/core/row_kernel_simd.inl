@@ -4,9 +4,13 @@
 // sqrt, pin mask, AoS load3/store3). Everything here has internal linkage, so the two ISA
 // translation units never share (ODR-merge) a function compiled for the other's ISA.
 //
-// Bits: every lane performs the scalar kernel's operations (cpu_solver.cpp, row_kernel_body) on
-// its particle, one for one and in the same order; IEEE +, -, *, / and sqrt are correctly rounded
-// in SIMD as in scalar code, -ffp-contract=off forbids FMA, `if (len > 0)` is the same select.
+// An optimised copy of the shared kernel (shaders/include/cloth_kernel.h: add_fan_triangle,
+// unit_or_zero, add_spring, add_body_forces, euler_update, diverged), the one place a formula is
+// written twice: GCC vector types cannot pass through the kernel's scalar-typed functions. Bits:
+// every lane performs the kernel's operations on its particle, one for one and in the same order;
+// IEEE +, -, *, / and sqrt are correctly rounded in SIMD as in scalar code, -ffp-contract=off
+// forbids FMA, `if (len > 0)` is the same select. tests/test_cloth.cpp "the SIMD row kernels ...
+// give the shared reference's bits" fails when they differ: change both together.
 // Do not include anything else here (no std headers with inline functions: see above).
 
 namespace {
