@@ -1,12 +1,13 @@
 // The CPU reference solver: deterministic (same input -> bit-identical output), float by default,
 // double for accuracy studies. The Vulkan solver is checked against it.
 //
-// One step, in this order (the GPU passes do the same per particle):
-//   1. normals   n_p = normalize(sum of the fan triangles' cross products around p)  [cloth only]
-//   2. force     F_p = sum over p's springs in gather order (SpringAdjacency)
+// One step, in this order (the GPU passes do the same per particle; every formula comes from
+// shaders/include/cloth_kernel.h, which both compile; docs/model.md has the equations):
+//   1. normals   n_p = normalize(sum of p's fan triangles' cross products)  [surfaces only]
+//   2. force     F_p = sum over p's springs in gather order (ClothTopology::edges)
 //                      + m g - mu m v + Kw <n, u_w> n
 //   3. contact   for each collider the particle touches (distance < 2 eps): remove the normal
-//                part of v and F only where it points into the collider (report §4, Figure 12)
+//                part of v and F only where it points into the collider (Figure 12)
 //   4. integrate explicit / semi-implicit Euler, RK4 (steps 1-3 at each stage), or implicit Euler
 //                (linearised backward Euler solved by PCG, implicit_euler.hpp; the new velocity's
 //                inward part removed for particles in contact)
@@ -26,13 +27,15 @@
 #include "vkcloth/params.hpp"
 #include "vkcloth/result.hpp"
 #include "vkcloth/system.hpp"
+#include "vkcloth/topology.hpp"
 
 namespace vkcloth {
 
 namespace detail {
 class ThreadPool;
 template <typename Real> struct ImplicitWorkspace;
-}
+template <typename Real> struct RowArgs;
+} // namespace detail
 
 struct CpuSolverOptions {
   /// Threads that share a step (including the caller's); 0 = the host's hardware threads.
@@ -46,8 +49,13 @@ template <typename Real> class CpuSolver {
 public:
   using Vec3 = glm::vec<3, Real, glm::defaultp>;
 
-  /// Validates `params` against `system` and copies the initial state.
-  static Result<CpuSolver> create(const ParticleSystem& system, SimParams params, CpuSolverOptions options = {});
+  /// A solver of `topology` (shared, immutable) with `params` (validated), starting from the
+  /// topology's rest state.
+  static Result<CpuSolver> create(std::shared_ptr<const ClothTopology> topology, SimParams params,
+                                  CpuSolverOptions options = {});
+  /// Convenience: prepares the topology of `system` first (ClothTopology::create).
+  static Result<CpuSolver> create(const ParticleSystem& system, SimParams params,
+                                  CpuSolverOptions options = {});
 
   CpuSolver(CpuSolver&&) noexcept;
   CpuSolver& operator=(CpuSolver&&) noexcept;
@@ -55,7 +63,8 @@ public:
 
   unsigned threads() const;
 
-  /// Advances one time step (params().substeps substeps of dt / substeps). On a blow-up the state is left as it was after the bad step.
+  /// Advances one time step (params().substeps substeps of dt / substeps). On a blow-up the state is left as
+  /// it was after the bad step.
   Result<void> step();
   /// Advances `steps` steps, stopping at the first error.
   Result<void> run(std::uint64_t steps);
@@ -76,7 +85,8 @@ public:
 
   std::uint64_t step_index() const { return step_; }
   double time() const { return static_cast<double>(step_) * params_.dt; }
-  const ParticleSystem& system() const { return *system_; }
+  const ParticleSystem& system() const { return topology_->system(); }
+  const std::shared_ptr<const ClothTopology>& topology() const { return topology_; }
 
   /// Moves one particle (a "hand"): sets its position and velocity for the next step.
   /// ErrorCode::invalid_argument (state unchanged) when `index` >= the particle count or a
@@ -92,42 +102,47 @@ public:
 
 private:
   CpuSolver();
-  // Per-particle kernels: each reads shared inputs and writes only particle p's outputs.
+  // Per-particle kernels (each formula from shaders/include/cloth_kernel.h): each reads shared
+  // inputs and writes only particle p's outputs.
   Vec3 normal_at(std::span<const Vec3> pos, std::size_t p) const;
   Vec3 force_at(std::span<const Vec3> pos, std::span<const Vec3> vel, std::size_t p) const;
-  /// normal_at + force_at for particle p: writes normal_[p] (cloth), returns the force.
+  /// normal_at + force_at for particle p: writes normal_[p], returns the force.
   Vec3 normal_force_at(std::span<const Vec3> pos, std::span<const Vec3> vel, std::size_t p);
-  void detect_stencil();
   void contact_at(Vec3 pos, Vec3& vel, Vec3& force) const;
   void project_at(Vec3& pos, Vec3& vel) const;
   template <typename F> void for_particles(F&& body);
   Result<void> check_finite() const;
   void substep(Real h);
+  // Explicit / semi-implicit Euler: contacts, update and projection of particle p with force f
+  // (writes force_[p], pos_next_[p], vel_[p]).
+  void euler_finish(std::size_t p, Vec3 f, Real h, bool semi);
+  void euler_substep(Real h, bool semi);
+  void row_sweep(Real h, bool semi); // euler_substep on a grid stencil (row_kernel.hpp)
+  detail::RowArgs<Real> row_args(Real h, bool semi);
+  void rk4_substep(Real h);
   void implicit_substep(Real h); // implicit_euler.cpp
 
+  /// A gather-list entry in the solver's precision (ClothTopology::edges() converted once).
   struct Edge {
     std::uint32_t other;
     Real rest_length;
     Real stiffness;
   };
 
-  std::shared_ptr<const ParticleSystem> system_;
+  std::shared_ptr<const ClothTopology> topology_;
   SimParams params_;
-  std::vector<std::uint32_t> edge_offsets_;
+  std::span<const std::uint32_t> edge_offsets_; // the topology's
   std::vector<Edge> edges_;
   std::vector<Real> mass_;
   std::vector<std::uint8_t> pinned_;
   std::vector<Vec3> pos_, vel_, force_, normal_;
-  std::vector<Vec3> pos_next_; // integration writes here while forces still read pos_
+  std::vector<Vec3> pos_next_;                     // integration writes here while forces still read pos_
   std::array<std::vector<Vec3>, 4> k_pos_, k_vel_; // RK4 stage derivatives
   std::vector<Vec3> stage_pos_, stage_vel_;
-  // Grid stencil: when every interior particle of a cloth (2 <= i < nx-2, 2 <= j < ny-2) has the
-  // same gather list up to translation (same relative neighbour offsets and spring constants, in
-  // the same order), force_at reads the constants from here instead of the CSR lists: same
-  // expressions, same summation order, so the same bits.
-  bool stencil_ = false;
+  // The topology's grid stencil (null: none): interior particles' springs from these constants
+  // instead of the CSR lists, same terms in the same order, so the same bits.
+  const GridStencil* stencil_ = nullptr;
   std::array<std::int64_t, 12> stencil_offset_{};
-  std::array<Edge, 12> stencil_edge_{};
   std::array<Real, 12> stencil_rest_{}, stencil_stiff_{};
   // Positions as SoA for the row kernel: x, y, z blocks of n + 2 soa_pad_ each, particle p of a
   // block at soa_pad_ + p (the pads let masked border lanes read absent neighbours). The row sweep
@@ -136,12 +151,8 @@ private:
   std::vector<Real> soa_, soa_next_;
   std::size_t soa_pad_ = 0;
   bool soa_valid_ = false;
-  // Per-particle stencil masks (row_kernel.hpp RowArgs::mask) when every particle's gather list is
-  // a subsequence of the stencil (make_cloth's grids): then all particles take the row kernel.
-  // Empty otherwise: border particles take the per-particle code.
-  std::vector<std::uint16_t> mask_;
   bool swept_finite_ = false; // the last substep's row sweep found every position/velocity finite
-  int simd_ = 0;           // row kernel ISA: 0 scalar, 1 AVX2, 2 AVX-512F (cpu_solver.cpp)
+  int simd_ = 0;              // row kernel ISA: 0 none, 1 AVX2, 2 AVX-512F (cpu_solver.cpp)
   std::uint64_t step_ = 0;
   std::unique_ptr<detail::ThreadPool> pool_;
   std::unique_ptr<detail::ImplicitWorkspace<Real>> implicit_; // created by the first implicit step
