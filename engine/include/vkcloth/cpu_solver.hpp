@@ -110,7 +110,6 @@ private:
   Vec3 normal_force_at(std::span<const Vec3> pos, std::span<const Vec3> vel, std::size_t p);
   void contact_at(Vec3 pos, Vec3& vel, Vec3& force) const;
   void project_at(Vec3& pos, Vec3& vel) const;
-  template <typename F> void for_particles(F&& body);
   Result<void> check_finite() const;
   void substep(Real h);
   // Explicit / semi-implicit Euler: contacts, update and projection of particle p with force f
@@ -120,7 +119,11 @@ private:
   void row_sweep(Real h, bool semi); // euler_substep on a grid stencil (row_kernel.hpp)
   detail::RowArgs<Real> row_args(Real h, bool semi);
   void rk4_substep(Real h);
-  void implicit_substep(Real h); // implicit_euler.cpp
+  // Implicit Euler (implicit_euler.cpp): forces, then the linear system, CG, and the update.
+  void implicit_substep(Real h);
+  void implicit_system(Real h);
+  void implicit_cg(Real h);
+  void implicit_update(Real h);
 
   /// A gather-list entry in the solver's precision (ClothTopology::edges() converted once).
   struct Edge {

@@ -227,13 +227,6 @@ template <typename Real> void CpuSolver<Real>::project_at(Vec3& pos, Vec3& vel) 
   }
 }
 
-template <typename Real> template <typename F> void CpuSolver<Real>::for_particles(F&& body) {
-  pool_->parallel_for(pos_.size(), [&](std::size_t begin, std::size_t end) {
-    for (std::size_t p = begin; p < end; ++p)
-      body(p);
-  });
-}
-
 template <typename Real> Result<void> CpuSolver<Real>::check_finite() const {
   const Real limit = Real(params_.divergence_limit);
   // bad_components first (no early exit, vectorised); only when something is bad does the loop
@@ -309,7 +302,8 @@ template <typename Real> void CpuSolver<Real>::euler_substep(const Real h, const
     return;
   }
   // One sweep: p's normal needs only positions (read-only here), and force_at reads p's own.
-  for_particles([&](std::size_t p) { euler_finish(p, normal_force_at(pos_, vel_, p), h, semi); });
+  pool_->for_each(pos_.size(),
+                  [&](std::size_t p) { euler_finish(p, normal_force_at(pos_, vel_, p), h, semi); });
   std::swap(pos_, pos_next_);
 }
 
@@ -458,12 +452,12 @@ template <typename Real> void CpuSolver<Real>::rk4_substep(const Real h) {
       stage_vel_ = vel_;
     } else {
       const Real c = kernel::rk4_c(st, h);
-      for_particles([&](std::size_t p) {
+      pool_->for_each(pos_.size(), [&](std::size_t p) {
         stage_pos_[p] = kernel::rk4_stage_point(pos_[p], k_pos_[st - 1][p], c);
         stage_vel_[p] = kernel::rk4_stage_point(vel_[p], k_vel_[st - 1][p], c);
       });
     }
-    for_particles([&](std::size_t p) {
+    pool_->for_each(pos_.size(), [&](std::size_t p) {
       Vec3 f = normal_force_at(stage_pos_, stage_vel_, p);
       if (!pinned_[p])
         contact_at(stage_pos_[p], stage_vel_[p], f);
@@ -474,7 +468,7 @@ template <typename Real> void CpuSolver<Real>::rk4_substep(const Real h) {
     });
   }
   const Real w = h / Real(6);
-  for_particles([&](std::size_t p) {
+  pool_->for_each(pos_.size(), [&](std::size_t p) {
     if (pinned_[p])
       return;
     Vec3 dp(0), dv(0);

@@ -20,6 +20,8 @@ template <typename Real, typename V> Real dot_all(const std::vector<V>& a, const
 
 } // namespace
 
+// The phases of one implicit substep (the method: implicit_euler.hpp). Each parallel sweep writes
+// only particle p's entries; the dot products are sequential, in particle order.
 template <typename Real> void CpuSolver<Real>::implicit_substep(const Real h) {
   const std::size_t n = pos_.size();
   if (!implicit_)
@@ -30,17 +32,8 @@ template <typename Real> void CpuSolver<Real>::implicit_substep(const Real h) {
     for (auto* v : {&w.vf, &w.diag_inv, &w.x, &w.r, &w.z, &w.d, &w.q})
       v->assign(n, Vec3(0));
   }
-  auto parallel = [&](auto&& body) {
-    pool_->parallel_for(n, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t p = begin; p < end; ++p)
-        body(p);
-    });
-  };
-  const Real mu_h = Real(1) + h * Real(params_.damping); // M - h D = (1 + h mu) M
-  const Real h2 = h * h;
-
   // 1. Forces and contact filtering as in the explicit step.
-  parallel([&](std::size_t p) {
+  pool_->for_each(pos_.size(), [&](std::size_t p) {
     Vec3 f = normal_force_at(pos_, vel_, p);
     Vec3 v = vel_[p];
     if (!pinned_[p])
@@ -48,8 +41,17 @@ template <typename Real> void CpuSolver<Real>::implicit_substep(const Real h) {
     force_[p] = f;
     w.vf[p] = v;
   });
-  // 2. Per-entry K_s, the Jacobi diagonal, b = h (f - h L v) filtered; r = b, z = P^-1 r, d = z.
-  parallel([&](std::size_t p) {
+  implicit_system(h);
+  implicit_cg(h);
+  implicit_update(h);
+}
+
+// 2. Per-entry K_s, the Jacobi diagonal, b = h (f - h L v) filtered; r = b, z = P^-1 r, d = z.
+template <typename Real> void CpuSolver<Real>::implicit_system(const Real h) {
+  auto& w = *implicit_;
+  const Real mu_h = Real(1) + h * Real(params_.damping); // M - h D = (1 + h mu) M
+  const Real h2 = h * h;
+  pool_->for_each(pos_.size(), [&](std::size_t p) {
     const Vec3 x = pos_[p];
     const Vec3 vp = w.vf[p];
     Vec3 lv(0);
@@ -72,15 +74,20 @@ template <typename Real> void CpuSolver<Real>::implicit_substep(const Real h) {
     w.z[p] = w.r[p] * w.diag_inv[p];
     w.d[p] = w.z[p];
   });
+}
 
-  // 3. Preconditioned CG on the filtered system.
+// 3. Preconditioned CG on the filtered system; records the iterations and residual in solve_.
+template <typename Real> void CpuSolver<Real>::implicit_cg(const Real h) {
+  auto& w = *implicit_;
+  const Real mu_h = Real(1) + h * Real(params_.damping);
+  const Real h2 = h * h;
   Real rz = dot_all<Real>(w.r, w.z);
   Real rr = dot_all<Real>(w.r, w.r);
   const Real rr0 = rr;
   const Real tol2 = Real(params_.cg_tolerance) * Real(params_.cg_tolerance);
   std::uint32_t it = 0;
   while (it < params_.cg_max_iterations && !(rr <= tol2 * rr0)) {
-    parallel([&](std::size_t p) { // q = S A d
+    pool_->for_each(pos_.size(), [&](std::size_t p) { // q = S A d
       if (pinned_[p]) {
         w.q[p] = Vec3(0);
         return;
@@ -95,7 +102,7 @@ template <typename Real> void CpuSolver<Real>::implicit_substep(const Real h) {
     if (!(dq > Real(0)))
       break;
     const Real alpha = rz / dq;
-    parallel([&](std::size_t p) {
+    pool_->for_each(pos_.size(), [&](std::size_t p) {
       w.x[p] += w.d[p] * alpha;
       w.r[p] -= w.q[p] * alpha;
       w.z[p] = w.r[p] * w.diag_inv[p];
@@ -107,14 +114,17 @@ template <typename Real> void CpuSolver<Real>::implicit_substep(const Real h) {
     ++it;
     if (rr <= tol2 * rr0)
       break; // converged: d is not needed any more
-    parallel([&](std::size_t p) { w.d[p] = w.z[p] + w.d[p] * beta; });
+    pool_->for_each(pos_.size(), [&](std::size_t p) { w.d[p] = w.z[p] + w.d[p] * beta; });
   }
   solve_.iterations = it;
   solve_.residual = rr0 > Real(0) ? std::sqrt(double(rr) / double(rr0)) : 0.0;
+}
 
-  // 4. v' = v + dv, the inward part removed in contact; x' = x + h v', projected.
-  // Only particle p's own state is read here, so the update is in place.
-  parallel([&](std::size_t p) {
+// 4. v' = v + dv, the inward part removed in contact; x' = x + h v', projected. Only particle p's
+// own state is read here, so the update is in place.
+template <typename Real> void CpuSolver<Real>::implicit_update(const Real h) {
+  auto& w = *implicit_;
+  pool_->for_each(pos_.size(), [&](std::size_t p) {
     if (pinned_[p])
       return; // stays put, velocity zero
     Vec3 v = w.vf[p] + w.x[p];
@@ -129,5 +139,11 @@ template <typename Real> void CpuSolver<Real>::implicit_substep(const Real h) {
 
 template void CpuSolver<float>::implicit_substep(float);
 template void CpuSolver<double>::implicit_substep(double);
+template void CpuSolver<float>::implicit_system(float);
+template void CpuSolver<double>::implicit_system(double);
+template void CpuSolver<float>::implicit_cg(float);
+template void CpuSolver<double>::implicit_cg(double);
+template void CpuSolver<float>::implicit_update(float);
+template void CpuSolver<double>::implicit_update(double);
 
 } // namespace vkcloth

@@ -32,6 +32,13 @@ public:
   /// The same with chunks of about `block` items (at least `block`, at most 2 x `block` - 1), so
   /// that the threads share the work by what each actually gets done.
   void parallel_blocks(std::size_t n, std::size_t block, const Fn& fn);
+  /// parallel_for calling body(i) for each i in [0, n).
+  template <typename Body> void for_each(std::size_t n, Body&& body) {
+    parallel_for(n, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i)
+        body(i);
+    });
+  }
 
 private:
   void run(std::size_t n, std::uint32_t blocks, const Fn& fn);
@@ -46,7 +53,7 @@ private:
   std::atomic<std::size_t> n_{0};
   std::atomic<std::uint32_t> blocks_{0};
   std::atomic<std::uint64_t> claim_{0};
-  std::atomic<std::uint32_t> finished_{0}; // blocks of the current job done
+  std::atomic<std::uint32_t> finished_{0};   // blocks of the current job done
   std::atomic<std::uint32_t> generation_{0}; // wakes the workers (spin, then atomic wait)
   std::atomic<bool> stop_{false};
 };
