@@ -26,6 +26,10 @@ template <bool B> struct Flag {
   static constexpr bool value = B;
 };
 
+// One vector of W particles per iteration: normal fan, the 12 stencil springs, body forces, the
+// Euler update and the finite check, in the kernel's order. It is long (~180 lines) on purpose:
+// one loop body whose every value stays in a vector register; split into functions, GCC spills
+// the 16-lane temporaries between them (the SoA loads and the 12 spring terms share them).
 template <typename T, bool wind, bool integrate, bool semi>
 std::int64_t simd_body(const vkcloth::detail::RowArgs<typename T::Real>& a, std::int64_t q0, std::int64_t q1,
                        bool& bad) {
