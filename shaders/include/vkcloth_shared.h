@@ -55,17 +55,17 @@ struct vec4 {
 #define VKCLOTH_TEXEL_BINDING_FLAGS 3
 #define VKCLOTH_TEXEL_BINDING_INSTANCES 4 // InstanceParams as RGBA32UI, 5 texels per instance
 
-// PushConstants::flags bits.
-#define VKCLOTH_FLAG_HAS_GRID 1u // the system is a cloth grid: rebuild normals
+// InstanceParams::flags bits.
+#define VKCLOTH_FLAG_HAS_GRID 1u // the topology is a grid: rebuild normals from the grid fan
 #define VKCLOTH_FLAG_WIND 2u     // wind strength != 0
 #define VKCLOTH_FLAG_CONTACT_BOTH 4u // contacts remove the whole normal part (Figure 12 variant)
 
-// PushConstants::integrator (same values as vkcloth::Integrator).
+// InstanceParams::integrator (the vkcloth::Integrator values; engine/src/core/kernel.hpp asserts it).
 #define VKCLOTH_INTEGRATOR_EXPLICIT_EULER 0u
 #define VKCLOTH_INTEGRATOR_SEMI_IMPLICIT_EULER 1u
 #define VKCLOTH_INTEGRATOR_RK4 2u
 
-// Collider::type (same values as vkcloth::Collider::Type).
+// Collider::type (the vkcloth::Collider::Type values; engine/src/core/kernel.hpp asserts it).
 #define VKCLOTH_COLLIDER_PLANE 0u
 #define VKCLOTH_COLLIDER_SPHERE 1u
 
