@@ -6,6 +6,7 @@
 #include "vkcloth/params.hpp"
 #include "vkcloth/result.hpp"
 #include "vkcloth/system.hpp"
+#include "vkcloth/topology.hpp"
 #include "vkcloth/scene.hpp"
 #include "vkcloth/gpu/gpu_solver.hpp"
 #include "vkcloth/gpu/world.hpp"

@@ -1,0 +1,108 @@
+// ClothTopology: everything a solver or renderer derives from a ParticleSystem's connectivity,
+// prepared ONCE (as Jolt's SoftBodySharedSettings::Optimize) and shared, immutable, by every
+// consumer (std::shared_ptr<const ClothTopology>): the flattened gather lists, the normal fans,
+// the triangle list and uvs, and the grid stencil fast path. Solvers then read, never re-derive,
+// so the CPU and the GPU cannot disagree on the summation order or on when the stencil applies.
+//
+// Meshes and grids share one representation: fans and triangles are general lists (a grid fills
+// them in its particular way); the grid stencil is an optional description of a fast path whose
+// results equal the general lists' term for term.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include <glm/vec2.hpp>
+
+#include "vkcloth/result.hpp"
+#include "vkcloth/system.hpp"
+
+namespace vkcloth {
+
+/// One gather-list entry: the spring's other end and its constants (double, as in the system;
+/// each solver converts to its own precision).
+struct GatherEdge {
+  std::uint32_t other = 0;
+  double rest_length = 0.0;
+  double stiffness = 0.0;
+};
+
+/// One triangle of particle p's normal fan: n_p += cross(x_a - x_p, x_b - x_p), an area-weighted
+/// vertex normal summed in fan order.
+struct FanTriangle {
+  std::uint32_t a = 0;
+  std::uint32_t b = 0;
+};
+
+/// The grid stencil fast path: every interior particle (2 <= i < nx-2, 2 <= j < ny-2) has the same
+/// gather list up to translation (same neighbour offsets, rest lengths and stiffnesses, same
+/// order), so a solver may sum those 12 terms with constant offsets and get the CSR path's bits.
+struct GridStencil {
+  std::array<std::int32_t, 12> offset{}; ///< neighbour = p + offset[k]
+  std::array<double, 12> rest_length{};
+  std::array<double, 12> stiffness{};
+  /// max(nx + 1, max |offset|): the farthest neighbour a (masked) lane may read, the CPU's SoA pad.
+  std::uint32_t reach = 0;
+  /// Per particle, when EVERY particle's gather list is a subsequence of the stencil in stencil
+  /// order (make_cloth grids): bit k (0..11) stencil spring k present, bit 12+k (0..3) normal fan
+  /// term k present (fan right/up, up/left, left/down, down/right). Empty otherwise: border
+  /// particles then take the per-particle CSR path.
+  std::vector<std::uint16_t> masks;
+  /// `masks` is non-empty and every particle's spring bits are exactly the stencil entries whose
+  /// neighbour (i + di, j + dj), |di|, |dj| <= 2, lies inside the grid: the GPU's SC_BORDER
+  /// condition (border particles evaluate the stencil with a bounds test instead of the CSR list).
+  bool border_geometric = false;
+};
+
+class ClothTopology {
+public:
+  /// Validates `system` (ParticleSystem::validate: errors name the problem) and prepares
+  /// everything below from a copy of it.
+  static Result<std::shared_ptr<const ClothTopology>> create(const ParticleSystem& system);
+
+  ClothTopology(const ClothTopology&) = delete;
+  ClothTopology& operator=(const ClothTopology&) = delete;
+
+  /// The source: rest state (initial positions, velocities), masses, pins, springs.
+  const ParticleSystem& system() const { return system_; }
+  std::size_t size() const { return system_.size(); }
+
+  /// CSR over particles, size() + 1 entries: particle p's gather list is
+  /// edges()[edge_offsets()[p] .. edge_offsets()[p+1]), in SpringAdjacency order, which is THE
+  /// force summation order of every solver.
+  std::span<const std::uint32_t> edge_offsets() const { return system_.adjacency.offsets; }
+  std::span<const GatherEdge> edges() const { return edges_; }
+
+  const std::optional<Grid>& grid() const { return system_.grid; }
+  /// Null when the grid stencil does not apply (no grid, a grid under 5 x 5, irregular interior).
+  const GridStencil* stencil() const { return stencil_ ? &*stencil_ : nullptr; }
+
+  /// 3 indices per counter-clockwise triangle; for a grid exactly gpu::grid_triangle_indices(nx,
+  /// ny); empty for chains.
+  std::span<const std::uint32_t> triangles() const { return triangles_; }
+  /// CSR over particles, size() + 1 entries (all zero without a surface: no normals).
+  std::span<const std::uint32_t> fan_offsets() const { return fan_offsets_; }
+  std::span<const FanTriangle> fans() const { return fans_; }
+  /// Texture coordinates per particle; a grid's (i, j) maps to (i / (nx-1), j / (ny-1)); zero for
+  /// chains.
+  std::span<const glm::vec2> uvs() const { return uvs_; }
+  /// A surface has normals, feels wind and is drawn as triangles (else: masses and springs).
+  bool has_surface() const { return !triangles_.empty(); }
+
+private:
+  ClothTopology() = default;
+
+  ParticleSystem system_;
+  std::vector<GatherEdge> edges_;
+  std::optional<GridStencil> stencil_;
+  std::vector<std::uint32_t> triangles_;
+  std::vector<std::uint32_t> fan_offsets_;
+  std::vector<FanTriangle> fans_;
+  std::vector<glm::vec2> uvs_;
+};
+
+} // namespace vkcloth

@@ -1,0 +1,178 @@
+#include "vkcloth/topology.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <utility>
+
+namespace vkcloth {
+
+namespace {
+
+bool same_constants(const GatherEdge& e, const GridStencil& st, int k) {
+  // Compared in double: equal doubles give equal floats, so the verdict holds in every precision.
+  return e.rest_length == st.rest_length[k] && e.stiffness == st.stiffness[k];
+}
+
+/// The fan of grid particle (i, j): neighbours right, up, left, down; each present adjacent pair
+/// (k, k+1 mod 4) is one triangle, in that order (CpuSolver::normal_at, force_body.glsl
+/// grid_normal, term for term).
+struct GridFan {
+  bool has[4];
+  std::uint32_t nb[4];
+  GridFan(std::uint32_t nx, std::uint32_t ny, std::uint32_t p) {
+    const std::uint32_t i = p % nx, j = p / nx;
+    has[0] = i + 1 < nx;
+    has[1] = j + 1 < ny;
+    has[2] = i > 0;
+    has[3] = j > 0;
+    nb[0] = p + 1;
+    nb[1] = p + nx;
+    nb[2] = p - 1;
+    nb[3] = p - nx;
+  }
+  bool term(int k) const { return has[k] && has[(k + 1) & 3]; }
+};
+
+/// The grid stencil of `t`'s gather lists, if it applies: the one detection rule every solver
+/// uses. The size limits (nx, ny >= 5; the first interior particle's list has 12 entries) are the
+/// ones the CPU and GPU solvers applied before this routine replaced theirs.
+std::optional<GridStencil> detect_stencil(const Grid& grid, std::span<const std::uint32_t> off,
+                                          std::span<const GatherEdge> edges) {
+  const std::int64_t nx = grid.nx, ny = grid.ny;
+  if (nx < 5 || ny < 5)
+    return std::nullopt;
+  const std::int64_t first = 2 * nx + 2;
+  if (off[std::size_t(first) + 1] - off[std::size_t(first)] != 12)
+    return std::nullopt;
+  GridStencil st;
+  for (int k = 0; k < 12; ++k) {
+    const GatherEdge& e = edges[off[std::size_t(first)] + std::size_t(k)];
+    const std::int64_t o = std::int64_t(e.other) - first;
+    if (o < std::numeric_limits<std::int32_t>::min() || o > std::numeric_limits<std::int32_t>::max())
+      return std::nullopt; // a neighbour no grid stencil reaches (the shaders take int offsets)
+    st.offset[std::size_t(k)] = static_cast<std::int32_t>(o);
+    st.rest_length[std::size_t(k)] = e.rest_length;
+    st.stiffness[std::size_t(k)] = e.stiffness;
+  }
+  // Every interior list equals the first one up to translation, in the same order.
+  for (std::int64_t j = 2; j < ny - 2; ++j)
+    for (std::int64_t i = 2; i < nx - 2; ++i) {
+      const std::size_t p = std::size_t(j * nx + i);
+      if (off[p + 1] - off[p] != 12)
+        return std::nullopt;
+      for (int k = 0; k < 12; ++k) {
+        const GatherEdge& e = edges[off[p] + std::size_t(k)];
+        if (std::int64_t(e.other) - std::int64_t(p) != st.offset[std::size_t(k)] || !same_constants(e, st, k))
+          return std::nullopt;
+      }
+    }
+  std::int64_t reach = nx + 1;
+  for (std::int32_t o : st.offset)
+    reach = std::max<std::int64_t>(reach, o < 0 ? -std::int64_t(o) : o);
+  st.reach = static_cast<std::uint32_t>(reach);
+
+  // Masks: every particle's list must be the stencil's, in order, with some springs left out
+  // (make_cloth's border particles are); the fan bits follow the grid fan.
+  const std::size_t n = std::size_t(nx * ny);
+  st.masks.assign(n, 0);
+  for (std::size_t p = 0; p < n; ++p) {
+    const GridFan fan(grid.nx, grid.ny, static_cast<std::uint32_t>(p));
+    unsigned m = 0;
+    for (int k = 0; k < 4; ++k)
+      if (fan.term(k))
+        m |= 1u << (12 + k);
+    int k = 0;
+    for (std::uint32_t e = off[p]; e < off[p + 1]; ++e, ++k) {
+      const GatherEdge& ed = edges[e];
+      while (k < 12 && (std::int64_t(ed.other) - std::int64_t(p) != st.offset[std::size_t(k)] ||
+                        !same_constants(ed, st, k)))
+        ++k;
+      if (k == 12) {
+        st.masks.clear(); // irregular: border particles take the CSR path
+        return st;
+      }
+      m |= 1u << k;
+    }
+    st.masks[p] = static_cast<std::uint16_t>(m);
+  }
+
+  // SC_BORDER: each offset is a (di, dj) step in [-2, 2]^2, and every border particle's list is
+  // exactly the stencil entries whose neighbour lies inside the grid, in stencil order (the
+  // interior lists were checked above).
+  std::int64_t di[12], dj[12];
+  for (std::size_t k = 0; k < 12; ++k) {
+    const std::int64_t shifted = std::int64_t(st.offset[k]) + 2 * nx + 2;
+    dj[k] = shifted / nx - 2;
+    di[k] = st.offset[k] - dj[k] * nx;
+    if (shifted < 0 || dj[k] < -2 || dj[k] > 2 || di[k] < -2 || di[k] > 2)
+      return st;
+  }
+  for (std::int64_t j = 0; j < ny; ++j)
+    for (std::int64_t i = 0; i < nx; ++i) {
+      if (i >= 2 && i < nx - 2 && j >= 2 && j < ny - 2)
+        continue;
+      const std::size_t p = std::size_t(j * nx + i);
+      std::size_t e = off[p];
+      for (int k = 0; k < 12; ++k) {
+        if (i + di[k] < 0 || i + di[k] >= nx || j + dj[k] < 0 || j + dj[k] >= ny)
+          continue;
+        if (e >= off[p + 1])
+          return st;
+        const GatherEdge& ed = edges[e++];
+        if (std::int64_t(ed.other) - std::int64_t(p) != st.offset[std::size_t(k)] ||
+            !same_constants(ed, st, k))
+          return st;
+      }
+      if (e != off[p + 1])
+        return st;
+    }
+  st.border_geometric = true;
+  return st;
+}
+
+} // namespace
+
+Result<std::shared_ptr<const ClothTopology>> ClothTopology::create(const ParticleSystem& system) {
+  VKCLOTH_TRY(system.validate());
+  std::shared_ptr<ClothTopology> t(new ClothTopology());
+  t->system_ = system;
+  const ParticleSystem& s = t->system_;
+  const std::size_t n = s.size();
+
+  t->edges_.reserve(s.adjacency.refs.size());
+  for (const SpringRef& r : s.adjacency.refs) {
+    const Spring& sp = s.springs[r.spring];
+    t->edges_.push_back(GatherEdge{r.other, sp.rest_length, sp.stiffness});
+  }
+
+  t->fan_offsets_.assign(n + 1, 0);
+  t->uvs_.assign(n, glm::vec2(0.0f));
+  if (s.grid) {
+    const std::uint32_t nx = s.grid->nx, ny = s.grid->ny;
+    for (std::uint32_t p = 0; p < n; ++p) {
+      const GridFan fan(nx, ny, p);
+      for (int k = 0; k < 4; ++k)
+        if (fan.term(k))
+          t->fans_.push_back(FanTriangle{fan.nb[k], fan.nb[(k + 1) & 3]});
+      t->fan_offsets_[p + 1] = static_cast<std::uint32_t>(t->fans_.size());
+    }
+    // Two counter-clockwise triangles (a, b, d), (a, d, c) per quad.
+    if (nx >= 2 && ny >= 2) {
+      t->triangles_.reserve(std::size_t(nx - 1) * (ny - 1) * 6);
+      for (std::uint32_t j = 0; j + 1 < ny; ++j)
+        for (std::uint32_t i = 0; i + 1 < nx; ++i) {
+          const std::uint32_t a = j * nx + i, b = a + 1, c = a + nx, d = c + 1;
+          t->triangles_.insert(t->triangles_.end(), {a, b, d, a, d, c});
+        }
+    }
+    // In float, as the GPU solver has always uploaded them (drawn images depend on these bits).
+    for (std::uint32_t j = 0; j < ny; ++j)
+      for (std::uint32_t i = 0; i < nx; ++i)
+        t->uvs_[std::size_t(j) * nx + i] =
+            glm::vec2(nx > 1 ? float(i) / float(nx - 1) : 0.0f, ny > 1 ? float(j) / float(ny - 1) : 0.0f);
+    t->stencil_ = detect_stencil(*s.grid, t->edge_offsets(), t->edges_);
+  }
+  return std::shared_ptr<const ClothTopology>(std::move(t));
+}
+
+} // namespace vkcloth
