@@ -39,7 +39,6 @@ Scene cloth_scene(const ClothDesc& d, SimParams p, std::string name) {
   Scene s;
   s.name = std::move(name);
   s.system = *make_cloth(d); // valid by construction
-  s.system_kind = "cloth";
   (void)p.validate();
   s.params = std::move(p);
   return s;
