@@ -95,6 +95,6 @@ int main(int argc, char** argv) {
     fmt::print(stderr, "error: {}\n", system.error().message);
     return 2;
   }
-  vkcloth::Scene scene{"cloth_" + opt.preset, std::move(*system), params, 500, "cloth"};
+  vkcloth::Scene scene{"cloth_" + opt.preset, std::move(*system), params, 500};
   return samples::run(scene, opt);
 }

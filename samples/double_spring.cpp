@@ -17,7 +17,6 @@ int main(int argc, char** argv) {
   vkcloth::Scene scene;
   scene.name = "double_spring";
   scene.system = *vkcloth::make_chain(chain);
-  scene.system_kind = "chain";
   scene.params.dt = 0.02;
   scene.params.damping = 0.1;
   if (auto v = scene.params.validate(); !v) return 2;

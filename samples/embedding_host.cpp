@@ -239,8 +239,12 @@ int main(int argc, char** argv) {
     auto falling_sys = make_cloth(falling);
     auto hanging_sys = make_cloth(hanging);
     if (!falling_sys || !hanging_sys) return std::fprintf(stderr, "make_cloth failed\n"), 1;
-    auto falling_topo = std::make_shared<const ParticleSystem>(std::move(falling_sys.value()));
-    auto hanging_topo = std::make_shared<const ParticleSystem>(std::move(hanging_sys.value()));
+    // Each topology is prepared once; every instance of it shares it (and one batch).
+    auto falling_prep = ClothTopology::create(*falling_sys);
+    auto hanging_prep = ClothTopology::create(*hanging_sys);
+    if (!falling_prep || !hanging_prep)
+      return std::fprintf(stderr, "ClothTopology::create failed\n"), 1;
+    const std::shared_ptr<const ClothTopology> falling_topo = *falling_prep, hanging_topo = *hanging_prep;
     SimParams on_sphere;
     on_sphere.dt = 0.01;
     on_sphere.colliders = {Collider::plane({0, 0, 1}, 0.0), Collider::sphere({-0.45, 0.0, 0.18}, 0.18)};
@@ -253,7 +257,8 @@ int main(int argc, char** argv) {
     auto b = world->add(hanging_topo, windy);
     // A second cloth of the same topology, behind the first, with its own start and wind.
     gpu::InitialState behind;
-    for (const Particle& q : hanging_topo->particles) behind.positions.push_back(q.position + glm::dvec3(-0.15, 0.55, 0.2));
+    for (const Particle& q : hanging_topo->system().particles)
+      behind.positions.push_back(q.position + glm::dvec3(-0.15, 0.55, 0.2));
     SimParams gusty = windy;
     gusty.wind.strength = 0.12;
     auto c = world->add(hanging_topo, gusty, behind);

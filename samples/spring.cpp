@@ -15,7 +15,6 @@ int main(int argc, char** argv) {
   vkcloth::Scene scene;
   scene.name = "spring";
   scene.system = *vkcloth::make_chain(chain); // a valid description: cannot fail
-  scene.system_kind = "chain";
   scene.params.dt = 0.02;
   scene.params.damping = 0.5; // the force -mu m v; with m = 1 the report's -mu v
   if (auto v = scene.params.validate(); !v) return 2;

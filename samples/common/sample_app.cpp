@@ -45,7 +45,7 @@ int run_offscreen(const vkcloth::Scene& scene, const Options& o) {
   if (!target) return fail(target.error());
   render::RendererOptions ro;
   ro.render_pass = target->render_pass();
-  auto renderer = render::ClothRenderer::create(*ctx, *solver, scene.system, ro);
+  auto renderer = render::ClothRenderer::create(*ctx, *solver, *solver->topology(), ro);
   if (!renderer) return fail(renderer.error());
   const render::Camera camera =
       render::Camera::frame(render::scene_bounds(scene.system, scene.params), float(o.width) / float(o.height));
@@ -119,7 +119,7 @@ int run_window(const vkcloth::Scene& scene, const Options& o) {
   if (!solver) return fail(solver.error());
   render::RendererOptions ro;
   ro.render_pass = w.render_pass();
-  auto renderer = render::ClothRenderer::create(w.context(), *solver, scene.system, ro);
+  auto renderer = render::ClothRenderer::create(w.context(), *solver, *solver->topology(), ro);
   if (!renderer) return fail(renderer.error());
   if (!w.create_frame_resources()) return fail(make_error(ErrorCode::vulkan, "swapchain creation failed"));
 

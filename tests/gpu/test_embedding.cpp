@@ -70,7 +70,8 @@ struct CountingAllocator {
   }
 };
 
-std::shared_ptr<const ParticleSystem> make_topology(std::uint32_t nx, std::uint32_t ny, bool horizontal = false) {
+std::shared_ptr<const ClothTopology> make_topology(std::uint32_t nx, std::uint32_t ny,
+                                                   bool horizontal = false) {
   ClothDesc d;
   d.nx = nx;
   d.ny = ny;
@@ -81,7 +82,9 @@ std::shared_ptr<const ParticleSystem> make_topology(std::uint32_t nx, std::uint3
   }
   auto s = make_cloth(d);
   REQUIRE(s.ok());
-  return std::make_shared<const ParticleSystem>(std::move(s.value()));
+  auto t = ClothTopology::create(*s);
+  REQUIRE(t.ok());
+  return *t;
 }
 
 std::unique_ptr<HostVulkan> host_or_skip(std::string& error) {
@@ -116,7 +119,7 @@ TEST_CASE("Embedding: host device and command buffer, record_step/record_steps, 
   params.wind.strength = 0.02;
   params.wind.direction = {0.3, 1.0, 0.1};
 
-  auto reference = GpuSolver::create(ctx, *topo, params);
+  auto reference = GpuSolver::create(ctx, topo, params);
   REQUIRE(reference.ok());
   REQUIRE(reference->simulate(10).ok());
   const auto ref_pos = reference->positions();
@@ -126,7 +129,7 @@ TEST_CASE("Embedding: host device and command buffer, record_step/record_steps, 
     auto adopted = Context::adopt(handles_of(*host, &counter.callbacks));
     REQUIRE(adopted.ok());
     CHECK(adopted->handles().allocator == &counter.callbacks);
-    auto gpu = GpuSolver::create(*adopted, *topo, params);
+    auto gpu = GpuSolver::create(*adopted, topo, params);
     REQUIRE(gpu.ok());
     CHECK(counter.live_count() > 0); // vkcloth's objects went through the host's callbacks
     REQUIRE(host->begin());
@@ -188,7 +191,7 @@ TEST_CASE("ClothWorld: many cloths, shared topology, add/remove, set_params == e
   p3.colliders = {Collider::plane({0, 0, 1}, 0.0), Collider::sphere({0.05, 0.0, 0.15}, 0.15)};
 
   struct Case {
-    std::shared_ptr<const ParticleSystem> topo;
+    std::shared_ptr<const ClothTopology> topo;
     SimParams params;
   };
   const Case cases[] = {{small, p0}, {small, p1}, {big, p2}, {falling, p3}}; // 0 and 1 share a topology
@@ -200,7 +203,7 @@ TEST_CASE("ClothWorld: many cloths, shared topology, add/remove, set_params == e
     auto id = world->add(c.topo, c.params);
     REQUIRE(id.ok());
     ids.push_back(*id);
-    auto g = GpuSolver::create(ctx, *c.topo, c.params);
+    auto g = GpuSolver::create(ctx, c.topo, c.params);
     REQUIRE(g.ok());
     alone.push_back(std::move(g.value()));
   }
@@ -238,10 +241,11 @@ TEST_CASE("ClothWorld: many cloths, shared topology, add/remove, set_params == e
   CHECK(world->params(ids[0])->wind.strength == 0.1);
   // Add one at run time (with its own initial state).
   InitialState init;
-  for (const Particle& q : small->particles) init.positions.push_back(q.position + glm::dvec3(0.0, 0.0, 0.25));
+  for (const Particle& q : small->system().particles)
+    init.positions.push_back(q.position + glm::dvec3(0.0, 0.0, 0.25));
   auto late = world->add(small, p0, init);
   REQUIRE(late.ok());
-  ParticleSystem moved = *small;
+  ParticleSystem moved = small->system();
   for (std::size_t p = 0; p < moved.particles.size(); ++p) moved.particles[p].position = init.positions[p];
   auto late_alone = GpuSolver::create(ctx, moved, p0);
   REQUIRE(late_alone.ok());
@@ -256,7 +260,7 @@ TEST_CASE("ClothWorld: many cloths, shared topology, add/remove, set_params == e
   REQUIRE(al.ok());
   CHECK(diff(*wl, *al).bitwise);
   // The parameter change mattered: the instance no longer matches the unchanged parameters.
-  auto unchanged = GpuSolver::create(ctx, *small, p0);
+  auto unchanged = GpuSolver::create(ctx, small, p0);
   REQUIRE(unchanged.ok());
   REQUIRE(unchanged->simulate(27).ok());
   CHECK(!diff(*world->positions(ids[0]), *unchanged->positions()).bitwise);
@@ -305,11 +309,12 @@ TEST_CASE("ClothWorld batches: one dispatch per pass for every instance of a top
   std::vector<GpuSolver> alone;
   for (std::size_t k = 0; k < params.size(); ++k) {
     InitialState init; // instance k starts k cm higher: distinct states in one batch
-    for (const Particle& q : topo->particles) init.positions.push_back(q.position + glm::dvec3(0.0, 0.0, 0.01 * double(k)));
+    for (const Particle& q : topo->system().particles)
+      init.positions.push_back(q.position + glm::dvec3(0.0, 0.0, 0.01 * double(k)));
     auto id = world->add(topo, params[k], init);
     REQUIRE(id.ok());
     ids.push_back(*id);
-    ParticleSystem moved = *topo;
+    ParticleSystem moved = topo->system();
     for (std::size_t p = 0; p < moved.particles.size(); ++p) moved.particles[p].position = init.positions[p];
     auto g = GpuSolver::create(ctx, moved, params[k]);
     REQUIRE(g.ok());
@@ -348,7 +353,7 @@ TEST_CASE("ClothWorld batches: one dispatch per pass for every instance of a top
   REQUIRE(world->remove(ids[2]).ok());
   auto late = world->add(topo, params[2]);
   REQUIRE(late.ok());
-  auto late_alone = GpuSolver::create(ctx, *topo, params[2]);
+  auto late_alone = GpuSolver::create(ctx, topo, params[2]);
   REQUIRE(late_alone.ok());
   CHECK(world->batch_count() == 1);
   // set_params within the batch (new wind, new colliders) and across batches (to RK4).
@@ -390,11 +395,11 @@ TEST_CASE("ClothWorld batches: a diverging instance is frozen and named, the oth
   REQUIRE(b.ok());
   REQUIRE(c.ok());
   CHECK(world->batch_count() == 1);
-  auto wild_alone = GpuSolver::create(ctx, *topo, wild);
+  auto wild_alone = GpuSolver::create(ctx, topo, wild);
   REQUIRE(wild_alone.ok());
   const auto alone_result = wild_alone->simulate(40, 40);
   REQUIRE(!alone_result.ok());
-  auto calm_alone = GpuSolver::create(ctx, *topo, calm);
+  auto calm_alone = GpuSolver::create(ctx, topo, calm);
   REQUIRE(calm_alone.ok());
   REQUIRE(calm_alone->simulate(40).ok());
 

@@ -220,9 +220,10 @@ TEST_CASE("Context: pipelines are made once per Context and shared by every solv
   CHECK(testing::pipeline_count(ctx) == made);
   auto world = ClothWorld::create(ctx);
   REQUIRE(world.ok());
-  auto topology = std::make_shared<const ParticleSystem>(*cloth);
-  auto a = world->add(topology, params);
-  auto b = world->add(topology, params);
+  auto topology = ClothTopology::create(*cloth);
+  REQUIRE(topology.ok());
+  auto a = world->add(*topology, params);
+  auto b = world->add(*topology, params);
   REQUIRE(a.ok());
   REQUIRE(b.ok());
   REQUIRE(world->remove(*a).ok());

@@ -63,7 +63,7 @@ inline std::optional<Rig> make_rig(gpu::Context& ctx, Scene scene, std::uint32_t
   RendererOptions ro;
   ro.render_pass = target->render_pass();
   ro.texture = std::move(texture);
-  auto renderer = ClothRenderer::create(ctx, *solver, scene.system, std::move(ro));
+  auto renderer = ClothRenderer::create(ctx, *solver, *solver->topology(), std::move(ro));
   REQUIRE_MESSAGE(renderer, (renderer ? "" : renderer.error().message));
   const Camera cam = Camera::frame(scene_bounds(scene.system, scene.params), float(w) / float(h));
   return Rig{std::move(scene), std::move(*solver), std::move(*target), std::move(*renderer), cam};

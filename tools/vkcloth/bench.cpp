@@ -183,14 +183,20 @@ Result<Row> bench_vulkan(gpu::Context& ctx, const BenchScene& sc, std::uint32_t 
 }
 
 /// `instances` cloths of the scene in one ClothWorld, one submission per `steps_per_submit` steps:
-/// batched (one shared topology: one dispatch per pass for all) or not (a topology copy each:
-/// every cloth its own dispatches, as separate solvers recorded into one command buffer).
+/// batched (one shared topology: one dispatch per pass for all) or not (a topology prepared for
+/// each: every cloth its own dispatches, as separate solvers recorded into one command buffer).
 Result<Row> bench_world(gpu::Context& ctx, const BenchScene& sc, std::uint32_t n, bool batched, const BenchOptions& o) {
   auto w = gpu::ClothWorld::create(ctx);
   if (!w) return w.error();
-  const auto shared = std::make_shared<const ParticleSystem>(sc.system);
-  for (std::uint32_t k = 0; k < o.instances; ++k)
-    VKCLOTH_TRY(w->add(batched ? shared : std::make_shared<const ParticleSystem>(sc.system), sc.params));
+  auto shared = ClothTopology::create(sc.system);
+  if (!shared)
+    return shared.error();
+  for (std::uint32_t k = 0; k < o.instances; ++k) {
+    auto own = batched ? shared : ClothTopology::create(sc.system);
+    if (!own)
+      return own.error();
+    VKCLOTH_TRY(w->add(*own, sc.params));
+  }
   VKCLOTH_TRY(w->simulate(o.warmup, o.steps_per_submit));
   std::vector<double> wall;
   for (unsigned r = 0; r < o.reps; ++r) {

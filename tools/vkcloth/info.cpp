@@ -31,7 +31,7 @@ int info_command(const SceneArgs& opt) {
     ++per_kind[static_cast<std::size_t>(sp.kind)];
 
   fmt::print("scene       {}\n", s.name);
-  fmt::print("system      {}", s.system_kind);
+  fmt::print("system      {}", s.system.grid ? "cloth" : "chain");
   if (s.system.grid)
     fmt::print(" ({} x {} grid, index j*nx+i)", s.system.grid->nx, s.system.grid->ny);
   fmt::print("\nparticles   {} ({} pinned, free mass {:g} kg)\n", s.system.size(), pinned, mass);

@@ -87,7 +87,7 @@ int render_command(const RenderOptions& opt) {
   if (!target)
     return report(target.error());
   ro.render_pass = target->render_pass();
-  auto renderer = render::ClothRenderer::create(*context, *solver, scene->system, std::move(ro));
+  auto renderer = render::ClothRenderer::create(*context, *solver, *solver->topology(), std::move(ro));
   if (!renderer)
     return report(renderer.error());
   if (!renderer->draws_cloth())

@@ -152,7 +152,7 @@ Result<void> Viewer::save_screenshot(const std::string& path, std::uint64_t fram
   render::RendererOptions so;
   so.render_pass = target->render_pass();
   so.texture = texture_;
-  auto shot_renderer = render::ClothRenderer::create(window_.context(), *solver_, scene_->system, so);
+  auto shot_renderer = render::ClothRenderer::create(window_.context(), *solver_, *solver_->topology(), so);
   if (!shot_renderer)
     return shot_renderer.error();
   auto img = target->render(*solver_, *shot_renderer, orbit_.camera(), 0);
@@ -187,7 +187,7 @@ int Viewer::run(const ViewOptions& opt) {
   render::RendererOptions ro;
   ro.render_pass = window_.render_pass();
   ro.texture = texture_;
-  auto rend = render::ClothRenderer::create(window_.context(), *solver_, scene_->system, ro);
+  auto rend = render::ClothRenderer::create(window_.context(), *solver_, *solver_->topology(), ro);
   if (!rend)
     return report(rend.error());
   renderer_.emplace(std::move(*rend));

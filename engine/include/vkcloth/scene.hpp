@@ -20,7 +20,7 @@ struct Scene {
   ParticleSystem system; ///< finalized
   SimParams params;      ///< validated (directions normalised)
   std::uint64_t steps = 500;
-  std::string system_kind; ///< "chain" | "cloth"
+  // The file's "system" key ("chain" | "cloth") is not stored: a cloth is system.grid.has_value().
 };
 
 /// Largest "integrator.steps" a scene may ask for.

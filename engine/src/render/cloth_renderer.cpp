@@ -93,7 +93,7 @@ void add_plane(std::vector<MeshVertex>& v, std::vector<std::uint32_t>& idx, glm:
 struct ClothRenderer::Impl {
   std::shared_ptr<gpu::Context::Impl> ctx; // first: outlives the objects below
   Palette palette;
-  bool grid = false;
+  bool surface = false; // ClothTopology::has_surface(): triangles; else masses and spring lines
   std::uint32_t particle_count = 0;
   float mass_radius = 0.02f;
 
@@ -123,19 +123,20 @@ struct ClothRenderer::Impl {
     return b;
   }
 
-  Result<void> build_geometry(const ParticleSystem& system, const SimParams& params,
+  Result<void> build_geometry(const ClothTopology& topology, const SimParams& params,
                               const RendererOptions& o);
   Result<void> upload_texture(const Image& img);
   Result<void> create_texture_set();
   Result<void> build_pipelines(const RendererOptions& o);
 };
 
-Result<void> ClothRenderer::Impl::build_geometry(const ParticleSystem& system, const SimParams& params,
+Result<void> ClothRenderer::Impl::build_geometry(const ClothTopology& topology, const SimParams& params,
                                                  const RendererOptions& o) {
-  // The cloth: two triangles per grid quad, (i, j) = j * nx + i; or a chain's springs as lines.
+  // The cloth: the topology's triangles; or a chain's springs as lines.
+  const ParticleSystem& system = topology.system();
   std::vector<std::uint32_t> idx;
-  if (system.grid) {
-    idx = gpu::grid_triangle_indices(system.grid->nx, system.grid->ny);
+  if (surface) {
+    idx.assign(topology.triangles().begin(), topology.triangles().end());
   } else {
     for (const Spring& s : system.springs)
       idx.insert(idx.end(), {s.a, s.b});
@@ -176,7 +177,7 @@ Result<void> ClothRenderer::Impl::build_geometry(const ParticleSystem& system, c
   unit_sphere.color = palette.chain;
   if (o.mass_radius > 0.0f) {
     mass_radius = o.mass_radius;
-  } else if (!system.grid) {
+  } else if (!surface) {
     double shortest = INFINITY;
     for (const Spring& s : system.springs)
       shortest = std::min(shortest, s.rest_length);
@@ -411,18 +412,17 @@ Result<void> ClothRenderer::Impl::build_pipelines(const RendererOptions& o) {
 }
 
 Result<ClothRenderer> ClothRenderer::create(gpu::Context& context, const gpu::GpuSolver& solver,
-                                            const ParticleSystem& system, RendererOptions options) {
-  if (system.size() != solver.particle_count())
-    return make_error(
-        ErrorCode::invalid_argument,
-        fmt::format(
-            "the system has {} particles but the solver {}: pass the system the solver was created from",
-            system.size(), solver.particle_count()));
-  return create(context, solver.params(), system, std::move(options));
+                                            const ClothTopology& topology, RendererOptions options) {
+  if (topology.size() != solver.particle_count())
+    return make_error(ErrorCode::invalid_argument,
+                      fmt::format("the topology has {} particles but the solver {}: pass the topology the "
+                                  "solver was created from (GpuSolver::topology())",
+                                  topology.size(), solver.particle_count()));
+  return create(context, solver.params(), topology, std::move(options));
 }
 
 Result<ClothRenderer> ClothRenderer::create(gpu::Context& context, const SimParams& params,
-                                            const ParticleSystem& system, RendererOptions options) {
+                                            const ClothTopology& topology, RendererOptions options) {
   if (!options.render_pass)
     return make_error(ErrorCode::invalid_argument, "RendererOptions::render_pass is required");
   auto impl = std::make_unique<Impl>();
@@ -433,15 +433,15 @@ Result<ClothRenderer> ClothRenderer::create(gpu::Context& context, const SimPara
         fmt::format("the Context's queue family {} on '{}' has no graphics support (create the Context with "
                     "ContextOptions::require_graphics)",
                     impl->ctx->queue_family, impl->ctx->name));
-  impl->grid = system.grid.has_value();
-  impl->particle_count = static_cast<std::uint32_t>(system.size());
+  impl->surface = topology.has_surface();
+  impl->particle_count = static_cast<std::uint32_t>(topology.size());
   Image texture = options.texture.width ? std::move(options.texture) : default_fabric_texture();
   const std::uint32_t max_side = impl->ctx->properties.limits.maxImageDimension2D;
   if (texture.width > max_side || texture.height > max_side)
     return make_error(ErrorCode::unsupported,
                       fmt::format("the texture is {} x {} but the device allows at most {} a side",
                                   texture.width, texture.height, max_side));
-  VKCLOTH_TRY(impl->build_geometry(system, params, options));
+  VKCLOTH_TRY(impl->build_geometry(topology, params, options));
   VKCLOTH_TRY(impl->upload_texture(texture));
   VKCLOTH_TRY(impl->build_pipelines(options));
   return ClothRenderer(std::move(impl));
@@ -455,7 +455,7 @@ const Palette& ClothRenderer::palette() const {
   return impl_->palette;
 }
 bool ClothRenderer::draws_cloth() const {
-  return impl_->grid;
+  return impl_->surface;
 }
 
 void ClothRenderer::record_draw(VkCommandBuffer cmd, const gpu::GpuSolver& solver, const Camera& camera,
@@ -494,7 +494,7 @@ void ClothRenderer::record_draw(VkCommandBuffer cmd, const gpu::InstanceBuffers&
     v.vkCmdDrawIndexed(cmd, r.count, 1, r.first, 0, 0);
   }
 
-  if (s.grid) {
+  if (s.surface) {
     // The cloth: the solver's current positions, normals and uvs as vertex buffers.
     v.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.cloth_pipeline);
     v.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.layout, 0, 1, &s.set, 0, nullptr);

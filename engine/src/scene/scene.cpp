@@ -205,14 +205,14 @@ Result<Scene> build_scene(const json& doc, std::string_view source_name) {
   Scene scene;
   if (!doc.contains("system"))
     return sd::shape_error("missing required key system (\"chain\" or \"cloth\")");
-  VKCLOTH_TRY(sd::read(doc, "", "system", scene.system_kind));
-  if (scene.system_kind != "chain" && scene.system_kind != "cloth")
-    return sd::shape_error(
-        fmt::format("system must be \"chain\" or \"cloth\", got \"{}\"", scene.system_kind));
-  const char* other = scene.system_kind == "chain" ? "cloth" : "chain";
+  std::string kind;
+  VKCLOTH_TRY(sd::read(doc, "", "system", kind));
+  if (kind != "chain" && kind != "cloth")
+    return sd::shape_error(fmt::format("system must be \"chain\" or \"cloth\", got \"{}\"", kind));
+  const char* other = kind == "chain" ? "cloth" : "chain";
   if (doc.contains(other))
-    return sd::shape_error(fmt::format("a \"{}\" section is not allowed in a scene whose system is \"{}\"",
-                                       other, scene.system_kind));
+    return sd::shape_error(
+        fmt::format("a \"{}\" section is not allowed in a scene whose system is \"{}\"", other, kind));
 
   scene.name = std::filesystem::path(source_name).stem().string();
   VKCLOTH_TRY(sd::read(doc, "", "name", scene.name));
@@ -225,7 +225,7 @@ Result<Scene> build_scene(const json& doc, std::string_view source_name) {
   VKCLOTH_TRY(sd::read(doc, "", "contact_inward_only", scene.params.contact_inward_only));
   VKCLOTH_TRY(scene.params.validate()); // ranges, before any large allocation below
 
-  auto system = scene.system_kind == "chain" ? read_chain(doc) : read_cloth(doc);
+  auto system = kind == "chain" ? read_chain(doc) : read_cloth(doc);
   if (!system)
     return system.error();
   scene.system = std::move(*system);

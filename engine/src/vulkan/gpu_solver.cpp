@@ -34,6 +34,11 @@ struct GpuSolver::Impl {
   }
 };
 
+Result<GpuSolver> GpuSolver::create(Context& context, std::shared_ptr<const ClothTopology> topology,
+                                    SimParams params, const GpuSolverOptions& options) {
+  return testing::create_solver(context, std::move(topology), std::move(params), options);
+}
+
 Result<GpuSolver> GpuSolver::create(Context& context, const ParticleSystem& system, SimParams params,
                                     const GpuSolverOptions& options) {
   return testing::create_solver(context, system, std::move(params), options);
@@ -41,14 +46,24 @@ Result<GpuSolver> GpuSolver::create(Context& context, const ParticleSystem& syst
 
 Result<GpuSolver> testing::create_solver(Context& context, const ParticleSystem& system, SimParams params,
                                          const GpuSolverOptions& options, const SolverKnobs& knobs) {
+  // Parameters first, as before topologies: their errors take precedence over the system's.
+  VKCLOTH_TRY(params.validate());
+  auto topology = ClothTopology::create(system);
+  if (!topology)
+    return topology.error();
+  return create_solver(context, std::move(*topology), std::move(params), options, knobs);
+}
+
+Result<GpuSolver> testing::create_solver(Context& context, std::shared_ptr<const ClothTopology> topology,
+                                         SimParams params, const GpuSolverOptions& options,
+                                         const SolverKnobs& knobs) {
   WorldOptions wo;
   wo.solver = options;
   auto world = create_world(context, std::move(wo), knobs);
   if (!world)
     return world.error();
-  // The world keeps its topology (for rebuilds when the integrator changes): a copy, since the
-  // caller's system need not outlive the solver.
-  auto id = world->add(std::make_shared<const ParticleSystem>(system), std::move(params));
+  // The world keeps the topology (for rebuilds when the integrator changes).
+  auto id = world->add(std::move(topology), std::move(params));
   if (!id)
     return id.error();
   auto impl = std::make_unique<GpuSolver::Impl>(GpuSolver::Impl{std::move(*world), *id, nullptr});
@@ -106,6 +121,9 @@ Result<std::vector<glm::vec3>> GpuSolver::forces() {
 }
 const std::vector<glm::vec2>& GpuSolver::uvs() const {
   return impl_->batch().uvs();
+}
+const std::shared_ptr<const ClothTopology>& GpuSolver::topology() const {
+  return impl_->instance().topology;
 }
 
 std::uint64_t GpuSolver::step_index() const {

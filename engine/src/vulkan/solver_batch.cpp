@@ -273,17 +273,17 @@ struct DispatchGrid {
   std::uint32_t x = 1, y = 1;
 };
 
-/// The device limits a batch of `batch` instances of `system` must fit, checked before any
+/// The device limits a batch of `batch` instances of `topology` must fit, checked before any
 /// allocation; errors name the buffer or dispatch and the limit.
-Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ParticleSystem& system, std::uint64_t batch,
-                                  const testing::SolverKnobs& knobs) {
-  const std::uint64_t n = system.size();
+Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ClothTopology& topology,
+                                  std::uint64_t batch, const testing::SolverKnobs& knobs) {
+  const std::uint64_t n = topology.size();
   const VkPhysicalDeviceLimits& lim = ctx.properties.limits;
   std::uint64_t max_bytes = lim.maxStorageBufferRange;
   const bool overridden = knobs.max_storage_buffer_bytes && knobs.max_storage_buffer_bytes < max_bytes;
   if (overridden)
     max_bytes = knobs.max_storage_buffer_bytes;
-  const std::uint64_t edges_n = system.adjacency.refs.size();
+  const std::uint64_t edges_n = topology.edges().size();
   const struct {
     const char* what;
     std::uint64_t bytes;
@@ -372,8 +372,7 @@ Result<void> SolverBatch::create_buffers() {
       return r.error();
     *b = std::move(*r);
   }
-  // The grid's triangle list for the host's drawing (instance-local indices; empty for chains).
-  index_count = nx >= 2 && ny >= 2 ? (nx - 1) * (ny - 1) * 6 : 0; // grid_triangle_indices(nx, ny).size()
+  // The topology's triangle list for the host's drawing (instance-local indices; empty for chains).
   {
     auto r =
         create_buffer(*ctx, std::max<VkDeviceSize>(VkDeviceSize(index_count) * sizeof(std::uint32_t), 16),
@@ -407,14 +406,15 @@ Result<void> SolverBatch::create_buffers() {
 
 // Initial state of every instance, converted as CpuSolver<float>::create converts it, and the
 // topology's constants; the scratch buffers zeroed.
-Result<void> SolverBatch::upload_initial_state(const ParticleSystem& system,
+Result<void> SolverBatch::upload_initial_state(const ClothTopology& topology,
                                                const std::vector<SlotState>& states) {
+  const ParticleSystem& system = topology.system();
   const std::size_t n = count;
   const std::size_t entries = std::size_t(size()) * n;
   const VkDeviceSize vec4_bytes = entries * 16;
   std::vector<sh::vec4> x0(entries), v0(entries), uv0(entries);
   std::vector<sh::ParticleInfo> info(n);
-  uvs_.assign(n, glm::vec2(0.0f));
+  uvs_.assign(topology.uvs().begin(), topology.uvs().end());
   for (std::size_t k = 0; k < size(); ++k) {
     const SlotState state = k < states.size() ? states[k] : SlotState{};
     for (std::size_t p = 0; p < n; ++p) {
@@ -427,26 +427,21 @@ Result<void> SolverBatch::upload_initial_state(const ParticleSystem& system,
       info[p] = {float(q.mass), q.pinned ? 1u : 0u};
     }
   }
-  for (std::uint32_t j = 0; j < ny; ++j)
-    for (std::uint32_t i = 0; i < nx; ++i) {
-      const glm::vec2 t(nx > 1 ? float(i) / float(nx - 1) : 0.0f, ny > 1 ? float(j) / float(ny - 1) : 0.0f);
-      uvs_[std::size_t(j) * nx + i] = t;
-      for (std::size_t k = 0; k < size(); ++k)
-        uv0[k * n + std::size_t(j) * nx + i] = {t.x, t.y, 0.0f, 0.0f};
-    }
+  for (std::size_t k = 0; k < size(); ++k)
+    for (std::size_t p = 0; p < n; ++p)
+      uv0[k * n + p] = {uvs_[p].x, uvs_[p].y, 0.0f, 0.0f};
   std::vector<sh::Edge> edge_data(edges_count);
   for (std::size_t e = 0; e < edges_count; ++e) {
-    const SpringRef& r = system.adjacency.refs[e];
-    const Spring& sp = system.springs[r.spring];
-    edge_data[e] = {r.other, float(sp.rest_length), float(sp.stiffness)};
+    const GatherEdge& g = topology.edges()[e];
+    edge_data[e] = {g.other, float(g.rest_length), float(g.stiffness)};
   }
-  const std::vector<std::uint32_t> triangles = grid_triangle_indices(nx, ny);
+  const std::span<const std::uint32_t> triangles = topology.triangles();
   const Upload uploads[] = {{&pos[0], x0.data(), vec4_bytes},
                             {&pos[1], x0.data(), vec4_bytes},
                             {&vel, v0.data(), vec4_bytes},
                             {&uv, uv0.data(), vec4_bytes},
                             {&particle, info.data(), n * sizeof(sh::ParticleInfo)},
-                            {&offsets, system.adjacency.offsets.data(), (n + 1) * sizeof(std::uint32_t)},
+                            {&offsets, topology.edge_offsets().data(), (n + 1) * sizeof(std::uint32_t)},
                             {&edges, edge_data.data(), edges_count * sizeof(sh::Edge)},
                             {&indices, triangles.data(), triangles.size() * sizeof(std::uint32_t)},
                             {&force, nullptr, 0},
@@ -500,13 +495,12 @@ Result<void> SolverBatch::upload(std::span<const Upload> uploads) {
 
 Result<std::unique_ptr<SolverBatch>>
 SolverBatch::create(const std::shared_ptr<Context::Impl>& ctx, CommandContext& commands,
-                    const ParticleSystem& system, std::vector<SimParams> params,
+                    const ClothTopology& topology, std::vector<SimParams> params,
                     const GpuSolverOptions& options, const testing::SolverKnobs& knobs,
                     const std::vector<SlotState>& states) {
   for (SimParams& p : params)
     VKCLOTH_TRY(p.validate());
-  VKCLOTH_TRY(system.validate());
-  auto grid = check_limits(*ctx, system, params.size(), knobs);
+  auto grid = check_limits(*ctx, topology, params.size(), knobs);
   if (!grid)
     return grid.error();
 
@@ -519,24 +513,25 @@ SolverBatch::create(const std::shared_ptr<Context::Impl>& ctx, CommandContext& c
     s.slots[k].params = std::move(params[k]);
   s.options = options;
   s.knobs = knobs;
-  s.count = s.pc.count = static_cast<std::uint32_t>(system.size());
-  s.edges_count = system.adjacency.refs.size();
+  s.count = s.pc.count = static_cast<std::uint32_t>(topology.size());
+  s.edges_count = topology.edges().size();
+  s.index_count = static_cast<std::uint32_t>(topology.triangles().size());
   s.groups_x = grid->x;
   s.groups_y = grid->y;
-  if (system.grid) {
-    s.nx = s.pc.nx = system.grid->nx;
-    s.ny = s.pc.ny = system.grid->ny;
+  if (const auto& g = topology.grid()) {
+    s.nx = s.pc.nx = g->nx;
+    s.ny = s.pc.ny = g->ny;
   }
   // On failure `impl` frees whatever the phases created so far.
   VKCLOTH_TRY(s.create_buffers());
   if (!knobs.csr_only)
-    s.detect_stencil(system);
+    s.set_stencil(topology);
   VKCLOTH_TRY(s.init_pipelines());
   VKCLOTH_TRY(s.write_sets());
   VKCLOTH_TRY(s.ensure_implicit());
   VKCLOTH_TRY(s.ensure_fused());
   s.upload_instance_params();
-  VKCLOTH_TRY(s.upload_initial_state(system, states));
+  VKCLOTH_TRY(s.upload_initial_state(topology, states));
   return impl;
 }
 

@@ -5,9 +5,8 @@
 // Buffers, descriptor sets and texel views are the batch's; layouts and pipelines the Context's
 // (pipelines.hpp). Internal to engine/src/vulkan.
 //
-// Topology: create() reads a ParticleSystem (its CSR gather lists, grid, particles) once; the
-// world keys batches by the shared topology object, so switching to a shared, prepared topology
-// (std::shared_ptr<const ClothTopology>) only changes create()'s parameter and the key's type.
+// Topology: create() reads a prepared ClothTopology (gather lists, grid stencil, triangles, uvs,
+// particles); the world keys batches by the shared topology object.
 #pragma once
 
 #include <cstdint>
@@ -24,6 +23,7 @@
 #include "resources.hpp"
 #include "vkcloth/gpu/gpu_solver.hpp"
 #include "vkcloth/gpu/testing.hpp"
+#include "vkcloth/topology.hpp"
 #include "vkcloth_shared.h"
 
 namespace vkcloth::gpu {
@@ -51,7 +51,7 @@ public:
   /// instance)); `states[k]` is instance k's initial state (missing entries: the topology's).
   /// `commands` (the owner's) serves the uploads and readbacks and must outlive the batch.
   static Result<std::unique_ptr<SolverBatch>>
-  create(const std::shared_ptr<Context::Impl>& ctx, CommandContext& commands, const ParticleSystem& topology,
+  create(const std::shared_ptr<Context::Impl>& ctx, CommandContext& commands, const ClothTopology& topology,
          std::vector<SimParams> params, const GpuSolverOptions& options, const testing::SolverKnobs& knobs,
          const std::vector<SlotState>& states = {});
   SolverBatch(const SolverBatch&) = delete;
@@ -114,7 +114,7 @@ private:
   // host-visible ones (per instance). Every object below is owned (resources.hpp): a new buffer
   // is one member here plus its creation.
   Buffer pos[2], vel, force, force_stage, vel_filt, normal, uv, stage_pos, stage_vel, acc_pos, acc_vel;
-  Buffer particle, offsets, edges, indices; // indices: grid_triangle_indices (drawing)
+  Buffer particle, offsets, edges, indices; // indices: the topology's triangles (drawing)
   std::uint32_t index_count = 0;
   Buffer colliders, flags, instances; // host-visible (written / read by the host)
   std::uint32_t collider_capacity = 0;
@@ -164,7 +164,7 @@ private:
 
   // Creation phases (create()), in order.
   Result<void> create_buffers();
-  void detect_stencil(const ParticleSystem& system);
+  void set_stencil(const ClothTopology& topology);
   Result<void> init_pipelines();
   Result<void> create_descriptor_sets();
   Result<void> create_texel_views();
@@ -174,7 +174,7 @@ private:
   Result<void> ensure_fused();
   Result<void> upload_colliders();
   void upload_instance_params();
-  Result<void> upload_initial_state(const ParticleSystem& system, const std::vector<SlotState>& states);
+  Result<void> upload_initial_state(const ClothTopology& topology, const std::vector<SlotState>& states);
   struct Upload {
     Buffer* dst;
     const void* data; // null: zero fill

@@ -155,75 +155,22 @@ Result<void> SolverBatch::ensure_fused() {
   return {};
 }
 
-// Like CpuSolver::detect_stencil: the stencil applies when every interior particle's gather list
-// (2 <= i < nx-2, 2 <= j < ny-2) is the same up to translation, in the same order, with the same
-// float constants. Then the shaders' interior branch sums exactly the CSR terms in CSR order.
-void SolverBatch::detect_stencil(const ParticleSystem& system) {
+// The topology's grid stencil (ClothTopology: the one detection rule, shared with the CPU) as
+// specialisation constants, its constants in float as the edges are uploaded.
+void SolverBatch::set_stencil(const ClothTopology& topology) {
   stencil = Stencil{};
-  if (!system.grid)
+  const GridStencil* st = topology.stencil();
+  if (!st)
     return;
-  const std::int64_t gx = system.grid->nx, gy = system.grid->ny;
-  if (gx < 5 || gy < 5)
-    return;
-  const auto& off = system.adjacency.offsets;
-  const auto& refs = system.adjacency.refs;
-  const std::int64_t first = 2 * gx + 2;
-  if (off[first + 1] - off[first] != 12)
-    return;
-  Stencil st;
-  st.enabled = 1;
-  st.nx = static_cast<std::uint32_t>(gx);
-  st.ny = static_cast<std::uint32_t>(gy);
-  for (int k = 0; k < 12; ++k) {
-    const SpringRef& r = refs[off[first] + k];
-    st.offset[k] = static_cast<std::int32_t>(std::int64_t(r.other) - first);
-    st.rest[k] = float(system.springs[r.spring].rest_length);
-    st.stiffness[k] = float(system.springs[r.spring].stiffness);
+  stencil.enabled = 1;
+  stencil.nx = topology.grid()->nx;
+  stencil.ny = topology.grid()->ny;
+  for (std::size_t k = 0; k < 12; ++k) {
+    stencil.offset[k] = st->offset[k];
+    stencil.rest[k] = float(st->rest_length[k]);
+    stencil.stiffness[k] = float(st->stiffness[k]);
   }
-  for (std::int64_t j = 2; j < gy - 2; ++j)
-    for (std::int64_t i = 2; i < gx - 2; ++i) {
-      const std::int64_t p = j * gx + i;
-      if (off[p + 1] - off[p] != 12)
-        return;
-      for (int k = 0; k < 12; ++k) {
-        const SpringRef& r = refs[off[p] + k];
-        const Spring& sp = system.springs[r.spring];
-        if (std::int64_t(r.other) - p != st.offset[k] || float(sp.rest_length) != st.rest[k] ||
-            float(sp.stiffness) != st.stiffness[k])
-          return;
-      }
-    }
-  stencil = st;
-  // Border particles (SC_BORDER): their lists must be the stencil entries whose neighbour lies in
-  // the grid, in stencil order, with the same constants; offsets must be (di, dj) in [-2, 2]^2.
-  std::int64_t di[12], dj[12];
-  for (int k = 0; k < 12; ++k) {
-    dj[k] = (st.offset[k] + 2 * gx + 2) / gx - 2;
-    di[k] = st.offset[k] - dj[k] * gx;
-    if (st.offset[k] + 2 * gx + 2 < 0 || dj[k] < -2 || dj[k] > 2 || di[k] < -2 || di[k] > 2)
-      return;
-  }
-  for (std::int64_t j = 0; j < gy; ++j)
-    for (std::int64_t i = 0; i < gx; ++i) {
-      if (i >= 2 && i < gx - 2 && j >= 2 && j < gy - 2)
-        continue; // checked above
-      const std::int64_t p = j * gx + i;
-      std::int64_t e = off[p];
-      for (int k = 0; k < 12; ++k) {
-        if (i + di[k] < 0 || i + di[k] >= gx || j + dj[k] < 0 || j + dj[k] >= gy)
-          continue;
-        if (e >= off[p + 1])
-          return;
-        const SpringRef& r = refs[e++];
-        const Spring& sp = system.springs[r.spring];
-        if (std::int64_t(r.other) - p != st.offset[k] || float(sp.rest_length) != st.rest[k] ||
-            float(sp.stiffness) != st.stiffness[k])
-          return;
-      }
-      if (e != off[p + 1])
-        return;
-    }
-  stencil.border = 1;
+  stencil.border = st->border_geometric ? 1u : 0u;
 }
 
 Result<void> SolverBatch::write_sets() {

@@ -189,7 +189,7 @@ ClothWorld::ClothWorld(ClothWorld&&) noexcept = default;
 ClothWorld& ClothWorld::operator=(ClothWorld&&) noexcept = default;
 ClothWorld::~ClothWorld() = default;
 
-Result<InstanceId> ClothWorld::add(std::shared_ptr<const ParticleSystem> topology, SimParams params,
+Result<InstanceId> ClothWorld::add(std::shared_ptr<const ClothTopology> topology, SimParams params,
                                    const InitialState& initial) {
   if (!topology)
     return make_error(ErrorCode::invalid_argument, "ClothWorld::add: the topology is null");
@@ -336,7 +336,7 @@ std::uint64_t ClothWorld::dispatches_recorded() const {
   return impl_->dispatches;
 }
 
-std::shared_ptr<const ParticleSystem> ClothWorld::topology(InstanceId id) const {
+std::shared_ptr<const ClothTopology> ClothWorld::topology(InstanceId id) const {
   auto inst = impl_->find(id);
   return inst ? (*inst)->topology : nullptr;
 }

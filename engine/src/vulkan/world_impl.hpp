@@ -20,14 +20,14 @@ namespace vkcloth::gpu {
 struct ClothWorld::Impl {
   using Batch = SolverBatch;
   struct Instance {
-    std::shared_ptr<const ParticleSystem> topology;
+    std::shared_ptr<const ClothTopology> topology;
     SimParams params;
     Batch* batch = nullptr;
     std::uint32_t slot = 0;
   };
   /// What instances must agree on to share a batch (and so its dispatches).
   struct BatchKey {
-    const ParticleSystem* topology = nullptr;
+    const ClothTopology* topology = nullptr;
     int family = 0; // 0: explicit / semi-implicit Euler, 1: RK4, 2: implicit Euler (one instance per batch)
     std::uint32_t substeps = 1;
     InstanceId only = 0; // implicit Euler: the instance (its CG reductions are per batch)

@@ -39,7 +39,6 @@ Scene cloth_scene(const ClothDesc& d, SimParams p, std::string name) {
   Scene s;
   s.name = std::move(name);
   s.system = *make_cloth(d); // valid by construction
-  s.system_kind = "cloth";
   (void)p.validate();
   s.params = std::move(p);
   return s;
@@ -167,7 +166,7 @@ render::Camera frame(const std::vector<const Run*>& runs, float aspect, glm::vec
 Result<render::Image> draw(Drawing& d, Run& run, const render::Camera& cam) {
   render::RendererOptions ro;
   ro.render_pass = d.target->render_pass();
-  auto rend = render::ClothRenderer::create(*d.ctx, *run.gpu, run.drawn, std::move(ro));
+  auto rend = render::ClothRenderer::create(*d.ctx, *run.gpu, *run.gpu->topology(), std::move(ro));
   if (!rend) return rend.error();
   return d.target->render(*run.gpu, *rend, cam, 0);
 }
@@ -482,7 +481,7 @@ Result<void> cloth_figures(Gallery& G) {
     const render::Camera cam = frame({&ref}, float(d.w) / float(d.h), {1.2f, -1.4f, 0.6f});
     render::RendererOptions ro;
     ro.render_pass = d.target->render_pass();
-    auto rend = render::ClothRenderer::create(*d.ctx, *s, scene.system, std::move(ro));
+    auto rend = render::ClothRenderer::create(*d.ctx, *s, *s->topology(), std::move(ro));
     if (!rend) return rend.error();
     std::vector<Panel> panels;
     std::uint64_t done = 0;

@@ -21,7 +21,6 @@ Scene chain_scene(ChainDesc desc, SimParams params, std::string name) {
   Scene s;
   s.name = std::move(name);
   s.system = *make_chain(desc); // the descriptions below are valid by construction
-  s.system_kind = "chain";
   (void)params.validate();
   s.params = params;
   return s;

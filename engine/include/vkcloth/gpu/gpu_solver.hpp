@@ -33,6 +33,7 @@
 #include "vkcloth/params.hpp"
 #include "vkcloth/result.hpp"
 #include "vkcloth/system.hpp"
+#include "vkcloth/topology.hpp"
 
 namespace vkcloth::gpu {
 
@@ -72,8 +73,12 @@ struct InstanceBuffers {
 
 class GpuSolver {
 public:
-  /// Validates `params` and `system` as CpuSolver::create does, checks the device limits BEFORE
-  /// allocating (ErrorCode::unsupported naming the buffer and the limit), uploads the state.
+  /// Validates `params` as CpuSolver::create does, checks the device limits BEFORE allocating
+  /// (ErrorCode::unsupported naming the buffer and the limit), uploads the state. `topology`
+  /// (ClothTopology::create, shared and immutable) must not be null.
+  static Result<GpuSolver> create(Context& context, std::shared_ptr<const ClothTopology> topology,
+                                  SimParams params, const GpuSolverOptions& options = {});
+  /// Convenience: prepares the topology of `system` first (ClothTopology::create validates it).
   static Result<GpuSolver> create(Context& context, const ParticleSystem& system, SimParams params,
                                   const GpuSolverOptions& options = {});
 
@@ -136,6 +141,8 @@ public:
   Result<std::vector<glm::vec3>> forces();
   /// Texture coordinates as uploaded.
   const std::vector<glm::vec2>& uvs() const;
+  /// The prepared topology the solver steps (for ClothRenderer::create).
+  const std::shared_ptr<const ClothTopology>& topology() const;
 
   std::uint64_t step_index() const;
   double time() const;

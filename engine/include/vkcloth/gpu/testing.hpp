@@ -12,6 +12,7 @@
 #include "vkcloth/params.hpp"
 #include "vkcloth/result.hpp"
 #include "vkcloth/system.hpp"
+#include "vkcloth/topology.hpp"
 
 namespace vkcloth::gpu::testing {
 
@@ -33,6 +34,9 @@ struct SolverKnobs {
 };
 
 /// GpuSolver::create with knobs.
+Result<GpuSolver> create_solver(Context& context, std::shared_ptr<const ClothTopology> topology,
+                                SimParams params, const GpuSolverOptions& options = {},
+                                const SolverKnobs& knobs = {});
 Result<GpuSolver> create_solver(Context& context, const ParticleSystem& system, SimParams params,
                                 const GpuSolverOptions& options = {}, const SolverKnobs& knobs = {});
 /// ClothWorld::create with knobs for every batch of the world.

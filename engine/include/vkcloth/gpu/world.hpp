@@ -1,7 +1,7 @@
-// Many cloths on one Context: a shared, immutable topology (a ParticleSystem held by
-// std::shared_ptr<const ParticleSystem>: particles' rest state, masses, pins, springs, rest
-// lengths, CSR gather lists, grid) and instances with their own state (positions, velocities)
-// and parameters (SimParams: integrator, dt, gravity, damping, wind, colliders, ...).
+// Many cloths on one Context: a shared, immutable topology (std::shared_ptr<const ClothTopology>,
+// prepared once from a ParticleSystem: particles' rest state, masses, pins, gather lists, grid
+// stencil, triangles) and instances with their own state (positions, velocities) and parameters
+// (SimParams: integrator, dt, gravity, damping, wind, colliders, ...).
 //
 // Batching: instances that share a topology (the same shared_ptr), an integrator family
 // (explicit and semi-implicit Euler together; RK4) and a substep count form one batch, stepped
@@ -34,11 +34,13 @@
 #include "vkcloth/params.hpp"
 #include "vkcloth/result.hpp"
 #include "vkcloth/system.hpp"
+#include "vkcloth/topology.hpp"
 
 namespace vkcloth::gpu {
 
 /// Two counter-clockwise triangles (a, b, d), (a, d, c) per grid quad, particle (i, j) = j*nx + i:
-/// the index list ClothRenderer draws; upload it as a VK_INDEX_TYPE_UINT32 index buffer.
+/// a grid topology's ClothTopology::triangles(), the index list ClothRenderer draws; upload it as
+/// a VK_INDEX_TYPE_UINT32 index buffer.
 std::vector<std::uint32_t> grid_triangle_indices(std::uint32_t nx, std::uint32_t ny);
 
 struct WorldOptions {
@@ -68,10 +70,10 @@ public:
   /// Frees every instance; work the caller recorded must have finished executing.
   ~ClothWorld();
 
-  /// Adds a cloth of `topology` (shared, must not change while the world holds it) with `params`;
-  /// validated as GpuSolver::create (errors name the parameter). Takes effect from the next
-  /// recording; no recorded work of this world may be pending.
-  Result<InstanceId> add(std::shared_ptr<const ParticleSystem> topology, SimParams params,
+  /// Adds a cloth of `topology` (ClothTopology::create; instances of the same pointer share a
+  /// batch) with `params`; validated as GpuSolver::create (errors name the parameter). Takes
+  /// effect from the next recording; no recorded work of this world may be pending.
+  Result<InstanceId> add(std::shared_ptr<const ClothTopology> topology, SimParams params,
                          const InitialState& initial = {});
   /// Removes an instance (its buffers are freed now: no recorded work of the world may be
   /// pending); the others keep their state. ErrorCode::invalid_argument for an unknown id.
@@ -111,7 +113,7 @@ public:
   std::size_t batch_count() const;
   std::uint64_t dispatches_recorded() const;
   /// The instance's shared topology (null for an unknown id).
-  std::shared_ptr<const ParticleSystem> topology(InstanceId id) const;
+  std::shared_ptr<const ClothTopology> topology(InstanceId id) const;
 
   /// Live instances in id (= recording) order.
   std::vector<InstanceId> instances() const;

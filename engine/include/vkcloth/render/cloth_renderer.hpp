@@ -27,6 +27,7 @@
 #include "vkcloth/render/image.hpp"
 #include "vkcloth/result.hpp"
 #include "vkcloth/system.hpp"
+#include "vkcloth/topology.hpp"
 
 namespace vkcloth::render {
 
@@ -57,16 +58,16 @@ struct Palette {
 
 class ClothRenderer {
 public:
-  /// Builds the pipelines for `options.render_pass`, the grid's index buffer (two triangles per
-  /// quad) or the chain's line list, the collider meshes (from solver.params().colliders) and the
-  /// texture. `system` must be the one the solver was created from. The Context's queue family
+  /// Builds the pipelines for `options.render_pass`, the index buffer (the topology's triangles,
+  /// or a chain's springs as lines), the collider meshes (from solver.params().colliders) and the
+  /// texture. `topology` must be the solver's (solver.topology()). The Context's queue family
   /// must support graphics (ContextOptions::require_graphics): ErrorCode::unsupported otherwise.
   static Result<ClothRenderer> create(gpu::Context& context, const gpu::GpuSolver& solver,
-                                      const ParticleSystem& system, RendererOptions options);
+                                      const ClothTopology& topology, RendererOptions options);
   /// The same for a ClothWorld instance: `params` gives the colliders to draw (world.params(id)),
-  /// `system` its topology (world.topology(id)).
+  /// `topology` its topology (world.topology(id)).
   static Result<ClothRenderer> create(gpu::Context& context, const SimParams& params,
-                                      const ParticleSystem& system, RendererOptions options);
+                                      const ClothTopology& topology, RendererOptions options);
 
   ClothRenderer(ClothRenderer&&) noexcept;
   ClothRenderer& operator=(ClothRenderer&&) noexcept;
@@ -86,7 +87,7 @@ public:
                    VkExtent2D extent) const;
 
   const Palette& palette() const;
-  /// True when `system` had a grid (a cloth is drawn); false: a chain (masses and springs).
+  /// True when the topology has a surface (a cloth is drawn); false: masses and springs.
   bool draws_cloth() const;
 
   struct Impl; ///< internal (engine/src/render)
