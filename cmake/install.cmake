@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # `cmake --install` produces a relocatable package: headers, the library (static by default,
 # shared with -DBUILD_SHARED_LIBS=ON), and a CMake config for find_package(vkcloth CONFIG).
 # Shaders are embedded in the library; the public headers need glm and Vulkan-Headers only.

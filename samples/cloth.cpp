@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Sample: the report's cloth (§3-4) in its configurations: a 10 x 10 grid over 1 x 1 m, 0.05 kg
 // per point, built with make_cloth(), with the colliders and wind set in SimParams.
 //   cloth --preset NAME [--offscreen]     (cloth --help lists the presets)
@@ -29,11 +30,17 @@ void falling(vkcloth::ClothDesc& d, double z) {
 
 const Preset presets[] = {
     {"structural", "hanging from two corners, structural springs only (K = 40; Figure 6)",
-     [](vkcloth::ClothDesc& d, vkcloth::SimParams&) { d.stiffness = {40, 0, 0}; }},
+     [](vkcloth::ClothDesc& d, vkcloth::SimParams&) {
+       d.stiffness = {40, 0, 0};
+     }},
     {"shear", "hanging, structural + shear springs (40 / 8)",
-     [](vkcloth::ClothDesc& d, vkcloth::SimParams&) { d.stiffness = {40, 8, 0}; }},
+     [](vkcloth::ClothDesc& d, vkcloth::SimParams&) {
+       d.stiffness = {40, 8, 0};
+     }},
     {"bend", "hanging, structural + shear + bend springs (40 / 8 / 8, the report's choice)",
-     [](vkcloth::ClothDesc& d, vkcloth::SimParams&) { d.stiffness = {40, 8, 8}; }},
+     [](vkcloth::ClothDesc& d, vkcloth::SimParams&) {
+       d.stiffness = {40, 8, 8};
+     }},
     {"plane", "falls flat onto the floor plane z = 0 (Figure 11, left)",
      [](vkcloth::ClothDesc& d, vkcloth::SimParams& p) {
        falling(d, 0.8);
@@ -50,7 +57,9 @@ const Preset presets[] = {
        p.colliders = {Collider::sphere({0, 0, 0.3}, 0.3), Collider::plane({0, 0, 1}, 0.0)};
      }},
     {"wind", "hanging, 40 / 8 / 8, wind K_w = 0.05 towards +y (Figures 13-15)",
-     [](vkcloth::ClothDesc&, vkcloth::SimParams& p) { p.wind = {0.05, {0, 1, 0}}; }},
+     [](vkcloth::ClothDesc&, vkcloth::SimParams& p) {
+       p.wind = {0.05, {0, 1, 0}};
+     }},
     {"no_structural", "no structural springs (shear + bend 8) onto the sphere: holes open (Figure 5)",
      [](vkcloth::ClothDesc& d, vkcloth::SimParams& p) {
        falling(d, 0.8);
@@ -69,13 +78,17 @@ const Preset presets[] = {
 
 int main(int argc, char** argv) {
   std::string list;
-  for (const Preset& p : presets) list += fmt::format("                         {:<14} {}\n", p.name, p.what);
+  for (const Preset& p : presets)
+    list += fmt::format("                         {:<14} {}\n", p.name, p.what);
   samples::Options opt = samples::parse_args(
-      argc, argv, "The report's cloth: 10 x 10 points over 1 x 1 m, 0.05 kg each, dt = 0.02, mu = 0.5.", list);
-  if (opt.preset.empty()) opt.preset = "bend";
+      argc, argv, "The report's cloth: 10 x 10 points over 1 x 1 m, 0.05 kg each, dt = 0.02, mu = 0.5.",
+      list);
+  if (opt.preset.empty())
+    opt.preset = "bend";
   const Preset* chosen = nullptr;
   for (const Preset& p : presets)
-    if (opt.preset == p.name) chosen = &p;
+    if (opt.preset == p.name)
+      chosen = &p;
   if (!chosen) {
     fmt::print(stderr, "error: unknown preset \"{}\"; known:\n{}", opt.preset, list);
     return 2;

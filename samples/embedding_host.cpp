@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // A minimal "host engine" that embeds vkcloth (docs/embedding.md): it creates ITS OWN Vulkan
 // instance and device (its own volk, not vkcloth::gpu::Context::create), owns its render pass,
 // images, command buffer and queue submission, and adds cloths through the public API only:
@@ -23,26 +24,28 @@ namespace {
 constexpr std::uint32_t width = 640, height = 480;
 std::uint32_t g_messages = 0;
 
-VKAPI_ATTR VkBool32 VKAPI_CALL on_message(VkDebugUtilsMessageSeverityFlagBitsEXT, VkDebugUtilsMessageTypeFlagsEXT,
+VKAPI_ATTR VkBool32 VKAPI_CALL on_message(VkDebugUtilsMessageSeverityFlagBitsEXT,
+                                          VkDebugUtilsMessageTypeFlagsEXT,
                                           const VkDebugUtilsMessengerCallbackDataEXT* d, void*) {
   ++g_messages;
   std::fprintf(stderr, "validation: %s\n", d->pMessage);
   return VK_FALSE;
 }
 
-#define CHECK_VK(call)                                                                   \
-  do {                                                                                   \
-    if (VkResult r_ = (call); r_ != VK_SUCCESS) {                                        \
-      std::fprintf(stderr, "%s failed: %d (line %d)\n", #call, int(r_), __LINE__);        \
-      return 1;                                                                          \
-    }                                                                                    \
+#define CHECK_VK(call)                                                                                       \
+  do {                                                                                                       \
+    if (VkResult r_ = (call); r_ != VK_SUCCESS) {                                                            \
+      std::fprintf(stderr, "%s failed: %d (line %d)\n", #call, int(r_), __LINE__);                           \
+      return 1;                                                                                              \
+    }                                                                                                        \
   } while (0)
 
 std::uint32_t memory_type(VkPhysicalDevice pd, std::uint32_t bits, VkMemoryPropertyFlags want) {
   VkPhysicalDeviceMemoryProperties mp;
   vkGetPhysicalDeviceMemoryProperties(pd, &mp);
   for (std::uint32_t i = 0; i < mp.memoryTypeCount; ++i)
-    if ((bits & (1u << i)) && (mp.memoryTypes[i].propertyFlags & want) == want) return i;
+    if ((bits & (1u << i)) && (mp.memoryTypes[i].propertyFlags & want) == want)
+      return i;
   return 0;
 }
 
@@ -54,9 +57,12 @@ int main(int argc, char** argv) {
   bool validate = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--out" && i + 1 < argc) out = argv[++i];
-    else if (a == "--frames" && i + 1 < argc) frames = std::stoi(argv[++i]);
-    else if (a == "--validate") validate = true;
+    if (a == "--out" && i + 1 < argc)
+      out = argv[++i];
+    else if (a == "--frames" && i + 1 < argc)
+      frames = std::stoi(argv[++i]);
+    else if (a == "--validate")
+      validate = true;
     else {
       std::fprintf(stderr, "usage: embedding_host [--out FILE.png] [--frames N] [--validate]\n");
       return 2;
@@ -64,7 +70,8 @@ int main(int argc, char** argv) {
   }
 
   // ---- The host's own Vulkan: instance, device, queue (nothing of vkcloth yet). ----
-  if (volkInitialize() != VK_SUCCESS) return std::fprintf(stderr, "no Vulkan loader\n"), 4;
+  if (volkInitialize() != VK_SUCCESS)
+    return std::fprintf(stderr, "no Vulkan loader\n"), 4;
   VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
   app.pApplicationName = "embedding_host";
   app.apiVersion = VK_API_VERSION_1_2;
@@ -72,8 +79,10 @@ int main(int argc, char** argv) {
   const char* exts[] = {VK_EXT_DEBUG_UTILS_EXTENSION_NAME, VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME};
   const VkValidationFeatureEnableEXT sync[] = {VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT};
   VkDebugUtilsMessengerCreateInfoEXT mi{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
-  mi.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-  mi.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT;
+  mi.messageSeverity =
+      VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+  mi.messageType =
+      VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT;
   mi.pfnUserCallback = on_message;
   VkValidationFeaturesEXT vf{VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT, &mi, 1, sync, 0, nullptr};
   VkInstanceCreateInfo ici{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
@@ -86,10 +95,12 @@ int main(int argc, char** argv) {
     ici.ppEnabledExtensionNames = exts;
   }
   VkInstance instance = VK_NULL_HANDLE;
-  if (vkCreateInstance(&ici, nullptr, &instance) != VK_SUCCESS) return std::fprintf(stderr, "vkCreateInstance failed\n"), 4;
+  if (vkCreateInstance(&ici, nullptr, &instance) != VK_SUCCESS)
+    return std::fprintf(stderr, "vkCreateInstance failed\n"), 4;
   volkLoadInstanceOnly(instance);
   VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
-  if (validate) CHECK_VK(vkCreateDebugUtilsMessengerEXT(instance, &mi, nullptr, &messenger));
+  if (validate)
+    CHECK_VK(vkCreateDebugUtilsMessengerEXT(instance, &mi, nullptr, &messenger));
   std::uint32_t n = 0;
   vkEnumeratePhysicalDevices(instance, &n, nullptr);
   std::vector<VkPhysicalDevice> pds(n);
@@ -102,10 +113,12 @@ int main(int argc, char** argv) {
     std::vector<VkQueueFamilyProperties> fams(nf);
     vkGetPhysicalDeviceQueueFamilyProperties(p, &nf, fams.data());
     for (std::uint32_t f = 0; f < nf && !pd; ++f)
-      if ((fams[f].queueFlags & (VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT)) == (VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT))
+      if ((fams[f].queueFlags & (VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT)) ==
+          (VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT))
         pd = p, family = f;
   }
-  if (!pd) return std::fprintf(stderr, "no device with a graphics + compute queue\n"), 4;
+  if (!pd)
+    return std::fprintf(stderr, "no device with a graphics + compute queue\n"), 4;
   const float priority = 1.0f;
   VkDeviceQueueCreateInfo qi{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO, nullptr, 0, family, 1, &priority};
   VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
@@ -118,8 +131,8 @@ int main(int argc, char** argv) {
   vkGetDeviceQueue(device, family, 0, &queue);
 
   // ---- The host's render target: colour + depth images, render pass, framebuffer, readback. ----
-  auto make_image = [&](VkFormat format, VkImageUsageFlags usage, VkImageAspectFlags aspect, VkImage& img, VkDeviceMemory& mem,
-                        VkImageView& view) {
+  auto make_image = [&](VkFormat format, VkImageUsageFlags usage, VkImageAspectFlags aspect, VkImage& img,
+                        VkDeviceMemory& mem, VkImageView& view) {
     VkImageCreateInfo ii{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
     ii.imageType = VK_IMAGE_TYPE_2D;
     ii.format = format;
@@ -146,16 +159,29 @@ int main(int argc, char** argv) {
   VkImageView color_view = VK_NULL_HANDLE, depth_view = VK_NULL_HANDLE;
   make_image(VK_FORMAT_R8G8B8A8_UNORM, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
              VK_IMAGE_ASPECT_COLOR_BIT, color, color_mem, color_view);
-  make_image(VK_FORMAT_D32_SFLOAT, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, VK_IMAGE_ASPECT_DEPTH_BIT, depth, depth_mem,
-             depth_view);
+  make_image(VK_FORMAT_D32_SFLOAT, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, VK_IMAGE_ASPECT_DEPTH_BIT,
+             depth, depth_mem, depth_view);
   VkAttachmentDescription att[2] = {};
-  att[0] = {0, VK_FORMAT_R8G8B8A8_UNORM, VK_SAMPLE_COUNT_1_BIT, VK_ATTACHMENT_LOAD_OP_CLEAR, VK_ATTACHMENT_STORE_OP_STORE,
-            VK_ATTACHMENT_LOAD_OP_DONT_CARE, VK_ATTACHMENT_STORE_OP_DONT_CARE, VK_IMAGE_LAYOUT_UNDEFINED,
+  att[0] = {0,
+            VK_FORMAT_R8G8B8A8_UNORM,
+            VK_SAMPLE_COUNT_1_BIT,
+            VK_ATTACHMENT_LOAD_OP_CLEAR,
+            VK_ATTACHMENT_STORE_OP_STORE,
+            VK_ATTACHMENT_LOAD_OP_DONT_CARE,
+            VK_ATTACHMENT_STORE_OP_DONT_CARE,
+            VK_IMAGE_LAYOUT_UNDEFINED,
             VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
-  att[1] = {0, VK_FORMAT_D32_SFLOAT, VK_SAMPLE_COUNT_1_BIT, VK_ATTACHMENT_LOAD_OP_CLEAR, VK_ATTACHMENT_STORE_OP_DONT_CARE,
-            VK_ATTACHMENT_LOAD_OP_DONT_CARE, VK_ATTACHMENT_STORE_OP_DONT_CARE, VK_IMAGE_LAYOUT_UNDEFINED,
+  att[1] = {0,
+            VK_FORMAT_D32_SFLOAT,
+            VK_SAMPLE_COUNT_1_BIT,
+            VK_ATTACHMENT_LOAD_OP_CLEAR,
+            VK_ATTACHMENT_STORE_OP_DONT_CARE,
+            VK_ATTACHMENT_LOAD_OP_DONT_CARE,
+            VK_ATTACHMENT_STORE_OP_DONT_CARE,
+            VK_IMAGE_LAYOUT_UNDEFINED,
             VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL};
-  VkAttachmentReference cref{0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL}, dref{1, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL};
+  VkAttachmentReference cref{0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL},
+      dref{1, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL};
   VkSubpassDescription sub{};
   sub.pipelineBindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS;
   sub.colorAttachmentCount = 1;
@@ -163,23 +189,31 @@ int main(int argc, char** argv) {
   sub.pDepthStencilAttachment = &dref;
   VkSubpassDependency deps[2] = {};
   // Attachments: earlier uses (previous frame) before this frame's writes.
-  deps[0] = {VK_SUBPASS_EXTERNAL, 0,
+  deps[0] = {VK_SUBPASS_EXTERNAL,
+             0,
              VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT | VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT |
                  VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
              VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT | VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT |
                  VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT,
-             VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT,
+             VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT |
+                 VK_ACCESS_TRANSFER_READ_BIT,
              VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_COLOR_ATTACHMENT_READ_BIT |
                  VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT,
              0};
   // The colour writes before the readback copy.
-  deps[1] = {0, VK_SUBPASS_EXTERNAL, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-             VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT, VK_ACCESS_TRANSFER_READ_BIT, 0};
+  deps[1] = {0,
+             VK_SUBPASS_EXTERNAL,
+             VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+             VK_PIPELINE_STAGE_TRANSFER_BIT,
+             VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
+             VK_ACCESS_TRANSFER_READ_BIT,
+             0};
   VkRenderPassCreateInfo rpi{VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO, nullptr, 0, 2, att, 1, &sub, 2, deps};
   VkRenderPass render_pass = VK_NULL_HANDLE;
   CHECK_VK(vkCreateRenderPass(device, &rpi, nullptr, &render_pass));
   const VkImageView views[2] = {color_view, depth_view};
-  VkFramebufferCreateInfo fbi{VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO, nullptr, 0, render_pass, 2, views, width, height, 1};
+  VkFramebufferCreateInfo fbi{
+      VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO, nullptr, 0, render_pass, 2, views, width, height, 1};
   VkFramebuffer framebuffer = VK_NULL_HANDLE;
   CHECK_VK(vkCreateFramebuffer(device, &fbi, nullptr, &framebuffer));
   VkBufferCreateInfo rbi{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
@@ -189,9 +223,10 @@ int main(int argc, char** argv) {
   CHECK_VK(vkCreateBuffer(device, &rbi, nullptr, &readback));
   VkMemoryRequirements rreq;
   vkGetBufferMemoryRequirements(device, readback, &rreq);
-  VkMemoryAllocateInfo rai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, nullptr, rreq.size,
-                           memory_type(pd, rreq.memoryTypeBits,
-                                       VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT)};
+  VkMemoryAllocateInfo rai{
+      VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, nullptr, rreq.size,
+      memory_type(pd, rreq.memoryTypeBits,
+                  VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT)};
   VkDeviceMemory readback_mem = VK_NULL_HANDLE;
   CHECK_VK(vkAllocateMemory(device, &rai, nullptr, &readback_mem));
   CHECK_VK(vkBindBufferMemory(device, readback, readback_mem, 0));
@@ -199,7 +234,8 @@ int main(int argc, char** argv) {
                               VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT, family};
   VkCommandPool pool = VK_NULL_HANDLE;
   CHECK_VK(vkCreateCommandPool(device, &cpi, nullptr, &pool));
-  VkCommandBufferAllocateInfo cai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO, nullptr, pool, VK_COMMAND_BUFFER_LEVEL_PRIMARY, 1};
+  VkCommandBufferAllocateInfo cai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO, nullptr, pool,
+                                  VK_COMMAND_BUFFER_LEVEL_PRIMARY, 1};
   VkCommandBuffer cmd = VK_NULL_HANDLE;
   CHECK_VK(vkAllocateCommandBuffers(device, &cai, &cmd));
   VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
@@ -218,9 +254,11 @@ int main(int argc, char** argv) {
     h.queue = queue;
     h.get_instance_proc_addr = vkGetInstanceProcAddr;
     auto context = gpu::Context::adopt(h);
-    if (!context) return std::fprintf(stderr, "%s\n", context.error().message.c_str()), 1;
+    if (!context)
+      return std::fprintf(stderr, "%s\n", context.error().message.c_str()), 1;
     auto world = gpu::ClothWorld::create(*context);
-    if (!world) return std::fprintf(stderr, "%s\n", world.error().message.c_str()), 1;
+    if (!world)
+      return std::fprintf(stderr, "%s\n", world.error().message.c_str()), 1;
 
     ClothDesc falling;
     falling.nx = falling.ny = 24;
@@ -233,12 +271,14 @@ int main(int argc, char** argv) {
     hanging.ny = 14;
     hanging.origin = {0.25, 0.2, 0.4};
     hanging.size = {0.7, 0.55};
-    hanging.stiffness.structural = 300.0; // the default 40 N/m would stretch 252 particles of 0.05 kg into a rope
+    hanging.stiffness.structural =
+        300.0; // the default 40 N/m would stretch 252 particles of 0.05 kg into a rope
     hanging.stiffness.shear = 30.0;
     hanging.stiffness.bend = 30.0;
     auto falling_sys = make_cloth(falling);
     auto hanging_sys = make_cloth(hanging);
-    if (!falling_sys || !hanging_sys) return std::fprintf(stderr, "make_cloth failed\n"), 1;
+    if (!falling_sys || !hanging_sys)
+      return std::fprintf(stderr, "make_cloth failed\n"), 1;
     // Each topology is prepared once; every instance of it shares it (and one batch).
     auto falling_prep = ClothTopology::create(*falling_sys);
     auto hanging_prep = ClothTopology::create(*hanging_sys);
@@ -262,7 +302,8 @@ int main(int argc, char** argv) {
     SimParams gusty = windy;
     gusty.wind.strength = 0.12;
     auto c = world->add(hanging_topo, gusty, behind);
-    if (!a || !b || !c) return std::fprintf(stderr, "ClothWorld::add failed\n"), 1;
+    if (!a || !b || !c)
+      return std::fprintf(stderr, "ClothWorld::add failed\n"), 1;
 
     render::RendererOptions ro;
     ro.render_pass = render_pass;
@@ -272,7 +313,13 @@ int main(int argc, char** argv) {
     auto rb = render::ClothRenderer::create(*context, windy, *hanging_topo, ro);
     auto rc = render::ClothRenderer::create(*context, gusty, *hanging_topo, ro);
     if (!ra || !rb || !rc)
-      return std::fprintf(stderr, "ClothRenderer::create: %s\n", (!ra ? ra : !rb ? rb : rc).error().message.c_str()), 1;
+      return std::fprintf(stderr, "ClothRenderer::create: %s\n",
+                          (!ra   ? ra
+                           : !rb ? rb
+                                 : rc)
+                              .error()
+                              .message.c_str()),
+             1;
     render::Camera camera;
     camera.eye = {0.4f, -2.6f, 1.5f};
     camera.target = {0.0f, 0.1f, 0.25f};
@@ -286,8 +333,13 @@ int main(int argc, char** argv) {
       world->record_steps(cmd, 2); // compute: both cloths, 2 steps
       world->record_barrier_to(cmd, VK_PIPELINE_STAGE_VERTEX_INPUT_BIT, VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT);
       const VkClearValue clears[2] = {{{{0.62f, 0.72f, 0.84f, 1.0f}}}, {{{1.0f, 0}}}};
-      VkRenderPassBeginInfo rb_info{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO, nullptr, render_pass, framebuffer,
-                                    {{0, 0}, {width, height}}, 2, clears};
+      VkRenderPassBeginInfo rb_info{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO,
+                                    nullptr,
+                                    render_pass,
+                                    framebuffer,
+                                    {{0, 0}, {width, height}},
+                                    2,
+                                    clears};
       vkCmdBeginRenderPass(cmd, &rb_info, VK_SUBPASS_CONTENTS_INLINE);
       // Each instance's buffers (and offset in them): the current positions alternate every step.
       ra->record_draw(cmd, *world->buffers(*a), camera, {width, height});
@@ -299,8 +351,10 @@ int main(int argc, char** argv) {
         region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
         region.imageExtent = {width, height, 1};
         vkCmdCopyImageToBuffer(cmd, color, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback, 1, &region);
-        VkMemoryBarrier host{VK_STRUCTURE_TYPE_MEMORY_BARRIER, nullptr, VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_HOST_READ_BIT};
-        vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &host, 0, nullptr, 0, nullptr);
+        VkMemoryBarrier host{VK_STRUCTURE_TYPE_MEMORY_BARRIER, nullptr, VK_ACCESS_TRANSFER_WRITE_BIT,
+                             VK_ACCESS_HOST_READ_BIT};
+        vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &host, 0,
+                             nullptr, 0, nullptr);
       }
       CHECK_VK(vkEndCommandBuffer(cmd));
       VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
@@ -317,11 +371,13 @@ int main(int argc, char** argv) {
     // CPU-side use of the results: the lowest particle of each cloth.
     for (auto id : world->instances()) {
       auto p = world->positions(id);
-      if (!p) return std::fprintf(stderr, "%s\n", p.error().message.c_str()), 1;
+      if (!p)
+        return std::fprintf(stderr, "%s\n", p.error().message.c_str()), 1;
       float lowest = 1e9f;
-      for (const auto& q : *p) lowest = std::min(lowest, q.z);
-      std::printf("cloth %llu: %zu particles, lowest z = %.4f after %d steps\n", static_cast<unsigned long long>(id), p->size(),
-                  double(lowest), 2 * frames);
+      for (const auto& q : *p)
+        lowest = std::min(lowest, q.z);
+      std::printf("cloth %llu: %zu particles, lowest z = %.4f after %d steps\n",
+                  static_cast<unsigned long long>(id), p->size(), double(lowest), 2 * frames);
     }
     render::Image img;
     img.width = width;
@@ -353,7 +409,8 @@ int main(int argc, char** argv) {
   vkFreeMemory(device, color_mem, nullptr);
   vkFreeMemory(device, depth_mem, nullptr);
   vkDestroyDevice(device, nullptr);
-  if (messenger) vkDestroyDebugUtilsMessengerEXT(instance, messenger, nullptr);
+  if (messenger)
+    vkDestroyDebugUtilsMessengerEXT(instance, messenger, nullptr);
   vkDestroyInstance(instance, nullptr);
   if (validate && g_messages) {
     std::fprintf(stderr, "%u validation messages\n", g_messages);

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # cmake -DSPV=in.spv -DOUT=out.hpp -DNAME=symbol -P embed_spirv.cmake
 # Writes a C++ header holding the SPIR-V words as `inline constexpr std::uint32_t NAME[]`.
 file(READ "${SPV}" hex HEX)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #version 450
 #extension GL_GOOGLE_include_directive : require
 // Force pass of the two-pass layout, one invocation per particle (CpuSolver::normal_at, force_at

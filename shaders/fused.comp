@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #version 450
 #extension GL_GOOGLE_include_directive : require
 // Fused Euler step, one invocation per particle of every instance of the batch, one dispatch per

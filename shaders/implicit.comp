@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #version 450
 #extension GL_GOOGLE_include_directive : require
 // Implicit Euler passes (engine/src/core/implicit_euler.hpp for the method), one invocation per

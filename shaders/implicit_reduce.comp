@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #version 450
 #extension GL_GOOGLE_include_directive : require
 // The final pass of the CG dot products: ONE workgroup sums the per-workgroup partials of the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The physics tests run against every backend: CPU float, CPU double and Vulkan (float, on the
 // shared validated Context of the GPU tests). On CI (CI=true) a missing Vulkan device fails;
 // elsewhere the Vulkan backend is left out with a message.
@@ -21,7 +22,9 @@ enum class Backend { cpu_float, cpu_double, vulkan };
 inline const char* to_string(Backend b) {
   return b == Backend::cpu_float ? "cpu float" : b == Backend::cpu_double ? "cpu double" : "vulkan";
 }
-inline bool is_float(Backend b) { return b != Backend::cpu_double; }
+inline bool is_float(Backend b) {
+  return b != Backend::cpu_double;
+}
 
 /// One solver behind a common face; state comes back in double whatever the backend computes in.
 class Sim {
@@ -37,7 +40,9 @@ public:
   glm::dvec3 velocity(std::size_t i) { return velocities().at(i); }
 };
 
-template <typename V> std::vector<glm::dvec3> widen(const V& v) { return std::vector<glm::dvec3>(v.begin(), v.end()); }
+template <typename V> std::vector<glm::dvec3> widen(const V& v) {
+  return std::vector<glm::dvec3>(v.begin(), v.end());
+}
 
 template <typename Real> class CpuSim final : public Sim {
 public:
@@ -72,8 +77,10 @@ private:
 /// The backends to test here: both CPU precisions, and Vulkan when a device is there.
 inline std::vector<Backend> backends() {
   auto& shared = gpu::test::shared_context();
-  if (shared.context) return {Backend::cpu_float, Backend::cpu_double, Backend::vulkan};
-  if (gpu::test::on_ci()) FAIL("CI=true but no Vulkan device: " << shared.error);
+  if (shared.context)
+    return {Backend::cpu_float, Backend::cpu_double, Backend::vulkan};
+  if (gpu::test::on_ci())
+    FAIL("CI=true but no Vulkan device: " << shared.error);
   MESSAGE("Vulkan backend left out, no device: " << shared.error);
   return {Backend::cpu_float, Backend::cpu_double};
 }
@@ -82,7 +89,8 @@ inline std::vector<Backend> backends() {
 inline std::vector<Backend> float_backends() {
   std::vector<Backend> r;
   for (Backend b : backends())
-    if (is_float(b)) r.push_back(b);
+    if (is_float(b))
+      r.push_back(b);
   return r;
 }
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Cloth (report §3-4): conservation, pins, rest state, collisions, wind, blow-up, determinism.
 // Every test runs on each backend (CPU float, CPU double, Vulkan) with a tolerance stated for float.
 #include <doctest/doctest.h>
@@ -44,7 +45,9 @@ ParticleSystem particle(glm::dvec3 pos, glm::dvec3 vel) {
 }
 
 /// The initial position as the backend stores it (rounded to float on float backends).
-glm::dvec3 stored(Backend b, glm::dvec3 p) { return is_float(b) ? glm::dvec3(glm::vec3(p)) : p; }
+glm::dvec3 stored(Backend b, glm::dvec3 p) {
+  return is_float(b) ? glm::dvec3(glm::vec3(p)) : p;
+}
 
 } // namespace
 
@@ -57,16 +60,19 @@ TEST_CASE("a free cloth without gravity, damping or colliders keeps its total mo
   auto sys = cloth(d);
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-0.5, 0.5);
-  for (Particle& p : sys.particles) p.velocity = {u(rng), u(rng), u(rng)};
+  for (Particle& p : sys.particles)
+    p.velocity = {u(rng), u(rng), u(rng)};
   for (Backend b : backends()) {
     CAPTURE(to_string(b));
     auto s = make_sim(b, sys, no_forces());
     glm::dvec3 p0{0.0}, p1{0.0};
     const auto v0 = s->velocities();
-    for (std::size_t k = 0; k < sys.size(); ++k) p0 += sys.particles[k].mass * v0[k];
+    for (std::size_t k = 0; k < sys.size(); ++k)
+      p0 += sys.particles[k].mass * v0[k];
     REQUIRE(s->run(500).ok());
     const auto v1 = s->velocities();
-    for (std::size_t k = 0; k < sys.size(); ++k) p1 += sys.particles[k].mass * v1[k];
+    for (std::size_t k = 0; k < sys.size(); ++k)
+      p1 += sys.particles[k].mass * v1[k];
     const double tol = is_float(b) ? 1e-5 : 1e-13; // float: rounding of 63 x 500 spring sums
     CHECK(std::abs(p1.x - p0.x) < tol);
     CHECK(std::abs(p1.y - p0.y) < tol);
@@ -109,7 +115,8 @@ TEST_CASE("a cloth at rest in its rest shape with no gravity stays there") {
     // float: rest lengths and spacings round differently, leaving forces of K * 1e-8 that,
     // undamped, move the particles by about 1e-6 over 1000 steps.
     const double tol = is_float(b) ? 1e-5 : 1e-12;
-    for (std::size_t k = 0; k < sys.size(); ++k) CHECK(glm::length(x[k] - sys.particles[k].position) < tol);
+    for (std::size_t k = 0; k < sys.size(); ++k)
+      CHECK(glm::length(x[k] - sys.particles[k].position) < tol);
   }
 }
 
@@ -120,7 +127,8 @@ TEST_CASE("the hanging cloth settles: kinetic energy decays, no NaN (report defa
   auto sys = cloth(d);
   const auto kinetic = [&](Sim& s) {
     double e = 0;
-    for (const glm::dvec3& v : s.velocities()) e += 0.5 * d.particle_mass * glm::dot(v, v);
+    for (const glm::dvec3& v : s.velocities())
+      e += 0.5 * d.particle_mass * glm::dot(v, v);
     return e;
   };
   for (Backend b : backends()) {
@@ -145,7 +153,8 @@ TEST_CASE("structural springs alone diverge past K_struct ~ 50 at dt = 0.02 (rep
       auto s = make_sim(b, cloth(d), SimParams{});
       auto r = s->run(3000);
       CHECK(r.ok() == (k < 50.0));
-      if (!r.ok()) CHECK(r.error().code == ErrorCode::diverged);
+      if (!r.ok())
+        CHECK(r.error().code == ErrorCode::diverged);
     }
 }
 
@@ -179,7 +188,8 @@ TEST_CASE("plane and sphere collisions: no particle ends inside a collider") {
     CHECK(min_sphere >= -1e-6); // float rounding of the projection onto r + eps
     CHECK(sphere_contacts > 20);
     double max_z = 0;
-    for (const glm::dvec3& x : s->positions()) max_z = std::max(max_z, x.z);
+    for (const glm::dvec3& x : s->positions())
+      max_z = std::max(max_z, x.z);
     CHECK(max_z < 0.05); // slid off the sphere and lies on the floor
   }
 }
@@ -200,7 +210,8 @@ TEST_CASE("contact keeps the tangential velocity and removes only the inward nor
   }
 }
 
-TEST_CASE("an outward velocity or force is not cancelled by a contact (the hand lifting the cloth, Figure 12)") {
+TEST_CASE(
+    "an outward velocity or force is not cancelled by a contact (the hand lifting the cloth, Figure 12)") {
   ValidationScope validation;
   for (Backend b : backends()) {
     CAPTURE(to_string(b));
@@ -236,14 +247,15 @@ TEST_CASE("an outward velocity or force is not cancelled by a contact (the hand 
       auto s = make_sim(b, particle(start, {0, 0, 0}), p);
       REQUIRE(s->run(10).ok());
       const glm::dvec3 x = s->position(0);
-      CHECK(x.z < start.z - 1e-3); // slid down...
-      CHECK(x.x > start.x);        // ...around the sphere
+      CHECK(x.z < start.z - 1e-3);         // slid down...
+      CHECK(x.x > start.x);                // ...around the sphere
       CHECK(glm::length(x) >= 1.0 - 1e-7); // and stayed outside (float: r + eps rounded)
     }
   }
 }
 
-TEST_CASE("contact_inward_only = false (Figure 12's variant) also cancels outward parts: the particle sticks") {
+TEST_CASE(
+    "contact_inward_only = false (Figure 12's variant) also cancels outward parts: the particle sticks") {
   ValidationScope validation;
   for (Backend b : backends()) {
     CAPTURE(to_string(b));
@@ -252,8 +264,8 @@ TEST_CASE("contact_inward_only = false (Figure 12's variant) also cancels outwar
     p.contact_inward_only = false;
     auto s = make_sim(b, particle({0, 0, 0.001}, {0.5, 0, 1.0}), p);
     REQUIRE(s->run(10).ok());
-    CHECK(s->velocity(0).z == 0.0);  // the outward velocity was removed...
-    CHECK(s->velocity(0).x == 0.5);  // ...the tangential part kept
+    CHECK(s->velocity(0).z == 0.0); // the outward velocity was removed...
+    CHECK(s->velocity(0).x == 0.5); // ...the tangential part kept
     CHECK(std::abs(s->position(0).z - 0.001) < 1e-7);
   }
 }
@@ -272,7 +284,8 @@ TEST_CASE("wind F = Kw <n, u> n: zero when the wind lies in the cloth plane, alo
     p.wind = {0.05, {1, 0, 1}};
     auto in_plane = make_sim(b, cloth(d), p);
     REQUIRE(in_plane->step().ok());
-    for (const glm::dvec3& f : in_plane->forces()) CHECK(glm::length(f) < tol);
+    for (const glm::dvec3& f : in_plane->forces())
+      CHECK(glm::length(f) < tol);
 
     p.wind = {0.05, {1, 1, 0}}; // normalised to (1, 1, 0)/sqrt 2: <n, u> = -+1/sqrt 2
     auto across = make_sim(b, cloth(d), p);
@@ -355,25 +368,27 @@ TEST_CASE("the CPU grid stencil gives the same results as the CSR gather lists")
   irregular.finalize();
   // With and without colliders: without, the vectorised row kernel also integrates.
   for (int colliders = 0; colliders < 2; ++colliders)
-  for (Integrator integ : {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::rk4}) {
-    CAPTURE(to_string(integ));
-    CAPTURE(colliders);
-    p.integrator = integ;
-    p.dt = integ == Integrator::explicit_euler ? 0.005 : 0.02;
-    if (colliders == 0) p.colliders.clear();
-    else p.colliders = {Collider::sphere({0, 0.2, 0.2}, 0.3)};
-    auto a = CpuSolver<float>::create(regular, p, {1});
-    auto b = CpuSolver<float>::create(irregular, p, {2});
-    REQUIRE(a.ok());
-    REQUIRE(b.ok());
-    REQUIRE(a->run(60).ok());
-    REQUIRE(b->run(60).ok());
-    std::size_t differ = 0;
-    for (std::size_t k = 0; k < a->positions().size(); ++k)
-      differ += a->positions()[k] != b->positions()[k] || a->velocities()[k] != b->velocities()[k] ||
-                a->normals()[k] != b->normals()[k];
-    CHECK(differ == 0);
-  }
+    for (Integrator integ : {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::rk4}) {
+      CAPTURE(to_string(integ));
+      CAPTURE(colliders);
+      p.integrator = integ;
+      p.dt = integ == Integrator::explicit_euler ? 0.005 : 0.02;
+      if (colliders == 0)
+        p.colliders.clear();
+      else
+        p.colliders = {Collider::sphere({0, 0.2, 0.2}, 0.3)};
+      auto a = CpuSolver<float>::create(regular, p, {1});
+      auto b = CpuSolver<float>::create(irregular, p, {2});
+      REQUIRE(a.ok());
+      REQUIRE(b.ok());
+      REQUIRE(a->run(60).ok());
+      REQUIRE(b->run(60).ok());
+      std::size_t differ = 0;
+      for (std::size_t k = 0; k < a->positions().size(); ++k)
+        differ += a->positions()[k] != b->positions()[k] || a->velocities()[k] != b->velocities()[k] ||
+                  a->normals()[k] != b->normals()[k];
+      CHECK(differ == 0);
+    }
 }
 
 TEST_CASE("the CPU row sweep: masked border rows and the per-particle border give the CSR lists' bits") {
@@ -395,7 +410,8 @@ TEST_CASE("the CPU row sweep: masked border rows and the per-particle border giv
   std::uniform_real_distribution<double> jitter(-0.004, 0.004);
   for (Particle& q : masked.particles) {
     q.position += glm::dvec3{jitter(rng), jitter(rng), jitter(rng)};
-    if (!q.pinned) q.velocity = glm::dvec3{jitter(rng), jitter(rng), jitter(rng)} * 10.0;
+    if (!q.pinned)
+      q.velocity = glm::dvec3{jitter(rng), jitter(rng), jitter(rng)} * 10.0;
   }
   ParticleSystem border = masked;
   border.springs.push_back(Spring{0, d.nx + 3, 0.1, 0.0, SpringKind::plain});
@@ -413,8 +429,10 @@ TEST_CASE("the CPU row sweep: masked border rows and the per-particle border giv
         CAPTURE(threads);
         p.integrator = integ;
         p.dt = integ == Integrator::explicit_euler ? 0.004 : 0.02;
-        if (colliders == 0) p.colliders.clear();
-        else p.colliders = {Collider::sphere({0, 0.2, 0.2}, 0.3)};
+        if (colliders == 0)
+          p.colliders.clear();
+        else
+          p.colliders = {Collider::sphere({0, 0.2, 0.2}, 0.3)};
         std::vector<CpuSolver<float>> s;
         for (const ParticleSystem* sys : {&masked, &border, &csr}) {
           auto c = CpuSolver<float>::create(*sys, p, {threads});
@@ -424,8 +442,11 @@ TEST_CASE("the CPU row sweep: masked border rows and the per-particle border giv
         for (CpuSolver<float>& c : s) {
           REQUIRE(c.run(15).ok());
           // A border and an interior particle moved by a "hand".
-          REQUIRE(c.set_particle(std::uint32_t(d.nx + 7), glm::vec3(-0.3f, 0.01f, 0.45f), glm::vec3(0.1f, 0, 0)).ok());
-          REQUIRE(c.set_particle(std::uint32_t(9 * d.nx + 20), glm::vec3(0.02f, 0.05f, 0.2f), glm::vec3(0)).ok());
+          REQUIRE(
+              c.set_particle(std::uint32_t(d.nx + 7), glm::vec3(-0.3f, 0.01f, 0.45f), glm::vec3(0.1f, 0, 0))
+                  .ok());
+          REQUIRE(
+              c.set_particle(std::uint32_t(9 * d.nx + 20), glm::vec3(0.02f, 0.05f, 0.2f), glm::vec3(0)).ok());
           REQUIRE(c.run(10).ok());
           SimParams rk = p;
           rk.integrator = Integrator::rk4;
@@ -462,14 +483,16 @@ TEST_CASE("the CPU row sweep's finite check catches a bad particle in any lane, 
   SimParams p;
   p.wind = {0.05, {0.2, 1, 0}};
   for (int colliders = 0; colliders < 2; ++colliders) {
-    if (colliders) p.colliders = {Collider::plane({0, 0, 1}, -5.0)};
+    if (colliders)
+      p.colliders = {Collider::plane({0, 0, 1}, -5.0)};
     for (unsigned threads : {1u, 2u}) {
       CAPTURE(colliders);
       CAPTURE(threads);
       std::size_t named = 0, tried = 0;
       for (std::uint32_t k = 0; k < sys.particles.size(); ++k) {
         const std::uint32_t row = k / d.nx;
-        if (!(row <= 2 || (row >= 22 && row <= 24) || row >= d.ny - 2)) continue;
+        if (!(row <= 2 || (row >= 22 && row <= 24) || row >= d.ny - 2))
+          continue;
         ++tried;
         auto s = CpuSolver<float>::create(sys, p, {threads});
         REQUIRE(s.ok());
@@ -506,8 +529,9 @@ std::vector<glm::vec<3, Real>> run_with_isa(const char* isa, const ParticleSyste
   return out;
 }
 
-template <typename Real> std::size_t bitwise_differences(const std::vector<glm::vec<3, Real>>& a,
-                                                         const std::vector<glm::vec<3, Real>>& b) {
+template <typename Real>
+std::size_t bitwise_differences(const std::vector<glm::vec<3, Real>>& a,
+                                const std::vector<glm::vec<3, Real>>& b) {
   REQUIRE(a.size() == b.size());
   std::size_t differ = 0;
   for (std::size_t k = 0; k < a.size(); ++k)
@@ -516,7 +540,8 @@ template <typename Real> std::size_t bitwise_differences(const std::vector<glm::
 }
 } // namespace
 
-TEST_CASE_TEMPLATE("the SIMD row kernels (AVX2, AVX-512) give the shared reference's bits", Real, float, double) {
+TEST_CASE_TEMPLATE("the SIMD row kernels (AVX2, AVX-512) give the shared reference's bits", Real, float,
+                   double) {
   // Odd sizes: interior runs of 33 particles = whole vectors plus a scalar remainder, and chunk
   // boundaries of the 2-thread split fall mid-row. Wind on, an interior pinned particle (the
   // kernel's pin select), a perturbed start so no lane sees a symmetric configuration. On a CPU
@@ -532,7 +557,8 @@ TEST_CASE_TEMPLATE("the SIMD row kernels (AVX2, AVX-512) give the shared referen
   std::uniform_real_distribution<double> jitter(-0.004, 0.004);
   for (Particle& q : sys.particles) {
     q.position += glm::dvec3{jitter(rng), jitter(rng), jitter(rng)};
-    if (!q.pinned) q.velocity = glm::dvec3{jitter(rng), jitter(rng), jitter(rng)} * 10.0;
+    if (!q.pinned)
+      q.velocity = glm::dvec3{jitter(rng), jitter(rng), jitter(rng)} * 10.0;
   }
   SimParams p;
   p.wind = {0.07, {0.2, 1, 0.1}};
@@ -542,8 +568,10 @@ TEST_CASE_TEMPLATE("the SIMD row kernels (AVX2, AVX-512) give the shared referen
       CAPTURE(colliders);
       p.integrator = integ;
       p.dt = integ == Integrator::explicit_euler ? 0.004 : 0.02;
-      if (colliders == 0) p.colliders.clear();
-      else p.colliders = {Collider::sphere({0, 0.2, 0.2}, 0.3)};
+      if (colliders == 0)
+        p.colliders.clear();
+      else
+        p.colliders = {Collider::sphere({0, 0.2, 0.2}, 0.3)};
       for (unsigned threads : {1u, 2u}) {
         CAPTURE(threads);
         const auto scalar = run_with_isa<Real>("scalar", sys, p, threads, 40);

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Implicit Euler (issue #8) and substeps: closed form and order, stability far beyond the
 // explicit limit, the stiff hanging cloth, CG convergence, substeps = k equals k small steps.
 #include <doctest/doctest.h>
@@ -59,7 +60,8 @@ double max_structural_strain(const ParticleSystem& s, const std::vector<glm::dve
 
 double kinetic(const ParticleSystem& s, const std::vector<glm::dvec3>& vel) {
   double e = 0.0;
-  for (std::size_t p = 0; p < vel.size(); ++p) e += 0.5 * s.particles[p].mass * glm::dot(vel[p], vel[p]);
+  for (std::size_t p = 0; p < vel.size(); ++p)
+    e += 0.5 * s.particles[p].mass * glm::dot(vel[p], vel[p]);
   return e;
 }
 
@@ -78,8 +80,9 @@ TEST_CASE("implicit Euler: the single spring matches the closed form to first or
       err[k] = std::abs(sim->position(1).z - closed_form_z(T, K, mu));
     }
     const double order1 = std::log2(err[0] / err[1]), order2 = std::log2(err[1] / err[2]);
-    MESSAGE(std::string(to_string(b)) << ": |z - z_exact| at t = 2 s: " << err[0] << ", " << err[1] << ", " << err[2]
-                         << " (dt = 0.02, 0.01, 0.005); observed order " << order1 << ", " << order2);
+    MESSAGE(std::string(to_string(b))
+            << ": |z - z_exact| at t = 2 s: " << err[0] << ", " << err[1] << ", " << err[2]
+            << " (dt = 0.02, 0.01, 0.005); observed order " << order1 << ", " << order2);
     CHECK(err[0] < 0.15); // backward Euler damps: 18 % of the 0.49 m amplitude at dt = 0.02
     CHECK(order1 == doctest::Approx(1.0).epsilon(0.15));
     CHECK(order2 == doctest::Approx(1.0).epsilon(0.15));
@@ -112,7 +115,8 @@ TEST_CASE("implicit Euler: CG reaches the tolerance on the test scenes (iteratio
   ClothDesc soft;
   soft.nx = 13;
   soft.ny = 9; // odd, non-square
-  Case cases[] = {{"spring", spring(20.0), 0.02}, {"cloth 13x9 (40/8/8)", *make_cloth(soft), 0.02},
+  Case cases[] = {{"spring", spring(20.0), 0.02},
+                  {"cloth 13x9 (40/8/8)", *make_cloth(soft), 0.02},
                   {"stiff cloth 16x16", stiff_cloth(16), 0.02}};
   for (const Case& c : cases) {
     auto s = CpuSolver<double>::create(c.system, implicit_params(c.dt));
@@ -172,7 +176,8 @@ TEST_CASE("implicit Euler: the stiff 64x64 cloth hangs stably where semi-implici
     REQUIRE(s->step().ok()); // includes the NaN / blow-up check
     max_it = std::max(max_it, s->last_solve().iterations);
     max_res = std::max(max_res, s->last_solve().residual);
-    if (k == 2) ke_early = kinetic(cloth, widen(s->velocities()));
+    if (k == 2)
+      ke_early = kinetic(cloth, widen(s->velocities()));
     if (k % 50 == 0) {
       const auto pos = widen(s->positions());
       max_strain = std::max(max_strain, max_structural_strain(cloth, pos));
@@ -180,10 +185,10 @@ TEST_CASE("implicit Euler: the stiff 64x64 cloth hangs stably where semi-implici
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double ke_end = kinetic(cloth, widen(s->velocities()));
-  MESSAGE("stiff cloth 64x64, dt = 0.02, " << steps << " implicit steps in " << wall << " s: max structural strain "
-                                           << max_strain << ", kinetic energy " << ke_early << " J (step 2) -> "
-                                           << ke_end << " J; CG at most " << max_it << " iterations, worst residual "
-                                           << max_res);
+  MESSAGE("stiff cloth 64x64, dt = 0.02, "
+          << steps << " implicit steps in " << wall << " s: max structural strain " << max_strain
+          << ", kinetic energy " << ke_early << " J (step 2) -> " << ke_end << " J; CG at most " << max_it
+          << " iterations, worst residual " << max_res);
   CHECK(max_strain < 0.05); // stated bound: 5 % stretch
   if (steps >= 1000)
     CHECK(ke_end < 1e-3 * ke_early); // the fall from rest is damped out
@@ -196,8 +201,8 @@ TEST_CASE("implicit Euler: the stiff 64x64 cloth hangs stably where semi-implici
 
 TEST_CASE("substeps: k substeps of dt/k equal k steps of dt/k, bit for bit") {
   for (Backend b : backends()) {
-    for (Integrator integ :
-         {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::rk4, Integrator::implicit_euler}) {
+    for (Integrator integ : {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::rk4,
+                             Integrator::implicit_euler}) {
       CAPTURE(std::string(to_string(b)));
       CAPTURE(std::string(to_string(integ)));
       ValidationScope vs;
@@ -220,7 +225,8 @@ TEST_CASE("substeps: k substeps of dt/k equal k steps of dt/k, bit for bit") {
       const auto pa = a->positions(), pc = c->positions();
       const auto va = a->velocities(), vc = c->velocities();
       bool same = true;
-      for (std::size_t p = 0; p < pa.size(); ++p) same = same && pa[p] == pc[p] && va[p] == vc[p];
+      for (std::size_t p = 0; p < pa.size(); ++p)
+        same = same && pa[p] == pc[p] && va[p] == vc[p];
       CHECK(same);
     }
   }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Builders and the system description: counts, rest lengths, index convention, gather order, errors.
 #include <doctest/doctest.h>
 
@@ -12,7 +13,8 @@ using namespace vkcloth;
 namespace {
 std::size_t count_kind(const ParticleSystem& s, SpringKind k) {
   std::size_t n = 0;
-  for (const Spring& sp : s.springs) n += sp.kind == k;
+  for (const Spring& sp : s.springs)
+    n += sp.kind == k;
   return n;
 }
 } // namespace
@@ -100,14 +102,16 @@ TEST_CASE("cloth pins: an explicit list replaces the corners; zero stiffness lea
   d.stiffness.bend = 0.0;
   auto sys = make_cloth(d);
   REQUIRE(sys.ok());
-  for (std::size_t k = 0; k < sys->particles.size(); ++k) CHECK(sys->particles[k].pinned == (k == 12));
+  for (std::size_t k = 0; k < sys->particles.size(); ++k)
+    CHECK(sys->particles[k].pinned == (k == 12));
   CHECK(count_kind(*sys, SpringKind::shear) == 0);
   CHECK(count_kind(*sys, SpringKind::bend) == 0);
   d.pins.clear();
   d.pin_default_corners = false;
   auto free_cloth = make_cloth(d);
   REQUIRE(free_cloth.ok());
-  for (const Particle& p : free_cloth->particles) CHECK_FALSE(p.pinned);
+  for (const Particle& p : free_cloth->particles)
+    CHECK_FALSE(p.pinned);
 }
 
 TEST_CASE("adjacency lists each spring at both ends, in increasing spring index (the gather order)") {
@@ -123,7 +127,8 @@ TEST_CASE("adjacency lists each spring at both ends, in increasing spring index 
     for (std::uint32_t e = adj.offsets[p]; e < adj.offsets[p + 1]; ++e) {
       const Spring& s = sys->springs[adj.refs[e].spring];
       CHECK(((s.a == p && s.b == adj.refs[e].other) || (s.b == p && s.a == adj.refs[e].other)));
-      if (e > adj.offsets[p]) CHECK(adj.refs[e - 1].spring < adj.refs[e].spring);
+      if (e > adj.offsets[p])
+        CHECK(adj.refs[e - 1].spring < adj.refs[e].spring);
     }
   // An interior particle has 4 structural + 4 shear + 4 bend springs.
   const std::size_t interior = 2 * 6 + 2;
@@ -197,7 +202,8 @@ TEST_CASE("ParticleSystem::validate refuses what no solver can run, naming the p
   ParticleSystem edited = *sys;
   edited.springs.push_back(Spring{0, 100, 1.0, 1.0, SpringKind::plain});
   edited.finalize(); // leaves the bad spring out of the gather lists; validate() names it
-  CHECK(edited.validate().error().message.find("joins particles 0 and 100, but there are 100") != std::string::npos);
+  CHECK(edited.validate().error().message.find("joins particles 0 and 100, but there are 100") !=
+        std::string::npos);
   ParticleSystem massless = *sys;
   massless.particles[0].mass = 0.0;
   CHECK(massless.validate().error().message.find("particle 0 has mass 0") != std::string::npos);

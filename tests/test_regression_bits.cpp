@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Bit-for-bit regression: every sample scene, under every integrator and at two larger grid sizes,
 // runs 200 steps on every backend; a hash of the positions' bits must equal the one recorded on the
 // commit before the "one source of truth" redesign (the table below). A refactor that changes one
@@ -30,7 +31,8 @@ std::uint64_t fnv1a(const std::vector<glm::dvec3>& v) {
     for (int k = 0; k < 3; ++k) {
       unsigned char b[sizeof(double)];
       std::memcpy(b, &p[k], sizeof b); // float widened to double is exact: same information
-      for (unsigned char c : b) h = (h ^ c) * 1099511628211ull;
+      for (unsigned char c : b)
+        h = (h ^ c) * 1099511628211ull;
     }
   return h;
 }
@@ -45,10 +47,13 @@ struct Case {
 // border masks) and 64 x 64 (full SIMD vectors).
 std::vector<Case> cases() {
   std::vector<Case> r;
-  for (const char* scene : {"spring", "double_spring", "cloth_hanging", "cloth_on_plane", "cloth_on_sphere", "cloth_wind"})
-    for (const char* integ : {"", "explicit_euler", "rk4", "implicit_euler"}) r.push_back({scene, integ, ""});
+  for (const char* scene :
+       {"spring", "double_spring", "cloth_hanging", "cloth_on_plane", "cloth_on_sphere", "cloth_wind"})
+    for (const char* integ : {"", "explicit_euler", "rk4", "implicit_euler"})
+      r.push_back({scene, integ, ""});
   for (const char* scene : {"cloth_hanging", "cloth_on_sphere", "cloth_wind"})
-    for (const char* res : {"[37, 23]", "[64, 64]"}) r.push_back({scene, "", res});
+    for (const char* res : {"[37, 23]", "[64, 64]"})
+      r.push_back({scene, "", res});
   return r;
 }
 
@@ -68,7 +73,8 @@ const Expected expected[] = {
 
 bool on_lavapipe() {
   auto& shared = gpu::test::shared_context();
-  if (!shared.context) return false;
+  if (!shared.context)
+    return false;
   return shared.context->device_name().find("llvmpipe") != std::string::npos;
 }
 
@@ -79,14 +85,17 @@ void check_backend(Backend b) {
   ValidationScope validation;
   for (const Case& c : cases()) {
     std::vector<std::string> overrides{"integrator.steps=200"};
-    if (*c.integrator) overrides.push_back(fmt::format("integrator.method={}", c.integrator));
+    if (*c.integrator)
+      overrides.push_back(fmt::format("integrator.method={}", c.integrator));
     // Explicit Euler diverges at the samples' dt (its stability limit; docs/model.md "Integrators").
-    if (std::string(c.integrator) == "explicit_euler") overrides.push_back("integrator.dt=0.002");
-    if (*c.resolution) overrides.push_back(fmt::format("cloth.resolution={}", c.resolution));
+    if (std::string(c.integrator) == "explicit_euler")
+      overrides.push_back("integrator.dt=0.002");
+    if (*c.resolution)
+      overrides.push_back(fmt::format("cloth.resolution={}", c.resolution));
     const std::string name = case_name(c, b);
     CAPTURE(name);
-    auto scene =
-        load_scene_file(std::filesystem::path(VKCLOTH_SCENES_DIR) / (std::string(c.scene) + ".json"), overrides);
+    auto scene = load_scene_file(std::filesystem::path(VKCLOTH_SCENES_DIR) / (std::string(c.scene) + ".json"),
+                                 overrides);
     REQUIRE_MESSAGE(scene.ok(), (scene.ok() ? "" : scene.error().message));
     auto sim = make_sim(b, scene->system, scene->params);
     const auto run = sim->run(200);
@@ -98,11 +107,12 @@ void check_backend(Backend b) {
     }
     const Expected* e = nullptr;
     for (const Expected& x : expected)
-      if (name == x.name) e = &x;
+      if (name == x.name)
+        e = &x;
     REQUIRE_MESSAGE(e != nullptr, "no recorded hash for " << name);
     if (b == Backend::vulkan && !lavapipe) {
-      MESSAGE(fmt::format("{}: 0x{:016x} (recorded on lavapipe: 0x{:016x}; not compared on this driver)", name, h,
-                          e->hash));
+      MESSAGE(fmt::format("{}: 0x{:016x} (recorded on lavapipe: 0x{:016x}; not compared on this driver)",
+                          name, h, e->hash));
       continue;
     }
     CHECK_MESSAGE(h == e->hash, fmt::format("{}: hash 0x{:016x}, recorded 0x{:016x}", name, h, e->hash));
@@ -119,9 +129,11 @@ TEST_CASE("regression: CPU double positions after 200 steps are bit-identical to
   check_backend(Backend::cpu_double);
 }
 
-TEST_CASE("regression: Vulkan positions after 200 steps are bit-identical to the recorded reference (lavapipe)") {
+TEST_CASE(
+    "regression: Vulkan positions after 200 steps are bit-identical to the recorded reference (lavapipe)") {
   const auto bs = backends(); // fails on CI without a device
-  if (bs.back() == Backend::vulkan) check_backend(Backend::vulkan);
+  if (bs.back() == Backend::vulkan)
+    check_backend(Backend::vulkan);
 }
 
 } // namespace vkcloth::test

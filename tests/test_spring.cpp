@@ -1,6 +1,7 @@
-// Single and coupled springs (docs/model.md "Springs", "Integrators") against closed forms and the integrators' stability theory.
-// The observations of the report run on every backend; the convergence-order and energy studies
-// need double precision and run on the CPU double solver.
+// SPDX-License-Identifier: MIT
+// Single and coupled springs (docs/model.md "Springs", "Integrators") against closed forms and the
+// integrators' stability theory. The observations of the report run on every backend; the convergence-order
+// and energy studies need double precision and run on the CPU double solver.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -59,8 +60,10 @@ TEST_CASE("single spring: period and decay of the damped oscillator, static sag 
   for (int k = 1; k <= 20000; ++k) {
     REQUIRE(s->step().ok());
     const double x = s->positions()[1].z - z_eq;
-    if (prev < 0 && x >= 0) crossings.push_back(s->time() - 0.001 * x / (x - prev));
-    if (prev > prev2 && prev > x && prev > 0) peaks.push_back(prev);
+    if (prev < 0 && x >= 0)
+      crossings.push_back(s->time() - 0.001 * x / (x - prev));
+    if (prev > prev2 && prev > x && prev > 0)
+      peaks.push_back(prev);
     prev2 = prev;
     prev = x;
   }
@@ -101,11 +104,13 @@ double excursion_after(Backend b, Integrator integ, double dt, double offset, in
   d.positions = {{0.0, 0.0, z_eq + offset}};
   auto sys = make_chain(d);
   auto s = make_sim(b, *sys, spring_params(integ, dt));
-  if (!s->run(std::uint64_t(steps)).ok()) return INFINITY;
+  if (!s->run(std::uint64_t(steps)).ok())
+    return INFINITY;
   return std::abs(s->position(1).z - z_eq);
 }
 
-TEST_CASE("report §2.2 stability (K = 20, mu = 0.5, m = 1) with semi-implicit Euler: 0.02 and 0.2 settle, 0.45 diverges") {
+TEST_CASE("report §2.2 stability (K = 20, mu = 0.5, m = 1) with semi-implicit Euler: 0.02 and 0.2 settle, "
+          "0.45 diverges") {
   ValidationScope validation;
   for (Backend b : backends()) {
     CAPTURE(to_string(b));
@@ -121,7 +126,8 @@ TEST_CASE("report §2.2 stability (K = 20, mu = 0.5, m = 1) with semi-implicit E
   }
 }
 
-TEST_CASE("semi-implicit Euler is unstable exactly where theory says: (K/m) dt^2 + 2 (mu/m) dt > 4, dt > 0.4234") {
+TEST_CASE(
+    "semi-implicit Euler is unstable exactly where theory says: (K/m) dt^2 + 2 (mu/m) dt > 4, dt > 0.4234") {
   // Started 1e-4 from equilibrium the motion is linear until it grows; far from it the spring can
   // fold through its anchor, where the force is discontinuous and the motion bounded but chaotic.
   ValidationScope validation;
@@ -134,7 +140,8 @@ TEST_CASE("semi-implicit Euler is unstable exactly where theory says: (K/m) dt^2
   }
 }
 
-TEST_CASE("explicit Euler (eq. 3 as written) is stable only while dt < mu/K = 0.025, so already unstable at 0.2") {
+TEST_CASE(
+    "explicit Euler (eq. 3 as written) is stable only while dt < mu/K = 0.025, so already unstable at 0.2") {
   ValidationScope validation;
   for (Backend b : backends()) {
     CAPTURE(to_string(b));

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // ClothTopology: the gather lists, normal fans, triangles, uvs and grid stencil every solver and
 // renderer reads, prepared once from a ParticleSystem.
 #include <doctest/doctest.h>

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """Compares two vkcloth builds with `vkcloth bench`, alternated in one session (A, B, A, B, ...),
 so that a noisy machine slows both alike. Prints, per configuration (backend, variant, size,
 instances), each build's median particle-steps/s over the rounds and the ratio B / A, and

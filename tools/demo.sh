@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # Builds vkcloth and runs the main demo: the report's hanging cloth in the wind, on the GPU when a
 # Vulkan device is there (lavapipe counts), else on the CPU reference solver; then, with a device,
 # renders the textured cloth falling onto the sphere to out/cloth_on_sphere.png (and

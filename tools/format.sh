@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # Formats the C++ sources (and the header shared with GLSL) with the repository's .clang-format.
 # Usage: tools/format.sh          rewrite the files in place
 #        tools/format.sh --check  change nothing; list the files that differ and exit 1 if any

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # Fuzzes the scene parser and validator (tests/fuzz/fuzz_scene.cpp) with libFuzzer, clang, ASan and
 # UBSan, for a bounded time. Usage: tools/fuzz.sh [seconds=60]
 # Seed corpus: samples/scenes/ and tests/fuzz/regressions/. A crash leaves its input in

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # Installs the Debian packages vkcloth needs. Idempotent; prints nothing when all is present.
 # Usage: tools/setup.sh [fuzz|format]   (fuzz: also clang and its libFuzzer runtime, for tools/fuzz.sh;
 #                                       format: clang-format, for tools/format.sh)

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # Opt-in soak test (not in tools/test.sh): 100 000 steps of each stable sample scene on the CPU
 # (and on Vulkan with --vulkan), checking no NaN/inf, no drift of pinned particles and no RSS
 # growth (vkcloth soak). Usage: tools/soak.sh [--vulkan] [steps=100000]

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # Builds vkcloth and runs the whole test suite (CPU physics, scene files, CLI, GPU on lavapipe
 # with the Khronos validation layer). Usage: tools/test.sh [preset]   (release | debug | asan)
 set -euo pipefail

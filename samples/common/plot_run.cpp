@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "plot_run.hpp"
 
 #include <fstream>
@@ -19,7 +20,8 @@ bool plot_chain(const vkcloth::Scene& scene, double seconds, const std::filesyst
   plot::Plot pos{fmt::format("{}: height of the masses", scene.name), "t (s)", "z (m)", {}, 0, 0, 640, 400};
   plot::Plot energy{fmt::format("{}: energy", scene.name), "t (s)", "E (J)", {}, 0, 0, 640, 400};
   const char* names[] = {"kinetic", "gravity", "spring", "total"};
-  for (int k = 0; k < 4; ++k) energy.series.push_back({names[k], plot::palette(std::size_t(k)), {}, {}, k == 3, {}});
+  for (int k = 0; k < 4; ++k)
+    energy.series.push_back({names[k], plot::palette(std::size_t(k)), {}, {}, k == 3, {}});
   for (std::size_t p = 0; p < scene.system.size(); ++p)
     if (!scene.system.particles[p].pinned)
       pos.series.push_back({fmt::format("mass {}", p), plot::palette(pos.series.size()), {}, {}, false, {}});

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // For the chain samples: run the CPU reference solver and plot the masses' height and the
 // energies over time as SVG (vkcloth_plot), next to the frames.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The samples' shared loop. The offscreen path uses only the engine's API (OffscreenTarget); the
 // window path records each frame itself into the window, swapchain and present render pass of
 // vkcloth_host_window, as a host application embedding vkcloth would (a condensed `vkcloth view`).
@@ -23,9 +24,12 @@ namespace {
 int fail(const vkcloth::Error& e) {
   fmt::print(stderr, "error: {}\n", e.message);
   switch (e.code) {
-  case vkcloth::ErrorCode::diverged: return 3;
-  case vkcloth::ErrorCode::no_device: return 4;
-  default: return 1;
+  case vkcloth::ErrorCode::diverged:
+    return 3;
+  case vkcloth::ErrorCode::no_device:
+    return 4;
+  default:
+    return 1;
   }
 }
 
@@ -38,17 +42,21 @@ int run_offscreen(const vkcloth::Scene& scene, const Options& o) {
   gpu::ContextOptions co;
   co.require_graphics = true; // the queue draws as well as computes
   auto ctx = gpu::Context::create(co);
-  if (!ctx) return fail(ctx.error());
+  if (!ctx)
+    return fail(ctx.error());
   auto solver = gpu::GpuSolver::create(*ctx, scene.system, scene.params);
-  if (!solver) return fail(solver.error());
+  if (!solver)
+    return fail(solver.error());
   auto target = render::OffscreenTarget::create(*ctx, o.width, o.height);
-  if (!target) return fail(target.error());
+  if (!target)
+    return fail(target.error());
   render::RendererOptions ro;
   ro.render_pass = target->render_pass();
   auto renderer = render::ClothRenderer::create(*ctx, *solver, *solver->topology(), ro);
-  if (!renderer) return fail(renderer.error());
-  const render::Camera camera =
-      render::Camera::frame(render::scene_bounds(scene.system, scene.params), float(o.width) / float(o.height));
+  if (!renderer)
+    return fail(renderer.error());
+  const render::Camera camera = render::Camera::frame(render::scene_bounds(scene.system, scene.params),
+                                                      float(o.width) / float(o.height));
   std::error_code ec;
   std::filesystem::create_directories(o.out, ec);
   const std::uint32_t frames = o.frames ? o.frames : 60;
@@ -56,13 +64,16 @@ int run_offscreen(const vkcloth::Scene& scene, const Options& o) {
   for (std::uint32_t f = 0; f < frames; ++f) {
     // One submission: `steps` steps, the compute -> vertex barrier, the draw, the readback.
     auto img = target->render(*solver, *renderer, camera, f == 0 ? 0 : steps);
-    if (!img) return fail(img.error());
+    if (!img)
+      return fail(img.error());
     const auto path = o.out / fmt::format("{}_{:04}.png", scene.name, f);
-    if (auto w = render::write_png(path, *img); !w) return fail(w.error());
+    if (auto w = render::write_png(path, *img); !w)
+      return fail(w.error());
   }
-  fmt::print("{}: {} frames ({} steps each, t = {:.3g} s) written to {}/{}_NNNN.png\n", scene.name, frames, steps,
-             solver->time(), o.out.string(), scene.name);
-  if (ctx->validation_message_count()) return 1;
+  fmt::print("{}: {} frames ({} steps each, t = {:.3g} s) written to {}/{}_NNNN.png\n", scene.name, frames,
+             steps, solver->time(), o.out.string(), scene.name);
+  if (ctx->validation_message_count())
+    return 1;
   return 0;
 }
 
@@ -91,13 +102,18 @@ int run_window(const vkcloth::Scene& scene, const Options& o) {
   w.set_host_pointer(&in);
   glfwSetKeyCallback(w.glfw(), [](GLFWwindow* win, int key, int, int action, int) {
     auto* i = static_cast<Input*>(host::Window::host_pointer(win));
-    if (action != GLFW_PRESS) return;
-    if (key == GLFW_KEY_ESCAPE) glfwSetWindowShouldClose(win, GLFW_TRUE);
-    if (key == GLFW_KEY_SPACE) i->paused = !i->paused;
-    if (key == GLFW_KEY_R) i->reset = true;
+    if (action != GLFW_PRESS)
+      return;
+    if (key == GLFW_KEY_ESCAPE)
+      glfwSetWindowShouldClose(win, GLFW_TRUE);
+    if (key == GLFW_KEY_SPACE)
+      i->paused = !i->paused;
+    if (key == GLFW_KEY_R)
+      i->reset = true;
   });
   glfwSetMouseButtonCallback(w.glfw(), [](GLFWwindow* win, int button, int action, int) {
-    if (button == GLFW_MOUSE_BUTTON_LEFT) static_cast<Input*>(host::Window::host_pointer(win))->dragging = action == GLFW_PRESS;
+    if (button == GLFW_MOUSE_BUTTON_LEFT)
+      static_cast<Input*>(host::Window::host_pointer(win))->dragging = action == GLFW_PRESS;
   });
   glfwSetCursorPosCallback(w.glfw(), [](GLFWwindow* win, double x, double y) {
     auto* i = static_cast<Input*>(host::Window::host_pointer(win));
@@ -111,17 +127,23 @@ int run_window(const vkcloth::Scene& scene, const Options& o) {
   // presents to our surface and draws.
   gpu::ContextOptions co;
   co.require_graphics = true;
-  if (!w.add_presentation(co)) return fail(make_error(ErrorCode::no_device, "GLFW reports no Vulkan surface support"));
-  if (auto r = w.create_context(co); !r) return fail(r.error());
-  if (!w.create_render_pass()) return fail(make_error(ErrorCode::vulkan, "vkCreateRenderPass failed"));
+  if (!w.add_presentation(co))
+    return fail(make_error(ErrorCode::no_device, "GLFW reports no Vulkan surface support"));
+  if (auto r = w.create_context(co); !r)
+    return fail(r.error());
+  if (!w.create_render_pass())
+    return fail(make_error(ErrorCode::vulkan, "vkCreateRenderPass failed"));
 
   auto solver = gpu::GpuSolver::create(w.context(), scene.system, scene.params);
-  if (!solver) return fail(solver.error());
+  if (!solver)
+    return fail(solver.error());
   render::RendererOptions ro;
   ro.render_pass = w.render_pass();
   auto renderer = render::ClothRenderer::create(w.context(), *solver, *solver->topology(), ro);
-  if (!renderer) return fail(renderer.error());
-  if (!w.create_frame_resources()) return fail(make_error(ErrorCode::vulkan, "swapchain creation failed"));
+  if (!renderer)
+    return fail(renderer.error());
+  if (!w.create_frame_resources())
+    return fail(make_error(ErrorCode::vulkan, "swapchain creation failed"));
 
   // Orbit camera around the scene's bounds.
   const render::Bounds b = render::scene_bounds(scene.system, scene.params);
@@ -136,11 +158,13 @@ int run_window(const vkcloth::Scene& scene, const Options& o) {
     glfwPollEvents();
     w.wait_last_frame();
     if (frame % 30 == 0)
-      if (auto r = solver->check_divergence(); !r) return fail(r.error());
+      if (auto r = solver->check_divergence(); !r)
+        return fail(r.error());
     if (in.reset) { // a fresh solver from the initial state (nothing is pending: the wait above)
       in.reset = false;
       auto s = gpu::GpuSolver::create(w.context(), scene.system, scene.params);
-      if (!s) return fail(s.error());
+      if (!s)
+        return fail(s.error());
       *solver = std::move(*s);
     }
     if (in.dragging) {
@@ -150,30 +174,40 @@ int run_window(const vkcloth::Scene& scene, const Options& o) {
     in.last_x = in.x, in.last_y = in.y;
     dist *= std::pow(0.9f, float(in.scroll));
     in.scroll = 0;
-    cam.eye = cam.target + dist * glm::vec3(std::cos(pitch) * std::cos(yaw), std::cos(pitch) * std::sin(yaw), std::sin(pitch));
+    cam.eye = cam.target + dist * glm::vec3(std::cos(pitch) * std::cos(yaw), std::cos(pitch) * std::sin(yaw),
+                                            std::sin(pitch));
     auto ready = w.ensure_swapchain();
-    if (!ready) return fail(make_error(ErrorCode::vulkan, "swapchain creation failed"));
-    if (!*ready) continue; // minimised
+    if (!ready)
+      return fail(make_error(ErrorCode::vulkan, "swapchain creation failed"));
+    if (!*ready)
+      continue; // minimised
     auto next = w.begin_frame();
-    if (!next) return fail(next.error());
-    if (!*next) continue; // out of date: recreated next time round
+    if (!next)
+      return fail(next.error());
+    if (!*next)
+      continue; // out of date: recreated next time round
     const host::Frame& f = **next;
-    if (!in.paused) solver->record_steps(f.cmd, steps);
+    if (!in.paused)
+      solver->record_steps(f.cmd, steps);
     // The compute -> graphics barrier: the steps' positions and normals, visible to the vertex fetch.
     solver->record_barrier_to(f.cmd, VK_PIPELINE_STAGE_VERTEX_INPUT_BIT, VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT);
     w.begin_render_pass(f, renderer->palette().background);
     renderer->record_draw(f.cmd, *solver, cam, f.extent);
-    if (!w.end_render_pass_and_submit(f)) return fail(make_error(ErrorCode::vulkan, "vkQueueSubmit failed"));
-    if (auto r = w.present(f); !r) return fail(r.error());
+    if (!w.end_render_pass_and_submit(f))
+      return fail(make_error(ErrorCode::vulkan, "vkQueueSubmit failed"));
+    if (auto r = w.present(f); !r)
+      return fail(r.error());
     ++frame;
   }
   w.wait_idle();
-  if (auto r = solver->check_divergence(); !r) return fail(r.error());
+  if (auto r = solver->check_divergence(); !r)
+    return fail(r.error());
   fmt::print("{}: {} frames, step {}\n", scene.name, frame, solver->step_index());
   return 0;
 }
 
-[[noreturn]] void usage_exit(const char* prog, const std::string& about, const std::string& presets, int code) {
+[[noreturn]] void usage_exit(const char* prog, const std::string& about, const std::string& presets,
+                             int code) {
   std::FILE* f = code ? stderr : stdout;
   fmt::print(f,
              "{}\n\nUsage: {} [options]\n"
@@ -184,7 +218,8 @@ int run_window(const vkcloth::Scene& scene, const Options& o) {
              "  --size WxH           image or window size (default 800x600)\n"
              "{}"
              "  --help               this text\n"
-             "Environment: VKCLOTH_VALIDATION=1 enables the Vulkan validation layer, VKCLOTH_DEVICE picks a device.\n",
+             "Environment: VKCLOTH_VALIDATION=1 enables the Vulkan validation layer, VKCLOTH_DEVICE picks a "
+             "device.\n",
              about, prog, presets.empty() ? "" : "  --preset NAME        one of:\n" + presets);
   std::exit(code);
 }
@@ -211,21 +246,28 @@ Options parse_args(int argc, char** argv, const std::string& about, const std::s
   };
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--help" || a == "-h") usage_exit(argv[0], about, presets_help, 0);
-    else if (a == "--offscreen") o.offscreen = true;
-    else if (a == "--frames") o.frames = number(value(i), "--frames");
-    else if (a == "--steps-per-frame") o.steps_per_frame = number(value(i), "--steps-per-frame");
-    else if (a == "--out") o.out = value(i);
+    if (a == "--help" || a == "-h")
+      usage_exit(argv[0], about, presets_help, 0);
+    else if (a == "--offscreen")
+      o.offscreen = true;
+    else if (a == "--frames")
+      o.frames = number(value(i), "--frames");
+    else if (a == "--steps-per-frame")
+      o.steps_per_frame = number(value(i), "--steps-per-frame");
+    else if (a == "--out")
+      o.out = value(i);
     else if (a == "--size") {
       const std::string s = value(i);
       unsigned w = 0, h = 0;
       char x = 0, extra = 0;
-      if (std::sscanf(s.c_str(), "%u%c%u%c", &w, &x, &h, &extra) != 3 || x != 'x' || !w || !h || w > 4096 || h > 4096) {
+      if (std::sscanf(s.c_str(), "%u%c%u%c", &w, &x, &h, &extra) != 3 || x != 'x' || !w || !h || w > 4096 ||
+          h > 4096) {
         fmt::print(stderr, "error: --size {}: expected WxH, e.g. 800x600\n", s);
         std::exit(2);
       }
       o.width = w, o.height = h;
-    } else if (a == "--preset" && !presets_help.empty()) o.preset = value(i);
+    } else if (a == "--preset" && !presets_help.empty())
+      o.preset = value(i);
     else {
       fmt::print(stderr, "error: unknown option {}\n", a);
       usage_exit(argv[0], about, presets_help, 2);

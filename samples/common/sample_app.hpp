@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // What every sample shares: its command line (--offscreen, --frames, --out, --size), and the
 // loop that simulates a scene on the GPU and draws it, either in a window (GLFW + a swapchain,
 // like `vkcloth view`) or offscreen to numbered PNG files (no display needed, e.g. lavapipe).
@@ -17,7 +18,7 @@ struct Options {
   std::uint32_t steps_per_frame = 0; ///< 0: about real time at 60 frames per second
   std::filesystem::path out = "out"; ///< offscreen frames and the samples' plots go here
   std::uint32_t width = 800, height = 600;
-  std::string preset;                ///< `cloth --preset NAME`
+  std::string preset; ///< `cloth --preset NAME`
 };
 
 /// Parses the shared options (and --preset when `presets_help` is not empty). Prints `--help`

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The per-particle physics of vkcloth, written ONCE for both backends: the compute shaders
 // include this file as GLSL (through common.glsl) and the CPU reference solver compiles it as
 // C++ (through engine/src/core/kernel.hpp, with GLM, for float and for double), as Jolt's

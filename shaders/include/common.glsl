@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // What every compute shader shares: workgroup size, push constants, the instance's parameters,
 // the topology and collider buffers, and the per-particle physics of cloth_kernel.h (the same
 // source the CPU reference compiles as C++), so lavapipe reproduces the CPU bit for bit.

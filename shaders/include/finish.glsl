@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The end of a step for one particle (CpuSolver: project, then the divergence check), shared by
 // integrate.comp, fused.comp and implicit.comp. Expects `pos_out` (POS_OUT) and `vel` (VEL) to be
 // declared.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The force evaluation of one particle, shared by force.comp (two-pass layout), fused.comp (one
 // pass per Euler step) and implicit.comp: vertex normal from the grid fan, spring gather in the
 // topology's order, gravity, damping, wind, then contact filtering; each formula from

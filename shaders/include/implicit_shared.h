@@ -1,8 +1,10 @@
+// SPDX-License-Identifier: MIT
 // Declarations shared by the implicit-Euler shaders (implicit.comp, implicit_reduce.comp) and the
 // C++ side (engine/src/vulkan/implicit_gpu.cpp). The implicit passes use their own descriptor set
 // layout: the main layout's bindings they need (same numbers, same buffers, vkcloth_shared.h)
-// plus the CG buffers below. The implicit passes run batches of one instance. Push constants: the main PushConstants, with fields the implicit
-// passes do not otherwise use carrying the pass parameters (VKCLOTH_IMPL_* below).
+// plus the CG buffers below. The implicit passes run batches of one instance. Push constants: the main
+// PushConstants, with fields the implicit passes do not otherwise use carrying the pass parameters
+// (VKCLOTH_IMPL_* below).
 #ifndef VKCLOTH_IMPLICIT_SHARED_H
 #define VKCLOTH_IMPLICIT_SHARED_H
 

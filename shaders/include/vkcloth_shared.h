@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Declarations shared by the GLSL compute shaders and the C++ Vulkan solver: workgroup size,
 // descriptor binding indices, push constants and the storage-buffer element layouts.
 // Declared ONCE here; C++ static_asserts at the bottom pin the std430 layout.
@@ -56,8 +57,8 @@ struct vec4 {
 #define VKCLOTH_TEXEL_BINDING_INSTANCES 4 // InstanceParams as RGBA32UI, 5 texels per instance
 
 // InstanceParams::flags bits.
-#define VKCLOTH_FLAG_HAS_GRID 1u // the topology is a grid: rebuild normals from the grid fan
-#define VKCLOTH_FLAG_WIND 2u     // wind strength != 0
+#define VKCLOTH_FLAG_HAS_GRID 1u     // the topology is a grid: rebuild normals from the grid fan
+#define VKCLOTH_FLAG_WIND 2u         // wind strength != 0
 #define VKCLOTH_FLAG_CONTACT_BOTH 4u // contacts remove the whole normal part (Figure 12 variant)
 
 // InstanceParams::integrator (the vkcloth::Integrator values; engine/src/core/kernel.hpp asserts it).
@@ -74,13 +75,13 @@ struct vec4 {
 
 /// Per-dispatch parameters (32 bytes), the same for every instance of the batch.
 struct PushConstants {
-  uint count; // particles per instance
-  uint nx;    // grid width (0 for chains)
-  uint ny;    // grid height
-  uint stage; // RK4 stage 0..3 (0 for Euler); implicit passes: the pass
-  uint step;  // 1-based step number since the batch's flag epoch (the step being computed)
-  uint pad0;  // implicit passes only (implicit_shared.h)
-  uint pad1;  // implicit passes only
+  uint count;   // particles per instance
+  uint nx;      // grid width (0 for chains)
+  uint ny;      // grid height
+  uint stage;   // RK4 stage 0..3 (0 for Euler); implicit passes: the pass
+  uint step;    // 1-based step number since the batch's flag epoch (the step being computed)
+  uint pad0;    // implicit passes only (implicit_shared.h)
+  uint pad1;    // implicit passes only
   float c_next; // implicit passes only
 };
 

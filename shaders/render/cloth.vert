@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #version 450
 #extension GL_GOOGLE_include_directive : require
 // The cloth straight from the solver's buffers: binding 0 = positions[current], 1 = normals,

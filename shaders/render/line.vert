@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #version 450
 #extension GL_GOOGLE_include_directive : require
 // Chain springs as lines between the solver's current positions (binding 0, vec4, stride 16).

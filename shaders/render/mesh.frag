@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #version 450
 #extension GL_GOOGLE_include_directive : require
 // Solid lit colour (mode 0) or a checkerboard of pc.color and a darker shade (mode 1: the floor).

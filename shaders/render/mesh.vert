@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #version 450
 #extension GL_GOOGLE_include_directive : require
 // Colliders and chain masses: binding 0 = mesh vertices (vec4 position, w = checker u; vec4

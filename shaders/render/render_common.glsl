@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Shared by the render shaders: push constants (128 bytes, the minimum every device offers) and
 // the lighting. Must match DrawConstants in engine/src/render/cloth_renderer.cpp.
 layout(push_constant) uniform DrawConstants {

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # ctest driver: install vkcloth from BUILD_DIR into a prefix, MOVE the prefix (the package must be
 # relocatable), then configure, build and run the consumer against it; or, with MODE=subdir,
 # build the consumer with add_subdirectory(SOURCE_DIR).

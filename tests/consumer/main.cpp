@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Consumer smoke test: builds a cloth through the public API only, steps it on the CPU and, when a
 // Vulkan device is there, on the GPU, and checks both agree. Exit 0 on success. The host also
 // calls Vulkan its own way (its own volk, or the loader directly), next to vkcloth.
@@ -17,11 +18,13 @@
 int main() {
   std::uint32_t host_version = 0;
 #if defined(HOST_USES_VOLK)
-  if (volkInitialize() == VK_SUCCESS) host_version = volkGetInstanceVersion();
+  if (volkInitialize() == VK_SUCCESS)
+    host_version = volkGetInstanceVersion();
   std::printf("host: its own volk, instance version %u.%u\n", VK_API_VERSION_MAJOR(host_version),
               VK_API_VERSION_MINOR(host_version));
 #else
-  if (vkEnumerateInstanceVersion(&host_version) != VK_SUCCESS) return 1;
+  if (vkEnumerateInstanceVersion(&host_version) != VK_SUCCESS)
+    return 1;
   std::printf("host: loader linked directly, instance version %u.%u\n", VK_API_VERSION_MAJOR(host_version),
               VK_API_VERSION_MINOR(host_version));
 #endif
@@ -53,10 +56,12 @@ int main() {
     return 1;
   }
   auto positions = gpu->positions();
-  if (!positions) return 1;
+  if (!positions)
+    return 1;
   double worst = 0.0;
   for (std::size_t i = 0; i < positions->size(); ++i)
-    for (int k = 0; k < 3; ++k) worst = std::fmax(worst, std::fabs((*positions)[i][k] - cpu->positions()[i][k]));
+    for (int k = 0; k < 3; ++k)
+      worst = std::fmax(worst, std::fabs((*positions)[i][k] - cpu->positions()[i][k]));
   std::printf("consumer: %zu particles on %s, max |gpu - cpu| = %g\n", positions->size(),
               context->device_name().c_str(), worst);
   return worst <= 1e-5 ? 0 : 1;

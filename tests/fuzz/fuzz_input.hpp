@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The scene fuzzer's input format, shared by the libFuzzer target (fuzz_scene.cpp) and the
 // regression test that replays tests/fuzz/regressions/ in the normal suite.
 //
@@ -29,21 +30,24 @@ inline bool run_scene_input(const std::uint8_t* data, std::size_t size) {
     while (overrides.size() < 8) {
       const std::size_t next = rest.find('\0');
       overrides.emplace_back(rest.substr(0, next));
-      if (next == std::string_view::npos) break;
+      if (next == std::string_view::npos)
+        break;
       rest = rest.substr(next + 1);
     }
   }
   auto scene = parse_scene(text, "fuzz.json", overrides);
   if (!scene.ok()) {
     // Every error has a message (the CLI prints it).
-    if (scene.error().message.empty()) __builtin_trap();
+    if (scene.error().message.empty())
+      __builtin_trap();
     return false;
   }
   // Keep each input fast: only small systems are stepped.
   if (scene->system.size() <= 4096) {
     auto solver = CpuSolver<float>::create(scene->system, scene->params, CpuSolverOptions{1});
-    if (!solver.ok()) __builtin_trap(); // a validated scene must be accepted by the solver
-    (void)solver->run(3);               // divergence is a valid outcome
+    if (!solver.ok())
+      __builtin_trap();   // a validated scene must be accepted by the solver
+    (void)solver->run(3); // divergence is a valid outcome
   }
   return true;
 }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // libFuzzer target: the scene parser and validator on arbitrary bytes plus overrides.
 // Build and run: tools/fuzz.sh [seconds]   (clang, -DVKCLOTH_FUZZ=ON; see docs/errors.md)
 #include "fuzz_input.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Shared helpers of the GPU tests: one validated Context per process, the CI/skip rule, the
 // per-test-case validation check, CPU-vs-GPU comparison.
 #pragma once
@@ -47,7 +48,8 @@ struct ValidationGuard {
   const Context& context;
   std::uint64_t start = context.validation_message_count();
   ~ValidationGuard() {
-    CHECK_MESSAGE(context.validation_message_count() == start, "Vulkan validation reported messages (see stderr)");
+    CHECK_MESSAGE(context.validation_message_count() == start,
+                  "Vulkan validation reported messages (see stderr)");
   }
 };
 
@@ -63,7 +65,8 @@ inline Diff diff(std::span<const glm::vec3> a, std::span<const glm::vec3> b) {
     for (int k = 0; k < 3; ++k) {
       const double e = std::abs(double(a[i][k]) - double(b[i][k]));
       d.max_abs = std::isnan(e) ? INFINITY : std::max(d.max_abs, e);
-      if (std::memcmp(&a[i][k], &b[i][k], sizeof(float)) != 0) d.bitwise = false;
+      if (std::memcmp(&a[i][k], &b[i][k], sizeof(float)) != 0)
+        d.bitwise = false;
     }
   return d;
 }
@@ -72,13 +75,16 @@ inline Diff diff(std::span<const glm::vec3> a, std::span<const glm::vec3> b) {
 
 /// Starts a GPU test case: binds `ctx` to the shared validated Context and checks validation at
 /// the end; without a device skips (or fails on CI).
-#define VKCLOTH_GPU_TEST_BEGIN(ctx)                                                                       \
-  auto& vkcloth_shared_ = ::vkcloth::gpu::test::shared_context();                                         \
-  if (!vkcloth_shared_.context) {                                                                         \
-    if (::vkcloth::gpu::test::on_ci()) FAIL("CI=true but no Vulkan device: " << vkcloth_shared_.error);  \
-    MESSAGE("skipped, no Vulkan device: " << vkcloth_shared_.error);                                      \
-    return;                                                                                               \
-  }                                                                                                       \
-  ::vkcloth::gpu::Context& ctx = *vkcloth_shared_.context;                                                \
-  REQUIRE(ctx.validation_enabled());                                                                      \
-  ::vkcloth::gpu::test::ValidationGuard vkcloth_guard_{ctx}
+#define VKCLOTH_GPU_TEST_BEGIN(ctx)                                                                          \
+  auto& vkcloth_shared_ = ::vkcloth::gpu::test::shared_context();                                            \
+  if (!vkcloth_shared_.context) {                                                                            \
+    if (::vkcloth::gpu::test::on_ci())                                                                       \
+      FAIL("CI=true but no Vulkan device: " << vkcloth_shared_.error);                                       \
+    MESSAGE("skipped, no Vulkan device: " << vkcloth_shared_.error);                                         \
+    return;                                                                                                  \
+  }                                                                                                          \
+  ::vkcloth::gpu::Context& ctx = *vkcloth_shared_.context;                                                   \
+  REQUIRE(ctx.validation_enabled());                                                                         \
+  ::vkcloth::gpu::test::ValidationGuard vkcloth_guard_ {                                                     \
+    ctx                                                                                                      \
+  }

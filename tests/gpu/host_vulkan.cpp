@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The test host's own Vulkan, through its own (unprefixed) volk: see host_vulkan.hpp.
 #include <volk.h>
 
@@ -10,7 +11,8 @@
 namespace vkcloth::gpu::test {
 namespace {
 
-VKAPI_ATTR VkBool32 VKAPI_CALL on_message(VkDebugUtilsMessageSeverityFlagBitsEXT, VkDebugUtilsMessageTypeFlagsEXT,
+VKAPI_ATTR VkBool32 VKAPI_CALL on_message(VkDebugUtilsMessageSeverityFlagBitsEXT,
+                                          VkDebugUtilsMessageTypeFlagsEXT,
                                           const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
   static_cast<HostVulkan*>(user)->messages.fetch_add(1);
   std::fprintf(stderr, "host validation: %s\n", data && data->pMessage ? data->pMessage : "?");
@@ -20,16 +22,20 @@ VKAPI_ATTR VkBool32 VKAPI_CALL on_message(VkDebugUtilsMessageSeverityFlagBitsEXT
 } // namespace
 
 std::unique_ptr<HostVulkan> HostVulkan::create(std::string& error) {
-  if (volkInitialize() != VK_SUCCESS) return error = "no Vulkan loader", nullptr;
+  if (volkInitialize() != VK_SUCCESS)
+    return error = "no Vulkan loader", nullptr;
   auto h = std::make_unique<HostVulkan>();
   VkDebugUtilsMessengerCreateInfoEXT mi{};
   mi.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT;
-  mi.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-  mi.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+  mi.messageSeverity =
+      VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+  mi.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
+                   VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
                    VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
   mi.pfnUserCallback = on_message;
   mi.pUserData = h.get();
-  const VkValidationFeatureEnableEXT enables[] = {VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT};
+  const VkValidationFeatureEnableEXT enables[] = {
+      VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT};
   VkValidationFeaturesEXT vf{};
   vf.sType = VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT;
   vf.enabledValidationFeatureCount = 1;
@@ -49,7 +55,8 @@ std::unique_ptr<HostVulkan> HostVulkan::create(std::string& error) {
   ci.ppEnabledLayerNames = layers;
   ci.enabledExtensionCount = 2;
   ci.ppEnabledExtensionNames = extensions;
-  if (vkCreateInstance(&ci, nullptr, &h->instance) != VK_SUCCESS) return error = "vkCreateInstance (with validation) failed", nullptr;
+  if (vkCreateInstance(&ci, nullptr, &h->instance) != VK_SUCCESS)
+    return error = "vkCreateInstance (with validation) failed", nullptr;
   volkLoadInstanceOnly(h->instance);
   h->get_instance_proc_addr = vkGetInstanceProcAddr;
   vkCreateDebugUtilsMessengerEXT(h->instance, &mi, nullptr, &h->messenger);
@@ -60,18 +67,21 @@ std::unique_ptr<HostVulkan> HostVulkan::create(std::string& error) {
   for (VkPhysicalDevice pd : pds) {
     VkPhysicalDeviceProperties props;
     vkGetPhysicalDeviceProperties(pd, &props);
-    if (props.apiVersion < VK_API_VERSION_1_2) continue;
+    if (props.apiVersion < VK_API_VERSION_1_2)
+      continue;
     std::uint32_t nf = 0;
     vkGetPhysicalDeviceQueueFamilyProperties(pd, &nf, nullptr);
     std::vector<VkQueueFamilyProperties> fams(nf);
     vkGetPhysicalDeviceQueueFamilyProperties(pd, &nf, fams.data());
     for (std::uint32_t f = 0; f < nf; ++f)
-      if ((fams[f].queueFlags & VK_QUEUE_COMPUTE_BIT) && (fams[f].queueFlags & VK_QUEUE_GRAPHICS_BIT) && !h->physical_device) {
+      if ((fams[f].queueFlags & VK_QUEUE_COMPUTE_BIT) && (fams[f].queueFlags & VK_QUEUE_GRAPHICS_BIT) &&
+          !h->physical_device) {
         h->physical_device = pd;
         h->family = f;
       }
   }
-  if (!h->physical_device) return error = "no Vulkan 1.2 device with a graphics + compute queue", nullptr;
+  if (!h->physical_device)
+    return error = "no Vulkan 1.2 device with a graphics + compute queue", nullptr;
   const float priority = 1.0f;
   VkDeviceQueueCreateInfo qi{};
   qi.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
@@ -82,7 +92,8 @@ std::unique_ptr<HostVulkan> HostVulkan::create(std::string& error) {
   di.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
   di.queueCreateInfoCount = 1;
   di.pQueueCreateInfos = &qi;
-  if (vkCreateDevice(h->physical_device, &di, nullptr, &h->device) != VK_SUCCESS) return error = "vkCreateDevice failed", nullptr;
+  if (vkCreateDevice(h->physical_device, &di, nullptr, &h->device) != VK_SUCCESS)
+    return error = "vkCreateDevice failed", nullptr;
   volkLoadDevice(h->device);
   vkGetDeviceQueue(h->device, h->family, 0, &h->queue);
   VkCommandPoolCreateInfo cp{};
@@ -105,16 +116,21 @@ std::unique_ptr<HostVulkan> HostVulkan::create(std::string& error) {
 HostVulkan::~HostVulkan() {
   if (device) {
     vkDeviceWaitIdle(device);
-    if (fence) vkDestroyFence(device, fence, nullptr);
-    if (pool) vkDestroyCommandPool(device, pool, nullptr);
+    if (fence)
+      vkDestroyFence(device, fence, nullptr);
+    if (pool)
+      vkDestroyCommandPool(device, pool, nullptr);
     vkDestroyDevice(device, nullptr);
   }
-  if (messenger) vkDestroyDebugUtilsMessengerEXT(instance, messenger, nullptr);
-  if (instance) vkDestroyInstance(instance, nullptr);
+  if (messenger)
+    vkDestroyDebugUtilsMessengerEXT(instance, messenger, nullptr);
+  if (instance)
+    vkDestroyInstance(instance, nullptr);
 }
 
 bool HostVulkan::begin() {
-  if (vkResetCommandBuffer(cmd, 0) != VK_SUCCESS) return false;
+  if (vkResetCommandBuffer(cmd, 0) != VK_SUCCESS)
+    return false;
   VkCommandBufferBeginInfo bi{};
   bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
   bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
@@ -122,12 +138,14 @@ bool HostVulkan::begin() {
 }
 
 bool HostVulkan::submit_and_wait() {
-  if (vkEndCommandBuffer(cmd) != VK_SUCCESS) return false;
+  if (vkEndCommandBuffer(cmd) != VK_SUCCESS)
+    return false;
   VkSubmitInfo si{};
   si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
   si.commandBufferCount = 1;
   si.pCommandBuffers = &cmd;
-  if (vkQueueSubmit(queue, 1, &si, fence) != VK_SUCCESS) return false;
+  if (vkQueueSubmit(queue, 1, &si, fence) != VK_SUCCESS)
+    return false;
   const bool ok = vkWaitForFences(device, 1, &fence, VK_TRUE, UINT64_MAX) == VK_SUCCESS;
   vkResetFences(device, 1, &fence);
   return ok;
@@ -139,9 +157,11 @@ bool HostVulkan::still_usable() {
   bi.size = 256;
   bi.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   VkBuffer b = VK_NULL_HANDLE;
-  if (vkCreateBuffer(device, &bi, nullptr, &b) != VK_SUCCESS) return false;
+  if (vkCreateBuffer(device, &bi, nullptr, &b) != VK_SUCCESS)
+    return false;
   vkDestroyBuffer(device, b, nullptr);
-  if (!begin() || !submit_and_wait()) return false;
+  if (!begin() || !submit_and_wait())
+    return false;
   return vkDeviceWaitIdle(device) == VK_SUCCESS;
 }
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // A test "host application": its own Vulkan instance, device, queue, command buffer and fence,
 // created through its own volk (host_vulkan.cpp), NOT through vkcloth::gpu::Context::create.
 // Validation + synchronization validation on; messages are counted (and printed).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Embedding (issue #7): a host-created device and command buffer, record_step / record_steps in
 // the host's own submission, the host's VkAllocationCallbacks, many cloths in a ClothWorld.
 #include "gpu_test_util.hpp"
@@ -25,20 +26,25 @@ struct CountingAllocator {
 
   CountingAllocator() {
     callbacks.pUserData = this;
-    callbacks.pfnAllocation = [](void* user, std::size_t size, std::size_t align, VkSystemAllocationScope) -> void* {
+    callbacks.pfnAllocation = [](void* user, std::size_t size, std::size_t align,
+                                 VkSystemAllocationScope) -> void* {
       return static_cast<CountingAllocator*>(user)->allocate(size, align);
     };
-    callbacks.pfnReallocation = [](void* user, void* old, std::size_t size, std::size_t align, VkSystemAllocationScope) -> void* {
+    callbacks.pfnReallocation = [](void* user, void* old, std::size_t size, std::size_t align,
+                                   VkSystemAllocationScope) -> void* {
       auto& a = *static_cast<CountingAllocator*>(user);
-      if (!old) return a.allocate(size, align);
-      if (size == 0) return a.release(old), nullptr;
+      if (!old)
+        return a.allocate(size, align);
+      if (size == 0)
+        return a.release(old), nullptr;
       std::size_t old_size;
       {
         const std::lock_guard lock(a.m);
         old_size = a.live.at(old);
       }
       void* p = a.allocate(size, align);
-      if (p) std::memcpy(p, old, std::min(size, old_size));
+      if (p)
+        std::memcpy(p, old, std::min(size, old_size));
       a.release(old);
       return p;
     };
@@ -49,11 +55,13 @@ struct CountingAllocator {
     void* p = std::aligned_alloc(align, (size + align - 1) / align * align);
     const std::lock_guard lock(m);
     ++calls;
-    if (p) live[p] = size;
+    if (p)
+      live[p] = size;
     return p;
   }
   void release(void* p) {
-    if (!p) return;
+    if (!p)
+      return;
     {
       const std::lock_guard lock(m);
       live.erase(p);
@@ -89,8 +97,10 @@ std::shared_ptr<const ClothTopology> make_topology(std::uint32_t nx, std::uint32
 
 std::unique_ptr<HostVulkan> host_or_skip(std::string& error) {
   auto h = HostVulkan::create(error);
-  if (!h && vkcloth::gpu::test::on_ci()) FAIL("CI=true but the test host could not create its device: " << error);
-  if (!h) MESSAGE("skipped: " << error);
+  if (!h && vkcloth::gpu::test::on_ci())
+    FAIL("CI=true but the test host could not create its device: " << error);
+  if (!h)
+    MESSAGE("skipped: " << error);
   return h;
 }
 
@@ -112,7 +122,8 @@ TEST_CASE("Embedding: host device and command buffer, record_step/record_steps, 
   VKCLOTH_GPU_TEST_BEGIN(ctx); // the standalone reference runs on the shared validated Context
   std::string error;
   auto host = host_or_skip(error);
-  if (!host) return;
+  if (!host)
+    return;
   CountingAllocator counter;
   auto topo = make_topology(11, 7);
   SimParams params;
@@ -133,7 +144,8 @@ TEST_CASE("Embedding: host device and command buffer, record_step/record_steps, 
     REQUIRE(gpu.ok());
     CHECK(counter.live_count() > 0); // vkcloth's objects went through the host's callbacks
     REQUIRE(host->begin());
-    for (int k = 0; k < 3; ++k) gpu->record_step(host->cmd);
+    for (int k = 0; k < 3; ++k)
+      gpu->record_step(host->cmd);
     gpu->record_steps(host->cmd, 7);
     gpu->record_barrier_to(host->cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
     REQUIRE(host->submit_and_wait());
@@ -215,7 +227,8 @@ TEST_CASE("ClothWorld: many cloths, shared topology, add/remove, set_params == e
     REQUIRE(w.ok());
     REQUIRE(a.ok());
     const auto d = diff(*w, *a);
-    CHECK_MESSAGE(d.bitwise, when << ": instance " << k << " differs from its own GpuSolver by " << d.max_abs);
+    CHECK_MESSAGE(d.bitwise,
+                  when << ": instance " << k << " differs from its own GpuSolver by " << d.max_abs);
     const auto wv = world->velocities(ids[k]);
     const auto av = alone[k].velocities();
     REQUIRE(wv.ok());
@@ -223,8 +236,10 @@ TEST_CASE("ClothWorld: many cloths, shared topology, add/remove, set_params == e
     CHECK(diff(*wv, *av).bitwise);
   };
   REQUIRE(world->simulate(15).ok());
-  for (auto& g : alone) REQUIRE(g.simulate(15).ok());
-  for (std::size_t k = 0; k < 4; ++k) compare(k, "after 15 steps");
+  for (auto& g : alone)
+    REQUIRE(g.simulate(15).ok());
+  for (std::size_t k = 0; k < 4; ++k)
+    compare(k, "after 15 steps");
 
   // Remove one at run time; the others keep their state and go on identically.
   REQUIRE(world->remove(ids[1]).ok());
@@ -246,14 +261,17 @@ TEST_CASE("ClothWorld: many cloths, shared topology, add/remove, set_params == e
   auto late = world->add(small, p0, init);
   REQUIRE(late.ok());
   ParticleSystem moved = small->system();
-  for (std::size_t p = 0; p < moved.particles.size(); ++p) moved.particles[p].position = init.positions[p];
+  for (std::size_t p = 0; p < moved.particles.size(); ++p)
+    moved.particles[p].position = init.positions[p];
   auto late_alone = GpuSolver::create(ctx, moved, p0);
   REQUIRE(late_alone.ok());
 
   REQUIRE(world->simulate(12, 5).ok());
-  for (std::size_t k : {0u, 2u, 3u}) REQUIRE(alone[k].simulate(12).ok());
+  for (std::size_t k : {0u, 2u, 3u})
+    REQUIRE(alone[k].simulate(12).ok());
   REQUIRE(late_alone->simulate(12).ok());
-  for (std::size_t k : {0u, 2u, 3u}) compare(k, "after remove + set_params + 12 steps");
+  for (std::size_t k : {0u, 2u, 3u})
+    compare(k, "after remove + set_params + 12 steps");
   const auto wl = world->positions(*late);
   const auto al = late_alone->positions();
   REQUIRE(wl.ok());
@@ -299,7 +317,8 @@ std::vector<SimParams> varied_euler_params() {
 
 } // namespace
 
-TEST_CASE("ClothWorld batches: one dispatch per pass for every instance of a topology, each bitwise == alone") {
+TEST_CASE(
+    "ClothWorld batches: one dispatch per pass for every instance of a topology, each bitwise == alone") {
   VKCLOTH_GPU_TEST_BEGIN(ctx);
   auto topo = make_topology(12, 9);
   const std::vector<SimParams> params = varied_euler_params();
@@ -315,7 +334,8 @@ TEST_CASE("ClothWorld batches: one dispatch per pass for every instance of a top
     REQUIRE(id.ok());
     ids.push_back(*id);
     ParticleSystem moved = topo->system();
-    for (std::size_t p = 0; p < moved.particles.size(); ++p) moved.particles[p].position = init.positions[p];
+    for (std::size_t p = 0; p < moved.particles.size(); ++p)
+      moved.particles[p].position = init.positions[p];
     auto g = GpuSolver::create(ctx, moved, params[k]);
     REQUIRE(g.ok());
     alone.push_back(std::move(g.value()));
@@ -327,7 +347,8 @@ TEST_CASE("ClothWorld batches: one dispatch per pass for every instance of a top
     REQUIRE(w.ok());
     REQUIRE(a.ok());
     const auto d = diff(*w, *a);
-    CHECK_MESSAGE(d.bitwise, when << ": instance " << k << " differs from its own GpuSolver by " << d.max_abs);
+    CHECK_MESSAGE(d.bitwise,
+                  when << ": instance " << k << " differs from its own GpuSolver by " << d.max_abs);
     CHECK(diff(*world->velocities(ids[k]), *alone[k].velocities()).bitwise);
     CHECK(diff(*world->normals(ids[k]), *alone[k].normals()).bitwise);
   };
@@ -335,8 +356,10 @@ TEST_CASE("ClothWorld batches: one dispatch per pass for every instance of a top
   const std::uint64_t before = world->dispatches_recorded();
   REQUIRE(world->simulate(25, 10).ok());
   CHECK(world->dispatches_recorded() - before == 25); // one fused dispatch per step for 6 cloths
-  for (auto& g : alone) REQUIRE(g.simulate(25).ok());
-  for (std::size_t k = 0; k < ids.size(); ++k) compare(k, "after 25 batched steps");
+  for (auto& g : alone)
+    REQUIRE(g.simulate(25).ok());
+  for (std::size_t k = 0; k < ids.size(); ++k)
+    compare(k, "after 25 batched steps");
   CHECK(world->step_index(ids[0]) == 25);
 
   // Drawing: one set of buffers, each instance at its own offset.
@@ -370,10 +393,13 @@ TEST_CASE("ClothWorld batches: one dispatch per pass for every instance of a top
 
   const std::uint64_t before2 = world->dispatches_recorded();
   REQUIRE(world->simulate(10).ok());
-  CHECK(world->dispatches_recorded() - before2 == 10 * (1 + 8)); // Euler batch + RK4 batch (2 passes x 4 stages)
-  for (std::size_t k : {0u, 1u, 3u, 4u, 5u}) REQUIRE(alone[k].simulate(10).ok());
+  CHECK(world->dispatches_recorded() - before2 ==
+        10 * (1 + 8)); // Euler batch + RK4 batch (2 passes x 4 stages)
+  for (std::size_t k : {0u, 1u, 3u, 4u, 5u})
+    REQUIRE(alone[k].simulate(10).ok());
   REQUIRE(late_alone->simulate(10).ok());
-  for (std::size_t k : {0u, 1u, 3u, 4u, 5u}) compare(k, "after rebuilds + 10 steps");
+  for (std::size_t k : {0u, 1u, 3u, 4u, 5u})
+    compare(k, "after rebuilds + 10 steps");
   CHECK(diff(*world->positions(*late), *late_alone->positions()).bitwise);
   CHECK(world->step_index(ids[0]) == 35);
   CHECK(world->step_index(*late) == 10);
@@ -406,8 +432,9 @@ TEST_CASE("ClothWorld batches: a diverging instance is frozen and named, the oth
   const auto r = world->simulate(40, 40); // one submission: the others finish their 40 steps
   REQUIRE(!r.ok());
   CHECK(r.error().code == ErrorCode::diverged);
-  CHECK_MESSAGE(r.error().message.find("cloth instance " + std::to_string(*b)) != std::string::npos, r.error().message);
-  CHECK(world->step_index(*b) == wild_alone->step_index()); // the same first bad step
+  CHECK_MESSAGE(r.error().message.find("cloth instance " + std::to_string(*b)) != std::string::npos,
+                r.error().message);
+  CHECK(world->step_index(*b) == wild_alone->step_index());             // the same first bad step
   CHECK(diff(*world->positions(*b), *wild_alone->positions()).bitwise); // frozen as after that step
   CHECK(diff(*world->positions(*a), *calm_alone->positions()).bitwise);
   CHECK(diff(*world->positions(*c), *calm_alone->positions()).bitwise);

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Context and error paths: device filters, adopting a host's handles, size limits, bad input.
 #include "gpu_test_util.hpp"
 #include "vkcloth/gpu/testing.hpp"
@@ -14,7 +15,8 @@ TEST_CASE("Context: a device filter that matches nothing is ErrorCode::no_device
   REQUIRE(!c.ok());
   CHECK(c.error().code == ErrorCode::no_device);
   MESSAGE(c.error().message);
-  if (shared_context().context) CHECK(c.error().message.find("no-such-device-1f2e3d") != std::string::npos);
+  if (shared_context().context)
+    CHECK(c.error().message.find("no-such-device-1f2e3d") != std::string::npos);
   o.device_filter = "4096"; // an index past the end
   auto c2 = Context::create(o);
   REQUIRE(!c2.ok());
@@ -153,7 +155,9 @@ TEST_CASE("Context: the validation messenger counts real errors, sync validation
   Context& ctx = *c;
   const HostHandles h = ctx.handles();
   const auto gdpa = ctx.device_proc_addr();
-#define LOAD(name) const auto name = reinterpret_cast<PFN_##name>(gdpa(h.device, #name)); REQUIRE((name != nullptr ? true : false))
+#define LOAD(name)                                                                                           \
+  const auto name = reinterpret_cast<PFN_##name>(gdpa(h.device, #name));                                     \
+  REQUIRE((name != nullptr ? true : false))
   LOAD(vkCreateCommandPool);
   LOAD(vkDestroyCommandPool);
   LOAD(vkAllocateCommandBuffers);
@@ -188,7 +192,8 @@ TEST_CASE("Context: the validation messenger counts real errors, sync validation
   // Deliberate hazard: copy the positions just written by the last dispatch WITHOUT the barrier
   // record_barrier_to() would add (read-after-write for synchronization validation).
   const VkBufferCopy region{0, 0, 16};
-  vkCmdCopyBuffer(cb, gpu->current_position_buffer(), gpu->position_buffer(gpu->current_position_index() ^ 1u), 1, &region);
+  vkCmdCopyBuffer(cb, gpu->current_position_buffer(),
+                  gpu->position_buffer(gpu->current_position_index() ^ 1u), 1, &region);
   REQUIRE(vkEndCommandBuffer(cb) == VK_SUCCESS);
   const std::uint64_t before_submit = ctx.validation_message_count();
   CHECK(before_submit >= 1); // the hazard is reported at record time

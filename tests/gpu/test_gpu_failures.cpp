@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Vulkan failure paths (issue #9): an allocation failing at any point of a solver's life is a clear
 // error, everything allocated before it is released, and the Context stays usable.
 #include <string>
@@ -24,12 +25,14 @@ private:
 };
 
 bool is_injected_oom(const Error& e) {
-  return e.code == ErrorCode::out_of_memory && e.message.find("VK_ERROR_OUT_OF_DEVICE_MEMORY") != std::string::npos;
+  return e.code == ErrorCode::out_of_memory &&
+         e.message.find("VK_ERROR_OUT_OF_DEVICE_MEMORY") != std::string::npos;
 }
 
 } // namespace
 
-TEST_CASE("GpuSolver: out of device memory at every allocation is reported, leaks nothing, keeps the Context usable") {
+TEST_CASE("GpuSolver: out of device memory at every allocation is reported, leaks nothing, keeps the Context "
+          "usable") {
   VKCLOTH_GPU_TEST_BEGIN(ctx);
   ClothDesc d;
   d.nx = 12;
@@ -69,7 +72,8 @@ TEST_CASE("GpuSolver: out of device memory at every allocation is reported, leak
         }
       }
       CHECK(ctx.live_allocation_count() == 0); // everything released, solver or not
-      if (!failed) break;
+      if (!failed)
+        break;
       ++failures;
     }
     CHECK(failures >= 5); // the walk really went through the solver's buffers

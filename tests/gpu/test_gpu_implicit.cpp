@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The Vulkan implicit-Euler step against the CPU reference (float) on the sample scenes. Not bit
 // for bit: the CG dot products are summed in a different (fixed) order on the GPU (workgroup
 // trees, then one workgroup over the partials) than on the CPU (sequential), so alpha and beta
@@ -16,7 +17,8 @@ using namespace vkcloth;
 TEST_CASE("GPU implicit Euler matches the CPU implicit solver on the sample scenes") {
   VKCLOTH_GPU_TEST_BEGIN(ctx);
   for (const auto& entry : std::filesystem::directory_iterator(VKCLOTH_SAMPLES_SCENES_DIR)) {
-    if (entry.path().extension() != ".json") continue;
+    if (entry.path().extension() != ".json")
+      continue;
     const std::string overrides[] = {"integrator.method=implicit_euler"};
     auto scene = load_scene_file(entry.path(), overrides);
     REQUIRE_MESSAGE(scene.ok(), (scene.ok() ? "" : scene.error().message));
@@ -31,9 +33,10 @@ TEST_CASE("GPU implicit Euler matches the CPU implicit solver on the sample scen
     REQUIRE(gp.ok());
     const auto d = gpu::test::diff(cpu->positions(), *gp);
     MESSAGE(entry.path().filename().string()
-            << ": max |p_cpu - p_gpu| after " << steps << " implicit steps = " << d.max_abs << " m; CG iterations cpu "
-            << cpu->last_solve().iterations << " (residual " << cpu->last_solve().residual << "), gpu "
-            << gpu->last_solve().iterations << " (residual " << gpu->last_solve().residual << ")");
+            << ": max |p_cpu - p_gpu| after " << steps << " implicit steps = " << d.max_abs
+            << " m; CG iterations cpu " << cpu->last_solve().iterations << " (residual "
+            << cpu->last_solve().residual << "), gpu " << gpu->last_solve().iterations << " (residual "
+            << gpu->last_solve().residual << ")");
     CHECK(d.max_abs < 1e-4);
     CHECK(gpu->last_solve().residual <= 1e-6);
   }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The Vulkan solver against CpuSolver<float>: every integrator on chains and cloth grids (odd,
 // non-square, strips, wind, collisions), determinism, ping-pong buffers, caller-recorded command
 // buffers, staging, divergence detection.
@@ -21,7 +22,8 @@ using namespace vkcloth::gpu::test;
 namespace {
 
 constexpr double tolerance = 1e-5;
-constexpr Integrator integrators[] = {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::rk4};
+constexpr Integrator integrators[] = {Integrator::explicit_euler, Integrator::semi_implicit_euler,
+                                      Integrator::rk4};
 
 struct TestScene {
   ParticleSystem system;
@@ -71,8 +73,10 @@ void check_against_cpu(Context& ctx, const std::string& name, TestScene scene, s
     scene.params.integrator = integrator;
     // Explicit Euler gains energy every step: at the default dt = 0.02 the cloths blow up within
     // 40 steps (on both solvers, identically); a quarter of the step keeps 100 steps bounded.
-    if (integrator == Integrator::explicit_euler && scene.system.grid) scene.params.dt = base_dt / 4;
-    else scene.params.dt = base_dt;
+    if (integrator == Integrator::explicit_euler && scene.system.grid)
+      scene.params.dt = base_dt / 4;
+    else
+      scene.params.dt = base_dt;
     auto cpu = CpuSolver<float>::create(scene.system, scene.params);
     REQUIRE(cpu.ok());
     auto gpu = testing::create_solver(ctx, scene.system, scene.params, options, knobs);
@@ -97,9 +101,10 @@ void check_against_cpu(Context& ctx, const std::string& name, TestScene scene, s
     double moved = 0.0;
     for (std::size_t i = 0; i < scene.system.size(); ++i)
       moved = std::max(moved, double(glm::length(glm::dvec3((*gp)[i]) - scene.system.particles[i].position)));
-    MESSAGE(fmt::format("{:<28} {:<20} dt {:<6} max|dp| = {:.3g}{} max|dv| = {:.3g} max|dn| = {:.3g} (moved {:.3g} m, gpu {:.2f} ms)",
-                        name, method, scene.params.dt, dp.max_abs, dp.bitwise ? " (bitwise)" : "", dv.max_abs, dn.max_abs,
-                        moved, gpu->last_gpu_ms()));
+    MESSAGE(fmt::format("{:<28} {:<20} dt {:<6} max|dp| = {:.3g}{} max|dv| = {:.3g} max|dn| = {:.3g} (moved "
+                        "{:.3g} m, gpu {:.2f} ms)",
+                        name, method, scene.params.dt, dp.max_abs, dp.bitwise ? " (bitwise)" : "", dv.max_abs,
+                        dn.max_abs, moved, gpu->last_gpu_ms()));
     CHECK(moved > 1e-3);
     CHECK(dp.max_abs <= tolerance);
     CHECK(dv.max_abs <= 100 * tolerance); // velocities ~ positions / dt
@@ -149,7 +154,8 @@ TEST_CASE("GPU matches CPU: horizontal cloth falling on a plane and a sphere") {
   REQUIRE(cpu.ok());
   REQUIRE(cpu->run(100).ok());
   float lowest = 1e9f;
-  for (const auto& p : cpu->positions()) lowest = std::min(lowest, p.z);
+  for (const auto& p : cpu->positions())
+    lowest = std::min(lowest, p.z);
   CHECK(lowest >= 0.0f);
   CHECK(lowest < 0.01f);
 }
@@ -223,7 +229,9 @@ TEST_CASE("GPU record_steps into a caller's command buffer") {
   const HostHandles h = ctx.handles();
   const auto gdpa = ctx.device_proc_addr();
   REQUIRE((gdpa != nullptr ? true : false));
-#define LOAD(name) const auto name = reinterpret_cast<PFN_##name>(gdpa(h.device, #name)); REQUIRE((name != nullptr ? true : false))
+#define LOAD(name)                                                                                           \
+  const auto name = reinterpret_cast<PFN_##name>(gdpa(h.device, #name));                                     \
+  REQUIRE((name != nullptr ? true : false))
   LOAD(vkCreateCommandPool);
   LOAD(vkDestroyCommandPool);
   LOAD(vkAllocateCommandBuffers);
@@ -263,7 +271,7 @@ TEST_CASE("GPU record_steps into a caller's command buffer") {
     gpu->record_barrier_to(cbs[k], VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
     REQUIRE(vkEndCommandBuffer(cbs[k]) == VK_SUCCESS);
   }
-  CHECK(gpu->step_index() == 9);           // counters advance at record time
+  CHECK(gpu->step_index() == 9); // counters advance at record time
   CHECK(gpu->current_position_index() == 1);
   VkSubmitInfo si{};
   si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
@@ -278,7 +286,8 @@ TEST_CASE("GPU record_steps into a caller's command buffer") {
   auto p = gpu->positions();
   REQUIRE(p.ok());
   const Diff d = diff(*p, cpu->positions());
-  MESSAGE(fmt::format("record_steps 5 + 4 rk4 steps: max|dp| = {:.3g}{}", d.max_abs, d.bitwise ? " (bitwise)" : ""));
+  MESSAGE(fmt::format("record_steps 5 + 4 rk4 steps: max|dp| = {:.3g}{}", d.max_abs,
+                      d.bitwise ? " (bitwise)" : ""));
   CHECK(d.max_abs <= tolerance);
   // simulate() continues from there.
   REQUIRE(gpu->simulate(3).ok());
@@ -301,8 +310,9 @@ TEST_CASE("GPU set_params between steps matches the CPU") {
   p.integrator = Integrator::rk4;
   p.wind.strength = 1.0;
   p.wind.direction = {0, 1, 0};
-  p.colliders = {Collider::sphere({0.5, 0.4, 0.3}, 0.2), Collider::plane({0, 0, 1}, -0.3), Collider::plane({0, 1, 0}, -0.2),
-                 Collider::plane({1, 0, 0}, -1.0), Collider::plane({-1, 0, 0}, -2.0)}; // more than the initial capacity
+  p.colliders = {Collider::sphere({0.5, 0.4, 0.3}, 0.2), Collider::plane({0, 0, 1}, -0.3),
+                 Collider::plane({0, 1, 0}, -0.2), Collider::plane({1, 0, 0}, -1.0),
+                 Collider::plane({-1, 0, 0}, -2.0)}; // more than the initial capacity
   REQUIRE(gpu->set_params(p).ok());
   REQUIRE(cpu->set_params(p).ok());
   REQUIRE(gpu->simulate(30).ok());
@@ -356,8 +366,8 @@ TEST_CASE("GPU fused step and two-pass layout agree with each other and with the
   w.params.wind.direction = {0.3, 1.0, 0.1};
   check_against_cpu(ctx, "cloth 37x23 + wind (two-pass)", std::move(w), 100, two_pass);
   check_against_cpu(ctx, "falling cloth (two-pass)", falling_cloth(), 100, two_pass);
-  check_against_cpu(ctx, "double spring (two-pass)", chain({1.0, 1.0}, {{0.1, 0.0, -0.4}, {0.3, 0.1, -0.9}}), 100,
-                    two_pass);
+  check_against_cpu(ctx, "double spring (two-pass)", chain({1.0, 1.0}, {{0.1, 0.0, -0.4}, {0.3, 0.1, -0.9}}),
+                    100, two_pass);
   GpuSolverOptions fused;
   fused.fused = true;
   testing::SolverKnobs rows;
@@ -370,7 +380,8 @@ TEST_CASE("GPU fused step and two-pass layout agree with each other and with the
     TestScene s = falling_cloth();
     s.params.wind.strength = 0.5;
     s.params.integrator = integrator;
-    if (integrator == Integrator::explicit_euler) s.params.dt /= 4;
+    if (integrator == Integrator::explicit_euler)
+      s.params.dt /= 4;
     std::vector<glm::vec3> out[2][4];
     for (int k = 0; k < 2; ++k) {
       GpuSolverOptions o;
@@ -391,7 +402,8 @@ TEST_CASE("GPU fused step and two-pass layout agree with each other and with the
   }
 }
 
-TEST_CASE("GPU grid stencil (specialisation constants) gives the CSR gather's bits, and the CPU's on lavapipe") {
+TEST_CASE(
+    "GPU grid stencil (specialisation constants) gives the CSR gather's bits, and the CPU's on lavapipe") {
   VKCLOTH_GPU_TEST_BEGIN(ctx);
   const bool cpu_device = ctx.device_name().find("llvmpipe") != std::string::npos;
   TestScene scenes[2] = {cloth(37, 23), falling_cloth()};
@@ -405,7 +417,8 @@ TEST_CASE("GPU grid stencil (specialisation constants) gives the CSR gather's bi
         CAPTURE(fused);
         s.params.integrator = integrator;
         const double dt = s.params.dt;
-        if (integrator == Integrator::explicit_euler) s.params.dt /= 4;
+        if (integrator == Integrator::explicit_euler)
+          s.params.dt /= 4;
         std::vector<glm::vec3> out[2][4];
         for (int k = 0; k < 2; ++k) {
           GpuSolverOptions o;
@@ -433,7 +446,8 @@ TEST_CASE("GPU grid stencil (specialisation constants) gives the CSR gather's bi
           CHECK(diff(out[0][2], cpu->forces()).bitwise);
           // Normals: equal values (a zero component's sign may differ; nothing downstream sees it).
           std::size_t differ = 0;
-          for (std::size_t k = 0; k < out[0][3].size(); ++k) differ += out[0][3][k] != cpu->normals()[k];
+          for (std::size_t k = 0; k < out[0][3].size(); ++k)
+            differ += out[0][3][k] != cpu->normals()[k];
           CHECK(differ == 0);
         }
         s.params.dt = dt;

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # Fails unless README.md contains, verbatim (indentation removed), the lines of SOURCE between
 # "// [quickstart]" and "// [/quickstart]".
 file(READ ${SOURCE} source)

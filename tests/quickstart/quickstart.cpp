@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The README's "C++ quick start", compiled and run as a test (quickstart:readme checks that the
 // README shows exactly the lines between the markers), so the snippet cannot rot.
 #include <cstdio>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Shared by the render tests: a validated Context whose queue does graphics, scenes, image
 // metrics and the golden-image comparison.
 #pragma once

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # ctest: the viewer under xvfb-run renders 30 frames, takes a screenshot and exits 0 with no
 # validation message. Usage: run_viewer.sh VKCLOTH SCENE OUT_DIR. Exit 77 (skip) without xvfb-run,
 # except on CI (CI=true), where it must be installed (tools/setup.sh installs it).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Content checks that a blank or wrong image cannot pass: known 3D points projected with the same
 // camera land on pixels of the expected colour; the texture's pattern shows; the two faces of the
 // cloth are shaded differently.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Golden images: scenes rendered at 160x120 on the offscreen target, compared with the PNGs in
 // tests/render/golden/ (metric in render_test_util.hpp: < 0.5% of the pixels with a channel
 // differing by more than 8). Regenerate: VKCLOTH_UPDATE_GOLDEN=1 ctest -R render:golden

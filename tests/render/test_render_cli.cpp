@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // `vkcloth render` as a separate process: texture errors (exit 2, the file named), --video
 // without ffmpeg, PNG outputs, a chain scene.
 #include <doctest/doctest.h>

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # Runs one sample offscreen for 3 frames with the validation layer on; fails on any validation
 # message, a non-zero exit, or missing frames / plots. Without a Vulkan device the sample exits 4:
 # the test is skipped (77), except under CI=true where it fails.

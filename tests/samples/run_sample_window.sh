@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # Runs one sample in its window (GLFW + swapchain) under xvfb-run for 20 frames with the validation
 # layer on; fails on any validation message, a non-zero exit, or fewer frames. Exit 77 (skip)
 # without xvfb-run or without a Vulkan device / display, except under CI=true where it fails.

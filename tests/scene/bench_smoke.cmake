@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # `vkcloth bench --json` smoke test: runs at tiny sizes and checks that the JSON parses and carries
 # the documented keys (docs/performance.md). No timing is asserted.
 execute_process(COMMAND "${VKCLOTH}" bench --backend all --sizes 16,32 --steps 20 --warmup 2 --reps 1 --instances 3

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Helpers of the CLI tests: run the built `vkcloth` as a separate process and read its outputs.
 #pragma once
 
@@ -91,6 +92,5 @@ inline bool have_vulkan_device() {
 }
 
 inline const std::string validate = "VKCLOTH_VALIDATION=1";
-
 
 } // namespace vkcloth::test

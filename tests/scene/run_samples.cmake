@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # Runs every sample scene with `vkcloth run` (CPU, float and double); fails on a non-zero exit.
 file(GLOB scenes "${SCENES}/*.json")
 if(NOT scenes)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Checks figures.json's "stability_map" (tools/vkcloth/figures/stability.cpp).
 #pragma once
 

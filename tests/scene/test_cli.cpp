@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The vkcloth command line, run as a separate process: exit codes, messages, CSV outputs.
 #include <doctest/doctest.h>
 
@@ -127,7 +128,6 @@ TEST_CASE("cli: info prints the parsed scene") {
 
 // ---- The Vulkan backend through the CLI (lavapipe in CI, with the validation layer on) ----
 
-
 TEST_CASE("vkcloth compare passes on every sample scene, with zero validation messages") {
   if (!have_vulkan_device())
     return;
@@ -148,8 +148,8 @@ TEST_CASE("vkcloth run --backend vulkan writes the positions the CPU writes (wit
   const fs::path cpu_csv = tmp_dir() / "wind_cpu.csv", gpu_csv = tmp_dir() / "wind_gpu.csv";
   const std::string scene = sample("cloth_wind.json") + " --steps 100 --integrator rk4";
   REQUIRE(run_cli("wind_cpu", "run " + scene + " --positions " + quote(cpu_csv.string())).code == 0);
-  const Outcome g = run_cli("wind_gpu", "run " + scene + " --backend vulkan --positions " + quote(gpu_csv.string()),
-                            validate);
+  const Outcome g = run_cli(
+      "wind_gpu", "run " + scene + " --backend vulkan --positions " + quote(gpu_csv.string()), validate);
   REQUIRE(g.code == 0);
   CHECK(g.err.find("validation") == std::string::npos);
   const auto a = read_csv(cpu_csv), b = read_csv(gpu_csv);
@@ -163,7 +163,8 @@ TEST_CASE("vkcloth run --backend vulkan writes the positions the CPU writes (wit
 TEST_CASE("vkcloth on Vulkan: divergence exits 3, no device exits 4, bad compare flags exit 2") {
   if (!have_vulkan_device())
     return;
-  const Outcome div = run_cli("gpu_div", "run " + sample("spring.json") + " --dt 0.45 --steps 200 --backend vulkan");
+  const Outcome div =
+      run_cli("gpu_div", "run " + sample("spring.json") + " --dt 0.45 --steps 200 --backend vulkan");
   CHECK(div.code == 3);
   CHECK(div.err.find("diverged") != std::string::npos);
 
@@ -171,16 +172,20 @@ TEST_CASE("vkcloth on Vulkan: divergence exits 3, no device exits 4, bad compare
                                "VKCLOTH_DEVICE=no-such-device");
   CHECK(none.code == 4);
   CHECK(none.err.find("no-such-device") != std::string::npos);
-  CHECK(run_cli("gpu_noicd", "devices", "VK_ICD_FILENAMES=/nonexistent.json VK_DRIVER_FILES=/nonexistent.json").code == 4);
+  CHECK(
+      run_cli("gpu_noicd", "devices", "VK_ICD_FILENAMES=/nonexistent.json VK_DRIVER_FILES=/nonexistent.json")
+          .code == 4);
 
   const Outcome tol = run_cli("cmp_tol", "compare " + sample("spring.json") + " --tolerance -1");
   CHECK(tol.code == 2);
   CHECK(tol.err.find("--tolerance") != std::string::npos);
-  CHECK(run_cli("gpu_double", "run " + sample("spring.json") + " --backend vulkan --precision double").code == 2);
+  CHECK(run_cli("gpu_double", "run " + sample("spring.json") + " --backend vulkan --precision double").code ==
+        2);
 }
 
 TEST_CASE("cli: hostile command-line values exit 2 and name the option or key") {
-  const Outcome huge = run_cli("host_steps_huge", "run " + sample("spring.json") + " --steps 99999999999999999999999");
+  const Outcome huge =
+      run_cli("host_steps_huge", "run " + sample("spring.json") + " --steps 99999999999999999999999");
   CHECK(huge.code == 2);
   CHECK(huge.err.find("steps") != std::string::npos);
   const Outcome big = run_cli("host_steps_big", "run " + sample("spring.json") + " --steps 1000000000000");
@@ -202,7 +207,8 @@ TEST_CASE("cli: hostile command-line values exit 2 and name the option or key") 
   CHECK(dev.err.find("scene size limit") != std::string::npos);
   const Outcome dir = run_cli("host_dir", "run /");
   CHECK(dir.code == 2);
-  const Outcome out = run_cli("host_out", "run " + sample("spring.json") + " --steps 1 --positions /nonexistent/dir/p.csv");
+  const Outcome out =
+      run_cli("host_out", "run " + sample("spring.json") + " --steps 1 --positions /nonexistent/dir/p.csv");
   CHECK(out.code == 2);
   CHECK(out.err.find("/nonexistent/dir/p.csv") != std::string::npos);
 }
@@ -213,19 +219,23 @@ TEST_CASE("cli: soak runs a short soak and reports drift and RSS") {
   CHECK(o.out.find("max pinned drift 0 m") != std::string::npos);
   CHECK(o.out.find("RSS") != std::string::npos);
   CHECK(run_cli("soak_bad", "soak " + sample("spring.json") + " --steps 0").code == 2);
-  const Outcome div = run_cli("soak_div", "soak " + sample("spring.json") + " --set integrator.dt=0.45 --steps 1000");
+  const Outcome div =
+      run_cli("soak_div", "soak " + sample("spring.json") + " --set integrator.dt=0.45 --steps 1000");
   CHECK(div.code == 3);
 }
 
 TEST_CASE("cli: --validate runs under the validation layer and passes on a clean run") {
   if (!have_vulkan_device())
     return;
-  const Outcome o = run_cli("validate_run", "--validate run " + sample("cloth_wind.json") + " --steps 50 --backend vulkan");
+  const Outcome o =
+      run_cli("validate_run", "--validate run " + sample("cloth_wind.json") + " --steps 50 --backend vulkan");
   CHECK(o.code == 0);
   CHECK(o.err.find("validation") == std::string::npos);
-  const Outcome c = run_cli("validate_cmp", "--validate compare " + sample("cloth_on_sphere.json") + " --steps 50");
+  const Outcome c =
+      run_cli("validate_cmp", "--validate compare " + sample("cloth_on_sphere.json") + " --steps 50");
   CHECK(c.code == 0);
-  const Outcome s = run_cli("validate_soak", "--validate soak " + sample("cloth_hanging.json") + " --steps 200 --backend vulkan --max-rss-growth 1000000");
+  const Outcome s = run_cli("validate_soak", "--validate soak " + sample("cloth_hanging.json") +
+                                                 " --steps 200 --backend vulkan --max-rss-growth 1000000");
   CHECK(s.code == 0);
   CHECK(s.out.find("max pinned drift 0 m") != std::string::npos);
   CHECK(run_cli("validate_help", "--help").out.find("--validate") != std::string::npos);

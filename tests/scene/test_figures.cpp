@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // `vkcloth figures`: the gallery exists and its numbers show the report's physics.
 #include <doctest/doctest.h>
 
@@ -20,8 +21,8 @@ void check_spring_physics(const nlohmann::json& m) {
   CHECK(std::abs(k["1000"]["final_z"].get<double>() - k["1000"]["rest_z"].get<double>()) < 1e-3);
   CHECK(k["5"]["final_z"].get<double>() < k["20"]["final_z"].get<double>() - 1.0);
   const auto& mu = m["spring"]["damping"];
-  CHECK(mu["0"]["late_amplitude"].get<double>() > 0.3);     // never settles
-  CHECK(mu["0.5"]["late_amplitude"].get<double>() < 0.01);  // settles
+  CHECK(mu["0"]["late_amplitude"].get<double>() > 0.3);                   // never settles
+  CHECK(mu["0.5"]["late_amplitude"].get<double>() < 0.01);                // settles
   CHECK(mu["100"]["velocity_sign_flips_last_20_steps"].get<int>() == 20); // the integrator's oscillation
   const auto& dt = m["spring"]["timestep"];
   CHECK_FALSE(dt["0.02"]["diverged"].get<bool>());
@@ -29,24 +30,28 @@ void check_spring_physics(const nlohmann::json& m) {
   CHECK(dt["0.45"]["diverged"].get<bool>());
   const auto& integ = m["spring"]["integrators"];
   CHECK(integ["rk4"]["max_error"].get<double>() < 1e-5);
-  CHECK(integ["semi_implicit_euler"]["max_error"].get<double>() < integ["explicit_euler"]["max_error"].get<double>());
+  CHECK(integ["semi_implicit_euler"]["max_error"].get<double>() <
+        integ["explicit_euler"]["max_error"].get<double>());
   const double e0 = integ["rk4"]["energy_start"].get<double>();
-  CHECK(integ["explicit_euler"]["energy_end"].get<double>() > e0 + 100.0);                 // gains energy
-  CHECK(std::abs(integ["semi_implicit_euler"]["energy_end"].get<double>() - e0) < 0.05);  // bounded
+  CHECK(integ["explicit_euler"]["energy_end"].get<double>() > e0 + 100.0);               // gains energy
+  CHECK(std::abs(integ["semi_implicit_euler"]["energy_end"].get<double>() - e0) < 0.05); // bounded
   CHECK(std::abs(integ["rk4"]["energy_end"].get<double>() - e0) < 1e-3);
   const auto& start = m["spring"]["stiff_start"];
   CHECK(start["1"]["late_amplitude"].get<double>() > 10.0 * start["0.4"]["late_amplitude"].get<double>());
-  CHECK(m["spring"]["double_spring"]["energy_end"].get<double>() < m["spring"]["double_spring"]["energy_start"].get<double>());
+  CHECK(m["spring"]["double_spring"]["energy_end"].get<double>() <
+        m["spring"]["double_spring"]["energy_start"].get<double>());
 }
 
-/// The cloth figures' numbers (docs/model.md "The report's observations"): each parameter study moves the way the report says.
+/// The cloth figures' numbers (docs/model.md "The report's observations"): each parameter study moves the way
+/// the report says.
 void check_cloth_physics(const nlohmann::json& m) {
   const auto& c = m["cloth"];
   auto num = [](const nlohmann::json& j) { return j.get<double>(); };
   const auto& ks = c["k_struct"]; // Figure 7: the sag decreases as K_struct grows
   CHECK(num(ks["5"]["sag"]) > num(ks["20"]["sag"]));
   CHECK(num(ks["20"]["sag"]) > num(ks["50"]["sag"]));
-  for (const char* k : {"5", "20", "50"}) CHECK_FALSE(ks[k]["diverged"].get<bool>());
+  for (const char* k : {"5", "20", "50"})
+    CHECK_FALSE(ks[k]["diverged"].get<bool>());
   const auto& sh = c["k_shear"]; // Figure 8: the diagonal shear decreases as K_shear grows
   CHECK(num(sh["1"]["diagonal_shear"]) > num(sh["10"]["diagonal_shear"]));
   CHECK(num(sh["10"]["diagonal_shear"]) > num(sh["40"]["diagonal_shear"]));
@@ -92,7 +97,8 @@ void check_gallery(const fs::path& dir) {
   REQUIRE_FALSE(html.empty());
   for (const auto& entry : fs::directory_iterator(dir)) {
     const std::string ext = entry.path().extension().string();
-    if (ext != ".svg" && ext != ".png") continue;
+    if (ext != ".svg" && ext != ".png")
+      continue;
     CAPTURE(entry.path().filename().string());
     CHECK(html.find(entry.path().filename().string()) != std::string::npos); // every picture is shown
     CHECK(fs::file_size(entry.path()) > 500);
@@ -115,8 +121,9 @@ TEST_CASE("vkcloth figures (cpu): the gallery and the physics behind it") {
   check_cloth_physics(m);
   check_stability_map(m);
   if (have_vulkan_device())
-    for (const char* f : {"cloth_k_struct.png", "cloth_k_shear.png", "cloth_k_bend.png", "cloth_wind.png",
-                          "cloth_contact.png", "cloth_collisions.png", "cloth_no_structural.png", "cloth_gpu.png"})
+    for (const char* f :
+         {"cloth_k_struct.png", "cloth_k_shear.png", "cloth_k_bend.png", "cloth_wind.png",
+          "cloth_contact.png", "cloth_collisions.png", "cloth_no_structural.png", "cloth_gpu.png"})
       CHECK_MESSAGE(fs::exists(out / f), f);
 }
 
@@ -125,7 +132,8 @@ TEST_CASE("vkcloth figures --backend vulkan: the same physics on the GPU, zero v
     return;
   const fs::path out = tmp_dir() / "figures_vulkan";
   fs::remove_all(out);
-  const Outcome o = run_cli("figures_vulkan", "figures --quick --backend vulkan --out " + quote(out.string()), validate);
+  const Outcome o =
+      run_cli("figures_vulkan", "figures --quick --backend vulkan --out " + quote(out.string()), validate);
   REQUIRE_MESSAGE(o.code == 0, o.err);
   CHECK(o.err.find("validation") == std::string::npos);
   check_gallery(out);

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Replays the scene fuzzer's regression inputs (tests/fuzz/regressions/) and its seed corpus
 // (samples/scenes/) through the fuzz target's own entry (tests/fuzz/fuzz_input.hpp).
 #include <doctest/doctest.h>
@@ -24,7 +25,8 @@ std::vector<std::uint8_t> bytes_of(const fs::path& p) {
 TEST_CASE("fuzz regressions: every committed input is handled without a crash") {
   int n = 0;
   for (const auto& e : fs::directory_iterator(VKCLOTH_FUZZ_REGRESSIONS_DIR)) {
-    if (e.path().extension() == ".md") continue;
+    if (e.path().extension() == ".md")
+      continue;
     CAPTURE(e.path().filename().string());
     const auto b = bytes_of(e.path());
     CHECK(!vkcloth::fuzz::run_scene_input(b.data(), b.size())); // all of them are refused

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Hostile inputs (issue #9): each must be a clear error naming the field and the value, never a
 // crash, a hang, a silent clamp or an unbounded allocation. docs/errors.md lists them in a table.
 #include <doctest/doctest.h>
@@ -28,13 +29,18 @@ Error refused(const std::string& text, std::initializer_list<std::string> needle
   return s.error();
 }
 
-std::string cloth(const std::string& body) { return R"({"system": "cloth", "cloth": )" + body + "}"; }
-std::string chain(const std::string& body) { return R"({"system": "chain", "chain": )" + body + "}"; }
+std::string cloth(const std::string& body) {
+  return R"({"system": "cloth", "cloth": )" + body + "}";
+}
+std::string chain(const std::string& body) {
+  return R"({"system": "chain", "chain": )" + body + "}";
+}
 
 std::string repeat(const std::string& s, std::size_t n) {
   std::string out;
   out.reserve(s.size() * n);
-  for (std::size_t k = 0; k < n; ++k) out += s;
+  for (std::size_t k = 0; k < n; ++k)
+    out += s;
   return out;
 }
 
@@ -50,7 +56,8 @@ TEST_CASE("hostile: deeply nested JSON is refused before parsing (no stack overf
   auto ok = parse_scene(R"({"system": "chain", "name": ")" + repeat("[", 1000) + "\"}", "s.json");
   CHECK(ok.ok());
   // An override value that is not (acceptable) JSON is taken as a plain string.
-  auto o = parse_scene(R"({"system": "chain"})", "s.json", std::vector<std::string>{"name=" + repeat("[", 1000)});
+  auto o =
+      parse_scene(R"({"system": "chain"})", "s.json", std::vector<std::string>{"name=" + repeat("[", 1000)});
   REQUIRE(o.ok());
   CHECK(o->name.size() == 1000);
 }
@@ -83,7 +90,8 @@ TEST_CASE("hostile: a 1 GB scene file is refused by its size, without reading it
 }
 
 TEST_CASE("hostile: an endless device (/dev/zero) is read only up to the limit") {
-  if (!std::filesystem::exists("/dev/zero")) return;
+  if (!std::filesystem::exists("/dev/zero"))
+    return;
   auto s = load_scene_file("/dev/zero");
   REQUIRE(!s.ok());
   CHECK(s.error().code == ErrorCode::io);
@@ -103,7 +111,9 @@ TEST_CASE("hostile: absurd sizes are refused before any allocation") {
 }
 
 TEST_CASE("hostile: a pins list longer than the grid is refused without walking it") {
-  std::string pins = std::string("[").append(repeat("[0, 0],", 200000)).append("[0, 0]]"); // no g++ 12 -Wrestrict false positive
+  std::string pins = std::string("[")
+                         .append(repeat("[0, 0],", 200000))
+                         .append("[0, 0]]"); // no g++ 12 -Wrestrict false positive
   const Error e = refused(cloth(R"({"resolution": [10, 10], "pins": )" + pins + "}"),
                           {"cloth.pins holds 200001 entries", "100 particles"});
   CHECK(e.code == ErrorCode::invalid_argument);
@@ -171,7 +181,8 @@ TEST_CASE("hostile: CpuSolver::set_particle with an out-of-range index or non-fi
   CHECK(r2.error().message.find("finite") != std::string::npos);
   auto r3 = solver->set_particle(1, glm::vec3(0), glm::vec3(0, INFINITY, 0));
   CHECK(!r3.ok());
-  for (std::size_t k = 0; k < before.size(); ++k) CHECK(solver->positions()[k] == before[k]);
+  for (std::size_t k = 0; k < before.size(); ++k)
+    CHECK(solver->positions()[k] == before[k]);
   CHECK(solver->set_particle(1, glm::vec3(0, 0, -0.5f), glm::vec3(0)).ok());
   CHECK(solver->positions()[1].z == -0.5f);
 }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Scene files that must be refused, each with a message naming the key and the value.
 #include <doctest/doctest.h>
 
@@ -127,7 +128,8 @@ TEST_CASE("unknown integrator names the key and the value") {
 TEST_CASE("substeps and the CG keys are range-checked") {
   expect_error(R"({"system": "chain", "integrator": {"substeps": 0}})", {"integrator.substeps", "0"});
   expect_error(R"({"system": "chain", "integrator": {"cg_tolerance": 2}})", {"integrator.cg_tolerance", "2"});
-  expect_error(R"({"system": "chain", "integrator": {"cg_max_iterations": 0}})", {"integrator.cg_max_iterations", "0"});
+  expect_error(R"({"system": "chain", "integrator": {"cg_max_iterations": 0}})",
+               {"integrator.cg_max_iterations", "0"});
 }
 
 TEST_CASE("bad overrides name the override and the path") {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Scene files that load: the samples, defaults for omitted keys, overrides.
 #include <doctest/doctest.h>
 

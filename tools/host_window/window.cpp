@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "vkcloth_host_window/window.hpp"
 
 #include <algorithm>
@@ -36,7 +37,8 @@ Window::~Window() {
   glfwTerminate();
 }
 
-std::optional<Window::OpenFailure> Window::open(std::uint32_t width, std::uint32_t height, const std::string& title) {
+std::optional<Window::OpenFailure> Window::open(std::uint32_t width, std::uint32_t height,
+                                                const std::string& title) {
   if (!glfwInit())
     return OpenFailure::no_display;
   if (!glfwVulkanSupported())
@@ -50,9 +52,13 @@ std::optional<Window::OpenFailure> Window::open(std::uint32_t width, std::uint32
   return std::nullopt;
 }
 
-void* Window::host_pointer(GLFWwindow* w) { return static_cast<Window*>(glfwGetWindowUserPointer(w))->host_pointer_; }
+void* Window::host_pointer(GLFWwindow* w) {
+  return static_cast<Window*>(glfwGetWindowUserPointer(w))->host_pointer_;
+}
 
-void Window::on_resize(GLFWwindow* w, int, int) { static_cast<Window*>(glfwGetWindowUserPointer(w))->resized_ = true; }
+void Window::on_resize(GLFWwindow* w, int, int) {
+  static_cast<Window*>(glfwGetWindowUserPointer(w))->resized_ = true;
+}
 
 bool Window::add_presentation(gpu::ContextOptions& options) {
   std::uint32_t count = 0;
@@ -143,9 +149,11 @@ Result<void> Window::create_render_pass() {
   // (one depth image serves every frame).
   dep[0].srcSubpass = VK_SUBPASS_EXTERNAL;
   dep[0].dstSubpass = 0;
-  dep[0].srcStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT;
+  dep[0].srcStageMask =
+      VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT;
   dep[0].srcAccessMask = VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
-  dep[0].dstStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT | VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT |
+  dep[0].dstStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT |
+                        VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT |
                         VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT;
   dep[0].dstAccessMask = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
                          VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
@@ -226,8 +234,9 @@ Result<void> Window::create_swapchain() {
   glfwGetFramebufferSize(window_, &fw, &fh);
   VkExtent2D extent = caps.currentExtent;
   if (extent.width == UINT32_MAX) // the surface takes the swapchain's size: the framebuffer's
-    extent = {std::clamp<std::uint32_t>(std::uint32_t(fw), caps.minImageExtent.width, caps.maxImageExtent.width),
-              std::clamp<std::uint32_t>(std::uint32_t(fh), caps.minImageExtent.height, caps.maxImageExtent.height)};
+    extent = {
+        std::clamp<std::uint32_t>(std::uint32_t(fw), caps.minImageExtent.width, caps.maxImageExtent.width),
+        std::clamp<std::uint32_t>(std::uint32_t(fh), caps.minImageExtent.height, caps.maxImageExtent.height)};
   if (extent.width == 0 || extent.height == 0)
     return {}; // minimised: no swapchain until restored
   std::uint32_t count = std::max(caps.minImageCount, 2u);
@@ -280,7 +289,8 @@ Result<void> Window::create_swapchain() {
   vkGetPhysicalDeviceMemoryProperties(physical_, &mp);
   std::uint32_t type = UINT32_MAX; // the first device-local type allowed, else the first allowed
   for (std::uint32_t i = 0; i < mp.memoryTypeCount && type == UINT32_MAX; ++i)
-    if ((req.memoryTypeBits & (1u << i)) && (mp.memoryTypes[i].propertyFlags & VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT))
+    if ((req.memoryTypeBits & (1u << i)) &&
+        (mp.memoryTypes[i].propertyFlags & VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT))
       type = i;
   for (std::uint32_t i = 0; i < mp.memoryTypeCount && type == UINT32_MAX; ++i)
     if (req.memoryTypeBits & (1u << i))
@@ -333,7 +343,9 @@ Result<void> Window::create_swapchain() {
   return {};
 }
 
-void Window::wait_last_frame() { vkWaitForFences(device_, 1, &in_flight_, VK_TRUE, UINT64_MAX); }
+void Window::wait_last_frame() {
+  vkWaitForFences(device_, 1, &in_flight_, VK_TRUE, UINT64_MAX);
+}
 
 void Window::wait_idle() {
   if (device_)
@@ -353,7 +365,8 @@ Result<bool> Window::ensure_swapchain() {
 
 Result<std::optional<Frame>> Window::begin_frame() {
   Frame f;
-  const VkResult r = vkAcquireNextImageKHR(device_, swapchain_, UINT64_MAX, acquired_, VK_NULL_HANDLE, &f.image);
+  const VkResult r =
+      vkAcquireNextImageKHR(device_, swapchain_, UINT64_MAX, acquired_, VK_NULL_HANDLE, &f.image);
   if (r == VK_ERROR_OUT_OF_DATE_KHR) {
     resized_ = true;
     return std::optional<Frame>{};

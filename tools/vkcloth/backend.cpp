@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "backend.hpp"
 
 #include <fmt/format.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The solver behind `vkcloth run` and `compare`, behind a small interface so that each backend
 // (backend.cpp: CPU, backend_vulkan.cpp: Vulkan) lives in its own file.
 #pragma once

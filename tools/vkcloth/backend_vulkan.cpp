@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // `--backend vulkan`: the GpuSolver on a Context of its own (VKCLOTH_DEVICE picks the device,
 // VKCLOTH_VALIDATION=1 turns on the Khronos validation layer).
 #include <fmt/format.h>
@@ -48,7 +49,8 @@ Result<std::unique_ptr<SimBackend>> make_vulkan_backend(const Scene& scene, Prec
   auto solver = gpu::GpuSolver::create(*context, scene.system, scene.params);
   if (!solver)
     return solver.error();
-  return std::unique_ptr<SimBackend>(std::make_unique<VulkanBackend>(std::move(*context), std::move(*solver)));
+  return std::unique_ptr<SimBackend>(
+      std::make_unique<VulkanBackend>(std::move(*context), std::move(*solver)));
 }
 
 } // namespace vkcloth::cli

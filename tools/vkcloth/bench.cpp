@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // `vkcloth bench`: throughput of the solvers on the report's hanging cloth (structural, shear and
 // bend springs, two pinned corners, wind) at several grid sizes, against this machine's memory
 // and compute ceilings. Bytes and flops per particle-step are counted from the kernels (the
@@ -56,7 +57,8 @@ Result<BenchScene> bench_scene(std::uint32_t n, Integrator integrator, double dt
   d.size = {1.0, 1.0};
   d.particle_mass = 0.05 * 4096.0 / (double(n) * double(n));
   auto sys = make_cloth(d);
-  if (!sys) return sys.error();
+  if (!sys)
+    return sys.error();
   SimParams p;
   p.integrator = integrator;
   p.dt = dt;
@@ -116,9 +118,9 @@ struct Row {
   unsigned threads = 0;
   std::uint64_t steps = 0;
   unsigned reps = 0;
-  double wall_ms = 0;          // median over reps of the wall time of `steps` steps
-  double gpu_ms = -1;          // median GPU (timestamp) time of `steps` steps; -1 for the CPU
-  std::string integrator;      // the scheme timed (implicit runs add a semi-implicit baseline row)
+  double wall_ms = 0;              // median over reps of the wall time of `steps` steps
+  double gpu_ms = -1;              // median GPU (timestamp) time of `steps` steps; -1 for the CPU
+  std::string integrator;          // the scheme timed (implicit runs add a semi-implicit baseline row)
   std::uint32_t cg_iterations = 0; // implicit_euler: CG iterations of the last step
   std::uint32_t instances = 1;     // cloths stepped together (ClothWorld rows)
   Cost cost;
@@ -131,13 +133,16 @@ double median(std::vector<double> v) {
 }
 
 using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
 
 Result<Row> bench_cpu(const BenchScene& sc, std::uint32_t n, const BenchOptions& o) {
   CpuSolverOptions co;
   co.threads = o.threads;
   auto s = CpuSolver<float>::create(sc.system, sc.params, co);
-  if (!s) return s.error();
+  if (!s)
+    return s.error();
   VKCLOTH_TRY(s->run(o.warmup));
   std::vector<double> wall;
   for (unsigned r = 0; r < o.reps; ++r) {
@@ -156,11 +161,13 @@ Result<Row> bench_cpu(const BenchScene& sc, std::uint32_t n, const BenchOptions&
   return row;
 }
 
-Result<Row> bench_vulkan(gpu::Context& ctx, const BenchScene& sc, std::uint32_t n, bool fused, const BenchOptions& o) {
+Result<Row> bench_vulkan(gpu::Context& ctx, const BenchScene& sc, std::uint32_t n, bool fused,
+                         const BenchOptions& o) {
   gpu::GpuSolverOptions go;
   go.fused = fused;
   auto s = gpu::GpuSolver::create(ctx, sc.system, sc.params, go);
-  if (!s) return s.error();
+  if (!s)
+    return s.error();
   VKCLOTH_TRY(s->simulate(o.warmup, o.steps_per_submit));
   std::vector<double> wall, gpu_ms;
   for (unsigned r = 0; r < o.reps; ++r) {
@@ -185,9 +192,11 @@ Result<Row> bench_vulkan(gpu::Context& ctx, const BenchScene& sc, std::uint32_t 
 /// `instances` cloths of the scene in one ClothWorld, one submission per `steps_per_submit` steps:
 /// batched (one shared topology: one dispatch per pass for all) or not (a topology prepared for
 /// each: every cloth its own dispatches, as separate solvers recorded into one command buffer).
-Result<Row> bench_world(gpu::Context& ctx, const BenchScene& sc, std::uint32_t n, bool batched, const BenchOptions& o) {
+Result<Row> bench_world(gpu::Context& ctx, const BenchScene& sc, std::uint32_t n, bool batched,
+                        const BenchOptions& o) {
   auto w = gpu::ClothWorld::create(ctx);
-  if (!w) return w.error();
+  if (!w)
+    return w.error();
   auto shared = ClothTopology::create(sc.system);
   if (!shared)
     return shared.error();
@@ -231,7 +240,8 @@ Result<std::vector<std::uint32_t>> parse_sizes(const std::string& text) {
                         fmt::format("--sizes: '{}' is not a grid side in 2..{}", item, max_cloth_side));
     out.push_back(static_cast<std::uint32_t>(v));
   }
-  if (out.empty()) return make_error(ErrorCode::invalid_argument, "--sizes: give at least one size, e.g. 64,256");
+  if (out.empty())
+    return make_error(ErrorCode::invalid_argument, "--sizes: give at least one size, e.g. 64,256");
   return out;
 }
 
@@ -241,13 +251,17 @@ int bench_command(const BenchOptions& o) {
                              fmt::format("--backend must be cpu, vulkan or all, got '{}'", o.backend)));
   const auto integrator = parse_integrator(o.integrator);
   if (!integrator)
-    return report(make_error(ErrorCode::invalid_argument,
-                             fmt::format("--integrator must be explicit_euler, semi_implicit_euler, rk4 or implicit_euler, got '{}'",
-                                         o.integrator)));
+    return report(make_error(
+        ErrorCode::invalid_argument,
+        fmt::format(
+            "--integrator must be explicit_euler, semi_implicit_euler, rk4 or implicit_euler, got '{}'",
+            o.integrator)));
   auto sizes = parse_sizes(o.sizes);
-  if (!sizes) return report(sizes.error());
+  if (!sizes)
+    return report(sizes.error());
   if (o.steps == 0 || o.reps == 0 || o.steps_per_submit == 0)
-    return report(make_error(ErrorCode::invalid_argument, "--steps, --reps and --steps-per-submit must be > 0"));
+    return report(
+        make_error(ErrorCode::invalid_argument, "--steps, --reps and --steps-per-submit must be > 0"));
   if (o.instances == 0 || o.instances > 4096)
     return report(make_error(ErrorCode::invalid_argument,
                              fmt::format("--instances must be in 1..4096, got {}", o.instances)));
@@ -259,22 +273,27 @@ int bench_command(const BenchOptions& o) {
   std::string vulkan_note;
   if (o.backend != "cpu") {
     auto c = gpu::Context::create();
-    if (c) ctx.emplace(std::move(*c));
-    else if (o.backend == "vulkan") return report(c.error());
-    else vulkan_note = c.error().message;
+    if (c)
+      ctx.emplace(std::move(*c));
+    else if (o.backend == "vulkan")
+      return report(c.error());
+    else
+      vulkan_note = c.error().message;
   }
 
   std::vector<Row> rows;
   for (std::uint32_t n : *sizes) {
     auto sc = bench_scene(n, *integrator, dt);
-    if (!sc) return report(sc.error());
+    if (!sc)
+      return report(sc.error());
     const double s = double(sc->system.adjacency.refs.size()) / double(sc->system.size());
     auto add = [&](Result<Row> r) -> int {
       if (!r && r.error().code == ErrorCode::unsupported) { // too large for this device: note it, go on
         fmt::print("note: n = {}: {}\n", n, r.error().message);
         return exit_ok;
       }
-      if (!r) return report(r.error());
+      if (!r)
+        return report(r.error());
       r->particles = sc->system.size() * r->instances;
       r->springs = sc->system.springs.size();
       r->steps = o.steps;
@@ -285,43 +304,54 @@ int bench_command(const BenchOptions& o) {
     };
     const bool implicit = *integrator == Integrator::implicit_euler;
     if (o.backend != "vulkan")
-      if (int e = add(bench_cpu(*sc, n, o))) return e;
+      if (int e = add(bench_cpu(*sc, n, o)))
+        return e;
     if (ctx) {
       const bool fused = o.variants.find("fused") != std::string::npos;
       const bool two_pass = o.variants.find("two_pass") != std::string::npos;
       if (fused || *integrator == Integrator::rk4 || implicit)
-        if (int e = add(bench_vulkan(*ctx, *sc, n, true, o))) return e;
+        if (int e = add(bench_vulkan(*ctx, *sc, n, true, o)))
+          return e;
       if (two_pass && *integrator != Integrator::rk4 && !implicit)
-        if (int e = add(bench_vulkan(*ctx, *sc, n, false, o))) return e;
+        if (int e = add(bench_vulkan(*ctx, *sc, n, false, o)))
+          return e;
       if (o.instances > 1) { // many cloths: one batch vs one dispatch chain per cloth, same submission
-        if (int e = add(bench_world(*ctx, *sc, n, true, o))) return e;
-        if (int e = add(bench_world(*ctx, *sc, n, false, o))) return e;
+        if (int e = add(bench_world(*ctx, *sc, n, true, o)))
+          return e;
+        if (int e = add(bench_world(*ctx, *sc, n, false, o)))
+          return e;
       }
     }
     if (implicit) { // the explicit baseline at the same size and dt, for the cost ratio
       auto base = bench_scene(n, Integrator::semi_implicit_euler, dt);
-      if (!base) return report(base.error());
+      if (!base)
+        return report(base.error());
       if (o.backend != "vulkan")
-        if (int e = add(bench_cpu(*base, n, o))) return e;
+        if (int e = add(bench_cpu(*base, n, o)))
+          return e;
       if (ctx)
-        if (int e = add(bench_vulkan(*ctx, *base, n, true, o))) return e;
+        if (int e = add(bench_vulkan(*ctx, *base, n, true, o)))
+          return e;
     }
   }
 
   // Table for people.
-  fmt::print("vkcloth bench: hanging cloth n x n (3 spring kinds, 2 pins, wind), {}, dt {:g} s, {} steps x {} reps "
-             "(median), warm-up {}\n",
-             o.integrator, dt, o.steps, o.reps, o.warmup);
-  fmt::print("ceilings: memory {:g} GB/s, compute {:g} GFLOP/s (--memory-gbps, --compute-gflops)\n", o.memory_gbps,
-             o.compute_gflops);
-  if (ctx) fmt::print("vulkan device: {}\n", ctx->device_name());
-  if (!vulkan_note.empty()) fmt::print("vulkan: skipped ({})\n", vulkan_note);
+  fmt::print(
+      "vkcloth bench: hanging cloth n x n (3 spring kinds, 2 pins, wind), {}, dt {:g} s, {} steps x {} reps "
+      "(median), warm-up {}\n",
+      o.integrator, dt, o.steps, o.reps, o.warmup);
+  fmt::print("ceilings: memory {:g} GB/s, compute {:g} GFLOP/s (--memory-gbps, --compute-gflops)\n",
+             o.memory_gbps, o.compute_gflops);
+  if (ctx)
+    fmt::print("vulkan device: {}\n", ctx->device_name());
+  if (!vulkan_note.empty())
+    fmt::print("vulkan: skipped ({})\n", vulkan_note);
   if (o.instances > 1)
     fmt::print("batched / unbatched rows: {} cloths of n x n in one ClothWorld (particles = all of them)\n",
                o.instances);
-  fmt::print("{:<7} {:<9} {:>5} {:>8} {:>3} {:>9} {:>9} {:>9} {:>6} {:>7} {:>5} {:>6} {:>8} {:>5}\n", "backend", "variant",
-             "n", "particles", "thr", "ms/step", "gpu ms", "M p-st/s", "B/p-st", "GB/s", "%mem", "fl/pst", "GFLOP/s",
-             "%cmp");
+  fmt::print("{:<7} {:<9} {:>5} {:>8} {:>3} {:>9} {:>9} {:>9} {:>6} {:>7} {:>5} {:>6} {:>8} {:>5}\n",
+             "backend", "variant", "n", "particles", "thr", "ms/step", "gpu ms", "M p-st/s", "B/p-st", "GB/s",
+             "%mem", "fl/pst", "GFLOP/s", "%cmp");
   nlohmann::json results = nlohmann::json::array();
   for (const Row& r : rows) {
     const double ms_step = r.wall_ms / double(r.steps);
@@ -329,11 +359,12 @@ int bench_command(const BenchOptions& o) {
     const double gbps = rate * r.cost.bytes * 1e-9;
     const double gflops = rate * r.cost.flops * 1e-9;
     const double gpu_step = r.gpu_ms >= 0 ? r.gpu_ms / double(r.steps) : -1.0;
-    fmt::print("{:<7} {:<9} {:>5} {:>8} {:>3} {:>9.4f} {:>9} {:>9.1f} {:>6.0f} {:>7.2f} {:>4.0f}% {:>6.0f} {:>8.2f} "
-               "{:>4.1f}%\n",
-               r.backend, r.variant, r.size, r.particles, r.backend == "cpu" ? fmt::format("{}", r.threads) : "-",
-               ms_step, gpu_step >= 0 ? fmt::format("{:.4f}", gpu_step) : "-", rate * 1e-6, r.cost.bytes, gbps,
-               100.0 * gbps / o.memory_gbps, r.cost.flops, gflops, 100.0 * gflops / o.compute_gflops);
+    fmt::print(
+        "{:<7} {:<9} {:>5} {:>8} {:>3} {:>9.4f} {:>9} {:>9.1f} {:>6.0f} {:>7.2f} {:>4.0f}% {:>6.0f} {:>8.2f} "
+        "{:>4.1f}%\n",
+        r.backend, r.variant, r.size, r.particles, r.backend == "cpu" ? fmt::format("{}", r.threads) : "-",
+        ms_step, gpu_step >= 0 ? fmt::format("{:.4f}", gpu_step) : "-", rate * 1e-6, r.cost.bytes, gbps,
+        100.0 * gbps / o.memory_gbps, r.cost.flops, gflops, 100.0 * gflops / o.compute_gflops);
     nlohmann::json j;
     j["backend"] = r.backend;
     j["variant"] = r.variant;
@@ -368,10 +399,11 @@ int bench_command(const BenchOptions& o) {
     if (r.integrator == "implicit_euler")
       for (const Row& e : rows)
         if (e.backend == r.backend && e.size == r.size && e.integrator == "semi_implicit_euler")
-          fmt::print("{} n = {}: implicit step {:.4f} ms vs semi-implicit {:.4f} ms: {:.1f}x the explicit cost "
-                     "({} CG iterations in the last step)\n",
-                     r.backend, r.size, r.wall_ms / double(r.steps), e.wall_ms / double(e.steps), r.wall_ms / e.wall_ms,
-                     r.cg_iterations);
+          fmt::print(
+              "{} n = {}: implicit step {:.4f} ms vs semi-implicit {:.4f} ms: {:.1f}x the explicit cost "
+              "({} CG iterations in the last step)\n",
+              r.backend, r.size, r.wall_ms / double(r.steps), e.wall_ms / double(e.steps),
+              r.wall_ms / e.wall_ms, r.cg_iterations);
   if (!o.json.empty()) {
     nlohmann::json doc;
     doc["schema"] = "vkcloth-bench/1";
@@ -400,16 +432,24 @@ int bench_command(const BenchOptions& o) {
 void add_bench_command(CLI::App& app, int* exit) {
   auto opt = std::make_shared<BenchOptions>();
   CLI::App* cmd = app.add_subcommand(
-      "bench", "Throughput of the solvers on the hanging cloth at several sizes, against the memory and compute "
-               "ceilings (docs/performance.md)");
-  cmd->add_option("--backend", opt->backend, "cpu | vulkan | all (all: Vulkan is skipped with a note if no device)")
+      "bench",
+      "Throughput of the solvers on the hanging cloth at several sizes, against the memory and compute "
+      "ceilings (docs/performance.md)");
+  cmd->add_option("--backend", opt->backend,
+                  "cpu | vulkan | all (all: Vulkan is skipped with a note if no device)")
       ->capture_default_str();
-  cmd->add_option("--sizes", opt->sizes, "Comma-separated grid sides n (n x n particles)")->capture_default_str();
+  cmd->add_option("--sizes", opt->sizes, "Comma-separated grid sides n (n x n particles)")
+      ->capture_default_str();
   cmd->add_option("--steps", opt->steps, "Timed steps per repetition")->capture_default_str();
-  cmd->add_option("--warmup", opt->warmup, "Untimed steps before the first repetition")->capture_default_str();
+  cmd->add_option("--warmup", opt->warmup, "Untimed steps before the first repetition")
+      ->capture_default_str();
   cmd->add_option("--reps", opt->reps, "Repetitions; the median is reported")->capture_default_str();
-  cmd->add_option("--integrator", opt->integrator, "explicit_euler | semi_implicit_euler | rk4 | implicit_euler (adds a semi-implicit baseline row and the cost ratio)")->capture_default_str();
-  cmd->add_option("--threads", opt->threads, "CPU solver threads (0: the host's hardware threads)")->capture_default_str();
+  cmd->add_option("--integrator", opt->integrator,
+                  "explicit_euler | semi_implicit_euler | rk4 | implicit_euler (adds a semi-implicit "
+                  "baseline row and the cost ratio)")
+      ->capture_default_str();
+  cmd->add_option("--threads", opt->threads, "CPU solver threads (0: the host's hardware threads)")
+      ->capture_default_str();
   cmd->add_option("--steps-per-submit", opt->steps_per_submit, "Vulkan: steps recorded per command buffer")
       ->capture_default_str();
   cmd->add_option("--instances", opt->instances,
@@ -417,9 +457,12 @@ void add_bench_command(CLI::App& app, int* exit) {
                   "unbatched (one per cloth)")
       ->capture_default_str();
   cmd->add_option("--dt", opt->dt, "Time step in seconds (default 5e-4, stable at every size)");
-  cmd->add_option("--memory-gbps", opt->memory_gbps, "Memory bandwidth ceiling in GB/s")->capture_default_str();
-  cmd->add_option("--compute-gflops", opt->compute_gflops, "Compute ceiling in GFLOP/s")->capture_default_str();
-  cmd->add_option("--variants", opt->variants, "Vulkan: fused | two_pass | fused,two_pass (semi-implicit and explicit Euler)")
+  cmd->add_option("--memory-gbps", opt->memory_gbps, "Memory bandwidth ceiling in GB/s")
+      ->capture_default_str();
+  cmd->add_option("--compute-gflops", opt->compute_gflops, "Compute ceiling in GFLOP/s")
+      ->capture_default_str();
+  cmd->add_option("--variants", opt->variants,
+                  "Vulkan: fused | two_pass | fused,two_pass (semi-implicit and explicit Euler)")
       ->capture_default_str()
       ->check([](const std::string& v) {
         return v == "fused" || v == "two_pass" || v == "fused,two_pass" || v == "two_pass,fused"

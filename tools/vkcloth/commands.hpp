@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The `vkcloth` subcommands. Each returns the process exit code (see exit_codes below).
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // `vkcloth compare`: the same scene on the CPU reference (float) and on Vulkan, side by side,
 // with the max and RMS position difference per window of steps.
 #include <algorithm>
@@ -35,7 +36,8 @@ int compare_command(const CompareOptions& opt) {
   const std::uint64_t total = scene->steps;
   const std::uint64_t window = opt.window ? opt.window : std::max<std::uint64_t>(1, (total + 9) / 10);
   fmt::print("{}: {} particles, {} steps of {:g} s ({}), cpu vs vulkan, float, tolerance {:g}\n", scene->name,
-             scene->system.size(), total, scene->params.dt, to_string(scene->params.integrator), opt.tolerance);
+             scene->system.size(), total, scene->params.dt, to_string(scene->params.integrator),
+             opt.tolerance);
   fmt::print("{:>21}  {:>12}  {:>12}\n", "steps", "max |dp|", "rms |dp|");
 
   std::vector<glm::dvec3> pc, vc, pg, vg;
@@ -86,8 +88,9 @@ int compare_command(const CompareOptions& opt) {
 void add_compare_command(CLI::App& app, int* exit) {
   auto opt = std::make_shared<CompareOptions>();
   CLI::App* cmd = app.add_subcommand(
-      "compare", "Run a scene on the CPU reference and on Vulkan; print the max and RMS position difference per "
-                 "window of steps; exit 5 above the tolerance");
+      "compare",
+      "Run a scene on the CPU reference and on Vulkan; print the max and RMS position difference per "
+      "window of steps; exit 5 above the tolerance");
   cmd->footer(exit_codes_footer);
   add_scene_options(*cmd, opt->args);
   cmd->add_option("--window", opt->window, "Steps per report row (default: a tenth of the run)")

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // `vkcloth devices`: the Vulkan devices the loader reports, and which one a solver would take.
 #include <fmt/format.h>
 
@@ -9,11 +10,16 @@ namespace {
 
 const char* type_name(VkPhysicalDeviceType t) {
   switch (t) {
-  case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return "discrete";
-  case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return "integrated";
-  case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return "virtual";
-  case VK_PHYSICAL_DEVICE_TYPE_CPU: return "cpu";
-  default: return "other";
+  case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+    return "discrete";
+  case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+    return "integrated";
+  case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+    return "virtual";
+  case VK_PHYSICAL_DEVICE_TYPE_CPU:
+    return "cpu";
+  default:
+    return "other";
   }
 }
 
@@ -23,12 +29,14 @@ int devices_command() {
     return report(list.error());
   int usable = 0;
   for (const gpu::DeviceInfo& d : *list) {
-    fmt::print("{}: {} ({}, Vulkan {}.{}){}\n", d.index, d.name, type_name(d.type), VK_API_VERSION_MAJOR(d.api_version),
-               VK_API_VERSION_MINOR(d.api_version), d.usable ? "" : " - not usable (needs Vulkan 1.2 and compute)");
+    fmt::print("{}: {} ({}, Vulkan {}.{}){}\n", d.index, d.name, type_name(d.type),
+               VK_API_VERSION_MAJOR(d.api_version), VK_API_VERSION_MINOR(d.api_version),
+               d.usable ? "" : " - not usable (needs Vulkan 1.2 and compute)");
     usable += d.usable;
   }
   if (usable == 0)
-    return report(make_error(ErrorCode::no_device, "no usable Vulkan device (install mesa-vulkan-drivers for lavapipe)"));
+    return report(make_error(ErrorCode::no_device,
+                             "no usable Vulkan device (install mesa-vulkan-drivers for lavapipe)"));
   gpu::ContextOptions options;
   options.validation = false;
   auto context = gpu::Context::create(options);
@@ -41,7 +49,8 @@ int devices_command() {
 } // namespace
 
 void add_devices_command(CLI::App& app, int* exit) {
-  CLI::App* cmd = app.add_subcommand("devices", "List the Vulkan devices and the one a solver would use (exit 4 if none)");
+  CLI::App* cmd = app.add_subcommand(
+      "devices", "List the Vulkan devices and the one a solver would use (exit 4 if none)");
   cmd->footer(exit_codes_footer);
   cmd->callback([exit] { *exit = devices_command(); });
 }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // `vkcloth info`: what a scene file turns into, for checking a scene before running it.
 #include <array>
 

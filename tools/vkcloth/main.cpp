@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // vkcloth: command-line front end to the scene loader and the solvers.
 #include <cstdlib>
 #include <cstring>
@@ -34,7 +35,6 @@ int report(const Error& e) {
   return exit_code(e);
 }
 
-
 const char* const exit_codes_footer = R"(Exit codes:
   0  success
   1  unexpected runtime failure (Vulkan error, out of memory), or Vulkan validation messages
@@ -67,15 +67,17 @@ void add_scene_options(CLI::App& cmd, SceneArgs& args, bool sugar) {
     return;
   cmd.add_option("--steps", args.steps, "Number of steps (sugar for --set integrator.steps=N)");
   cmd.add_option("--dt", args.dt, "Time step in seconds (sugar for --set integrator.dt=X)");
-  cmd.add_option("--integrator", args.integrator,
-                 "explicit_euler | semi_implicit_euler | rk4 | implicit_euler (sugar for --set integrator.method=NAME)");
+  cmd.add_option(
+      "--integrator", args.integrator,
+      "explicit_euler | semi_implicit_euler | rk4 | implicit_euler (sugar for --set integrator.method=NAME)");
 }
 
 } // namespace vkcloth::cli
 
 int main(int argc, char** argv) {
   using namespace vkcloth::cli;
-  CLI::App app{"vkcloth: mass-spring cloth simulation on the CPU reference solver and on Vulkan compute", "vkcloth"};
+  CLI::App app{"vkcloth: mass-spring cloth simulation on the CPU reference solver and on Vulkan compute",
+               "vkcloth"};
   app.footer(exit_codes_footer);
   app.require_subcommand(1);
 
@@ -114,7 +116,8 @@ int main(int argc, char** argv) {
   const char* v = std::getenv("VKCLOTH_VALIDATION");
   const bool validating = v && *v && std::strcmp(v, "0") != 0 && std::strcmp(v, "false") != 0;
   if (const auto n = vkcloth::gpu::Context::process_validation_message_count(); validating && n > 0) {
-    fmt::print(stderr, "vkcloth: Vulkan validation reported {} message{} (see above)\n", n, n == 1 ? "" : "s");
+    fmt::print(stderr, "vkcloth: Vulkan validation reported {} message{} (see above)\n", n,
+               n == 1 ? "" : "s");
     if (exit == exit_ok)
       return exit_failure;
   }

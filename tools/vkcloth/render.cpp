@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // `vkcloth render`: simulate a scene on the GPU and draw it offscreen to PNG files (one frame, or
 // a numbered sequence), optionally assembled into a video with ffmpeg. No display needed.
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Helpers shared by `vkcloth render` and `vkcloth view`: image size and camera options, the
 // Context options for drawing.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // `vkcloth run`: load, simulate, write CSVs, summarise.
 #include <algorithm>
 #include <cerrno>
@@ -168,8 +169,9 @@ int run_command(const RunOptions& opt) {
       to_string(scene->params.integrator), opt.backend, opt.precision, backend.time(), wall, max_disp);
   if (scene->params.integrator == Integrator::implicit_euler) {
     const SolveStats cg = backend.last_solve();
-    fmt::print("implicit_euler: last solve {} CG iterations, relative residual {:.3g} (tolerance {:g}, cap {})\n",
-               cg.iterations, cg.residual, scene->params.cg_tolerance, scene->params.cg_max_iterations);
+    fmt::print(
+        "implicit_euler: last solve {} CG iterations, relative residual {:.3g} (tolerance {:g}, cap {})\n",
+        cg.iterations, cg.residual, scene->params.cg_tolerance, scene->params.cg_max_iterations);
   }
   return exit_ok;
 }
@@ -181,15 +183,17 @@ void add_run_command(CLI::App& app, int* exit) {
   CLI::App* cmd = app.add_subcommand("run", "Simulate a scene and optionally write CSV traces");
   cmd->footer(exit_codes_footer);
   add_scene_options(*cmd, opt->args);
-  auto* trace = cmd->add_option("--trace", opt->trace,
-                                "Write every particle's state to a CSV file: step,time,particle,x,y,z,vx,vy,vz "
-                                "(step 0 then every K steps)");
+  auto* trace =
+      cmd->add_option("--trace", opt->trace,
+                      "Write every particle's state to a CSV file: step,time,particle,x,y,z,vx,vy,vz "
+                      "(step 0 then every K steps)");
   cmd->add_option("--trace-every", opt->trace_every, "K for --trace (default 1)")
       ->check(CLI::PositiveNumber)
       ->needs(trace);
   cmd->add_option("--positions", opt->positions, "Write the final positions to a CSV file: particle,x,y,z");
   cmd->add_option("--backend", opt->backend, "Solver backend: cpu | vulkan (default cpu)");
-  cmd->add_option("--precision", opt->precision, "Solver arithmetic: float | double (default float; vulkan: float)")
+  cmd->add_option("--precision", opt->precision,
+                  "Solver arithmetic: float | double (default float; vulkan: float)")
       ->check(CLI::IsMember({"float", "double"}));
   cmd->callback([opt, exit] { *exit = run_command(*opt); });
 }

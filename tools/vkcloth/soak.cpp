@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // `vkcloth soak`: a long run that checks what a short test cannot: no NaN/inf after many steps,
 // pinned particles exactly where they started, no growth of the process's memory. Opt-in (not in
 // the test suite): tools/soak.sh runs it on the stable samples.
@@ -31,7 +32,7 @@ struct SoakOptions {
   SceneArgs args;
   std::string backend = "cpu";
   std::uint64_t steps = 100000;
-  std::uint64_t checks = 100;        ///< state checks over the run
+  std::uint64_t checks = 100; ///< state checks over the run
   std::uint64_t max_rss_growth_kib = 1024;
 };
 
@@ -66,8 +67,9 @@ int soak_command(const SoakOptions& opt) {
     for (std::size_t k = 0; k < pos.size(); ++k) {
       for (int c = 0; c < 3; ++c)
         if (!std::isfinite(pos[k][c]) || !std::isfinite(vel[k][c]))
-          return report(make_error(ErrorCode::diverged, fmt::format("soak: particle {} is not finite at step {}", k,
-                                                                    backend.step_index())));
+          return report(
+              make_error(ErrorCode::diverged,
+                         fmt::format("soak: particle {} is not finite at step {}", k, backend.step_index())));
       if (scene->system.particles[k].pinned)
         max_pin_drift = std::max(max_pin_drift, glm::length(pos[k] - initial[k]));
       max_speed = std::max(max_speed, glm::length(vel[k]));
@@ -77,13 +79,14 @@ int soak_command(const SoakOptions& opt) {
   const long long growth = static_cast<long long>(rss1) - static_cast<long long>(rss0);
   fmt::print("soak {} ({}): {} particles, {} steps, simulated {:.6g} s; max pinned drift {:.3g} m, max speed "
              "{:.6g} m/s, RSS {} KiB -> {} KiB ({:+} KiB)\n",
-             scene->name, opt.backend, scene->system.size(), backend.step_index(), backend.time(), max_pin_drift,
-             max_speed, rss0, rss1, growth);
+             scene->name, opt.backend, scene->system.size(), backend.step_index(), backend.time(),
+             max_pin_drift, max_speed, rss0, rss1, growth);
   if (max_pin_drift != 0.0)
-    return report(make_error(ErrorCode::diverged, fmt::format("soak: pinned particles moved by {:.3g} m", max_pin_drift)));
+    return report(make_error(ErrorCode::diverged,
+                             fmt::format("soak: pinned particles moved by {:.3g} m", max_pin_drift)));
   if (growth > static_cast<long long>(opt.max_rss_growth_kib))
-    return report(make_error(ErrorCode::out_of_memory,
-                             fmt::format("soak: RSS grew by {} KiB (limit {} KiB)", growth, opt.max_rss_growth_kib)));
+    return report(make_error(ErrorCode::out_of_memory, fmt::format("soak: RSS grew by {} KiB (limit {} KiB)",
+                                                                   growth, opt.max_rss_growth_kib)));
   return exit_ok;
 }
 
@@ -92,11 +95,14 @@ int soak_command(const SoakOptions& opt) {
 void add_soak_command(CLI::App& app, int* exit) {
   auto opt = std::make_shared<SoakOptions>();
   CLI::App* cmd = app.add_subcommand(
-      "soak", "Long run: checks no NaN/inf, no drift of pinned particles, no RSS growth (exit 3 / 1 on failure)");
+      "soak",
+      "Long run: checks no NaN/inf, no drift of pinned particles, no RSS growth (exit 3 / 1 on failure)");
   cmd->footer(exit_codes_footer);
   add_scene_options(*cmd, opt->args, /*sugar=*/false);
-  cmd->add_option("--steps", opt->steps, "Steps to run (default 100000)")->check(CLI::Range(std::uint64_t{1}, std::uint64_t{max_scene_steps}));
-  cmd->add_option("--checks", opt->checks, "State checks over the run (default 100)")->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1000000}));
+  cmd->add_option("--steps", opt->steps, "Steps to run (default 100000)")
+      ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{max_scene_steps}));
+  cmd->add_option("--checks", opt->checks, "State checks over the run (default 100)")
+      ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1000000}));
   cmd->add_option("--max-rss-growth", opt->max_rss_growth_kib, "Allowed RSS growth in KiB (default 1024)");
   cmd->add_option("--backend", opt->backend, "Solver backend: cpu | vulkan (default cpu)");
   cmd->callback([opt, exit] { *exit = soak_command(*opt); });

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // `vkcloth view`: an interactive window (GLFW + a Vulkan swapchain) drawing the GPU solver live.
 // Mouse: left-drag orbits, or drags the particle under the cursor (the report's hand lifting the
 // cloth); wheel zooms. Keys: space pause, S / right arrow single step, R reset, W wind on/off,
@@ -70,8 +71,9 @@ Result<void> Viewer::open_window(std::uint32_t width, std::uint32_t height) {
   if (auto failure = window_.open(width, height, fmt::format("vkcloth: {}", scene_->name))) {
     switch (*failure) {
     case host::Window::OpenFailure::no_display:
-      return make_error(ErrorCode::no_device, "cannot open a window: GLFW found no display (set DISPLAY, or run "
-                                              "under xvfb-run; `vkcloth render` needs no display)");
+      return make_error(ErrorCode::no_device,
+                        "cannot open a window: GLFW found no display (set DISPLAY, or run "
+                        "under xvfb-run; `vkcloth render` needs no display)");
     case host::Window::OpenFailure::no_vulkan:
       return make_error(ErrorCode::no_device, "GLFW found no Vulkan loader with window-system support");
     case host::Window::OpenFailure::no_window:

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "view_input.hpp"
 
 #include <algorithm>
@@ -10,7 +11,9 @@
 namespace vkcloth::cli {
 namespace {
 
-Input& input_of(GLFWwindow* w) { return *static_cast<Input*>(host::Window::host_pointer(w)); }
+Input& input_of(GLFWwindow* w) {
+  return *static_cast<Input*>(host::Window::host_pointer(w));
+}
 
 /// The cursor's ray in world space.
 struct Ray {
@@ -98,7 +101,8 @@ void apply_mouse(Input& input, Orbit& orbit, Hold& hold, gpu::GpuSolver& solver,
   const VkExtent2D extent = window.extent(); // 0 x 0 while minimised: nothing to pick in
   if (input.scroll != 0.0) {
     orbit.distance *= std::pow(0.9f, float(input.scroll));
-    orbit.distance = std::clamp(orbit.distance, 0.05f * orbit.scene_radius, 50.0f * orbit.scene_radius + 1.0f);
+    orbit.distance =
+        std::clamp(orbit.distance, 0.05f * orbit.scene_radius, 50.0f * orbit.scene_radius + 1.0f);
     input.scroll = 0.0;
   }
   if (input.left_pressed && extent.width) {

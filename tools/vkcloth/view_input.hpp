@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // `vkcloth view`'s mouse and keyboard. The GLFW callbacks only record what happened (Input); once
 // per frame, apply_mouse turns it into the orbit camera's motion or a held particle's drag.
 // Keys: space pause, S / right arrow single step (repeats), R reset, W wind on/off, Esc quit.

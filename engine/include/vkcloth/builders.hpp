@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Builders for the report's systems: a chain of springs and a cloth grid (docs/model.md "Springs").
 #pragma once
 
@@ -46,7 +47,8 @@ struct ClothDesc {
   glm::dvec2 size{1.0, 1.0};
   glm::dvec3 origin{0.0, 0.0, 0.0};
   ClothOrientation orientation = ClothOrientation::vertical;
-  double particle_mass = 0.05; ///< vkcloth's choice (the report gives no mass); docs/model.md "The report's observations"
+  double particle_mass =
+      0.05; ///< vkcloth's choice (the report gives no mass); docs/model.md "The report's observations"
   ClothStiffness stiffness;
   /// Pinned (i, j) cells; empty means the two top corners (0, ny-1) and (nx-1, ny-1).
   std::vector<std::array<std::uint32_t, 2>> pins;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The CPU reference solver: deterministic (same input -> bit-identical output), float by default,
 // double for accuracy studies. The Vulkan solver is checked against it.
 //

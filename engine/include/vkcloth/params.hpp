@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Simulation parameters shared by every solver: integrator, time step, forces, colliders.
 // Units: metres, seconds, kilograms; z is up.
 #pragma once
@@ -15,7 +16,8 @@ namespace vkcloth {
 
 /// Time integrators, each named for what it is (see docs/scene-format.md).
 enum class Integrator : std::uint32_t {
-  explicit_euler = 0,      ///< p += dt v_old; v += dt a   (the report's update as written; docs/model.md "Integrators")
+  explicit_euler =
+      0, ///< p += dt v_old; v += dt a   (the report's update as written; docs/model.md "Integrators")
   semi_implicit_euler = 1, ///< v += dt a; p += dt v_new   (what the report observed; the default)
   rk4 = 2,                 ///< classic 4-stage Runge-Kutta on (p, v)
   implicit_euler = 3,      ///< backward Euler (Baraff & Witkin 1998), linearised, solved by PCG
@@ -47,7 +49,7 @@ struct Collider {
 
 /// Wind F = Kw <n, u_w> n on each cloth vertex, n its unit normal, u_w the unit wind direction.
 struct Wind {
-  double strength = 0.0;            ///< Kw
+  double strength = 0.0;               ///< Kw
   glm::dvec3 direction{1.0, 0.0, 0.0}; ///< normalised by validate()
 };
 
@@ -69,8 +71,8 @@ struct SimParams {
   /// Projection distance eps: a particle found inside a collider is put back at surface + eps.
   /// A particle closer than 2 eps to a surface is "in contact" (its inward v and F are removed).
   double contact_epsilon = 1e-3;
-  /// Remove only the parts of v and F that point INTO a collider (the default; docs/model.md "Collisions"). False
-  /// removes the whole normal part, the variant of the report's Figure 12 where the cloth sticks.
+  /// Remove only the parts of v and F that point INTO a collider (the default; docs/model.md "Collisions").
+  /// False removes the whole normal part, the variant of the report's Figure 12 where the cloth sticks.
   bool contact_inward_only = true;
   /// A position with a coordinate |x_i| > this, or a non-finite position or velocity, is a blow-up
   /// (docs/model.md "Divergence").

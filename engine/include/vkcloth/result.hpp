@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Errors as values: every fallible vkcloth call returns Result<T> (a value or an Error).
 // The library never calls exit() and never throws across its API.
 #pragma once
@@ -30,19 +31,29 @@ struct Error {
 
 inline const char* to_string(ErrorCode c) {
   switch (c) {
-  case ErrorCode::invalid_argument: return "invalid argument";
-  case ErrorCode::io: return "i/o error";
-  case ErrorCode::parse: return "parse error";
-  case ErrorCode::diverged: return "simulation diverged";
-  case ErrorCode::no_device: return "no Vulkan device";
-  case ErrorCode::vulkan: return "Vulkan error";
-  case ErrorCode::out_of_memory: return "out of memory";
-  case ErrorCode::unsupported: return "unsupported";
+  case ErrorCode::invalid_argument:
+    return "invalid argument";
+  case ErrorCode::io:
+    return "i/o error";
+  case ErrorCode::parse:
+    return "parse error";
+  case ErrorCode::diverged:
+    return "simulation diverged";
+  case ErrorCode::no_device:
+    return "no Vulkan device";
+  case ErrorCode::vulkan:
+    return "Vulkan error";
+  case ErrorCode::out_of_memory:
+    return "out of memory";
+  case ErrorCode::unsupported:
+    return "unsupported";
   }
   return "error";
 }
 
-inline Error make_error(ErrorCode code, std::string message) { return Error{code, std::move(message), 0}; }
+inline Error make_error(ErrorCode code, std::string message) {
+  return Error{code, std::move(message), 0};
+}
 
 /// Either a T or an Error. Small stand-in for std::expected (not in the C++20 library we target).
 template <typename T> class [[nodiscard]] Result {
@@ -83,7 +94,8 @@ private:
 } // namespace vkcloth
 
 /// Propagates an error from an expression returning Result<...>.
-#define VKCLOTH_TRY(expr)                                                                               \
-  do {                                                                                                  \
-    if (auto vkcloth_try_r_ = (expr); !vkcloth_try_r_.ok()) return vkcloth_try_r_.error();              \
+#define VKCLOTH_TRY(expr)                                                                                    \
+  do {                                                                                                       \
+    if (auto vkcloth_try_r_ = (expr); !vkcloth_try_r_.ok())                                                  \
+      return vkcloth_try_r_.error();                                                                         \
   } while (0)

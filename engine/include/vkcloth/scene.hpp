@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Scene files: a JSON description of a system (chain or cloth) and its simulation parameters.
 // The format is documented key by key in docs/scene-format.md.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The particle-spring system description that every solver consumes (CPU and Vulkan).
 // Topology (springs, rest lengths, the per-particle gather lists, the grid shape for normals) is
 // built once here; solvers copy the initial state and own their runtime state.
@@ -59,7 +60,7 @@ struct SpringAdjacency {
 struct ParticleSystem {
   std::vector<Particle> particles;
   std::vector<Spring> springs;
-  std::optional<Grid> grid; ///< set for cloth; chains have no surface (no normals, no wind)
+  std::optional<Grid> grid;  ///< set for cloth; chains have no surface (no normals, no wind)
   SpringAdjacency adjacency; ///< filled by finalize()
 
   std::size_t size() const { return particles.size(); }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // ClothTopology: everything a solver or renderer derives from a ParticleSystem's connectivity,
 // prepared ONCE (as Jolt's SoftBodySharedSettings::Optimize) and shared, immutable, by every
 // consumer (std::shared_ptr<const ClothTopology>): the flattened gather lists, the normal fans,

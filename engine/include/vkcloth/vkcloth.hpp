@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Umbrella header of the vkcloth library.
 #pragma once
 

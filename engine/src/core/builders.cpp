@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "vkcloth/builders.hpp"
 
 #include <algorithm>
@@ -9,28 +10,39 @@
 namespace vkcloth {
 namespace {
 
-Error bad(std::string message) { return make_error(ErrorCode::invalid_argument, std::move(message)); }
-bool finite(glm::dvec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+Error bad(std::string message) {
+  return make_error(ErrorCode::invalid_argument, std::move(message));
+}
+bool finite(glm::dvec3 v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
 
 } // namespace
 
 Result<ParticleSystem> make_chain(const ChainDesc& d) {
   const std::size_t n = d.masses.size();
-  if (n == 0) return bad("chain.masses must hold at least one mass");
-  if (n > max_particles) return bad(fmt::format("chain.masses holds {} masses, more than the limit {}", n, max_particles));
+  if (n == 0)
+    return bad("chain.masses must hold at least one mass");
+  if (n > max_particles)
+    return bad(fmt::format("chain.masses holds {} masses, more than the limit {}", n, max_particles));
   auto per_spring = [&](const std::vector<double>& v, const char* key) -> Result<std::vector<double>> {
-    if (v.size() == 1) return std::vector<double>(n, v[0]); // one value for every spring
+    if (v.size() == 1)
+      return std::vector<double>(n, v[0]); // one value for every spring
     if (v.size() != n)
       return bad(fmt::format("chain.{} must hold 1 or {} values (one per mass), got {}", key, n, v.size()));
     return v;
   };
   auto k = per_spring(d.stiffness, "stiffness");
-  if (!k) return k.error();
+  if (!k)
+    return k.error();
   auto l0 = per_spring(d.rest_lengths, "rest_lengths");
-  if (!l0) return l0.error();
-  if (!finite(d.anchor)) return bad("chain.anchor must be finite");
+  if (!l0)
+    return l0.error();
+  if (!finite(d.anchor))
+    return bad("chain.anchor must be finite");
   if (!d.positions.empty() && d.positions.size() != n)
-    return bad(fmt::format("chain.positions must hold {} positions (one per mass), got {}", n, d.positions.size()));
+    return bad(
+        fmt::format("chain.positions must hold {} positions (one per mass), got {}", n, d.positions.size()));
 
   ParticleSystem sys;
   sys.particles.push_back(Particle{d.anchor, {}, 1.0, true});
@@ -44,10 +56,11 @@ Result<ParticleSystem> make_chain(const ChainDesc& d) {
       return bad(fmt::format("chain.rest_lengths[{}] must be finite and >= 0, got {}", i, (*l0)[i]));
     below.z -= (*l0)[i]; // default: hanging straight down, each spring at rest length
     const glm::dvec3 p = d.positions.empty() ? below : d.positions[i];
-    if (!finite(p)) return bad(fmt::format("chain.positions[{}] must be finite", i));
+    if (!finite(p))
+      return bad(fmt::format("chain.positions[{}] must be finite", i));
     sys.particles.push_back(Particle{p, {}, d.masses[i], false});
-    sys.springs.push_back(Spring{static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(i + 1), (*l0)[i], (*k)[i],
-                                 SpringKind::plain});
+    sys.springs.push_back(Spring{static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(i + 1), (*l0)[i],
+                                 (*k)[i], SpringKind::plain});
   }
   sys.finalize();
   return sys;
@@ -55,37 +68,42 @@ Result<ParticleSystem> make_chain(const ChainDesc& d) {
 
 Result<ParticleSystem> make_cloth(const ClothDesc& d) {
   if (d.nx < 1 || d.ny < 1 || d.nx > max_cloth_side || d.ny > max_cloth_side)
-    return bad(fmt::format("cloth.resolution [{}, {}] is out of range: each side must be in 1..{}", d.nx, d.ny,
-                           max_cloth_side));
+    return bad(fmt::format("cloth.resolution [{}, {}] is out of range: each side must be in 1..{}", d.nx,
+                           d.ny, max_cloth_side));
   const std::uint64_t count = std::uint64_t(d.nx) * d.ny;
   if (count > max_particles)
-    return bad(fmt::format("cloth.resolution [{}, {}] makes {} particles, more than the limit {}", d.nx, d.ny, count,
-                           max_particles));
+    return bad(fmt::format("cloth.resolution [{}, {}] makes {} particles, more than the limit {}", d.nx, d.ny,
+                           count, max_particles));
   if (!std::isfinite(d.size.x) || !std::isfinite(d.size.y) || d.size.x <= 0.0 || d.size.y <= 0.0)
     return bad(fmt::format("cloth.size must be finite and > 0, got [{}, {}]", d.size.x, d.size.y));
-  if (!finite(d.origin)) return bad("cloth.origin must be finite");
+  if (!finite(d.origin))
+    return bad("cloth.origin must be finite");
   if (!std::isfinite(d.particle_mass) || d.particle_mass <= 0.0)
     return bad(fmt::format("cloth.particle_mass must be finite and > 0, got {}", d.particle_mass));
   const std::pair<const char*, double> ks[] = {
       {"structural", d.stiffness.structural}, {"shear", d.stiffness.shear}, {"bend", d.stiffness.bend}};
   for (auto [name, k] : ks)
-    if (!std::isfinite(k) || k < 0.0) return bad(fmt::format("cloth.stiffness.{} must be finite and >= 0, got {}", name, k));
+    if (!std::isfinite(k) || k < 0.0)
+      return bad(fmt::format("cloth.stiffness.{} must be finite and >= 0, got {}", name, k));
 
   const std::uint32_t nx = d.nx, ny = d.ny;
   const double dx = nx > 1 ? d.size.x / (nx - 1) : 0.0;
   const double dy = ny > 1 ? d.size.y / (ny - 1) : 0.0;
   const glm::dvec3 eu{1, 0, 0};
-  const glm::dvec3 ev = d.orientation == ClothOrientation::vertical ? glm::dvec3{0, 0, 1} : glm::dvec3{0, 1, 0};
+  const glm::dvec3 ev =
+      d.orientation == ClothOrientation::vertical ? glm::dvec3{0, 0, 1} : glm::dvec3{0, 1, 0};
 
   ParticleSystem sys;
   sys.grid = Grid{nx, ny};
   sys.particles.resize(count);
   for (std::uint32_t j = 0; j < ny; ++j)
     for (std::uint32_t i = 0; i < nx; ++i)
-      sys.particles[j * nx + i] = Particle{d.origin + (i * dx) * eu + (j * dy) * ev, {}, d.particle_mass, false};
+      sys.particles[j * nx + i] =
+          Particle{d.origin + (i * dx) * eu + (j * dy) * ev, {}, d.particle_mass, false};
 
   std::vector<std::array<std::uint32_t, 2>> pins = d.pins;
-  if (pins.empty() && d.pin_default_corners) pins = {{0, ny - 1}, {nx - 1, ny - 1}};
+  if (pins.empty() && d.pin_default_corners)
+    pins = {{0, ny - 1}, {nx - 1, ny - 1}};
   for (std::size_t k = 0; k < pins.size(); ++k) {
     const auto [i, j] = pins[k];
     if (i >= nx || j >= ny)
@@ -94,13 +112,17 @@ Result<ParticleSystem> make_cloth(const ClothDesc& d) {
   }
 
   // Springs are emitted kind by kind (structural, shear, bend); this order is the gather order.
-  auto add = [&](std::uint32_t i0, std::uint32_t j0, std::uint32_t i1, std::uint32_t j1, double rest, double k,
-                 SpringKind kind) { sys.springs.push_back(Spring{j0 * nx + i0, j1 * nx + i1, rest, k, kind}); };
+  auto add = [&](std::uint32_t i0, std::uint32_t j0, std::uint32_t i1, std::uint32_t j1, double rest,
+                 double k, SpringKind kind) {
+    sys.springs.push_back(Spring{j0 * nx + i0, j1 * nx + i1, rest, k, kind});
+  };
   if (d.stiffness.structural > 0.0) {
     for (std::uint32_t j = 0; j < ny; ++j)
-      for (std::uint32_t i = 0; i + 1 < nx; ++i) add(i, j, i + 1, j, dx, d.stiffness.structural, SpringKind::structural);
+      for (std::uint32_t i = 0; i + 1 < nx; ++i)
+        add(i, j, i + 1, j, dx, d.stiffness.structural, SpringKind::structural);
     for (std::uint32_t j = 0; j + 1 < ny; ++j)
-      for (std::uint32_t i = 0; i < nx; ++i) add(i, j, i, j + 1, dy, d.stiffness.structural, SpringKind::structural);
+      for (std::uint32_t i = 0; i < nx; ++i)
+        add(i, j, i, j + 1, dy, d.stiffness.structural, SpringKind::structural);
   }
   if (d.stiffness.shear > 0.0) {
     const double diag = std::sqrt(dx * dx + dy * dy);
@@ -112,9 +134,11 @@ Result<ParticleSystem> make_cloth(const ClothDesc& d) {
   }
   if (d.stiffness.bend > 0.0) {
     for (std::uint32_t j = 0; j < ny; ++j)
-      for (std::uint32_t i = 0; i + 2 < nx; ++i) add(i, j, i + 2, j, 2 * dx, d.stiffness.bend, SpringKind::bend);
+      for (std::uint32_t i = 0; i + 2 < nx; ++i)
+        add(i, j, i + 2, j, 2 * dx, d.stiffness.bend, SpringKind::bend);
     for (std::uint32_t j = 0; j + 2 < ny; ++j)
-      for (std::uint32_t i = 0; i < nx; ++i) add(i, j, i, j + 2, 2 * dy, d.stiffness.bend, SpringKind::bend);
+      for (std::uint32_t i = 0; i < nx; ++i)
+        add(i, j, i, j + 2, 2 * dy, d.stiffness.bend, SpringKind::bend);
   }
   sys.finalize();
   return sys;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "vkcloth/cpu_solver.hpp"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // CpuSolver's implicit Euler substep (the method: implicit_euler.hpp). Float expressions are
 // written in the order shaders/implicit_*.comp use.
 #include "implicit_euler.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Implicit (backward) Euler for the CPU reference solver (Baraff & Witkin 1998, "Large steps in
 // cloth simulation"), linearised once per (sub)step:
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The per-particle physics as C++: shaders/include/cloth_kernel.h, the one source the compute
 // shaders include too, compiled here with GLM (which follows GLSL's syntax) once for float
 // (kernel::f32, CpuSolver<float>: the GPU's bits) and once for double (kernel::f64). Both sets
@@ -30,29 +31,24 @@ static_assert(VKCLOTH_INTEGRATOR_RK4 == std::uint32_t(vkcloth::Integrator::rk4))
 
 namespace vkcloth::kernel {
 
-namespace f32 {
-using real = float;
-using vec3 = glm::vec3;
+// What cloth_kernel.h expects besides real and vec3; the nested namespaces below find these.
 using uint = std::uint32_t;
 using std::abs;
 using std::max;
 using std::sqrt;
-inline bool all_finite(vec3 v) {
+template <typename V> bool all_finite(V v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
+
+namespace f32 {
+using real = float;
+using vec3 = glm::vec3;
 #include "cloth_kernel.h"
 } // namespace f32
 
 namespace f64 {
 using real = double;
 using vec3 = glm::dvec3;
-using uint = std::uint32_t;
-using std::abs;
-using std::max;
-using std::sqrt;
-inline bool all_finite(vec3 v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
 #include "cloth_kernel.h"
 } // namespace f64
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The interior row kernel for AVX2: 8 floats / 4 doubles per vector. This file alone is compiled
 // with -mavx2 (engine/CMakeLists.txt; no -mfma) and is only called when the CPU has AVX2.
 #include "row_kernel.hpp"
@@ -54,7 +55,8 @@ struct IsaF : IsaGeneric<float, vf8, vi8, 8> {
     V* out[3] = {&x, &y, &z};
     for (int k = 0; k < 3; ++k) {
       const __m256i i = iv(perm8.d[k]);
-      __m256 r = _mm256_blendv_ps(_mm256_permutevar8x32_ps(a, i), _mm256_permutevar8x32_ps(b, i), mk(perm8.dm1[k]));
+      __m256 r =
+          _mm256_blendv_ps(_mm256_permutevar8x32_ps(a, i), _mm256_permutevar8x32_ps(b, i), mk(perm8.dm1[k]));
       r = _mm256_blendv_ps(r, _mm256_permutevar8x32_ps(c, i), mk(perm8.dm2[k]));
       *out[k] = (V)r;
     }
@@ -62,8 +64,8 @@ struct IsaF : IsaGeneric<float, vf8, vi8, 8> {
   static void store3(float* p, V x, V y, V z) {
     for (int o = 0; o < 3; ++o) {
       const __m256i i = iv(perm8.s[o]);
-      __m256 r = _mm256_blendv_ps(_mm256_permutevar8x32_ps((__m256)x, i), _mm256_permutevar8x32_ps((__m256)y, i),
-                                  mk(perm8.sm1[o]));
+      __m256 r = _mm256_blendv_ps(_mm256_permutevar8x32_ps((__m256)x, i),
+                                  _mm256_permutevar8x32_ps((__m256)y, i), mk(perm8.sm1[o]));
       r = _mm256_blendv_ps(r, _mm256_permutevar8x32_ps((__m256)z, i), mk(perm8.sm2[o]));
       _mm256_storeu_ps(p + 8 * o, r);
     }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The interior row kernel for AVX-512F: 16 floats / 8 doubles per vector. This file alone is
 // compiled with -mavx512f (engine/CMakeLists.txt) and is only called when the CPU has AVX-512F.
 #include "row_kernel.hpp"
@@ -53,19 +54,23 @@ struct IsaF : IsaGeneric<float, vf16, vi16, 16> {
     const __m512 a = _mm512_loadu_ps(p), b = _mm512_loadu_ps(p + 16), c = _mm512_loadu_ps(p + 32);
     V* out[3] = {&x, &y, &z};
     for (int k = 0; k < 3; ++k)
-      *out[k] = (V)_mm512_permutex2var_ps(_mm512_permutex2var_ps(a, idx(perm_f.d1[k]), b), idx(perm_f.d2[k]), c);
+      *out[k] =
+          (V)_mm512_permutex2var_ps(_mm512_permutex2var_ps(a, idx(perm_f.d1[k]), b), idx(perm_f.d2[k]), c);
   }
   static void store3(float* p, V x, V y, V z) {
     for (int o = 0; o < 3; ++o)
-      _mm512_storeu_ps(p + 16 * o, _mm512_permutex2var_ps(_mm512_permutex2var_ps((__m512)x, idx(perm_f.s1[o]), (__m512)y),
-                                                          idx(perm_f.s2[o]), (__m512)z));
+      _mm512_storeu_ps(p + 16 * o,
+                       _mm512_permutex2var_ps(_mm512_permutex2var_ps((__m512)x, idx(perm_f.s1[o]), (__m512)y),
+                                              idx(perm_f.s2[o]), (__m512)z));
   }
   static M pinmask(const std::uint8_t* p) {
-    const vi16 v = (vi16)_mm512_maskz_cvtepu8_epi32(__mmask16(0xFFFF), _mm_loadu_si128(reinterpret_cast<const __m128i*>(p)));
+    const vi16 v = (vi16)_mm512_maskz_cvtepu8_epi32(__mmask16(0xFFFF),
+                                                    _mm_loadu_si128(reinterpret_cast<const __m128i*>(p)));
     return v != 0;
   }
   static M loadmask(const std::uint16_t* p) {
-    return (vi16)_mm512_maskz_cvtepu16_epi32(__mmask16(0xFFFF), _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)));
+    return (vi16)_mm512_maskz_cvtepu16_epi32(__mmask16(0xFFFF),
+                                             _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)));
   }
 };
 
@@ -80,12 +85,14 @@ struct IsaD : IsaGeneric<double, vd8, vl8, 8> {
     const __m512d a = _mm512_loadu_pd(p), b = _mm512_loadu_pd(p + 8), c = _mm512_loadu_pd(p + 16);
     V* out[3] = {&x, &y, &z};
     for (int k = 0; k < 3; ++k)
-      *out[k] = (V)_mm512_permutex2var_pd(_mm512_permutex2var_pd(a, idx(perm_d.d1[k]), b), idx(perm_d.d2[k]), c);
+      *out[k] =
+          (V)_mm512_permutex2var_pd(_mm512_permutex2var_pd(a, idx(perm_d.d1[k]), b), idx(perm_d.d2[k]), c);
   }
   static void store3(double* p, V x, V y, V z) {
     for (int o = 0; o < 3; ++o)
-      _mm512_storeu_pd(p + 8 * o, _mm512_permutex2var_pd(_mm512_permutex2var_pd((__m512d)x, idx(perm_d.s1[o]), (__m512d)y),
-                                                         idx(perm_d.s2[o]), (__m512d)z));
+      _mm512_storeu_pd(
+          p + 8 * o, _mm512_permutex2var_pd(_mm512_permutex2var_pd((__m512d)x, idx(perm_d.s1[o]), (__m512d)y),
+                                            idx(perm_d.s2[o]), (__m512d)z));
   }
 };
 

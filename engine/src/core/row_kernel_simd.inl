@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The interior row kernel, vectorised across particles with GCC vector extensions. Included by
 // row_kernel_avx2.cpp / row_kernel_avx512.cpp after they define, inside an anonymous namespace,
 // the ISA traits `IsaF` / `IsaD` (Real, V = W lanes of Real, M = W lanes of same-width ints,
@@ -20,11 +21,11 @@ template <typename T> inline typename T::V ld(const typename T::Real* p) {
   __builtin_memcpy(&v, p, sizeof v);
   return v;
 }
-template <typename T> inline typename T::V bc(typename T::Real x) { return typename T::V{} + x; }
+template <typename T> inline typename T::V bc(typename T::Real x) {
+  return typename T::V{} + x;
+}
 
-template <bool B> struct Flag {
-  static constexpr bool value = B;
-};
+template <bool B> struct Flag { static constexpr bool value = B; };
 
 // One vector of W particles per iteration: normal fan, the 12 stencil springs, body forces, the
 // Euler update and the finite check, in the kernel's order. It is long (~180 lines) on purpose:
@@ -55,7 +56,8 @@ std::int64_t simd_body(const vkcloth::detail::RowArgs<typename T::Real>& a, std:
           wx = bc<T>(a.wx), wy = bc<T>(a.wy), wz = bc<T>(a.wz), dt = bc<T>(a.dt);
   const V lim = bc<T>(a.limit), nlim = bc<T>(-a.limit);
   M lane{}; // lane index, to leave a tail vector's skipped lanes out of the finite check
-  for (int l = 0; l < W; ++l) lane[l] = l;
+  for (int l = 0; l < W; ++l)
+    lane[l] = l;
   M ok = lane == lane; // all lanes true: every value written so far passed the finite check
   const std::int64_t nx = a.nx;
   std::int64_t O[12];
@@ -91,7 +93,8 @@ std::int64_t simd_body(const vkcloth::detail::RowArgs<typename T::Real>& a, std:
       }
     };
     M mk{};
-    if constexpr (Masked) mk = T::loadmask(mask + q);
+    if constexpr (Masked)
+      mk = T::loadmask(mask + q);
     auto has = [&](int bit) -> M { return (mk & (1 << bit)) != 0; }; // only used when Masked
     const V x0 = ld<T>(px + q), y0 = ld<T>(py + q), z0 = ld<T>(pz + q);
     const V e0x = ld<T>(px + q + 1) - x0, e0y = ld<T>(py + q + 1) - y0, e0z = ld<T>(pz + q + 1) - z0;
@@ -99,16 +102,16 @@ std::int64_t simd_body(const vkcloth::detail::RowArgs<typename T::Real>& a, std:
     const V e2x = ld<T>(px + q - 1) - x0, e2y = ld<T>(py + q - 1) - y0, e2z = ld<T>(pz + q - 1) - z0;
     const V e3x = ld<T>(px + q - nx) - x0, e3y = ld<T>(py + q - nx) - y0, e3z = ld<T>(pz + q - nx) - z0;
     V sx = zero, sy = zero, sz = zero;
-#define VKCLOTH_CROSS_ADD(bit, ax, ay, az, bx, by, bz)                                                                  \
-  if constexpr (Masked) {                                                                                              \
-    const M h = has(bit);                                                                                              \
-    sx = h ? sx + (ay * bz - by * az) : sx;                                                                            \
-    sy = h ? sy + (az * bx - bz * ax) : sy;                                                                            \
-    sz = h ? sz + (ax * by - bx * ay) : sz;                                                                            \
-  } else {                                                                                                             \
-    sx = sx + (ay * bz - by * az);                                                                                     \
-    sy = sy + (az * bx - bz * ax);                                                                                     \
-    sz = sz + (ax * by - bx * ay);                                                                                     \
+#define VKCLOTH_CROSS_ADD(bit, ax, ay, az, bx, by, bz)                                                       \
+  if constexpr (Masked) {                                                                                    \
+    const M h = has(bit);                                                                                    \
+    sx = h ? sx + (ay * bz - by * az) : sx;                                                                  \
+    sy = h ? sy + (az * bx - bz * ax) : sy;                                                                  \
+    sz = h ? sz + (ax * by - bx * ay) : sz;                                                                  \
+  } else {                                                                                                   \
+    sx = sx + (ay * bz - by * az);                                                                           \
+    sy = sy + (az * bx - bz * ax);                                                                           \
+    sz = sz + (ax * by - bx * ay);                                                                           \
   }
     VKCLOTH_CROSS_ADD(12, e0x, e0y, e0z, e1x, e1y, e1z)
     VKCLOTH_CROSS_ADD(13, e1x, e1y, e1z, e2x, e2y, e2z)
@@ -127,7 +130,8 @@ std::int64_t simd_body(const vkcloth::detail::RowArgs<typename T::Real>& a, std:
       const V len = T::sqrt(ux * ux + uy * uy + uz * uz);
       const V c = K[k] * (len - L[k]) / len;
       M pos = len > zero;
-      if constexpr (Masked) pos = pos & has(k);
+      if constexpr (Masked)
+        pos = pos & has(k);
       const V tx = fx + ux * c, ty = fy + uy * c, tz = fz + uz * c;
       fx = pos ? tx : fx;
       fy = pos ? ty : fy;
@@ -180,55 +184,72 @@ std::int64_t simd_body(const vkcloth::detail::RowArgs<typename T::Real>& a, std:
       put3(vel + 3 * q, ux, uy, uz);
       // check_finite's test (bad_components), lane by lane: |x| <= limit (false for NaN) is
       // x <= limit and -limit <= x; c - c == 0 fails for inf and NaN.
-      M good = (ox <= lim) & (nlim <= ox) & (ox - ox == zero) & (oy <= lim) & (nlim <= oy) & (oy - oy == zero) &
-               (oz <= lim) & (nlim <= oz) & (oz - oz == zero) & (ux - ux == zero) & (uy - uy == zero) &
-               (uz - uz == zero);
-      if constexpr (Tail) good = good | (lane < skip);
+      M good = (ox <= lim) & (nlim <= ox) & (ox - ox == zero) & (oy <= lim) & (nlim <= oy) &
+               (oy - oy == zero) & (oz <= lim) & (nlim <= oz) & (oz - oz == zero) & (ux - ux == zero) &
+               (uy - uy == zero) & (uz - uz == zero);
+      if constexpr (Tail)
+        good = good | (lane < skip);
       ok = ok & good;
     }
   };
   // Interior vectors (all W masks full) take the unmasked code; with no mask array, all do.
   auto full = [&](std::int64_t q) {
-    if (!mask) return true;
+    if (!mask)
+      return true;
     constexpr int words = W / 4; // 4 masks per 64-bit word (W is a multiple of 4)
     std::uint64_t w[words];
     __builtin_memcpy(w, mask + q, sizeof w);
     std::uint64_t acc = ~std::uint64_t(0);
-    for (int l = 0; l < words; ++l) acc &= w[l];
+    for (int l = 0; l < words; ++l)
+      acc &= w[l];
     return acc == ~std::uint64_t(0);
   };
   std::int64_t done = q0;
   for (; done + W <= q1; done += W) {
-    if (full(done)) vec(done, 0, Flag<false>{}, Flag<false>{});
-    else vec(done, 0, Flag<false>{}, Flag<true>{});
+    if (full(done))
+      vec(done, 0, Flag<false>{}, Flag<false>{});
+    else
+      vec(done, 0, Flag<false>{}, Flag<true>{});
   }
   if (done < q1 && q1 - q0 >= W) { // the remainder as one vector overlapping the previous one
     const std::int64_t q = q1 - W;
-    if (full(q)) vec(q, int(W - (q1 - done)), Flag<true>{}, Flag<false>{});
-    else vec(q, int(W - (q1 - done)), Flag<true>{}, Flag<true>{});
+    if (full(q))
+      vec(q, int(W - (q1 - done)), Flag<true>{}, Flag<false>{});
+    else
+      vec(q, int(W - (q1 - done)), Flag<true>{}, Flag<true>{});
     done = q1;
   }
   if constexpr (integrate) {
     bool all = true;
-    for (int l = 0; l < W; ++l) all = all && ok[l] != 0;
-    if (!all) bad = true;
+    for (int l = 0; l < W; ++l)
+      all = all && ok[l] != 0;
+    if (!all)
+      bad = true;
   }
   return done;
 }
 
 template <typename T>
-std::int64_t simd_dispatch(const vkcloth::detail::RowArgs<typename T::Real>& a, std::int64_t q0, std::int64_t q1,
-                           bool& bad) {
+std::int64_t simd_dispatch(const vkcloth::detail::RowArgs<typename T::Real>& a, std::int64_t q0,
+                           std::int64_t q1, bool& bad) {
   const int v = (a.wind ? 4 : 0) | (a.integrate ? 2 : 0) | (a.semi ? 1 : 0);
   switch (v) {
-  case 0: return simd_body<T, false, false, false>(a, q0, q1, bad);
-  case 1: return simd_body<T, false, false, true>(a, q0, q1, bad);
-  case 2: return simd_body<T, false, true, false>(a, q0, q1, bad);
-  case 3: return simd_body<T, false, true, true>(a, q0, q1, bad);
-  case 4: return simd_body<T, true, false, false>(a, q0, q1, bad);
-  case 5: return simd_body<T, true, false, true>(a, q0, q1, bad);
-  case 6: return simd_body<T, true, true, false>(a, q0, q1, bad);
-  default: return simd_body<T, true, true, true>(a, q0, q1, bad);
+  case 0:
+    return simd_body<T, false, false, false>(a, q0, q1, bad);
+  case 1:
+    return simd_body<T, false, false, true>(a, q0, q1, bad);
+  case 2:
+    return simd_body<T, false, true, false>(a, q0, q1, bad);
+  case 3:
+    return simd_body<T, false, true, true>(a, q0, q1, bad);
+  case 4:
+    return simd_body<T, true, false, false>(a, q0, q1, bad);
+  case 5:
+    return simd_body<T, true, false, true>(a, q0, q1, bad);
+  case 6:
+    return simd_body<T, true, true, false>(a, q0, q1, bad);
+  default:
+    return simd_body<T, true, true, true>(a, q0, q1, bad);
   }
 }
 
@@ -250,12 +271,14 @@ template <typename Real, typename V, typename M, int W> struct IsaGeneric {
   }
   static M pinmask(const std::uint8_t* p) {
     M m;
-    for (int l = 0; l < W; ++l) m[l] = p[l] ? -1 : 0;
+    for (int l = 0; l < W; ++l)
+      m[l] = p[l] ? -1 : 0;
     return m;
   }
   static M loadmask(const std::uint16_t* p) {
     M m;
-    for (int l = 0; l < W; ++l) m[l] = p[l];
+    for (int l = 0; l < W; ++l)
+      m[l] = p[l];
     return m;
   }
 };

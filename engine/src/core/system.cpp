@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "vkcloth/system.hpp"
 
 #include <fmt/format.h>
@@ -6,10 +7,14 @@ namespace vkcloth {
 
 const char* to_string(SpringKind kind) {
   switch (kind) {
-  case SpringKind::plain: return "plain";
-  case SpringKind::structural: return "structural";
-  case SpringKind::shear: return "shear";
-  case SpringKind::bend: return "bend";
+  case SpringKind::plain:
+    return "plain";
+  case SpringKind::structural:
+    return "structural";
+  case SpringKind::shear:
+    return "shear";
+  case SpringKind::bend:
+    return "bend";
   }
   return "?";
 }
@@ -22,16 +27,19 @@ void ParticleSystem::finalize() {
   // A spring with an end out of range is left out here; validate() reports it.
   const auto valid = [n](const Spring& s) { return s.a < n && s.b < n; };
   for (const Spring& s : springs) {
-    if (!valid(s)) continue;
+    if (!valid(s))
+      continue;
     ++adjacency.offsets[s.a + 1];
     ++adjacency.offsets[s.b + 1];
   }
-  for (std::size_t p = 0; p < n; ++p) adjacency.offsets[p + 1] += adjacency.offsets[p];
+  for (std::size_t p = 0; p < n; ++p)
+    adjacency.offsets[p + 1] += adjacency.offsets[p];
   adjacency.refs.assign(adjacency.offsets[n], SpringRef{});
   std::vector<std::uint32_t> fill(adjacency.offsets.begin(), adjacency.offsets.end() - 1);
   for (std::uint32_t k = 0; k < springs.size(); ++k) {
     const Spring& s = springs[k];
-    if (!valid(s)) continue;
+    if (!valid(s))
+      continue;
     adjacency.refs[fill[s.a]++] = SpringRef{s.b, k};
     adjacency.refs[fill[s.b]++] = SpringRef{s.a, k};
   }
@@ -40,20 +48,23 @@ void ParticleSystem::finalize() {
 Result<void> ParticleSystem::validate() const {
   const std::size_t n = particles.size();
   auto bad = [](std::string m) { return make_error(ErrorCode::invalid_argument, std::move(m)); };
-  if (n == 0) return bad("the particle system is empty");
+  if (n == 0)
+    return bad("the particle system is empty");
   if (adjacency.offsets.size() != n + 1 || adjacency.refs.size() != adjacency.offsets[n])
     return bad("the particle system was not finalized (call finalize())");
   if (grid && std::uint64_t(grid->nx) * grid->ny != n)
     return bad(fmt::format("grid {} x {} does not match the {} particles", grid->nx, grid->ny, n));
   for (std::size_t k = 0; k < springs.size(); ++k)
     if (springs[k].a >= n || springs[k].b >= n)
-      return bad(fmt::format("spring {} joins particles {} and {}, but there are {}", k, springs[k].a, springs[k].b, n));
+      return bad(fmt::format("spring {} joins particles {} and {}, but there are {}", k, springs[k].a,
+                             springs[k].b, n));
   for (const SpringRef& r : adjacency.refs)
     if (r.other >= n || r.spring >= springs.size())
       return bad("the particle system's adjacency refers to a missing particle or spring (call finalize())");
   for (std::size_t p = 0; p < n; ++p)
     if (!particles[p].pinned && !(particles[p].mass > 0.0))
-      return bad(fmt::format("particle {} has mass {}; free particles need a mass > 0", p, particles[p].mass));
+      return bad(
+          fmt::format("particle {} has mass {}; free particles need a mass > 0", p, particles[p].mass));
   return {};
 }
 

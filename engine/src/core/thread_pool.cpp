@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "thread_pool.hpp"
 
 #include <algorithm>
@@ -19,14 +20,16 @@ constexpr auto spin_for = std::chrono::microseconds(50);
 } // namespace
 
 ThreadPool::ThreadPool(unsigned threads) {
-  for (unsigned i = 1; i < threads; ++i) workers_.emplace_back([this] { worker(); });
+  for (unsigned i = 1; i < threads; ++i)
+    workers_.emplace_back([this] { worker(); });
 }
 
 ThreadPool::~ThreadPool() {
   stop_.store(true);
   generation_.fetch_add(1);
   generation_.notify_all();
-  for (std::thread& t : workers_) t.join();
+  for (std::thread& t : workers_)
+    t.join();
 }
 
 void ThreadPool::parallel_for(std::size_t n, const Fn& fn) {
@@ -60,23 +63,28 @@ void ThreadPool::run(std::size_t n, std::uint32_t blocks, const Fn& fn) {
   claim_loop(g);
   // Every block is claimed now; wait for the ones other threads are still running.
   for (unsigned spins = 0; finished_.load(std::memory_order_acquire) != blocks; ++spins) {
-    if (spins < 4096) VKCLOTH_PAUSE();
-    else std::this_thread::yield(); // a worker was preempted mid-block: let it run
+    if (spins < 4096)
+      VKCLOTH_PAUSE();
+    else
+      std::this_thread::yield(); // a worker was preempted mid-block: let it run
   }
 }
 
 void ThreadPool::claim_loop(std::uint32_t g) {
   std::uint64_t v = claim_.load(std::memory_order_acquire);
   for (;;) {
-    if (std::uint32_t(v >> 32) != g) return; // a later job: this one is over
+    if (std::uint32_t(v >> 32) != g)
+      return; // a later job: this one is over
     const std::uint32_t i = std::uint32_t(v);
     const Fn* fn = fn_.load(std::memory_order_relaxed);
     const std::size_t n = n_.load(std::memory_order_relaxed);
     const std::uint32_t blocks = blocks_.load(std::memory_order_relaxed);
-    if (i >= blocks) return;
+    if (i >= blocks)
+      return;
     // Succeeds only while the counter still reads (g, i): the job read above is g's, since the
     // caller replaces it only after all of g's blocks were claimed and finished.
-    if (!claim_.compare_exchange_weak(v, v + 1, std::memory_order_acq_rel, std::memory_order_acquire)) continue;
+    if (!claim_.compare_exchange_weak(v, v + 1, std::memory_order_acq_rel, std::memory_order_acquire))
+      continue;
     (*fn)(n * i / blocks, n * (std::size_t(i) + 1) / blocks);
     finished_.fetch_add(1, std::memory_order_release);
     v = claim_.load(std::memory_order_acquire);
@@ -100,7 +108,8 @@ void ThreadPool::worker() {
         }
       }
     }
-    if (stop_.load()) return;
+    if (stop_.load())
+      return;
     seen = g;
     claim_loop(g);
   }

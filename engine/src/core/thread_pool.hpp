@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // A small fork-join pool for the CPU solver. A job is [0, n) cut into blocks; the caller and the
 // workers claim blocks one at a time (an atomic counter), so a thread the OS delays does not hold
 // the others up: whoever runs takes the next block, and the caller waits only for blocks already

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "vkcloth/render/camera.hpp"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Internal to engine/src/render: builds on the Vulkan internals of engine/src/vulkan (volk device
 // table, owned objects and their creation in resources.hpp, barriers, errors).
 #pragma once

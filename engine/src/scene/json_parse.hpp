@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // JSON text -> document, with errors a person can act on: file:line:column, and for a number that
 // overflows a double (1e999) the key path it was written under.
 #pragma once
@@ -20,7 +21,8 @@ struct JsonParseFailure {
 /// Deepest nesting of arrays and objects accepted (the scene format needs 4).
 inline constexpr std::size_t max_json_depth = 64;
 
-/// Parses `text` (refusing nesting deeper than max_json_depth); on failure fills `failure` and returns false. Never throws (except bad_alloc).
+/// Parses `text` (refusing nesting deeper than max_json_depth); on failure fills `failure` and returns false.
+/// Never throws (except bad_alloc).
 bool parse_json(std::string_view text, nlohmann::json& out, JsonParseFailure& failure);
 
 /// 1-based line and column of a byte offset.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Typed, path-aware reads from a nlohmann::json document. Every error names the full key path
 // ("cloth.stiffness.bend", "colliders[1].radius") and the offending JSON value.
 #pragma once

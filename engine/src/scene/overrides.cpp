@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "overrides.hpp"
 
 #include <cctype>
@@ -51,8 +52,8 @@ Result<void> apply_override(nlohmann::json& doc, std::string_view spec) {
   const std::string_view key = spec.substr(0, eq), text = spec.substr(eq + 1);
   const std::vector<std::string> parts = split_path(key);
   if (parts.size() > max_override_depth)
-    return shape_error(fmt::format("override '{}': the key path has {} parts, more than {}", spec.substr(0, 200),
-                                   parts.size(), max_override_depth));
+    return shape_error(fmt::format("override '{}': the key path has {} parts, more than {}",
+                                   spec.substr(0, 200), parts.size(), max_override_depth));
   for (const std::string& p : parts)
     if (p.empty())
       return shape_error(fmt::format("override '{}': the key path '{}' has an empty part", spec, key));

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // "key.path=value" overrides applied to a scene document before it is validated.
 #pragma once
 

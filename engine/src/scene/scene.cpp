@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Scene JSON -> Scene. Shape checks (keys, types, finiteness) happen here; range checks are left to
 // SimParams::validate(), make_chain() and make_cloth(), whose messages use the same key names.
 #include "vkcloth/scene.hpp"
@@ -30,7 +31,8 @@ Result<void> read_integrator(const json& doc, SimParams& params, std::uint64_t& 
   SCENE_TRY_ASSIGN(obj, sd::read_object(doc, "", "integrator"));
   if (!obj)
     return {};
-  VKCLOTH_TRY(sd::check_keys(*obj, "integrator", {"method", "dt", "steps", "substeps", "cg_tolerance", "cg_max_iterations"}));
+  VKCLOTH_TRY(sd::check_keys(*obj, "integrator",
+                             {"method", "dt", "steps", "substeps", "cg_tolerance", "cg_max_iterations"}));
   std::string method = to_string(params.integrator);
   VKCLOTH_TRY(sd::read(*obj, "integrator", "method", method));
   const auto integ = parse_integrator(method);
@@ -177,9 +179,10 @@ Result<ParticleSystem> read_cloth(const json& doc) {
     if (pins) {
       d.pin_default_corners = false; // "pins": [] means nothing pinned
       if (const std::uint64_t cells = std::uint64_t(d.nx) * d.ny; pins->size() > cells)
-        return make_error(ErrorCode::invalid_argument,
-                          fmt::format("cloth.pins holds {} entries, more than the {} x {} grid's {} particles",
-                                      pins->size(), d.nx, d.ny, cells));
+        return make_error(
+            ErrorCode::invalid_argument,
+            fmt::format("cloth.pins holds {} entries, more than the {} x {} grid's {} particles",
+                        pins->size(), d.nx, d.ny, cells));
       for (std::size_t n = 0; n < pins->size(); ++n) {
         const json& p = (*pins)[n];
         const std::string path = fmt::format("cloth.pins[{}]", n);
@@ -243,9 +246,9 @@ Result<Scene> parse_scene(std::string_view json_text, std::string_view source_na
                           std::span<const std::string> overrides) {
   try {
     if (json_text.size() > max_scene_bytes)
-      return make_error(ErrorCode::parse, fmt::format("{}: the scene is {} bytes, more than the limit {} ({} MiB)",
-                                                      source_name, json_text.size(), max_scene_bytes,
-                                                      max_scene_bytes >> 20));
+      return make_error(ErrorCode::parse,
+                        fmt::format("{}: the scene is {} bytes, more than the limit {} ({} MiB)", source_name,
+                                    json_text.size(), max_scene_bytes, max_scene_bytes >> 20));
     json doc;
     if (sd::JsonParseFailure f; !sd::parse_json(json_text, doc, f)) {
       const auto [line, col] = sd::line_col(json_text, f.byte);
@@ -278,8 +281,9 @@ Result<Scene> load_scene_file(const std::filesystem::path& path, std::span<const
     if (std::filesystem::is_directory(path, ec))
       return make_error(ErrorCode::io, fmt::format("{}: is a directory, not a scene file", path.string()));
     if (const auto size = std::filesystem::file_size(path, ec); !ec && size > max_scene_bytes)
-      return make_error(ErrorCode::io, fmt::format("{}: the file is {} bytes, more than the scene size limit {} ({} MiB)",
-                                                   path.string(), size, max_scene_bytes, max_scene_bytes >> 20));
+      return make_error(ErrorCode::io,
+                        fmt::format("{}: the file is {} bytes, more than the scene size limit {} ({} MiB)",
+                                    path.string(), size, max_scene_bytes, max_scene_bytes >> 20));
     std::ifstream in(path, std::ios::binary);
     if (!in)
       return make_error(ErrorCode::io, fmt::format("{}: cannot open the scene file", path.string()));

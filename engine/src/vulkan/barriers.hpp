@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Every pipeline barrier vkcloth records (solver, world, renderer, offscreen target) lives here,
 // each saying why it is needed and what it orders. Classic vkCmdPipelineBarrier (core 1.0, so an
 // adopted device needs no synchronization2 feature). The solver uses global memory barriers: one

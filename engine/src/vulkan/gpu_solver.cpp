@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // GpuSolver: a ClothWorld of one instance (world_impl.hpp). Every step, readback and rebuild is
 // the world's and its batch's (solver_batch.cpp); this file only maps the single-cloth API onto
 // them: the instance's own divergence error (without the world's "cloth instance N" prefix),

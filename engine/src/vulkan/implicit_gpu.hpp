@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The implicit-Euler step on Vulkan (internal to GpuSolver): the CPU reference's linearised
 // backward Euler + PCG (engine/src/core/implicit_euler.hpp) as compute passes, recorded without a
 // CPU round trip per iteration. Per substep:

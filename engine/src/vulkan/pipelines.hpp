@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The compute pipelines of one Context, made once and shared by every batch (GpuSolver,
 // ClothWorld) on it: shader modules, descriptor set layouts, pipeline layouts, a VkPipelineCache,
 // and the pipelines keyed by (shader, specialisation constants), e.g. force.comp per grid stencil,

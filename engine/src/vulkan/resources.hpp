@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Owning, move-only wrappers of every Vulkan object vkcloth creates on a Context's device, and the
 // one place that creates buffers, images, shader modules and compute pipelines, and submits
 // one-off command buffers. Adding a buffer to a solver means adding one member: its destructor

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // SolverBatch: buffers, uploads, stepping, readbacks and divergence flags of one batch (the
 // descriptor sets and pipelines: solver_pipelines.cpp).
 #include "solver_batch.hpp"

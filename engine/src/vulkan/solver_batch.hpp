@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // SolverBatch: the Vulkan solver's engine, a BATCH of instances (cloths) that share one topology
 // and one integrator family, stepped together: one dispatch per pass serves every instance
 // (instance = gl_WorkGroupID.z, vkcloth_shared.h). ClothWorld owns its batches and groups its

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // SolverBatch (solver_batch.hpp): descriptor set layouts, sets and texel views, the compute
 // pipelines (force, integrate, the fused variants) and their specialisation constants (the grid
 // stencil). The stepping, buffers and readbacks are in solver_batch.cpp.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "vk_internal.hpp"
 
 #include "pipelines.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Internal to engine/src/vulkan: volk, the Context internals and errors (objects: resources.hpp).
 // Include this FIRST in every .cpp here: volk.h must precede any other Vulkan header.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // ClothWorld::Impl: the world's instances and the batches (SolverBatch) that step them. Internal
 // to engine/src/vulkan; GpuSolver (a world of one instance) reaches its batch through it.
 #pragma once

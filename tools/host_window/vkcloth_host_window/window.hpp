@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // vkcloth_host_window: what a host program needs to show vkcloth in a window, shared by
 // `vkcloth view` and the samples' windowed mode. A GLFW window and its Vulkan surface, the Context
 // that presents to it, a swapchain (recreated on resize) with a depth buffer, the present render

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Line plots written as standalone SVG files (library vkcloth_plot): used by `vkcloth figures`
 // and by the samples (spring, double_spring), which write their position and energy plots with it.
 #pragma once
@@ -9,10 +10,10 @@ namespace vkcloth::plot {
 
 struct Series {
   std::string label;
-  std::string color;              ///< any SVG colour, e.g. "#1f77b4"
-  std::vector<double> x, y;       ///< same length; non-finite points end the line
+  std::string color;        ///< any SVG colour, e.g. "#1f77b4"
+  std::vector<double> x, y; ///< same length; non-finite points end the line
   bool dashed = false;
-  std::string note;               ///< drawn at the last point, e.g. "diverged at t = 3.2 s"
+  std::string note; ///< drawn at the last point, e.g. "diverged at t = 3.2 s"
 };
 
 struct Plot {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The cloth figures of the report (§3-5): parameter studies and collisions as labelled image
 // grids, rendered offscreen with the renderer, and the numbers behind them in figures.json.
 //
@@ -5,8 +6,9 @@
 // buffers. Either backend's final positions are handed to a "display" GpuSolver: the same system with
 // its particles placed at the result and all pinned, stepped once so that the force pass rebuilds the
 // normals the renderer shades with (pinned particles never move). (The simulating GpuSolver's own
-// normals are one step behind its positions, which shows on a moving cloth.) On lavapipe both backends compute the
-// same bits, so both galleries show the same pictures (tests/scene/test_figures.cpp compares them).
+// normals are one step behind its positions, which shows on a moving cloth.) On lavapipe both backends
+// compute the same bits, so both galleries show the same pictures (tests/scene/test_figures.cpp compares
+// them).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -29,9 +31,9 @@ namespace {
 /// A finished simulation: the final state and (when drawing is possible) a GpuSolver holding it.
 struct Run {
   Scene scene;
-  ParticleSystem drawn;             ///< the system the drawing solver was created from
+  ParticleSystem drawn; ///< the system the drawing solver was created from
   std::vector<glm::dvec3> initial, pos;
-  std::string diverged;             ///< the error message when the run blew up (the state is the last good one)
+  std::string diverged; ///< the error message when the run blew up (the state is the last good one)
   std::optional<gpu::GpuSolver> gpu;
 };
 
@@ -83,33 +85,42 @@ Result<gpu::GpuSolver> display_solver(gpu::Context& ctx, Run& run) {
     run.drawn.particles[i].pinned = true;
   }
   auto s = gpu::GpuSolver::create(ctx, run.drawn, run.scene.params);
-  if (!s) return s.error();
+  if (!s)
+    return s.error();
   // Every particle is pinned: the step moves nothing and rebuilds the normals for the shading.
   VKCLOTH_TRY(s->simulate(1));
   return s;
 }
 
-std::vector<glm::dvec3> to_d(std::span<const glm::vec3> v) { return {v.begin(), v.end()}; }
+std::vector<glm::dvec3> to_d(std::span<const glm::vec3> v) {
+  return {v.begin(), v.end()};
+}
 
 Result<Run> simulate_cloth(Drawing& d, Scene scene, std::uint64_t steps, const std::string& backend) {
   Run run;
   run.scene = std::move(scene);
-  for (const Particle& p : run.scene.system.particles) run.initial.push_back(p.position);
+  for (const Particle& p : run.scene.system.particles)
+    run.initial.push_back(p.position);
   if (backend == "vulkan") {
     auto s = gpu::GpuSolver::create(*d.ctx, run.scene.system, run.scene.params);
-    if (!s) return s.error();
+    if (!s)
+      return s.error();
     if (auto r = s->simulate(steps); !r) {
-      if (r.error().code != ErrorCode::diverged) return r.error();
+      if (r.error().code != ErrorCode::diverged)
+        return r.error();
       run.diverged = r.error().message;
     }
     auto p = s->positions();
-    if (!p) return p.error();
+    if (!p)
+      return p.error();
     run.pos = to_d(*p);
   } else {
     auto s = CpuSolver<float>::create(run.scene.system, run.scene.params);
-    if (!s) return s.error();
+    if (!s)
+      return s.error();
     if (auto r = s->run(steps); !r) {
-      if (r.error().code != ErrorCode::diverged) return r.error();
+      if (r.error().code != ErrorCode::diverged)
+        return r.error();
       run.diverged = r.error().message;
     }
     run.pos = to_d(s->positions());
@@ -118,7 +129,8 @@ Result<Run> simulate_cloth(Drawing& d, Scene scene, std::uint64_t steps, const s
   // simulating GpuSolver's normals are those of its last force pass, one step behind its positions.
   if (d.ctx) {
     auto g = display_solver(*d.ctx, run);
-    if (!g) return g.error();
+    if (!g)
+      return g.error();
     run.gpu.emplace(std::move(*g));
   }
   return run;
@@ -136,7 +148,8 @@ render::Camera tighten(render::Camera c, const render::Bounds& b, float aspect) 
     const glm::vec3 p{k & 1 ? b.hi.x : b.lo.x, k & 2 ? b.hi.y : b.lo.y, k & 4 ? b.hi.z : b.lo.z};
     const glm::vec3 q = p - c.target;
     const float toward_eye = -glm::dot(q, fwd);
-    dist = std::max({dist, toward_eye + std::abs(glm::dot(q, right)) / th, toward_eye + std::abs(glm::dot(q, up)) / tv});
+    dist = std::max(
+        {dist, toward_eye + std::abs(glm::dot(q, right)) / th, toward_eye + std::abs(glm::dot(q, up)) / tv});
   }
   dist *= 1.06f; // margin
   const float r = std::max(b.radius(), 0.05f);
@@ -148,11 +161,13 @@ render::Camera tighten(render::Camera c, const render::Bounds& b, float aspect) 
 
 /// One camera for all panels of a figure: framed tightly on the union of their final states and
 /// (with `with_spheres`) their spheres.
-render::Camera frame(const std::vector<const Run*>& runs, float aspect, glm::vec3 from, bool with_spheres = true) {
+render::Camera frame(const std::vector<const Run*>& runs, float aspect, glm::vec3 from,
+                     bool with_spheres = true) {
   render::Bounds b{glm::vec3(1e30f), glm::vec3(-1e30f)};
   for (const Run* r : runs) {
     for (const glm::dvec3& p : r->pos)
-      if (glm::length(p) < 50.0) b.lo = glm::min(b.lo, glm::vec3(p)), b.hi = glm::max(b.hi, glm::vec3(p));
+      if (glm::length(p) < 50.0)
+        b.lo = glm::min(b.lo, glm::vec3(p)), b.hi = glm::max(b.hi, glm::vec3(p));
     if (with_spheres)
       for (const Collider& c : r->scene.params.colliders)
         if (c.type == Collider::Type::sphere) {
@@ -167,23 +182,27 @@ Result<render::Image> draw(Drawing& d, Run& run, const render::Camera& cam) {
   render::RendererOptions ro;
   ro.render_pass = d.target->render_pass();
   auto rend = render::ClothRenderer::create(*d.ctx, *run.gpu, *run.gpu->topology(), std::move(ro));
-  if (!rend) return rend.error();
+  if (!rend)
+    return rend.error();
   return d.target->render(*run.gpu, *rend, cam, 0);
 }
 
 /// Renders the runs as one labelled grid (when a device is there) and adds it to the gallery.
-Result<void> grid_figure(Gallery& G, Drawing& d, std::vector<Run>& runs, const std::vector<std::string>& labels,
-                         const std::string& file, const std::string& section, const std::string& title,
-                         const std::string& caption, glm::vec3 from = {0.9f, -1.6f, 1.0f},
-                         bool with_spheres = true) {
-  if (!d.ctx) return {};
+Result<void> grid_figure(Gallery& G, Drawing& d, std::vector<Run>& runs,
+                         const std::vector<std::string>& labels, const std::string& file,
+                         const std::string& section, const std::string& title, const std::string& caption,
+                         glm::vec3 from = {0.9f, -1.6f, 1.0f}, bool with_spheres = true) {
+  if (!d.ctx)
+    return {};
   std::vector<const Run*> all;
-  for (const Run& r : runs) all.push_back(&r);
+  for (const Run& r : runs)
+    all.push_back(&r);
   const render::Camera cam = frame(all, float(d.w) / float(d.h), from, with_spheres);
   std::vector<Panel> panels;
   for (std::size_t i = 0; i < runs.size(); ++i) {
     auto img = draw(d, runs[i], cam);
-    if (!img) return img.error();
+    if (!img)
+      return img.error();
     panels.push_back({std::move(*img), labels[i] + (runs[i].diverged.empty() ? "" : " (DIVERGED)")});
   }
   VKCLOTH_TRY(render::write_png(G.dir / file, compose_grid(panels, title)));
@@ -193,12 +212,15 @@ Result<void> grid_figure(Gallery& G, Drawing& d, std::vector<Run>& runs, const s
 
 // --- the numbers behind the pictures ------------------------------------------------------------
 
-std::size_t at(const Grid& g, std::uint32_t i, std::uint32_t j) { return std::size_t(j) * g.nx + i; }
+std::size_t at(const Grid& g, std::uint32_t i, std::uint32_t j) {
+  return std::size_t(j) * g.nx + i;
+}
 
 /// Largest downward displacement of a particle since the start (m).
 double sag(const Run& r) {
   double s = 0.0;
-  for (std::size_t i = 0; i < r.pos.size(); ++i) s = std::max(s, r.initial[i].z - r.pos[i].z);
+  for (std::size_t i = 0; i < r.pos.size(); ++i)
+    s = std::max(s, r.initial[i].z - r.pos[i].z);
   return s;
 }
 
@@ -233,9 +255,11 @@ double bend_angle(const Run& r, std::uint32_t stride = 1) {
   };
   const std::uint32_t s = stride;
   for (std::uint32_t j = 0; j < g.ny; ++j)
-    for (std::uint32_t i = s; i + s < g.nx; ++i) add(at(g, i - s, j), at(g, i, j), at(g, i + s, j));
+    for (std::uint32_t i = s; i + s < g.nx; ++i)
+      add(at(g, i - s, j), at(g, i, j), at(g, i + s, j));
   for (std::uint32_t i = 0; i < g.nx; ++i)
-    for (std::uint32_t j = s; j + s < g.ny; ++j) add(at(g, i, j - s), at(g, i, j), at(g, i, j + s));
+    for (std::uint32_t j = s; j + s < g.ny; ++j)
+      add(at(g, i, j - s), at(g, i, j), at(g, i, j + s));
   return sum / n;
 }
 
@@ -246,8 +270,10 @@ double max_neighbour_ratio(const Run& r) {
   double m = 0.0;
   for (std::uint32_t j = 0; j < g.ny; ++j)
     for (std::uint32_t i = 0; i < g.nx; ++i) {
-      if (i + 1 < g.nx) m = std::max(m, glm::length(r.pos[at(g, i + 1, j)] - r.pos[at(g, i, j)]));
-      if (j + 1 < g.ny) m = std::max(m, glm::length(r.pos[at(g, i, j + 1)] - r.pos[at(g, i, j)]));
+      if (i + 1 < g.nx)
+        m = std::max(m, glm::length(r.pos[at(g, i + 1, j)] - r.pos[at(g, i, j)]));
+      if (j + 1 < g.ny)
+        m = std::max(m, glm::length(r.pos[at(g, i, j + 1)] - r.pos[at(g, i, j)]));
     }
   return m / spacing;
 }
@@ -256,7 +282,8 @@ double max_neighbour_ratio(const Run& r) {
 double wind_displacement(const Run& r) {
   const glm::dvec3 u = r.scene.params.wind.direction;
   double s = 0.0;
-  for (std::size_t i = 0; i < r.pos.size(); ++i) s += glm::dot(r.pos[i] - r.initial[i], u);
+  for (std::size_t i = 0; i < r.pos.size(); ++i)
+    s += glm::dot(r.pos[i] - r.initial[i], u);
   return s / double(r.pos.size());
 }
 
@@ -269,7 +296,8 @@ nlohmann::json contact_metrics(const Run& r, const Collider& sphere, double eps)
     on += touching;
     mean_z += p.z;
     max_z = std::max(max_z, p.z);
-    if (touching) max_z_on = std::max(max_z_on, p.z);
+    if (touching)
+      max_z_on = std::max(max_z_on, p.z);
   }
   return {{"on_sphere_fraction", double(on) / double(r.pos.size())},
           {"mean_z", mean_z / double(r.pos.size())},
@@ -278,13 +306,16 @@ nlohmann::json contact_metrics(const Run& r, const Collider& sphere, double eps)
           {"diverged", !r.diverged.empty()}};
 }
 
-std::string key(double v) { return fmt::format("{:g}", v); }
+std::string key(double v) {
+  return fmt::format("{:g}", v);
+}
 
 } // namespace
 
 Result<void> cloth_figures(Gallery& G) {
   Drawing d;
-  if (G.quick) d.w = 240, d.h = 180;
+  if (G.quick)
+    d.w = 240, d.h = 180;
   {
     gpu::ContextOptions o;
     o.require_graphics = true;
@@ -292,14 +323,17 @@ Result<void> cloth_figures(Gallery& G) {
     if (ctx) {
       d.ctx.emplace(std::move(*ctx));
       auto t = render::OffscreenTarget::create(*d.ctx, d.w, d.h);
-      if (!t) return t.error();
+      if (!t)
+        return t.error();
       d.target.emplace(std::move(*t));
     } else if (G.backend == "vulkan" || ctx.error().code != ErrorCode::no_device) {
       return ctx.error();
     } else {
       d.unavailable = ctx.error().message;
-      fmt::print(stderr, "figures: no Vulkan device ({}): the cloth numbers are computed, the cloth pictures "
-                         "are skipped\n", d.unavailable);
+      fmt::print(stderr,
+                 "figures: no Vulkan device ({}): the cloth numbers are computed, the cloth pictures "
+                 "are skipped\n",
+                 d.unavailable);
     }
   }
   auto& M = G.metrics["cloth"];
@@ -310,9 +344,10 @@ Result<void> cloth_figures(Gallery& G) {
   };
   const std::string sec3 = "Cloth springs (report §3, Figures 5-9)";
   const std::string sec4 = "Collisions and wind (report §4, Figures 11-13)";
-  const std::string note = "The report's cloth: 10 x 10 points over 1 x 1 m, 0.05 kg per point, dt = 0.02 s, "
-                           "mu = 0.5, semi-implicit Euler, hanging from its two top corners; stretchy by design "
-                           "(K ~ 40 for a 5 kg cloth). ";
+  const std::string note =
+      "The report's cloth: 10 x 10 points over 1 x 1 m, 0.05 kg per point, dt = 0.02 s, "
+      "mu = 0.5, semi-implicit Euler, hanging from its two top corners; stretchy by design "
+      "(K ~ 40 for a 5 kg cloth). ";
 
   progress("Figure 7: K_struct = 5 / 20 / 50");
   { // Figure 7: structural springs only
@@ -320,16 +355,19 @@ Result<void> cloth_figures(Gallery& G) {
     std::vector<std::string> labels;
     for (double k : {5.0, 20.0, 50.0}) {
       auto r = simulate_cloth(d, cloth_scene(hanging(k, 0, 0), params(), "k_struct"), 500, G.backend);
-      if (!r) return r.error();
-      M["k_struct"][key(k)] = {{"sag", sag(*r)}, {"max_neighbour_ratio", max_neighbour_ratio(*r)},
+      if (!r)
+        return r.error();
+      M["k_struct"][key(k)] = {{"sag", sag(*r)},
+                               {"max_neighbour_ratio", max_neighbour_ratio(*r)},
                                {"diverged", !r->diverged.empty()}};
       runs.push_back(std::move(*r));
       labels.push_back(fmt::format("K_struct = {:g}", k));
     }
-    VKCLOTH_TRY(grid_figure(G, d, runs, labels, "cloth_k_struct.png", sec3, "Figure 7: K_struct = 5 / 20 / 50",
-                            note + "Structural springs only, after 10 s. The softer the springs, the more the cloth "
-                                   "stretches under gravity (sag in figures.json: cloth.k_struct), most at the "
-                                   "corners."));
+    VKCLOTH_TRY(
+        grid_figure(G, d, runs, labels, "cloth_k_struct.png", sec3, "Figure 7: K_struct = 5 / 20 / 50",
+                    note + "Structural springs only, after 10 s. The softer the springs, the more the cloth "
+                           "stretches under gravity (sag in figures.json: cloth.k_struct), most at the "
+                           "corners."));
   }
   progress("Figure 8: K_shear = 1 / 10 / 40");
   { // Figure 8: shear with K_struct = 1
@@ -337,16 +375,18 @@ Result<void> cloth_figures(Gallery& G) {
     std::vector<std::string> labels;
     for (double k : {1.0, 10.0, 40.0}) {
       auto r = simulate_cloth(d, cloth_scene(hanging(1, k, 0), params(), "k_shear"), 500, G.backend);
-      if (!r) return r.error();
-      M["k_shear"][key(k)] = {{"diagonal_shear", diagonal_shear(*r)}, {"sag", sag(*r)},
-                              {"diverged", !r->diverged.empty()}};
+      if (!r)
+        return r.error();
+      M["k_shear"][key(k)] = {
+          {"diagonal_shear", diagonal_shear(*r)}, {"sag", sag(*r)}, {"diverged", !r->diverged.empty()}};
       runs.push_back(std::move(*r));
       labels.push_back(fmt::format("K_shear = {:g}", k));
     }
     VKCLOTH_TRY(grid_figure(G, d, runs, labels, "cloth_k_shear.png", sec3, "Figure 8: K_shear = 1 / 10 / 40",
-                            note + "K_struct = 1, no bend springs, after 10 s. Stiffer shear springs keep the "
-                                   "cells square: the diagonal shear (mean |d1 - d2| / d over the cells, "
-                                   "cloth.k_shear) decreases."));
+                            note +
+                                "K_struct = 1, no bend springs, after 10 s. Stiffer shear springs keep the "
+                                "cells square: the diagonal shear (mean |d1 - d2| / d over the cells, "
+                                "cloth.k_shear) decreases."));
   }
   progress("Figure 9: K_bend = 2 / 15 / 40");
   { // Figure 9: bend with K_struct = 5
@@ -354,19 +394,23 @@ Result<void> cloth_figures(Gallery& G) {
     std::vector<std::string> labels;
     for (double k : {2.0, 15.0, 40.0}) {
       auto r = simulate_cloth(d, cloth_scene(hanging(5, 0, k), params(), "k_bend"), 500, G.backend);
-      if (!r) return r.error();
-      M["k_bend"][key(k)] = {{"fold_angle_deg", bend_angle(*r, 2)}, {"edge_angle_deg", bend_angle(*r, 1)},
-                             {"sag", sag(*r)}, {"diverged", !r->diverged.empty()}};
+      if (!r)
+        return r.error();
+      M["k_bend"][key(k)] = {{"fold_angle_deg", bend_angle(*r, 2)},
+                             {"edge_angle_deg", bend_angle(*r, 1)},
+                             {"sag", sag(*r)},
+                             {"diverged", !r->diverged.empty()}};
       runs.push_back(std::move(*r));
       labels.push_back(fmt::format("K_bend = {:g}", k));
     }
     VKCLOTH_TRY(grid_figure(G, d, runs, labels, "cloth_k_bend.png", sec3, "Figure 9: K_bend = 2 / 15 / 40",
-                            note + "K_struct = 5, no shear springs, after 10 s. Stiffer bend springs fold the "
-                                   "cloth less: the fold angle, the mean angle between consecutive segments two "
-                                   "points long (the bend springs' span) along rows and columns, decreases "
-                                   "(cloth.k_bend.*.fold_angle_deg). The angle between single edges "
-                                   "(edge_angle_deg) does not: a bend spring joins points 2 apart, so with soft "
-                                   "structural springs the points in between zigzag freely."));
+                            note +
+                                "K_struct = 5, no shear springs, after 10 s. Stiffer bend springs fold the "
+                                "cloth less: the fold angle, the mean angle between consecutive segments two "
+                                "points long (the bend springs' span) along rows and columns, decreases "
+                                "(cloth.k_bend.*.fold_angle_deg). The angle between single edges "
+                                "(edge_angle_deg) does not: a bend spring joins points 2 apart, so with soft "
+                                "structural springs the points in between zigzag freely."));
   }
   progress("Figure 5: no structural springs");
   { // Figure 5: holes without structural springs
@@ -380,21 +424,22 @@ Result<void> cloth_figures(Gallery& G) {
       ClothDesc desc = horizontal(2.0, ks, 4, 4);
       desc.particle_mass = 0.5;
       auto r = simulate_cloth(d, cloth_scene(desc, p, "holes"), 40, G.backend);
-      if (!r) return r.error();
+      if (!r)
+        return r.error();
       M["no_structural"][ks == 0.0 ? "without_structural" : "with_structural"] = {
           {"max_neighbour_ratio", max_neighbour_ratio(*r)}, {"diverged", !r->diverged.empty()}};
       runs.push_back(std::move(*r));
       labels.push_back(ks == 0.0 ? "no structural" : "K_struct = 40");
     }
-    VKCLOTH_TRY(grid_figure(G, d, runs, labels, "cloth_no_structural.png", sec3,
-                            "Figure 5: without structural springs", note +
-                            "Here a heavier cloth (0.5 kg per point, shear and bend springs K = 4) dropped from "
-                            "z = 2 m onto a small sphere (r = 0.15 m) on the floor, at the impact (t = 0.8 s). "
-                            "Without structural springs the grid is two interleaved lattices (shear and bend "
-                            "springs join only points of the same parity of i + j) that nothing ties together: "
-                            "the sphere pushes between them and opens a hole (largest distance between direct "
-                            "neighbours over the spacing, cloth.no_structural). Left: K_struct = 0, right: 40.",
-                            {0.6f, -1.2f, 1.6f}));
+    VKCLOTH_TRY(grid_figure(
+        G, d, runs, labels, "cloth_no_structural.png", sec3, "Figure 5: without structural springs",
+        note + "Here a heavier cloth (0.5 kg per point, shear and bend springs K = 4) dropped from "
+               "z = 2 m onto a small sphere (r = 0.15 m) on the floor, at the impact (t = 0.8 s). "
+               "Without structural springs the grid is two interleaved lattices (shear and bend "
+               "springs join only points of the same parity of i + j) that nothing ties together: "
+               "the sphere pushes between them and opens a hole (largest distance between direct "
+               "neighbours over the spacing, cloth.no_structural). Left: K_struct = 0, right: 40.",
+        {0.6f, -1.2f, 1.6f}));
   }
   progress("Figure 11: plane / plane and sphere");
   { // Figure 11: collisions with the plane, then the plane and the sphere
@@ -403,19 +448,25 @@ Result<void> cloth_figures(Gallery& G) {
     for (int with_sphere = 0; with_sphere < 2; ++with_sphere) {
       SimParams p = params();
       p.colliders = {Collider::plane({0, 0, 1}, 0.0)};
-      if (with_sphere) p.colliders.insert(p.colliders.begin(), Collider::sphere({0, 0, 0.3}, 0.3));
+      if (with_sphere)
+        p.colliders.insert(p.colliders.begin(), Collider::sphere({0, 0, 0.3}, 0.3));
       auto r = simulate_cloth(d, cloth_scene(horizontal(0.8), p, "collisions"), 150, G.backend);
-      if (!r) return r.error();
+      if (!r)
+        return r.error();
       double min_z = 1e30;
-      for (const glm::dvec3& q : r->pos) min_z = std::min(min_z, q.z);
-      M["collisions"][with_sphere ? "plane_sphere" : "plane"] = {{"min_z", min_z}, {"diverged", !r->diverged.empty()}};
-      if (with_sphere) M["collisions"]["plane_sphere"].update(contact_metrics(*r, p.colliders[0], p.contact_epsilon));
+      for (const glm::dvec3& q : r->pos)
+        min_z = std::min(min_z, q.z);
+      M["collisions"][with_sphere ? "plane_sphere" : "plane"] = {{"min_z", min_z},
+                                                                 {"diverged", !r->diverged.empty()}};
+      if (with_sphere)
+        M["collisions"]["plane_sphere"].update(contact_metrics(*r, p.colliders[0], p.contact_epsilon));
       runs.push_back(std::move(*r));
       labels.push_back(with_sphere ? "plane + sphere" : "plane");
     }
-    VKCLOTH_TRY(grid_figure(G, d, runs, labels, "cloth_collisions.png", sec4, "Figure 11: collisions",
-                            note + "Dropped flat from z = 0.8 m, K = 40 / 8 / 8, after 3 s: on the floor (left), "
-                                   "on the sphere (r = 0.3 m) and the floor (right). Nothing goes through."));
+    VKCLOTH_TRY(
+        grid_figure(G, d, runs, labels, "cloth_collisions.png", sec4, "Figure 11: collisions",
+                    note + "Dropped flat from z = 0.8 m, K = 40 / 8 / 8, after 3 s: on the floor (left), "
+                           "on the sphere (r = 0.3 m) and the floor (right). Nothing goes through."));
   }
   progress("Figure 12: contact_inward_only true / false");
   { // Figure 12: the into-collider test
@@ -431,20 +482,21 @@ Result<void> cloth_figures(Gallery& G) {
       p.colliders = {sphere};
       p.contact_inward_only = inward;
       auto r = simulate_cloth(d, cloth_scene(horizontal(0.5), p, "contact"), 20, G.backend);
-      if (!r) return r.error();
+      if (!r)
+        return r.error();
       M["contact"][inward ? "inward_only" : "cancel_all"] = contact_metrics(*r, sphere, p.contact_epsilon);
       runs.push_back(std::move(*r));
       labels.push_back(inward ? "inward only (true)" : "cancel all (false)");
     }
-    VKCLOTH_TRY(grid_figure(G, d, runs, labels, "cloth_contact.png", sec4,
-                            "Figure 12: the into-collider test", note +
-                            "Started flat at z = 0.5 m inside a large sphere (r = 3 m, centre z = 3.4 m): the first "
-                            "projection puts it on the sphere's underside, where gravity points away from the "
-                            "surface. After 0.4 s. Left: contact_inward_only = true, only the parts of v and F "
-                            "pointing into the sphere are removed, so the cloth falls. Right: false, the whole "
-                            "normal part is removed, gravity with it: the cloth stays glued under the sphere "
-                            "(on_sphere_fraction: points within 2 eps of the surface; mean_z; cloth.contact).",
-                            {0.9f, -1.6f, -0.25f}, /*with_spheres=*/false));
+    VKCLOTH_TRY(grid_figure(
+        G, d, runs, labels, "cloth_contact.png", sec4, "Figure 12: the into-collider test",
+        note + "Started flat at z = 0.5 m inside a large sphere (r = 3 m, centre z = 3.4 m): the first "
+               "projection puts it on the sphere's underside, where gravity points away from the "
+               "surface. After 0.4 s. Left: contact_inward_only = true, only the parts of v and F "
+               "pointing into the sphere are removed, so the cloth falls. Right: false, the whole "
+               "normal part is removed, gravity with it: the cloth stays glued under the sphere "
+               "(on_sphere_fraction: points within 2 eps of the surface; mean_z; cloth.contact).",
+        {0.9f, -1.6f, -0.25f}, /*with_spheres=*/false));
   }
   progress("Figure 13: K_w = 0.01 / 0.02 / 0.05");
   { // Figure 13: wind
@@ -454,17 +506,19 @@ Result<void> cloth_figures(Gallery& G) {
       SimParams p = params();
       p.wind = {kw, {0, 1, 0}};
       auto r = simulate_cloth(d, cloth_scene(hanging(40, 8, 8), p, "wind"), 250, G.backend);
-      if (!r) return r.error();
+      if (!r)
+        return r.error();
       M["wind"][key(kw)] = {{"displacement", wind_displacement(*r)}, {"diverged", !r->diverged.empty()}};
       runs.push_back(std::move(*r));
       labels.push_back(fmt::format("K_w = {:g}", kw));
     }
-    VKCLOTH_TRY(grid_figure(G, d, runs, labels, "cloth_wind.png", sec4, "Figure 13: K_w = 0.01 / 0.02 / 0.05",
-                            note + "K = 40 / 8 / 8, wind along +y (towards the back), after 5 s, seen from the "
-                                   "side. F_w = K_w <n, u_w> n per point is small against the 0.49 N weight of a "
-                                   "point, so the push is small, but it grows with K_w (mean displacement along "
-                                   "the wind, cloth.wind).",
-                            {1.7f, -0.5f, 0.5f}));
+    VKCLOTH_TRY(
+        grid_figure(G, d, runs, labels, "cloth_wind.png", sec4, "Figure 13: K_w = 0.01 / 0.02 / 0.05",
+                    note + "K = 40 / 8 / 8, wind along +y (towards the back), after 5 s, seen from the "
+                           "side. F_w = K_w <n, u_w> n per point is small against the 0.49 N weight of a "
+                           "point, so the push is small, but it grows with K_w (mean displacement along "
+                           "the wind, cloth.wind).",
+                    {1.7f, -0.5f, 0.5f}));
   }
   if (d.ctx) { // Figure 14: the GPU solver, three spring kinds and wind, at three instants
     progress("Figure 14: the GPU result");
@@ -473,38 +527,46 @@ Result<void> cloth_figures(Gallery& G) {
     ClothDesc desc = hanging(40, 8, 8);
     Scene scene = cloth_scene(desc, p, "gpu_wind");
     auto s = gpu::GpuSolver::create(*d.ctx, scene.system, scene.params);
-    if (!s) return s.error();
+    if (!s)
+      return s.error();
     Run ref;
     ref.scene = scene;
     ref.drawn = scene.system;
-    for (const Particle& q : scene.system.particles) ref.pos.push_back(q.position), ref.pos.back().y += 0.25;
+    for (const Particle& q : scene.system.particles)
+      ref.pos.push_back(q.position), ref.pos.back().y += 0.25;
     const render::Camera cam = frame({&ref}, float(d.w) / float(d.h), {1.2f, -1.4f, 0.6f});
     render::RendererOptions ro;
     ro.render_pass = d.target->render_pass();
     auto rend = render::ClothRenderer::create(*d.ctx, *s, *s->topology(), std::move(ro));
-    if (!rend) return rend.error();
+    if (!rend)
+      return rend.error();
     std::vector<Panel> panels;
     std::uint64_t done = 0;
     for (std::uint64_t at_step : {25u, 100u, 250u}) {
       VKCLOTH_TRY(s->simulate(at_step - done));
       done = at_step;
       auto img = d.target->render(*s, *rend, cam, 0);
-      if (!img) return img.error();
+      if (!img)
+        return img.error();
       panels.push_back({std::move(*img), fmt::format("t = {:g} s", double(at_step) * p.dt)});
     }
     auto pos = s->positions();
-    if (!pos) return pos.error();
+    if (!pos)
+      return pos.error();
     Run fin;
     fin.scene = scene;
-    for (const Particle& q : scene.system.particles) fin.initial.push_back(q.position);
+    for (const Particle& q : scene.system.particles)
+      fin.initial.push_back(q.position);
     fin.pos = to_d(*pos);
-    M["gpu"] = {{"device", d.ctx->device_name()}, {"wind_displacement", wind_displacement(fin)}, {"sag", sag(fin)}};
+    M["gpu"] = {
+        {"device", d.ctx->device_name()}, {"wind_displacement", wind_displacement(fin)}, {"sag", sag(fin)}};
     VKCLOTH_TRY(render::write_png(G.dir / "cloth_gpu.png", compose_grid(panels, "Figure 14: on the GPU")));
-    G.figures.push_back({"cloth_gpu.png", "The GPU solver (report §5, Figures 14-15)", "Figure 14: on the GPU",
-                         note + "Always simulated by the Vulkan solver (force and integration in compute "
-                                "shaders), whatever --backend says, and drawn straight from its buffers: the "
-                                "textured cloth with structural, shear and bend springs (40 / 8 / 8) and wind "
-                                "K_w = 0.05 along +y, at t = 0.5, 2 and 5 s."});
+    G.figures.push_back(
+        {"cloth_gpu.png", "The GPU solver (report §5, Figures 14-15)", "Figure 14: on the GPU",
+         note + "Always simulated by the Vulkan solver (force and integration in compute "
+                "shaders), whatever --backend says, and drawn straight from its buffers: the "
+                "textured cloth with structural, shear and bend springs (40 / 8 / 8) and wind "
+                "K_w = 0.05 along +y, at t = 0.5, 2 and 5 s."});
   }
   progress("done");
   return {};

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Registers `vkcloth figures`.
 #include <chrono>
 #include <filesystem>
@@ -18,11 +19,13 @@ struct FiguresOptions {
 
 int figures_command(const FiguresOptions& opt) {
   if (opt.backend != "cpu" && opt.backend != "vulkan")
-    return report(make_error(ErrorCode::invalid_argument, fmt::format("unknown backend \"{}\" (known: cpu, vulkan)", opt.backend)));
+    return report(make_error(ErrorCode::invalid_argument,
+                             fmt::format("unknown backend \"{}\" (known: cpu, vulkan)", opt.backend)));
   std::error_code ec;
   std::filesystem::create_directories(opt.out, ec);
   if (ec)
-    return report(make_error(ErrorCode::io, fmt::format("cannot create the output directory {}: {}", opt.out, ec.message())));
+    return report(make_error(
+        ErrorCode::io, fmt::format("cannot create the output directory {}: {}", opt.out, ec.message())));
   figures::Gallery gallery{opt.out, opt.backend, {}, nlohmann::json::object(), opt.quick};
   const auto t0 = std::chrono::steady_clock::now();
   fmt::print(stderr, "figures: springs...\n");
@@ -32,7 +35,8 @@ int figures_command(const FiguresOptions& opt) {
              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   if (auto r = figures::cloth_figures(gallery); !r)
     return report(r.error());
-  if (auto r = figures::stability_figures(gallery); !r) return report(r.error());
+  if (auto r = figures::stability_figures(gallery); !r)
+    return report(r.error());
   if (auto r = gallery.write_index(); !r)
     return report(r.error());
   fmt::print("{} figures in {}/index.html ({:.1f} s)\n", gallery.figures.size(), opt.out,
@@ -44,13 +48,16 @@ int figures_command(const FiguresOptions& opt) {
 
 void add_figures_command(CLI::App& app, int* exit) {
   auto opt = std::make_shared<FiguresOptions>();
-  CLI::App* cmd = app.add_subcommand("figures", "Regenerate the report's figures (SVG plots, images) and an index.html gallery");
+  CLI::App* cmd = app.add_subcommand(
+      "figures", "Regenerate the report's figures (SVG plots, images) and an index.html gallery");
   cmd->footer(exit_codes_footer);
   cmd->add_option("--out", opt->out, "Output directory (default out/figures)");
-  cmd->add_option("--backend", opt->backend,
-                  "Solver backend: cpu | vulkan (default cpu). The cloth pictures are drawn by the Vulkan "
-                  "renderer either way (the CPU result is uploaded for drawing); Figure 14 is always the GPU solver");
-  cmd->add_flag("--quick", opt->quick, "Smaller cloth pictures (240x180 panels instead of 400x300); same numbers");
+  cmd->add_option(
+      "--backend", opt->backend,
+      "Solver backend: cpu | vulkan (default cpu). The cloth pictures are drawn by the Vulkan "
+      "renderer either way (the CPU result is uploaded for drawing); Figure 14 is always the GPU solver");
+  cmd->add_flag("--quick", opt->quick,
+                "Smaller cloth pictures (240x180 panels instead of 400x300); same numbers");
   cmd->callback([opt, exit] { *exit = figures_command(*opt); });
 }
 

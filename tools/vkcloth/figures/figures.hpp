@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // `vkcloth figures`: the report's figures, regenerated as SVG plots and image grids, with an
 // index.html gallery and a figures.json of the numbers behind them (checked by the tests).
 #pragma once
@@ -39,10 +40,12 @@ struct Trace {
   std::string diverged; ///< the error message when the run blew up
   double diverged_at = -1.0;
 };
-Result<Trace> simulate(const Scene& scene, const std::string& backend, std::uint64_t steps, std::uint64_t every);
+Result<Trace> simulate(const Scene& scene, const std::string& backend, std::uint64_t steps,
+                       std::uint64_t every);
 
 /// Kinetic + gravitational + spring energy of a state of `scene`'s system.
-double total_energy(const Scene& scene, const std::vector<glm::dvec3>& pos, const std::vector<glm::dvec3>& vel);
+double total_energy(const Scene& scene, const std::vector<glm::dvec3>& pos,
+                    const std::vector<glm::dvec3>& vel);
 
 Result<void> spring_figures(Gallery& gallery);
 /// Figures 5, 7-9, 11-14: labelled image grids (rendered offscreen; skipped without a Vulkan device

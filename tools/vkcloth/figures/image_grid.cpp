@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "image_grid.hpp"
 
 #include <algorithm>
@@ -44,7 +45,8 @@ constexpr Glyph font[] = {
 const Glyph* find_glyph(char c) {
   const char u = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
   for (const Glyph& g : font)
-    if (g.c == u) return &g;
+    if (g.c == u)
+      return &g;
   return nullptr;
 }
 
@@ -58,21 +60,26 @@ void fill(render::Image& img, int x0, int y0, int w, int h, const std::uint8_t r
 
 } // namespace
 
-int text_width(const std::string& text, int scale) { return text.empty() ? 0 : int(text.size()) * 6 * scale - scale; }
+int text_width(const std::string& text, int scale) {
+  return text.empty() ? 0 : int(text.size()) * 6 * scale - scale;
+}
 
-void draw_text(render::Image& img, int x, int y, const std::string& text, int scale, const std::uint8_t rgb[3]) {
+void draw_text(render::Image& img, int x, int y, const std::string& text, int scale,
+               const std::uint8_t rgb[3]) {
   for (char c : text) {
     if (const Glyph* g = find_glyph(c))
       for (int r = 0; r < 7; ++r)
         for (int col = 0; col < 5; ++col)
-          if (g->rows[std::size_t(r)] & (0x10 >> col)) fill(img, x + col * scale, y + r * scale, scale, scale, rgb);
+          if (g->rows[std::size_t(r)] & (0x10 >> col))
+            fill(img, x + col * scale, y + r * scale, scale, scale, rgb);
     x += 6 * scale;
   }
 }
 
 render::Image compose_grid(const std::vector<Panel>& panels, const std::string& title) {
   constexpr int gap = 6, title_h = 30, label_h = 26, scale = 2;
-  const int pw = panels.empty() ? 0 : int(panels[0].image.width), ph = panels.empty() ? 0 : int(panels[0].image.height);
+  const int pw = panels.empty() ? 0 : int(panels[0].image.width),
+            ph = panels.empty() ? 0 : int(panels[0].image.height);
   const int n = int(panels.size());
   render::Image out;
   out.width = std::uint32_t(std::max(gap + n * (pw + gap), text_width(title, scale) + 2 * gap));
@@ -85,9 +92,11 @@ render::Image compose_grid(const std::vector<Panel>& panels, const std::string& 
     const int x0 = gap + i * (pw + gap), y0 = title_h;
     for (int y = 0; y < std::min(ph, int(src.height)); ++y)
       for (int x = 0; x < std::min(pw, int(src.width)); ++x)
-        std::copy_n(src.pixel(std::uint32_t(x), std::uint32_t(y)), 4, out.pixel(std::uint32_t(x0 + x), std::uint32_t(y0 + y)));
+        std::copy_n(src.pixel(std::uint32_t(x), std::uint32_t(y)), 4,
+                    out.pixel(std::uint32_t(x0 + x), std::uint32_t(y0 + y)));
     const std::string& label = panels[std::size_t(i)].label;
-    draw_text(out, x0 + (pw - text_width(label, scale)) / 2, y0 + ph + (label_h - 7 * scale) / 2, label, scale, ink);
+    draw_text(out, x0 + (pw - text_width(label, scale)) / 2, y0 + ph + (label_h - 7 * scale) / 2, label,
+              scale, ink);
   }
   return out;
 }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Labelled image grids for the cloth figures: panels side by side, a title strip on top and a
 // label under each panel, drawn with a tiny built-in 5 x 7 bitmap font (no font files needed).
 #pragma once
@@ -17,7 +18,8 @@ struct Panel {
 
 /// Draws `text` at (x, y) (top-left of the first glyph), each font pixel a `scale` x `scale` block.
 /// Letters are drawn as capitals; characters outside the font are drawn as a blank.
-void draw_text(render::Image& img, int x, int y, const std::string& text, int scale, const std::uint8_t rgb[3]);
+void draw_text(render::Image& img, int x, int y, const std::string& text, int scale,
+               const std::uint8_t rgb[3]);
 /// Width in pixels of `text` drawn at `scale`.
 int text_width(const std::string& text, int scale);
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Vulkan context for the compute solver: either a headless instance + device of its own (tools,
 // samples, tests) or a host's existing handles (an engine embedding vkcloth). The solver only
 // ever borrows a Context; a Context destroys only the handles it created.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The Vulkan compute solver: the CPU reference's step (cpu_solver.hpp) as two compute passes per
 // particle, force.comp and integrate.comp, with the same float expression order, so on a driver
 // without FMA contraction it reproduces CpuSolver<float> (lavapipe: bit for bit).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Test-only knobs and hooks of the Vulkan backend: not part of the stable API. Tests, benchmarks
 // and diagnostics include this header; applications have no reason to.
 #pragma once

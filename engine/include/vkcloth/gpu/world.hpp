@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Many cloths on one Context: a shared, immutable topology (std::shared_ptr<const ClothTopology>,
 // prepared once from a ParticleSystem: particles' rest state, masses, pins, gather lists, grid
 // stencil, triangles) and instances with their own state (positions, velocities) and parameters

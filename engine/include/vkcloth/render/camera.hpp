@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // A look-at perspective camera for the renderer, with automatic framing of a scene and the
 // projection of world points to pixels (tests use it to know where things must appear).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Draws a GpuSolver's cloth (or chain) and its colliders with Vulkan graphics, straight from the
 // solver's buffers: positions[current], normals and uvs are bound as vertex buffers (vec4, stride
 // 16); nothing goes through the CPU. It records into the caller's command buffer, inside the

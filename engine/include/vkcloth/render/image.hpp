@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // RGBA8 images on the host: textures for the renderer, frames read back from it, PNG files.
 #pragma once
 

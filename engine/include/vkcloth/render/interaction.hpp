@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Interaction with a running GpuSolver from a viewer: holding one particle where the mouse is
 // (the report's "hand lifting the cloth"), without a CPU round trip of the state.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // An offscreen target for the renderer: a colour image (RGBA8) + depth, its render pass and
 // framebuffer, and the readback of a frame to an Image. Used by `vkcloth render` and the tests.
 #pragma once
