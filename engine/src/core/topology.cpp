@@ -34,6 +34,70 @@ struct GridFan {
   bool term(int k) const { return has[k] && has[(k + 1) & 3]; }
 };
 
+/// Per-particle masks (GridStencil::masks): every particle's list must be the stencil's, in order,
+/// with some springs left out (make_cloth's border particles are); the fan bits follow the grid
+/// fan. Empty when some list is irregular (border particles then take the CSR path).
+std::vector<std::uint16_t> stencil_masks(const Grid& grid, std::span<const std::uint32_t> off,
+                                         std::span<const GatherEdge> edges, const GridStencil& st) {
+  const std::size_t n = std::size_t(grid.nx) * grid.ny;
+  std::vector<std::uint16_t> masks(n, 0);
+  for (std::size_t p = 0; p < n; ++p) {
+    const GridFan fan(grid.nx, grid.ny, static_cast<std::uint32_t>(p));
+    unsigned m = 0;
+    for (int k = 0; k < 4; ++k)
+      if (fan.term(k))
+        m |= 1u << (12 + k);
+    int k = 0;
+    for (std::uint32_t e = off[p]; e < off[p + 1]; ++e, ++k) {
+      const GatherEdge& ed = edges[e];
+      while (k < 12 && (std::int64_t(ed.other) - std::int64_t(p) != st.offset[std::size_t(k)] ||
+                        !same_constants(ed, st, k)))
+        ++k;
+      if (k == 12)
+        return {};
+      m |= 1u << k;
+    }
+    masks[p] = static_cast<std::uint16_t>(m);
+  }
+  return masks;
+}
+
+/// The GPU's SC_BORDER condition: each offset is a (di, dj) step in [-2, 2]^2, and every border
+/// particle's list is exactly the stencil entries whose neighbour lies inside the grid, in stencil
+/// order (the interior lists were checked by detect_stencil).
+bool border_is_geometric(const Grid& grid, std::span<const std::uint32_t> off,
+                         std::span<const GatherEdge> edges, const GridStencil& st) {
+  const std::int64_t nx = grid.nx, ny = grid.ny;
+  std::int64_t di[12], dj[12];
+  for (std::size_t k = 0; k < 12; ++k) {
+    const std::int64_t shifted = std::int64_t(st.offset[k]) + 2 * nx + 2;
+    dj[k] = shifted / nx - 2;
+    di[k] = st.offset[k] - dj[k] * nx;
+    if (shifted < 0 || dj[k] < -2 || dj[k] > 2 || di[k] < -2 || di[k] > 2)
+      return false;
+  }
+  for (std::int64_t j = 0; j < ny; ++j)
+    for (std::int64_t i = 0; i < nx; ++i) {
+      if (i >= 2 && i < nx - 2 && j >= 2 && j < ny - 2)
+        continue;
+      const std::size_t p = std::size_t(j * nx + i);
+      std::size_t e = off[p];
+      for (int k = 0; k < 12; ++k) {
+        if (i + di[k] < 0 || i + di[k] >= nx || j + dj[k] < 0 || j + dj[k] >= ny)
+          continue;
+        if (e >= off[p + 1])
+          return false;
+        const GatherEdge& ed = edges[e++];
+        if (std::int64_t(ed.other) - std::int64_t(p) != st.offset[std::size_t(k)] ||
+            !same_constants(ed, st, k))
+          return false;
+      }
+      if (e != off[p + 1])
+        return false;
+    }
+  return true;
+}
+
 /// The grid stencil of `t`'s gather lists, if it applies: the one detection rule every solver
 /// uses. The size limits (nx, ny >= 5; the first interior particle's list has 12 entries) are the
 /// ones the CPU and GPU solvers applied before this routine replaced theirs.
@@ -72,62 +136,8 @@ std::optional<GridStencil> detect_stencil(const Grid& grid, std::span<const std:
     reach = std::max<std::int64_t>(reach, o < 0 ? -std::int64_t(o) : o);
   st.reach = static_cast<std::uint32_t>(reach);
 
-  // Masks: every particle's list must be the stencil's, in order, with some springs left out
-  // (make_cloth's border particles are); the fan bits follow the grid fan.
-  const std::size_t n = std::size_t(nx * ny);
-  st.masks.assign(n, 0);
-  for (std::size_t p = 0; p < n; ++p) {
-    const GridFan fan(grid.nx, grid.ny, static_cast<std::uint32_t>(p));
-    unsigned m = 0;
-    for (int k = 0; k < 4; ++k)
-      if (fan.term(k))
-        m |= 1u << (12 + k);
-    int k = 0;
-    for (std::uint32_t e = off[p]; e < off[p + 1]; ++e, ++k) {
-      const GatherEdge& ed = edges[e];
-      while (k < 12 && (std::int64_t(ed.other) - std::int64_t(p) != st.offset[std::size_t(k)] ||
-                        !same_constants(ed, st, k)))
-        ++k;
-      if (k == 12) {
-        st.masks.clear(); // irregular: border particles take the CSR path
-        return st;
-      }
-      m |= 1u << k;
-    }
-    st.masks[p] = static_cast<std::uint16_t>(m);
-  }
-
-  // SC_BORDER: each offset is a (di, dj) step in [-2, 2]^2, and every border particle's list is
-  // exactly the stencil entries whose neighbour lies inside the grid, in stencil order (the
-  // interior lists were checked above).
-  std::int64_t di[12], dj[12];
-  for (std::size_t k = 0; k < 12; ++k) {
-    const std::int64_t shifted = std::int64_t(st.offset[k]) + 2 * nx + 2;
-    dj[k] = shifted / nx - 2;
-    di[k] = st.offset[k] - dj[k] * nx;
-    if (shifted < 0 || dj[k] < -2 || dj[k] > 2 || di[k] < -2 || di[k] > 2)
-      return st;
-  }
-  for (std::int64_t j = 0; j < ny; ++j)
-    for (std::int64_t i = 0; i < nx; ++i) {
-      if (i >= 2 && i < nx - 2 && j >= 2 && j < ny - 2)
-        continue;
-      const std::size_t p = std::size_t(j * nx + i);
-      std::size_t e = off[p];
-      for (int k = 0; k < 12; ++k) {
-        if (i + di[k] < 0 || i + di[k] >= nx || j + dj[k] < 0 || j + dj[k] >= ny)
-          continue;
-        if (e >= off[p + 1])
-          return st;
-        const GatherEdge& ed = edges[e++];
-        if (std::int64_t(ed.other) - std::int64_t(p) != st.offset[std::size_t(k)] ||
-            !same_constants(ed, st, k))
-          return st;
-      }
-      if (e != off[p + 1])
-        return st;
-    }
-  st.border_geometric = true;
+  st.masks = stencil_masks(grid, off, edges, st);
+  st.border_geometric = !st.masks.empty() && border_is_geometric(grid, off, edges, st);
   return st;
 }
 

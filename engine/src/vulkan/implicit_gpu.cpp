@@ -109,6 +109,8 @@ Result<void> ImplicitGpu::create_pipelines() {
   return {};
 }
 
+// Long (~85 lines) but flat: one switch that maps each binding of the implicit layout
+// (implicit_shared.h) to its buffer, a table to scan rather than logic to follow.
 Result<void> ImplicitGpu::write_sets(const ImplicitInputs& in) {
   const auto bindings = implicit_bindings();
   std::vector<VkDescriptorBufferInfo> infos(2 * bindings.size()); // creation only: not the hot path
