@@ -73,10 +73,10 @@ inline Diff diff(std::span<const glm::vec3> a, std::span<const glm::vec3> b) {
 
 } // namespace vkcloth::gpu::test
 
-/// Starts a GPU test case: binds `ctx` to the shared validated Context and checks validation at
-/// the end; without a device skips (or fails on CI).
-#define VKCLOTH_GPU_TEST_BEGIN(ctx)                                                                          \
-  auto& vkcloth_shared_ = ::vkcloth::gpu::test::shared_context();                                            \
+/// Starts a GPU test case on `shared` (a SharedContext-like {context, error}): binds `ctx` to its
+/// validated Context and checks validation at the end; without a device skips (or fails on CI).
+#define VKCLOTH_TEST_WITH_CONTEXT(ctx, shared)                                                               \
+  auto& vkcloth_shared_ = (shared);                                                                          \
   if (!vkcloth_shared_.context) {                                                                            \
     if (::vkcloth::gpu::test::on_ci())                                                                       \
       FAIL("CI=true but no Vulkan device: " << vkcloth_shared_.error);                                       \
@@ -88,3 +88,6 @@ inline Diff diff(std::span<const glm::vec3> a, std::span<const glm::vec3> b) {
   ::vkcloth::gpu::test::ValidationGuard vkcloth_guard_ {                                                     \
     ctx                                                                                                      \
   }
+
+/// Starts a GPU test case on the shared compute Context.
+#define VKCLOTH_GPU_TEST_BEGIN(ctx) VKCLOTH_TEST_WITH_CONTEXT(ctx, ::vkcloth::gpu::test::shared_context())

@@ -159,18 +159,6 @@ inline void check_golden(const std::string& name, const Image& actual) {
 
 } // namespace vkcloth::render::test
 
-/// Starts a render test case: binds `ctx` to the shared validated graphics Context and checks
-/// validation at the end; without a device skips (or fails on CI).
+/// Starts a render test case on the shared graphics Context (VKCLOTH_TEST_WITH_CONTEXT).
 #define VKCLOTH_RENDER_TEST_BEGIN(ctx)                                                                       \
-  auto& vkcloth_shared_ = ::vkcloth::render::test::render_context();                                         \
-  if (!vkcloth_shared_.context) {                                                                            \
-    if (::vkcloth::gpu::test::on_ci())                                                                       \
-      FAIL("CI=true but no Vulkan device: " << vkcloth_shared_.error);                                       \
-    MESSAGE("skipped, no Vulkan device: " << vkcloth_shared_.error);                                         \
-    return;                                                                                                  \
-  }                                                                                                          \
-  ::vkcloth::gpu::Context& ctx = *vkcloth_shared_.context;                                                   \
-  REQUIRE(ctx.validation_enabled());                                                                         \
-  ::vkcloth::gpu::test::ValidationGuard vkcloth_guard_ {                                                     \
-    ctx                                                                                                      \
-  }
+  VKCLOTH_TEST_WITH_CONTEXT(ctx, ::vkcloth::render::test::render_context())
