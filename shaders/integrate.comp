@@ -2,7 +2,8 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 // Integration pass, one invocation per particle (the CPU reference's update after the forces,
-// then projection and the divergence check; formulas from cloth_kernel.h). Euler: one pass per step. RK4: one pass per stage;
+// then projection and the divergence check; formulas from cloth_kernel.h). Euler: one pass per
+// step. RK4: one pass per stage;
 // stages 0..2 write the next stage's (STAGE_POS, STAGE_VEL) and the running sums, stage 3
 // writes the new state. Reads FORCE_OUT, VEL_FILT (own), POS_BASE, VEL; writes POS_OUT, VEL.
 #include "vkcloth_shared.h"
