@@ -46,9 +46,9 @@ void main() {
     return;
   }
 
-  // RK4 stage k: k_pos = stage velocity (after contacts), k_vel = F / m; zero when pinned.
-  precise vec3 kp = pinned ? vec3(0.0) : vf;
-  precise vec3 kv = pinned ? vec3(0.0) : f / m;
+  // RK4 stage k: its derivative (cloth_kernel.h rk4_derivative).
+  vec3 kp, kv;
+  rk4_derivative(pinned, vf, f, m, kp, kv);
   const vec3 sp = rk4_accumulate(pc.stage, pc.stage == 0u ? vec3(0.0) : acc_pos[g].xyz, kp);
   const vec3 sv = rk4_accumulate(pc.stage, pc.stage == 0u ? vec3(0.0) : acc_vel[g].xyz, kv);
   const vec3 v0 = vel[g].xyz;

@@ -162,6 +162,16 @@ KFN precise vec3 rk4_stage_point(vec3 y0, vec3 k_prev, real c) {
   precise vec3 y = y0 + k_prev * c;
   return y;
 }
+// The stage's derivative (k_pos, k_vel) = (v, F / m) after contacts; zero for a pinned particle.
+KFN void rk4_derivative(bool pinned, vec3 v, vec3 f, real m, OUT(vec3) k_pos, OUT(vec3) k_vel) {
+  k_pos = vec3(real(0));
+  k_vel = vec3(real(0));
+  if (!pinned) { // a pinned particle may have no mass
+    precise vec3 a = f / m;
+    k_pos = v;
+    k_vel = a;
+  }
+}
 // Running sum k1 + 2 k2 + 2 k3 + k4, one stage at a time (same order as summing at the end).
 KFN precise vec3 rk4_accumulate(uint stage, vec3 sum, vec3 k) {
   precise vec3 s = stage == 0u ? k : (stage < 3u ? sum + k * real(2) : sum + k);

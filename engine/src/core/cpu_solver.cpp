@@ -464,8 +464,7 @@ template <typename Real> void CpuSolver<Real>::rk4_substep(const Real h) {
         contact_at(stage_pos_[p], stage_vel_[p], f);
       if (st == 0)
         force_[p] = f;
-      k_pos_[st][p] = pinned_[p] ? Vec3(0) : stage_vel_[p];
-      k_vel_[st][p] = pinned_[p] ? Vec3(0) : f / mass_[p];
+      kernel::rk4_derivative(pinned_[p] != 0, stage_vel_[p], f, mass_[p], k_pos_[st][p], k_vel_[st][p]);
     });
   }
   const Real w = h / Real(6);
