@@ -8,7 +8,10 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <optional>
+#include <vector>
 
+#include "vkcloth/mesh.hpp"
 #include "vkcloth/params.hpp"
 #include "vkcloth/result.hpp"
 #include "vkcloth/system.hpp"
@@ -21,6 +24,11 @@ struct Scene {
   ParticleSystem system; ///< finalized
   SimParams params;      ///< validated (directions normalised)
   std::uint64_t steps = 500;
+  /// A mesh cloth's base-colour texture (a glTF material's), for the renderer and the exporter.
+  std::optional<MeshTexture> texture;
+  /// What loading dropped or ignored (degenerate faces, a pin region that pins nothing, ...):
+  /// the CLI prints each as "warning: ...".
+  std::vector<std::string> warnings;
   // The file's "system" key ("chain" | "cloth") is not stored: a cloth is system.grid.has_value().
 };
 

@@ -8,6 +8,7 @@
 #include <optional>
 #include <vector>
 
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 #include "vkcloth/result.hpp"
@@ -42,6 +43,16 @@ struct Grid {
   std::uint32_t ny = 0;
 };
 
+/// The triangle surface of a cloth that is not a grid (a mesh, vkcloth/mesh.hpp): normals come
+/// from each particle's triangle fan, drawing and export use these triangles and uvs.
+struct Surface {
+  std::vector<std::uint32_t> triangles; ///< 3 particle indices per counter-clockwise triangle
+  std::vector<glm::vec2> uvs;           ///< one per particle
+  /// The file's vertex index of each particle (a mesh's particles are renumbered for locality and
+  /// its isolated vertices dropped); outputs list particles in this order. Empty: identity.
+  std::vector<std::uint32_t> source_vertex;
+};
+
 /// One entry of a particle's gather list: the spring's other end and its constants.
 struct SpringRef {
   std::uint32_t other = 0;
@@ -60,7 +71,8 @@ struct SpringAdjacency {
 struct ParticleSystem {
   std::vector<Particle> particles;
   std::vector<Spring> springs;
-  std::optional<Grid> grid;  ///< set for cloth; chains have no surface (no normals, no wind)
+  std::optional<Grid> grid;       ///< set for a grid cloth
+  std::optional<Surface> surface; ///< set for a mesh cloth; chains have neither (no normals, no wind)
   SpringAdjacency adjacency; ///< filled by finalize()
 
   std::size_t size() const { return particles.size(); }
@@ -69,7 +81,7 @@ struct ParticleSystem {
   void finalize();
 
   /// What every solver checks before it starts: not empty, finalized, grid size = particle
-  /// count, springs and gather lists within range, free particles with a mass > 0.
+  /// count, not both a grid and a surface, surface indices in range and one uv per particle, springs and gather lists within range, free particles with a mass > 0.
   Result<void> validate() const;
 };
 

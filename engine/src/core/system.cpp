@@ -54,6 +54,22 @@ Result<void> ParticleSystem::validate() const {
     return bad("the particle system was not finalized (call finalize())");
   if (grid && std::uint64_t(grid->nx) * grid->ny != n)
     return bad(fmt::format("grid {} x {} does not match the {} particles", grid->nx, grid->ny, n));
+  if (grid && surface)
+    return bad("the particle system has both a grid and a surface; a cloth is one or the other");
+  if (surface) {
+    if (surface->triangles.size() % 3 != 0)
+      return bad(fmt::format("the surface's triangle list holds {} indices, not a multiple of 3",
+                             surface->triangles.size()));
+    for (std::size_t k = 0; k < surface->triangles.size(); ++k)
+      if (surface->triangles[k] >= n)
+        return bad(fmt::format("surface triangle {} refers to particle {}, but there are {}", k / 3,
+                               surface->triangles[k], n));
+    if (surface->uvs.size() != n)
+      return bad(fmt::format("the surface has {} uvs for {} particles", surface->uvs.size(), n));
+    if (!surface->source_vertex.empty() && surface->source_vertex.size() != n)
+      return bad(fmt::format("the surface's source_vertex has {} entries for {} particles",
+                             surface->source_vertex.size(), n));
+  }
   for (std::size_t k = 0; k < springs.size(); ++k)
     if (springs[k].a >= n || springs[k].b >= n)
       return bad(fmt::format("spring {} joins particles {} and {}, but there are {}", k, springs[k].a,
