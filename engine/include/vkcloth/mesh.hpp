@@ -80,7 +80,7 @@ struct MeshClothDesc {
   /// has `particle_mass`.
   std::optional<double> density;
   double particle_mass = 0.05;
-  ClothStiffness stiffness; ///< a kind with zero stiffness is left out, as on the grid
+  ClothStiffness stiffness;                ///< a kind with zero stiffness is left out, as on the grid
   std::vector<std::uint32_t> pin_vertices; ///< vertex indices of the file
   std::optional<PinRegion> pin_region;
   /// Renumber particles for memory locality (meshoptimizer); every output keeps the file's order

@@ -47,7 +47,12 @@ struct Grid {
 /// from each particle's triangle fan, drawing and export use these triangles and uvs.
 struct Surface {
   std::vector<std::uint32_t> triangles; ///< 3 particle indices per counter-clockwise triangle
-  std::vector<glm::vec2> uvs;           ///< one per particle
+  /// The faces normals are summed over (triangles and quads, counter-clockwise): face f is
+  /// faces[face_offsets[f] .. face_offsets[f+1]); each corner p adds cross(x_next - x_p,
+  /// x_prev - x_p), so a quad mesh of a grid gets the grid's normals. Empty: the triangles.
+  std::vector<std::uint32_t> face_offsets;
+  std::vector<std::uint32_t> faces;
+  std::vector<glm::vec2> uvs; ///< one per particle
   /// The file's vertex index of each particle (a mesh's particles are renumbered for locality and
   /// its isolated vertices dropped); outputs list particles in this order. Empty: identity.
   std::vector<std::uint32_t> source_vertex;
@@ -73,7 +78,7 @@ struct ParticleSystem {
   std::vector<Spring> springs;
   std::optional<Grid> grid;       ///< set for a grid cloth
   std::optional<Surface> surface; ///< set for a mesh cloth; chains have neither (no normals, no wind)
-  SpringAdjacency adjacency; ///< filled by finalize()
+  SpringAdjacency adjacency;      ///< filled by finalize()
 
   std::size_t size() const { return particles.size(); }
 
@@ -81,7 +86,8 @@ struct ParticleSystem {
   void finalize();
 
   /// What every solver checks before it starts: not empty, finalized, grid size = particle
-  /// count, not both a grid and a surface, surface indices in range and one uv per particle, springs and gather lists within range, free particles with a mass > 0.
+  /// count, not both a grid and a surface, surface indices in range and one uv per particle, springs and
+  /// gather lists within range, free particles with a mass > 0.
   Result<void> validate() const;
 };
 

@@ -64,6 +64,16 @@ Result<void> ParticleSystem::validate() const {
       if (surface->triangles[k] >= n)
         return bad(fmt::format("surface triangle {} refers to particle {}, but there are {}", k / 3,
                                surface->triangles[k], n));
+    const auto& fo = surface->face_offsets;
+    if (!fo.empty() && (fo.front() != 0 || fo.back() != surface->faces.size()))
+      return bad("the surface's face_offsets do not span its face list");
+    for (std::size_t f = 0; f + 1 < fo.size(); ++f)
+      if (fo[f + 1] < fo[f] + 3)
+        return bad(fmt::format("surface face {} has {} corners; faces need at least 3", f,
+                               std::int64_t(fo[f + 1]) - std::int64_t(fo[f])));
+    for (std::uint32_t v : surface->faces)
+      if (v >= n)
+        return bad(fmt::format("a surface face refers to particle {}, but there are {}", v, n));
     if (surface->uvs.size() != n)
       return bad(fmt::format("the surface has {} uvs for {} particles", surface->uvs.size(), n));
     if (!surface->source_vertex.empty() && surface->source_vertex.size() != n)

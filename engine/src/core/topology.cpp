@@ -98,6 +98,28 @@ bool border_is_geometric(const Grid& grid, std::span<const std::uint32_t> off,
   return true;
 }
 
+/// Each particle's fan from a list of faces (triangles or quads), in face order: the corner at p
+/// of face (.., prev, p, next, ..) adds cross(x_next - x_p, x_prev - x_p), the face's
+/// counter-clockwise normal there. Triangle (a, b, c) gives a (b, c), b (c, a), c (a, b); the quads
+/// of a grid give the grid fan's four terms.
+void fill_fans(std::span<const std::uint32_t> face_offsets, std::span<const std::uint32_t> faces,
+               std::size_t n, std::vector<std::uint32_t>& offsets, std::vector<FanTriangle>& fans) {
+  offsets.assign(n + 1, 0);
+  for (std::uint32_t v : faces)
+    ++offsets[v + 1];
+  for (std::size_t p = 0; p < n; ++p)
+    offsets[p + 1] += offsets[p];
+  fans.assign(offsets[n], FanTriangle{});
+  std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
+  for (std::size_t f = 0; f + 1 < face_offsets.size(); ++f) {
+    const std::uint32_t first = face_offsets[f], size = face_offsets[f + 1] - first;
+    for (std::uint32_t k = 0; k < size; ++k) {
+      const std::uint32_t p = faces[first + k];
+      fans[fill[p]++] = FanTriangle{faces[first + (k + 1) % size], faces[first + (k + size - 1) % size]};
+    }
+  }
+}
+
 /// The grid stencil of `t`'s gather lists, if it applies: the one detection rule every solver
 /// uses. The size limits (nx, ny >= 5; the first interior particle's list has 12 entries) are the
 /// ones the CPU and GPU solvers applied before this routine replaced theirs.
@@ -182,6 +204,17 @@ Result<std::shared_ptr<const ClothTopology>> ClothTopology::create(const Particl
         t->uvs_[std::size_t(j) * nx + i] =
             glm::vec2(nx > 1 ? float(i) / float(nx - 1) : 0.0f, ny > 1 ? float(j) / float(ny - 1) : 0.0f);
     t->stencil_ = detect_stencil(*s.grid, t->edge_offsets(), t->edges_);
+  } else if (s.surface) {
+    t->triangles_ = s.surface->triangles;
+    t->uvs_ = s.surface->uvs;
+    if (s.surface->face_offsets.empty()) {
+      std::vector<std::uint32_t> offsets(t->triangles_.size() / 3 + 1);
+      for (std::size_t f = 0; f < offsets.size(); ++f)
+        offsets[f] = static_cast<std::uint32_t>(3 * f);
+      fill_fans(offsets, t->triangles_, n, t->fan_offsets_, t->fans_);
+    } else {
+      fill_fans(s.surface->face_offsets, s.surface->faces, n, t->fan_offsets_, t->fans_);
+    }
   }
   return std::shared_ptr<const ClothTopology>(std::move(t));
 }

@@ -137,6 +137,93 @@ Result<ParticleSystem> read_chain(const json& doc) {
   return make_chain(d);
 }
 
+Result<void> read_stiffness(const json& cloth, ClothStiffness& k) {
+  SCENE_TRY_ASSIGN(obj, sd::read_object(cloth, "cloth", "stiffness"));
+  if (!obj)
+    return {};
+  VKCLOTH_TRY(sd::check_keys(*obj, "cloth.stiffness", {"structural", "shear", "bend"}));
+  VKCLOTH_TRY(sd::read(*obj, "cloth.stiffness", "structural", k.structural));
+  VKCLOTH_TRY(sd::read(*obj, "cloth.stiffness", "shear", k.shear));
+  return sd::read(*obj, "cloth.stiffness", "bend", k.bend);
+}
+
+Result<void> read_mesh_transform(const json& cloth, MeshTransform& t) {
+  SCENE_TRY_ASSIGN(obj, sd::read_object(cloth, "cloth", "mesh_transform"));
+  if (!obj)
+    return {};
+  VKCLOTH_TRY(sd::check_keys(*obj, "cloth.mesh_transform", {"translate", "rotate_deg", "scale"}));
+  VKCLOTH_TRY(sd::read(*obj, "cloth.mesh_transform", "translate", t.translate));
+  VKCLOTH_TRY(sd::read(*obj, "cloth.mesh_transform", "rotate_deg", t.rotate_deg));
+  return sd::read(*obj, "cloth.mesh_transform", "scale", t.scale);
+}
+
+Result<void> read_mesh_pins(const json& cloth, MeshClothDesc& d) {
+  SCENE_TRY_ASSIGN(pins, sd::read_array(cloth, "cloth", "pin_vertices"));
+  if (pins) {
+    if (pins->size() > max_particles)
+      return make_error(ErrorCode::invalid_argument,
+                        fmt::format("cloth.pin_vertices holds {} entries, more than the limit {}",
+                                    pins->size(), max_particles));
+    for (std::size_t k = 0; k < pins->size(); ++k) {
+      SCENE_TRY_ASSIGN(v, sd::as_integer((*pins)[k], fmt::format("cloth.pin_vertices[{}]", k),
+                                         std::numeric_limits<std::uint32_t>::max()));
+      d.pin_vertices.push_back(static_cast<std::uint32_t>(v));
+    }
+  }
+  SCENE_TRY_ASSIGN(region, sd::read_object(cloth, "cloth", "pin_region"));
+  if (region) {
+    VKCLOTH_TRY(sd::check_keys(*region, "cloth.pin_region", {"min", "max"}));
+    for (const char* key : {"min", "max"})
+      if (!region->contains(key))
+        return sd::shape_error(fmt::format("cloth.pin_region.{} is required", key));
+    PinRegion r;
+    VKCLOTH_TRY(sd::read(*region, "cloth.pin_region", "min", r.min));
+    VKCLOTH_TRY(sd::read(*region, "cloth.pin_region", "max", r.max));
+    d.pin_region = r;
+  }
+  return {};
+}
+
+/// A cloth made from a mesh file ("cloth": {"mesh": ...}), the path relative to the scene file.
+Result<void> read_mesh_cloth(const json& cloth, const std::filesystem::path& scene_dir, Scene& scene) {
+  for (const char* grid_key : {"resolution", "size", "origin", "orientation", "pins"})
+    if (cloth.contains(grid_key))
+      return sd::shape_error(fmt::format(
+          "cloth.{} is a grid key, not allowed with cloth.mesh (the mesh gives the vertices; pin with "
+          "cloth.pin_vertices or cloth.pin_region)",
+          grid_key));
+  VKCLOTH_TRY(sd::check_keys(
+      cloth, "cloth",
+      {"mesh", "mesh_transform", "density", "particle_mass", "stiffness", "pin_vertices", "pin_region"}));
+  std::string file;
+  VKCLOTH_TRY(sd::read(cloth, "cloth", "mesh", file));
+  MeshClothDesc d;
+  VKCLOTH_TRY(read_mesh_transform(cloth, d.transform));
+  if (cloth.contains("density") && cloth.contains("particle_mass"))
+    return sd::shape_error("give cloth.density (kg/m^2) or cloth.particle_mass (kg per vertex), not both");
+  if (cloth.contains("density")) {
+    double density = 0.0;
+    VKCLOTH_TRY(sd::read(cloth, "cloth", "density", density));
+    d.density = density;
+  }
+  VKCLOTH_TRY(sd::read(cloth, "cloth", "particle_mass", d.particle_mass));
+  VKCLOTH_TRY(read_stiffness(cloth, d.stiffness));
+  VKCLOTH_TRY(read_mesh_pins(cloth, d));
+
+  const std::filesystem::path path =
+      std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : scene_dir / file;
+  auto mesh = read_mesh(path);
+  if (!mesh)
+    return mesh.error();
+  auto made = make_mesh_cloth(*mesh, d);
+  if (!made)
+    return Error{made.error().code, fmt::format("{}: {}", path.string(), made.error().message), 0};
+  scene.system = std::move(made->system);
+  scene.warnings = std::move(made->warnings);
+  scene.texture = std::move(mesh->texture);
+  return {};
+}
+
 Result<ParticleSystem> read_cloth(const json& doc) {
   ClothDesc d;
   SCENE_TRY_ASSIGN(obj, sd::read_object(doc, "", "cloth"));
@@ -168,13 +255,7 @@ Result<ParticleSystem> read_cloth(const json& doc) {
       return sd::shape_error(
           fmt::format("cloth.orientation must be \"vertical\" or \"horizontal\", got \"{}\"", orientation));
     VKCLOTH_TRY(sd::read(*obj, "cloth", "particle_mass", d.particle_mass));
-    SCENE_TRY_ASSIGN(k, sd::read_object(*obj, "cloth", "stiffness"));
-    if (k) {
-      VKCLOTH_TRY(sd::check_keys(*k, "cloth.stiffness", {"structural", "shear", "bend"}));
-      VKCLOTH_TRY(sd::read(*k, "cloth.stiffness", "structural", d.stiffness.structural));
-      VKCLOTH_TRY(sd::read(*k, "cloth.stiffness", "shear", d.stiffness.shear));
-      VKCLOTH_TRY(sd::read(*k, "cloth.stiffness", "bend", d.stiffness.bend));
-    }
+    VKCLOTH_TRY(read_stiffness(*obj, d.stiffness));
     SCENE_TRY_ASSIGN(pins, sd::read_array(*obj, "cloth", "pins"));
     if (pins) {
       d.pin_default_corners = false; // "pins": [] means nothing pinned
@@ -228,6 +309,11 @@ Result<Scene> build_scene(const json& doc, std::string_view source_name) {
   VKCLOTH_TRY(sd::read(doc, "", "contact_inward_only", scene.params.contact_inward_only));
   VKCLOTH_TRY(scene.params.validate()); // ranges, before any large allocation below
 
+  if (const json* cloth = kind == "cloth" && doc.contains("cloth") ? &doc["cloth"] : nullptr;
+      cloth && cloth->is_object() && cloth->contains("mesh")) {
+    VKCLOTH_TRY(read_mesh_cloth(*cloth, std::filesystem::path(source_name).parent_path(), scene));
+    return scene;
+  }
   auto system = kind == "chain" ? read_chain(doc) : read_cloth(doc);
   if (!system)
     return system.error();

@@ -1,0 +1,125 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
+"""Writes the sample meshes of samples/meshes/ (OBJ, a few kB each), deterministically:
+
+  tablecloth.obj      a round cloth of irregular triangles (jittered rings, zipped together)
+  flag_with_hole.obj  a quad flag, 1.2 m x 0.8 m in the x-z plane, with a round hole
+  skirt.obj           an open cylinder of quads (a skirt), its top ring at z = 0
+
+Usage: tools/make_meshes.py [OUT_DIR]   (default: samples/meshes next to this script's parent)
+A test (samples:meshes_up_to_date) regenerates them and compares with the committed files.
+"""
+import math
+import os
+import sys
+
+
+def rand01(k):
+    """A deterministic hash in [0, 1): the same meshes on every machine and Python version."""
+    x = (k * 2654435761 + 12345) & 0xFFFFFFFF
+    x ^= x >> 15
+    x = (x * 2246822519) & 0xFFFFFFFF
+    x ^= x >> 13
+    return x / 2**32
+
+
+def write_obj(path, comment, positions, uvs, faces):
+    lines = [f"# {comment}", "# written by tools/make_meshes.py"]
+    lines += [f"v {x:.4f} {y:.4f} {z:.4f}" for x, y, z in positions]
+    lines += [f"vt {u:.4f} {v:.4f}" for u, v in uvs]
+    lines += ["f " + " ".join(f"{i + 1}/{i + 1}" for i in face) for face in faces]
+    with open(path, "w", newline="\n") as f:
+        f.write("\n".join(lines) + "\n")
+
+
+def tablecloth(rings=8, radius=0.5):
+    """Ring k (1..rings) holds 6k vertices, each rotated and pushed in or out a little; the rings are
+    zipped into triangles by always advancing along the ring whose next vertex comes first in angle."""
+    positions, uvs, ring_ids = [(0.0, 0.0, 0.0)], [(0.5, 0.5)], [[0]]
+    for k in range(1, rings + 1):
+        ids, n = [], 6 * k
+        for j in range(n):
+            jitter_a = (rand01(1000 * k + j) - 0.5) * 0.45 * (2 * math.pi / n)
+            jitter_r = (rand01(7919 * k + j) - 0.5) * 0.35 * (radius / rings) if k < rings else 0.0
+            a = 2 * math.pi * j / n + jitter_a + 0.3 * k
+            r = radius * k / rings + jitter_r
+            ids.append(len(positions))
+            positions.append((r * math.cos(a), r * math.sin(a), 0.0))
+            uvs.append((0.5 + 0.5 * r * math.cos(a) / radius, 0.5 + 0.5 * r * math.sin(a) / radius))
+        ring_ids.append(ids)
+
+    def angle(v):
+        x, y, _ = positions[v]
+        return math.atan2(y, x) % (2 * math.pi)
+
+    faces = []
+    for k in range(1, rings + 1):
+        inner, outer = ring_ids[k - 1], ring_ids[k]
+        if len(inner) == 1:
+            faces += [(inner[0], outer[j], outer[(j + 1) % len(outer)]) for j in range(len(outer))]
+            continue
+        # Start both rings at their vertex of smallest angle, then merge by angle (counter-clockwise).
+        inner = sorted(inner, key=angle)
+        outer = sorted(outer, key=angle)
+        i = o = 0
+        while i < len(inner) or o < len(outer):
+            ni = angle(inner[(i + 1) % len(inner)]) + (2 * math.pi if i + 1 >= len(inner) else 0)
+            no = angle(outer[(o + 1) % len(outer)]) + (2 * math.pi if o + 1 >= len(outer) else 0)
+            if o < len(outer) and (i >= len(inner) or no <= ni):
+                faces.append((inner[i % len(inner)], outer[o], outer[(o + 1) % len(outer)]))
+                o += 1
+            else:
+                faces.append((inner[i], outer[o % len(outer)], inner[(i + 1) % len(inner)]))
+                i += 1
+    return positions, uvs, faces
+
+
+def flag_with_hole(nx=25, nz=17, width=1.2, height=0.8, hole=(0.75, 0.4, 0.16)):
+    """An nx x nz vertex grid of quads in the x-z plane, minus the quads whose centre is in the hole
+    (the vertices only those quads used are left out too)."""
+    dx, dz = width / (nx - 1), height / (nz - 1)
+    cx, cz, r = hole
+    quads = []
+    for j in range(nz - 1):
+        for i in range(nx - 1):
+            mx, mz = (i + 0.5) * dx, (j + 0.5) * dz
+            if (mx - cx) ** 2 + (mz - cz) ** 2 >= r * r:
+                a = j * nx + i
+                quads.append((a, a + 1, a + 1 + nx, a + nx))
+    used = sorted({v for q in quads for v in q})
+    index = {v: k for k, v in enumerate(used)}
+    positions = [((v % nx) * dx, 0.0, (v // nx) * dz) for v in used]
+    uvs = [((v % nx) / (nx - 1), (v // nx) / (nz - 1)) for v in used]
+    return positions, uvs, [tuple(index[v] for v in q) for q in quads]
+
+
+def skirt(around=32, rows=9, radius=0.25, length=0.4, flare=0.08):
+    """An open cylinder (slightly flared towards the hem) of quads; row 0 is the waist at z = 0."""
+    positions, uvs, faces = [], [], []
+    for j in range(rows):
+        r = radius + flare * j / (rows - 1)
+        z = -length * j / (rows - 1)
+        for i in range(around):
+            a = 2 * math.pi * i / around
+            positions.append((r * math.cos(a), r * math.sin(a), z))
+            uvs.append((i / around, 1.0 - j / (rows - 1)))
+    for j in range(rows - 1):
+        for i in range(around):
+            a, b = j * around + i, j * around + (i + 1) % around
+            faces.append((a, a + around, b + around, b))  # counter-clockwise seen from outside
+    return positions, uvs, faces
+
+
+def main():
+    out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..", "samples", "meshes")
+    os.makedirs(out, exist_ok=True)
+    write_obj(os.path.join(out, "tablecloth.obj"), "round tablecloth, radius 0.5 m, irregular triangles",
+              *tablecloth())
+    write_obj(os.path.join(out, "flag_with_hole.obj"), "flag 1.2 m x 0.8 m (x-z plane) with a round hole, quads",
+              *flag_with_hole())
+    write_obj(os.path.join(out, "skirt.obj"), "skirt: open cylinder of quads, waist radius 0.25 m at z = 0",
+              *skirt())
+
+
+if __name__ == "__main__":
+    main()
