@@ -130,7 +130,8 @@ Mesh square(bool as_triangles) {
 }
 
 std::size_t count_kind(const ParticleSystem& s, SpringKind k) {
-  return std::size_t(std::count_if(s.springs.begin(), s.springs.end(), [k](const Spring& sp) { return sp.kind == k; }));
+  return std::size_t(
+      std::count_if(s.springs.begin(), s.springs.end(), [k](const Spring& sp) { return sp.kind == k; }));
 }
 
 bool has_warning(const MeshCloth& c, const std::string& part) {
@@ -318,8 +319,8 @@ TEST_CASE("uvs: the file's when present, else a planar projection on the widest 
 
 TEST_CASE("degenerate faces and isolated vertices are dropped with a warning that counts them") {
   Mesh m = square(false);
-  m.positions.push_back({5, 5, 5}); // vertex 4: isolated
-  m.positions.push_back({1, 0, 0}); // vertex 5: same place as vertex 1
+  m.positions.push_back({5, 5, 5});                   // vertex 4: isolated
+  m.positions.push_back({1, 0, 0});                   // vertex 5: same place as vertex 1
   m.indices.insert(m.indices.end(), {0, 1, 5});       // zero-length edge 1-5
   m.indices.insert(m.indices.end(), {0, 1, 1});       // repeated vertex
   m.indices.insert(m.indices.end(), {0, 1, 2, 3, 0}); // a pentagon with a repeated corner
@@ -351,7 +352,8 @@ TEST_CASE("bad meshes and pins are errors naming the element") {
   CHECK(error_of(out_of_range, d).find("face 0 refers to vertex 9") != std::string::npos);
   Mesh all_degenerate = square(false);
   all_degenerate.positions = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
-  CHECK(error_of(all_degenerate, d).find("every one of the mesh's 1 faces is degenerate") != std::string::npos);
+  CHECK(error_of(all_degenerate, d).find("every one of the mesh's 1 faces is degenerate") !=
+        std::string::npos);
 
   MeshClothDesc pin = d;
   pin.pin_vertices = {1, 4};
@@ -370,5 +372,6 @@ TEST_CASE("bad meshes and pins are errors naming the element") {
 
   MeshClothDesc region = d;
   region.pin_region = PinRegion{{5, 5, 5}, {6, 6, 6}};
-  CHECK(has_warning(mesh_cloth(square(false), region), "cloth.pin_region [5, 5, 5] .. [6, 6, 6] pins no vertex"));
+  CHECK(has_warning(mesh_cloth(square(false), region),
+                    "cloth.pin_region [5, 5, 5] .. [6, 6, 6] pins no vertex"));
 }

@@ -7,6 +7,8 @@
   skirt.obj           an open cylinder of quads (a skirt), its top ring at z = 0
 
 Usage: tools/make_meshes.py [OUT_DIR]   (default: samples/meshes next to this script's parent)
+       tools/make_meshes.py --tablecloth-rings N FILE.obj   (one tablecloth of 1 + 3 N (N + 1) vertices;
+                                                             N = 147 gives the bench's ~65 000)
 A test (samples:meshes_up_to_date) regenerates them and compares with the committed files.
 """
 import math
@@ -111,6 +113,10 @@ def skirt(around=32, rows=9, radius=0.25, length=0.4, flare=0.08):
 
 
 def main():
+    if len(sys.argv) == 4 and sys.argv[1] == "--tablecloth-rings":
+        rings = int(sys.argv[2])
+        write_obj(sys.argv[3], f"round tablecloth, {rings} rings, irregular triangles", *tablecloth(rings, 0.5))
+        return
     out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..", "samples", "meshes")
     os.makedirs(out, exist_ok=True)
     write_obj(os.path.join(out, "tablecloth.obj"), "round tablecloth, radius 0.5 m, irregular triangles",

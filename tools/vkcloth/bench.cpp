@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <numeric>
 #include <optional>
 #include <sstream>
 #include <thread>
@@ -19,6 +20,7 @@
 #include "vkcloth/cpu_solver.hpp"
 #include "vkcloth/gpu/gpu_solver.hpp"
 #include "vkcloth/gpu/world.hpp"
+#include "vkcloth/mesh.hpp"
 
 namespace vkcloth::cli {
 namespace {
@@ -38,6 +40,7 @@ struct BenchOptions {
   double compute_gflops = 192.0;
   std::string json;
   std::string variants = "fused,two_pass"; // Vulkan layouts to time (RK4 and implicit: always one)
+  std::string mesh; // also time this mesh (OBJ / glTF): reordered, in file order, and shuffled
 };
 
 /// The benchmark scene at n x n: a 1 m x 1 m vertical cloth hanging from its two top corners, in
@@ -68,15 +71,58 @@ Result<BenchScene> bench_scene(std::uint32_t n, Integrator integrator, double dt
   return BenchScene{std::move(*sys), p};
 }
 
+/// The bench's cloth made from a mesh file instead of a grid: the same per-particle mass scaling
+/// (the total mass of the 64 x 64 cloth), stiffnesses, wind and dt; vertex 0 pinned. `order`:
+/// "meshopt" (the library's default renumbering), "file" (the file's vertex order) or "shuffled"
+/// (the file's vertices in a fixed pseudo-random order: what reordering is up against when a
+/// file's order has no locality).
+Result<BenchScene> mesh_bench_scene(const Mesh& file, const std::string& order, Integrator integrator,
+                                    double dt) {
+  Mesh mesh = file;
+  if (order == "shuffled") {
+    const std::size_t n = mesh.positions.size();
+    std::vector<std::uint32_t> to(n);
+    std::iota(to.begin(), to.end(), 0u);
+    std::uint64_t state = 0x9e3779b97f4a7c15ull;
+    for (std::size_t k = n; k > 1; --k) { // Fisher-Yates with a fixed LCG: the same order every run
+      state = state * 6364136223846793005ull + 1442695040888963407ull;
+      std::swap(to[k - 1], to[(state >> 33) % k]);
+    }
+    for (std::size_t v = 0; v < n; ++v)
+      mesh.positions[to[v]] = file.positions[v];
+    if (!mesh.uvs.empty())
+      for (std::size_t v = 0; v < n; ++v)
+        mesh.uvs[to[v]] = file.uvs[v];
+    for (std::uint32_t& i : mesh.indices)
+      i = to[i];
+  }
+  MeshClothDesc d;
+  d.reorder = order == "meshopt";
+  d.particle_mass = 0.05 * 4096.0 / double(std::max<std::size_t>(mesh.positions.size(), 1));
+  d.pin_vertices = {0};
+  auto cloth = make_mesh_cloth(mesh, d);
+  if (!cloth)
+    return cloth.error();
+  SimParams p;
+  p.integrator = integrator;
+  p.dt = dt;
+  p.wind.strength = 2.0 * d.particle_mass;
+  p.wind.direction = {0.3, 1.0, 0.1};
+  VKCLOTH_TRY(p.validate());
+  return BenchScene{std::move(cloth->system), p};
+}
+
 /// Bytes and flops per particle-step counted from the kernels (docs/performance.md, "Counting").
 /// `s` is the mean number of springs per particle (gather-list entries / particles).
 struct Cost {
   double bytes = 0, flops = 0;
 };
 
-double kernel_flops(double s, bool grid, bool wind) {
-  const double normal = grid ? 69.0 : 0.0; // 4 edges 12, 4 crosses 36, sum 12, length 5 + sqrt 1, divide 3
-  const double springs = 18.0 * s;         // u 3, dot 5, sqrt 1, (len - L) 1, k * 1, / len 1, u * 3, += 3
+double kernel_flops(double s, bool grid, double fans, bool wind) {
+  // grid: 4 edges 12, 4 crosses 36, sum 12, length 5 + sqrt 1, divide 3; a mesh's fan: per term
+  // 2 edges 6, a cross 9, sum 3, then the same normalisation 9.
+  const double normal = grid ? 69.0 : fans > 0.0 ? 18.0 * fans + 9.0 : 0.0;
+  const double springs = 18.0 * s; // u 3, dot 5, sqrt 1, (len - L) 1, k * 1, / len 1, u * 3, += 3
   const double external = 6.0 + 7.0 + (wind ? 12.0 : 0.0); // gravity, damping, wind
   return normal + springs + external;
 }
@@ -84,14 +130,16 @@ double kernel_flops(double s, bool grid, bool wind) {
 // `grid`: the bench's regular cloth, whose springs both solvers sum from the grid stencil (no
 // CSR reads since round 4); `steps_per_submit`: fused Vulkan steps store forces and normals only
 // in the last step of a submission.
-Cost cost_of(const std::string& variant, Integrator integrator, double s, bool grid, bool wind,
+// `fans`: a mesh's mean normal-fan terms per particle (0 for grids and chains), read from CSR lists.
+Cost cost_of(const std::string& variant, Integrator integrator, double s, bool grid, double fans, bool wind,
              std::uint32_t steps_per_submit) {
   Cost c;
-  const double eval = kernel_flops(s, grid, wind);
+  const double eval = kernel_flops(s, grid, fans, wind);
   const bool rk4 = integrator == Integrator::rk4;
   // Euler update: a = f/m 3, two axpys 12. RK4: 4 stages (eval + k sums 6 + next stage 12), final 12.
   c.flops = rk4 ? 4.0 * (eval + 18.0) + 12.0 : eval + 15.0;
-  const double csr = grid ? 0.0 : 4.0 + 12.0 * s; // offsets + 12-byte edges
+  // offsets + 12-byte edges; a mesh's fan lists: offsets + 8-byte terms
+  const double csr = grid ? 0.0 : 4.0 + 12.0 * s + (fans > 0.0 ? 4.0 + 8.0 * fans : 0.0);
   if (variant == "cpu") {
     // float vec3 (12 B): read pos, vel; write pos_next, vel, force, normal (and, on grids, the
     // next step's SoA position copy); mass 4 + pinned 1.
@@ -123,6 +171,8 @@ struct Row {
   std::string integrator;          // the scheme timed (implicit runs add a semi-implicit baseline row)
   std::uint32_t cg_iterations = 0; // implicit_euler: CG iterations of the last step
   std::uint32_t instances = 1;     // cloths stepped together (ClothWorld rows)
+  std::string scene = "grid";      // "grid" (n x n) or "mesh" (--mesh)
+  std::string order;               // mesh rows: "meshopt", "file" or "shuffled"
   Cost cost;
 };
 
@@ -245,6 +295,23 @@ Result<std::vector<std::uint32_t>> parse_sizes(const std::string& text) {
   return out;
 }
 
+double per_particle_step(const Row& r) {
+  return r.wall_ms / (double(r.particles) * double(r.steps));
+}
+
+/// The grid row of the same backend, variant and integrator whose particle count is closest to a
+/// mesh row's: the mesh's cost is quoted against it.
+const Row* nearest_grid(const std::vector<Row>& rows, const Row& mesh) {
+  const Row* best = nullptr;
+  for (const Row& g : rows)
+    if (g.scene == "grid" && g.backend == mesh.backend && g.variant == mesh.variant &&
+        g.integrator == mesh.integrator && g.instances == 1 &&
+        (!best || std::abs(double(g.particles) - double(mesh.particles)) <
+                      std::abs(double(best->particles) - double(mesh.particles))))
+      best = &g;
+  return best;
+}
+
 int bench_command(const BenchOptions& o) {
   if (o.backend != "cpu" && o.backend != "vulkan" && o.backend != "all")
     return report(make_error(ErrorCode::invalid_argument,
@@ -282,56 +349,82 @@ int bench_command(const BenchOptions& o) {
   }
 
   std::vector<Row> rows;
-  for (std::uint32_t n : *sizes) {
-    auto sc = bench_scene(n, *integrator, dt);
-    if (!sc)
-      return report(sc.error());
-    const double s = double(sc->system.adjacency.refs.size()) / double(sc->system.size());
+  const bool implicit = *integrator == Integrator::implicit_euler;
+  // Times one scene on the chosen backends (CPU; Vulkan fused / two-pass; ClothWorld batches).
+  auto time_scene = [&](const BenchScene& sc, std::uint32_t n, const std::string& scene,
+                        const std::string& order) -> int {
+    const double s = double(sc.system.adjacency.refs.size()) / double(sc.system.size());
+    double fans = 0.0;
+    if (sc.system.surface) {
+      auto t = ClothTopology::create(sc.system);
+      if (!t)
+        return report(t.error());
+      fans = double((*t)->fans().size()) / double(sc.system.size());
+    }
     auto add = [&](Result<Row> r) -> int {
       if (!r && r.error().code == ErrorCode::unsupported) { // too large for this device: note it, go on
-        fmt::print("note: n = {}: {}\n", n, r.error().message);
+        fmt::print("note: {} n = {}: {}\n", scene, n, r.error().message);
         return exit_ok;
       }
       if (!r)
         return report(r.error());
-      r->particles = sc->system.size() * r->instances;
-      r->springs = sc->system.springs.size();
+      r->particles = sc.system.size() * r->instances;
+      r->springs = sc.system.springs.size();
       r->steps = o.steps;
       r->reps = o.reps;
-      r->cost = cost_of(r->variant, *integrator, s, true, true, o.steps_per_submit);
+      r->scene = scene;
+      r->order = order;
+      r->cost = cost_of(r->variant, sc.params.integrator, s, scene == "grid", fans, true, o.steps_per_submit);
       rows.push_back(*r);
       return exit_ok;
     };
-    const bool implicit = *integrator == Integrator::implicit_euler;
     if (o.backend != "vulkan")
-      if (int e = add(bench_cpu(*sc, n, o)))
+      if (int e = add(bench_cpu(sc, n, o)))
         return e;
-    if (ctx) {
-      const bool fused = o.variants.find("fused") != std::string::npos;
-      const bool two_pass = o.variants.find("two_pass") != std::string::npos;
-      if (fused || *integrator == Integrator::rk4 || implicit)
-        if (int e = add(bench_vulkan(*ctx, *sc, n, true, o)))
-          return e;
-      if (two_pass && *integrator != Integrator::rk4 && !implicit)
-        if (int e = add(bench_vulkan(*ctx, *sc, n, false, o)))
-          return e;
-      if (o.instances > 1) { // many cloths: one batch vs one dispatch chain per cloth, same submission
-        if (int e = add(bench_world(*ctx, *sc, n, true, o)))
-          return e;
-        if (int e = add(bench_world(*ctx, *sc, n, false, o)))
-          return e;
-      }
+    if (!ctx)
+      return exit_ok;
+    const bool fused = o.variants.find("fused") != std::string::npos;
+    const bool two_pass = o.variants.find("two_pass") != std::string::npos;
+    const bool rk4 = sc.params.integrator == Integrator::rk4;
+    const bool imp = sc.params.integrator == Integrator::implicit_euler;
+    if (fused || rk4 || imp)
+      if (int e = add(bench_vulkan(*ctx, sc, n, true, o)))
+        return e;
+    if (two_pass && !rk4 && !imp)
+      if (int e = add(bench_vulkan(*ctx, sc, n, false, o)))
+        return e;
+    if (o.instances > 1 && scene == "grid") { // many cloths: one batch vs one dispatch chain per cloth
+      if (int e = add(bench_world(*ctx, sc, n, true, o)))
+        return e;
+      if (int e = add(bench_world(*ctx, sc, n, false, o)))
+        return e;
     }
+    return exit_ok;
+  };
+  for (std::uint32_t n : *sizes) {
+    auto sc = bench_scene(n, *integrator, dt);
+    if (!sc)
+      return report(sc.error());
+    if (int e = time_scene(*sc, n, "grid", ""))
+      return e;
     if (implicit) { // the explicit baseline at the same size and dt, for the cost ratio
       auto base = bench_scene(n, Integrator::semi_implicit_euler, dt);
       if (!base)
         return report(base.error());
-      if (o.backend != "vulkan")
-        if (int e = add(bench_cpu(*base, n, o)))
-          return e;
-      if (ctx)
-        if (int e = add(bench_vulkan(*ctx, *base, n, true, o)))
-          return e;
+      if (int e = time_scene(*base, n, "grid", ""))
+        return e;
+    }
+  }
+  if (!o.mesh.empty()) {
+    auto mesh = read_mesh(o.mesh);
+    if (!mesh)
+      return report(mesh.error());
+    for (const char* order : {"meshopt", "file", "shuffled"}) {
+      auto sc = mesh_bench_scene(*mesh, order, *integrator, dt);
+      if (!sc)
+        return report(sc.error());
+      if (int e = time_scene(*sc, 0, "mesh", order))
+        return e;
     }
   }
 
@@ -349,7 +442,9 @@ int bench_command(const BenchOptions& o) {
   if (o.instances > 1)
     fmt::print("batched / unbatched rows: {} cloths of n x n in one ClothWorld (particles = all of them)\n",
                o.instances);
-  fmt::print("{:<7} {:<9} {:>5} {:>8} {:>3} {:>9} {:>9} {:>9} {:>6} {:>7} {:>5} {:>6} {:>8} {:>5}\n",
+  if (!o.mesh.empty())
+    fmt::print("mesh rows: {} (n column: the particle order: meshopt, file or shuffled)\n", o.mesh);
+  fmt::print("{:<7} {:<9} {:>8} {:>8} {:>3} {:>9} {:>9} {:>9} {:>6} {:>7} {:>5} {:>6} {:>8} {:>5}\n",
              "backend", "variant", "n", "particles", "thr", "ms/step", "gpu ms", "M p-st/s", "B/p-st", "GB/s",
              "%mem", "fl/pst", "GFLOP/s", "%cmp");
   nlohmann::json results = nlohmann::json::array();
@@ -360,10 +455,11 @@ int bench_command(const BenchOptions& o) {
     const double gflops = rate * r.cost.flops * 1e-9;
     const double gpu_step = r.gpu_ms >= 0 ? r.gpu_ms / double(r.steps) : -1.0;
     fmt::print(
-        "{:<7} {:<9} {:>5} {:>8} {:>3} {:>9.4f} {:>9} {:>9.1f} {:>6.0f} {:>7.2f} {:>4.0f}% {:>6.0f} {:>8.2f} "
+        "{:<7} {:<9} {:>8} {:>8} {:>3} {:>9.4f} {:>9} {:>9.1f} {:>6.0f} {:>7.2f} {:>4.0f}% {:>6.0f} {:>8.2f} "
         "{:>4.1f}%\n",
-        r.backend, r.variant, r.size, r.particles, r.backend == "cpu" ? fmt::format("{}", r.threads) : "-",
-        ms_step, gpu_step >= 0 ? fmt::format("{:.4f}", gpu_step) : "-", rate * 1e-6, r.cost.bytes, gbps,
+        r.backend, r.variant, r.scene == "grid" ? fmt::format("{}", r.size) : r.order, r.particles,
+        r.backend == "cpu" ? fmt::format("{}", r.threads) : "-", ms_step,
+        gpu_step >= 0 ? fmt::format("{:.4f}", gpu_step) : "-", rate * 1e-6, r.cost.bytes, gbps,
         100.0 * gbps / o.memory_gbps, r.cost.flops, gflops, 100.0 * gflops / o.compute_gflops);
     nlohmann::json j;
     j["backend"] = r.backend;
@@ -376,6 +472,12 @@ int bench_command(const BenchOptions& o) {
           j["implicit_over_explicit"] = r.wall_ms / e.wall_ms;
     }
     j["size"] = r.size;
+    j["scene"] = r.scene;
+    if (r.scene == "mesh") {
+      j["order"] = r.order;
+      if (const Row* g = nearest_grid(rows, r))
+        j["mesh_over_grid"] = per_particle_step(r) / per_particle_step(*g);
+    }
     j["instances"] = r.instances;
     j["particles"] = r.particles;
     j["springs"] = r.springs;
@@ -404,10 +506,17 @@ int bench_command(const BenchOptions& o) {
               "({} CG iterations in the last step)\n",
               r.backend, r.size, r.wall_ms / double(r.steps), e.wall_ms / double(e.steps),
               r.wall_ms / e.wall_ms, r.cg_iterations);
+  for (const Row& r : rows)
+    if (const Row* g = r.scene == "mesh" ? nearest_grid(rows, r) : nullptr)
+      fmt::print(
+          "{} {} mesh ({} order, {} particles): {:.2f}x the cost per particle-step of the {} x {} grid\n",
+          r.backend, r.variant, r.order, r.particles, per_particle_step(r) / per_particle_step(*g), g->size,
+          g->size);
   if (!o.json.empty()) {
     nlohmann::json doc;
     doc["schema"] = "vkcloth-bench/1";
     doc["scene"] = "hanging_cloth";
+    doc["mesh"] = o.mesh.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.mesh);
     doc["integrator"] = o.integrator;
     doc["dt"] = dt;
     doc["steps"] = o.steps;
@@ -469,6 +578,10 @@ void add_bench_command(CLI::App& app, int* exit) {
                    ? std::string()
                    : std::string("expected fused, two_pass or fused,two_pass");
       });
+  cmd->add_option("--mesh", opt->mesh,
+                  "Also time the cloth made from this OBJ / glTF mesh, with its particles renumbered by "
+                  "meshoptimizer, in the file's order and shuffled, against the grid of nearest size")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--json", opt->json, "Also write the results as JSON to FILE (keys: docs/performance.md)");
   cmd->footer(exit_codes_footer);
   cmd->callback([opt, exit] { *exit = bench_command(*opt); });

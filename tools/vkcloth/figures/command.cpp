@@ -15,6 +15,7 @@ struct FiguresOptions {
   std::string out = "out/figures";
   std::string backend = "cpu";
   bool quick = false;
+  std::string samples = VKCLOTH_SAMPLES_DIR;
 };
 
 int figures_command(const FiguresOptions& opt) {
@@ -26,7 +27,7 @@ int figures_command(const FiguresOptions& opt) {
   if (ec)
     return report(make_error(
         ErrorCode::io, fmt::format("cannot create the output directory {}: {}", opt.out, ec.message())));
-  figures::Gallery gallery{opt.out, opt.backend, {}, nlohmann::json::object(), opt.quick};
+  figures::Gallery gallery{opt.out, opt.backend, {}, nlohmann::json::object(), opt.quick, opt.samples};
   const auto t0 = std::chrono::steady_clock::now();
   fmt::print(stderr, "figures: springs...\n");
   if (auto r = figures::spring_figures(gallery); !r)
@@ -58,6 +59,11 @@ void add_figures_command(CLI::App& app, int* exit) {
       "renderer either way (the CPU result is uploaded for drawing); Figure 14 is always the GPU solver");
   cmd->add_flag("--quick", opt->quick,
                 "Smaller cloth pictures (240x180 panels instead of 400x300); same numbers");
+  cmd->add_option(
+         "--samples", opt->samples,
+         "The samples directory holding scenes/ and meshes/ for the mesh figure (default: the source "
+         "tree's)")
+      ->capture_default_str();
   cmd->callback([opt, exit] { *exit = figures_command(*opt); });
 }
 

@@ -28,6 +28,7 @@ struct Gallery {
   std::vector<Figure> figures;
   nlohmann::json metrics = nlohmann::json::object(); ///< the numbers behind the pictures
   bool quick = false; ///< --quick: smaller cloth pictures (same physics, same numbers)
+  std::filesystem::path samples = VKCLOTH_SAMPLES_DIR; ///< --samples: scenes/ and meshes/ of the mesh figure
 
   Result<void> write_text(const std::string& file, const std::string& text) const;
   Result<void> write_index() const; ///< index.html and figures.json
@@ -48,7 +49,8 @@ double total_energy(const Scene& scene, const std::vector<glm::dvec3>& pos,
                     const std::vector<glm::dvec3>& vel);
 
 Result<void> spring_figures(Gallery& gallery);
-/// Figures 5, 7-9, 11-14: labelled image grids (rendered offscreen; skipped without a Vulkan device
+/// Figures 5, 7-9, 11-14 and the mesh samples (samples/scenes/{tablecloth_on_sphere, flag_with_hole,
+/// skirt}.json): labelled image grids (rendered offscreen; skipped without a Vulkan device
 /// on the CPU backend, the numbers are computed either way) and metrics["cloth"].
 Result<void> cloth_figures(Gallery& gallery);
 /// The (K_struct, dt) stability map of semi-implicit Euler, RK4 and implicit Euler (stability.cpp).
