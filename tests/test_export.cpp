@@ -235,7 +235,7 @@ TEST_CASE("export: OBJ frames read back in the file's order, with round-trip pre
   }
 }
 
-TEST_CASE("export: one frame is a still mesh; a texture is embedded with its MIME type") {
+TEST_CASE("export: one frame is a still mesh, and a texture is embedded with its MIME type") {
   const ParticleSystem system = shuffled_mesh_cloth();
   Recorded one = mesh_frames(system);
   one.frames.resize(1);
