@@ -293,6 +293,7 @@ TEST_CASE("export: errors name the problem and the value") {
   message_has(rec->add_frame(0.0, frame), "particle 7");
   frame[7].y = 0.0;
   message_has(rec->add_frame(-1.0, frame), "-1");
+  message_has(rec->add_frame(1e39, frame), "finite"); // beyond float's range
   REQUIRE(rec->add_frame(0.5, frame));
   message_has(rec->add_frame(0.5, frame), "not after");
   CHECK(rec->frame_count() == 1);

@@ -80,16 +80,21 @@ Result<ExportSurface> export_surface(const ParticleSystem& system) {
   return out;
 }
 
-/// One position per particle, each finite in float (what a glTF float accessor can hold).
+/// Finite and within float's range (converting a larger double to float is undefined).
+bool fits_float(double x) {
+  return std::abs(x) <= double(std::numeric_limits<float>::max());
+}
+
+/// One position per particle, each one a float can hold (what a glTF float accessor stores).
 Result<void> check_positions(std::span<const glm::dvec3> positions, std::size_t particles,
                              std::string_view what) {
   if (positions.size() != particles)
     return invalid(fmt::format("{}: {} positions for {} particles", what, positions.size(), particles));
   for (std::size_t p = 0; p < positions.size(); ++p) {
-    const glm::vec3 f(positions[p]);
-    if (!std::isfinite(f.x) || !std::isfinite(f.y) || !std::isfinite(f.z))
+    const glm::dvec3 x = positions[p];
+    if (!fits_float(x.x) || !fits_float(x.y) || !fits_float(x.z))
       return invalid(fmt::format("{}: particle {} has a position ({}, {}, {}) that is not finite in float",
-                                 what, p, positions[p].x, positions[p].y, positions[p].z));
+                                 what, p, x.x, x.y, x.z));
   }
   return {};
 }
@@ -264,11 +269,6 @@ void add_weights_animation(tinygltf::Model& m, const std::vector<float>& times, 
 /// glTF's binary container stores its length in 32 bits; leave room for the JSON.
 constexpr std::size_t max_gltf_buffer_bytes = (std::size_t{1} << 32) - (std::size_t{64} << 20);
 
-std::size_t gltf_buffer_estimate(std::size_t vertices, std::size_t triangles_indices, std::size_t frames,
-                                 std::size_t texture_bytes) {
-  return frames * vertices * 12 + vertices * 8 + triangles_indices * 4 + frames * frames * 4 + texture_bytes;
-}
-
 } // namespace
 
 // ---- public ---------------------------------------------------------------------------------
@@ -306,6 +306,19 @@ struct AnimationRecorder::Impl {
   std::vector<std::vector<float>> frames; ///< x, y, z per output vertex
 
   tinygltf::Model model() const;
+
+  /// Checked as frames come, before they fill the memory: `frame_total` frames must fit in a glb.
+  Result<void> check_size(std::size_t frame_total) const {
+    const std::size_t n = surface.order.size();
+    const std::size_t bytes = frame_total * n * 12 + n * 8 + surface.triangles.size() * 4 +
+                              frame_total * frame_total * 4 + (texture ? texture->encoded.size() : 0);
+    if (bytes > max_gltf_buffer_bytes)
+      return invalid(
+          fmt::format("{} frames of {} vertices need about {} bytes, over glTF's 4 GiB limit: record "
+                      "fewer frames",
+                      frame_total, n, bytes));
+    return {};
+  }
 };
 
 /// One mesh (frame 0 as POSITION, frame f > 0 as morph target f - 1) on one node that turns
@@ -368,13 +381,14 @@ Result<AnimationRecorder> AnimationRecorder::create(const ParticleSystem& system
 
 Result<void> AnimationRecorder::add_frame(double time, std::span<const glm::dvec3> positions) {
   const std::string what = fmt::format("frame {} (time {} s)", impl_->frames.size(), time);
-  const auto t = static_cast<float>(time); // as the file stores it
-  if (!std::isfinite(t) || t < 0.0f)
+  if (!fits_float(time) || time < 0.0)
     return invalid(fmt::format("{}: the time must be finite and not negative", what));
+  const auto t = static_cast<float>(time); // as the file stores it
   if (!impl_->times.empty() && t <= impl_->times.back())
     return invalid(fmt::format("{}: not after the previous frame's time {} s (compared as float seconds)",
                                what, impl_->times.back()));
   VKCLOTH_TRY(check_positions(positions, impl_->surface.order.size(), what));
+  VKCLOTH_TRY(impl_->check_size(impl_->frames.size() + 1));
   impl_->times.push_back(t);
   impl_->frames.push_back(output_positions(impl_->surface, positions));
   return {};
@@ -388,14 +402,6 @@ Result<void> AnimationRecorder::write_gltf(const std::filesystem::path& path) co
   VKCLOTH_TRY(check_gltf_path(path));
   if (impl_->frames.empty())
     return invalid(fmt::format("cannot export {}: no frames were recorded", path.string()));
-  const std::size_t estimate =
-      gltf_buffer_estimate(impl_->surface.order.size(), impl_->surface.triangles.size(), impl_->frames.size(),
-                           impl_->texture ? impl_->texture->encoded.size() : 0);
-  if (estimate > max_gltf_buffer_bytes)
-    return invalid(
-        fmt::format("cannot export {}: {} frames of {} vertices need about {} bytes, over glTF's 4 GiB "
-                    "limit; record fewer frames",
-                    path.string(), impl_->frames.size(), impl_->surface.order.size(), estimate));
   const bool binary = lower_extension(path) == ".glb";
   const tinygltf::Model model = impl_->model();
   std::ostringstream out;
