@@ -6,7 +6,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <memory>
+#include <optional>
 
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
@@ -14,6 +16,7 @@
 
 #include "backend.hpp"
 #include "commands.hpp"
+#include "vkcloth/export.hpp"
 #include "vkcloth/scene.hpp"
 
 namespace vkcloth::cli {
@@ -67,11 +70,14 @@ private:
   int last_ = -1;
 };
 
+/// Rows in the file's vertex order; the particle column is the file's vertex index (a mesh's
+/// Surface::source_vertex; the particle index for grids and chains).
 void write_trace_rows(std::FILE* f, std::uint64_t step, double time, const std::vector<glm::dvec3>& p,
-                      const std::vector<glm::dvec3>& v) {
-  for (std::size_t k = 0; k < p.size(); ++k)
-    fmt::print(f, "{},{:.9g},{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n", step, time, k, p[k].x, p[k].y,
-               p[k].z, v[k].x, v[k].y, v[k].z);
+                      const std::vector<glm::dvec3>& v, const ParticleSystem& system,
+                      const std::vector<std::uint32_t>& order) {
+  for (const std::uint32_t k : order)
+    fmt::print(f, "{},{:.9g},{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n", step, time,
+               file_vertex(system, k), p[k].x, p[k].y, p[k].z, v[k].x, v[k].y, v[k].z);
 }
 
 struct RunOptions {
@@ -81,6 +87,86 @@ struct RunOptions {
   std::string positions; ///< empty: no final positions file
   std::string backend = "cpu";
   std::string precision = "float";
+  std::string export_path;                   ///< .glb or .gltf; empty: none
+  std::string obj_frames;                    ///< a directory; empty: none
+  std::optional<std::uint64_t> export_every; ///< K for both; unset: 1
+};
+
+/// --export and --obj-frames: a frame at step 0 and every K steps (as --trace rows); OBJs are
+/// written as they come, the glTF at the end (or at a blow-up, with the frames before it).
+class FrameExport {
+public:
+  /// Checks the paths and that the scene has a surface, before anything is simulated.
+  static Result<FrameExport> create(const RunOptions& opt, const Scene& scene) {
+    FrameExport e(scene.system);
+    if (opt.export_every && opt.export_path.empty() && opt.obj_frames.empty())
+      return make_error(ErrorCode::invalid_argument, "--export-every needs --export or --obj-frames");
+    e.every_ = opt.export_every.value_or(1);
+    if (!opt.export_path.empty()) {
+      VKCLOTH_TRY(check_gltf_path(opt.export_path));
+      auto recorder = AnimationRecorder::create(scene.system, scene.texture);
+      if (!recorder)
+        return make_error(recorder.error().code, "--export: " + recorder.error().message);
+      VKCLOTH_TRY(probe_writable(opt.export_path));
+      e.gltf_path_ = opt.export_path;
+      e.recorder_.emplace(std::move(*recorder));
+    }
+    if (!opt.obj_frames.empty()) {
+      std::error_code ec;
+      std::filesystem::create_directories(opt.obj_frames, ec);
+      if (ec)
+        return make_error(ErrorCode::io, fmt::format("--obj-frames: cannot create the directory {}: {}",
+                                                     opt.obj_frames, ec.message()));
+      e.obj_dir_ = opt.obj_frames;
+    }
+    return e;
+  }
+
+  bool enabled() const { return recorder_ || !obj_dir_.empty(); }
+  std::uint64_t every() const { return every_; }
+
+  Result<void> add(double time, const std::vector<glm::dvec3>& positions) {
+    if (recorder_)
+      VKCLOTH_TRY(recorder_->add_frame(time, positions));
+    if (!obj_dir_.empty()) {
+      const auto path = obj_dir_ / fmt::format("frame_{:05}.obj", frames_);
+      if (auto r = write_obj_frame(path, *system_, positions); !r)
+        return make_error(r.error().code, "--obj-frames: " + r.error().message);
+    }
+    ++frames_;
+    return {};
+  }
+
+  /// Writes the glTF (nothing to do for OBJs); prints what was exported.
+  Result<void> finish() const {
+    if (recorder_)
+      VKCLOTH_TRY(recorder_->write_gltf(gltf_path_));
+    if (recorder_)
+      fmt::print("exported {} frames to {}\n", frames_, gltf_path_.string());
+    if (!obj_dir_.empty())
+      fmt::print("exported {} OBJ frames to {}\n", frames_, obj_dir_.string());
+    return {};
+  }
+
+private:
+  explicit FrameExport(const ParticleSystem& system) : system_(&system) {}
+
+  /// The glTF is written at the end: fail on an unwritable path now, not after the run.
+  static Result<void> probe_writable(const std::string& path) {
+    std::FILE* f = std::fopen(path.c_str(), "wb");
+    if (!f)
+      return make_error(ErrorCode::io,
+                        fmt::format("cannot write the export file {}: {}", path, std::strerror(errno)));
+    std::fclose(f);
+    return {};
+  }
+
+  const ParticleSystem* system_;
+  std::uint64_t every_ = 1;
+  std::optional<AnimationRecorder> recorder_;
+  std::filesystem::path gltf_path_;
+  std::filesystem::path obj_dir_;
+  std::uint64_t frames_ = 0;
 };
 
 int run_command(const RunOptions& opt) {
@@ -90,6 +176,10 @@ int run_command(const RunOptions& opt) {
   auto scene = load_scene_file(opt.args.scene, opt.args.overrides());
   if (!scene)
     return report(scene.error());
+  auto frames_r = FrameExport::create(opt, *scene);
+  if (!frames_r)
+    return report(frames_r.error());
+  FrameExport& frames = *frames_r;
   auto backend_r = make_backend(opt.backend, *scene, *precision);
   if (!backend_r)
     return report(backend_r.error());
@@ -118,31 +208,45 @@ int run_command(const RunOptions& opt) {
   if (auto r = read(); !r)
     return report(r.error());
   const std::vector<glm::dvec3> initial = pos; // in the solver's precision, for the displacement
-  if (trace) {
-    write_trace_rows(trace.get(), 0, backend.time(), pos, vel);
-  }
+  const std::vector<std::uint32_t> order = file_order(scene->system);
+  if (trace)
+    write_trace_rows(trace.get(), 0, backend.time(), pos, vel, scene->system, order);
+  if (frames.enabled())
+    if (auto r = frames.add(backend.time(), pos); !r)
+      return report(r.error());
+  const auto next_multiple = [](std::uint64_t done, std::uint64_t k) { return (done / k + 1) * k; };
 
   const auto t0 = std::chrono::steady_clock::now();
   {
     Progress progress(total);
     std::uint64_t done = 0;
     while (done < total) {
-      // Step to the next trace row or progress redraw, whichever comes first.
+      // Step to the next trace row, exported frame or progress redraw, whichever comes first.
       std::uint64_t next = progress.next_tick(done);
       if (trace)
-        next = std::min(next, (done / every + 1) * every);
+        next = std::min(next, next_multiple(done, every));
+      if (frames.enabled())
+        next = std::min(next, next_multiple(done, frames.every()));
       next = std::min(next, total);
       if (auto r = backend.step(next - done); !r) {
         if (trace)
-          std::fflush(trace.get()); // the rows before the blow-up stay
+          std::fflush(trace.get());       // the rows before the blow-up stay
+        if (auto w = frames.finish(); !w) // and so do the frames
+          report(w.error());
         return report(r.error());
       }
       done = next;
-      if (trace && done % every == 0) {
+      const bool trace_due = trace && done % every == 0;
+      const bool frame_due = frames.enabled() && done % frames.every() == 0;
+      if (trace_due || frame_due) {
         if (auto r = read(); !r)
           return report(r.error());
-        write_trace_rows(trace.get(), backend.step_index(), backend.time(), pos, vel);
       }
+      if (trace_due)
+        write_trace_rows(trace.get(), backend.step_index(), backend.time(), pos, vel, scene->system, order);
+      if (frame_due)
+        if (auto r = frames.add(backend.time(), pos); !r)
+          return report(r.error());
       progress.update(done);
     }
   }
@@ -158,6 +262,8 @@ int run_command(const RunOptions& opt) {
   for (File* f : {&trace, &positions})
     if (*f && (std::fflush(f->get()) != 0 || std::ferror(f->get())))
       return report(make_error(ErrorCode::io, "writing an output file failed (disk full?)"));
+  if (auto r = frames.finish(); !r)
+    return report(r.error());
 
   double max_disp = 0.0;
   for (std::size_t k = 0; k < pos.size(); ++k)
@@ -180,16 +286,27 @@ int run_command(const RunOptions& opt) {
 
 void add_run_command(CLI::App& app, int* exit) {
   auto opt = std::make_shared<RunOptions>();
-  CLI::App* cmd = app.add_subcommand("run", "Simulate a scene and optionally write CSV traces");
+  CLI::App* cmd = app.add_subcommand(
+      "run", "Simulate a scene; optionally write CSV traces and export the animation (glTF, OBJ)");
   cmd->footer(exit_codes_footer);
   add_scene_options(*cmd, opt->args);
   auto* trace =
       cmd->add_option("--trace", opt->trace,
                       "Write every particle's state to a CSV file: step,time,particle,x,y,z,vx,vy,vz "
-                      "(step 0 then every K steps)");
+                      "(step 0 then every K steps; for a mesh cloth, particle is the file's vertex index)");
   cmd->add_option("--trace-every", opt->trace_every, "K for --trace (default 1)")
       ->check(CLI::PositiveNumber)
       ->needs(trace);
+  cmd->add_option(
+      "--export", opt->export_path,
+      "Write the animated cloth as glTF 2.0: FILE.glb (binary) or FILE.gltf (JSON, buffer embedded); "
+      "frames at step 0 then every K steps (--export-every), in the mesh file's vertex order");
+  cmd->add_option("--export-every", opt->export_every, "K for --export and --obj-frames (default 1)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option(
+         "--obj-frames", opt->obj_frames,
+         "Write one OBJ per exported frame into DIR (created): frame_00000.obj, frame_00001.obj, ...")
+      ->type_name("DIR");
   cmd->add_option("--positions", opt->positions, "Write the final positions to a CSV file: particle,x,y,z");
   cmd->add_option("--backend", opt->backend, "Solver backend: cpu | vulkan (default cpu)");
   cmd->add_option("--precision", opt->precision,

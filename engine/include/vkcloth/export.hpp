@@ -19,7 +19,12 @@
 namespace vkcloth {
 
 /// Collects frames of one cloth (a grid or a mesh) and writes them as one animated glTF 2.0
-/// file (docs/scene-format.md "Export" says how the animation is encoded and its size per frame).
+/// file (docs/scene-format.md "Export"): one mesh whose POSITION is the first frame, one morph
+/// target per later frame (float position deltas) and a "weights" animation with STEP
+/// interpolation, one-hot per frame; TEXCOORD_0, no normals (viewers compute them); the node
+/// rotates vkcloth's z up to glTF's y up. Size per frame: 12 N bytes of deltas + 4 F bytes of
+/// weights + ~250 bytes of JSON (N vertices, F frames; measured 24,646 B at N = 2000, F = 100).
+/// Frames are kept in memory (12 N bytes each) until write_gltf.
 class AnimationRecorder {
 public:
   /// `system` must have a surface (a grid or a mesh): chains have no triangles to export.
@@ -43,6 +48,19 @@ private:
   explicit AnimationRecorder(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };
+
+/// The particles in the order every output lists them (glTF, OBJ, the CLI's --trace): a mesh's
+/// by file vertex (Surface::source_vertex ascending), else particle order. Output vertex k is
+/// particle file_order(system)[k].
+std::vector<std::uint32_t> file_order(const ParticleSystem& system);
+
+/// The file's vertex index of particle `p`: Surface::source_vertex[p], or `p` for grids, chains
+/// and meshes kept in file order.
+std::uint32_t file_vertex(const ParticleSystem& system, std::uint32_t p);
+
+/// What write_gltf checks first: the extension is .glb or .gltf (any case), else
+/// ErrorCode::invalid_argument naming it. Lets a caller refuse a path before a long run.
+Result<void> check_gltf_path(const std::filesystem::path& path);
 
 /// Writes one OBJ of the cloth's surface at `positions` (solver order), in the file's vertex
 /// order with uvs. Errors: ErrorCode::io naming the path.
