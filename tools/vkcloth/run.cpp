@@ -255,9 +255,10 @@ int run_command(const RunOptions& opt) {
   if (auto r = read(); !r)
     return report(r.error());
   if (positions) {
-    fmt::print(positions.get(), "particle,x,y,z\n");
-    for (std::size_t k = 0; k < pos.size(); ++k)
-      fmt::print(positions.get(), "{},{:.9g},{:.9g},{:.9g}\n", k, pos[k].x, pos[k].y, pos[k].z);
+    fmt::print(positions.get(), "particle,x,y,z\n"); // in the file's vertex order, as --trace
+    for (const std::uint32_t k : order)
+      fmt::print(positions.get(), "{},{:.9g},{:.9g},{:.9g}\n", file_vertex(scene->system, k), pos[k].x, pos[k].y,
+                 pos[k].z);
   }
   for (File* f : {&trace, &positions})
     if (*f && (std::fflush(f->get()) != 0 || std::ferror(f->get())))
