@@ -182,6 +182,24 @@ Result<std::shared_ptr<const ClothTopology>> ClothTopology::create(const Particl
         t->uvs_[std::size_t(j) * nx + i] =
             glm::vec2(nx > 1 ? float(i) / float(nx - 1) : 0.0f, ny > 1 ? float(j) / float(ny - 1) : 0.0f);
     t->stencil_ = detect_stencil(*s.grid, t->edge_offsets(), t->edges_);
+  } else if (s.surface) {
+    // A mesh: its triangles and uvs as given. Each triangle (a, b, c), in order, adds one fan
+    // term to each corner, the other two corners counter-clockwise: a {b, c}, b {c, a}, c {a, b}.
+    const std::vector<std::uint32_t>& tri = s.surface->triangles;
+    t->triangles_ = tri;
+    std::copy(s.surface->uvs.begin(), s.surface->uvs.end(), t->uvs_.begin());
+    for (std::uint32_t corner : tri)
+      ++t->fan_offsets_[corner + 1];
+    for (std::size_t p = 0; p < n; ++p)
+      t->fan_offsets_[p + 1] += t->fan_offsets_[p];
+    t->fans_.resize(tri.size());
+    std::vector<std::uint32_t> next(t->fan_offsets_.begin(), t->fan_offsets_.end() - 1);
+    for (std::size_t k = 0; k + 2 < tri.size(); k += 3) {
+      const std::uint32_t a = tri[k], b = tri[k + 1], c = tri[k + 2];
+      t->fans_[next[a]++] = FanTriangle{b, c};
+      t->fans_[next[b]++] = FanTriangle{c, a};
+      t->fans_[next[c]++] = FanTriangle{a, b};
+    }
   }
   return std::shared_ptr<const ClothTopology>(std::move(t));
 }
