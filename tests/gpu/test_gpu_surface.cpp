@@ -176,8 +176,8 @@ void check_surface_against_cpu(Context& ctx, const std::string& name, const Part
       }
       MESSAGE(fmt::format("{:<30} {:<20} {:<9} max|dp| = {:.3g}{} max|dv| = {:.3g} max|dn| = {:.3g} (moved "
                           "{:.3g} m)",
-                          name, method, fused ? "fused" : "two-pass", dp.max_abs, dp.bitwise ? " (bitwise)" : "",
-                          dv.max_abs, dn.max_abs, moved));
+                          name, method, fused ? "fused" : "two-pass", dp.max_abs,
+                          dp.bitwise ? " (bitwise)" : "", dv.max_abs, dn.max_abs, moved));
       CHECK(moved > 1e-2);
       CHECK(shortest_normal > 0.999); // every particle has a fan: a unit normal on the GPU
       CHECK(dp.max_abs <= 1e-5);
@@ -209,8 +209,8 @@ TEST_CASE("surface topology: fans from the triangles, every particle of the patc
     smallest = std::min(smallest, fan);
     largest = std::max(largest, fan);
   }
-  MESSAGE(fmt::format("patch: {} particles, {} triangles, {} springs, fans of {} to {} triangles", topo.size(),
-                      topo.triangles().size() / 3, s.springs.size(), smallest, largest));
+  MESSAGE(fmt::format("patch: {} particles, {} triangles, {} springs, fans of {} to {} triangles",
+                      topo.size(), topo.triangles().size() / 3, s.springs.size(), smallest, largest));
   CHECK(smallest >= 1);
   CHECK(largest >= 7); // irregular: valences differ (a regular grid's are 1 to 6)
 }
@@ -253,8 +253,9 @@ TEST_CASE("GPU implicit Euler on an irregular mesh surface matches the CPU impli
   REQUIRE(cpu->run(100).ok());
   const Outputs g = run_gpu(ctx, patch, p, 100, true);
   const Diff dp = diff(g.x, cpu->positions()), dn = diff(g.n, cpu->normals());
-  MESSAGE(fmt::format("irregular patch + wind, implicit Euler, 100 steps: max|dp| = {:.3g}{} max|dn| = {:.3g}",
-                      dp.max_abs, dp.bitwise ? " (bitwise)" : "", dn.max_abs));
+  MESSAGE(
+      fmt::format("irregular patch + wind, implicit Euler, 100 steps: max|dp| = {:.3g}{} max|dn| = {:.3g}",
+                  dp.max_abs, dp.bitwise ? " (bitwise)" : "", dn.max_abs));
   CHECK(dp.max_abs <= 1e-4);
   CHECK(dn.max_abs <= 1e-3);
 }
@@ -287,8 +288,8 @@ TEST_CASE("GPU fan-list normals on a grid give the grid path's bits (every integ
     CHECK(testing::pipeline_count(ctx) > pipelines);
   }
   for (const auto& [system, base] : scenes)
-    for (Integrator integrator : {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::rk4,
-                                  Integrator::implicit_euler})
+    for (Integrator integrator : {Integrator::explicit_euler, Integrator::semi_implicit_euler,
+                                  Integrator::rk4, Integrator::implicit_euler})
       for (bool fused : {true, false}) {
         CAPTURE(system.size());
         CAPTURE(to_string(integrator));
