@@ -171,7 +171,8 @@ TEST_CASE("mesh render: the hole and the outside show the background, the cloth 
   INFO("mean cloth colour above " << ring_colour[0].r << ", " << ring_colour[0].g << ", " << ring_colour[0].b
                                   << "; below " << ring_colour[1].r << ", " << ring_colour[1].g << ", "
                                   << ring_colour[1].b);
-  CHECK(ring_colour[1].b / std::max(ring_colour[1].r, 1.0f) > 1.2f * ring_colour[0].b / std::max(ring_colour[0].r, 1.0f));
+  CHECK(ring_colour[1].b / std::max(ring_colour[1].r, 1.0f) >
+        1.2f * ring_colour[0].b / std::max(ring_colour[0].r, 1.0f));
 }
 
 TEST_CASE("mesh render: an encoded PNG texture (RendererOptions::encoded_texture) colours the cloth") {
@@ -179,7 +180,8 @@ TEST_CASE("mesh render: an encoded PNG texture (RendererOptions::encoded_texture
   RendererOptions ro;
   ro.encoded_texture = MeshTexture{"test green.png", png_bytes(solid(8, 4, {30, 200, 40}), "green.png")};
   MeshRig rig = make_mesh_rig(ctx, std::move(ro));
-  const Camera cam = Camera::frame(scene_bounds(rig.solver.topology()->system(), still()), float(W) / float(H));
+  const Camera cam =
+      Camera::frame(scene_bounds(rig.solver.topology()->system(), still()), float(W) / float(H));
   auto img = rig.target.render(rig.solver, rig.renderer, cam, 1);
   REQUIRE(img);
   REQUIRE(write_png(out_dir() / "mesh_green.png", *img));
@@ -216,8 +218,8 @@ TEST_CASE("image: decode_image decodes PNG bytes, and its errors name the source
   gradient.width = 5;
   gradient.height = 3;
   for (std::uint32_t k = 0; k < 15; ++k)
-    gradient.rgba.insert(gradient.rgba.end(),
-                         {std::uint8_t(k * 17), std::uint8_t(255 - k * 11), std::uint8_t(k * 3), std::uint8_t(255 - k)});
+    gradient.rgba.insert(gradient.rgba.end(), {std::uint8_t(k * 17), std::uint8_t(255 - k * 11),
+                                               std::uint8_t(k * 3), std::uint8_t(255 - k)});
   const std::vector<std::uint8_t> png = png_bytes(gradient, "gradient.png");
   auto ok = decode_image(png, "gradient");
   REQUIRE_MESSAGE(ok, (ok ? "" : ok.error().message));
