@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: MIT
 // The force evaluation of one particle, shared by force.comp (two-pass layout), fused.comp (one
-// pass per Euler step) and implicit.comp: vertex normal from the grid fan, spring gather in the
-// topology's order, gravity, damping, wind, then contact filtering; each formula from
-// cloth_kernel.h, which the CPU reference compiles too. Reads POS_IN (all particles), OFFSETS,
-// EDGES, PARTICLE.
+// pass per Euler step) and implicit.comp: vertex normal from the grid fan or the topology's fan
+// lists, spring gather in the topology's order, gravity, damping, wind, then contact filtering;
+// each formula from cloth_kernel.h, which the CPU reference compiles too. Reads POS_IN (all
+// particles), OFFSETS, EDGES, FAN_OFFSETS, FANS, PARTICLE.
 #ifndef VKCLOTH_FORCE_BODY_GLSL
 #define VKCLOTH_FORCE_BODY_GLSL
 
@@ -28,6 +28,8 @@ bool pinned_at(uint p) { return particle[p].pinned != 0u; }
 #endif
 layout(std430, set = 0, binding = VKCLOTH_BINDING_OFFSETS) readonly buffer OffsetBuf { uint offsets[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_EDGES) readonly buffer EdgeBuf { Edge edges[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_FAN_OFFSETS) readonly buffer FanOffsetBuf { uint fan_offsets[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_FANS) readonly buffer FanBuf { FanEntry fans[]; };
 
 // Grid stencil (specialisation constants, set by the host when every interior particle's gather
 // list is the same up to translation: GpuSolver detect_stencil, like CpuSolver::detect_stencil).
@@ -77,6 +79,10 @@ layout(constant_id = 38) const float SC_K11 = 0.0;
 // the CSR loop, which llvmpipe runs for every 8-lane group holding a border particle (and whose
 // per-lane loads it pays, masked, for every group).
 layout(constant_id = 39) const bool SC_BORDER = false;
+// False: no instance of the batch takes the fan-list normal (VKCLOTH_FLAG_HAS_FANS), the fan loop
+// compiled out (llvmpipe would run its body once per group even when no invocation enters it).
+// The host sets it with the fused.comp and force.comp pipelines; implicit.comp keeps the default.
+layout(constant_id = 42) const bool SC_FANS = true;
 
 // Bit `bit` when stencil neighbour `off` of grid particle (i, j) lies inside the grid
 // (off = dj nx + di with |di|, |dj| <= 2; compile-time constants after specialisation).
@@ -116,11 +122,27 @@ vec3 grid_normal(uint p) {
   return unit_or_zero(sum);
 }
 
+// The topology's fan around p (ClothTopology::fans, a mesh surface), in order: term for term
+// CpuSolver::normal_at, so the same bits. Edge vectors `precise` as in grid_normal.
+vec3 fan_normal(uint p) {
+  const vec3 x = pos_at(p);
+  vec3 sum = vec3(0.0);
+  const uint end = fan_offsets[p + 1u];
+  for (uint t = fan_offsets[p]; t < end; ++t) {
+    const FanEntry f = fans[t];
+    precise vec3 ea = pos_at(f.a) - x;
+    precise vec3 eb = pos_at(f.b) - x;
+    add_fan_triangle(sum, ea, eb);
+  }
+  return unit_or_zero(sum);
+}
+
 // Force on particle p (index within the instance) after contacts (f), its velocity after contacts (v, in: the state velocity)
 // and its unit normal (nrm).
 void particle_force(uint p, inout vec3 v_io, out vec3 f_out, out vec3 nrm_out) {
   vec3 nrm = vec3(0.0);
   if ((ip.flags & VKCLOTH_FLAG_HAS_GRID) != 0u) nrm = grid_normal(p);
+  else if (SC_FANS && (ip.flags & VKCLOTH_FLAG_HAS_FANS) != 0u) nrm = fan_normal(p);
 
   const vec3 x = pos_at(p);
   vec3 f = vec3(0.0);

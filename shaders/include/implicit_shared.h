@@ -14,17 +14,17 @@
 namespace vkcloth::gpu::shared {
 #endif
 
-#define VKCLOTH_BINDING_IMPL_VF 18       // contact-filtered velocity (vec4)
-#define VKCLOTH_BINDING_IMPL_KS 19       // per CSR entry: K_s as 2 vec4 (xx yy zz xy | xz yz - -)
-#define VKCLOTH_BINDING_IMPL_DIAG_INV 20 // 1 / diag(A), zero for pinned particles (vec4)
-#define VKCLOTH_BINDING_IMPL_X 21        // CG solution dv (vec4)
-#define VKCLOTH_BINDING_IMPL_R 22        // residual
-#define VKCLOTH_BINDING_IMPL_Z 23        // preconditioned residual
-#define VKCLOTH_BINDING_IMPL_D 24        // search direction
-#define VKCLOTH_BINDING_IMPL_Q 25        // S A d
-#define VKCLOTH_BINDING_IMPL_PARTIALS 26 // one vec2 per workgroup: its partial dot products
-#define VKCLOTH_BINDING_IMPL_STATE 27    // CgState
-#define VKCLOTH_BINDING_IMPL_ARGS 28     // indirect dispatch arguments (CgArgs)
+#define VKCLOTH_BINDING_IMPL_VF 20       // contact-filtered velocity (vec4)
+#define VKCLOTH_BINDING_IMPL_KS 21       // per CSR entry: K_s as 2 vec4 (xx yy zz xy | xz yz - -)
+#define VKCLOTH_BINDING_IMPL_DIAG_INV 22 // 1 / diag(A), zero for pinned particles (vec4)
+#define VKCLOTH_BINDING_IMPL_X 23        // CG solution dv (vec4)
+#define VKCLOTH_BINDING_IMPL_R 24        // residual
+#define VKCLOTH_BINDING_IMPL_Z 25        // preconditioned residual
+#define VKCLOTH_BINDING_IMPL_D 26        // search direction
+#define VKCLOTH_BINDING_IMPL_Q 27        // S A d
+#define VKCLOTH_BINDING_IMPL_PARTIALS 28 // one vec2 per workgroup: its partial dot products
+#define VKCLOTH_BINDING_IMPL_STATE 29    // CgState
+#define VKCLOTH_BINDING_IMPL_ARGS 30     // indirect dispatch arguments (CgArgs)
 
 // implicit.comp passes (PushConstants::stage).
 #define VKCLOTH_IMPL_FORCE 0u     // normal, force, contact filtering -> FORCE_OUT, NORMAL, VF
@@ -63,6 +63,7 @@ struct CgArgs {
 };
 
 #ifdef __cplusplus
+static_assert(VKCLOTH_BINDING_IMPL_VF == VKCLOTH_BINDING_COUNT); // right after the main layout's bindings
 static_assert(sizeof(CgState) == 48);
 static_assert(sizeof(CgArgs) == 32);
 } // namespace vkcloth::gpu::shared

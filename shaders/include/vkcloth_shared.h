@@ -27,25 +27,27 @@ struct vec4 {
 // Descriptor bindings (set 0). One layout serves both pipelines; each shader declares the
 // bindings it uses. Four descriptor sets differ only in which buffers sit behind the
 // *_IN / *_BASE / *_OUT / FORCE_OUT bindings (position parity x state-or-RK4-stage input).
-#define VKCLOTH_BINDING_POS_IN 0     // positions the force pass reads (state or RK4 stage)
-#define VKCLOTH_BINDING_VEL_IN 1     // velocities the force pass reads (state or RK4 stage)
-#define VKCLOTH_BINDING_FORCE_OUT 2  // force after contacts (state force, or RK4 stage scratch)
-#define VKCLOTH_BINDING_VEL_FILT 3   // velocity after contact filtering (force -> integrate)
-#define VKCLOTH_BINDING_NORMAL 4     // unit vertex normals (cloth), written every force pass
-#define VKCLOTH_BINDING_POS_BASE 5   // positions at the start of the step (= positions[read])
-#define VKCLOTH_BINDING_POS_OUT 6    // positions at the end of the step (= positions[write])
-#define VKCLOTH_BINDING_VEL 7        // state velocities (read and written by integrate)
-#define VKCLOTH_BINDING_STAGE_POS 8  // RK4 stage positions y_k
-#define VKCLOTH_BINDING_STAGE_VEL 9  // RK4 stage velocities
-#define VKCLOTH_BINDING_ACC_POS 10   // RK4 running sum k1 + 2 k2 + 2 k3 + k4 (positions)
-#define VKCLOTH_BINDING_ACC_VEL 11   // RK4 running sum (velocities)
-#define VKCLOTH_BINDING_PARTICLE 12  // ParticleInfo per particle
-#define VKCLOTH_BINDING_OFFSETS 13   // CSR offsets, count + 1 entries (SpringAdjacency::offsets)
-#define VKCLOTH_BINDING_EDGES 14     // CSR entries in gather order (Edge)
-#define VKCLOTH_BINDING_COLLIDERS 15 // Collider array (collider_count entries, at least one slot)
-#define VKCLOTH_BINDING_FLAGS 16     // Flags per instance (divergence detection)
-#define VKCLOTH_BINDING_INSTANCES 17 // InstanceParams per instance
-#define VKCLOTH_BINDING_COUNT 18
+#define VKCLOTH_BINDING_POS_IN 0       // positions the force pass reads (state or RK4 stage)
+#define VKCLOTH_BINDING_VEL_IN 1       // velocities the force pass reads (state or RK4 stage)
+#define VKCLOTH_BINDING_FORCE_OUT 2    // force after contacts (state force, or RK4 stage scratch)
+#define VKCLOTH_BINDING_VEL_FILT 3     // velocity after contact filtering (force -> integrate)
+#define VKCLOTH_BINDING_NORMAL 4       // unit vertex normals (cloth), written every force pass
+#define VKCLOTH_BINDING_POS_BASE 5     // positions at the start of the step (= positions[read])
+#define VKCLOTH_BINDING_POS_OUT 6      // positions at the end of the step (= positions[write])
+#define VKCLOTH_BINDING_VEL 7          // state velocities (read and written by integrate)
+#define VKCLOTH_BINDING_STAGE_POS 8    // RK4 stage positions y_k
+#define VKCLOTH_BINDING_STAGE_VEL 9    // RK4 stage velocities
+#define VKCLOTH_BINDING_ACC_POS 10     // RK4 running sum k1 + 2 k2 + 2 k3 + k4 (positions)
+#define VKCLOTH_BINDING_ACC_VEL 11     // RK4 running sum (velocities)
+#define VKCLOTH_BINDING_PARTICLE 12    // ParticleInfo per particle
+#define VKCLOTH_BINDING_OFFSETS 13     // CSR offsets, count + 1 entries (SpringAdjacency::offsets)
+#define VKCLOTH_BINDING_EDGES 14       // CSR entries in gather order (Edge)
+#define VKCLOTH_BINDING_COLLIDERS 15   // Collider array (collider_count entries, at least one slot)
+#define VKCLOTH_BINDING_FLAGS 16       // Flags per instance (divergence detection)
+#define VKCLOTH_BINDING_INSTANCES 17   // InstanceParams per instance
+#define VKCLOTH_BINDING_FAN_OFFSETS 18 // normal fans' CSR offsets, count + 1 (ClothTopology::fan_offsets)
+#define VKCLOTH_BINDING_FANS 19        // FanEntry per fan triangle (ClothTopology::fans)
+#define VKCLOTH_BINDING_COUNT 20
 
 // Set 1 (force.comp, fused.comp): POS_IN again, as an RGBA32F uniform texel buffer view,
 // PARTICLE as an RG32UI one (x: the mass's bits, y: pinned), and (fused.comp) VEL as RGBA32F and
@@ -60,6 +62,7 @@ struct vec4 {
 #define VKCLOTH_FLAG_HAS_GRID 1u     // the topology is a grid: rebuild normals from the grid fan
 #define VKCLOTH_FLAG_WIND 2u         // wind strength != 0
 #define VKCLOTH_FLAG_CONTACT_BOTH 4u // contacts remove the whole normal part (Figure 12 variant)
+#define VKCLOTH_FLAG_HAS_FANS 8u     // a surface that is not a grid: normals from FAN_OFFSETS / FANS
 
 // InstanceParams::integrator (the vkcloth::Integrator values; engine/src/core/kernel.hpp asserts it).
 #define VKCLOTH_INTEGRATOR_EXPLICIT_EULER 0u
@@ -118,6 +121,13 @@ struct Edge {
   float stiffness;
 };
 
+/// One triangle of a particle's normal fan (ClothTopology's FanTriangle; std430: 8 bytes):
+/// n_p += cross(x_a - x_p, x_b - x_p).
+struct FanEntry {
+  uint a;
+  uint b;
+};
+
 /// A plane {n.p = offset} (shape = (n, offset)) or a sphere (shape = (centre, radius)).
 struct Collider {
   vec4 shape;
@@ -145,6 +155,7 @@ static_assert(offsetof(InstanceParams, dt) == 48);
 static_assert(offsetof(InstanceParams, limit) == 64);
 static_assert(sizeof(ParticleInfo) == 8);
 static_assert(sizeof(Edge) == 12);
+static_assert(sizeof(FanEntry) == 8);
 static_assert(sizeof(Collider) == 32);
 static_assert(offsetof(Collider, type) == 16);
 static_assert(sizeof(Flags) == 16);

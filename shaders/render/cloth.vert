@@ -2,7 +2,8 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 // The cloth straight from the solver's buffers: binding 0 = positions[current], 1 = normals,
-// 2 = uvs; each a vec4 per particle (stride 16), indexed by the grid's triangle list.
+// 2 = uvs; each a vec4 per particle (stride 16), indexed by the topology's triangle list (a grid's
+// or a mesh's, holes and boundaries as they are).
 #include "render_common.glsl"
 layout(location = 0) in vec4 in_pos;
 layout(location = 1) in vec4 in_normal;

@@ -98,7 +98,7 @@ struct ClothRenderer::Impl {
   std::uint32_t particle_count = 0;
   float mass_radius = 0.02f;
 
-  Buffer cloth_index; // grid triangles, or chain springs as a line list
+  Buffer cloth_index; // the topology's triangles (grid or mesh), or chain springs as a line list
   std::uint32_t cloth_index_count = 0;
   Buffer mesh_vertices, mesh_index, zero_instance;
   std::vector<MeshRange> colliders;
@@ -436,7 +436,23 @@ Result<ClothRenderer> ClothRenderer::create(gpu::Context& context, const SimPara
                     impl->ctx->queue_family, impl->ctx->name));
   impl->surface = topology.has_surface();
   impl->particle_count = static_cast<std::uint32_t>(topology.size());
-  Image texture = options.texture.width ? std::move(options.texture) : default_fabric_texture();
+  if (options.texture.width && options.encoded_texture)
+    return make_error(
+        ErrorCode::invalid_argument,
+        fmt::format("RendererOptions sets both a texture ({} x {}) and an encoded texture ('{}'); "
+                    "set one",
+                    options.texture.width, options.texture.height, options.encoded_texture->source));
+  Image texture;
+  if (options.texture.width) {
+    texture = std::move(options.texture);
+  } else if (options.encoded_texture) {
+    auto decoded = decode_image(options.encoded_texture->encoded, options.encoded_texture->source);
+    if (!decoded)
+      return decoded.error();
+    texture = std::move(*decoded);
+  } else {
+    texture = default_fabric_texture();
+  }
   const std::uint32_t max_side = impl->ctx->properties.limits.maxImageDimension2D;
   if (texture.width > max_side || texture.height > max_side)
     return make_error(ErrorCode::unsupported,

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <string>
 #include <system_error>
 
 #include <fmt/format.h>
@@ -11,6 +13,36 @@
 #include <stb/stb_image_write.h>
 
 namespace vkcloth::render {
+
+namespace {
+
+/// The checks load_image and decode_image share, after stbi_info: `what` names the image
+/// ("texture file 'cloth.png'", "texture 'flag.glb images[0]'").
+Result<void> check_size(const std::string& what, int w, int h, std::uint32_t max_side) {
+  if (w <= 0 || h <= 0)
+    return make_error(ErrorCode::io, fmt::format("{} is zero-sized ({} x {})", what, w, h));
+  if (std::uint32_t(w) > max_side || std::uint32_t(h) > max_side)
+    return make_error(ErrorCode::io, fmt::format("{} is too large: {} x {} (at most {} pixels a side)", what,
+                                                 w, h, max_side));
+  return {};
+}
+
+/// Takes stb_image's RGBA pixels (freed here), or its failure reason.
+Result<Image> take_pixels(const std::string& what, stbi_uc* data, int w, int h) {
+  if (!data) {
+    const char* why = stbi_failure_reason();
+    return make_error(ErrorCode::io,
+                      fmt::format("{} could not be decoded ({})", what, why ? why : "corrupt data"));
+  }
+  Image img;
+  img.width = std::uint32_t(w);
+  img.height = std::uint32_t(h);
+  img.rgba.assign(data, data + std::size_t(w) * std::size_t(h) * 4);
+  stbi_image_free(data);
+  return img;
+}
+
+} // namespace
 
 Result<Image> load_image(const std::filesystem::path& path, std::uint32_t max_side) {
   const std::string name = path.string();
@@ -25,24 +57,29 @@ Result<Image> load_image(const std::filesystem::path& path, std::uint32_t max_si
     return make_error(ErrorCode::io, fmt::format("texture file '{}' is not a readable PNG/JPEG image ({})",
                                                  name, why ? why : "unknown format"));
   }
-  if (w <= 0 || h <= 0)
-    return make_error(ErrorCode::io, fmt::format("texture file '{}' is zero-sized ({} x {})", name, w, h));
-  if (std::uint32_t(w) > max_side || std::uint32_t(h) > max_side)
+  const std::string what = fmt::format("texture file '{}'", name);
+  VKCLOTH_TRY(check_size(what, w, h, max_side));
+  return take_pixels(what, stbi_load(name.c_str(), &w, &h, &comp, 4), w, h);
+}
+
+Result<Image> decode_image(std::span<const std::uint8_t> bytes, std::string_view source,
+                           std::uint32_t max_side) {
+  const std::string what = fmt::format("texture '{}'", source);
+  if (bytes.empty())
+    return make_error(ErrorCode::io, fmt::format("{} is empty (0 bytes)", what));
+  if (bytes.size() > std::size_t(std::numeric_limits<int>::max()))
     return make_error(ErrorCode::io,
-                      fmt::format("texture file '{}' is too large: {} x {} (at most {} pixels a side)", name,
-                                  w, h, max_side));
-  stbi_uc* data = stbi_load(name.c_str(), &w, &h, &comp, 4);
-  if (!data) {
+                      fmt::format("{} is too large to decode: {} bytes (stb_image takes at most {})", what,
+                                  bytes.size(), std::numeric_limits<int>::max()));
+  const int len = static_cast<int>(bytes.size());
+  int w = 0, h = 0, comp = 0;
+  if (!stbi_info_from_memory(bytes.data(), len, &w, &h, &comp)) {
     const char* why = stbi_failure_reason();
-    return make_error(ErrorCode::io, fmt::format("texture file '{}' could not be decoded ({})", name,
-                                                 why ? why : "corrupt data"));
+    return make_error(ErrorCode::io, fmt::format("{} ({} bytes) is not a readable PNG/JPEG image ({})", what,
+                                                 bytes.size(), why ? why : "unknown format"));
   }
-  Image img;
-  img.width = std::uint32_t(w);
-  img.height = std::uint32_t(h);
-  img.rgba.assign(data, data + std::size_t(w) * std::size_t(h) * 4);
-  stbi_image_free(data);
-  return img;
+  VKCLOTH_TRY(check_size(what, w, h, max_side));
+  return take_pixels(what, stbi_load_from_memory(bytes.data(), len, &w, &h, &comp, 4), w, h);
 }
 
 Result<void> write_png(const std::filesystem::path& path, const Image& image) {

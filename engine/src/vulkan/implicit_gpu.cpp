@@ -109,7 +109,7 @@ Result<void> ImplicitGpu::create_pipelines() {
   return {};
 }
 
-// Long (~85 lines) but flat: one switch that maps each binding of the implicit layout
+// Long (~90 lines) but flat: one switch that maps each binding of the implicit layout
 // (implicit_shared.h) to its buffer, a table to scan rather than logic to follow.
 Result<void> ImplicitGpu::write_sets(const ImplicitInputs& in) {
   const auto bindings = implicit_bindings();
@@ -152,6 +152,12 @@ Result<void> ImplicitGpu::write_sets(const ImplicitInputs& in) {
         break;
       case VKCLOTH_BINDING_INSTANCES:
         b = in.instances;
+        break;
+      case VKCLOTH_BINDING_FAN_OFFSETS:
+        b = in.fan_offsets;
+        break;
+      case VKCLOTH_BINDING_FANS:
+        b = in.fans;
         break;
       case VKCLOTH_BINDING_IMPL_VF:
         b = vf_.buffer;

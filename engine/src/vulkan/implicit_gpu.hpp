@@ -25,7 +25,8 @@ namespace vkcloth::gpu {
 /// The solver's buffers the implicit passes share (same bindings as the main layout). The
 /// implicit passes run batches of one instance (the CG reductions are per instance).
 struct ImplicitInputs {
-  VkBuffer pos[2], vel, force, normal, particle, offsets, edges, colliders, flags, instances;
+  VkBuffer pos[2], vel, force, normal, particle, offsets, edges, colliders, flags, instances, fan_offsets,
+      fans;
 };
 
 class ImplicitGpu {

@@ -69,7 +69,8 @@ void SolverBatch::upload_instance_params() {
     const float dt =
         float(params.substeps == 1 ? params.dt : params.dt / double(params.substeps)); // as the CPU
     sh::InstanceParams ip{};
-    ip.flags = (nx ? VKCLOTH_FLAG_HAS_GRID : 0u) |
+    ip.flags = (normals == Normals::grid ? VKCLOTH_FLAG_HAS_GRID : 0u) |
+               (normals == Normals::fans ? VKCLOTH_FLAG_HAS_FANS : 0u) |
                (float(params.wind.strength) != 0.0f ? VKCLOTH_FLAG_WIND : 0u) |
                (params.contact_inward_only ? 0u : VKCLOTH_FLAG_CONTACT_BOTH);
     ip.integrator = static_cast<std::uint32_t>(params.integrator);
@@ -278,6 +279,7 @@ struct DispatchGrid {
 /// allocation; errors name the buffer or dispatch and the limit.
 Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ClothTopology& topology,
                                   std::uint64_t batch, const testing::SolverKnobs& knobs) {
+  const bool fan_lists = SolverBatch::normals_of(topology, knobs) == SolverBatch::Normals::fans;
   const std::uint64_t n = topology.size();
   const VkPhysicalDeviceLimits& lim = ctx.properties.limits;
   std::uint64_t max_bytes = lim.maxStorageBufferRange;
@@ -285,6 +287,7 @@ Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ClothTopology&
   if (overridden)
     max_bytes = knobs.max_storage_buffer_bytes;
   const std::uint64_t edges_n = topology.edges().size();
+  const std::uint64_t fans_n = fan_lists ? topology.fans().size() : 0;
   const struct {
     const char* what;
     std::uint64_t bytes;
@@ -292,6 +295,7 @@ Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ClothTopology&
     std::uint64_t items;
   } needs[] = {{"per-particle (vec4)", batch * n * 16, 16, batch * n},
                {"spring adjacency", edges_n * sizeof(sh::Edge), sizeof(sh::Edge), edges_n},
+               {"normal fans", fans_n * sizeof(sh::FanEntry), sizeof(sh::FanEntry), fans_n},
                {"particle constants", n * sizeof(sh::ParticleInfo), sizeof(sh::ParticleInfo), n}};
   for (const auto& need : needs)
     if (need.bytes > max_bytes)
@@ -366,7 +370,11 @@ Result<void> SolverBatch::create_buffers() {
       {&acc_vel, vec4_bytes, "rk4 sums (velocities)"},
       {&particle, std::max<VkDeviceSize>(n * sizeof(sh::ParticleInfo), 16), "particle constants"},
       {&offsets, std::max<VkDeviceSize>((n + 1) * sizeof(std::uint32_t), 16), "adjacency offsets"},
-      {&edges, std::max<VkDeviceSize>(edges_count * sizeof(sh::Edge), 16), "adjacency"}};
+      {&edges, std::max<VkDeviceSize>(edges_count * sizeof(sh::Edge), 16), "adjacency"},
+      // Without fan normals: one zeroed element each (a valid binding the shaders never index).
+      {&fan_offsets, std::max<VkDeviceSize>(fans_count ? (n + 1) * sizeof(std::uint32_t) : 0, 16),
+       "normal fan offsets"},
+      {&fans, std::max<VkDeviceSize>(fans_count * sizeof(sh::FanEntry), 16), "normal fans"}};
   for (auto [b, bytes, what] : device_buffers) {
     auto r = create_buffer(*ctx, bytes, usage, MemoryUse::device, allow_map, what, families);
     if (!r)
@@ -436,23 +444,31 @@ Result<void> SolverBatch::upload_initial_state(const ClothTopology& topology,
     const GatherEdge& g = topology.edges()[e];
     edge_data[e] = {g.other, float(g.rest_length), float(g.stiffness)};
   }
+  // The fans as uploaded (FanTriangle and FanEntry are both two uint32 indices; copied field by
+  // field all the same), or nothing: a zeroed element (Normals::grid and none never read them).
+  std::vector<sh::FanEntry> fan_data(fans_count);
+  for (std::size_t t = 0; t < fans_count; ++t)
+    fan_data[t] = {topology.fans()[t].a, topology.fans()[t].b};
   const std::span<const std::uint32_t> triangles = topology.triangles();
-  const Upload uploads[] = {{&pos[0], x0.data(), vec4_bytes},
-                            {&pos[1], x0.data(), vec4_bytes},
-                            {&vel, v0.data(), vec4_bytes},
-                            {&uv, uv0.data(), vec4_bytes},
-                            {&particle, info.data(), n * sizeof(sh::ParticleInfo)},
-                            {&offsets, topology.edge_offsets().data(), (n + 1) * sizeof(std::uint32_t)},
-                            {&edges, edge_data.data(), edges_count * sizeof(sh::Edge)},
-                            {&indices, triangles.data(), triangles.size() * sizeof(std::uint32_t)},
-                            {&force, nullptr, 0},
-                            {&force_stage, nullptr, 0},
-                            {&vel_filt, nullptr, 0},
-                            {&normal, nullptr, 0},
-                            {&stage_pos, nullptr, 0},
-                            {&stage_vel, nullptr, 0},
-                            {&acc_pos, nullptr, 0},
-                            {&acc_vel, nullptr, 0}};
+  const Upload uploads[] = {
+      {&pos[0], x0.data(), vec4_bytes},
+      {&pos[1], x0.data(), vec4_bytes},
+      {&vel, v0.data(), vec4_bytes},
+      {&uv, uv0.data(), vec4_bytes},
+      {&particle, info.data(), n * sizeof(sh::ParticleInfo)},
+      {&offsets, topology.edge_offsets().data(), (n + 1) * sizeof(std::uint32_t)},
+      {&edges, edge_data.data(), edges_count * sizeof(sh::Edge)},
+      {&fan_offsets, fans_count ? topology.fan_offsets().data() : nullptr, (n + 1) * sizeof(std::uint32_t)},
+      {&fans, fans_count ? fan_data.data() : nullptr, fans_count * sizeof(sh::FanEntry)},
+      {&indices, triangles.data(), triangles.size() * sizeof(std::uint32_t)},
+      {&force, nullptr, 0},
+      {&force_stage, nullptr, 0},
+      {&vel_filt, nullptr, 0},
+      {&normal, nullptr, 0},
+      {&stage_pos, nullptr, 0},
+      {&stage_vel, nullptr, 0},
+      {&acc_pos, nullptr, 0},
+      {&acc_vel, nullptr, 0}};
   return upload(uploads);
 }
 
@@ -494,6 +510,13 @@ Result<void> SolverBatch::upload(std::span<const Upload> uploads) {
   });
 }
 
+SolverBatch::Normals SolverBatch::normals_of(const ClothTopology& topology,
+                                             const testing::SolverKnobs& knobs) {
+  if (topology.grid() && !knobs.fan_normals)
+    return Normals::grid; // every grid, even one without triangles (a strip: zero normals)
+  return topology.fans().empty() ? Normals::none : Normals::fans;
+}
+
 Result<std::unique_ptr<SolverBatch>>
 SolverBatch::create(const std::shared_ptr<Context::Impl>& ctx, CommandContext& commands,
                     const ClothTopology& topology, std::vector<SimParams> params,
@@ -516,6 +539,8 @@ SolverBatch::create(const std::shared_ptr<Context::Impl>& ctx, CommandContext& c
   s.knobs = knobs;
   s.count = s.pc.count = static_cast<std::uint32_t>(topology.size());
   s.edges_count = topology.edges().size();
+  s.normals = normals_of(topology, knobs);
+  s.fans_count = s.normals == Normals::fans ? topology.fans().size() : 0;
   s.index_count = static_cast<std::uint32_t>(topology.triangles().size());
   s.groups_x = grid->x;
   s.groups_y = grid->y;

@@ -6,8 +6,8 @@
 // Buffers, descriptor sets and texel views are the batch's; layouts and pipelines the Context's
 // (pipelines.hpp). Internal to engine/src/vulkan.
 //
-// Topology: create() reads a prepared ClothTopology (gather lists, grid stencil, triangles, uvs,
-// particles); the world keys batches by the shared topology object.
+// Topology: create() reads a prepared ClothTopology (gather lists, grid stencil, normal fans,
+// triangles, uvs, particles); the world keys batches by the shared topology object.
 #pragma once
 
 #include <cstdint>
@@ -91,6 +91,16 @@ public:
   SolveStats last_solve() const { return implicit ? implicit->stats() : SolveStats{}; }
   bool uses_staging() const { return staging; }
 
+  /// Where the force pass takes the vertex normals from (one choice per batch: its topology's).
+  enum class Normals : std::uint32_t {
+    none, ///< a chain: zero normals, no wind
+    grid, ///< the unrolled grid fan (force_body.glsl grid_normal, VKCLOTH_FLAG_HAS_GRID)
+    fans  ///< the topology's fan lists (fan_normal, VKCLOTH_FLAG_HAS_FANS): meshes
+  };
+  /// The normal path of `topology`'s batches: a grid's own fast path unless `knobs.fan_normals`;
+  /// the fan lists for any other topology with fans.
+  static Normals normals_of(const ClothTopology& topology, const testing::SolverKnobs& knobs);
+
   /// Grid stencil (force_body.glsl's specialisation constants 0..39): constant_id order.
   struct Stencil {
     std::uint32_t enabled = 0; // VkBool32
@@ -109,13 +119,16 @@ private:
   std::vector<Slot> slots; // one per instance; slot k's particles are at k * count in the buffers
   std::uint32_t count = 0; // particles per instance
   std::uint32_t nx = 0, ny = 0;
+  Normals normals = Normals::none;
   bool staging = false;
 
   // Per-particle vec4 buffers (slots() x count entries), then the shared topology, then the small
   // host-visible ones (per instance). Every object below is owned (resources.hpp): a new buffer
   // is one member here plus its creation.
   Buffer pos[2], vel, force, force_stage, vel_filt, normal, uv, stage_pos, stage_vel, acc_pos, acc_vel;
-  Buffer particle, offsets, edges, indices; // indices: the topology's triangles (drawing)
+  // The shared topology: particle constants, gather lists, normal fans (filled only for
+  // Normals::fans, else one zeroed element), triangles (`indices`, for drawing).
+  Buffer particle, offsets, edges, fan_offsets, fans, indices;
   std::uint32_t index_count = 0;
   Buffer colliders, flags, instances; // host-visible (written / read by the host)
   std::uint32_t collider_capacity = 0;
@@ -141,6 +154,7 @@ private:
   std::uint32_t groups_x = 1, groups_y = 1;
   Stencil stencil;
   std::uint64_t edges_count = 0;
+  std::uint64_t fans_count = 0; // entries of `fans` (0 unless Normals::fans)
 
   shared::PushConstants pc{};            // per dispatch (count, grid, stage, step)
   std::uint64_t recorded = 0;            // recorded steps since the flag epoch: flag step numbers

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // SolverBatch (solver_batch.hpp): descriptor set layouts, sets and texel views, the compute
 // pipelines (force, integrate, the fused variants) and their specialisation constants (the grid
-// stencil). The stepping, buffers and readbacks are in solver_batch.cpp.
+// stencil, the fused variant, the fan-normal switch). The stepping, buffers and readbacks are in
+// solver_batch.cpp.
 #include "resources.hpp"
 
 #include <array>
@@ -21,16 +22,18 @@ namespace sh = shared;
 
 namespace {
 
-/// The specialisation constants of force_body.glsl (ids 0..39: the grid stencil) followed by
-/// `extra` (fused.comp: 40 SC_WRITE_AUX, 41 SC_COLLIDERS), as 32-bit words.
-template <std::size_t N>
-std::array<std::uint32_t, 40 + N> stencil_constants(const SolverBatch::Stencil& st,
-                                                    const std::array<std::uint32_t, N>& extra) {
+/// The specialisation constants of force.comp and fused.comp, as 32-bit words by constant_id:
+/// 0..39 the grid stencil (force_body.glsl), 40 SC_WRITE_AUX (fused.comp only; force.comp has no
+/// constant 40, and an entry for an id a shader lacks is ignored), 41 SC_COLLIDERS (common.glsl),
+/// 42 SC_FANS (force_body.glsl), each a VkBool32.
+std::array<std::uint32_t, 43> solver_constants(const SolverBatch::Stencil& st, bool write_aux, bool colliders,
+                                               bool fans) {
   static_assert(sizeof(SolverBatch::Stencil) == 40 * 4);
-  std::array<std::uint32_t, 40 + N> words{};
+  std::array<std::uint32_t, 43> words{};
   std::memcpy(words.data(), &st, sizeof(st));
-  for (std::size_t k = 0; k < N; ++k)
-    words[40 + k] = extra[k];
+  words[40] = write_aux ? 1u : 0u;
+  words[41] = colliders ? 1u : 0u;
+  words[42] = fans ? 1u : 0u;
   return words;
 }
 
@@ -125,10 +128,11 @@ Result<void> SolverBatch::create_texel_views() {
   return {};
 }
 
-// force.comp (specialised with the grid stencil) and integrate.comp, from the Context's registry.
+// force.comp (specialised with the grid stencil and the fan switch; contact loops kept, the
+// default) and integrate.comp, from the Context's registry.
 Result<void> SolverBatch::create_pipelines() {
   using Shader = PipelineRegistry::Shader;
-  const auto constants = stencil_constants<0>(stencil, {});
+  const auto constants = solver_constants(stencil, true, true, normals == Normals::fans);
   auto fp = ctx->pipelines->pipeline(Shader::force, constants);
   if (!fp)
     return fp.error();
@@ -147,7 +151,7 @@ Result<void> SolverBatch::ensure_fused() {
   if (!options.fused || (fused_pipes[0][col] && fused_pipes[1][col]))
     return {};
   for (std::uint32_t aux = 0; aux < 2; ++aux) {
-    const auto constants = stencil_constants<2>(stencil, {aux, col}); // VkBool32 SC_WRITE_AUX, SC_COLLIDERS
+    const auto constants = solver_constants(stencil, aux != 0, col != 0, normals == Normals::fans);
     auto p = ctx->pipelines->pipeline(PipelineRegistry::Shader::fused, constants);
     if (!p)
       return p.error();
@@ -199,6 +203,8 @@ Result<void> SolverBatch::write_sets() {
       by_binding[VKCLOTH_BINDING_COLLIDERS] = &colliders;
       by_binding[VKCLOTH_BINDING_FLAGS] = &flags;
       by_binding[VKCLOTH_BINDING_INSTANCES] = &instances;
+      by_binding[VKCLOTH_BINDING_FAN_OFFSETS] = &fan_offsets;
+      by_binding[VKCLOTH_BINDING_FANS] = &fans;
       for (std::uint32_t b = 0; b < VKCLOTH_BINDING_COUNT; ++b, ++k) {
         infos[k] = VkDescriptorBufferInfo{by_binding[b]->buffer, 0, VK_WHOLE_SIZE};
         writes[k] = VkWriteDescriptorSet{};
@@ -222,7 +228,9 @@ Result<void> SolverBatch::write_sets() {
                                  edges.buffer,
                                  colliders.buffer,
                                  flags.buffer,
-                                 instances.buffer});
+                                 instances.buffer,
+                                 fan_offsets.buffer,
+                                 fans.buffer});
   return {};
 }
 

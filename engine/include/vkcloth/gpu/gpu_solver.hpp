@@ -12,8 +12,9 @@
 //
 // Buffers (device-local storage buffers, vec4 per particle, w unused; positions have w = 1):
 // positions[2] (ping-pong), velocities, forces, normals (unit, zero for chains; fused Euler
-// stores forces and normals in the last step of a recording), uvs (i/(nx-1), j/(ny-1) for grids,
-// zero for chains), the grid's triangle indices, plus internal scratch. A GpuSolver is a
+// stores forces and normals in the last step of a recording), uvs (ClothTopology::uvs: i/(nx-1),
+// j/(ny-1) for grids, a mesh's own, zero for chains), the topology's triangle indices, plus internal
+// scratch. Normals come from the grid fan (grids) or the topology's fan lists (meshes). A GpuSolver is a
 // gpu::ClothWorld of one instance (world.hpp: many cloths of one topology, same shaders, one
 // dispatch per pass), with the single-cloth conveniences below.
 //
@@ -64,10 +65,10 @@ struct InstanceBuffers {
   VkDeviceSize offset = 0;
   VkDeviceSize stride = 16; ///< GpuSolver::stride
   std::uint32_t count = 0;
-  std::uint32_t nx = 0, ny = 0; ///< grid size (0 for chains): grid_triangle_indices(nx, ny)
-  /// grid_triangle_indices(nx, ny) on the device (VK_INDEX_TYPE_UINT32, index_count entries,
-  /// indices relative to the instance's first particle: bind the vertex buffers at `offset`).
-  /// Empty (index_count 0) for chains.
+  std::uint32_t nx = 0, ny = 0; ///< grid size (0 for chains and meshes)
+  /// ClothTopology::triangles() on the device (VK_INDEX_TYPE_UINT32, index_count entries; a grid's
+  /// are grid_triangle_indices(nx, ny)), indices relative to the instance's first particle: bind
+  /// the vertex buffers at `offset`. Empty (index_count 0) for chains.
   VkBuffer indices = VK_NULL_HANDLE;
   std::uint32_t index_count = 0;
 };

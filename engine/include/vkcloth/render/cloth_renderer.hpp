@@ -5,6 +5,9 @@
 // caller's render pass (a VkRenderPass subpass with one colour and one depth attachment), so an
 // engine can embed it, or ignore it and bind the same buffers itself.
 //
+// The cloth is any ClothTopology surface (a grid or a mesh: its triangles, boundaries and holes as
+// they are) drawn two-sided (no culling; the back face tinted); a chain is masses and springs.
+//
 // Synchronisation (the caller's, once per frame): after GpuSolver::record_steps() and BEFORE the
 // render pass, call
 //   solver.record_barrier_to(cmd, VK_PIPELINE_STAGE_VERTEX_INPUT_BIT, VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT);
@@ -18,12 +21,14 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 
 #include <glm/vec3.hpp>
 #include <vulkan/vulkan_core.h>
 
 #include "vkcloth/gpu/context.hpp"
 #include "vkcloth/gpu/gpu_solver.hpp"
+#include "vkcloth/mesh.hpp"
 #include "vkcloth/render/camera.hpp"
 #include "vkcloth/render/image.hpp"
 #include "vkcloth/result.hpp"
@@ -37,8 +42,14 @@ struct RendererOptions {
   VkRenderPass render_pass = VK_NULL_HANDLE;
   std::uint32_t subpass = 0;
   VkSampleCountFlagBits samples = VK_SAMPLE_COUNT_1_BIT;
-  /// The cloth's texture; empty (0 x 0): the built-in fabric (default_fabric_texture()).
+  /// The cloth's texture; empty (0 x 0): `encoded_texture`, else the built-in fabric
+  /// (default_fabric_texture()).
   Image texture;
+  /// The cloth's texture as a file's bytes (PNG / JPEG: a mesh's vkcloth::MeshTexture, e.g.
+  /// Scene::texture), decoded by create() with decode_image(); corrupt bytes fail create() with
+  /// ErrorCode::io naming MeshTexture::source. Setting both this and `texture` is
+  /// ErrorCode::invalid_argument.
+  std::optional<MeshTexture> encoded_texture;
   /// Where the floor plane is drawn (a square of this half-size around the scene's bounds
   /// centre projected onto the plane); 0: from the scene's bounds.
   float floor_half_size = 0.0f;
@@ -61,8 +72,9 @@ class ClothRenderer {
 public:
   /// Builds the pipelines for `options.render_pass`, the index buffer (the topology's triangles,
   /// or a chain's springs as lines), the collider meshes (from solver.params().colliders) and the
-  /// texture. `topology` must be the solver's (solver.topology()). The Context's queue family
-  /// must support graphics (ContextOptions::require_graphics): ErrorCode::unsupported otherwise.
+  /// texture (decoded first when `options.encoded_texture` is set). `topology` must be the solver's
+  /// (solver.topology()). The Context's queue family must support graphics
+  /// (ContextOptions::require_graphics): ErrorCode::unsupported otherwise.
   static Result<ClothRenderer> create(gpu::Context& context, const gpu::GpuSolver& solver,
                                       const ClothTopology& topology, RendererOptions options);
   /// The same for a ClothWorld instance: `params` gives the colliders to draw (world.params(id)),

@@ -4,6 +4,8 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <span>
+#include <string_view>
 #include <vector>
 
 #include "vkcloth/result.hpp"
@@ -29,6 +31,13 @@ inline constexpr std::uint32_t max_texture_size = 8192;
 /// names the file): missing or unreadable, corrupt or not an image, zero-sized, a side larger
 /// than `max_side`.
 Result<Image> load_image(const std::filesystem::path& path, std::uint32_t max_side = max_texture_size);
+
+/// Decodes a PNG / JPEG / BMP / TGA file's bytes held in memory (stb_image; e.g. a glTF
+/// material's texture, vkcloth::MeshTexture::encoded) as RGBA. `source` names the bytes in
+/// messages ("flag.glb images[0]"). Errors (ErrorCode::io, naming `source`): no bytes, not an
+/// image or corrupt (stb_image's reason), zero-sized, a side larger than `max_side`.
+Result<Image> decode_image(std::span<const std::uint8_t> bytes, std::string_view source,
+                           std::uint32_t max_side = max_texture_size);
 
 /// Writes a PNG (stb_image_write). ErrorCode::io naming the file on failure.
 Result<void> write_png(const std::filesystem::path& path, const Image& image);
