@@ -108,6 +108,6 @@ int main(int argc, char** argv) {
     fmt::print(stderr, "error: {}\n", system.error().message);
     return 2;
   }
-  vkcloth::Scene scene{"cloth_" + opt.preset, std::move(*system), params, 500};
+  vkcloth::Scene scene{"cloth_" + opt.preset, std::move(*system), params, 500, std::nullopt, {}};
   return samples::run(scene, opt);
 }

@@ -10,6 +10,7 @@
 #include <CLI/CLI.hpp>
 
 #include "vkcloth/result.hpp"
+#include "vkcloth/scene.hpp"
 
 namespace vkcloth::cli {
 
@@ -37,6 +38,9 @@ struct SceneArgs {
   std::optional<std::string> integrator;
   /// --set values followed by the sugar flags, as key.path=value strings.
   std::vector<std::string> overrides() const;
+  /// load_scene_file(scene, overrides()), printing each of the scene's warnings (a mesh's dropped
+  /// faces, a pin region that pins nothing) as "vkcloth: warning: ..." on stderr.
+  Result<Scene> load() const;
 };
 
 /// The exit-code table, shown under every command's --help.

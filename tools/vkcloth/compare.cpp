@@ -20,7 +20,7 @@ struct CompareOptions {
 };
 
 int compare_command(const CompareOptions& opt) {
-  auto scene = load_scene_file(opt.args.scene, opt.args.overrides());
+  auto scene = opt.args.load();
   if (!scene)
     return report(scene.error());
   if (!std::isfinite(opt.tolerance) || opt.tolerance < 0.0)

@@ -15,7 +15,7 @@ std::string vec(glm::dvec3 v) {
 }
 
 int info_command(const SceneArgs& opt) {
-  auto scene_r = load_scene_file(opt.scene, opt.overrides());
+  auto scene_r = opt.load();
   if (!scene_r)
     return report(scene_r.error());
   const Scene& s = *scene_r;

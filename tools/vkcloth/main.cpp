@@ -56,6 +56,14 @@ std::vector<std::string> SceneArgs::overrides() const {
   return out;
 }
 
+Result<Scene> SceneArgs::load() const {
+  auto loaded = load_scene_file(scene, overrides());
+  if (loaded)
+    for (const std::string& w : loaded->warnings)
+      fmt::print(stderr, "vkcloth: warning: {}\n", w);
+  return loaded;
+}
+
 void add_scene_options(CLI::App& cmd, SceneArgs& args, bool sugar) {
   cmd.add_option("scene", args.scene, "Scene file (JSON)")->required();
   cmd.add_option("--set", args.sets,

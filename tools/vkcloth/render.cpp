@@ -63,7 +63,7 @@ int render_command(const RenderOptions& opt) {
                                  "--frames DIR still writes the PNG sequence",
                                  opt.video)));
   }
-  auto scene = load_scene_file(opt.args.scene, opt.args.overrides());
+  auto scene = opt.args.load();
   if (!scene)
     return report(scene.error());
   render::RendererOptions ro;
@@ -72,6 +72,8 @@ int render_command(const RenderOptions& opt) {
     if (!tex)
       return report(tex.error());
     ro.texture = std::move(*tex);
+  } else {
+    ro.encoded_texture = scene->texture; // a glTF mesh's base-colour texture, if it has one
   }
   const float aspect = float(size->first) / float(size->second);
   auto camera = make_camera(opt.camera, opt.fov, *scene, aspect);
@@ -185,7 +187,9 @@ void add_render_command(CLI::App& app, int* exit) {
                   "eye_x,eye_y,eye_z,target_x,target_y,target_z (default: framed from the scene's bounds)");
   cmd->add_option("--fov", opt->fov, "Vertical field of view in degrees (default 40)")
       ->check(CLI::Range(5.0f, 150.0f));
-  cmd->add_option("--texture", opt->texture, "Cloth texture (PNG or JPEG; default: the built-in fabric)");
+  cmd->add_option(
+      "--texture", opt->texture,
+      "Cloth texture (PNG or JPEG; default: a glTF mesh's own texture, else the built-in fabric)");
   cmd->add_option("--frames", opt->frames_dir,
                   "Write a numbered PNG sequence DIR/frame_00000.png, one every K steps");
   cmd->add_option("--every", opt->every, "K for --frames / --video (default 10)")->check(CLI::PositiveNumber);

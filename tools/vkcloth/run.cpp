@@ -173,7 +173,7 @@ int run_command(const RunOptions& opt) {
   const auto precision = parse_precision(opt.precision);
   if (!precision)
     return report(make_error(ErrorCode::invalid_argument, "--precision must be float or double"));
-  auto scene = load_scene_file(opt.args.scene, opt.args.overrides());
+  auto scene = opt.args.load();
   if (!scene)
     return report(scene.error());
   auto frames_r = FrameExport::create(opt, *scene);
@@ -257,8 +257,8 @@ int run_command(const RunOptions& opt) {
   if (positions) {
     fmt::print(positions.get(), "particle,x,y,z\n"); // in the file's vertex order, as --trace
     for (const std::uint32_t k : order)
-      fmt::print(positions.get(), "{},{:.9g},{:.9g},{:.9g}\n", file_vertex(scene->system, k), pos[k].x, pos[k].y,
-                 pos[k].z);
+      fmt::print(positions.get(), "{},{:.9g},{:.9g},{:.9g}\n", file_vertex(scene->system, k), pos[k].x,
+                 pos[k].y, pos[k].z);
   }
   for (File* f : {&trace, &positions})
     if (*f && (std::fflush(f->get()) != 0 || std::ferror(f->get())))

@@ -37,7 +37,7 @@ struct SoakOptions {
 };
 
 int soak_command(const SoakOptions& opt) {
-  auto scene = load_scene_file(opt.args.scene, opt.args.overrides());
+  auto scene = opt.args.load();
   if (!scene)
     return report(scene.error());
   auto backend_r = make_backend(opt.backend, *scene, Precision::float32);

@@ -169,12 +169,17 @@ int Viewer::run(const ViewOptions& opt) {
   auto size = parse_size(opt.size);
   if (!size)
     return report(size.error());
-  auto scene = load_scene_file(opt.args.scene, opt.args.overrides());
+  auto scene = opt.args.load();
   if (!scene)
     return report(scene.error());
   scene_.emplace(std::move(*scene));
   if (!opt.texture.empty()) {
     auto tex = render::load_image(opt.texture);
+    if (!tex)
+      return report(tex.error());
+    texture_ = std::move(*tex);
+  } else if (scene_->texture) { // a glTF mesh's base-colour texture
+    auto tex = render::decode_image(scene_->texture->encoded, scene_->texture->source);
     if (!tex)
       return report(tex.error());
     texture_ = std::move(*tex);
@@ -240,7 +245,9 @@ void add_view_command(CLI::App& app, int* exit) {
   cmd->footer(exit_codes_footer);
   add_scene_options(*cmd, opt->args);
   cmd->add_option("--size", opt->size, "Window size WxH (default 1024x768)");
-  cmd->add_option("--texture", opt->texture, "Cloth texture (PNG or JPEG; default: the built-in fabric)");
+  cmd->add_option(
+      "--texture", opt->texture,
+      "Cloth texture (PNG or JPEG; default: a glTF mesh's own texture, else the built-in fabric)");
   cmd->add_option("--frames", opt->frames, "Quit by itself after N frames (0: run until closed)");
   cmd->add_option("--screenshot", opt->screenshot, "Save the last frame as a PNG on exit");
   cmd->add_option("--steps-per-frame", opt->steps_per_frame,
