@@ -4,10 +4,10 @@
 // tinyobjloader is lenient: it reads "nan" or "abc" as 0, drops faces with fewer than 3 vertices,
 // checks face indices only against the whole file, and its errors do not always name the line. So a
 // pre-scan of our own checks every v, vt and f line first, with errors naming the file and the line,
-// and tinyobjloader then reads only those lines, comments stripped, through its streaming callback
-// API (never triangulates, no 255-vertex cap on a face, no allocation per face). The coordinates are
-// the pre-scan's (std::from_chars, correctly rounded, so what format_obj writes reads back exactly;
-// tinyobjloader's own number parser is off by a few ulps).
+// and tinyobjloader then reads the faces, comments stripped, through its streaming callback API
+// (never triangulates, no 255-vertex cap on a face, no allocation per face). The coordinates are the
+// pre-scan's (std::from_chars, correctly rounded, so what format_obj writes reads back exactly;
+// tinyobjloader's own number parser is off by a few ulps): tinyobjloader only counts v and vt lines.
 #include <charconv>
 #include <cmath>
 #include <limits>
@@ -30,6 +30,21 @@ struct Line {
   std::string_view text;
 };
 
+/// Position of the first character of `s` at or after `from` for which `pred` holds, or s.size().
+/// (string_view::find_first_of calls memchr on the set for every character: far slower here.)
+template <typename Pred> std::size_t find_if(std::string_view s, std::size_t from, Pred pred) {
+  while (from < s.size() && !pred(s[from]))
+    ++from;
+  return from;
+}
+
+bool is_end_of_line(char c) {
+  return c == '\n' || c == '\r';
+}
+bool is_blank(char c) {
+  return c == ' ' || c == '\t';
+}
+
 /// The lines of an OBJ text, split where tinyobjloader splits them: "\n", "\r\n" or "\r".
 class Lines {
 public:
@@ -38,10 +53,10 @@ public:
   bool next(Line& line) {
     if (done_)
       return false;
-    const std::size_t end = rest_.find_first_of("\r\n");
+    const std::size_t end = find_if(rest_, 0, is_end_of_line);
     line.number = ++number_;
     line.text = rest_.substr(0, end);
-    if (end == std::string_view::npos) {
+    if (end == rest_.size()) {
       done_ = true;
     } else {
       rest_.remove_prefix(end + (rest_.substr(end, 2) == "\r\n" ? 2 : 1));
@@ -63,13 +78,12 @@ public:
   explicit Words(std::string_view text) : rest_(text) {}
 
   bool next(std::string_view& word) {
-    const std::size_t begin = rest_.find_first_not_of(" \t");
-    if (begin == std::string_view::npos)
+    const std::size_t begin = find_if(rest_, 0, [](char c) { return !is_blank(c); });
+    if (begin == rest_.size())
       return false;
-    rest_.remove_prefix(begin);
-    const std::size_t end = rest_.find_first_of(" \t");
-    word = rest_.substr(0, end);
-    rest_.remove_prefix(word.size());
+    const std::size_t end = find_if(rest_, begin, is_blank);
+    word = rest_.substr(begin, end - begin);
+    rest_.remove_prefix(end);
     return true;
   }
 
@@ -350,8 +364,8 @@ Result<void> check_face(Words& words, const ElementCounts& counts, std::string_v
   return {};
 }
 
-/// What pass 2 hands to tinyobjloader: the v, vt and f lines (each at its own line number, comments
-/// stripped, other lines blank) and what it found.
+/// What pass 2 hands to tinyobjloader: the f lines (comments stripped), a placeholder for each v
+/// and vt line, each at its own line number, other lines blank; and what it found.
 struct CheckedText {
   std::string text;
   FaceScan faces;
@@ -373,7 +387,12 @@ Result<CheckedText> check_faces(std::string_view text, const ObjVertices& vertic
       VKCLOTH_TRY(check_face(words, counts, source, line.number, out.faces));
     counts.vertices_before += keyword == "v";
     counts.texcoords_before += keyword == "vt";
-    if (keyword == "v" || keyword == "vt" || keyword == "f")
+    // tinyobjloader only counts v and vt lines (their values are the pre-scan's): zeros parse fastest.
+    if (keyword == "v")
+      out.text += "v 0 0 0";
+    else if (keyword == "vt")
+      out.text += "vt 0 0";
+    else if (keyword == "f")
       out.text += line.text;
     out.text += '\n';
   }
