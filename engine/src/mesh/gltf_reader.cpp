@@ -254,7 +254,7 @@ std::string expand_nothing(const std::string& path, void*) {
 
 bool read_whole_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
   if (!file_exists(path, user)) {
-    *err = "not below the glTF's directory";
+    *err = "not a regular file in the glTF's directory";
     return false;
   }
   auto bytes = mesh_detail::read_mesh_file(path);
