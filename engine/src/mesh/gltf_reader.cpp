@@ -37,16 +37,6 @@ Error gltf_error(std::string_view source, std::string_view what, ErrorCode code 
   return make_error(code, fmt::format("{}: {}", source, what));
 }
 
-/// A string from the file as messages quote it: at most 64 characters, unprintable bytes as \xNN.
-std::string in_quotes(std::string_view s) {
-  std::string out = "'";
-  for (const char c : s.substr(0, 64)) {
-    const auto u = static_cast<unsigned char>(c);
-    out += (u >= 0x20 && u < 0x7f) ? std::string(1, c) : fmt::format("\\x{:02x}", u);
-  }
-  return out + (s.size() > 64 ? "...'" : "'");
-}
-
 // ---- GLB container ---------------------------------------------------------------------------------
 
 constexpr std::uint32_t glb_magic = 0x46546C67; // "glTF"
@@ -209,17 +199,18 @@ Result<void> check_buffer(const json& buffer, std::size_t k, const fs::path& bas
         source,
         fmt::format("buffers[{}] is the file {}, but the glTF was read from memory without a base "
                     "directory",
-                    k, in_quotes(uri)),
+                    k, mesh_detail::in_quotes(uri)),
         ErrorCode::io);
   const fs::path path = base_dir / decode_uri(uri);
   std::error_code ec;
   if (!fs::is_regular_file(path, ec))
     return gltf_error(source,
-                      fmt::format("buffers[{}]: cannot find the file {}", k, in_quotes(path.string())),
+                      fmt::format("buffers[{}]: cannot find the file {} in {}", k,
+                                  mesh_detail::in_quotes(uri), base_dir.string()),
                       ErrorCode::io);
   if (const auto size = fs::file_size(path, ec); !ec && size != length)
     return gltf_error(source, fmt::format("buffers[{}]: the file {} holds {} bytes, but byteLength is {}", k,
-                                          in_quotes(path.string()), size, length));
+                                          mesh_detail::in_quotes(uri), size, length));
   return {};
 }
 
@@ -300,7 +291,8 @@ Result<tinygltf::Model> load_model(std::span<const std::uint8_t> bytes, bool bin
              : loader.LoadASCIIFromString(&model, &err, &warn, reinterpret_cast<const char*>(bytes.data()),
                                           size, files.base_dir);
   if (!loaded)
-    return gltf_error(source, fmt::format("invalid glTF (tinygltf: {})", in_quotes(first_line(err))));
+    return gltf_error(source,
+                      fmt::format("invalid glTF (tinygltf: {})", mesh_detail::in_quotes(first_line(err))));
   return model;
 }
 
@@ -618,7 +610,7 @@ Result<std::vector<std::uint8_t>> image_bytes(const tinygltf::Model& model, int 
     bytes = image.image;
   } else if (!image.uri.empty() && !is_data_uri(image.uri)) {
     return gltf_error(source,
-                      fmt::format("{}: cannot read the file {}{}", label, in_quotes(image.uri),
+                      fmt::format("{}: cannot read the file {}{}", label, mesh_detail::in_quotes(image.uri),
                                   files.base_dir.empty()
                                       ? " (the glTF was read from memory without a base directory)"
                                       : " in " + files.base_dir),
@@ -626,7 +618,7 @@ Result<std::vector<std::uint8_t>> image_bytes(const tinygltf::Model& model, int 
   }
   if (!is_png_or_jpeg(bytes))
     return gltf_error(source, fmt::format("{} is not a PNG or JPEG image (mimeType {}, {} bytes)", label,
-                                          in_quotes(image.mimeType), bytes.size()));
+                                          mesh_detail::in_quotes(image.mimeType), bytes.size()));
   return bytes;
 }
 

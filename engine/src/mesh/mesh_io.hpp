@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <new>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -22,6 +23,17 @@ Result<std::vector<std::uint8_t>> read_mesh_file(const std::filesystem::path& pa
 
 /// ErrorCode::parse when `size` bytes held in memory exceed max_mesh_bytes.
 Result<void> check_mesh_size(std::size_t size, std::string_view source_name);
+
+/// A word or string from a file as messages quote it: at most `max_chars` characters, unprintable
+/// bytes as \xNN, in single quotes.
+inline std::string in_quotes(std::string_view s, std::size_t max_chars = 48) {
+  std::string out = "'";
+  for (const char c : s.substr(0, max_chars)) {
+    const auto u = static_cast<unsigned char>(c);
+    out += (u >= 0x20 && u < 0x7f) ? std::string(1, c) : fmt::format("\\x{:02x}", u);
+  }
+  return out + (s.size() > max_chars ? "...'" : "'");
+}
 
 /// Runs `parse()`; std::bad_alloc becomes ErrorCode::out_of_memory and any other exception
 /// ErrorCode::parse, both naming `source_name`, so nothing escapes the public API.

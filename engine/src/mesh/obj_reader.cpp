@@ -91,16 +91,6 @@ private:
   std::string_view rest_;
 };
 
-/// A word as messages quote it: at most 32 characters, unprintable bytes as \xNN.
-std::string in_quotes(std::string_view word) {
-  std::string out = "'";
-  for (const char c : word.substr(0, 32)) {
-    const auto u = static_cast<unsigned char>(c);
-    out += (u >= 0x20 && u < 0x7f) ? std::string(1, c) : fmt::format("\\x{:02x}", u);
-  }
-  return out + (word.size() > 32 ? "...'" : "'");
-}
-
 enum class NumberKind { ok, not_a_number, too_large };
 
 /// A decimal number, correctly rounded; "1e-400" underflows to 0, "1e400" is too large.
@@ -151,12 +141,13 @@ Result<Numbers> read_numbers(Words& words, std::string_view axes, std::string_vi
     const NumberKind kind = parse_number(word, v);
     const bool checked = n.count < axes.size();
     if (kind == NumberKind::not_a_number)
-      return line_error(source, line,
-                        fmt::format("{} {}: {} is not a number", what.kind, what.number, in_quotes(word)));
+      return line_error(
+          source, line,
+          fmt::format("{} {}: {} is not a number", what.kind, what.number, mesh_detail::in_quotes(word)));
     if (checked && kind == NumberKind::too_large)
       return line_error(source, line,
                         fmt::format("{} {}: {} = {} is out of range (|coordinate| > 1e30)", what.kind,
-                                    what.number, axes[n.count], in_quotes(word)));
+                                    what.number, axes[n.count], mesh_detail::in_quotes(word)));
     if (checked && !std::isfinite(v))
       return line_error(
           source, line,
@@ -311,7 +302,7 @@ Result<bool> check_corner(std::string_view word, const ElementCounts& counts, st
     return line_error(
         source, line,
         fmt::format("{} is not a vertex reference (v, v/vt, v//vn or v/vt/vn with integer indices)",
-                    in_quotes(word)));
+                    mesh_detail::in_quotes(word)));
   if (ref->vertex == 0 || (ref->texcoord && *ref->texcoord == 0))
     return line_error(source, line, "face index 0 is invalid (OBJ indices start at 1)");
   if (!resolve_index(ref->vertex, counts.vertices_before, counts.vertices))
