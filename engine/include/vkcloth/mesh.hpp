@@ -44,6 +44,9 @@ inline constexpr std::size_t max_mesh_bytes = std::size_t{256} << 20;
 
 /// Reads an OBJ file (v, vt, f; o/g/s/usemtl/mtllib are ignored). Errors (ErrorCode::io for a
 /// missing or unreadable file, ErrorCode::parse otherwise) name the file and the line.
+/// Faces keep their vertex count (quads and n-gons are not triangulated). uvs: each vertex takes the
+/// vt of the first face corner that references it (a seam's other uvs are dropped), (0, 0) when no
+/// face does; none when the faces have no vt. uvs and positions are as the file holds them (no flip).
 Result<Mesh> read_obj(const std::filesystem::path& path);
 /// The same from memory; `source_name` names it in messages.
 Result<Mesh> parse_obj(std::string_view text, std::string_view source_name);
@@ -51,6 +54,9 @@ Result<Mesh> parse_obj(std::string_view text, std::string_view source_name);
 /// Reads a glTF 2.0 file, .gltf (JSON, buffers beside it or as data: URIs) or .glb: every
 /// triangle primitive of the first mesh, with its POSITION, TEXCOORD_0 and indices, and its
 /// material's base-colour texture. Errors name the file and the accessor, buffer view or buffer.
+/// Nothing else is applied: no node transform, skin or morph target (the mesh is in its own space).
+/// The texture is the first triangle primitive's that has one. A URI is a file name relative to the
+/// .gltf's directory (never expanded); `parse_gltf` without `base_dir` refuses external files.
 Result<Mesh> read_gltf(const std::filesystem::path& path);
 /// The same from memory (`binary`: .glb); external buffers are looked up in `base_dir`.
 Result<Mesh> parse_gltf(std::span<const std::uint8_t> bytes, bool binary, std::string_view source_name,
