@@ -162,7 +162,6 @@ TEST_CASE("a grid as a quad mesh, or as its triangle pairs, gives the grid build
   }
 }
 
-#if 0 // MERGE: enable with the OBJ reader
 TEST_CASE("a grid written as a quad OBJ and read back gives the grid's springs") {
   const ClothDesc g = report_grid(7, 5);
   const ParticleSystem grid = grid_system(g);
@@ -171,8 +170,6 @@ TEST_CASE("a grid written as a quad OBJ and read back gives the grid's springs")
   CHECK(read->face_offsets.size() == 6 * 4 + 1);
   check_same_springs(grid, mesh_cloth(*read, like_grid(g)).system);
 }
-
-#endif
 
 TEST_CASE("a quad mesh of a grid gives each particle the grid's normal fan terms") {
   const ParticleSystem grid = grid_system(report_grid(6, 5));

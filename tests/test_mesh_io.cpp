@@ -71,11 +71,11 @@ const char* const ref_obj = "# a quad and a triangle\n"
                             "v 1 1 0 # a comment after the values\n"
                             "v 0 1 0\n"
                             "v 2 0 0.5 1\n"
-                            "vt 0 0\n"
-                            "vt 0.5 0\n"
+                            "vt 0 1\n" // OBJ's v goes up: these are ref_uvs with v -> 1 - v
                             "vt 0.5 1\n"
-                            "vt 0 1\n"
-                            "vt 1 0.25 0\n"
+                            "vt 0.5 0\n"
+                            "vt 0 0\n"
+                            "vt 1 0.75 0\n"
                             "vn 0 0 1\n"
                             "g front\n"
                             "usemtl cotton\n"
@@ -279,7 +279,7 @@ TEST_CASE("obj: the first corner that references a vertex gives its uv; unrefere
                      "f 1/1 2/2 3/3\nf 3/4 2/4 1/4\n",
                      "seam.obj");
   REQUIRE_MESSAGE(m.ok(), m.error().message);
-  CHECK(m->uvs == std::vector<glm::dvec2>{{0.25, 0.5}, {1, 0}, {0, 1}, {0, 0}});
+  CHECK(m->uvs == std::vector<glm::dvec2>{{0.25, 0.5}, {1, 1}, {0, 0}, {0, 0}}); // v flipped: 1 - vt's v
 }
 
 TEST_CASE("obj errors: face indices name the line and the index") {

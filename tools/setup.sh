@@ -11,7 +11,7 @@ packages=(
   libglm-dev doctest-dev nlohmann-json3-dev libfmt-dev libcli11-dev
   mesa-vulkan-drivers vulkan-validationlayers vulkan-tools
   libglfw3-dev libstb-dev xvfb xauth
-  libtinyobjloader-dev libtinygltf-dev libmeshoptimizer-dev
+  libtinyobjloader-dev libtinygltf-dev libmeshoptimizer-dev python3
 )
 [[ ${1:-} == fuzz ]] && packages+=(clang libclang-rt-14-dev)
 [[ ${1:-} == format ]] && packages+=(clang-format)

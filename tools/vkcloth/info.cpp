@@ -32,9 +32,15 @@ int info_command(const SceneArgs& opt) {
     ++per_kind[static_cast<std::size_t>(sp.kind)];
 
   fmt::print("scene       {}\n", s.name);
-  fmt::print("system      {}", s.system.grid ? "cloth" : "chain");
+  fmt::print("system      {}", s.system.grid || s.system.surface ? "cloth" : "chain");
   if (s.system.grid)
     fmt::print(" ({} x {} grid, index j*nx+i)", s.system.grid->nx, s.system.grid->ny);
+  if (const auto& surface = s.system.surface) {
+    const std::size_t faces =
+        surface->face_offsets.empty() ? surface->triangles.size() / 3 : surface->face_offsets.size() - 1;
+    fmt::print(" (mesh: {} faces, {} triangles; outputs in the file's vertex order)", faces,
+               surface->triangles.size() / 3);
+  }
   fmt::print("\nparticles   {} ({} pinned, free mass {:g} kg)\n", s.system.size(), pinned, mass);
   fmt::print("springs     {}", s.system.springs.size());
   for (SpringKind k : {SpringKind::plain, SpringKind::structural, SpringKind::shear, SpringKind::bend})

@@ -31,7 +31,9 @@ struct MeshTexture {
 /// face_offsets[f+1]), counter-clockwise seen from the front; faces have 3 or more vertices.
 struct Mesh {
   std::vector<glm::dvec3> positions;
-  std::vector<glm::dvec2> uvs; ///< empty, or one per vertex
+  /// Empty, or one per vertex, glTF's convention: (0, 0) is the image's top-left corner, v grows
+  /// downwards (the OBJ reader and writers flip OBJ's upward v).
+  std::vector<glm::dvec2> uvs;
   std::vector<std::uint32_t> face_offsets{0};
   std::vector<std::uint32_t> indices;
   std::optional<MeshTexture> texture; ///< a glTF material's base-colour texture
@@ -46,7 +48,8 @@ inline constexpr std::size_t max_mesh_bytes = std::size_t{256} << 20;
 /// missing or unreadable file, ErrorCode::parse otherwise) name the file and the line.
 /// Faces keep their vertex count (quads and n-gons are not triangulated). uvs: each vertex takes the
 /// vt of the first face corner that references it (a seam's other uvs are dropped), (0, 0) when no
-/// face does; none when the faces have no vt. uvs and positions are as the file holds them (no flip).
+/// face does; none when the faces have no vt. Positions are as the file holds them; uvs are
+/// flipped to glTF's convention (v = 1 - vt's v, see Mesh::uvs).
 Result<Mesh> read_obj(const std::filesystem::path& path);
 /// The same from memory; `source_name` names it in messages.
 Result<Mesh> parse_obj(std::string_view text, std::string_view source_name);

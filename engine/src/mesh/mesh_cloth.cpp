@@ -483,7 +483,7 @@ std::string format_obj(const Mesh& mesh) {
   for (const glm::dvec3& p : mesh.positions)
     text += fmt::format("v {:.17g} {:.17g} {:.17g}\n", p.x, p.y, p.z);
   for (const glm::dvec2& t : mesh.uvs)
-    text += fmt::format("vt {:.9g} {:.9g}\n", t.x, t.y);
+    text += fmt::format("vt {:.17g} {:.17g}\n", t.x, 1.0 - t.y); // OBJ's v goes up (Mesh::uvs)
   const bool uv = !mesh.uvs.empty();
   for (std::size_t f = 0; f < mesh.face_count(); ++f) {
     text += 'f';

@@ -429,7 +429,9 @@ struct FaceBuilder {
       mesh.indices.push_back(*v);
       if (with_uvs && !uv_set[*v]) { // the first corner that references a vertex gives its uv
         uv_set[*v] = true;
-        mesh.uvs[*v] = vertices->texcoords[*vt];
+        // OBJ's v goes up from the image's bottom row; vkcloth's (glTF's, Vulkan's) goes down from its top.
+        const glm::dvec2 vt_uv = vertices->texcoords[*vt];
+        mesh.uvs[*v] = glm::dvec2(vt_uv.x, 1.0 - vt_uv.y);
       }
     }
     mesh.face_offsets.push_back(static_cast<std::uint32_t>(mesh.indices.size()));
