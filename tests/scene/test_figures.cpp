@@ -47,6 +47,17 @@ void check_spring_physics(const nlohmann::json& m) {
 void check_cloth_physics(const nlohmann::json& m) {
   const auto& c = m["cloth"];
   auto num = [](const nlohmann::json& j) { return j.get<double>(); };
+  // The mesh samples: none blows up; the tablecloth drapes the sphere but stays above the floor
+  // it started 0.62 m above; the flag flies (limp, at 1 kg/m^2, it sagged 1.5 m); the skirt hangs
+  // from its pinned waist over the sphere.
+  for (const char* name : {"tablecloth_on_sphere", "flag_with_hole", "skirt"}) {
+    CAPTURE(name);
+    CHECK_FALSE(c["meshes"][name]["diverged"].get<bool>());
+  }
+  CHECK(num(c["meshes"]["tablecloth_on_sphere"]["sag"]) > 0.3);
+  CHECK(num(c["meshes"]["tablecloth_on_sphere"]["sag"]) < 0.62);
+  CHECK(num(c["meshes"]["flag_with_hole"]["sag"]) < 1.0);
+  CHECK(num(c["meshes"]["skirt"]["sag"]) < 0.1);
   const auto& ks = c["k_struct"]; // Figure 7: the sag decreases as K_struct grows
   CHECK(num(ks["5"]["sag"]) > num(ks["20"]["sag"]));
   CHECK(num(ks["20"]["sag"]) > num(ks["50"]["sag"]));
@@ -121,9 +132,9 @@ TEST_CASE("vkcloth figures (cpu): the gallery and the physics behind it") {
   check_cloth_physics(m);
   check_stability_map(m);
   if (have_vulkan_device())
-    for (const char* f :
-         {"cloth_k_struct.png", "cloth_k_shear.png", "cloth_k_bend.png", "cloth_wind.png",
-          "cloth_contact.png", "cloth_collisions.png", "cloth_no_structural.png", "cloth_gpu.png"})
+    for (const char* f : {"cloth_k_struct.png", "cloth_k_shear.png", "cloth_k_bend.png", "cloth_wind.png",
+                          "cloth_contact.png", "cloth_collisions.png", "cloth_no_structural.png",
+                          "cloth_gpu.png", "cloth_meshes.png"})
       CHECK_MESSAGE(fs::exists(out / f), f);
 }
 
@@ -145,8 +156,9 @@ TEST_CASE("vkcloth figures --backend vulkan: the same physics on the GPU, zero v
   fs::remove_all(cpu);
   const Outcome oc = run_cli("figures_vulkan_cpu_reference", "figures --quick --out " + quote(cpu.string()));
   REQUIRE_MESSAGE(oc.code == 0, oc.err);
-  for (const char* f : {"cloth_k_struct.png", "cloth_k_shear.png", "cloth_k_bend.png", "cloth_wind.png",
-                        "cloth_contact.png", "cloth_collisions.png", "cloth_no_structural.png"}) {
+  for (const char* f :
+       {"cloth_k_struct.png", "cloth_k_shear.png", "cloth_k_bend.png", "cloth_wind.png", "cloth_contact.png",
+        "cloth_collisions.png", "cloth_no_structural.png", "cloth_meshes.png"}) {
     const std::string file = f;
     CAPTURE(file);
     CHECK(differing_fraction(out / file, cpu / file) < 0.005);

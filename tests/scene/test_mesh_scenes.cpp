@@ -62,14 +62,15 @@ TEST_CASE("cloth.mesh: the path is relative to the scene file; transform, densit
     CHECK(sys.particles[p].position.z >= 2.0);
   }
   CHECK(mass == doctest::Approx(0.4 * 1.5 * 0.5)); // 1.5 m x 0.5 m after the scale
-  CHECK(pinned == 3); // vertex 4, and 3 and 7 at x = 1.5
+  CHECK(pinned == 3);                              // vertex 4, and 3 and 7 at x = 1.5
 }
 
 TEST_CASE("cloth.mesh errors name the key, the file and the element") {
   write_strip("strip.obj");
   CHECK(error_of(R"({"mesh": "strip.obj", "resolution": [4, 4]})").find("cloth.resolution is a grid key") !=
         std::string::npos);
-  CHECK(error_of(R"({"mesh": "strip.obj", "pins": []})").find("cloth.pins is a grid key") != std::string::npos);
+  CHECK(error_of(R"({"mesh": "strip.obj", "pins": []})").find("cloth.pins is a grid key") !=
+        std::string::npos);
   CHECK(error_of(R"({"mesh": "strip.obj", "density": 1, "particle_mass": 1})")
             .find("cloth.density (kg/m^2) or cloth.particle_mass") != std::string::npos);
   CHECK(error_of(R"({"mesh": "no_such.obj"})").find("no_such.obj") != std::string::npos);
@@ -77,8 +78,8 @@ TEST_CASE("cloth.mesh errors name the key, the file and the element") {
             .find("cloth.pin_vertices[0] = 8 is outside the mesh (8 vertices)") != std::string::npos);
   CHECK(error_of(R"({"mesh": "strip.obj", "pin_region": {"min": [0, 0, 0]}})").find("cloth.pin_region.max") !=
         std::string::npos);
-  CHECK(error_of(R"({"mesh": "strip.obj", "mesh_transform": {"scale": 0}})").find("cloth.mesh_transform.scale") !=
-        std::string::npos);
+  CHECK(error_of(R"({"mesh": "strip.obj", "mesh_transform": {"scale": 0}})")
+            .find("cloth.mesh_transform.scale") != std::string::npos);
   CHECK(error_of(R"({"mesh": "strip.obj", "mesh_transform": {"rotate": [0, 0, 1]}})")
             .find("unknown key cloth.mesh_transform.rotate") != std::string::npos);
   CHECK(error_of(R"({"mesh": "strip.stl"})").find(".stl") != std::string::npos);
@@ -86,8 +87,7 @@ TEST_CASE("cloth.mesh errors name the key, the file and the element") {
 
 TEST_CASE("the CLI prints a mesh scene's warnings and exits 2 on a bad mesh, naming the file and line") {
   write_strip("strip.obj");
-  std::ofstream(tmp_dir() / "warn.json")
-      << R"({"system": "cloth", "integrator": {"steps": 2},
+  std::ofstream(tmp_dir() / "warn.json") << R"({"system": "cloth", "integrator": {"steps": 2},
              "cloth": {"mesh": "strip.obj", "pin_region": {"min": [5, 5, 5], "max": [6, 6, 6]}}})";
   auto ok = run_cli("mesh_warn", "run " + (tmp_dir() / "warn.json").string());
   CHECK(ok.code == 0);
@@ -103,7 +103,8 @@ TEST_CASE("the CLI prints a mesh scene's warnings and exits 2 on a bad mesh, nam
 TEST_CASE("--trace and --positions list a mesh's vertices in the file's order") {
   // The tablecloth's particles are renumbered (meshoptimizer); the CSV rows must not be.
   const std::string csv = (tmp_dir() / "tablecloth_positions.csv").string();
-  auto r = run_cli("mesh_positions", "run " + scenes + "/tablecloth_on_sphere.json --steps 1 --positions " + csv);
+  auto r =
+      run_cli("mesh_positions", "run " + scenes + "/tablecloth_on_sphere.json --steps 1 --positions " + csv);
   REQUIRE(r.code == 0);
   auto mesh = read_obj(scenes + "/../meshes/tablecloth.obj");
   REQUIRE(mesh.ok());

@@ -318,7 +318,9 @@ Result<void> mesh_figure(Gallery& G, Drawing& d, nlohmann::json& M) {
   fmt::print(stderr, "figures: cloth meshes (tablecloth, flag with a hole, skirt)\n");
   std::vector<Run> runs;
   std::vector<std::string> labels;
-  for (const char* name : {"tablecloth_on_sphere", "flag_with_hole", "skirt"}) {
+  const std::pair<const char*, const char*> samples[] = {
+      {"tablecloth_on_sphere", "tablecloth"}, {"flag_with_hole", "flag"}, {"skirt", "skirt"}};
+  for (const auto& [name, label] : samples) {
     auto scene = load_scene_file(G.samples / "scenes" / (std::string(name) + ".json"));
     if (!scene)
       return Error{scene.error().code, scene.error().message + " (the mesh figure: --samples DIR)", 0};
@@ -332,7 +334,7 @@ Result<void> mesh_figure(Gallery& G, Drawing& d, nlohmann::json& M) {
                          {"sag", sag(*run)},
                          {"time", t},
                          {"diverged", !run->diverged.empty()}};
-    labels.push_back(fmt::format("{} ({} vertices, t = {:g} s)", name, run->pos.size(), t));
+    labels.push_back(fmt::format("{}, {} v, {:g} s", label, run->pos.size(), t));
     runs.push_back(std::move(*run));
   }
   return grid_figure(
