@@ -61,4 +61,8 @@ inline constexpr std::uint64_t max_particles = 1ull << 24;
 
 Result<ParticleSystem> make_cloth(const ClothDesc& desc);
 
+/// The checks a grid and a mesh cloth share: particle_mass finite and > 0, each stiffness finite
+/// and >= 0 (messages name cloth.particle_mass / cloth.stiffness.<kind> and the value).
+Result<void> check_cloth_material(double particle_mass, const ClothStiffness& stiffness);
+
 } // namespace vkcloth

@@ -19,6 +19,17 @@ bool finite(glm::dvec3 v) {
 
 } // namespace
 
+Result<void> check_cloth_material(double particle_mass, const ClothStiffness& stiffness) {
+  if (!std::isfinite(particle_mass) || particle_mass <= 0.0)
+    return bad(fmt::format("cloth.particle_mass must be finite and > 0, got {}", particle_mass));
+  const std::pair<const char*, double> ks[] = {
+      {"structural", stiffness.structural}, {"shear", stiffness.shear}, {"bend", stiffness.bend}};
+  for (auto [name, k] : ks)
+    if (!std::isfinite(k) || k < 0.0)
+      return bad(fmt::format("cloth.stiffness.{} must be finite and >= 0, got {}", name, k));
+  return {};
+}
+
 Result<ParticleSystem> make_chain(const ChainDesc& d) {
   const std::size_t n = d.masses.size();
   if (n == 0)
@@ -78,13 +89,7 @@ Result<ParticleSystem> make_cloth(const ClothDesc& d) {
     return bad(fmt::format("cloth.size must be finite and > 0, got [{}, {}]", d.size.x, d.size.y));
   if (!finite(d.origin))
     return bad("cloth.origin must be finite");
-  if (!std::isfinite(d.particle_mass) || d.particle_mass <= 0.0)
-    return bad(fmt::format("cloth.particle_mass must be finite and > 0, got {}", d.particle_mass));
-  const std::pair<const char*, double> ks[] = {
-      {"structural", d.stiffness.structural}, {"shear", d.stiffness.shear}, {"bend", d.stiffness.bend}};
-  for (auto [name, k] : ks)
-    if (!std::isfinite(k) || k < 0.0)
-      return bad(fmt::format("cloth.stiffness.{} must be finite and >= 0, got {}", name, k));
+  VKCLOTH_TRY(check_cloth_material(d.particle_mass, d.stiffness));
 
   const std::uint32_t nx = d.nx, ny = d.ny;
   const double dx = nx > 1 ? d.size.x / (nx - 1) : 0.0;

@@ -62,13 +62,7 @@ Result<void> check_desc(const MeshClothDesc& d) {
     return bad(fmt::format("cloth.mesh_transform.scale must be finite and > 0, got {}", t.scale));
   if (d.density && (!std::isfinite(*d.density) || *d.density <= 0.0))
     return bad(fmt::format("cloth.density must be finite and > 0 (kg/m^2), got {}", *d.density));
-  if (!std::isfinite(d.particle_mass) || d.particle_mass <= 0.0)
-    return bad(fmt::format("cloth.particle_mass must be finite and > 0, got {}", d.particle_mass));
-  const std::pair<const char*, double> ks[] = {
-      {"structural", d.stiffness.structural}, {"shear", d.stiffness.shear}, {"bend", d.stiffness.bend}};
-  for (auto [name, k] : ks)
-    if (!std::isfinite(k) || k < 0.0)
-      return bad(fmt::format("cloth.stiffness.{} must be finite and >= 0, got {}", name, k));
+  VKCLOTH_TRY(check_cloth_material(d.particle_mass, d.stiffness));
   if (d.pin_region) {
     const PinRegion& r = *d.pin_region;
     if (!usable(r.min) || !usable(r.max))
@@ -115,11 +109,13 @@ glm::dvec3 transformed(const MeshTransform& t, glm::dvec3 p) {
   return t.translate + glm::dvec3(r * glm::dvec4(t.scale * p, 1.0));
 }
 
-/// Twice the vector area of a polygon (Newell): its length is zero for a degenerate face.
+/// Twice the vector area of a polygon, as a fan from its first corner (relative coordinates: no
+/// cancellation far from the origin); its length is zero for a degenerate face.
 glm::dvec3 vector_area(std::span<const std::uint32_t> face, const std::vector<glm::dvec3>& x) {
   glm::dvec3 sum(0.0);
-  for (std::size_t k = 0; k < face.size(); ++k)
-    sum += glm::cross(x[face[k]], x[face[(k + 1) % face.size()]]);
+  const glm::dvec3 o = x[face[0]];
+  for (std::size_t k = 1; k + 1 < face.size(); ++k)
+    sum += glm::cross(x[face[k]] - o, x[face[k + 1]] - o);
   return sum;
 }
 
@@ -212,12 +208,13 @@ Faces merge_right_triangle_pairs(const Faces& faces, const std::vector<glm::dvec
     }
     if (std::size_t(partner[f]) < f)
       continue; // emitted with its partner
-    // (q at the right angle, then r, p): the partner holds p, r and s; the quad is (q, r, s, p).
+    // (q at the right angle, then r, p): the partner holds p, r and s; the quad is (q, r, s, p),
+    // written from r so that its split (0, 1, 2), (0, 2, 3) is the file's diagonal r-p again.
     const auto t = faces[f], u = faces[std::size_t(partner[f])];
     const std::uint32_t q = t[std::size_t(right[f])], r = t[std::size_t((right[f] + 1) % 3)],
                         p = t[std::size_t((right[f] + 2) % 3)];
     const std::uint32_t s = u[std::size_t(right[std::size_t(partner[f])])];
-    out.add(std::array{q, r, s, p});
+    out.add(std::array{r, s, p, q});
   }
   return out;
 }
