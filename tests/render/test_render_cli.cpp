@@ -12,6 +12,11 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
+
+#include "vkcloth/builders.hpp"
+#include "vkcloth/export.hpp"
+#include "vkcloth/render/image.hpp"
 
 namespace fs = std::filesystem;
 
@@ -35,7 +40,7 @@ fs::path tmp_dir() {
   return d;
 }
 
-Outcome vkcloth(const std::string& tag, const std::string& args, const std::string& env = "") {
+Outcome run_vkcloth(const std::string& tag, const std::string& args, const std::string& env = "") {
   const fs::path out = tmp_dir() / (tag + ".stdout"), err = tmp_dir() / (tag + ".stderr");
   const std::string cmd = env + " '" + VKCLOTH_CLI_PATH + "' " + args + " >'" + out.string() + "' 2>'" +
                           err.string() + "' </dev/null";
@@ -68,8 +73,9 @@ const std::string scenes = VKCLOTH_SCENES_DIR;
 
 TEST_CASE("render: a missing texture file is exit 2 naming the file") {
   const fs::path tex = tmp_dir() / "does_not_exist.png";
-  const Outcome o = vkcloth("tex_missing", "render " + scenes + "/cloth_on_sphere.json --steps 1 --out " +
-                                               (tmp_dir() / "x.png").string() + " --texture " + tex.string());
+  const Outcome o =
+      run_vkcloth("tex_missing", "render " + scenes + "/cloth_on_sphere.json --steps 1 --out " +
+                                     (tmp_dir() / "x.png").string() + " --texture " + tex.string());
   CHECK(o.code == 2);
   CHECK(o.err.find("does_not_exist.png") != std::string::npos);
   CHECK(o.err.find("does not exist") != std::string::npos);
@@ -78,17 +84,18 @@ TEST_CASE("render: a missing texture file is exit 2 naming the file") {
 TEST_CASE("render: a corrupt texture file is exit 2 naming the file") {
   const fs::path tex = tmp_dir() / "corrupt_texture.jpg";
   std::ofstream(tex) << "\xff\xd8\xff garbage, not a JPEG";
-  const Outcome o = vkcloth("tex_corrupt", "render " + scenes + "/cloth_on_sphere.json --steps 1 --out " +
-                                               (tmp_dir() / "x.png").string() + " --texture " + tex.string());
+  const Outcome o =
+      run_vkcloth("tex_corrupt", "render " + scenes + "/cloth_on_sphere.json --steps 1 --out " +
+                                     (tmp_dir() / "x.png").string() + " --texture " + tex.string());
   CHECK(o.code == 2);
   CHECK(o.err.find("corrupt_texture.jpg") != std::string::npos);
 }
 
 TEST_CASE("render: --video without ffmpeg is exit 2 with a clear message") {
-  const Outcome o = vkcloth("video_no_ffmpeg",
-                            "render " + scenes + "/cloth_on_sphere.json --steps 2 --video " +
-                                (tmp_dir() / "v.mp4").string(),
-                            "PATH=/nonexistent");
+  const Outcome o = run_vkcloth("video_no_ffmpeg",
+                                "render " + scenes + "/cloth_on_sphere.json --steps 2 --video " +
+                                    (tmp_dir() / "v.mp4").string(),
+                                "PATH=/nonexistent");
   CHECK(o.code == 2);
   CHECK(o.err.find("needs ffmpeg") != std::string::npos);
 }
@@ -98,9 +105,9 @@ TEST_CASE("render: --out and --frames write PNGs, a chain renders too") {
   fs::remove_all(frames);
   const fs::path out = tmp_dir() / "final.png";
   fs::remove(out);
-  const Outcome o = vkcloth("frames", "render " + scenes +
-                                          "/cloth_on_sphere.json --steps 6 --every 3 --size 64x48 --frames " +
-                                          frames.string() + " --out " + out.string());
+  const Outcome o = run_vkcloth(
+      "frames", "render " + scenes + "/cloth_on_sphere.json --steps 6 --every 3 --size 64x48 --frames " +
+                    frames.string() + " --out " + out.string());
   if (device_missing(o))
     return;
   REQUIRE_MESSAGE(o.code == 0, o.err);
@@ -109,9 +116,50 @@ TEST_CASE("render: --out and --frames write PNGs, a chain renders too") {
   CHECK_FALSE(fs::exists(frames / "frame_00003.png"));
   CHECK(fs::file_size(out) > 0);
 
-  const Outcome c = vkcloth("chain", "render " + scenes + "/spring.json --steps 5 --size 64x48 --out " +
-                                         (tmp_dir() / "spring.png").string());
+  const Outcome c = run_vkcloth("chain", "render " + scenes + "/spring.json --steps 5 --size 64x48 --out " +
+                                             (tmp_dir() / "spring.png").string());
   REQUIRE_MESSAGE(c.code == 0, c.err);
   CHECK(c.err.find("chain") != std::string::npos);
   CHECK(fs::file_size(tmp_dir() / "spring.png") > 0);
+}
+
+TEST_CASE("render: a glTF mesh scene is drawn with the file's base-colour texture") {
+  // A 6 x 6 horizontal cloth written as a .glb whose material's texture is plain green.
+  vkcloth::ClothDesc d;
+  d.nx = d.ny = 6;
+  d.orientation = vkcloth::ClothOrientation::horizontal;
+  d.origin = {-0.5, -0.5, 0.5};
+  auto system = vkcloth::make_cloth(d);
+  REQUIRE(system.ok());
+  vkcloth::render::Image green;
+  green.width = green.height = 4;
+  for (int k = 0; k < 16; ++k)
+    green.rgba.insert(green.rgba.end(), {20, 210, 40, 255});
+  REQUIRE(vkcloth::render::write_png(tmp_dir() / "green.png", green).ok());
+  std::ifstream png(tmp_dir() / "green.png", std::ios::binary);
+  const std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(png)),
+                                        std::istreambuf_iterator<char>());
+  auto rec = vkcloth::AnimationRecorder::create(*system, vkcloth::MeshTexture{"green.png", bytes});
+  REQUIRE(rec.ok());
+  std::vector<glm::dvec3> x;
+  for (const vkcloth::Particle& p : system->particles)
+    x.push_back(p.position);
+  REQUIRE(rec->add_frame(0.0, x).ok());
+  REQUIRE(rec->write_gltf(tmp_dir() / "green_cloth.glb").ok());
+  std::ofstream(tmp_dir() / "green_cloth.json")
+      << R"({"system": "cloth", "integrator": {"steps": 1}, "cloth": {"mesh": "green_cloth.glb"}})";
+
+  const fs::path out = tmp_dir() / "green_cloth.png";
+  const Outcome o = run_vkcloth("gltf_texture", "render " + (tmp_dir() / "green_cloth.json").string() +
+                                                    " --size 96x72 --out " + out.string());
+  if (device_missing(o))
+    return;
+  REQUIRE_MESSAGE(o.code == 0, o.err);
+  auto img = vkcloth::render::load_image(out);
+  REQUIRE(img.ok());
+  std::size_t greenish = 0;
+  for (std::size_t k = 0; k + 3 < img->rgba.size(); k += 4)
+    greenish += img->rgba[k + 1] > 2 * img->rgba[k] && img->rgba[k + 1] > 2 * img->rgba[k + 2];
+  // The cloth fills a good part of the frame (framed on the scene); the fabric default has no such green.
+  CHECK(greenish > img->rgba.size() / 4 / 10);
 }
