@@ -20,7 +20,9 @@
 namespace vkcloth::fuzz {
 
 /// Returns true when the scene loaded. Must never crash, hang or leak, whatever the bytes.
-inline bool run_scene_input(const std::uint8_t* data, std::size_t size) {
+/// `source` names the scene: a "cloth.mesh" path is relative to its directory (the seed corpus
+/// passes the sample's own path, so the mesh samples load their OBJ files).
+inline bool run_scene_input(const std::uint8_t* data, std::size_t size, const char* source = "fuzz.json") {
   const std::string_view all(reinterpret_cast<const char*>(data), size);
   const std::size_t nul = all.find('\0');
   const std::string_view text = all.substr(0, nul);
@@ -35,7 +37,7 @@ inline bool run_scene_input(const std::uint8_t* data, std::size_t size) {
       rest = rest.substr(next + 1);
     }
   }
-  auto scene = parse_scene(text, "fuzz.json", overrides);
+  auto scene = parse_scene(text, source, overrides);
   if (!scene.ok()) {
     // Every error has a message (the CLI prints it).
     if (scene.error().message.empty())

@@ -40,6 +40,6 @@ TEST_CASE("fuzz regressions: the seed corpus (sample scenes) loads through the f
   for (const auto& e : fs::directory_iterator(VKCLOTH_SCENES_DIR)) {
     CAPTURE(e.path().filename().string());
     const auto b = bytes_of(e.path());
-    CHECK(vkcloth::fuzz::run_scene_input(b.data(), b.size()));
+    CHECK(vkcloth::fuzz::run_scene_input(b.data(), b.size(), e.path().c_str()));
   }
 }
