@@ -3,7 +3,8 @@
 // pass per Euler step) and implicit.comp: vertex normal from the grid fan or the topology's fan
 // lists, spring gather in the topology's order, gravity, damping, wind, then contact filtering;
 // each formula from cloth_kernel.h, which the CPU reference compiles too. Reads POS_IN (all
-// particles), OFFSETS, EDGES, FAN_OFFSETS, FANS, PARTICLE.
+// particles), OFFSETS, EDGES, FAN_OFFSETS, FANS, PARTICLE (with VKCLOTH_POS_TEXEL
+// through set 1's texel views, see below).
 #ifndef VKCLOTH_FORCE_BODY_GLSL
 #define VKCLOTH_FORCE_BODY_GLSL
 
@@ -15,21 +16,43 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_POS_IN) readonly buffer PosIn 
 // texel buffer views (set 1): llvmpipe (Mesa 22.x) turns an SSBO load into a per-lane loop with a
 // bounds check and a branch per component, a texel fetch into one vectorised gather of the 8
 // lanes' texels. A 32-bit texel fetch is a copy: same bits.
+// The topology's lists the same way: offsets_at(p) = offsets[p], edge_at(e) = edges[e],
+// fan_offsets_at(p) = fan_offsets[p], fan_at(t) = fans[t] (the mesh path: CSR gather, fan normal).
+// EDGES is viewed as R32UI, 3 texels per 12-byte Edge (no RGB32 texel format is mandatory).
 #ifdef VKCLOTH_POS_TEXEL
 layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_POS_IN) uniform samplerBuffer pos_in_texel;
 layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_PARTICLE) uniform usamplerBuffer particle_texel;
+layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_OFFSETS) uniform usamplerBuffer offsets_texel;
+layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_EDGES) uniform usamplerBuffer edges_texel;
+layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_FAN_OFFSETS) uniform usamplerBuffer fan_offsets_texel;
+layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_FANS) uniform usamplerBuffer fans_texel;
 vec3 pos_at(uint q) { return texelFetch(pos_in_texel, int(base + q)).xyz; }
 float mass_at(uint p) { return uintBitsToFloat(texelFetch(particle_texel, int(p)).x); }
 bool pinned_at(uint p) { return texelFetch(particle_texel, int(p)).y != 0u; }
+uint offsets_at(uint p) { return texelFetch(offsets_texel, int(p)).x; }
+Edge edge_at(uint e) {
+  const int t = VKCLOTH_EDGE_TEXELS * int(e);
+  return Edge(texelFetch(edges_texel, t).x, uintBitsToFloat(texelFetch(edges_texel, t + 1).x),
+              uintBitsToFloat(texelFetch(edges_texel, t + 2).x));
+}
+uint fan_offsets_at(uint p) { return texelFetch(fan_offsets_texel, int(p)).x; }
+FanEntry fan_at(uint t) {
+  const uvec2 f = texelFetch(fans_texel, int(t)).xy;
+  return FanEntry(f.x, f.y);
+}
 #else
-vec3 pos_at(uint q) { return pos_in[base + q].xyz; }
-float mass_at(uint p) { return particle[p].mass; }
-bool pinned_at(uint p) { return particle[p].pinned != 0u; }
-#endif
 layout(std430, set = 0, binding = VKCLOTH_BINDING_OFFSETS) readonly buffer OffsetBuf { uint offsets[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_EDGES) readonly buffer EdgeBuf { Edge edges[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_FAN_OFFSETS) readonly buffer FanOffsetBuf { uint fan_offsets[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_FANS) readonly buffer FanBuf { FanEntry fans[]; };
+vec3 pos_at(uint q) { return pos_in[base + q].xyz; }
+float mass_at(uint p) { return particle[p].mass; }
+bool pinned_at(uint p) { return particle[p].pinned != 0u; }
+uint offsets_at(uint p) { return offsets[p]; }
+Edge edge_at(uint e) { return edges[e]; }
+uint fan_offsets_at(uint p) { return fan_offsets[p]; }
+FanEntry fan_at(uint t) { return fans[t]; }
+#endif
 
 // Grid stencil (specialisation constants, set by the host when every interior particle's gather
 // list is the same up to translation: GpuSolver detect_stencil, like CpuSolver::detect_stencil).
@@ -127,9 +150,9 @@ vec3 grid_normal(uint p) {
 vec3 fan_normal(uint p) {
   const vec3 x = pos_at(p);
   vec3 sum = vec3(0.0);
-  const uint end = fan_offsets[p + 1u];
-  for (uint t = fan_offsets[p]; t < end; ++t) {
-    const FanEntry f = fans[t];
+  const uint end = fan_offsets_at(p + 1u);
+  for (uint t = fan_offsets_at(p); t < end; ++t) {
+    const FanEntry f = fan_at(t);
     precise vec3 ea = pos_at(f.a) - x;
     precise vec3 eb = pos_at(f.b) - x;
     add_fan_triangle(sum, ea, eb);
@@ -171,9 +194,9 @@ void particle_force(uint p, inout vec3 v_io, out vec3 f_out, out vec3 nrm_out) {
     if ((has & 1024u) != 0u) spring_term(f, x, uint(q + SC_OFF10), SC_L10, SC_K10);
     if ((has & 2048u) != 0u) spring_term(f, x, uint(q + SC_OFF11), SC_L11, SC_K11);
   } else {
-    const uint end = offsets[p + 1];
-    for (uint e = offsets[p]; e < end; ++e) {
-      const Edge s = edges[e];
+    const uint end = offsets_at(p + 1u);
+    for (uint e = offsets_at(p); e < end; ++e) {
+      const Edge s = edge_at(e);
       spring_term(f, x, s.other, s.rest_length, s.stiffness);
     }
   }

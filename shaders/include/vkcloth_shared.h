@@ -51,12 +51,19 @@ struct vec4 {
 
 // Set 1 (force.comp, fused.comp): POS_IN again, as an RGBA32F uniform texel buffer view,
 // PARTICLE as an RG32UI one (x: the mass's bits, y: pinned), and (fused.comp) VEL as RGBA32F and
-// FLAGS as R32UI; INSTANCES as RGBA32UI (common.glsl begin_instance).
+// FLAGS as R32UI; INSTANCES as RGBA32UI (common.glsl begin_instance); the topology's lists
+// (force_body.glsl offsets_at, edge_at, fan_offsets_at, fan_at) as R32UI / RG32UI views.
 #define VKCLOTH_TEXEL_BINDING_POS_IN 0
 #define VKCLOTH_TEXEL_BINDING_PARTICLE 1
 #define VKCLOTH_TEXEL_BINDING_VEL 2
 #define VKCLOTH_TEXEL_BINDING_FLAGS 3
-#define VKCLOTH_TEXEL_BINDING_INSTANCES 4 // InstanceParams as RGBA32UI, 5 texels per instance
+#define VKCLOTH_TEXEL_BINDING_INSTANCES 4   // InstanceParams as RGBA32UI, 5 texels per instance
+#define VKCLOTH_TEXEL_BINDING_OFFSETS 5     // OFFSETS as R32UI
+#define VKCLOTH_TEXEL_BINDING_EDGES 6       // EDGES as R32UI, VKCLOTH_EDGE_TEXELS texels per Edge
+#define VKCLOTH_TEXEL_BINDING_FAN_OFFSETS 7 // FAN_OFFSETS as R32UI
+#define VKCLOTH_TEXEL_BINDING_FANS 8        // FANS as RG32UI, one texel per FanEntry
+#define VKCLOTH_TEXEL_BINDING_COUNT 9
+#define VKCLOTH_EDGE_TEXELS 3 // 32-bit words per Edge (static_assert below)
 
 // InstanceParams::flags bits.
 #define VKCLOTH_FLAG_HAS_GRID 1u     // the topology is a grid: rebuild normals from the grid fan
@@ -155,6 +162,7 @@ static_assert(offsetof(InstanceParams, dt) == 48);
 static_assert(offsetof(InstanceParams, limit) == 64);
 static_assert(sizeof(ParticleInfo) == 8);
 static_assert(sizeof(Edge) == 12);
+static_assert(sizeof(Edge) == VKCLOTH_EDGE_TEXELS * 4);
 static_assert(sizeof(FanEntry) == 8);
 static_assert(sizeof(Collider) == 32);
 static_assert(offsetof(Collider, type) == 16);

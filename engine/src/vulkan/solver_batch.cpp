@@ -316,6 +316,22 @@ Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ClothTopology&
                     "{} texels per texel buffer view but the device allows {} (maxTexelBufferElements); "
                     "use fewer particles or fewer instances of one topology",
                     ctx.name, batch * n, batch, n, batch * n, lim.maxTexelBufferElements));
+  // So are the topology's lists (force_body.glsl offsets_at, edge_at, fan_offsets_at, fan_at):
+  // n + 1 offsets, VKCLOTH_EDGE_TEXELS texels per spring entry, one per fan triangle.
+  const struct {
+    const char* what;
+    std::uint64_t texels;
+  } lists[] = {{"spring adjacency offsets", n + 1},
+               {"spring adjacency", edges_n * VKCLOTH_EDGE_TEXELS},
+               {"normal fan offsets", fan_lists ? n + 1 : 0},
+               {"normal fans", fans_n}};
+  for (const auto& list : lists)
+    if (list.texels > lim.maxTexelBufferElements)
+      return make_error(ErrorCode::unsupported,
+                        fmt::format("the system is too large for device '{}': its {} need {} texels in a "
+                                    "texel buffer view but the device allows {} (maxTexelBufferElements); "
+                                    "use fewer springs or particles",
+                                    ctx.name, list.what, list.texels, lim.maxTexelBufferElements));
   const std::uint64_t groups = (n + VKCLOTH_WORKGROUP_SIZE - 1) / VKCLOTH_WORKGROUP_SIZE;
   std::uint64_t row = lim.maxComputeWorkGroupCount[0];
   if (knobs.max_workgroups_x)

@@ -146,9 +146,11 @@ private:
   VkDescriptorSet sets[2][2] = {}; // [positions read index][0: state input, 1: RK4 stage input]
   // Set 1 of force.comp / fused.comp: POS_IN as an RGBA32F uniform texel buffer (force_body.glsl
   // pos_at), the particle constants as an RG32UI one, velocities, flags, instance parameters.
-  // pos_views [0], [1]: positions[0], positions[1]; [2]: RK4 stage positions.
+  // pos_views [0], [1]: positions[0], positions[1]; [2]: RK4 stage positions. The topology's
+  // spring and fan lists too (force_body.glsl offsets_at, edge_at, fan_offsets_at, fan_at).
   BufferView pos_views[3];
   BufferView particle_view, vel_view, flags_view, instances_view;
+  BufferView offsets_view, edges_view, fan_offsets_view, fans_view;
   VkDescriptorSet texel_sets[3] = {};
   CommandContext* commands = nullptr; // the owner's (ClothWorld): uploads, readbacks
   std::uint32_t groups_x = 1, groups_y = 1;

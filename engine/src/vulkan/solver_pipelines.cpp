@@ -56,8 +56,9 @@ Result<void> SolverBatch::init_pipelines() {
 // Four storage sets ([read][state / RK4 stage input], written by write_sets()) and three texel sets.
 Result<void> SolverBatch::create_descriptor_sets() {
   const auto& v = vk();
-  const VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 4 * VKCLOTH_BINDING_COUNT},
-                                         {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 5 * 3}};
+  const VkDescriptorPoolSize sizes[2] = {
+      {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 4 * VKCLOTH_BINDING_COUNT},
+      {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, VKCLOTH_TEXEL_BINDING_COUNT * 3}};
   VkDescriptorPoolCreateInfo dp{};
   dp.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
   dp.maxSets = 4 + 3;
@@ -81,33 +82,43 @@ Result<void> SolverBatch::create_descriptor_sets() {
 }
 
 // The texel sets never change: positions[0/1] and the stage positions live as long as the batch.
-// Set k: its positions view (k = 0, 1: positions[k]; 2: stage positions) and the same four shared
-// views. Uniform texel buffer support is mandatory for these formats.
+// Set k: its positions view (k = 0, 1: positions[k]; 2: stage positions) and the same eight shared
+// views. Uniform texel buffer support is mandatory for these formats. Edges are viewed as R32UI,
+// VKCLOTH_EDGE_TEXELS texels per Edge (no RGB32 format is mandatory for texel buffers).
 Result<void> SolverBatch::create_texel_views() {
   const struct {
     const Buffer* buffer;
     VkFormat format;
     BufferView* view;
     const char* what;
-  } views[7] = {{&pos[0], VK_FORMAT_R32G32B32A32_SFLOAT, &pos_views[0], "positions[0]"},
-                {&pos[1], VK_FORMAT_R32G32B32A32_SFLOAT, &pos_views[1], "positions[1]"},
-                {&stage_pos, VK_FORMAT_R32G32B32A32_SFLOAT, &pos_views[2], "stage positions"},
-                {&particle, VK_FORMAT_R32G32_UINT, &particle_view, "particle constants"},
-                {&vel, VK_FORMAT_R32G32B32A32_SFLOAT, &vel_view, "velocities"},
-                {&flags, VK_FORMAT_R32_UINT, &flags_view, "flags"},
-                {&instances, VK_FORMAT_R32G32B32A32_UINT, &instances_view, "instance parameters"}};
+  } views[11] = {{&pos[0], VK_FORMAT_R32G32B32A32_SFLOAT, &pos_views[0], "positions[0]"},
+                 {&pos[1], VK_FORMAT_R32G32B32A32_SFLOAT, &pos_views[1], "positions[1]"},
+                 {&stage_pos, VK_FORMAT_R32G32B32A32_SFLOAT, &pos_views[2], "stage positions"},
+                 {&particle, VK_FORMAT_R32G32_UINT, &particle_view, "particle constants"},
+                 {&vel, VK_FORMAT_R32G32B32A32_SFLOAT, &vel_view, "velocities"},
+                 {&flags, VK_FORMAT_R32_UINT, &flags_view, "flags"},
+                 {&instances, VK_FORMAT_R32G32B32A32_UINT, &instances_view, "instance parameters"},
+                 {&offsets, VK_FORMAT_R32_UINT, &offsets_view, "adjacency offsets"},
+                 {&edges, VK_FORMAT_R32_UINT, &edges_view, "adjacency"},
+                 {&fan_offsets, VK_FORMAT_R32_UINT, &fan_offsets_view, "normal fan offsets"},
+                 {&fans, VK_FORMAT_R32G32_UINT, &fans_view, "normal fans"}};
+  static_assert(sizeof(sh::FanEntry) == 8, "one RG32UI texel per FanEntry");
   for (const auto& view : views) {
     auto r = create_buffer_view(*ctx, view.buffer->buffer, view.format, view.what);
     if (!r)
       return r.error();
     *view.view = std::move(*r);
   }
-  const std::pair<const BufferView*, std::uint32_t> shared_views[4] = {
+  const std::pair<const BufferView*, std::uint32_t> shared_views[VKCLOTH_TEXEL_BINDING_COUNT - 1] = {
       {&particle_view, VKCLOTH_TEXEL_BINDING_PARTICLE},
       {&vel_view, VKCLOTH_TEXEL_BINDING_VEL},
       {&flags_view, VKCLOTH_TEXEL_BINDING_FLAGS},
-      {&instances_view, VKCLOTH_TEXEL_BINDING_INSTANCES}};
-  std::array<VkWriteDescriptorSet, 15> writes{};
+      {&instances_view, VKCLOTH_TEXEL_BINDING_INSTANCES},
+      {&offsets_view, VKCLOTH_TEXEL_BINDING_OFFSETS},
+      {&edges_view, VKCLOTH_TEXEL_BINDING_EDGES},
+      {&fan_offsets_view, VKCLOTH_TEXEL_BINDING_FAN_OFFSETS},
+      {&fans_view, VKCLOTH_TEXEL_BINDING_FANS}};
+  std::array<VkWriteDescriptorSet, VKCLOTH_TEXEL_BINDING_COUNT * 3> writes{};
   std::size_t w = 0;
   auto write = [&](VkDescriptorSet set, std::uint32_t binding, const BufferView& view) {
     writes[w] = VkWriteDescriptorSet{};
