@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
 # CTest: the Khronos glTF validator (tools/validate_gltf.mjs) finds no error and no warning in
-# what vkcloth exports: a grid cloth from `vkcloth run --export` as .glb and .gltf, and the export
+# what vkcloth exports: a grid cloth from `vkcloth run --export` as .glb and .gltf, a mesh cloth
+# (the tablecloth sample) as .glb, and the export
 # tests' textured mesh animation (an embedded PNG). Without node or the validator it exits 77
 # (CTest: skipped), except under CI=true where that is a failure.
 # Usage: validate_export.sh VKCLOTH EXPORT_TESTS EXPORT_TESTS_TMP SOURCE_DIR WORK_DIR
@@ -21,9 +22,12 @@ scene=$source/samples/scenes/cloth_hanging.json
 for ext in glb gltf; do
   "$vkcloth" run "$scene" --steps 40 --export "$work/cloth_hanging.$ext" --export-every 4 >/dev/null
 done
+# A mesh cloth (irregular triangles, renumbered particles, file-order output).
+"$vkcloth" run "$source/samples/scenes/tablecloth_on_sphere.json" --steps 60 --export "$work/tablecloth.glb" \
+  --export-every 6 >/dev/null
 "$export_tests" --test-case='*texture is embedded*' >/dev/null
 status=0
-node "$source/tools/validate_gltf.mjs" --no-warnings "$work/cloth_hanging.glb" "$work/cloth_hanging.gltf" \
+node "$source/tools/validate_gltf.mjs" --no-warnings "$work/cloth_hanging.glb" "$work/cloth_hanging.gltf" "$work/tablecloth.glb" \
   "$export_tmp/textured.glb" "$export_tmp/textured.gltf" || status=$?
 ((status == 77)) && missing "the glTF validator is not installed"
 exit "$status"
