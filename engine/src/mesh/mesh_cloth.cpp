@@ -308,32 +308,31 @@ private:
   std::unordered_set<std::uint64_t> seen_;
 };
 
-/// order[p] = the file vertex that becomes particle p: the vertices some face uses, renumbered by
-/// first use after meshoptimizer's vertex-cache triangle order (neighbours get nearby indices, so
-/// the gather reads nearby memory), or in file order.
-std::vector<std::uint32_t> particle_order(const Faces& faces, std::size_t n_file, bool reorder) {
+/// order[p] = the file vertex that becomes particle p: the vertices some face uses, in
+/// meshoptimizer's spatial order (a Morton curve: neighbours get nearby indices, so the gather reads
+/// nearby memory), or in file order.
+std::vector<std::uint32_t> particle_order(const Faces& faces, const std::vector<glm::dvec3>& x,
+                                          bool reorder) {
+  const std::size_t n_file = x.size();
+  std::vector<char> used(n_file, 0);
+  for (std::uint32_t v : faces.corners)
+    used[v] = 1;
   std::vector<std::uint32_t> order;
-  if (!reorder) {
-    std::vector<char> used(n_file, 0);
-    for (std::uint32_t v : faces.corners)
-      used[v] = 1;
-    for (std::uint32_t v = 0; v < n_file; ++v)
-      if (used[v])
-        order.push_back(v);
-    return order;
-  }
-  std::vector<std::uint32_t> tris;
-  for (std::size_t f = 0; f < faces.size(); ++f)
-    for (std::size_t k = 1; k + 1 < faces[f].size(); ++k)
-      tris.insert(tris.end(), {faces[f][0], faces[f][k], faces[f][k + 1]});
-  meshopt_optimizeVertexCache(tris.data(), tris.data(), tris.size(), n_file);
-  std::vector<std::uint32_t> remap(n_file);
-  const std::size_t used = meshopt_optimizeVertexFetchRemap(remap.data(), tris.data(), tris.size(), n_file);
-  order.assign(used, 0);
   for (std::uint32_t v = 0; v < n_file; ++v)
-    if (remap[v] != ~0u)
-      order[remap[v]] = v;
-  return order;
+    if (used[v])
+      order.push_back(v);
+  if (!reorder)
+    return order;
+  std::vector<float> xyz;
+  xyz.reserve(3 * order.size());
+  for (std::uint32_t v : order)
+    xyz.insert(xyz.end(), {float(x[v].x), float(x[v].y), float(x[v].z)});
+  std::vector<std::uint32_t> remap(order.size()); // remap[k] = the new place of order[k]
+  meshopt_spatialSortRemap(remap.data(), xyz.data(), order.size(), 3 * sizeof(float));
+  std::vector<std::uint32_t> sorted(order.size());
+  for (std::size_t k = 0; k < order.size(); ++k)
+    sorted[remap[k]] = order[k];
+  return sorted;
 }
 
 /// Texture coordinates: the file's, else a planar projection on the two widest axes of the mesh's
@@ -442,7 +441,7 @@ Result<MeshCloth> make_mesh_cloth(const Mesh& mesh, const MeshClothDesc& desc) {
                                        first_dropped));
   faces = merge_right_triangle_pairs(faces, world);
 
-  std::vector<std::uint32_t> order = particle_order(faces, n_file, desc.reorder);
+  std::vector<std::uint32_t> order = particle_order(faces, world, desc.reorder);
   if (const std::size_t isolated = n_file - order.size(); isolated > 0)
     out.warnings.push_back(
         fmt::format("dropped {} (in no face)", plural(isolated, "isolated vertex", "isolated vertices")));
