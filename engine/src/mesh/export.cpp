@@ -56,12 +56,9 @@ Result<ExportSurface> export_surface(const ParticleSystem& system) {
   auto topology = ClothTopology::create(system); // validates the system
   if (!topology)
     return topology.error();
-  // A mesh's triangles and uvs are its Surface's (ClothTopology exposes the same lists); a grid's
-  // are made by the topology.
-  const std::span<const std::uint32_t> triangles =
-      system.surface ? std::span<const std::uint32_t>(system.surface->triangles) : (*topology)->triangles();
-  const std::span<const glm::vec2> uvs =
-      system.surface ? std::span<const glm::vec2>(system.surface->uvs) : (*topology)->uvs();
+  // The topology's lists: a mesh's own triangles and uvs, or those it makes for a grid.
+  const std::span<const std::uint32_t> triangles = (*topology)->triangles();
+  const std::span<const glm::vec2> uvs = (*topology)->uvs();
   if (triangles.empty())
     return invalid(fmt::format("the cloth ({} particles) has no triangles to export", system.size()));
 

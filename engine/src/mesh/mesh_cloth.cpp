@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <numeric>
 #include <span>
 #include <unordered_map>
 #include <unordered_set>
@@ -15,6 +14,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <meshoptimizer.h>
 
+#include "vkcloth/export.hpp"
 #include "vkcloth/mesh.hpp"
 
 namespace vkcloth {
@@ -122,10 +122,8 @@ glm::dvec3 vector_area(std::span<const std::uint32_t> face, const std::vector<gl
 bool degenerate(std::span<const std::uint32_t> face, const std::vector<glm::dvec3>& x) {
   for (std::size_t k = 0; k < face.size(); ++k)
     if (x[face[k]] == x[face[(k + 1) % face.size()]])
-      return true;      // a repeated vertex or a zero-length edge
-  if (face.size() == 3) // exactly, not as a polygon's vector area: no cancellation on a sliver
-    return glm::cross(x[face[1]] - x[face[0]], x[face[2]] - x[face[0]]) == glm::dvec3(0.0);
-  return glm::length(vector_area(face, x)) == 0.0;
+      return true; // a repeated vertex or a zero-length edge
+  return vector_area(face, x) == glm::dvec3(0.0);
 }
 
 /// The file's faces as triangles and quads (larger polygons split into a triangle fan), without
@@ -510,12 +508,8 @@ Mesh surface_mesh(const ParticleSystem& system, std::span<const glm::dvec3> posi
   if (!system.surface)
     return m;
   const Surface& s = *system.surface;
-  // Particles sorted by file vertex (isolated file vertices were dropped: indices close up).
-  std::vector<std::uint32_t> by_file(n);
-  std::iota(by_file.begin(), by_file.end(), 0u);
-  if (!s.source_vertex.empty())
-    std::sort(by_file.begin(), by_file.end(),
-              [&](std::uint32_t a, std::uint32_t b) { return s.source_vertex[a] < s.source_vertex[b]; });
+  // Particles in file vertex order (isolated file vertices were dropped: indices close up).
+  const std::vector<std::uint32_t> by_file = file_order(system);
   std::vector<std::uint32_t> out_index(n);
   for (std::uint32_t k = 0; k < n; ++k) {
     out_index[by_file[k]] = k;
