@@ -5,7 +5,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 preset=${1:-release}
-tools/setup.sh
+tools/setup.sh validator # also the glTF validator the export tests run (build/npm)
 cmake --preset "$preset" >/dev/null
 cmake --build --preset "$preset"
 extra=()
