@@ -3,6 +3,7 @@
 // Units: metres, seconds, kilograms; z is up.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -53,6 +54,32 @@ struct Wind {
   glm::dvec3 direction{1.0, 0.0, 0.0}; ///< normalised by validate()
 };
 
+/// Stretch control (docs/model.md "Stretch control"), applied after each (sub)step's update: off by
+/// default (the report's model). Provot's strain limiting projects every structural spring longer
+/// than (1 + max_strain) L0 back to that length, `iterations` sweeps over the springs in colour
+/// order (Gauss-Seidel, each colour a set of springs that share no particle); tethers (long-range
+/// attachments, Kim, Chentanez and Mueller 2012) keep each particle within (1 + max_strain) of its
+/// rest distance to the pinned particles it hangs from (up to 4, nearest first). The position
+/// changes update the velocities (v += dx / dt); the colliders' projection follows.
+struct StretchLimit {
+  enum class Method : std::uint32_t { off = 0, tethers = 1, provot = 2, both = 3 };
+  /// How a tether's rest length is measured in the rest state: straight, or along the cloth.
+  enum class TetherDistance : std::uint32_t { euclidean = 0, geodesic = 1 };
+  Method method = Method::off;
+  double max_strain = 0.1;     ///< > 0: the largest allowed (|u| - L0) / L0
+  std::uint32_t iterations = 4; ///< 1..100 Provot sweeps per substep
+  TetherDistance tether_distance = TetherDistance::geodesic;
+
+  bool provot() const { return method == Method::provot || method == Method::both; }
+  bool tethers() const { return method == Method::tethers || method == Method::both; }
+  bool enabled() const { return method != Method::off; }
+};
+
+const char* to_string(StretchLimit::Method method);
+std::optional<StretchLimit::Method> parse_stretch_method(std::string_view name);
+const char* to_string(StretchLimit::TetherDistance distance);
+std::optional<StretchLimit::TetherDistance> parse_tether_distance(std::string_view name);
+
 struct SimParams {
   Integrator integrator = Integrator::semi_implicit_euler;
   double dt = 0.02;
@@ -77,6 +104,7 @@ struct SimParams {
   /// A position with a coordinate |x_i| > this, or a non-finite position or velocity, is a blow-up
   /// (docs/model.md "Divergence").
   double divergence_limit = 1e4;
+  StretchLimit stretch_limit; ///< off by default
 
   /// Checks every field (finite, in range) and normalises directions. The message names the field.
   Result<void> validate();

@@ -43,6 +43,40 @@ std::optional<Integrator> parse_integrator(std::string_view name) {
   return std::nullopt;
 }
 
+const char* to_string(StretchLimit::Method method) {
+  switch (method) {
+  case StretchLimit::Method::off:
+    return "off";
+  case StretchLimit::Method::tethers:
+    return "tethers";
+  case StretchLimit::Method::provot:
+    return "provot";
+  case StretchLimit::Method::both:
+    return "both";
+  }
+  return "?";
+}
+
+std::optional<StretchLimit::Method> parse_stretch_method(std::string_view name) {
+  using M = StretchLimit::Method;
+  for (M m : {M::off, M::tethers, M::provot, M::both})
+    if (name == to_string(m))
+      return m;
+  return std::nullopt;
+}
+
+const char* to_string(StretchLimit::TetherDistance distance) {
+  return distance == StretchLimit::TetherDistance::euclidean ? "euclidean" : "geodesic";
+}
+
+std::optional<StretchLimit::TetherDistance> parse_tether_distance(std::string_view name) {
+  using D = StretchLimit::TetherDistance;
+  for (D d : {D::euclidean, D::geodesic})
+    if (name == to_string(d))
+      return d;
+  return std::nullopt;
+}
+
 Result<void> SimParams::validate() {
   if (static_cast<std::uint32_t>(integrator) > static_cast<std::uint32_t>(Integrator::implicit_euler))
     return bad(
@@ -73,6 +107,12 @@ Result<void> SimParams::validate() {
     return bad(fmt::format("contact_epsilon must be finite and >= 0, got {}", contact_epsilon));
   if (!std::isfinite(divergence_limit) || divergence_limit <= 0.0)
     return bad(fmt::format("divergence_limit must be finite and > 0, got {}", divergence_limit));
+  if (std::uint32_t(stretch_limit.method) > std::uint32_t(StretchLimit::Method::both))
+    return bad(fmt::format("stretch_limit.method: unknown method {}", std::uint32_t(stretch_limit.method)));
+  if (!std::isfinite(stretch_limit.max_strain) || stretch_limit.max_strain <= 0.0)
+    return bad(fmt::format("stretch_limit.max_strain must be finite and > 0, got {}", stretch_limit.max_strain));
+  if (stretch_limit.iterations < 1 || stretch_limit.iterations > 100)
+    return bad(fmt::format("stretch_limit.iterations must be in 1..100, got {}", stretch_limit.iterations));
   for (std::size_t k = 0; k < colliders.size(); ++k) {
     Collider& c = colliders[k];
     if (c.type == Collider::Type::plane) {
