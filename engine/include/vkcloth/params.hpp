@@ -68,7 +68,7 @@ struct StretchLimit {
   Method method = Method::off;
   double max_strain = 0.1;     ///< > 0: the largest allowed (|u| - L0) / L0
   std::uint32_t iterations = 4; ///< 1..100 Provot sweeps per substep
-  TetherDistance tether_distance = TetherDistance::geodesic;
+  TetherDistance tether_distance = TetherDistance::euclidean;
 
   bool provot() const { return method == Method::provot || method == Method::both; }
   bool tethers() const { return method == Method::tethers || method == Method::both; }
