@@ -135,6 +135,52 @@ KFN void project_out(uint type, vec3 a, real b, real eps, INOUT(vec3) x, INOUT(v
   remove_inward(v, n, false);
 }
 
+// ---- Stretch control (docs/model.md "Stretch control") ----------------------------------------
+
+// The longest a link of rest length `rest` may be: (1 + max_strain) rest.
+KFN precise real stretch_bound(real rest, real max_strain) {
+  precise real s = real(1) + max_strain;
+  precise real b = rest * s;
+  return b;
+}
+
+// Moves x by dx and gives v the velocity of that move (v += dx / h), so that the step's velocity
+// stays the position change over the step.
+KFN void apply_correction(INOUT(vec3) x, INOUT(vec3) v, vec3 dx, real h) {
+  precise vec3 nx = x + dx;
+  precise vec3 nv = v + dx / h;
+  x = nx;
+  v = nv;
+}
+
+// Provot (1995): a link (xa, xb) longer than `bound` is shortened to `bound`; its free ends share
+// the correction (half each, all of it when the other end is pinned). da, db: the moves of a, b.
+KFN void provot_link(vec3 xa, vec3 xb, bool pinned_a, bool pinned_b, real bound, OUT(vec3) da, OUT(vec3) db) {
+  da = vec3(real(0));
+  db = vec3(real(0));
+  precise vec3 u = xb - xa;
+  precise real len = sqrt(dot3(u, u));
+  if (!(len > bound) || (pinned_a && pinned_b))
+    return;
+  precise real share = pinned_a || pinned_b ? real(1) : real(0.5);
+  precise vec3 c = u * (share * (len - bound) / len); // along a -> b
+  if (!pinned_a)
+    da = c;
+  if (!pinned_b)
+    db = -c;
+}
+
+// A tether (Kim, Chentanez and Mueller 2012): x farther than `bound` from its (pinned) anchor goes
+// back onto the sphere of radius `bound` around it. Returns the move.
+KFN precise vec3 tether_move(vec3 x, vec3 anchor, real bound) {
+  precise vec3 u = x - anchor;
+  precise real len = sqrt(dot3(u, u));
+  precise vec3 d = vec3(real(0));
+  if (len > bound)
+    d = u * ((bound - len) / len);
+  return d;
+}
+
 // ---- Integrators (docs/model.md "Integrators") ------------------------------------------------
 
 // Eq. 3 (explicit: x with the old v) or semi-implicit Euler (x with the new v); a = F / m.

@@ -60,6 +60,9 @@ void begin_instance() {
   ip.band = uintBitsToFloat(d.z);
   ip.eps = uintBitsToFloat(d.w);
   ip.limit = uintBitsToFloat(e.x);
+  ip.max_strain = uintBitsToFloat(e.y);
+  ip.stretch = e.z;
+  ip.stretch_sweeps = e.w;
 #else
   base = inst * pc.count;
   ip = instances[inst];

@@ -14,17 +14,17 @@
 namespace vkcloth::gpu::shared {
 #endif
 
-#define VKCLOTH_BINDING_IMPL_VF 20       // contact-filtered velocity (vec4)
-#define VKCLOTH_BINDING_IMPL_KS 21       // per CSR entry: K_s as 2 vec4 (xx yy zz xy | xz yz - -)
-#define VKCLOTH_BINDING_IMPL_DIAG_INV 22 // 1 / diag(A), zero for pinned particles (vec4)
-#define VKCLOTH_BINDING_IMPL_X 23        // CG solution dv (vec4)
-#define VKCLOTH_BINDING_IMPL_R 24        // residual
-#define VKCLOTH_BINDING_IMPL_Z 25        // preconditioned residual
-#define VKCLOTH_BINDING_IMPL_D 26        // search direction
-#define VKCLOTH_BINDING_IMPL_Q 27        // S A d
-#define VKCLOTH_BINDING_IMPL_PARTIALS 28 // one vec2 per workgroup: its partial dot products
-#define VKCLOTH_BINDING_IMPL_STATE 29    // CgState
-#define VKCLOTH_BINDING_IMPL_ARGS 30     // indirect dispatch arguments (CgArgs)
+#define VKCLOTH_BINDING_IMPL_VF 22       // contact-filtered velocity (vec4)
+#define VKCLOTH_BINDING_IMPL_KS 23       // per CSR entry: K_s as 2 vec4 (xx yy zz xy | xz yz - -)
+#define VKCLOTH_BINDING_IMPL_DIAG_INV 24 // 1 / diag(A), zero for pinned particles (vec4)
+#define VKCLOTH_BINDING_IMPL_X 25        // CG solution dv (vec4)
+#define VKCLOTH_BINDING_IMPL_R 26        // residual
+#define VKCLOTH_BINDING_IMPL_Z 27        // preconditioned residual
+#define VKCLOTH_BINDING_IMPL_D 28        // search direction
+#define VKCLOTH_BINDING_IMPL_Q 29        // S A d
+#define VKCLOTH_BINDING_IMPL_PARTIALS 30 // one vec2 per workgroup: its partial dot products
+#define VKCLOTH_BINDING_IMPL_STATE 31    // CgState
+#define VKCLOTH_BINDING_IMPL_ARGS 32     // indirect dispatch arguments (CgArgs)
 
 // implicit.comp passes (PushConstants::stage).
 #define VKCLOTH_IMPL_FORCE 0u     // normal, force, contact filtering -> FORCE_OUT, NORMAL, VF

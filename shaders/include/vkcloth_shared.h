@@ -47,7 +47,11 @@ struct vec4 {
 #define VKCLOTH_BINDING_INSTANCES 17   // InstanceParams per instance
 #define VKCLOTH_BINDING_FAN_OFFSETS 18 // normal fans' CSR offsets, count + 1 (ClothTopology::fan_offsets)
 #define VKCLOTH_BINDING_FANS 19        // FanEntry per fan triangle (ClothTopology::fans)
-#define VKCLOTH_BINDING_COUNT 20
+#define VKCLOTH_BINDING_STRAIN_LINKS                                                                         \
+  20 // StrainLink per strain link, in colour order (ClothTopology::strain_links)
+#define VKCLOTH_BINDING_TETHERS                                                                              \
+  21 // TetherSlot, VKCLOTH_TETHERS_PER_PARTICLE per particle, euclidean then geodesic
+#define VKCLOTH_BINDING_COUNT 22
 
 // Set 1 (force.comp, fused.comp): POS_IN again, as an RGBA32F uniform texel buffer view,
 // PARTICLE as an RG32UI one (x: the mass's bits, y: pinned), and (fused.comp) VEL as RGBA32F and
@@ -71,6 +75,13 @@ struct vec4 {
 #define VKCLOTH_FLAG_CONTACT_BOTH 4u // contacts remove the whole normal part (Figure 12 variant)
 #define VKCLOTH_FLAG_HAS_FANS 8u     // a surface that is not a grid: normals from FAN_OFFSETS / FANS
 
+// InstanceParams::stretch bits (SimParams::stretch_limit).
+#define VKCLOTH_STRETCH_PROVOT 1u       // Provot sweeps over the strain links (strain_links.comp)
+#define VKCLOTH_STRETCH_TETHERS 2u      // tethers (strain_finish.comp)
+#define VKCLOTH_STRETCH_GEODESIC 4u     // tethers with geodesic rest lengths (the second half of TETHERS)
+#define VKCLOTH_TETHERS_PER_PARTICLE 4u // vkcloth::tethers_per_particle
+#define VKCLOTH_NO_TETHER 0xffffffffu   // an unused tether slot (vkcloth::no_tether)
+
 // InstanceParams::integrator (the vkcloth::Integrator values; engine/src/core/kernel.hpp asserts it).
 #define VKCLOTH_INTEGRATOR_EXPLICIT_EULER 0u
 #define VKCLOTH_INTEGRATOR_SEMI_IMPLICIT_EULER 1u
@@ -88,10 +99,10 @@ struct PushConstants {
   uint count;   // particles per instance
   uint nx;      // grid width (0 for chains)
   uint ny;      // grid height
-  uint stage;   // RK4 stage 0..3 (0 for Euler); implicit passes: the pass
+  uint stage;   // RK4 stage 0..3 (0 for Euler); implicit passes: the pass; strain_links.comp: the sweep
   uint step;    // 1-based step number since the batch's flag epoch (the step being computed)
-  uint pad0;    // implicit passes only (implicit_shared.h)
-  uint pad1;    // implicit passes only
+  uint pad0;    // implicit passes (implicit_shared.h); strain_links.comp: the colour's first link
+  uint pad1;    // implicit passes; strain_links.comp: the colour's link count
   float c_next; // implicit passes only
 };
 
@@ -110,9 +121,9 @@ struct InstanceParams {
   float band;           // contact band 2 eps
   float eps;            // projection distance eps
   float limit;          // divergence limit
-  uint pad0;
-  uint pad1;
-  uint pad2;
+  float max_strain;     // stretch_limit.max_strain
+  uint stretch;         // VKCLOTH_STRETCH_* (0: stretch control off)
+  uint stretch_sweeps;  // stretch_limit.iterations: Provot sweeps per substep
 };
 
 /// Per-particle constants (std430: 8 bytes).
@@ -133,6 +144,19 @@ struct Edge {
 struct FanEntry {
   uint a;
   uint b;
+};
+
+/// A strain link (ClothTopology's StrainLink; std430: 12 bytes).
+struct StrainLink {
+  uint a;
+  uint b;
+  float rest_length;
+};
+
+/// One tether slot of a particle (ClothTopology's Tether; std430: 8 bytes).
+struct TetherSlot {
+  uint anchor; // VKCLOTH_NO_TETHER: no tether in this slot (nor in the following ones)
+  float rest_length;
 };
 
 /// A plane {n.p = offset} (shape = (n, offset)) or a sphere (shape = (centre, radius)).
@@ -164,6 +188,9 @@ static_assert(sizeof(ParticleInfo) == 8);
 static_assert(sizeof(Edge) == 12);
 static_assert(sizeof(Edge) == VKCLOTH_EDGE_TEXELS * 4);
 static_assert(sizeof(FanEntry) == 8);
+static_assert(sizeof(StrainLink) == 12);
+static_assert(sizeof(TetherSlot) == 8);
+static_assert(offsetof(InstanceParams, max_strain) == 68);
 static_assert(sizeof(Collider) == 32);
 static_assert(offsetof(Collider, type) == 16);
 static_assert(sizeof(Flags) == 16);

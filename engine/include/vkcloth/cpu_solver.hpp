@@ -14,7 +14,9 @@
 //                inward part removed for particles in contact)
 //   5. project   a particle inside a collider is put back at surface + eps, and its inward
 //                velocity removed; pinned particles are left where they are
-//   6. check     NaN/inf or |p| > divergence_limit -> Error{diverged} naming the step and time
+//   6. stretch   stretch_limit on: Provot sweeps over the strain links colour by colour, then the
+//                tethers, then the projection again; the moves update the velocities (v += dx / h)
+//   7. check     NaN/inf or |p| > divergence_limit -> Error{diverged} naming the step and time
 #pragma once
 
 #include <array>
@@ -125,6 +127,8 @@ private:
   void implicit_system(Real h);
   void implicit_cg(Real h);
   void implicit_update(Real h);
+  // Stretch control after a substep (docs/model.md "Stretch control").
+  void limit_stretch(Real h);
 
   /// A gather-list entry in the solver's precision (ClothTopology::edges() converted once).
   struct Edge {
@@ -157,6 +161,18 @@ private:
   bool soa_valid_ = false;
   bool swept_finite_ = false; // the last substep's row sweep found every position/velocity finite
   int simd_ = 0;              // row kernel ISA: 0 none, 1 AVX2, 2 AVX-512F (cpu_solver.cpp)
+  // Stretch control in the solver's precision (converted from the topology when first needed).
+  struct Link {
+    std::uint32_t a, b;
+    Real rest_length;
+  };
+  struct TetherSlot {
+    std::uint32_t anchor;
+    Real rest_length;
+  };
+  std::vector<Link> strain_links_;
+  std::vector<TetherSlot> tethers_;
+  StretchLimit::TetherDistance tether_kind_ = StretchLimit::TetherDistance::euclidean;
   std::uint64_t step_ = 0;
   std::unique_ptr<detail::ThreadPool> pool_;
   std::unique_ptr<detail::ImplicitWorkspace<Real>> implicit_; // created by the first implicit step

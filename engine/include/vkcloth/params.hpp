@@ -66,7 +66,7 @@ struct StretchLimit {
   /// How a tether's rest length is measured in the rest state: straight, or along the cloth.
   enum class TetherDistance : std::uint32_t { euclidean = 0, geodesic = 1 };
   Method method = Method::off;
-  double max_strain = 0.1;     ///< > 0: the largest allowed (|u| - L0) / L0
+  double max_strain = 0.1;      ///< > 0: the largest allowed (|u| - L0) / L0
   std::uint32_t iterations = 4; ///< 1..100 Provot sweeps per substep
   TetherDistance tether_distance = TetherDistance::euclidean;
 

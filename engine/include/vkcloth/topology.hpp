@@ -13,12 +13,14 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <span>
 #include <vector>
 
 #include <glm/vec2.hpp>
 
+#include "vkcloth/params.hpp"
 #include "vkcloth/result.hpp"
 #include "vkcloth/system.hpp"
 
@@ -59,6 +61,24 @@ struct GridStencil {
   bool border_geometric = false;
 };
 
+/// A spring the strain limit keeps from stretching (Provot): structural springs, and a chain's
+/// springs. Rest length as in the system.
+struct StrainLink {
+  std::uint32_t a = 0;
+  std::uint32_t b = 0;
+  double rest_length = 0.0;
+};
+
+/// Slots per particle in ClothTopology::tethers(); a slot without a tether has anchor no_tether.
+inline constexpr std::uint32_t tethers_per_particle = 4;
+inline constexpr std::uint32_t no_tether = 0xffffffffu;
+
+/// A long-range attachment of a particle to a pinned particle (its anchor) and its rest distance.
+struct Tether {
+  std::uint32_t anchor = no_tether;
+  double rest_length = 0.0;
+};
+
 class ClothTopology {
 public:
   /// Validates `system` (ParticleSystem::validate: errors name the problem) and prepares
@@ -94,6 +114,20 @@ public:
   /// A surface has normals, feels wind and is drawn as triangles (else: masses and springs).
   bool has_surface() const { return !triangles_.empty(); }
 
+  /// Stretch control (SimParams::stretch_limit; docs/model.md "Stretch control"). The strain
+  /// links grouped by colour: colour c is strain_links()[strain_colour_offsets()[c] ..
+  /// strain_colour_offsets()[c+1]), links of one colour share no particle (greedy colouring in
+  /// spring order), so each colour is projected in parallel and the sweep is the same on every
+  /// backend. Within a colour, links keep their spring order.
+  std::span<const StrainLink> strain_links() const { return strain_links_; }
+  std::span<const std::uint32_t> strain_colour_offsets() const { return strain_colour_offsets_; }
+  /// tethers_per_particle slots per particle (particle p's at [p * tethers_per_particle, ...)): the
+  /// pinned particles nearest to p along the springs (structural, shear and chain springs at their
+  /// rest lengths), nearest first, with rest distances measured straight (euclidean) or along
+  /// those springs (geodesic) in the rest state. Pinned particles and particles no pinned
+  /// particle reaches have none. Computed on the first call for each kind (thread-safe).
+  std::span<const Tether> tethers(StretchLimit::TetherDistance distance) const;
+
 private:
   ClothTopology() = default;
 
@@ -104,6 +138,11 @@ private:
   std::vector<std::uint32_t> fan_offsets_;
   std::vector<FanTriangle> fans_;
   std::vector<glm::vec2> uvs_;
+  std::vector<StrainLink> strain_links_;
+  std::vector<std::uint32_t> strain_colour_offsets_;
+  // Tethers, computed on first use (tethers()): [0] euclidean, [1] geodesic.
+  mutable std::once_flag tethers_once_[2];
+  mutable std::vector<Tether> tethers_[2];
 };
 
 } // namespace vkcloth

@@ -278,6 +278,57 @@ template <typename Real> void CpuSolver<Real>::substep(const Real h) {
     implicit_substep(h);
     break;
   }
+  if (params_.stretch_limit.enabled())
+    limit_stretch(h);
+}
+
+// The tethers first (anchors are pinned: every particle's tethers are independent of the
+// others'), then Provot's sweeps (one colour at a time: its links share no particle, so they are
+// projected in parallel with the same result as in order), so that the structural springs get
+// the last word; then the colliders' projection, since a correction may have pulled a particle
+// into one. Each formula: cloth_kernel.h; the GPU: strain_finish.comp and strain_links.comp.
+template <typename Real> void CpuSolver<Real>::limit_stretch(const Real h) {
+  const StretchLimit& sl = params_.stretch_limit;
+  const Real max_strain = Real(sl.max_strain);
+  if (strain_links_.empty() && !topology_->strain_links().empty())
+    for (const StrainLink& l : topology_->strain_links())
+      strain_links_.push_back(Link{l.a, l.b, Real(l.rest_length)});
+  if (sl.tethers()) {
+    if (tethers_.empty() || tether_kind_ != sl.tether_distance) {
+      tethers_.clear();
+      for (const Tether& t : topology_->tethers(sl.tether_distance))
+        tethers_.push_back(TetherSlot{t.anchor, Real(t.rest_length)});
+      tether_kind_ = sl.tether_distance;
+    }
+    pool_->for_each(pos_.size(), [&](std::size_t p) {
+      for (std::uint32_t k = 0; !pinned_[p] && k < tethers_per_particle; ++k) {
+        const TetherSlot& t = tethers_[p * tethers_per_particle + k];
+        if (t.anchor == no_tether)
+          break;
+        const Vec3 d =
+            kernel::tether_move(pos_[p], pos_[t.anchor], kernel::stretch_bound(t.rest_length, max_strain));
+        kernel::apply_correction(pos_[p], vel_[p], d, h);
+      }
+    });
+  }
+  const std::span<const std::uint32_t> colours = topology_->strain_colour_offsets();
+  for (std::uint32_t it = 0; sl.provot() && it < sl.iterations; ++it)
+    for (std::size_t c = 0; c + 1 < colours.size(); ++c)
+      pool_->for_each(colours[c + 1] - colours[c], [&](std::size_t k) {
+        const Link& l = strain_links_[colours[c] + k];
+        Vec3 da, db;
+        kernel::provot_link(pos_[l.a], pos_[l.b], pinned_[l.a] != 0, pinned_[l.b] != 0,
+                            kernel::stretch_bound(l.rest_length, max_strain), da, db);
+        kernel::apply_correction(pos_[l.a], vel_[l.a], da, h);
+        kernel::apply_correction(pos_[l.b], vel_[l.b], db, h);
+      });
+  if (!params_.colliders.empty())
+    pool_->for_each(pos_.size(), [&](std::size_t p) {
+      if (!pinned_[p])
+        project_at(pos_[p], vel_[p]);
+    });
+  soa_valid_ = false;
+  swept_finite_ = false;
 }
 
 template <typename Real>

@@ -110,7 +110,8 @@ Result<void> SimParams::validate() {
   if (std::uint32_t(stretch_limit.method) > std::uint32_t(StretchLimit::Method::both))
     return bad(fmt::format("stretch_limit.method: unknown method {}", std::uint32_t(stretch_limit.method)));
   if (!std::isfinite(stretch_limit.max_strain) || stretch_limit.max_strain <= 0.0)
-    return bad(fmt::format("stretch_limit.max_strain must be finite and > 0, got {}", stretch_limit.max_strain));
+    return bad(
+        fmt::format("stretch_limit.max_strain must be finite and > 0, got {}", stretch_limit.max_strain));
   if (stretch_limit.iterations < 1 || stretch_limit.iterations > 100)
     return bad(fmt::format("stretch_limit.iterations must be in 1..100, got {}", stretch_limit.iterations));
   for (std::size_t k = 0; k < colliders.size(); ++k) {

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "vkcloth/topology.hpp"
 
+#include "stretch_topology.hpp"
+
 #include <algorithm>
 #include <limits>
 #include <utility>
@@ -216,7 +218,15 @@ Result<std::shared_ptr<const ClothTopology>> ClothTopology::create(const Particl
       fill_fans(s.surface->face_offsets, s.surface->faces, n, t->fan_offsets_, t->fans_);
     }
   }
+  detail::colour_strain_links(s, t->strain_links_, t->strain_colour_offsets_);
   return std::shared_ptr<const ClothTopology>(std::move(t));
+}
+
+std::span<const Tether> ClothTopology::tethers(StretchLimit::TetherDistance distance) const {
+  const bool geodesic = distance == StretchLimit::TetherDistance::geodesic;
+  const int k = geodesic ? 1 : 0;
+  std::call_once(tethers_once_[k], [&] { tethers_[k] = detail::find_tethers(system_, geodesic); });
+  return tethers_[k];
 }
 
 } // namespace vkcloth

@@ -77,6 +77,39 @@ Result<void> read_wind(const json& doc, SimParams& params) {
   return sd::read(*obj, "wind", "direction", params.wind.direction);
 }
 
+// Absent: off (the report's model). Present: "method" is required, the rest have defaults.
+Result<void> read_stretch_limit(const json& doc, SimParams& params) {
+  SCENE_TRY_ASSIGN(obj, sd::read_object(doc, "", "stretch_limit"));
+  if (!obj)
+    return {};
+  const char* path = "stretch_limit";
+  VKCLOTH_TRY(sd::check_keys(*obj, path, {"method", "max_strain", "iterations", "tether_distance"}));
+  StretchLimit& sl = params.stretch_limit;
+  if (!obj->contains("method"))
+    return sd::shape_error("stretch_limit.method is required: \"tethers\", \"provot\", \"both\" or \"off\"");
+  std::string name;
+  VKCLOTH_TRY(sd::read(*obj, path, "method", name));
+  const auto method = parse_stretch_method(name);
+  if (!method)
+    return sd::shape_error(fmt::format(
+        "stretch_limit.method must be \"tethers\", \"provot\", \"both\" or \"off\", got \"{}\"", name));
+  sl.method = *method;
+  VKCLOTH_TRY(sd::read(*obj, path, "max_strain", sl.max_strain));
+  if (obj->contains("iterations")) {
+    SCENE_TRY_ASSIGN(it, sd::as_integer((*obj)["iterations"], "stretch_limit.iterations", 1000000));
+    sl.iterations = static_cast<std::uint32_t>(it); // the range (1..100) is validate()'s
+  }
+  if (obj->contains("tether_distance")) {
+    VKCLOTH_TRY(sd::read(*obj, path, "tether_distance", name));
+    const auto distance = parse_tether_distance(name);
+    if (!distance)
+      return sd::shape_error(fmt::format(
+          "stretch_limit.tether_distance must be \"euclidean\" or \"geodesic\", got \"{}\"", name));
+    sl.tether_distance = *distance;
+  }
+  return {};
+}
+
 Result<void> read_colliders(const json& doc, SimParams& params) {
   SCENE_TRY_ASSIGN(arr, sd::read_array(doc, "", "colliders"));
   if (!arr)
@@ -283,9 +316,10 @@ Result<ParticleSystem> read_cloth(const json& doc) {
 Result<Scene> build_scene(const json& doc, std::string_view source_name) {
   if (!doc.is_object())
     return sd::shape_error(fmt::format("the scene must be a JSON object, got {}", doc.type_name()));
-  VKCLOTH_TRY(sd::check_keys(doc, "",
-                             {"name", "system", "integrator", "physics", "chain", "cloth", "wind",
-                              "colliders", "contact_epsilon", "contact_inward_only", "divergence_limit"}));
+  VKCLOTH_TRY(
+      sd::check_keys(doc, "",
+                     {"name", "system", "integrator", "physics", "chain", "cloth", "wind", "colliders",
+                      "contact_epsilon", "contact_inward_only", "divergence_limit", "stretch_limit"}));
   Scene scene;
   if (!doc.contains("system"))
     return sd::shape_error("missing required key system (\"chain\" or \"cloth\")");
@@ -304,6 +338,7 @@ Result<Scene> build_scene(const json& doc, std::string_view source_name) {
   VKCLOTH_TRY(read_physics(doc, scene.params));
   VKCLOTH_TRY(read_wind(doc, scene.params));
   VKCLOTH_TRY(read_colliders(doc, scene.params));
+  VKCLOTH_TRY(read_stretch_limit(doc, scene.params));
   VKCLOTH_TRY(sd::read(doc, "", "contact_epsilon", scene.params.contact_epsilon));
   VKCLOTH_TRY(sd::read(doc, "", "divergence_limit", scene.params.divergence_limit));
   VKCLOTH_TRY(sd::read(doc, "", "contact_inward_only", scene.params.contact_inward_only));

@@ -11,6 +11,8 @@
 #include "vkcloth/shaders/implicit_comp_spv.hpp"
 #include "vkcloth/shaders/implicit_reduce_comp_spv.hpp"
 #include "vkcloth/shaders/integrate_comp_spv.hpp"
+#include "vkcloth/shaders/strain_finish_comp_spv.hpp"
+#include "vkcloth/shaders/strain_links_comp_spv.hpp"
 #include "vkcloth_shared.h"
 
 namespace vkcloth::gpu {
@@ -35,6 +37,10 @@ ShaderCode code_of(PipelineRegistry::Shader s) {
     return {spirv::implicit_comp_spv, "implicit.comp"};
   case S::implicit_reduce:
     return {spirv::implicit_reduce_comp_spv, "implicit_reduce.comp"};
+  case S::strain_links:
+    return {spirv::strain_links_comp_spv, "strain_links.comp"};
+  case S::strain_finish:
+    return {spirv::strain_finish_comp_spv, "strain_finish.comp"};
   }
   return {{}, "?"};
 }

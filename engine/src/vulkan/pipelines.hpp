@@ -23,9 +23,10 @@ std::span<const std::uint32_t> implicit_bindings();
 
 class PipelineRegistry {
 public:
-  enum class Shader { force, integrate, fused, implicit, implicit_reduce };
+  enum class Shader { force, integrate, fused, implicit, implicit_reduce, strain_links, strain_finish };
 
-  /// Set 0 (storage buffers) and set 1 (texel views) of force/integrate/fused.comp and their layout.
+  /// Set 0 (storage buffers) and set 1 (texel views) of force/integrate/fused.comp and their
+  /// layout (strain_links/strain_finish.comp use it too, set 0 only).
   struct SolverLayouts {
     VkDescriptorSetLayout storage = VK_NULL_HANDLE, texel = VK_NULL_HANDLE;
     VkPipelineLayout layout = VK_NULL_HANDLE;

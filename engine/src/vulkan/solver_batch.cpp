@@ -86,6 +86,13 @@ void SolverBatch::upload_instance_params() {
     ip.eps = float(params.contact_epsilon);
     ip.band = 2.0f * ip.eps;
     ip.limit = float(params.divergence_limit);
+    const StretchLimit& sl = params.stretch_limit;
+    ip.max_strain = float(sl.max_strain);
+    ip.stretch = (sl.provot() ? VKCLOTH_STRETCH_PROVOT : 0u) | (sl.tethers() ? VKCLOTH_STRETCH_TETHERS : 0u) |
+                 (sl.tethers() && sl.tether_distance == StretchLimit::TetherDistance::geodesic
+                      ? VKCLOTH_STRETCH_GEODESIC
+                      : 0u);
+    ip.stretch_sweeps = sl.iterations;
     *out++ = ip;
   }
 }
@@ -180,8 +187,35 @@ Result<void> SolverBatch::set_params(std::uint32_t slot, SimParams params) {
   VKCLOTH_TRY(upload_colliders());
   VKCLOTH_TRY(ensure_implicit());
   VKCLOTH_TRY(ensure_fused());
+  VKCLOTH_TRY(ensure_tethers());
   upload_instance_params();
   return {};
+}
+
+// The tethers of both rest-length kinds (VKCLOTH_BINDING_TETHERS: euclidean, then geodesic),
+// uploaded when an instance first asks for tethers; the buffer replaces the zeroed element.
+Result<void> SolverBatch::ensure_tethers() {
+  bool wanted = false;
+  for (const Slot& s : slots)
+    wanted = wanted || s.params.stretch_limit.tethers();
+  if (!wanted || tethers_uploaded)
+    return {};
+  static_assert(VKCLOTH_TETHERS_PER_PARTICLE == tethers_per_particle && VKCLOTH_NO_TETHER == no_tether);
+  std::vector<sh::TetherSlot> data;
+  data.reserve(2 * std::size_t(count) * tethers_per_particle);
+  for (auto kind : {StretchLimit::TetherDistance::euclidean, StretchLimit::TetherDistance::geodesic})
+    for (const Tether& t : batch_topology->tethers(kind))
+      data.push_back({t.anchor, float(t.rest_length)});
+  const VkDeviceSize bytes = data.size() * sizeof(sh::TetherSlot);
+  auto b = create_buffer(*ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                         MemoryUse::device, !knobs.force_staging, "tethers");
+  if (!b)
+    return b.error();
+  tethers = std::move(*b);
+  const Upload up[] = {{&tethers, data.data(), bytes}};
+  VKCLOTH_TRY(upload(up));
+  tethers_uploaded = true;
+  return write_sets();
 }
 
 Result<void> SolverBatch::ensure_implicit() {
@@ -224,6 +258,56 @@ void SolverBatch::record_copy_slot(VkCommandBuffer c, const SolverBatch& from, s
 }
 
 void SolverBatch::record_substep(VkCommandBuffer c, bool first, bool last) {
+  record_update(c, first, last);
+  if (any_stretch())
+    record_stretch(c, parity);
+}
+
+// The tethers per particle, Provot's sweeps (one dispatch per colour: its links share no
+// particle), then the projection per particle; each pass after a barrier. Instances with fewer
+// sweeps, without tethers, colliders or stretch control skip what they do not need
+// (strain_finish.comp, strain_links.comp).
+void SolverBatch::record_stretch(VkCommandBuffer c, std::uint32_t read) {
+  const auto& v = vk();
+  std::uint32_t sweeps = 0;
+  bool tethered = false;
+  for (const Slot& s : slots) {
+    const StretchLimit& sl = s.params.stretch_limit;
+    if (sl.provot())
+      sweeps = std::max(sweeps, sl.iterations);
+    tethered = tethered || sl.tethers();
+  }
+  v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &sets[read][0], 0, nullptr);
+  sh::PushConstants spc = pc;
+  auto per_particle = [&](std::uint32_t stage) {
+    spc.stage = stage; // 0: tethers, 1: projection
+    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, strain_finish_pipeline);
+    v.vkCmdPushConstants(c, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(spc), &spc);
+    barriers::dispatch_to_dispatch(v, c); // the update (or the last colour) -> this pass
+    v.vkCmdDispatch(c, groups_x, groups_y, size());
+    ++dispatches_;
+  };
+  if (tethered)
+    per_particle(0);
+  if (sweeps)
+    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, strain_links_pipeline);
+  for (std::uint32_t sweep = 0; sweep < sweeps; ++sweep)
+    for (std::size_t k = 0; k + 1 < strain_colours.size(); ++k) {
+      spc.stage = sweep;
+      spc.pad0 = strain_colours[k];
+      spc.pad1 = strain_colours[k + 1] - strain_colours[k];
+      const std::uint32_t groups = (spc.pad1 + VKCLOTH_WORKGROUP_SIZE - 1) / VKCLOTH_WORKGROUP_SIZE;
+      const std::uint32_t gx = std::min(groups, groups_x), gy = (groups + gx - 1) / gx;
+      v.vkCmdPushConstants(c, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(spc), &spc);
+      barriers::dispatch_to_dispatch(v, c); // the previous pass or colour -> this colour
+      v.vkCmdDispatch(c, gx, gy, size());
+      ++dispatches_;
+    }
+  if (any_colliders())
+    per_particle(1);
+}
+
+void SolverBatch::record_update(VkCommandBuffer c, bool first, bool last) {
   const auto& v = vk();
   const std::uint32_t read = parity;
   if (family().integrator == Integrator::implicit_euler) {
@@ -390,7 +474,10 @@ Result<void> SolverBatch::create_buffers() {
       // Without fan normals: one zeroed element each (a valid binding the shaders never index).
       {&fan_offsets, std::max<VkDeviceSize>(fans_count ? (n + 1) * sizeof(std::uint32_t) : 0, 16),
        "normal fan offsets"},
-      {&fans, std::max<VkDeviceSize>(fans_count * sizeof(sh::FanEntry), 16), "normal fans"}};
+      {&fans, std::max<VkDeviceSize>(fans_count * sizeof(sh::FanEntry), 16), "normal fans"},
+      {&strain_links, std::max<VkDeviceSize>(strain_link_count() * sizeof(sh::StrainLink), 16),
+       "strain links"},
+      {&tethers, 16, "tethers (none yet)"}};
   for (auto [b, bytes, what] : device_buffers) {
     auto r = create_buffer(*ctx, bytes, usage, MemoryUse::device, allow_map, what, families);
     if (!r)
@@ -465,8 +552,14 @@ Result<void> SolverBatch::upload_initial_state(const ClothTopology& topology,
   std::vector<sh::FanEntry> fan_data(fans_count);
   for (std::size_t t = 0; t < fans_count; ++t)
     fan_data[t] = {topology.fans()[t].a, topology.fans()[t].b};
+  std::vector<sh::StrainLink> link_data;
+  for (const StrainLink& l : topology.strain_links())
+    link_data.push_back({l.a, l.b, float(l.rest_length)});
   const std::span<const std::uint32_t> triangles = topology.triangles();
   const Upload uploads[] = {
+      {&strain_links, link_data.empty() ? nullptr : link_data.data(),
+       link_data.size() * sizeof(sh::StrainLink)},
+      {&tethers, nullptr, 0},
       {&pos[0], x0.data(), vec4_bytes},
       {&pos[1], x0.data(), vec4_bytes},
       {&vel, v0.data(), vec4_bytes},
@@ -558,6 +651,8 @@ SolverBatch::create(const std::shared_ptr<Context::Impl>& ctx, CommandContext& c
   s.normals = normals_of(topology, knobs);
   s.fans_count = s.normals == Normals::fans ? topology.fans().size() : 0;
   s.index_count = static_cast<std::uint32_t>(topology.triangles().size());
+  s.batch_topology = &topology;
+  s.strain_colours.assign(topology.strain_colour_offsets().begin(), topology.strain_colour_offsets().end());
   s.groups_x = grid->x;
   s.groups_y = grid->y;
   if (const auto& g = topology.grid()) {
@@ -574,6 +669,7 @@ SolverBatch::create(const std::shared_ptr<Context::Impl>& ctx, CommandContext& c
   VKCLOTH_TRY(s.ensure_fused());
   s.upload_instance_params();
   VKCLOTH_TRY(s.upload_initial_state(topology, states));
+  VKCLOTH_TRY(s.ensure_tethers());
   return impl;
 }
 

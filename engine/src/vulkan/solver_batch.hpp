@@ -129,6 +129,14 @@ private:
   // The shared topology: particle constants, gather lists, normal fans (filled only for
   // Normals::fans, else one zeroed element), triangles (`indices`, for drawing).
   Buffer particle, offsets, edges, fan_offsets, fans, indices;
+  // Stretch control: the strain links in colour order, and the tethers (one zeroed element until
+  // an instance asks for tethers: ensure_tethers()).
+  Buffer strain_links, tethers;
+  std::vector<std::uint32_t> strain_colours; // the topology's colour offsets (colours + 1)
+  bool tethers_uploaded = false;
+  // The batch's topology, for what is uploaded when first needed (the tethers): alive as long as
+  // the batch, since every instance of the batch holds it (ClothWorld::Impl::Instance).
+  const ClothTopology* batch_topology = nullptr;
   std::uint32_t index_count = 0;
   Buffer colliders, flags, instances; // host-visible (written / read by the host)
   std::uint32_t collider_capacity = 0;
@@ -137,6 +145,7 @@ private:
   VkDescriptorSetLayout set_layout = VK_NULL_HANDLE, texel_layout = VK_NULL_HANDLE;
   VkPipelineLayout layout = VK_NULL_HANDLE;
   VkPipeline force_pipeline = VK_NULL_HANDLE, integrate_pipeline = VK_NULL_HANDLE;
+  VkPipeline strain_links_pipeline = VK_NULL_HANDLE, strain_finish_pipeline = VK_NULL_HANDLE;
   // fused.comp variants, looked up when first needed (ensure_fused): [write_aux][colliders].
   // write_aux = 0 (SC_WRITE_AUX false: no force and normal stores) for every fused substep of a
   // recorded batch of steps but the last, since only the last one's forces and normals can be
@@ -166,6 +175,12 @@ private:
   std::uint64_t dispatches_ = 0;         // recorded so far (ClothWorld::dispatches_recorded)
 
   const SimParams& family() const { return slots.front().params; } // integrator family, substeps
+  bool any_stretch() const {
+    for (const Slot& s : slots)
+      if (s.params.stretch_limit.enabled())
+        return true;
+    return false;
+  }
   bool any_colliders() const {
     for (const Slot& s : slots)
       if (!s.params.colliders.empty())
@@ -177,6 +192,7 @@ private:
     return VkDeviceSize(slot) * count * GpuSolver::stride;
   }
   VkDeviceSize slot_bytes() const { return VkDeviceSize(count) * GpuSolver::stride; }
+  std::size_t strain_link_count() const { return strain_colours.empty() ? 0 : strain_colours.back(); }
   const Buffer& buffer_of(Field field) const;
 
   // Creation phases (create()), in order.
@@ -189,6 +205,9 @@ private:
   Result<void> write_sets();
   Result<void> ensure_implicit();
   Result<void> ensure_fused();
+  Result<void> ensure_tethers();
+  /// Stretch control after a substep's update (strain_links.comp sweeps, strain_finish.comp).
+  void record_stretch(VkCommandBuffer cmd, std::uint32_t read);
   Result<void> upload_colliders();
   void upload_instance_params();
   Result<void> upload_initial_state(const ClothTopology& topology, const std::vector<SlotState>& states);
@@ -201,6 +220,8 @@ private:
 
   /// `last`: the last substep of this recording (the fused variant that stores forces and normals).
   void record_substep(VkCommandBuffer cmd, bool first, bool last);
+  /// One substep's update (force and integrate passes, fused.comp, or the implicit solve).
+  void record_update(VkCommandBuffer cmd, bool first, bool last);
 };
 
 } // namespace vkcloth::gpu

@@ -152,6 +152,14 @@ Result<void> SolverBatch::create_pipelines() {
   if (!ip)
     return ip.error();
   integrate_pipeline = *ip;
+  auto lp = ctx->pipelines->pipeline(Shader::strain_links, {});
+  if (!lp)
+    return lp.error();
+  strain_links_pipeline = *lp;
+  auto sp = ctx->pipelines->pipeline(Shader::strain_finish, {});
+  if (!sp)
+    return sp.error();
+  strain_finish_pipeline = *sp;
   return {};
 }
 
@@ -216,6 +224,8 @@ Result<void> SolverBatch::write_sets() {
       by_binding[VKCLOTH_BINDING_INSTANCES] = &instances;
       by_binding[VKCLOTH_BINDING_FAN_OFFSETS] = &fan_offsets;
       by_binding[VKCLOTH_BINDING_FANS] = &fans;
+      by_binding[VKCLOTH_BINDING_STRAIN_LINKS] = &strain_links;
+      by_binding[VKCLOTH_BINDING_TETHERS] = &tethers;
       for (std::uint32_t b = 0; b < VKCLOTH_BINDING_COUNT; ++b, ++k) {
         infos[k] = VkDescriptorBufferInfo{by_binding[b]->buffer, 0, VK_WHOLE_SIZE};
         writes[k] = VkWriteDescriptorSet{};

@@ -1,0 +1,102 @@
+// SPDX-License-Identifier: MIT
+#include "stretch_topology.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <queue>
+#include <tuple>
+
+#include <glm/geometric.hpp>
+
+namespace vkcloth::detail {
+namespace {
+
+bool is_strain_link(SpringKind kind) {
+  return kind == SpringKind::structural || kind == SpringKind::plain;
+}
+
+// The springs tethers travel along: the cloth's in-plane springs (bend springs skip a particle
+// and would shorten a geodesic through a fold).
+bool is_tether_path(SpringKind kind) {
+  return kind == SpringKind::structural || kind == SpringKind::shear || kind == SpringKind::plain;
+}
+
+} // namespace
+
+void colour_strain_links(const ParticleSystem& system, std::vector<StrainLink>& links,
+                         std::vector<std::uint32_t>& offsets) {
+  // Greedy: each link takes the smallest colour none of the links at its two ends has yet.
+  // `seen[c] == s + 1` marks colour c as taken for link s (no clearing between links).
+  const std::vector<Spring>& springs = system.springs;
+  const SpringAdjacency& adj = system.adjacency;
+  std::vector<std::uint32_t> colour(springs.size(), no_tether);
+  std::vector<std::size_t> seen;
+  std::uint32_t colours = 0;
+  for (std::size_t s = 0; s < springs.size(); ++s) {
+    if (!is_strain_link(springs[s].kind))
+      continue;
+    for (std::uint32_t end : {springs[s].a, springs[s].b})
+      for (std::uint32_t r = adj.offsets[end]; r < adj.offsets[end + 1]; ++r)
+        if (const std::uint32_t c = colour[adj.refs[r].spring]; c != no_tether)
+          seen[c] = s + 1;
+    std::uint32_t c = 0;
+    while (c < colours && seen[c] == s + 1)
+      ++c;
+    if (c == colours) {
+      ++colours;
+      seen.push_back(0);
+    }
+    colour[s] = c;
+  }
+  offsets.assign(colours + 1, 0);
+  for (std::size_t s = 0; s < springs.size(); ++s)
+    if (colour[s] != no_tether)
+      ++offsets[colour[s] + 1];
+  for (std::uint32_t c = 0; c < colours; ++c)
+    offsets[c + 1] += offsets[c];
+  links.resize(offsets.back());
+  std::vector<std::uint32_t> next(offsets.begin(), offsets.end() - 1);
+  for (std::size_t s = 0; s < springs.size(); ++s)
+    if (colour[s] != no_tether)
+      links[next[colour[s]]++] = StrainLink{springs[s].a, springs[s].b, springs[s].rest_length};
+}
+
+std::vector<Tether> find_tethers(const ParticleSystem& system, bool geodesic) {
+  // Dijkstra from every pinned particle at once, each particle keeping the first
+  // tethers_per_particle distinct anchors that reach it: a (particle, anchor) pair is settled at
+  // its shortest distance along the springs, the nearest anchors first.
+  const std::size_t n = system.size();
+  const SpringAdjacency& adj = system.adjacency;
+  std::vector<Tether> slots(n * tethers_per_particle);
+  std::vector<std::uint32_t> found(n, 0);
+  using Entry = std::tuple<double, std::uint32_t, std::uint32_t>; // distance, particle, anchor
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<>> queue;
+  for (std::uint32_t p = 0; p < n; ++p)
+    if (system.particles[p].pinned)
+      queue.emplace(0.0, p, p);
+  while (!queue.empty()) {
+    const auto [d, p, anchor] = queue.top();
+    queue.pop();
+    Tether* const mine = &slots[std::size_t(p) * tethers_per_particle];
+    if (found[p] == tethers_per_particle ||
+        std::any_of(mine, mine + found[p], [&](const Tether& t) { return t.anchor == anchor; }))
+      continue;
+    const glm::dvec3 x = system.particles[p].position, xa = system.particles[anchor].position;
+    mine[found[p]++] = Tether{anchor, geodesic ? d : glm::length(x - xa)};
+    for (std::uint32_t r = adj.offsets[p]; r < adj.offsets[p + 1]; ++r) {
+      const Spring& s = system.springs[adj.refs[r].spring];
+      const std::uint32_t q = adj.refs[r].other;
+      if (is_tether_path(s.kind) && !system.particles[q].pinned && found[q] < tethers_per_particle)
+        queue.emplace(d + s.rest_length, q, anchor);
+    }
+  }
+  // Pinned particles are their own anchor (found above at distance 0): they need no tether.
+  for (std::uint32_t p = 0; p < n; ++p)
+    if (system.particles[p].pinned)
+      std::fill_n(&slots[std::size_t(p) * tethers_per_particle], tethers_per_particle, Tether{});
+  return slots;
+}
+
+} // namespace vkcloth::detail

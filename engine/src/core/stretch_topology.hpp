@@ -1,0 +1,23 @@
+// SPDX-License-Identifier: MIT
+// What stretch control derives from a system's connectivity (ClothTopology, docs/model.md
+// "Stretch control"): the strain links in colours, and the tethers. Internal to the engine.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "vkcloth/topology.hpp"
+
+namespace vkcloth::detail {
+
+/// The system's strain links (structural and chain springs) grouped by a greedy colouring in
+/// spring order: `links` sorted by colour (stable), `offsets` the colours' ranges (colours + 1
+/// entries; one zero entry without links).
+void colour_strain_links(const ParticleSystem& system, std::vector<StrainLink>& links,
+                         std::vector<std::uint32_t>& offsets);
+
+/// tethers_per_particle slots per particle: the nearest pinned particles along the springs
+/// (structural, shear, chain) with euclidean or geodesic rest distances.
+std::vector<Tether> find_tethers(const ParticleSystem& system, bool geodesic);
+
+} // namespace vkcloth::detail
