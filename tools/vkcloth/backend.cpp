@@ -22,6 +22,10 @@ public:
     return {};
   }
 
+  Result<StrainStats> strain(const ParticleSystem& system) override {
+    return structural_strain(system, solver_.positions());
+  }
+
   std::uint64_t step_index() const override { return solver_.step_index(); }
   SolveStats last_solve() const override { return solver_.last_solve(); }
   double time() const override { return solver_.time(); }

@@ -11,6 +11,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "vkcloth/measure.hpp"
 #include "vkcloth/result.hpp"
 #include "vkcloth/scene.hpp"
 
@@ -30,6 +31,9 @@ public:
   /// Copies the current state out (the vectors are resized to the particle count).
   virtual Result<void> read_state(std::vector<glm::dvec3>& positions,
                                   std::vector<glm::dvec3>& velocities) = 0;
+  /// structural_strain() of the current positions, read in the solver's precision (the Vulkan
+  /// backend reads back the positions only).
+  virtual Result<StrainStats> strain(const ParticleSystem& system) = 0;
   /// Steps taken so far, and the simulated time step_index() * dt.
   virtual std::uint64_t step_index() const = 0;
   virtual double time() const = 0;

@@ -28,6 +28,13 @@ public:
     return {};
   }
 
+  Result<StrainStats> strain(const ParticleSystem& system) override {
+    auto p = solver_.positions();
+    if (!p)
+      return p.error();
+    return structural_strain(system, std::span<const glm::vec3>(*p));
+  }
+
   std::uint64_t step_index() const override { return solver_.step_index(); }
   SolveStats last_solve() const override { return solver_.last_solve(); }
   double time() const override { return solver_.time(); }

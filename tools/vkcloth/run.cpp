@@ -12,11 +12,13 @@
 
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
+#include <nlohmann/json.hpp>
 #include <unistd.h>
 
 #include "backend.hpp"
 #include "commands.hpp"
 #include "vkcloth/export.hpp"
+#include "vkcloth/measure.hpp"
 #include "vkcloth/scene.hpp"
 
 namespace vkcloth::cli {
@@ -90,6 +92,20 @@ struct RunOptions {
   std::string export_path;                   ///< .glb or .gltf; empty: none
   std::string obj_frames;                    ///< a directory; empty: none
   std::optional<std::uint64_t> export_every; ///< K for both; unset: 1
+  std::uint64_t strain_every = 1;            ///< K for "over the run" of the structural strain
+  std::string json;                          ///< the summary as JSON; empty: none
+};
+
+/// The largest structural strain over the run (cloths): step 0, every K-th step and the last one.
+struct StrainTrack {
+  StrainStats run;
+  std::uint64_t run_step = 0;
+  void add(const StrainStats& s, std::uint64_t step) {
+    if (s.max > run.max) {
+      run = s;
+      run_step = step;
+    }
+  }
 };
 
 /// --export and --obj-frames: a frame at step 0 and every K steps (as --trace rows); OBJs are
@@ -186,7 +202,7 @@ int run_command(const RunOptions& opt) {
   SimBackend& backend = **backend_r;
 
   // Open the outputs first: a typo in a path should not cost a whole run.
-  File trace, positions;
+  File trace, positions, json;
   if (!opt.trace.empty()) {
     auto f = open_output(opt.trace, "trace");
     if (!f)
@@ -201,6 +217,13 @@ int run_command(const RunOptions& opt) {
     positions = std::move(*f);
   }
 
+  if (!opt.json.empty()) {
+    auto f = open_output(opt.json, "JSON");
+    if (!f)
+      return report(f.error());
+    json = std::move(*f);
+  }
+
   std::vector<glm::dvec3> pos, vel;
   const auto read = [&] { return backend.read_state(pos, vel); };
   const std::uint64_t total = scene->steps;
@@ -208,6 +231,16 @@ int run_command(const RunOptions& opt) {
   if (auto r = read(); !r)
     return report(r.error());
   const std::vector<glm::dvec3> initial = pos; // in the solver's precision, for the displacement
+  // The positions are exact copies of the solver's, so the strain of `pos` is the solver's.
+  const auto strain_of_pos = [&] {
+    return structural_strain(scene->system, std::span<const glm::dvec3>(pos));
+  };
+  auto strain0 = strain_of_pos();
+  if (!strain0)
+    return report(strain0.error());
+  const bool track_strain = strain0->count > 0; // chains (and K_struct = 0) have no structural spring
+  const std::uint64_t strain_every = std::max<std::uint64_t>(opt.strain_every, 1);
+  StrainTrack strain{*strain0, 0};
   const std::vector<std::uint32_t> order = file_order(scene->system);
   if (trace)
     write_trace_rows(trace.get(), 0, backend.time(), pos, vel, scene->system, order);
@@ -227,6 +260,8 @@ int run_command(const RunOptions& opt) {
         next = std::min(next, next_multiple(done, every));
       if (frames.enabled())
         next = std::min(next, next_multiple(done, frames.every()));
+      if (track_strain)
+        next = std::min(next, next_multiple(done, strain_every));
       next = std::min(next, total);
       if (auto r = backend.step(next - done); !r) {
         if (trace)
@@ -241,6 +276,13 @@ int run_command(const RunOptions& opt) {
       if (trace_due || frame_due) {
         if (auto r = read(); !r)
           return report(r.error());
+      }
+      if (track_strain && (done % strain_every == 0 || done == total)) {
+        // From `pos` when it was just read; else the backend reads the positions only.
+        auto s = trace_due || frame_due ? strain_of_pos() : backend.strain(scene->system);
+        if (!s)
+          return report(s.error());
+        strain.add(*s, backend.step_index());
       }
       if (trace_due)
         write_trace_rows(trace.get(), backend.step_index(), backend.time(), pos, vel, scene->system, order);
@@ -274,11 +316,64 @@ int run_command(const RunOptions& opt) {
       "max displacement {:.6g} m\n",
       scene->name, scene->system.size(), scene->system.springs.size(), backend.step_index(), scene->params.dt,
       to_string(scene->params.integrator), opt.backend, opt.precision, backend.time(), wall, max_disp);
-  if (scene->params.integrator == Integrator::implicit_euler) {
-    const SolveStats cg = backend.last_solve();
+  const SolveStats cg = backend.last_solve();
+  if (scene->params.integrator == Integrator::implicit_euler)
     fmt::print(
         "implicit_euler: last solve {} CG iterations, relative residual {:.3g} (tolerance {:g}, cap {})\n",
         cg.iterations, cg.residual, scene->params.cg_tolerance, scene->params.cg_max_iterations);
+  std::optional<StrainStats> end_strain;
+  if (track_strain) {
+    auto s = strain_of_pos();
+    if (!s)
+      return report(s.error());
+    end_strain = *s;
+    strain.add(*s, backend.step_index()); // already there unless the run had no steps
+    const Spring& sp = scene->system.springs[end_strain->spring];
+    fmt::print(
+        "largest structural strain: {:.6g} at the end (spring {}: particles {}-{}), {:.6g} over the run "
+        "(step {}{})\n",
+        end_strain->max, end_strain->spring, file_vertex(scene->system, sp.a),
+        file_vertex(scene->system, sp.b), strain.run.max, strain.run_step,
+        strain_every > 1 ? fmt::format(", sampled every {} steps", strain_every) : "");
+  }
+  if (json) {
+    nlohmann::json doc;
+    doc["schema"] = "vkcloth-run/1";
+    doc["scene"] = scene->name;
+    doc["particles"] = scene->system.size();
+    doc["springs"] = scene->system.springs.size();
+    doc["steps"] = backend.step_index();
+    doc["dt"] = scene->params.dt;
+    doc["integrator"] = to_string(scene->params.integrator);
+    doc["backend"] = opt.backend;
+    doc["precision"] = opt.precision;
+    doc["simulated_time"] = backend.time();
+    doc["wall_s"] = wall;
+    doc["max_displacement"] = max_disp;
+    doc["implicit_euler"] =
+        scene->params.integrator == Integrator::implicit_euler
+            ? nlohmann::json{{"cg_iterations", cg.iterations}, {"cg_residual", cg.residual}}
+            : nlohmann::json(nullptr);
+    if (end_strain) {
+      const auto ends = [&](std::uint32_t k) {
+        const Spring& sp = scene->system.springs[k];
+        return nlohmann::json::array({file_vertex(scene->system, sp.a), file_vertex(scene->system, sp.b)});
+      };
+      doc["max_structural_strain"] = {{"end", end_strain->max},
+                                      {"end_spring", end_strain->spring},
+                                      {"end_particles", ends(end_strain->spring)},
+                                      {"run", strain.run.max},
+                                      {"run_step", strain.run_step},
+                                      {"run_spring", strain.run.spring},
+                                      {"run_particles", ends(strain.run.spring)},
+                                      {"every", strain_every},
+                                      {"structural_springs", end_strain->count}};
+    } else {
+      doc["max_structural_strain"] = nullptr;
+    }
+    fmt::print(json.get(), "{}\n", doc.dump(2));
+    if (std::fflush(json.get()) != 0 || std::ferror(json.get()))
+      return report(make_error(ErrorCode::io, "writing the JSON file failed (disk full?)"));
   }
   return exit_ok;
 }
@@ -309,6 +404,13 @@ void add_run_command(CLI::App& app, int* exit) {
          "Write one OBJ per exported frame into DIR (created): frame_00000.obj, frame_00001.obj, ...")
       ->type_name("DIR");
   cmd->add_option("--positions", opt->positions, "Write the final positions to a CSV file: particle,x,y,z");
+  cmd->add_option("--strain-every", opt->strain_every,
+                  "Cloths: take the largest structural strain over the run from step 0, every K-th and the "
+                  "last step (default 1: every step; on Vulkan each one reads the positions back)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--json", opt->json,
+                  "Also write the summary as JSON to FILE (keys: docs/scene-format.md; not written on "
+                  "divergence)");
   cmd->add_option("--backend", opt->backend, "Solver backend: cpu | vulkan (default cpu)");
   cmd->add_option("--precision", opt->precision,
                   "Solver arithmetic: float | double (default float; vulkan: float)")

@@ -4,6 +4,7 @@
 
 #include "vkcloth/builders.hpp"
 #include "vkcloth/cpu_solver.hpp"
+#include "vkcloth/measure.hpp"
 #include "vkcloth/params.hpp"
 #include "vkcloth/result.hpp"
 #include "vkcloth/system.hpp"
