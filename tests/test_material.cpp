@@ -286,3 +286,32 @@ TEST_CASE("material: every value must be finite and > 0, the message naming the 
   for (std::string_view name : material_preset_names())
     CHECK(check_material(*material_preset(name)).ok());
 }
+
+TEST_CASE("material: a clamped strip droops under its own weight by the same amount at 9 and 17 points "
+          "(bending)") {
+  // A cantilever (Peirce's bending test): 0.2 m x 0.1 m horizontal, the part at x <= 0.05 m clamped
+  // (pinned), 0.15 m overhang, about 1.1 bending lengths (B / (rho g))^(1/3) = 13.7 cm. Without
+  // bending stiffness it hangs straight down (droop 0.150 m, measured); bending holds it up.
+  auto droop = [](std::uint32_t n, double bend) {
+    const Material m{0.2, 5e4, 5e3, bend, 2.0}; // h_min = 9.7 mm
+    ClothDesc d;
+    d.nx = n;
+    d.ny = (n - 1) / 2 + 1;
+    d.size = {0.2, 0.1};
+    d.orientation = ClothOrientation::horizontal;
+    d.material = m;
+    d.pin_default_corners = false;
+    for (std::uint32_t j = 0; j < d.ny; ++j)
+      for (std::uint32_t i = 0; i <= (n - 1) / 4; ++i) // x <= 0.05
+        d.pins.push_back({i, j});
+    const double z = -settled_lowest_z(cloth(d), m.damping, 0.05, 200);
+    MESSAGE(fmt::format("bend {} N m, {} x {}: droop {:.4f} m", bend, d.nx, d.ny, z));
+    return z;
+  };
+  // Measured: 0.1114 (5 x 3, h = 5 cm: 3 cells of overhang), 0.0986 (9 x 5), 0.0978 m (17 x 9).
+  const double d5 = droop(5, 5e-3), d9 = droop(9, 5e-3), d17 = droop(17, 5e-3);
+  CHECK(d9 == doctest::Approx(d17).epsilon(0.02));
+  CHECK(d5 == doctest::Approx(d17).epsilon(0.15));
+  CHECK(d17 < 0.11);                                             // bending holds it up ...
+  CHECK(droop(17, 1e-8) == doctest::Approx(0.15).epsilon(0.01)); // ... without it, it hangs down
+}
