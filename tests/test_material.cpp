@@ -315,3 +315,40 @@ TEST_CASE("material: a clamped strip droops under its own weight by the same amo
   CHECK(d17 < 0.11);                                             // bending holds it up ...
   CHECK(droop(17, 1e-8) == doctest::Approx(0.15).epsilon(0.01)); // ... without it, it hangs down
 }
+
+TEST_CASE("material: a triangle mesh gets positive stiffnesses, half on its border, and density x area") {
+  // A regular hexagon of side 0.1 m around its centre: 6 equilateral triangles (none pair into quads).
+  Mesh mesh;
+  mesh.positions.push_back({0, 0, 0});
+  for (int k = 0; k < 6; ++k)
+    mesh.positions.push_back({0.1 * std::cos(k * M_PI / 3), 0.1 * std::sin(k * M_PI / 3), 0.0});
+  for (std::uint32_t k = 0; k < 6; ++k) {
+    mesh.indices.insert(mesh.indices.end(), {0u, 1 + k, 1 + (k + 1) % 6});
+    mesh.face_offsets.push_back(static_cast<std::uint32_t>(mesh.indices.size()));
+  }
+  MeshClothDesc md;
+  md.material = *material_preset("cotton");
+  md.reorder = false;
+  auto made = make_mesh_cloth(mesh, md);
+  if (!made.ok())
+    FAIL(made.error().message);
+  const double area = 6 * std::sqrt(3.0) / 4 * 0.01;
+  CHECK(total_mass(made->system) == doctest::Approx(0.15 * area).epsilon(1e-12));
+  CHECK(made->system.particles[0].mass == doctest::Approx(0.15 * area / 3).epsilon(1e-12)); // 6 thirds
+  const double ks = *spring_stiffness(*md.material, SpringKind::structural, 0.1, 0.1);
+  int spokes = 0, rim = 0, bends = 0;
+  for (const Spring& sp : made->system.springs) {
+    CHECK(sp.stiffness > 0.0);
+    if (sp.kind == SpringKind::structural)
+      (sp.a == 0 || sp.b == 0 ? spokes : rim) +=
+          sp.stiffness == doctest::Approx((sp.a == 0 || sp.b == 0) ? ks : ks / 2).epsilon(1e-12);
+    if (sp.kind == SpringKind::bend) // across each spoke: rim vertices sqrt 3 * 0.1 apart, h = rest / 2
+      bends +=
+          sp.stiffness == doctest::Approx(*spring_stiffness(*md.material, SpringKind::bend,
+                                                            std::sqrt(3.0) * 0.05, std::sqrt(3.0) * 0.05))
+                              .epsilon(1e-12);
+  }
+  CHECK(spokes == 6);
+  CHECK(rim == 6);
+  CHECK(bends == 6);
+}

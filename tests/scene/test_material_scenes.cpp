@@ -3,6 +3,7 @@
 // form, the --set override, and every bad input of issue 17 point 6 with the key in the message.
 #include <doctest/doctest.h>
 
+#include <fstream>
 #include <initializer_list>
 #include <string>
 #include <vector>
@@ -132,4 +133,31 @@ TEST_CASE("a scene file with cloth.material and its CLI error: exit 2, the file 
   CHECK(o.code == 2);
   CHECK_MESSAGE(o.err.find("material_missing.json: cloth.material.stretch is required") != std::string::npos,
                 o.err);
+}
+
+TEST_CASE("cloth.material on a mesh scene: masses from its density, the file's edge lengths as spacings") {
+  const auto obj = vkcloth::test::tmp_dir() / "material_strip.obj";
+  std::ofstream(obj)
+      << "v 0 0 0\nv 0.1 0 0\nv 0.2 0 0\nv 0.3 0 0\nv 0 0 0.1\nv 0.1 0 0.1\nv 0.2 0 0.1\nv 0.3 0 "
+         "0.1\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\n";
+  auto s = parse_scene(R"({"system": "cloth", "cloth": {"mesh": "material_strip.obj", "material": "silk"}})",
+                       (vkcloth::test::tmp_dir() / "material_mesh.json").string());
+  if (!s.ok())
+    FAIL(s.error().message);
+  CHECK(total_mass(*s) == doctest::Approx(0.05 * 0.03).epsilon(1e-12));
+  CHECK(s->params.damping == 0.5);
+  // Every structural spring is a side of 0.1 m: the inner ones (shared by two quads) the full
+  // K_s = C - G - 4 K_b, the border ones half.
+  const Material silk = *material_preset("silk");
+  const double ks = *spring_stiffness(silk, SpringKind::structural, 0.1, 0.1);
+  int inner = 0, border = 0;
+  for (const Spring& sp : s->system.springs)
+    if (sp.kind == SpringKind::structural) {
+      if (sp.stiffness == doctest::Approx(ks).epsilon(1e-12))
+        ++inner;
+      else if (sp.stiffness == doctest::Approx(ks / 2).epsilon(1e-12))
+        ++border;
+    }
+  CHECK(inner == 2);
+  CHECK(border == 8);
 }
