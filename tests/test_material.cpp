@@ -175,7 +175,7 @@ TEST_CASE("material: a strip hanging from its top row stretches rho g L^2 / (2 E
 }
 
 TEST_CASE("material: cotton hangs the same at 16 x 16, 32 x 32 and 64 x 64 (lowest point within 5 % of its "
-          "size); per-particle values do not") {
+          "size), per-particle values do not") {
   const auto t0 = std::chrono::steady_clock::now();
   // 1 m x 1 m, vertical, the two top corners pinned, the bottom edge starting at z = 0; implicit
   // Euler, dt = 0.1, 30 steps (3 s: 150 steps of 0.02 give the same lowest point to 0.1 mm).

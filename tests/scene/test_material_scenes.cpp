@@ -79,7 +79,7 @@ TEST_CASE("--set cloth.material=denim replaces the material (a bare word is a pr
   CHECK(total_mass(parse(cloth("{}"), {"cloth.material=rubber"})) == doctest::Approx(1.1).epsilon(1e-12));
 }
 
-TEST_CASE("vkcloth run --set cloth.material=denim runs the material sample; an unknown preset exits 2 "
+TEST_CASE("vkcloth run --set cloth.material=denim runs the material sample, an unknown preset exits 2 "
           "listing them") {
   const auto ok = run_cli("material_denim",
                           "run " + sample("cloth_material.json") + " --steps 20 --set cloth.material=denim");
