@@ -4,11 +4,14 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
+#include <span>
 #include <vector>
 
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "vkcloth/material.hpp"
 #include "vkcloth/result.hpp"
 #include "vkcloth/system.hpp"
 
@@ -50,6 +53,11 @@ struct ClothDesc {
   double particle_mass =
       0.05; ///< vkcloth's choice (the report gives no mass); docs/model.md "The report's observations"
   ClothStiffness stiffness;
+  /// A physical material (docs/model.md "Materials"): when set it replaces `particle_mass` and
+  /// `stiffness`: lumped masses (density times each cell's area shared by its 4 corners) and
+  /// per-direction spring stiffnesses from spring_stiffness() for the spacings dx, dy. Needs a grid of
+  /// at least 2 x 2. (The material's damping is a SimParams value: the caller sets it.)
+  std::optional<Material> material;
   /// Pinned (i, j) cells; empty means the two top corners (0, ny-1) and (nx-1, ny-1).
   std::vector<std::array<std::uint32_t, 2>> pins;
   bool pin_default_corners = true; ///< when false and `pins` is empty, nothing is pinned
@@ -60,6 +68,16 @@ inline constexpr std::uint32_t max_cloth_side = 8192;
 inline constexpr std::uint64_t max_particles = 1ull << 24;
 
 Result<ParticleSystem> make_cloth(const ClothDesc& desc);
+
+/// Twice the vector area of a polygon `face` (indices into `x`), as a fan from its first corner
+/// (relative coordinates: no cancellation far from the origin); zero for a degenerate face.
+glm::dvec3 polygon_vector_area(std::span<const std::uint32_t> face, std::span<const glm::dvec3> x);
+
+/// Lumped masses (grid and mesh): every particle's mass is `density` times its share of the area of
+/// its faces, each face's area shared equally by its corners. Faces in CSR form: face f is
+/// corners[face_offsets[f] .. face_offsets[f+1]); `x` the positions, one per particle.
+void lump_masses(std::span<const std::uint32_t> face_offsets, std::span<const std::uint32_t> corners,
+                 std::span<const glm::dvec3> x, double density, std::span<Particle> particles);
 
 /// The checks a grid and a mesh cloth share: particle_mass finite and > 0, each stiffness finite
 /// and >= 0 (messages name cloth.particle_mass / cloth.stiffness.<kind> and the value).

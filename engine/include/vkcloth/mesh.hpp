@@ -89,7 +89,13 @@ struct MeshClothDesc {
   /// has `particle_mass`.
   std::optional<double> density;
   double particle_mass = 0.05;
-  ClothStiffness stiffness;                ///< a kind with zero stiffness is left out, as on the grid
+  ClothStiffness stiffness; ///< a kind with zero stiffness is left out, as on the grid
+  /// A physical material (docs/model.md "Materials"): when set it replaces `density`,
+  /// `particle_mass` and `stiffness`: masses lumped with its density, each spring's stiffness from
+  /// spring_stiffness() with the spring's own spacing on a square lattice (structural: its rest
+  /// length; shear: rest / sqrt 2; bend: rest / 2), so a quad mesh of a square grid gets the grid's
+  /// springs. (Its damping is a SimParams value: the caller sets it.)
+  std::optional<Material> material;
   std::vector<std::uint32_t> pin_vertices; ///< vertex indices of the file
   std::optional<PinRegion> pin_region;
   /// Renumber particles for memory locality (meshoptimizer); every output keeps the file's order

@@ -19,6 +19,26 @@ bool finite(glm::dvec3 v) {
 
 } // namespace
 
+glm::dvec3 polygon_vector_area(std::span<const std::uint32_t> face, std::span<const glm::dvec3> x) {
+  glm::dvec3 sum(0.0);
+  const glm::dvec3 o = x[face[0]];
+  for (std::size_t k = 1; k + 1 < face.size(); ++k)
+    sum += glm::cross(x[face[k]] - o, x[face[k + 1]] - o);
+  return sum;
+}
+
+void lump_masses(std::span<const std::uint32_t> face_offsets, std::span<const std::uint32_t> corners,
+                 std::span<const glm::dvec3> x, double density, std::span<Particle> particles) {
+  for (Particle& p : particles)
+    p.mass = 0.0;
+  for (std::size_t f = 0; f + 1 < face_offsets.size(); ++f) {
+    const auto face = corners.subspan(face_offsets[f], face_offsets[f + 1] - face_offsets[f]);
+    const double area = 0.5 * glm::length(polygon_vector_area(face, x));
+    for (std::uint32_t v : face)
+      particles[v].mass += density * area / double(face.size());
+  }
+}
+
 Result<void> check_cloth_material(double particle_mass, const ClothStiffness& stiffness) {
   if (!std::isfinite(particle_mass) || particle_mass <= 0.0)
     return bad(fmt::format("cloth.particle_mass must be finite and > 0, got {}", particle_mass));
@@ -89,11 +109,34 @@ Result<ParticleSystem> make_cloth(const ClothDesc& d) {
     return bad(fmt::format("cloth.size must be finite and > 0, got [{}, {}]", d.size.x, d.size.y));
   if (!finite(d.origin))
     return bad("cloth.origin must be finite");
-  VKCLOTH_TRY(check_cloth_material(d.particle_mass, d.stiffness));
+  if (d.material) {
+    VKCLOTH_TRY(check_material(*d.material));
+    if (d.nx < 2 || d.ny < 2)
+      return bad(
+          fmt::format("cloth.material needs a grid of at least 2 x 2 points, got [{}, {}]", d.nx, d.ny));
+  } else {
+    VKCLOTH_TRY(check_cloth_material(d.particle_mass, d.stiffness));
+  }
 
   const std::uint32_t nx = d.nx, ny = d.ny;
   const double dx = nx > 1 ? d.size.x / (nx - 1) : 0.0;
   const double dy = ny > 1 ? d.size.y / (ny - 1) : 0.0;
+  // Per-direction stiffness: along i (spacing dx) and along j (dy); the same without a material.
+  ClothStiffness ki = d.stiffness, kj = d.stiffness;
+  if (d.material) {
+    const Material& m = *d.material;
+    auto k = [&](SpringKind kind, double along, double across) {
+      return spring_stiffness(m, kind, along, across);
+    };
+    auto si = k(SpringKind::structural, dx, dy), sj = k(SpringKind::structural, dy, dx);
+    auto sh = k(SpringKind::shear, dx, dy);
+    auto bi = k(SpringKind::bend, dx, dy), bj = k(SpringKind::bend, dy, dx);
+    for (const Result<double>* r : {&si, &sj, &sh, &bi, &bj})
+      if (!*r)
+        return r->error();
+    ki = {*si, *sh, *bi};
+    kj = {*sj, *sh, *bj};
+  }
   const glm::dvec3 eu{1, 0, 0};
   const glm::dvec3 ev =
       d.orientation == ClothOrientation::vertical ? glm::dvec3{0, 0, 1} : glm::dvec3{0, 1, 0};
@@ -121,29 +164,48 @@ Result<ParticleSystem> make_cloth(const ClothDesc& d) {
                  double k, SpringKind kind) {
     sys.springs.push_back(Spring{j0 * nx + i0, j1 * nx + i1, rest, k, kind});
   };
-  if (d.stiffness.structural > 0.0) {
+  // A material's springs along the border stand for half a cell (as the border's masses do):
+  // half the stiffness, so that the lattice's energy under a uniform strain is the membrane's.
+  const double half = d.material ? 0.5 : 1.0;
+  auto row_edge = [&](std::uint32_t j) { return j == 0 || j == ny - 1 ? half : 1.0; };
+  auto col_edge = [&](std::uint32_t i) { return i == 0 || i == nx - 1 ? half : 1.0; };
+  // A kind is left out when its stiffness is zero (a material's are all > 0 but structural).
+  if (ki.structural > 0.0 || kj.structural > 0.0) {
     for (std::uint32_t j = 0; j < ny; ++j)
       for (std::uint32_t i = 0; i + 1 < nx; ++i)
-        add(i, j, i + 1, j, dx, d.stiffness.structural, SpringKind::structural);
+        add(i, j, i + 1, j, dx, row_edge(j) * ki.structural, SpringKind::structural);
     for (std::uint32_t j = 0; j + 1 < ny; ++j)
       for (std::uint32_t i = 0; i < nx; ++i)
-        add(i, j, i, j + 1, dy, d.stiffness.structural, SpringKind::structural);
+        add(i, j, i, j + 1, dy, col_edge(i) * kj.structural, SpringKind::structural);
   }
-  if (d.stiffness.shear > 0.0) {
+  if (ki.shear > 0.0) {
     const double diag = std::sqrt(dx * dx + dy * dy);
     for (std::uint32_t j = 0; j + 1 < ny; ++j)
       for (std::uint32_t i = 0; i + 1 < nx; ++i) {
-        add(i, j, i + 1, j + 1, diag, d.stiffness.shear, SpringKind::shear);
-        add(i + 1, j, i, j + 1, diag, d.stiffness.shear, SpringKind::shear);
+        add(i, j, i + 1, j + 1, diag, ki.shear, SpringKind::shear);
+        add(i + 1, j, i, j + 1, diag, ki.shear, SpringKind::shear);
       }
   }
-  if (d.stiffness.bend > 0.0) {
+  if (ki.bend > 0.0 || kj.bend > 0.0) {
     for (std::uint32_t j = 0; j < ny; ++j)
       for (std::uint32_t i = 0; i + 2 < nx; ++i)
-        add(i, j, i + 2, j, 2 * dx, d.stiffness.bend, SpringKind::bend);
+        add(i, j, i + 2, j, 2 * dx, row_edge(j) * ki.bend, SpringKind::bend);
     for (std::uint32_t j = 0; j + 2 < ny; ++j)
       for (std::uint32_t i = 0; i < nx; ++i)
-        add(i, j, i, j + 2, 2 * dy, d.stiffness.bend, SpringKind::bend);
+        add(i, j, i, j + 2, 2 * dy, col_edge(i) * kj.bend, SpringKind::bend);
+  }
+  if (d.material) { // lumped masses over the grid's cells (a, a+1, a+1+nx, a+nx)
+    std::vector<glm::dvec3> x(count);
+    for (std::size_t p = 0; p < count; ++p)
+      x[p] = sys.particles[p].position;
+    std::vector<std::uint32_t> offsets{0}, corners;
+    for (std::uint32_t j = 0; j + 1 < ny; ++j)
+      for (std::uint32_t i = 0; i + 1 < nx; ++i) {
+        const std::uint32_t a = j * nx + i;
+        corners.insert(corners.end(), {a, a + 1, a + 1 + nx, a + nx});
+        offsets.push_back(static_cast<std::uint32_t>(corners.size()));
+      }
+    lump_masses(offsets, corners, x, d.material->density, sys.particles);
   }
   sys.finalize();
   return sys;

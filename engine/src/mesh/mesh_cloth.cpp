@@ -60,9 +60,12 @@ Result<void> check_desc(const MeshClothDesc& d) {
       return bad("cloth.mesh_transform.translate and rotate_deg must be finite");
   if (!std::isfinite(t.scale) || t.scale <= 0.0)
     return bad(fmt::format("cloth.mesh_transform.scale must be finite and > 0, got {}", t.scale));
-  if (d.density && (!std::isfinite(*d.density) || *d.density <= 0.0))
+  if (d.material)
+    VKCLOTH_TRY(check_material(*d.material));
+  else if (d.density && (!std::isfinite(*d.density) || *d.density <= 0.0))
     return bad(fmt::format("cloth.density must be finite and > 0 (kg/m^2), got {}", *d.density));
-  VKCLOTH_TRY(check_cloth_material(d.particle_mass, d.stiffness));
+  if (!d.material)
+    VKCLOTH_TRY(check_cloth_material(d.particle_mass, d.stiffness));
   if (d.pin_region) {
     const PinRegion& r = *d.pin_region;
     if (!usable(r.min) || !usable(r.max))
@@ -109,21 +112,11 @@ glm::dvec3 transformed(const MeshTransform& t, glm::dvec3 p) {
   return t.translate + glm::dvec3(r * glm::dvec4(t.scale * p, 1.0));
 }
 
-/// Twice the vector area of a polygon, as a fan from its first corner (relative coordinates: no
-/// cancellation far from the origin); its length is zero for a degenerate face.
-glm::dvec3 vector_area(std::span<const std::uint32_t> face, const std::vector<glm::dvec3>& x) {
-  glm::dvec3 sum(0.0);
-  const glm::dvec3 o = x[face[0]];
-  for (std::size_t k = 1; k + 1 < face.size(); ++k)
-    sum += glm::cross(x[face[k]] - o, x[face[k + 1]] - o);
-  return sum;
-}
-
 bool degenerate(std::span<const std::uint32_t> face, const std::vector<glm::dvec3>& x) {
   for (std::size_t k = 0; k < face.size(); ++k)
     if (x[face[k]] == x[face[(k + 1) % face.size()]])
       return true; // a repeated vertex or a zero-length edge
-  return vector_area(face, x) == glm::dvec3(0.0);
+  return polygon_vector_area(face, x) == glm::dvec3(0.0);
 }
 
 /// The file's faces as triangles and quads (larger polygons split into a triangle fan), without
@@ -260,12 +253,16 @@ std::uint32_t opposite(std::span<const std::uint32_t> face, std::uint32_t a, std
 /// Springs from faces, kind by kind (structural, shear, bend), each unordered pair once.
 class SpringBuilder {
 public:
-  SpringBuilder(const std::vector<glm::dvec3>& x, const ClothStiffness& k) : x_(x), k_(k) {}
+  SpringBuilder(const std::vector<glm::dvec3>& x, const ClothStiffness& k, const std::optional<Material>& m)
+      : x_(x), k_(k), material_(m) {}
 
-  void build(const Faces& faces, const EdgeFaces& edges) {
+  /// Fails only with a material whose structural stiffness would be negative at some spacing.
+  Result<void> build(const Faces& faces, const EdgeFaces& edges) {
     for (std::size_t f = 0; f < faces.size(); ++f) // structural: the faces' sides
-      for (std::size_t k = 0; k < faces[f].size(); ++k)
-        add(faces[f][k], faces[f][(k + 1) % faces[f].size()], k_.structural, SpringKind::structural);
+      for (std::size_t k = 0; k < faces[f].size(); ++k) {
+        const std::uint32_t a = faces[f][k], b = faces[f][(k + 1) % faces[f].size()];
+        add(a, b, k_.structural, SpringKind::structural, border(edges, a, b) ? 0.5 : 1.0);
+      }
     for (std::size_t f = 0; f < faces.size(); ++f) // shear: both diagonals of each quad
       if (const auto q = faces[f]; q.size() == 4) {
         add(q[0], q[2], k_.shear, SpringKind::shear);
@@ -274,15 +271,35 @@ public:
     for (std::size_t f = 0; f < faces.size(); ++f) // bend: across each interior side, in face order
       for (std::size_t k = 0; k < faces[f].size(); ++k)
         add_bend(faces, edges, f, faces[f][k], faces[f][(k + 1) % faces[f].size()]);
+    return error_ ? Result<void>(*error_) : Result<void>{};
   }
 
   std::vector<Spring> springs;
 
 private:
-  void add(std::uint32_t a, std::uint32_t b, double k, SpringKind kind) {
-    if (k <= 0.0 || a == b || !seen_.insert(edge_key(a, b)).second)
+  /// A side of one face only. With a material, springs along the border get `border_scale`
+  /// times the stiffness (they stand for half a cell, as on the grid).
+  static bool border(const EdgeFaces& edges, std::uint32_t a, std::uint32_t b) {
+    return edges.at(edge_key(a, b))[1] < 0;
+  }
+
+  void add(std::uint32_t a, std::uint32_t b, double k, SpringKind kind, double border_scale = 1.0) {
+    if ((!material_ && k <= 0.0) || a == b || !seen_.insert(edge_key(a, b)).second)
       return;
-    springs.push_back(Spring{a, b, glm::length(x_[b] - x_[a]), k, kind});
+    const double rest = glm::length(x_[b] - x_[a]);
+    if (material_) { // the spring's local spacing h, on a square lattice (docs/model.md "Materials")
+      const double h = kind == SpringKind::bend    ? 0.5 * rest
+                       : kind == SpringKind::shear ? rest / std::sqrt(2.0)
+                                                   : rest;
+      auto km = spring_stiffness(*material_, kind, h, h);
+      if (!km) {
+        if (!error_)
+          error_ = km.error();
+        return;
+      }
+      k = *km * border_scale;
+    }
+    springs.push_back(Spring{a, b, rest, k, kind});
   }
 
   // Quads: the vertices two sides apart across the shared side (the grid's (i, j) - (i + 2, j));
@@ -293,9 +310,11 @@ private:
     if (g < 0 || std::size_t(g) < f)
       return; // a boundary side, or the pair was handled from the other face
     const auto p = faces[f], q = faces[std::size_t(g)];
-    if (p.size() == 4 && q.size() == 4) {
-      add(other_neighbour(p, a, b), other_neighbour(q, a, b), k_.bend, SpringKind::bend);
-      add(other_neighbour(p, b, a), other_neighbour(q, b, a), k_.bend, SpringKind::bend);
+    if (p.size() == 4 && q.size() == 4) { // through a (its two sides on the border: along it), then b
+      const std::uint32_t pa = other_neighbour(p, a, b), qa = other_neighbour(q, a, b);
+      const std::uint32_t pb = other_neighbour(p, b, a), qb = other_neighbour(q, b, a);
+      add(pa, qa, k_.bend, SpringKind::bend, border(edges, pa, a) && border(edges, a, qa) ? 0.5 : 1.0);
+      add(pb, qb, k_.bend, SpringKind::bend, border(edges, pb, b) && border(edges, b, qb) ? 0.5 : 1.0);
     } else if (p.size() == 3 && q.size() == 3) {
       add(opposite(p, a, b), opposite(q, a, b), k_.bend, SpringKind::bend);
     }
@@ -303,6 +322,8 @@ private:
 
   const std::vector<glm::dvec3>& x_;
   ClothStiffness k_;
+  const std::optional<Material>& material_; ///< when set, every stiffness comes from it
+  std::optional<Error> error_;
   std::unordered_set<std::uint64_t> seen_;
 };
 
@@ -357,18 +378,6 @@ std::vector<glm::vec2> particle_uvs(const Mesh& m, std::span<const std::uint32_t
   for (std::size_t p = 0; p < order.size(); ++p)
     uvs[p] = glm::vec2(unit(order[p], u), unit(order[p], v));
   return uvs;
-}
-
-/// Lumped masses: each face's area shared equally by its corners, times the density.
-void lump_masses(const Faces& faces, const std::vector<glm::dvec3>& x, double density,
-                 std::vector<Particle>& particles) {
-  for (Particle& p : particles)
-    p.mass = 0.0;
-  for (std::size_t f = 0; f < faces.size(); ++f) {
-    const double area = 0.5 * glm::length(vector_area(faces[f], x));
-    for (std::uint32_t v : faces[f])
-      particles[v].mass += density * area / double(faces[f].size());
-  }
 }
 
 Result<void> apply_pins(const MeshClothDesc& d, const std::vector<glm::dvec3>& x,
@@ -455,15 +464,16 @@ Result<MeshCloth> make_mesh_cloth(const Mesh& mesh, const MeshClothDesc& desc) {
   auto edges = edge_faces(faces, order);
   if (!edges)
     return edges.error();
-  SpringBuilder springs(x, desc.stiffness);
-  springs.build(faces, *edges);
+  SpringBuilder springs(x, desc.stiffness, desc.material);
+  VKCLOTH_TRY(springs.build(faces, *edges));
 
   ParticleSystem& sys = out.system;
   sys.particles.resize(order.size());
   for (std::size_t p = 0; p < order.size(); ++p)
     sys.particles[p] = Particle{x[p], {}, desc.particle_mass, false};
-  if (desc.density)
-    lump_masses(faces, x, *desc.density, sys.particles);
+  if (desc.material || desc.density) // lumped masses (builders.hpp), shared with the grid
+    lump_masses(faces.offsets, faces.corners, x, desc.material ? desc.material->density : *desc.density,
+                sys.particles);
   VKCLOTH_TRY(apply_pins(desc, x, particle_of, sys.particles, out.warnings));
   sys.springs = std::move(springs.springs);
   sys.surface = make_surface(mesh, faces, std::move(order));

@@ -14,6 +14,7 @@
 #include "json_read.hpp"
 #include "overrides.hpp"
 #include "vkcloth/builders.hpp"
+#include "vkcloth/material.hpp"
 
 namespace vkcloth {
 namespace sd = scene_detail;
@@ -180,6 +181,47 @@ Result<void> read_stiffness(const json& cloth, ClothStiffness& k) {
   return sd::read(*obj, "cloth.stiffness", "bend", k.bend);
 }
 
+/// "cloth.material": a preset name or an object with all five values (docs/scene-format.md
+/// "Materials"); exclusive with the per-particle keys. Absent: nothing.
+Result<std::optional<Material>> read_material(const json& cloth) {
+  auto it = cloth.find("material");
+  if (it == cloth.end())
+    return std::optional<Material>{};
+  for (const char* key : {"particle_mass", "stiffness", "density"})
+    if (cloth.contains(key) && (std::string_view(key) != "density" || cloth.contains("mesh")))
+      return sd::shape_error(
+          fmt::format("cloth.material and cloth.{} exclude each other: give a material (it "
+                      "sets the masses and stiffnesses) or the per-particle keys",
+                      key));
+  if (it->is_string()) {
+    const std::string name = it->get<std::string>();
+    if (auto m = material_preset(name))
+      return std::optional<Material>(*m);
+    return make_error(
+        ErrorCode::invalid_argument,
+        fmt::format("cloth.material: unknown preset \"{}\" (presets: {})", name, material_preset_list()));
+  }
+  if (!it->is_object())
+    return sd::shape_error(fmt::format(
+        "cloth.material must be a preset name (\"cotton\", ...) or an object, got {}", sd::show(*it)));
+  VKCLOTH_TRY(sd::check_keys(*it, "cloth.material", {"density", "stretch", "shear", "bend", "damping"}));
+  Material m;
+  const std::pair<const char*, double*> fields[] = {{"density", &m.density},
+                                                    {"stretch", &m.stretch},
+                                                    {"shear", &m.shear},
+                                                    {"bend", &m.bend},
+                                                    {"damping", &m.damping}};
+  for (auto [key, out] : fields) {
+    if (!it->contains(key))
+      return sd::shape_error(fmt::format(
+          "cloth.material.{} is required (a material object gives density, stretch, shear, bend and damping)",
+          key));
+    VKCLOTH_TRY(sd::read(*it, "cloth.material", key, *out));
+  }
+  VKCLOTH_TRY(check_material(m));
+  return std::optional<Material>(m);
+}
+
 Result<void> read_mesh_transform(const json& cloth, MeshTransform& t) {
   SCENE_TRY_ASSIGN(obj, sd::read_object(cloth, "cloth", "mesh_transform"));
   if (!obj)
@@ -218,19 +260,21 @@ Result<void> read_mesh_pins(const json& cloth, MeshClothDesc& d) {
 }
 
 /// A cloth made from a mesh file ("cloth": {"mesh": ...}), the path relative to the scene file.
-Result<void> read_mesh_cloth(const json& cloth, const std::filesystem::path& scene_dir, Scene& scene) {
+Result<void> read_mesh_cloth(const json& cloth, const std::filesystem::path& scene_dir,
+                             const std::optional<Material>& material, Scene& scene) {
   for (const char* grid_key : {"resolution", "size", "origin", "orientation", "pins"})
     if (cloth.contains(grid_key))
       return sd::shape_error(fmt::format(
           "cloth.{} is a grid key, not allowed with cloth.mesh (the mesh gives the vertices; pin with "
           "cloth.pin_vertices or cloth.pin_region)",
           grid_key));
-  VKCLOTH_TRY(sd::check_keys(
-      cloth, "cloth",
-      {"mesh", "mesh_transform", "density", "particle_mass", "stiffness", "pin_vertices", "pin_region"}));
+  VKCLOTH_TRY(sd::check_keys(cloth, "cloth",
+                             {"mesh", "mesh_transform", "density", "particle_mass", "stiffness", "material",
+                              "pin_vertices", "pin_region"}));
   std::string file;
   VKCLOTH_TRY(sd::read(cloth, "cloth", "mesh", file));
   MeshClothDesc d;
+  d.material = material;
   VKCLOTH_TRY(read_mesh_transform(cloth, d.transform));
   if (cloth.contains("density") && cloth.contains("particle_mass"))
     return sd::shape_error("give cloth.density (kg/m^2) or cloth.particle_mass (kg per vertex), not both");
@@ -257,13 +301,14 @@ Result<void> read_mesh_cloth(const json& cloth, const std::filesystem::path& sce
   return {};
 }
 
-Result<ParticleSystem> read_cloth(const json& doc) {
+Result<ParticleSystem> read_cloth(const json& doc, const std::optional<Material>& material) {
   ClothDesc d;
+  d.material = material;
   SCENE_TRY_ASSIGN(obj, sd::read_object(doc, "", "cloth"));
   if (obj) {
     VKCLOTH_TRY(sd::check_keys(
         *obj, "cloth",
-        {"resolution", "size", "origin", "orientation", "particle_mass", "stiffness", "pins"}));
+        {"resolution", "size", "origin", "orientation", "particle_mass", "stiffness", "material", "pins"}));
     if (auto it = obj->find("resolution"); it != obj->end()) {
       if (!it->is_array() || it->size() != 2)
         return sd::shape_error(
@@ -336,6 +381,19 @@ Result<Scene> build_scene(const json& doc, std::string_view source_name) {
   VKCLOTH_TRY(sd::read(doc, "", "name", scene.name));
   VKCLOTH_TRY(read_integrator(doc, scene.params, scene.steps));
   VKCLOTH_TRY(read_physics(doc, scene.params));
+  std::optional<Material> material; // cloth.material: its damping is mu, so it is read before validate()
+  if (const json* cloth = kind == "cloth" && doc.contains("cloth") ? &doc["cloth"] : nullptr;
+      cloth && cloth->is_object()) {
+    SCENE_TRY_ASSIGN(m, read_material(*cloth));
+    material = m;
+  }
+  if (material) {
+    if (const auto it = doc.find("physics"); it != doc.end() && it->contains("damping"))
+      return sd::shape_error(fmt::format("physics.damping and cloth.material exclude each other: the "
+                                         "material's damping ({} 1/s) is mu",
+                                         material->damping));
+    scene.params.damping = material->damping;
+  }
   VKCLOTH_TRY(read_wind(doc, scene.params));
   VKCLOTH_TRY(read_colliders(doc, scene.params));
   VKCLOTH_TRY(read_stretch_limit(doc, scene.params));
@@ -346,10 +404,10 @@ Result<Scene> build_scene(const json& doc, std::string_view source_name) {
 
   if (const json* cloth = kind == "cloth" && doc.contains("cloth") ? &doc["cloth"] : nullptr;
       cloth && cloth->is_object() && cloth->contains("mesh")) {
-    VKCLOTH_TRY(read_mesh_cloth(*cloth, std::filesystem::path(source_name).parent_path(), scene));
+    VKCLOTH_TRY(read_mesh_cloth(*cloth, std::filesystem::path(source_name).parent_path(), material, scene));
     return scene;
   }
-  auto system = kind == "chain" ? read_chain(doc) : read_cloth(doc);
+  auto system = kind == "chain" ? read_chain(doc) : read_cloth(doc, material);
   if (!system)
     return system.error();
   scene.system = std::move(*system);
