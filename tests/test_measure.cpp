@@ -89,7 +89,7 @@ TEST_CASE("structural strain names the most stretched spring and its particles")
   CHECK(std::abs(r0->max) < 1e-12);
 }
 
-TEST_CASE("structural strain ignores shear, bend and chain springs; bad sizes are errors") {
+TEST_CASE("structural strain ignores shear, bend and chain springs, and bad sizes are errors") {
   ParticleSystem s = grid(4, 4);
   // Every non-structural spring at half its rest length's worth of rest: strain 1 there.
   for (Spring& sp : s.springs)

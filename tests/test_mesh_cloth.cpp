@@ -215,7 +215,7 @@ TEST_CASE("a grid scene and its quad mesh follow the same trajectory for 200 ste
   }
 }
 
-TEST_CASE("triangles get bend springs across each shared edge and no shear; quads get both diagonals") {
+TEST_CASE("triangles get bend springs across each shared edge and no shear, and quads get both diagonals") {
   MeshClothDesc d;
   const MeshCloth tris = mesh_cloth(square(true), d);
   // A right-triangle pair is merged back into its quad only when the file is quad-dominant: two
@@ -259,7 +259,7 @@ TEST_CASE("density gives lumped masses: each face's area shared by its corners")
   CHECK(total == doctest::Approx(0.2 * 4.0 * area));
 }
 
-TEST_CASE("mesh_transform scales, rotates (z last) and translates; pins by index and by region") {
+TEST_CASE("mesh_transform scales, rotates (z last) and translates, and pins by index and by region") {
   MeshClothDesc d;
   d.transform = {{10.0, 0.0, 1.0}, {0.0, 0.0, 90.0}, 2.0};
   d.reorder = false;

@@ -257,7 +257,7 @@ TEST_CASE("obj: shortest round-trip coordinates read back exactly (correctly rou
   CHECK(m->positions == expected);
 }
 
-TEST_CASE("obj: n-gons are kept; no vt, or vt no face uses, leaves uvs empty") {
+TEST_CASE("obj: n-gons are kept, and no vt, or vt no face uses, leaves uvs empty") {
   auto m = parse_obj("v 0 0 0\nv 1 0 0\nv 2 1 0\nv 1 2 0\nv 0 1 0\nvt 0 0\nf 1 2 3 4 5\n", "ngon.obj");
   REQUIRE_MESSAGE(m.ok(), m.error().message);
   CHECK(m->face_offsets == std::vector<std::uint32_t>{0, 5});
@@ -274,7 +274,7 @@ TEST_CASE("obj: n-gons are kept; no vt, or vt no face uses, leaves uvs empty") {
   CHECK(n->face_offsets == std::vector<std::uint32_t>{0, 300});
 }
 
-TEST_CASE("obj: the first corner that references a vertex gives its uv; unreferenced vertices get 0") {
+TEST_CASE("obj: the first corner that references a vertex gives its uv, and unreferenced vertices get 0") {
   auto m = parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 5 5 5\nvt 0.25 0.5\nvt 1 0\nvt 0 1\nvt 0.75 0.75\n"
                      "f 1/1 2/2 3/3\nf 3/4 2/4 1/4\n",
                      "seam.obj");
@@ -373,7 +373,7 @@ TEST_CASE("gltf: the same triangles from .gltf (base64 data: buffer), .glb and f
   CHECK(from_glb->positions == ref_positions);
 }
 
-TEST_CASE("gltf: primitives merge with offset indices; no indices means sequential; other modes skipped") {
+TEST_CASE("gltf: primitives merge with offset indices, and no indices means sequential, and other modes skipped") {
   TestGltf g = ref_gltf();
   auto& prims = g.doc["meshes"][0]["primitives"];
   prims.push_back({{"attributes", {{"POSITION", 0}, {"TEXCOORD_0", 1}}}, {"mode", 1}}); // lines: skipped
@@ -440,7 +440,7 @@ TEST_CASE("gltf: the base-colour texture keeps the PNG's encoded bytes (data: UR
   CHECK(c->texture->encoded == png);
 }
 
-TEST_CASE("gltf: an external .bin buffer beside the .gltf; none from memory") {
+TEST_CASE("gltf: an external .bin buffer beside the .gltf, and none from memory") {
   const fs::path dir = temp_dir() / "external";
   fs::create_directories(dir);
   TestGltf g = ref_gltf();

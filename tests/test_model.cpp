@@ -72,7 +72,7 @@ TEST_CASE("cloth spring counts and rest lengths follow the real, non-square spac
   CHECK(sys->springs.back().stiffness == 8.0);
 }
 
-TEST_CASE("cloth index convention: particle (i, j) is j * nx + i; vertical spans x-z, horizontal x-y") {
+TEST_CASE("cloth index convention: particle (i, j) is j * nx + i, and vertical spans x-z, horizontal x-y") {
   ClothDesc d;
   d.nx = 4;
   d.ny = 3;
@@ -94,7 +94,7 @@ TEST_CASE("cloth index convention: particle (i, j) is j * nx + i; vertical spans
   CHECK(h->particles[1 * 4 + 2].position.z == doctest::Approx(3.0));
 }
 
-TEST_CASE("cloth pins: an explicit list replaces the corners; zero stiffness leaves a kind out") {
+TEST_CASE("cloth pins: an explicit list replaces the corners, and zero stiffness leaves a kind out") {
   ClothDesc d;
   d.nx = d.ny = 5;
   d.pins = {{2, 2}};

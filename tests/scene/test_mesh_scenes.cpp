@@ -44,7 +44,7 @@ std::string error_of(const std::string& cloth_body) {
 
 } // namespace
 
-TEST_CASE("cloth.mesh: the path is relative to the scene file; transform, density and pins apply") {
+TEST_CASE("cloth.mesh: the path is relative to the scene file, and transform, density and pins apply") {
   write_strip("strip.obj");
   auto s = parse_in_tmp(R"({"mesh": "strip.obj", "mesh_transform": {"translate": [0, 0, 2], "scale": 0.5},
                             "density": 0.4, "pin_vertices": [4], "pin_region": {"min": [1.4, -1, 0], "max": [2, 1, 9]}})");
