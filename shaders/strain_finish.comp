@@ -7,47 +7,45 @@
 // reads); pc.stage 1, after the sweeps: the colliders' projection again (a correction may have
 // pulled the particle into one).
 #include "vkcloth_shared.h"
+#define VKCLOTH_PC_COPY
 #include "common.glsl"
+#include "strain_texel.glsl"
 
-layout(std430, set = 0, binding = VKCLOTH_BINDING_POS_OUT) buffer PosOut {
-  vec4 pos_out[];
-};
-layout(std430, set = 0, binding = VKCLOTH_BINDING_VEL) buffer VelBuf {
-  vec4 vel[];
-};
-layout(std430, set = 0, binding = VKCLOTH_BINDING_TETHERS) readonly buffer TetherBuf {
-  TetherSlot tethers[];
-};
+layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_TETHERS) uniform usamplerBuffer tethers_texel;
 
 void main() {
   begin_instance();
   const uint p = particle_index();
-  if (p >= pc.count || frozen() || ip.stretch == 0u || particle[p].pinned != 0u)
+  if (p >= pc.count || ip.stretch == 0u)
     return;
   const bool tether_pass = pc.stage == 0u;
-  if (tether_pass ? (ip.stretch & VKCLOTH_STRETCH_TETHERS) == 0u : ip.collider_count == 0u)
+  if ((tether_pass ? (ip.stretch & VKCLOTH_STRETCH_TETHERS) == 0u : ip.collider_count == 0u) || pinned_at(p) ||
+      frozen_now())
     return;
-  const uint g = base + p;
-  vec3 x = pos_out[g].xyz;
-  vec3 v = vel[g].xyz;
+  vec3 x = pos_now(p);
+  vec3 v = vel_now(p);
+  bool moved = false;
   if (tether_pass) {
     // Euclidean rest lengths first, geodesic ones after (pc.count * VKCLOTH_TETHERS_PER_PARTICLE slots each).
     const uint first =
         ((ip.stretch & VKCLOTH_STRETCH_GEODESIC) != 0u ? pc.count + p : p) * VKCLOTH_TETHERS_PER_PARTICLE;
     for (uint k = 0u; k < VKCLOTH_TETHERS_PER_PARTICLE; ++k) {
-      const TetherSlot t = tethers[first + k];
-      if (t.anchor == VKCLOTH_NO_TETHER)
-        break;
-      const vec3 d =
-          tether_move(x, pos_out[base + t.anchor].xyz, stretch_bound(t.rest_length, ip.max_strain));
-      apply_correction(x, v, d, ip.dt);
+      const uvec2 t = texelFetch(tethers_texel, int(first + k)).xy; // TetherSlot: anchor, rest length
+      if (t.x == VKCLOTH_NO_TETHER) break;
+      vec3 d;
+      if (tether_move(x, pos_now(t.x), stretch_bound(uintBitsToFloat(t.y), ip.max_strain), d)) {
+        apply_correction(x, v, d, ip.dt);
+        moved = true;
+      }
     }
   } else {
     for (uint c = 0u; c < ip.collider_count; ++c) {
       const Collider col = colliders[ip.collider_first + c];
       project_out(col.type, col.shape.xyz, col.shape.w, ip.eps, x, v);
     }
+    moved = true;
   }
-  pos_out[g] = vec4(x, 1.0);
-  vel[g] = vec4(v, 0.0);
+  if (!moved) return;
+  pos_out[base + p] = vec4(x, 1.0);
+  vel[base + p] = vec4(v, 0.0);
 }

@@ -8,35 +8,29 @@
 // two particles' new positions (POS_OUT) and velocities (VEL); the colours follow each other
 // with a barrier between them, as the CPU's loop over colours.
 #include "vkcloth_shared.h"
+#define VKCLOTH_PC_COPY
 #include "common.glsl"
+#include "strain_texel.glsl"
 
-layout(std430, set = 0, binding = VKCLOTH_BINDING_POS_OUT) buffer PosOut {
-  vec4 pos_out[];
-};
-layout(std430, set = 0, binding = VKCLOTH_BINDING_VEL) buffer VelBuf {
-  vec4 vel[];
-};
-layout(std430, set = 0, binding = VKCLOTH_BINDING_STRAIN_LINKS) readonly buffer LinkBuf {
-  StrainLink links[];
-};
+layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_STRAIN_LINKS) uniform usamplerBuffer links_texel;
 
 void main() {
   begin_instance();
   const uint k = particle_index(); // the link within its colour
-  if (k >= pc.pad1 || frozen() || (ip.stretch & VKCLOTH_STRETCH_PROVOT) == 0u ||
-      pc.stage >= ip.stretch_sweeps)
+  if (k >= pc.pad1 || (ip.stretch & VKCLOTH_STRETCH_PROVOT) == 0u || pc.stage >= ip.stretch_sweeps || frozen_now())
     return;
-  const StrainLink l = links[pc.pad0 + k];
-  const uint ga = base + l.a, gb = base + l.b;
-  vec3 xa = pos_out[ga].xyz, xb = pos_out[gb].xyz;
-  vec3 va = vel[ga].xyz, vb = vel[gb].xyz;
+  const int t = 3 * int(pc.pad0 + k); // StrainLink as 3 R32UI texels
+  const uint a = texelFetch(links_texel, t).x, b = texelFetch(links_texel, t + 1).x;
+  const float rest = uintBitsToFloat(texelFetch(links_texel, t + 2).x);
+  vec3 xa = pos_now(a), xb = pos_now(b);
   vec3 da, db;
-  provot_link(xa, xb, particle[l.a].pinned != 0u, particle[l.b].pinned != 0u,
-              stretch_bound(l.rest_length, ip.max_strain), da, db);
+  if (!provot_link(xa, xb, pinned_at(a), pinned_at(b), stretch_bound(rest, ip.max_strain), da, db))
+    return; // within the bound: nothing moves
+  vec3 va = vel_now(a), vb = vel_now(b);
   apply_correction(xa, va, da, ip.dt);
   apply_correction(xb, vb, db, ip.dt);
-  pos_out[ga] = vec4(xa, 1.0);
-  pos_out[gb] = vec4(xb, 1.0);
-  vel[ga] = vec4(va, 0.0);
-  vel[gb] = vec4(vb, 0.0);
+  pos_out[base + a] = vec4(xa, 1.0);
+  pos_out[base + b] = vec4(xb, 1.0);
+  vel[base + a] = vec4(va, 0.0);
+  vel[base + b] = vec4(vb, 0.0);
 }

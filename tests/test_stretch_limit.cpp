@@ -32,11 +32,9 @@ ParticleSystem hanging(std::uint32_t n, double k_struct = 5.0) {
 }
 
 double max_structural_strain(const ParticleSystem& s, const std::vector<glm::dvec3>& x) {
-  double m = 0.0;
-  for (const Spring& sp : s.springs)
-    if (sp.kind == SpringKind::structural)
-      m = std::max(m, (glm::length(x[sp.b] - x[sp.a]) - sp.rest_length) / sp.rest_length);
-  return m;
+  const auto strain = structural_strain(s, x);
+  REQUIRE(strain.ok());
+  return strain->max;
 }
 
 SimParams limited(StretchLimit::Method method, std::uint32_t iterations, double dt) {

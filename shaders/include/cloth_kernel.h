@@ -155,30 +155,39 @@ KFN void apply_correction(INOUT(vec3) x, INOUT(vec3) v, vec3 dx, real h) {
 
 // Provot (1995): a link (xa, xb) longer than `bound` is shortened to `bound`; its free ends share
 // the correction (half each, all of it when the other end is pinned). da, db: the moves of a, b.
-KFN void provot_link(vec3 xa, vec3 xb, bool pinned_a, bool pinned_b, real bound, OUT(vec3) da, OUT(vec3) db) {
+// Most links are within the bound: they cost a dot product and a compare, no square root, and
+// return false (nothing moves).
+KFN bool provot_link(vec3 xa, vec3 xb, bool pinned_a, bool pinned_b, real bound, OUT(vec3) da, OUT(vec3) db) {
   da = vec3(real(0));
   db = vec3(real(0));
   precise vec3 u = xb - xa;
-  precise real len = sqrt(dot3(u, u));
-  if (!(len > bound) || (pinned_a && pinned_b))
-    return;
+  precise real len2 = dot3(u, u);
+  precise real bound2 = bound * bound;
+  if (!(len2 > bound2) || (pinned_a && pinned_b))
+    return false;
+  precise real len = sqrt(len2);
   precise real share = pinned_a || pinned_b ? real(1) : real(0.5);
   precise vec3 c = u * (share * (len - bound) / len); // along a -> b
   if (!pinned_a)
     da = c;
   if (!pinned_b)
     db = -c;
+  return true;
 }
 
 // A tether (Kim, Chentanez and Mueller 2012): x farther than `bound` from its (pinned) anchor goes
-// back onto the sphere of radius `bound` around it. Returns the move.
-KFN precise vec3 tether_move(vec3 x, vec3 anchor, real bound) {
+// back onto the sphere of radius `bound` around it: d is the move. False (d = 0) when x is within.
+KFN bool tether_move(vec3 x, vec3 anchor, real bound, OUT(vec3) d) {
+  d = vec3(real(0));
   precise vec3 u = x - anchor;
-  precise real len = sqrt(dot3(u, u));
-  precise vec3 d = vec3(real(0));
-  if (len > bound)
-    d = u * ((bound - len) / len);
-  return d;
+  precise real len2 = dot3(u, u);
+  precise real bound2 = bound * bound;
+  if (!(len2 > bound2))
+    return false;
+  precise real len = sqrt(len2);
+  precise vec3 m = u * ((bound - len) / len);
+  d = m;
+  return true;
 }
 
 // ---- Integrators (docs/model.md "Integrators") ------------------------------------------------

@@ -53,7 +53,7 @@ struct vec4 {
   21 // TetherSlot, VKCLOTH_TETHERS_PER_PARTICLE per particle, euclidean then geodesic
 #define VKCLOTH_BINDING_COUNT 22
 
-// Set 1 (force.comp, fused.comp): POS_IN again, as an RGBA32F uniform texel buffer view,
+// Set 1 (force.comp, fused.comp, strain_*.comp): POS_IN again, as an RGBA32F uniform texel buffer view,
 // PARTICLE as an RG32UI one (x: the mass's bits, y: pinned), and (fused.comp) VEL as RGBA32F and
 // FLAGS as R32UI; INSTANCES as RGBA32UI (common.glsl begin_instance); the topology's lists
 // (force_body.glsl offsets_at, edge_at, fan_offsets_at, fan_at) as R32UI / RG32UI views.
@@ -66,7 +66,9 @@ struct vec4 {
 #define VKCLOTH_TEXEL_BINDING_EDGES 6       // EDGES as R32UI, VKCLOTH_EDGE_TEXELS texels per Edge
 #define VKCLOTH_TEXEL_BINDING_FAN_OFFSETS 7 // FAN_OFFSETS as R32UI
 #define VKCLOTH_TEXEL_BINDING_FANS 8        // FANS as RG32UI, one texel per FanEntry
-#define VKCLOTH_TEXEL_BINDING_COUNT 9
+#define VKCLOTH_TEXEL_BINDING_STRAIN_LINKS 9 // STRAIN_LINKS as R32UI, 3 texels per StrainLink
+#define VKCLOTH_TEXEL_BINDING_TETHERS 10     // TETHERS as RG32UI, one texel per TetherSlot
+#define VKCLOTH_TEXEL_BINDING_COUNT 11
 #define VKCLOTH_EDGE_TEXELS 3 // 32-bit words per Edge (static_assert below)
 
 // InstanceParams::flags bits.

@@ -40,7 +40,8 @@ struct BenchOptions {
   double compute_gflops = 192.0;
   std::string json;
   std::string variants = "fused,two_pass"; // Vulkan layouts to time (RK4 and implicit: always one)
-  std::string mesh; // also time this mesh (OBJ / glTF): reordered, in file order, and shuffled
+  std::string mesh;    // also time this mesh (OBJ / glTF): reordered, in file order, and shuffled
+  std::string stretch; // also time each grid with stretch_limit {method: this, max_strain 0.1, 4 sweeps}
 };
 
 /// The benchmark scene at n x n: a 1 m x 1 m vertical cloth hanging from its two top corners, in
@@ -300,7 +301,7 @@ double per_particle_step(const Row& r) {
 }
 
 /// The grid row of the same backend, variant and integrator whose particle count is closest to a
-/// mesh row's: the mesh's cost is quoted against it.
+/// mesh row's (or a stretch row's: its own grid): that row's cost is quoted against it.
 const Row* nearest_grid(const std::vector<Row>& rows, const Row& mesh) {
   const Row* best = nullptr;
   for (const Row& g : rows)
@@ -374,7 +375,7 @@ int bench_command(const BenchOptions& o) {
       r->reps = o.reps;
       r->scene = scene;
       r->order = order;
-      r->cost = cost_of(r->variant, sc.params.integrator, s, scene == "grid", fans, true, o.steps_per_submit);
+      r->cost = cost_of(r->variant, sc.params.integrator, s, scene != "mesh", fans, true, o.steps_per_submit);
       rows.push_back(*r);
       return exit_ok;
     };
@@ -407,6 +408,14 @@ int bench_command(const BenchOptions& o) {
       return report(sc.error());
     if (int e = time_scene(*sc, n, "grid", ""))
       return e;
+    if (!o.stretch.empty()) { // the same grid with stretch control, for its cost ratio
+      auto limited = bench_scene(n, *integrator, dt);
+      if (!limited)
+        return report(limited.error());
+      limited->params.stretch_limit.method = *parse_stretch_method(o.stretch);
+      if (int e = time_scene(*limited, n, "stretch", o.stretch))
+        return e;
+    }
     if (implicit) { // the explicit baseline at the same size and dt, for the cost ratio
       auto base = bench_scene(n, Integrator::semi_implicit_euler, dt);
       if (!base)
@@ -444,6 +453,11 @@ int bench_command(const BenchOptions& o) {
                o.instances);
   if (!o.mesh.empty())
     fmt::print("mesh rows: {} (n column: the particle order: meshopt, file or shuffled)\n", o.mesh);
+  if (!o.stretch.empty())
+    fmt::print(
+        "stretch rows: n x n with stretch_limit {{method: {}, max_strain: 0.1, iterations: 4}} (n column: "
+        "n+{})\n",
+        o.stretch, o.stretch);
   fmt::print("{:<7} {:<9} {:>8} {:>8} {:>3} {:>9} {:>9} {:>9} {:>6} {:>7} {:>5} {:>6} {:>8} {:>5}\n",
              "backend", "variant", "n", "particles", "thr", "ms/step", "gpu ms", "M p-st/s", "B/p-st", "GB/s",
              "%mem", "fl/pst", "GFLOP/s", "%cmp");
@@ -457,8 +471,11 @@ int bench_command(const BenchOptions& o) {
     fmt::print(
         "{:<7} {:<9} {:>8} {:>8} {:>3} {:>9.4f} {:>9} {:>9.1f} {:>6.0f} {:>7.2f} {:>4.0f}% {:>6.0f} {:>8.2f} "
         "{:>4.1f}%\n",
-        r.backend, r.variant, r.scene == "grid" ? fmt::format("{}", r.size) : r.order, r.particles,
-        r.backend == "cpu" ? fmt::format("{}", r.threads) : "-", ms_step,
+        r.backend, r.variant,
+        r.scene == "grid"      ? fmt::format("{}", r.size)
+        : r.scene == "stretch" ? fmt::format("{}+{}", r.size, r.order)
+                               : r.order,
+        r.particles, r.backend == "cpu" ? fmt::format("{}", r.threads) : "-", ms_step,
         gpu_step >= 0 ? fmt::format("{:.4f}", gpu_step) : "-", rate * 1e-6, r.cost.bytes, gbps,
         100.0 * gbps / o.memory_gbps, r.cost.flops, gflops, 100.0 * gflops / o.compute_gflops);
     nlohmann::json j;
@@ -477,6 +494,11 @@ int bench_command(const BenchOptions& o) {
       j["order"] = r.order;
       if (const Row* g = nearest_grid(rows, r))
         j["mesh_over_grid"] = per_particle_step(r) / per_particle_step(*g);
+    }
+    if (r.scene == "stretch") {
+      j["stretch_method"] = r.order;
+      if (const Row* g = nearest_grid(rows, r))
+        j["stretch_over_plain"] = per_particle_step(r) / per_particle_step(*g);
     }
     j["instances"] = r.instances;
     j["particles"] = r.particles;
@@ -512,6 +534,13 @@ int bench_command(const BenchOptions& o) {
           "{} {} mesh ({} order, {} particles): {:.2f}x the cost per particle-step of the {} x {} grid\n",
           r.backend, r.variant, r.order, r.particles, per_particle_step(r) / per_particle_step(*g), g->size,
           g->size);
+  for (const Row& r : rows)
+    if (const Row* g = r.scene == "stretch" ? nearest_grid(rows, r) : nullptr)
+      fmt::print(
+          "{} {} n = {}: stretch control ({}, 4 sweeps) costs {:.0f} % of the plain step ({:.4f} vs {:.4f} "
+          "ms)\n",
+          r.backend, r.variant, r.size, r.order, 100.0 * (per_particle_step(r) / per_particle_step(*g) - 1.0),
+          r.wall_ms / double(r.steps), g->wall_ms / double(g->steps));
   if (!o.json.empty()) {
     nlohmann::json doc;
     doc["schema"] = "vkcloth-bench/1";
@@ -582,6 +611,11 @@ void add_bench_command(CLI::App& app, int* exit) {
                   "Also time the cloth made from this OBJ / glTF mesh, with its particles renumbered by "
                   "meshoptimizer, in the file's order and shuffled, against the grid of nearest size")
       ->check(CLI::ExistingFile);
+  cmd->add_option(
+         "--stretch", opt->stretch,
+         "Also time each grid with stretch control (tethers, provot or both; max_strain 0.1, 4 sweeps) "
+         "against the plain step")
+      ->check(CLI::IsMember({"tethers", "provot", "both"}));
   cmd->add_option("--json", opt->json, "Also write the results as JSON to FILE (keys: docs/performance.md)");
   cmd->footer(exit_codes_footer);
   cmd->callback([opt, exit] { *exit = bench_command(*opt); });

@@ -305,9 +305,9 @@ template <typename Real> void CpuSolver<Real>::limit_stretch(const Real h) {
         const TetherSlot& t = tethers_[p * tethers_per_particle + k];
         if (t.anchor == no_tether)
           break;
-        const Vec3 d =
-            kernel::tether_move(pos_[p], pos_[t.anchor], kernel::stretch_bound(t.rest_length, max_strain));
-        kernel::apply_correction(pos_[p], vel_[p], d, h);
+        Vec3 d;
+        if (kernel::tether_move(pos_[p], pos_[t.anchor], kernel::stretch_bound(t.rest_length, max_strain), d))
+          kernel::apply_correction(pos_[p], vel_[p], d, h);
       }
     });
   }
@@ -317,8 +317,9 @@ template <typename Real> void CpuSolver<Real>::limit_stretch(const Real h) {
       pool_->for_each(colours[c + 1] - colours[c], [&](std::size_t k) {
         const Link& l = strain_links_[colours[c] + k];
         Vec3 da, db;
-        kernel::provot_link(pos_[l.a], pos_[l.b], pinned_[l.a] != 0, pinned_[l.b] != 0,
-                            kernel::stretch_bound(l.rest_length, max_strain), da, db);
+        if (!kernel::provot_link(pos_[l.a], pos_[l.b], pinned_[l.a] != 0, pinned_[l.b] != 0,
+                                 kernel::stretch_bound(l.rest_length, max_strain), da, db))
+          return;
         kernel::apply_correction(pos_[l.a], vel_[l.a], da, h);
         kernel::apply_correction(pos_[l.b], vel_[l.b], db, h);
       });

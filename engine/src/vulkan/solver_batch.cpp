@@ -207,14 +207,18 @@ Result<void> SolverBatch::ensure_tethers() {
     for (const Tether& t : batch_topology->tethers(kind))
       data.push_back({t.anchor, float(t.rest_length)});
   const VkDeviceSize bytes = data.size() * sizeof(sh::TetherSlot);
-  auto b = create_buffer(*ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+  auto b = create_buffer(*ctx, bytes,
+                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                             VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT,
                          MemoryUse::device, !knobs.force_staging, "tethers");
   if (!b)
     return b.error();
+  tethers_view.reset(); // before the buffer it views
   tethers = std::move(*b);
   const Upload up[] = {{&tethers, data.data(), bytes}};
   VKCLOTH_TRY(upload(up));
   tethers_uploaded = true;
+  VKCLOTH_TRY(create_tethers_view());
   return write_sets();
 }
 
@@ -277,7 +281,9 @@ void SolverBatch::record_stretch(VkCommandBuffer c, std::uint32_t read) {
       sweeps = std::max(sweeps, sl.iterations);
     tethered = tethered || sl.tethers();
   }
-  v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &sets[read][0], 0, nullptr);
+  // Set 1 of the positions being written: the passes read positions[write] through its texel view.
+  const VkDescriptorSet bound_sets[2] = {sets[read][0], texel_sets[read ^ 1u]};
+  v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 2, bound_sets, 0, nullptr);
   sh::PushConstants spc = pc;
   auto per_particle = [&](std::uint32_t stage) {
     spc.stage = stage; // 0: tethers, 1: projection

@@ -81,17 +81,16 @@ Result<void> SolverBatch::create_descriptor_sets() {
   return {};
 }
 
-// The texel sets never change: positions[0/1] and the stage positions live as long as the batch.
-// Set k: its positions view (k = 0, 1: positions[k]; 2: stage positions) and the same eight shared
-// views. Uniform texel buffer support is mandatory for these formats. Edges are viewed as R32UI,
-// VKCLOTH_EDGE_TEXELS texels per Edge (no RGB32 format is mandatory for texel buffers).
+// Set k: its positions view (k = 0, 1: positions[k]; 2: stage positions) and the same shared
+// views. Uniform texel buffer support is mandatory for these formats. Edges and strain links are
+// viewed as R32UI, 3 texels each (no RGB32 format is mandatory for texel buffers).
 Result<void> SolverBatch::create_texel_views() {
   const struct {
     const Buffer* buffer;
     VkFormat format;
     BufferView* view;
     const char* what;
-  } views[11] = {{&pos[0], VK_FORMAT_R32G32B32A32_SFLOAT, &pos_views[0], "positions[0]"},
+  } views[12] = {{&pos[0], VK_FORMAT_R32G32B32A32_SFLOAT, &pos_views[0], "positions[0]"},
                  {&pos[1], VK_FORMAT_R32G32B32A32_SFLOAT, &pos_views[1], "positions[1]"},
                  {&stage_pos, VK_FORMAT_R32G32B32A32_SFLOAT, &pos_views[2], "stage positions"},
                  {&particle, VK_FORMAT_R32G32_UINT, &particle_view, "particle constants"},
@@ -101,14 +100,26 @@ Result<void> SolverBatch::create_texel_views() {
                  {&offsets, VK_FORMAT_R32_UINT, &offsets_view, "adjacency offsets"},
                  {&edges, VK_FORMAT_R32_UINT, &edges_view, "adjacency"},
                  {&fan_offsets, VK_FORMAT_R32_UINT, &fan_offsets_view, "normal fan offsets"},
-                 {&fans, VK_FORMAT_R32G32_UINT, &fans_view, "normal fans"}};
+                 {&fans, VK_FORMAT_R32G32_UINT, &fans_view, "normal fans"},
+                 {&strain_links, VK_FORMAT_R32_UINT, &strain_links_view, "strain links"}};
   static_assert(sizeof(sh::FanEntry) == 8, "one RG32UI texel per FanEntry");
+  static_assert(sizeof(sh::StrainLink) == 12, "three R32UI texels per StrainLink");
   for (const auto& view : views) {
     auto r = create_buffer_view(*ctx, view.buffer->buffer, view.format, view.what);
     if (!r)
       return r.error();
     *view.view = std::move(*r);
   }
+  return create_tethers_view();
+}
+
+// The tethers' view (again when ensure_tethers() replaces the buffer), then every texel set.
+Result<void> SolverBatch::create_tethers_view() {
+  static_assert(sizeof(sh::TetherSlot) == 8, "one RG32UI texel per TetherSlot");
+  auto r = create_buffer_view(*ctx, tethers.buffer, VK_FORMAT_R32G32_UINT, "tethers");
+  if (!r)
+    return r.error();
+  tethers_view = std::move(*r);
   const std::pair<const BufferView*, std::uint32_t> shared_views[VKCLOTH_TEXEL_BINDING_COUNT - 1] = {
       {&particle_view, VKCLOTH_TEXEL_BINDING_PARTICLE},
       {&vel_view, VKCLOTH_TEXEL_BINDING_VEL},
@@ -117,7 +128,9 @@ Result<void> SolverBatch::create_texel_views() {
       {&offsets_view, VKCLOTH_TEXEL_BINDING_OFFSETS},
       {&edges_view, VKCLOTH_TEXEL_BINDING_EDGES},
       {&fan_offsets_view, VKCLOTH_TEXEL_BINDING_FAN_OFFSETS},
-      {&fans_view, VKCLOTH_TEXEL_BINDING_FANS}};
+      {&fans_view, VKCLOTH_TEXEL_BINDING_FANS},
+      {&strain_links_view, VKCLOTH_TEXEL_BINDING_STRAIN_LINKS},
+      {&tethers_view, VKCLOTH_TEXEL_BINDING_TETHERS}};
   std::array<VkWriteDescriptorSet, VKCLOTH_TEXEL_BINDING_COUNT * 3> writes{};
   std::size_t w = 0;
   auto write = [&](VkDescriptorSet set, std::uint32_t binding, const BufferView& view) {
