@@ -83,6 +83,40 @@ void check_cloth_physics(const nlohmann::json& m) {
   const auto& col = c["collisions"]; // Figure 11: nothing goes through the floor
   CHECK(num(col["plane"]["min_z"]) > -1e-6);
   CHECK(num(col["plane_sphere"]["min_z"]) > -1e-6);
+  // Figure 7 with and without the strain limit: without it the soft springs stretch far (strain 6.4 at
+  // K = 5); with it (both, 10 %, 4 sweeps) every K keeps the largest strain near 10 %.
+  const auto& sl = c["strain_limit"];
+  for (const std::string k : {"5", "20", "50"}) {
+    CAPTURE(k);
+    CHECK_FALSE(sl["off"][k]["diverged"].get<bool>());
+    CHECK_FALSE(sl["on"][k]["diverged"].get<bool>());
+    CHECK(num(sl["on"][k]["max_strain"]) < 0.2);
+    CHECK(num(sl["on"][k]["min_z"]) > num(sl["off"][k]["min_z"]) - 1e-6); // hangs no lower
+  }
+  CHECK(num(sl["off"]["5"]["max_strain"]) > 1.0);
+  CHECK(num(sl["off"]["5"]["max_strain"]) > num(sl["off"]["20"]["max_strain"]));
+  CHECK(num(sl["off"]["20"]["max_strain"]) > num(sl["off"]["50"]["max_strain"]));
+  CHECK(num(sl["on"]["5"]["min_z"]) > num(sl["off"]["5"]["min_z"]) + 1.0);
+  // One material at three resolutions: the same drape (lowest points within 5 % of the 1 m cloth).
+  const auto& res = c["resolution"];
+  for (const std::string n : {"16", "32", "64"}) {
+    CAPTURE(n);
+    CHECK_FALSE(res[n]["diverged"].get<bool>());
+    CHECK(std::isfinite(num(res[n]["min_z"])));
+    CHECK(num(res[n]["min_z"]) < 0.5); // below the bottom edge's start: it sags
+  }
+  CHECK(num(res["min_z_spread_percent"]) < 5.0);
+  // The presets over the sphere: each fell (below its start at z = 0.8 m) and stays above the floor.
+  for (const std::string name : {"cotton", "silk", "denim", "leather", "rubber"}) {
+    CAPTURE(name);
+    const auto& pr = c["presets"][name];
+    CHECK_FALSE(pr["diverged"].get<bool>());
+    CHECK(std::isfinite(num(pr["min_z"])));
+    CHECK(num(pr["min_z"]) < 0.8 - 0.3);
+    CHECK(num(pr["min_z"]) > -1e-6);
+    CHECK(num(pr["below_equator"]) > 0.0); // hangs below the sphere's equator
+  }
+  CHECK(num(c["presets"]["silk"]["min_z"]) < num(c["presets"]["leather"]["min_z"])); // limp hangs lower
 }
 
 /// The render golden-image metric (tests/render/render_test_util.hpp): a pixel differs when a
@@ -132,9 +166,10 @@ TEST_CASE("vkcloth figures (cpu): the gallery and the physics behind it") {
   check_cloth_physics(m);
   check_stability_map(m);
   if (have_vulkan_device())
-    for (const char* f : {"cloth_k_struct.png", "cloth_k_shear.png", "cloth_k_bend.png", "cloth_wind.png",
-                          "cloth_contact.png", "cloth_collisions.png", "cloth_no_structural.png",
-                          "cloth_gpu.png", "cloth_meshes.png"})
+    for (const char* f :
+         {"cloth_k_struct.png", "cloth_k_shear.png", "cloth_k_bend.png", "cloth_wind.png",
+          "cloth_contact.png", "cloth_collisions.png", "cloth_no_structural.png", "cloth_gpu.png",
+          "cloth_meshes.png", "cloth_strain_limit.png", "cloth_resolution.png", "cloth_presets.png"})
       CHECK_MESSAGE(fs::exists(out / f), f);
 }
 
@@ -158,7 +193,7 @@ TEST_CASE("vkcloth figures --backend vulkan: the same physics on the GPU, zero v
   REQUIRE_MESSAGE(oc.code == 0, oc.err);
   for (const char* f :
        {"cloth_k_struct.png", "cloth_k_shear.png", "cloth_k_bend.png", "cloth_wind.png", "cloth_contact.png",
-        "cloth_collisions.png", "cloth_no_structural.png", "cloth_meshes.png"}) {
+        "cloth_collisions.png", "cloth_no_structural.png", "cloth_meshes.png", "cloth_strain_limit.png"}) {
     const std::string file = f;
     CAPTURE(file);
     CHECK(differing_fraction(out / file, cpu / file) < 0.005);

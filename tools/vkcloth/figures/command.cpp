@@ -56,7 +56,8 @@ void add_figures_command(CLI::App& app, int* exit) {
   cmd->add_option(
       "--backend", opt->backend,
       "Solver backend: cpu | vulkan (default cpu). The cloth pictures are drawn by the Vulkan "
-      "renderer either way (the CPU result is uploaded for drawing); Figure 14 is always the GPU solver");
+      "renderer either way (the CPU result is uploaded for drawing); Figure 14 is always the GPU solver, "
+      "the material figures (three resolutions, presets over the sphere) always the CPU solver");
   cmd->add_flag("--quick", opt->quick,
                 "Smaller cloth pictures (240x180 panels instead of 400x300); same numbers");
   cmd->add_option(

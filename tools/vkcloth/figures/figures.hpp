@@ -49,9 +49,10 @@ double total_energy(const Scene& scene, const std::vector<glm::dvec3>& pos,
                     const std::vector<glm::dvec3>& vel);
 
 Result<void> spring_figures(Gallery& gallery);
-/// Figures 5, 7-9, 11-14 and the mesh samples (samples/scenes/{tablecloth_on_sphere, flag_with_hole,
-/// skirt}.json): labelled image grids (rendered offscreen; skipped without a Vulkan device
-/// on the CPU backend, the numbers are computed either way) and metrics["cloth"].
+/// Figures 5, 7-9, 11-14, the mesh samples (samples/scenes/{tablecloth_on_sphere, flag_with_hole,
+/// skirt}.json), Figure 7 with and without the strain limit, cotton at three resolutions and the
+/// material presets over the sphere: labelled image grids (rendered offscreen; skipped without a Vulkan
+/// device on the CPU backend, the numbers are computed either way) and metrics["cloth"].
 Result<void> cloth_figures(Gallery& gallery);
 /// The (K_struct, dt) stability map of semi-implicit Euler, RK4 and implicit Euler (stability.cpp).
 Result<void> stability_figures(Gallery& gallery);

@@ -76,20 +76,22 @@ void draw_text(render::Image& img, int x, int y, const std::string& text, int sc
   }
 }
 
-render::Image compose_grid(const std::vector<Panel>& panels, const std::string& title) {
+render::Image compose_grid(const std::vector<Panel>& panels, const std::string& title, std::size_t columns) {
   constexpr int gap = 6, title_h = 30, label_h = 26, scale = 2;
   const int pw = panels.empty() ? 0 : int(panels[0].image.width),
             ph = panels.empty() ? 0 : int(panels[0].image.height);
   const int n = int(panels.size());
+  const int cols = columns == 0 ? n : std::min(n, int(columns));
+  const int rows = cols == 0 ? 0 : (n + cols - 1) / cols;
   render::Image out;
-  out.width = std::uint32_t(std::max(gap + n * (pw + gap), text_width(title, scale) + 2 * gap));
-  out.height = std::uint32_t(title_h + ph + label_h + gap);
+  out.width = std::uint32_t(std::max(gap + cols * (pw + gap), text_width(title, scale) + 2 * gap));
+  out.height = std::uint32_t(title_h + std::max(rows, 1) * (ph + label_h) + gap);
   out.rgba.assign(std::size_t(out.width) * out.height * 4, 255);
   const std::uint8_t ink[3] = {20, 20, 28};
   draw_text(out, gap, (title_h - 7 * scale) / 2, title, scale, ink);
   for (int i = 0; i < n; ++i) {
     const render::Image& src = panels[std::size_t(i)].image;
-    const int x0 = gap + i * (pw + gap), y0 = title_h;
+    const int x0 = gap + (i % cols) * (pw + gap), y0 = title_h + (i / cols) * (ph + label_h);
     for (int y = 0; y < std::min(ph, int(src.height)); ++y)
       for (int x = 0; x < std::min(pw, int(src.width)); ++x)
         std::copy_n(src.pixel(std::uint32_t(x), std::uint32_t(y)), 4,

@@ -3,6 +3,7 @@
 // label under each panel, drawn with a tiny built-in 5 x 7 bitmap font (no font files needed).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -23,7 +24,9 @@ void draw_text(render::Image& img, int x, int y, const std::string& text, int sc
 /// Width in pixels of `text` drawn at `scale`.
 int text_width(const std::string& text, int scale);
 
-/// The panels (all the same size) in one row, a title strip above, each label centred under its panel.
-render::Image compose_grid(const std::vector<Panel>& panels, const std::string& title);
+/// The panels (all the same size) in rows of `columns` (0: all in one row), a title strip above, each
+/// label centred under its panel.
+render::Image compose_grid(const std::vector<Panel>& panels, const std::string& title,
+                           std::size_t columns = 0);
 
 } // namespace vkcloth::figures
