@@ -290,6 +290,17 @@ template <typename Real> void CpuSolver<Real>::substep(const Real h) {
 template <typename Real> void CpuSolver<Real>::limit_stretch(const Real h) {
   const StretchLimit& sl = params_.stretch_limit;
   const Real max_strain = Real(sl.max_strain);
+  // The row sweep's SoA copy of the positions (when valid) follows every move, so the next sweep
+  // need not transpose the whole state again.
+  const std::size_t stride = pos_.size() + 2 * soa_pad_;
+  Real* const soa = soa_valid_ ? soa_.data() + soa_pad_ : nullptr;
+  auto moved = [&](std::size_t q) {
+    if (!soa)
+      return;
+    soa[q] = pos_[q].x;
+    soa[stride + q] = pos_[q].y;
+    soa[2 * stride + q] = pos_[q].z;
+  };
   if (strain_links_.empty() && !topology_->strain_links().empty())
     for (const StrainLink& l : topology_->strain_links())
       strain_links_.push_back(Link{l.a, l.b, Real(l.rest_length)});
@@ -306,8 +317,11 @@ template <typename Real> void CpuSolver<Real>::limit_stretch(const Real h) {
         if (t.anchor == no_tether)
           break;
         Vec3 d;
-        if (kernel::tether_move(pos_[p], pos_[t.anchor], kernel::stretch_bound(t.rest_length, max_strain), d))
+        if (kernel::tether_move(pos_[p], pos_[t.anchor], kernel::stretch_bound(t.rest_length, max_strain),
+                                d)) {
           kernel::apply_correction(pos_[p], vel_[p], d, h);
+          moved(p);
+        }
       }
     });
   }
@@ -322,14 +336,17 @@ template <typename Real> void CpuSolver<Real>::limit_stretch(const Real h) {
           return;
         kernel::apply_correction(pos_[l.a], vel_[l.a], da, h);
         kernel::apply_correction(pos_[l.b], vel_[l.b], db, h);
+        moved(l.a);
+        moved(l.b);
       });
   if (!params_.colliders.empty())
     pool_->for_each(pos_.size(), [&](std::size_t p) {
-      if (!pinned_[p])
+      if (!pinned_[p]) {
         project_at(pos_[p], vel_[p]);
+        moved(p);
+      }
     });
-  soa_valid_ = false;
-  swept_finite_ = false;
+  swept_finite_ = false; // the moves are checked with the rest of the state (check_finite)
 }
 
 template <typename Real>
