@@ -373,7 +373,8 @@ TEST_CASE("gltf: the same triangles from .gltf (base64 data: buffer), .glb and f
   CHECK(from_glb->positions == ref_positions);
 }
 
-TEST_CASE("gltf: primitives merge with offset indices, and no indices means sequential, and other modes skipped") {
+TEST_CASE(
+    "gltf: primitives merge with offset indices, and no indices means sequential, and other modes skipped") {
   TestGltf g = ref_gltf();
   auto& prims = g.doc["meshes"][0]["primitives"];
   prims.push_back({{"attributes", {{"POSITION", 0}, {"TEXCOORD_0", 1}}}, {"mode", 1}}); // lines: skipped
