@@ -151,3 +151,30 @@ TEST_CASE("load_scene_file: a missing file is an i/o error naming it") {
   CHECK(s.error().code == ErrorCode::io);
   CHECK(s.error().message.find("/nonexistent/dir/scene.json") != std::string::npos);
 }
+
+TEST_CASE("stretch_limit: bad input names the key and the value (issue 17 point 6)") {
+  const std::string base = R"({"system": "cloth", "stretch_limit": )";
+  expect_error(base + R"({"method": "both", "max_strain": 0}})",
+               {"stretch_limit.max_strain", "> 0", "got 0"});
+  expect_error(base + R"({"method": "both", "max_strain": -0.1}})", {"stretch_limit.max_strain", "-0.1"});
+  expect_error(base + R"({"method": "both", "iterations": 0}})",
+               {"stretch_limit.iterations", "1..100", "got 0"});
+  expect_error(base + R"({"method": "both", "iterations": 101}})", {"stretch_limit.iterations", "got 101"});
+  expect_error(base + R"({"method": "both", "iterations": 2.5}})", {"stretch_limit.iterations"});
+  expect_error(base + R"({"method": "hard"}})", {"stretch_limit.method", "\"hard\"", "provot"});
+  expect_error(base + R"({"max_strain": 0.1}})", {"stretch_limit.method is required"});
+  expect_error(base + R"({"method": "both", "tether_distance": "manhattan"}})",
+               {"stretch_limit.tether_distance", "\"manhattan\""});
+  expect_error(base + R"({"method": "both", "sweeps": 4}})", {"unknown key stretch_limit.sweeps"});
+  // --set reaches every key, and turns the limit on in a scene without one.
+  expect_error(R"({"system": "cloth"})", {"stretch_limit.max_strain", "got 0"},
+               {"stretch_limit.method=both", "stretch_limit.max_strain=0"});
+  auto on = parse_scene(R"({"system": "cloth"})", "ok.json",
+                        std::vector<std::string>{"stretch_limit.method=provot"});
+  REQUIRE(on.ok());
+  CHECK(on->params.stretch_limit.method == StretchLimit::Method::provot);
+  CHECK(on->params.stretch_limit.iterations == 4);
+  auto off = parse_scene(R"({"system": "cloth"})", "ok.json");
+  REQUIRE(off.ok());
+  CHECK(!off->params.stretch_limit.enabled()); // off by default: the report's model
+}
