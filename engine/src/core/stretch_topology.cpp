@@ -77,7 +77,8 @@ std::vector<Tether> find_tethers(const ParticleSystem& system, bool geodesic) {
     if (system.particles[p].pinned)
       queue.emplace(0.0, p, p);
   while (!queue.empty()) {
-    const auto [d, p, anchor] = queue.top();
+    const double d = std::get<0>(queue.top());
+    const std::uint32_t p = std::get<1>(queue.top()), anchor = std::get<2>(queue.top());
     queue.pop();
     Tether* const mine = &slots[std::size_t(p) * tethers_per_particle];
     if (found[p] == tethers_per_particle ||
