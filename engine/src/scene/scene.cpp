@@ -78,6 +78,22 @@ Result<void> read_wind(const json& doc, SimParams& params) {
   return sd::read(*obj, "wind", "direction", params.wind.direction);
 }
 
+// obj[key], a string, through `parse` into `out` (absent: `out` stays); a name `parse` refuses is
+// an error listing the `choices`.
+template <typename T, typename Parse>
+Result<void> read_choice(const json& obj, const char* path, const char* key, Parse parse, const char* choices,
+                         T& out) {
+  if (!obj.contains(key))
+    return {};
+  std::string name;
+  VKCLOTH_TRY(sd::read(obj, path, key, name));
+  const std::optional<T> value = parse(name);
+  if (!value)
+    return sd::shape_error(fmt::format("{}.{} must be {}, got \"{}\"", path, key, choices, name));
+  out = *value;
+  return {};
+}
+
 // Absent: off (the report's model). Present: "method" is required, the rest have defaults.
 Result<void> read_stretch_limit(const json& doc, SimParams& params) {
   SCENE_TRY_ASSIGN(obj, sd::read_object(doc, "", "stretch_limit"));
@@ -86,29 +102,17 @@ Result<void> read_stretch_limit(const json& doc, SimParams& params) {
   const char* path = "stretch_limit";
   VKCLOTH_TRY(sd::check_keys(*obj, path, {"method", "max_strain", "iterations", "tether_distance"}));
   StretchLimit& sl = params.stretch_limit;
+  const char* methods = "\"tethers\", \"provot\", \"both\" or \"off\"";
   if (!obj->contains("method"))
-    return sd::shape_error("stretch_limit.method is required: \"tethers\", \"provot\", \"both\" or \"off\"");
-  std::string name;
-  VKCLOTH_TRY(sd::read(*obj, path, "method", name));
-  const auto method = parse_stretch_method(name);
-  if (!method)
-    return sd::shape_error(fmt::format(
-        "stretch_limit.method must be \"tethers\", \"provot\", \"both\" or \"off\", got \"{}\"", name));
-  sl.method = *method;
+    return sd::shape_error(fmt::format("stretch_limit.method is required: {}", methods));
+  VKCLOTH_TRY(read_choice(*obj, path, "method", parse_stretch_method, methods, sl.method));
   VKCLOTH_TRY(sd::read(*obj, path, "max_strain", sl.max_strain));
   if (obj->contains("iterations")) {
     SCENE_TRY_ASSIGN(it, sd::as_integer((*obj)["iterations"], "stretch_limit.iterations", 1000000));
     sl.iterations = static_cast<std::uint32_t>(it); // the range (1..100) is validate()'s
   }
-  if (obj->contains("tether_distance")) {
-    VKCLOTH_TRY(sd::read(*obj, path, "tether_distance", name));
-    const auto distance = parse_tether_distance(name);
-    if (!distance)
-      return sd::shape_error(fmt::format(
-          "stretch_limit.tether_distance must be \"euclidean\" or \"geodesic\", got \"{}\"", name));
-    sl.tether_distance = *distance;
-  }
-  return {};
+  return read_choice(*obj, path, "tether_distance", parse_tether_distance, "\"euclidean\" or \"geodesic\"",
+                     sl.tether_distance);
 }
 
 Result<void> read_colliders(const json& doc, SimParams& params) {
