@@ -110,6 +110,11 @@ std::unique_ptr<HostVulkan> HostVulkan::create(std::string& error) {
   VkFenceCreateInfo fi{};
   fi.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
   vkCreateFence(h->device, &fi, nullptr, &h->fence);
+  ca.commandBufferCount = frames_in_flight;
+  vkAllocateCommandBuffers(h->device, &ca, h->frame_cmd);
+  fi.flags = VK_FENCE_CREATE_SIGNALED_BIT;
+  for (VkFence& f : h->frame_fence)
+    vkCreateFence(h->device, &fi, nullptr, &f);
   return h;
 }
 
@@ -118,6 +123,9 @@ HostVulkan::~HostVulkan() {
     vkDeviceWaitIdle(device);
     if (fence)
       vkDestroyFence(device, fence, nullptr);
+    for (VkFence f : frame_fence)
+      if (f)
+        vkDestroyFence(device, f, nullptr);
     if (pool)
       vkDestroyCommandPool(device, pool, nullptr);
     vkDestroyDevice(device, nullptr);
@@ -149,6 +157,31 @@ bool HostVulkan::submit_and_wait() {
   const bool ok = vkWaitForFences(device, 1, &fence, VK_TRUE, UINT64_MAX) == VK_SUCCESS;
   vkResetFences(device, 1, &fence);
   return ok;
+}
+
+bool HostVulkan::begin_frame(std::uint32_t k) {
+  if (vkWaitForFences(device, 1, &frame_fence[k], VK_TRUE, UINT64_MAX) != VK_SUCCESS ||
+      vkResetFences(device, 1, &frame_fence[k]) != VK_SUCCESS ||
+      vkResetCommandBuffer(frame_cmd[k], 0) != VK_SUCCESS)
+    return false;
+  VkCommandBufferBeginInfo bi{};
+  bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+  bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  return vkBeginCommandBuffer(frame_cmd[k], &bi) == VK_SUCCESS;
+}
+
+bool HostVulkan::submit_frame(std::uint32_t k) {
+  if (vkEndCommandBuffer(frame_cmd[k]) != VK_SUCCESS)
+    return false;
+  VkSubmitInfo si{};
+  si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
+  si.commandBufferCount = 1;
+  si.pCommandBuffers = &frame_cmd[k];
+  return vkQueueSubmit(queue, 1, &si, frame_fence[k]) == VK_SUCCESS;
+}
+
+bool HostVulkan::wait_frames() {
+  return vkWaitForFences(device, frames_in_flight, frame_fence, VK_TRUE, UINT64_MAX) == VK_SUCCESS;
 }
 
 bool HostVulkan::still_usable() {

@@ -25,6 +25,11 @@ struct HostVulkan {
   VkFence fence = VK_NULL_HANDLE;
   PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr;
   std::atomic<std::uint64_t> messages{0};
+  /// Frames in flight (a renderer's ring): a command buffer and a fence each, used by
+  /// begin_frame / submit_frame (created signalled, as a host's first frame expects).
+  static constexpr std::uint32_t frames_in_flight = 2;
+  VkCommandBuffer frame_cmd[frames_in_flight] = {};
+  VkFence frame_fence[frames_in_flight] = {};
 
   /// Null with `error` set when no Vulkan 1.2 device with a compute queue (or no validation layer).
   static std::unique_ptr<HostVulkan> create(std::string& error);
@@ -37,6 +42,13 @@ struct HostVulkan {
   bool begin();
   /// Ends `cmd`, submits it on `queue` and waits for `fence`.
   bool submit_and_wait();
+  /// Waits for frame slot `k`'s previous submission (its fence), resets and begins its command
+  /// buffer, as a renderer does at the start of a frame.
+  bool begin_frame(std::uint32_t k);
+  /// Ends frame slot `k`'s command buffer and submits it WITHOUT waiting (its fence signals).
+  bool submit_frame(std::uint32_t k);
+  /// Waits for every frame slot's last submission.
+  bool wait_frames();
   /// The host's device still works: creates and destroys a buffer, submits an empty command
   /// buffer and waits, vkDeviceWaitIdle.
   bool still_usable();

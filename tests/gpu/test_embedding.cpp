@@ -4,6 +4,7 @@
 #include "gpu_test_util.hpp"
 #include "host_vulkan.hpp"
 
+#include <cmath>
 #include <cstddef>
 #include <cstdlib>
 #include <cstring>
@@ -445,4 +446,136 @@ TEST_CASE("ClothWorld batches: a diverging instance is frozen and named, the oth
   REQUIRE(!again.ok());
   CHECK(world->step_index(*b) == wild_alone->step_index());
   CHECK(diff(*world->positions(*b), frozen_at).bitwise);
+}
+
+namespace {
+
+/// Frame k's per-frame parameters: the host's frame time, its wind and a sphere it animates.
+StepParams frame_params(int k) {
+  StepParams s;
+  s.dt = 0.004 + 0.002 * std::sin(0.7 * k);
+  s.gravity = glm::dvec3(0.8 * std::sin(0.3 * k), 0.0, -9.81);
+  Wind w;
+  w.direction = {1.0, 0.2 * std::cos(0.5 * k), 0.3};
+  w.strength = 0.02 * (1.0 + std::cos(0.9 * k));
+  s.wind = w;
+  s.colliders = std::vector<Collider>{Collider::sphere({0.02 * k - 0.2, 0.0, 0.0}, 0.25)};
+  return s;
+}
+
+SimParams frame_start_params() {
+  SimParams p;
+  p.integrator = Integrator::semi_implicit_euler;
+  p.colliders = {Collider::sphere({-0.2, 0.0, 0.0}, 0.25)};
+  return p;
+}
+
+} // namespace
+
+TEST_CASE("Per-frame parameters: two frames in flight changing dt, gravity, wind and a moving sphere "
+          "every frame give the bits of one frame at a time") {
+  VKCLOTH_GPU_TEST_BEGIN(ctx);
+  std::string error;
+  auto host = host_or_skip(error);
+  if (!host)
+    return;
+  auto adopted = Context::adopt(handles_of(*host, nullptr));
+  REQUIRE(adopted.ok());
+  auto topo = make_topology(16, 12, true);
+  constexpr int frames = 30;
+  constexpr std::uint32_t steps_per_frame = 2;
+
+  // In flight: frame k records into slot k % 2 and is submitted without waiting (a renderer's
+  // ring); only slot reuse waits (for frame k - 2). A solver and a world of two instances.
+  auto flying = GpuSolver::create(*adopted, topo, frame_start_params());
+  auto world = ClothWorld::create(*adopted);
+  REQUIRE(flying.ok());
+  REQUIRE(world.ok());
+  auto a = world->add(topo, frame_start_params());
+  auto b = world->add(topo, frame_start_params());
+  REQUIRE(a.ok());
+  REQUIRE(b.ok());
+  double expected_time = 0.0;
+  for (int k = 0; k < frames; ++k) {
+    const std::uint32_t slot = std::uint32_t(k) % HostVulkan::frames_in_flight;
+    REQUIRE(host->begin_frame(slot));
+    const StepParams s = frame_params(k);
+    REQUIRE(flying->record_steps(host->frame_cmd[slot], steps_per_frame, s).ok());
+    REQUIRE(world->set_step_params(*a, s).ok());
+    REQUIRE(world->set_step_params(*b, frame_params(k + 7)).ok()); // its own sequence
+    world->record_steps(host->frame_cmd[slot], steps_per_frame);
+    world->record_barrier_to(host->frame_cmd[slot], VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
+    REQUIRE(host->submit_frame(slot));
+    expected_time += steps_per_frame * *s.dt;
+  }
+  REQUIRE(host->wait_frames());
+  CHECK(flying->time() == doctest::Approx(expected_time).epsilon(1e-12));
+
+  // One frame at a time: set_params, simulate (submitted and waited for), on the shared Context;
+  // and the CPU reference.
+  auto serial = GpuSolver::create(ctx, topo, frame_start_params());
+  auto serial_b = GpuSolver::create(ctx, topo, frame_start_params());
+  auto cpu = CpuSolver<float>::create(topo, frame_start_params());
+  REQUIRE(serial.ok());
+  REQUIRE(serial_b.ok());
+  REQUIRE(cpu.ok());
+  for (int k = 0; k < frames; ++k) {
+    REQUIRE(serial->set_params(frame_params(k).applied_to(serial->params())).ok());
+    REQUIRE(serial->simulate(steps_per_frame).ok());
+    REQUIRE(serial_b->set_params(frame_params(k + 7).applied_to(serial_b->params())).ok());
+    REQUIRE(serial_b->simulate(steps_per_frame).ok());
+    REQUIRE(cpu->set_params(frame_params(k).applied_to(cpu->params())).ok());
+    for (std::uint32_t s = 0; s < steps_per_frame; ++s)
+      REQUIRE(cpu->step().ok());
+  }
+  const auto want = serial->positions();
+  const auto want_b = serial_b->positions();
+  const auto got = flying->positions();
+  const auto got_a = world->positions(*a);
+  const auto got_b = world->positions(*b);
+  const auto want_v = serial->velocities();
+  const auto got_v = flying->velocities();
+  REQUIRE((want && want_b && got && got_a && got_b && want_v && got_v));
+  CHECK_MESSAGE(diff(*got, *want).bitwise, "in flight vs one at a time: " << diff(*got, *want).max_abs << " m");
+  CHECK(diff(*got_v, *want_v).bitwise);
+  CHECK(diff(*got_a, *want).bitwise);
+  CHECK(diff(*got_b, *want_b).bitwise);
+  CHECK_MESSAGE(diff(*got_a, *got_b).max_abs > 1e-4, "the two instances' sequences differ, so must their cloths");
+  const std::vector<glm::vec3> cpu_pos(cpu->positions().begin(), cpu->positions().end());
+  CHECK_MESSAGE(diff(*want, cpu_pos).max_abs < 1e-5, "GPU vs CPU: " << diff(*want, cpu_pos).max_abs << " m");
+  // The sphere moved under the cloth: it did touch it (the colliders were not a no-op).
+  float lowest = 1e9f;
+  for (const auto& x : *got)
+    lowest = std::min(lowest, x.z);
+  CHECK(lowest < 0.25f);
+
+  // Bad per-frame values: the error names the field, nothing is recorded.
+  REQUIRE(host->begin_frame(0));
+  StepParams bad;
+  bad.dt = -0.01;
+  const std::uint64_t before = flying->step_index();
+  auto r = flying->record_steps(host->frame_cmd[0], 1, bad);
+  REQUIRE_FALSE(r.ok());
+  CHECK(r.error().message.find("dt") != std::string::npos);
+  CHECK(flying->step_index() == before);
+  REQUIRE(host->submit_frame(0));
+
+  // A change that rebuilds (another integrator) while frames are in flight: vkcloth waits for
+  // them itself (the Context's queue), then goes on from the same state.
+  REQUIRE(host->begin_frame(1));
+  flying->record_steps(host->frame_cmd[1], 3);
+  REQUIRE(host->submit_frame(1));
+  SimParams rk4 = flying->params();
+  rk4.integrator = Integrator::rk4;
+  REQUIRE(flying->set_params(rk4).ok());
+  REQUIRE(serial->simulate(3).ok());
+  REQUIRE(serial->set_params(rk4).ok());
+  REQUIRE(flying->simulate(2).ok());
+  REQUIRE(serial->simulate(2).ok());
+  const auto after = flying->positions();
+  const auto after_serial = serial->positions();
+  REQUIRE((after && after_serial));
+  CHECK(diff(*after, *after_serial).bitwise);
+  REQUIRE(host->wait_frames());
+  CHECK(host->messages.load() == 0);
 }

@@ -87,7 +87,8 @@ public:
   const SolveStats& last_solve() const { return solve_; }
 
   std::uint64_t step_index() const { return step_; }
-  double time() const { return static_cast<double>(step_) * params_.dt; }
+  /// Simulated time: the sum of the steps' dt (dt may change between steps, StepParams).
+  double time() const { return time_; }
   const ParticleSystem& system() const { return topology_->system(); }
   const std::shared_ptr<const ClothTopology>& topology() const { return topology_; }
 
@@ -174,6 +175,7 @@ private:
   std::vector<TetherSlot> tethers_;
   StretchLimit::TetherDistance tether_kind_ = StretchLimit::TetherDistance::euclidean;
   std::uint64_t step_ = 0;
+  double time_ = 0.0;
   std::unique_ptr<detail::ThreadPool> pool_;
   std::unique_ptr<detail::ImplicitWorkspace<Real>> implicit_; // created by the first implicit step
   SolveStats solve_;

@@ -110,4 +110,20 @@ struct SimParams {
   Result<void> validate();
 };
 
+/// What a host changes every frame (its frame time, its wind, its animated colliders), applied
+/// from the next recorded step: GpuSolver::record_steps(cmd, steps, step), ClothWorld::
+/// set_step_params, or applied_to() + CpuSolver::set_params. The GPU backend records these values
+/// into the command buffer (vkCmdUpdateBuffer), so a host with several frames in flight may change
+/// them every frame without waiting. An empty field keeps the current value.
+struct StepParams {
+  std::optional<double> dt;
+  std::optional<glm::dvec3> gravity;
+  std::optional<Wind> wind;
+  /// The whole collider list (e.g. the same colliders at this frame's positions).
+  std::optional<std::vector<Collider>> colliders;
+
+  /// `params` with the fields set here replaced (not validated: SimParams::validate does that).
+  SimParams applied_to(SimParams params) const;
+};
+
 } // namespace vkcloth

@@ -255,6 +255,7 @@ template <typename Real> Result<void> CpuSolver<Real>::step() {
   for (std::uint32_t s = 0; s < k; ++s)
     substep(h);
   ++step_;
+  time_ += params_.dt;
   if (swept_finite_)
     return {}; // the last substep's row sweep already checked every particle
   return check_finite();

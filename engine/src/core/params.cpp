@@ -137,4 +137,16 @@ Result<void> SimParams::validate() {
   return {};
 }
 
+SimParams StepParams::applied_to(SimParams params) const {
+  if (dt)
+    params.dt = *dt;
+  if (gravity)
+    params.gravity = *gravity;
+  if (wind)
+    params.wind = *wind;
+  if (colliders)
+    params.colliders = *colliders;
+  return params;
+}
+
 } // namespace vkcloth

@@ -76,6 +76,13 @@ inline void before_batch_copy(const VolkDeviceTable& vk, VkCommandBuffer cmd) {
          VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT);
 }
 
+/// An empty submission's only command (CommandContext::wait_for_earlier_work): everything
+/// submitted earlier on the queue completes before it, so its fence signals only then (an
+/// execution dependency chain; no memory is accessed).
+inline void drain(const VolkDeviceTable& vk, VkCommandBuffer cmd) {
+  memory(vk, cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0);
+}
+
 /// After those copies: visible to the next steps, to a renderer's vertex reads and to the host
 /// (the old batch's divergence flags are read right after this submission).
 inline void after_batch_copy(const VolkDeviceTable& vk, VkCommandBuffer cmd) {
@@ -91,9 +98,10 @@ inline void after_batch_copy(const VolkDeviceTable& vk, VkCommandBuffer cmd) {
 
 namespace vkcloth::gpu::barriers {
 
-/// Before the host's own edits of the state buffers (vkCmdUpdateBuffer of a held particle):
-/// every earlier access (dispatches' writes, the renderer's vertex reads) completes and earlier
-/// writes are visible before the transfer writes.
+/// Before the host's own edits recorded into the command buffer (vkCmdUpdateBuffer of a held
+/// particle, of changed parameters and colliders): every earlier access (dispatches' reads and
+/// writes, the renderer's vertex reads) completes and earlier writes are visible before the
+/// transfer writes (WAR, WAW). For parameters, before_steps() then makes them visible (RAW).
 inline void before_host_edit(const VolkDeviceTable& vk, VkCommandBuffer cmd) {
   memory(vk, cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_WRITE_BIT,
          VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);

@@ -87,6 +87,11 @@ const SimParams& GpuSolver::params() const {
 void GpuSolver::record_steps(VkCommandBuffer cmd, std::uint32_t steps) {
   impl_->world.record_steps(cmd, steps);
 }
+Result<void> GpuSolver::record_steps(VkCommandBuffer cmd, std::uint32_t steps, const StepParams& step) {
+  VKCLOTH_TRY(impl_->world.set_step_params(impl_->id, step));
+  impl_->world.record_steps(cmd, steps);
+  return {};
+}
 void GpuSolver::record_step(VkCommandBuffer cmd) {
   impl_->world.record_steps(cmd, 1);
 }
@@ -131,7 +136,7 @@ std::uint64_t GpuSolver::step_index() const {
   return impl_->batch().slot(impl_->slot()).step;
 }
 double GpuSolver::time() const {
-  return static_cast<double>(step_index()) * params().dt;
+  return impl_->batch().slot(impl_->slot()).time;
 }
 std::uint32_t GpuSolver::particle_count() const {
   return impl_->batch().particle_count();

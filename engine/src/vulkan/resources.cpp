@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "resources.hpp"
 
+#include "barriers.hpp"
+
 #include <algorithm>
 #include <string>
 
@@ -269,6 +271,10 @@ Result<void> CommandContext::begin() {
   bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   VKCLOTH_VK_TRY(v.vkBeginCommandBuffer(cmd_, &bi), fmt::format("vkBeginCommandBuffer ({})", owner_));
   return {};
+}
+
+Result<void> CommandContext::wait_for_earlier_work() {
+  return submit_and_wait([&](VkCommandBuffer c) { barriers::drain(ctx_->vk, c); });
 }
 
 Result<void> CommandContext::end_submit_wait() {

@@ -188,6 +188,10 @@ public:
     record(cmd_);
     return end_submit_wait();
   }
+  /// Returns once every command submitted earlier on the Context's queue has completed (an empty
+  /// submission behind barriers::drain): before replacing a buffer or descriptor set that the
+  /// host's recorded work may still use.
+  Result<void> wait_for_earlier_work();
 
 private:
   Result<void> begin();

@@ -30,23 +30,32 @@ std::string vec_str(glm::vec3 v) {
 
 } // namespace
 
-// Every instance's colliders, one after the other (InstanceParams::collider_first).
-Result<void> SolverBatch::upload_colliders() {
+// The collider buffer holds every instance's colliders (InstanceParams::collider_first); more
+// colliders than it has room for replace it and rewrite the descriptor sets, so recorded work that
+// may still read the old one is waited for first.
+Result<void> SolverBatch::ensure_collider_capacity() {
   std::uint32_t n = 0;
   for (const Slot& slot : slots)
     n += static_cast<std::uint32_t>(slot.params.colliders.size());
-  if (n > collider_capacity || !colliders.buffer) {
-    const std::uint32_t cap = std::max<std::uint32_t>(n, 4);
-    auto b = create_buffer(*ctx, cap * sizeof(sh::Collider), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                           MemoryUse::host_upload, true, "colliders");
-    if (!b)
-      return b.error();
-    colliders = std::move(*b);
-    collider_capacity = cap;
-    if (sets[0][0])
-      VKCLOTH_TRY(write_sets());
-  }
-  auto* out = static_cast<sh::Collider*>(colliders.mapped);
+  if (n <= collider_capacity && colliders.buffer)
+    return {};
+  if (colliders.buffer)
+    VKCLOTH_TRY(commands->wait_for_earlier_work());
+  const std::uint32_t cap = std::max<std::uint32_t>(n, 4);
+  auto b = create_buffer(*ctx, cap * sizeof(sh::Collider),
+                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                         MemoryUse::host_upload, true, "colliders");
+  if (!b)
+    return b.error();
+  colliders = std::move(*b);
+  collider_capacity = cap;
+  if (sets[0][0])
+    VKCLOTH_TRY(write_sets());
+  return {};
+}
+
+std::vector<sh::Collider> SolverBatch::packed_colliders() const {
+  std::vector<sh::Collider> out;
   for (const Slot& slot : slots)
     for (const Collider& c : slot.params.colliders) {
       sh::Collider g{};
@@ -55,13 +64,13 @@ Result<void> SolverBatch::upload_colliders() {
         g.shape = {float(c.normal.x), float(c.normal.y), float(c.normal.z), float(c.offset)};
       else
         g.shape = {float(c.center.x), float(c.center.y), float(c.center.z), float(c.radius)};
-      *out++ = g;
+      out.push_back(g);
     }
-  return {};
+  return out;
 }
 
-void SolverBatch::upload_instance_params() {
-  auto* out = static_cast<sh::InstanceParams*>(instances.mapped);
+std::vector<sh::InstanceParams> SolverBatch::packed_instance_params() const {
+  std::vector<sh::InstanceParams> out;
   std::uint32_t first_collider = 0;
   for (const Slot& slot : slots) {
     const SimParams& params = slot.params;
@@ -93,8 +102,38 @@ void SolverBatch::upload_instance_params() {
                       ? VKCLOTH_STRETCH_GEODESIC
                       : 0u);
     ip.stretch_sweeps = sl.iterations;
-    *out++ = ip;
+    out.push_back(ip);
   }
+  return out;
+}
+
+// At creation (no recorded work yet): straight into the mapped buffers.
+void SolverBatch::write_params_now() {
+  const auto ip = packed_instance_params();
+  std::memcpy(instances.mapped, ip.data(), ip.size() * sizeof(sh::InstanceParams));
+  const auto col = packed_colliders();
+  if (!col.empty())
+    std::memcpy(colliders.mapped, col.data(), col.size() * sizeof(sh::Collider));
+  params_dirty = false;
+}
+
+// Later changes travel in the command buffer: each recording carries the values it steps with, so
+// frames in flight never see a buffer the host rewrote under them (docs/embedding.md).
+void SolverBatch::record_params_update(VkCommandBuffer c) {
+  if (!params_dirty)
+    return;
+  barriers::before_host_edit(vk(), c); // earlier steps' reads of the parameters finish first
+  const auto update = [&](const Buffer& dst, const void* data, std::size_t bytes) {
+    constexpr std::size_t max_update = 65536; // vkCmdUpdateBuffer's limit per call
+    for (std::size_t at = 0; at < bytes; at += max_update)
+      vk().vkCmdUpdateBuffer(c, dst.buffer, at, std::min(max_update, bytes - at),
+                             static_cast<const char*>(data) + at);
+  };
+  const auto ip = packed_instance_params();
+  update(instances, ip.data(), ip.size() * sizeof(sh::InstanceParams));
+  const auto col = packed_colliders();
+  update(colliders, col.data(), col.size() * sizeof(sh::Collider));
+  params_dirty = false; // before_steps() next makes the transfer writes visible to the dispatches
 }
 
 const Buffer& SolverBatch::buffer_of(Field field) const {
@@ -162,6 +201,7 @@ void SolverBatch::refresh_flags() {
 void SolverBatch::carry_over(std::uint32_t slot, const Slot& old) {
   Slot& now = slots[slot];
   now.step = now.epoch_step = old.step; // flag steps count from this batch's creation
+  now.time = old.time;
   now.diverged = old.diverged;
   // first_bad_step 0 is before every recorded step (1-based): frozen() holds from the first one.
   if (now.diverged)
@@ -184,12 +224,11 @@ InstanceBuffers SolverBatch::buffers(std::uint32_t slot) const {
 
 Result<void> SolverBatch::set_params(std::uint32_t slot, SimParams params) {
   slots[slot].params = std::move(params);
-  VKCLOTH_TRY(upload_colliders());
+  params_dirty = true;
+  VKCLOTH_TRY(ensure_collider_capacity());
   VKCLOTH_TRY(ensure_implicit());
   VKCLOTH_TRY(ensure_fused());
-  VKCLOTH_TRY(ensure_tethers());
-  upload_instance_params();
-  return {};
+  return ensure_tethers();
 }
 
 // The tethers of both rest-length kinds (VKCLOTH_BINDING_TETHERS: euclidean, then geodesic),
@@ -200,6 +239,7 @@ Result<void> SolverBatch::ensure_tethers() {
     wanted = wanted || s.params.stretch_limit.tethers();
   if (!wanted || tethers_uploaded)
     return {};
+  VKCLOTH_TRY(commands->wait_for_earlier_work()); // write_sets() below: no recorded work may use the sets
   static_assert(VKCLOTH_TETHERS_PER_PARTICLE == tethers_per_particle && VKCLOTH_NO_TETHER == no_tether);
   std::vector<sh::TetherSlot> data;
   data.reserve(2 * std::size_t(count) * tethers_per_particle);
@@ -235,6 +275,7 @@ Result<void> SolverBatch::ensure_implicit() {
 void SolverBatch::record(VkCommandBuffer c, std::uint32_t steps) {
   if (steps == 0)
     return;
+  record_params_update(c);
   barriers::before_steps(vk(), c);
   bool first = true;
   for (std::uint32_t s = 0; s < steps; ++s) {
@@ -246,8 +287,10 @@ void SolverBatch::record(VkCommandBuffer c, std::uint32_t steps) {
     }
     ++recorded;
     for (Slot& slot : slots)
-      if (!slot.diverged)
+      if (!slot.diverged) {
         ++slot.step;
+        slot.time += slot.params.dt;
+      }
   }
 }
 
@@ -513,13 +556,13 @@ Result<void> SolverBatch::create_buffers() {
       static_cast<sh::Flags*>(flags.mapped)[k] = sh::Flags{0, VKCLOTH_NO_BAD_STEP, VKCLOTH_NO_BAD_STEP, 0};
   }
   {
-    auto r = create_buffer(*ctx, size() * sizeof(sh::InstanceParams), small, MemoryUse::host_upload, true,
-                           "instance parameters");
+    auto r = create_buffer(*ctx, size() * sizeof(sh::InstanceParams), small | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                           MemoryUse::host_upload, true, "instance parameters");
     if (!r)
       return r.error();
     instances = std::move(*r);
   }
-  return upload_colliders();
+  return ensure_collider_capacity();
 }
 
 // Initial state of every instance, converted as CpuSolver<float>::create converts it, and the
@@ -673,7 +716,7 @@ SolverBatch::create(const std::shared_ptr<Context::Impl>& ctx, CommandContext& c
   VKCLOTH_TRY(s.write_sets());
   VKCLOTH_TRY(s.ensure_implicit());
   VKCLOTH_TRY(s.ensure_fused());
-  s.upload_instance_params();
+  s.write_params_now();
   VKCLOTH_TRY(s.upload_initial_state(topology, states));
   VKCLOTH_TRY(s.ensure_tethers());
   return impl;

@@ -42,6 +42,7 @@ public:
     SimParams params;
     std::uint64_t step = 0;       // completed steps (the bad one when diverged)
     std::uint64_t epoch_step = 0; // `step` when this batch's flag epoch began (its creation)
+    double time = 0.0;            // simulated time: the sum of the recorded steps' dt
     std::optional<Error> diverged;
   };
   /// The per-particle buffers a readback can copy.
@@ -61,8 +62,10 @@ public:
   std::uint32_t size() const { return static_cast<std::uint32_t>(slots.size()); }
   std::uint32_t particle_count() const { return count; }
   const Slot& slot(std::uint32_t k) const { return slots[k]; }
-  /// New parameters for one instance (validated by the caller; same family and substeps). Uploads
-  /// its colliders and parameters; looks up (never re-creates) the pipelines they need.
+  /// New parameters for one instance (validated by the caller; same family and substeps), recorded
+  /// into the next record() (race-free with recorded work pending); looks up (never re-creates)
+  /// the pipelines they need. More colliders than the batch has room for, or the first tethers,
+  /// need new buffers: those wait for the earlier work on the Context's queue first.
   Result<void> set_params(std::uint32_t slot, SimParams params);
 
   /// Records `steps` steps of every instance; advances the host-side counters now.
@@ -138,8 +141,11 @@ private:
   // the batch, since every instance of the batch holds it (ClothWorld::Impl::Instance).
   const ClothTopology* batch_topology = nullptr;
   std::uint32_t index_count = 0;
-  Buffer colliders, flags, instances; // host-visible (written / read by the host)
+  // Host-visible: the divergence flags (read by the host); the colliders and the instance
+  // parameters (written by the host at creation, then by vkCmdUpdateBuffer in record()).
+  Buffer colliders, flags, instances;
   std::uint32_t collider_capacity = 0;
+  bool params_dirty = false; // set_params() since the last record(): record_params_update() due
 
   // Layouts and pipelines: the Context's (PipelineRegistry, pipelines.hpp), shared by every batch.
   VkDescriptorSetLayout set_layout = VK_NULL_HANDLE, texel_layout = VK_NULL_HANDLE;
@@ -209,8 +215,11 @@ private:
   Result<void> ensure_tethers();
   /// Stretch control after a substep's update (strain_links.comp sweeps, strain_finish.comp).
   void record_stretch(VkCommandBuffer cmd, std::uint32_t read);
-  Result<void> upload_colliders();
-  void upload_instance_params();
+  Result<void> ensure_collider_capacity();
+  std::vector<shared::Collider> packed_colliders() const;
+  std::vector<shared::InstanceParams> packed_instance_params() const;
+  void write_params_now();
+  void record_params_update(VkCommandBuffer cmd);
   Result<void> upload_initial_state(const ClothTopology& topology, const std::vector<SlotState>& states);
   struct Upload {
     Buffer* dst;

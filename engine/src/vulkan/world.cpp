@@ -70,6 +70,7 @@ Result<ClothWorld::Impl::Instance*> ClothWorld::Impl::find(InstanceId id) {
 Result<void> ClothWorld::Impl::rebuild(const BatchKey& key, const std::vector<InstanceId>& members,
                                        const std::map<InstanceId, const InitialState*>& fresh) {
   if (members.empty()) {
+    VKCLOTH_TRY(commands.wait_for_earlier_work()); // recorded steps may still use its buffers
     batches.erase(key);
     return {};
   }
@@ -90,6 +91,8 @@ Result<void> ClothWorld::Impl::rebuild(const BatchKey& key, const std::vector<In
   for (InstanceId id : members)
     if (!fresh.count(id))
       sources.insert(instances.at(id).batch);
+  // The copy's leading barrier (ALL_COMMANDS) and its fence also mean that every earlier
+  // submission on the queue (the host's recorded steps) has completed: the old batches are idle.
   if (!sources.empty())
     VKCLOTH_TRY(commands.submit_and_wait([&](VkCommandBuffer c) {
       barriers::before_batch_copy(ctx->vk, c);
@@ -266,6 +269,13 @@ Result<void> ClothWorld::set_params(InstanceId id, SimParams params) {
   std::vector<InstanceId> left = s.batches.at(old_key).members;
   std::erase(left, id);
   return s.rebuild(old_key, left, {});
+}
+
+Result<void> ClothWorld::set_step_params(InstanceId id, const StepParams& step) {
+  auto found = impl_->find(id);
+  if (!found)
+    return found.error();
+  return set_params(id, step.applied_to((*found)->params));
 }
 
 Result<SimParams> ClothWorld::params(InstanceId id) const {

@@ -18,9 +18,8 @@
 // gpu::ClothWorld of one instance (world.hpp: many cloths of one topology, same shaders, one
 // dispatch per pass), with the single-cloth conveniences below.
 //
-// Thread safety: none; one thread drives a solver. Known limitations: the step counter of the
-// divergence flags is 32-bit (about 4e9 steps per solver); set_params() must not be called while
-// recorded steps of this solver are still pending on the GPU.
+// Thread safety: none; one thread drives a solver. Known limitation: the step counter of the
+// divergence flags is 32-bit (about 4e9 steps per solver).
 #pragma once
 
 #include <cstdint>
@@ -92,9 +91,14 @@ public:
   /// caller recorded with record_steps() must have finished executing (or never be submitted).
   ~GpuSolver();
 
-  /// Replaces the parameters (validated). No recorded work of this solver may be pending. A new
-  /// integrator family or substep count rebuilds the solver's buffers (the state is copied on the
-  /// GPU, bit for bit; current_position_index() restarts at 0); no pipeline is re-created.
+  /// Replaces the parameters (validated) from the next recorded step. The values are recorded into
+  /// that command buffer (vkCmdUpdateBuffer), never written to memory that pending work reads: a
+  /// host with frames in flight may change them every frame. A new integrator family or substep
+  /// count rebuilds the solver's buffers (the state is copied on the GPU, bit for bit;
+  /// current_position_index() restarts at 0); more colliders than the solver has room for, or the
+  /// first tethers, replace a buffer. Those three first wait for every earlier submission on the
+  /// Context's queue (submit your recordings there, or wait for them yourself). No pipeline is
+  /// re-created.
   Result<void> set_params(SimParams params);
   const SimParams& params() const;
 
@@ -117,6 +121,10 @@ public:
   /// them back the same way before record_steps(). Or set GpuSolverOptions::sharing_queue_families
   /// (CONCURRENT buffers): then only the semaphore and record_barrier_to() are needed.
   void record_steps(VkCommandBuffer cmd, std::uint32_t steps);
+  /// set_params(step.applied_to(params())), then record_steps(cmd, steps): this recording and the
+  /// next ones step with the frame's dt, gravity, wind and colliders (race-free with frames in
+  /// flight). Invalid values: the error names the field, nothing is recorded.
+  Result<void> record_steps(VkCommandBuffer cmd, std::uint32_t steps, const StepParams& step);
   /// record_steps(cmd, 1): one step (the whole step: all substeps, RK4 stages or CG passes).
   void record_step(VkCommandBuffer cmd);
   /// Records the barrier that makes the last record_steps() writes visible to `dst_stage` /
@@ -147,6 +155,7 @@ public:
   const std::shared_ptr<const ClothTopology>& topology() const;
 
   std::uint64_t step_index() const;
+  /// Simulated time: the sum of the recorded steps' dt.
   double time() const;
   std::uint32_t particle_count() const;
 

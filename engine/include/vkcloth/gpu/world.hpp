@@ -15,7 +15,8 @@
 // instances are batches of one (their CG reductions are per instance).
 // add() / remove() / an integrator change in set_params() rebuild the batch concerned: new
 // buffers and descriptor sets; the other instances' state is copied on the GPU (one submission,
-// waited for). Other set_params() changes only rewrite the instance's parameters. No call
+// waited for, which also waits for the earlier work on the Context's queue). Other set_params()
+// changes are recorded into the next recording's command buffer: per frame, frames in flight. No call
 // re-creates a pipeline: every pipeline (per shader and specialisation: grid stencil, fused
 // variants) is made once per Context, when a batch first needs it, and shared by all batches.
 //
@@ -79,9 +80,15 @@ public:
   /// Removes an instance (its buffers are freed now: no recorded work of the world may be
   /// pending); the others keep their state. ErrorCode::invalid_argument for an unknown id.
   Result<void> remove(InstanceId id);
-  /// New parameters from the next recorded step; an integrator family or substep change moves the
-  /// instance to another batch (a rebuild, see the header note). No pipeline is re-created.
+  /// New parameters from the next recorded step. The values travel in that recording's command
+  /// buffer (vkCmdUpdateBuffer), so changing them every frame with frames in flight is race-free.
+  /// An integrator family or substep change moves the instance to another batch (a rebuild, see
+  /// the header note), as do more colliders than the batch has room for or the first tethers:
+  /// those first wait for every earlier submission on the Context's queue. No pipeline is
+  /// re-created.
   Result<void> set_params(InstanceId id, SimParams params);
+  /// set_params(id, step.applied_to(params(id))): the per-frame fields (dt, gravity, wind, colliders).
+  Result<void> set_step_params(InstanceId id, const StepParams& step);
   Result<SimParams> params(InstanceId id) const;
 
   /// Records one step of every instance into the host's command buffer (see GpuSolver::record_steps
