@@ -25,5 +25,5 @@ void main() {
   particle_force(p, v, f, nrm);
   force_out[g] = vec4(f, 0.0);
   vel_filt[g] = vec4(v, 0.0);
-  normal_out[g] = vec4(nrm, 0.0);
+  normal_out[g] = normal_output(nrm);
 }

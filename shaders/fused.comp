@@ -53,7 +53,7 @@ void main() {
   particle_force(p, vf, f, nrm);
   if (SC_WRITE_AUX && !fr) {
     force_out[g] = vec4(f, 0.0);
-    normal_out[g] = vec4(nrm, 0.0);
+    normal_out[g] = normal_output(nrm);
   }
 
   const bool pinned = pinned_at(p);

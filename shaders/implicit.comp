@@ -68,7 +68,7 @@ void main() {
     vec3 f, nrm;
     particle_force(p, v, f, nrm); // contact filtering included (not for pinned particles)
     force_out[p] = vec4(f, 0.0);
-    normal_out[p] = vec4(nrm, 0.0);
+    normal_out[p] = normal_output(nrm);
     vf[p] = vec4(v, 0.0);
     return;
   }

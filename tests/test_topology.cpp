@@ -4,7 +4,10 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <array>
+#include <limits>
 #include <string>
+#include <utility>
 
 #include "vkcloth/gpu/world.hpp"
 #include "vkcloth/vkcloth.hpp"
@@ -201,4 +204,79 @@ TEST_CASE("an invalid system is an error naming the problem") {
   auto mismatch = ClothTopology::create(g);
   REQUIRE_FALSE(mismatch.ok());
   CHECK(mismatch.error().message.find("7 x 6") != std::string::npos);
+}
+
+TEST_CASE("grid uvs: the default, a uv_transform, the caller's own, and bad ones refused") {
+  ClothDesc d;
+  d.nx = 5;
+  d.ny = 3;
+  const auto plain = prepare(make_cloth(d).value());
+  CHECK(plain->uvs()[0] == glm::vec2(0.0f, 0.0f));
+  CHECK(plain->uvs()[4] == glm::vec2(1.0f, 0.0f));
+  CHECK(plain->uvs()[14] == glm::vec2(1.0f, 1.0f));
+
+  // Swap u and v and flip the new v: (s, t) -> (t, 1 - s), a quarter turn of the texture.
+  d.uv_transform = UvTransform{{0.0f, 1.0f}, {0.0f, -1.0f}, {1.0f, 0.0f}};
+  const auto turned = prepare(make_cloth(d).value());
+  for (std::uint32_t j = 0; j < d.ny; ++j)
+    for (std::uint32_t i = 0; i < d.nx; ++i) {
+      const glm::vec2 st = plain->uvs()[j * d.nx + i];
+      CHECK(turned->uvs()[j * d.nx + i] == glm::vec2(st.y, 1.0f - st.x));
+    }
+  // The identity transform leaves the default bits (every image drawn so far depends on them).
+  d.uv_transform = UvTransform{};
+  CHECK(std::ranges::equal(prepare(make_cloth(d).value())->uvs(), plain->uvs()));
+
+  std::vector<glm::vec2> own(15);
+  for (std::size_t k = 0; k < own.size(); ++k)
+    own[k] = {0.1f * float(k), -0.5f};
+  d.uvs = own;
+  CHECK(std::ranges::equal(prepare(make_cloth(d).value())->uvs(), own));
+
+  d.uvs.pop_back();
+  auto wrong_count = make_cloth(d);
+  REQUIRE_FALSE(wrong_count.ok());
+  CHECK(wrong_count.error().message.find("14 texture coordinates for a 5 x 3 grid of 15") !=
+        std::string::npos);
+  d.uvs = own;
+  d.uvs[7].y = std::numeric_limits<float>::quiet_NaN();
+  auto not_finite = make_cloth(d);
+  REQUIRE_FALSE(not_finite.ok());
+  CHECK(not_finite.error().message.find("texture coordinate 7 is not finite") != std::string::npos);
+  d.uvs.clear();
+  d.uv_transform.u_axis.x = std::numeric_limits<float>::infinity();
+  REQUIRE_FALSE(make_cloth(d).ok());
+}
+
+TEST_CASE("the grid's triangle strip with restart holds the triangle list's triangles, same winding") {
+  for (auto [nx, ny] : {std::pair{2u, 2u}, std::pair{5u, 3u}, std::pair{4u, 7u}}) {
+    const auto strip = gpu::grid_triangle_strip_indices(nx, ny);
+    CHECK(strip.size() == std::size_t(ny - 1) * (2 * nx + 1) - 1);
+    // Decode as Vulkan does: triangle k of a strip is (v_k, v_k+1, v_k+2), odd k (v_k, v_k+2, v_k+1)
+    // (the spec's counting restarts with every strip); rotate each so its smallest index is first.
+    using Tri = std::array<std::uint32_t, 3>;
+    auto canonical = [](Tri t) {
+      std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+      return t;
+    };
+    std::vector<Tri> from_strip, from_list;
+    std::size_t start = 0;
+    for (std::size_t e = 0; e <= strip.size(); ++e) {
+      if (e < strip.size() && strip[e] != gpu::strip_restart_index)
+        continue;
+      for (std::size_t k = start; k + 2 < e; ++k) {
+        const bool odd = (k - start) % 2 == 1;
+        from_strip.push_back(canonical(odd ? Tri{strip[k], strip[k + 2], strip[k + 1]}
+                                           : Tri{strip[k], strip[k + 1], strip[k + 2]}));
+      }
+      start = e + 1;
+    }
+    const auto list = gpu::grid_triangle_indices(nx, ny);
+    for (std::size_t k = 0; k < list.size(); k += 3)
+      from_list.push_back(canonical({list[k], list[k + 1], list[k + 2]}));
+    std::ranges::sort(from_strip);
+    std::ranges::sort(from_list);
+    CHECK(from_strip == from_list);
+  }
+  CHECK(gpu::grid_triangle_strip_indices(1, 5).empty());
 }

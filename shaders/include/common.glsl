@@ -40,6 +40,12 @@ InstanceParams ip;
 layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_INSTANCES) uniform usamplerBuffer instances_texel;
 #endif
 
+// The normal as stored for the host (GpuSolverOptions::flip_normals). The physics uses n itself;
+// flipping changes nothing there anyway (wind Kw <n, u> n is even in n).
+vec4 normal_output(vec3 nrm) {
+  return vec4((ip.flags & VKCLOTH_FLAG_FLIP_NORMALS) != 0u ? -nrm : nrm, 0.0);
+}
+
 void begin_instance() {
   inst = gl_WorkGroupID.z;
 #ifdef VKCLOTH_PC_COPY

@@ -72,10 +72,11 @@ struct vec4 {
 #define VKCLOTH_EDGE_TEXELS 3 // 32-bit words per Edge (static_assert below)
 
 // InstanceParams::flags bits.
-#define VKCLOTH_FLAG_HAS_GRID 1u     // the topology is a grid: rebuild normals from the grid fan
-#define VKCLOTH_FLAG_WIND 2u         // wind strength != 0
-#define VKCLOTH_FLAG_CONTACT_BOTH 4u // contacts remove the whole normal part (Figure 12 variant)
-#define VKCLOTH_FLAG_HAS_FANS 8u     // a surface that is not a grid: normals from FAN_OFFSETS / FANS
+#define VKCLOTH_FLAG_HAS_GRID 1u      // the topology is a grid: rebuild normals from the grid fan
+#define VKCLOTH_FLAG_WIND 2u          // wind strength != 0
+#define VKCLOTH_FLAG_CONTACT_BOTH 4u  // contacts remove the whole normal part (Figure 12 variant)
+#define VKCLOTH_FLAG_HAS_FANS 8u      // a surface that is not a grid: normals from FAN_OFFSETS / FANS
+#define VKCLOTH_FLAG_FLIP_NORMALS 16u // store -n in the normals buffer (GpuSolverOptions::flip_normals)
 
 // InstanceParams::stretch bits (SimParams::stretch_limit).
 #define VKCLOTH_STRETCH_PROVOT 1u       // Provot sweeps over the strain links (strain_links.comp)

@@ -504,7 +504,8 @@ TEST_CASE("Per-frame parameters: two frames in flight changing dt, gravity, wind
     REQUIRE(world->set_step_params(*a, s).ok());
     REQUIRE(world->set_step_params(*b, frame_params(k + 7)).ok()); // its own sequence
     world->record_steps(host->frame_cmd[slot], steps_per_frame);
-    world->record_barrier_to(host->frame_cmd[slot], VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
+    world->record_barrier_to(host->frame_cmd[slot], VK_PIPELINE_STAGE_TRANSFER_BIT,
+                             VK_ACCESS_TRANSFER_READ_BIT);
     REQUIRE(host->submit_frame(slot));
     expected_time += steps_per_frame * *s.dt;
   }
@@ -536,11 +537,13 @@ TEST_CASE("Per-frame parameters: two frames in flight changing dt, gravity, wind
   const auto want_v = serial->velocities();
   const auto got_v = flying->velocities();
   REQUIRE((want && want_b && got && got_a && got_b && want_v && got_v));
-  CHECK_MESSAGE(diff(*got, *want).bitwise, "in flight vs one at a time: " << diff(*got, *want).max_abs << " m");
+  CHECK_MESSAGE(diff(*got, *want).bitwise,
+                "in flight vs one at a time: " << diff(*got, *want).max_abs << " m");
   CHECK(diff(*got_v, *want_v).bitwise);
   CHECK(diff(*got_a, *want).bitwise);
   CHECK(diff(*got_b, *want_b).bitwise);
-  CHECK_MESSAGE(diff(*got_a, *got_b).max_abs > 1e-4, "the two instances' sequences differ, so must their cloths");
+  CHECK_MESSAGE(diff(*got_a, *got_b).max_abs > 1e-4,
+                "the two instances' sequences differ, so must their cloths");
   const std::vector<glm::vec3> cpu_pos(cpu->positions().begin(), cpu->positions().end());
   CHECK_MESSAGE(diff(*want, cpu_pos).max_abs < 1e-5, "GPU vs CPU: " << diff(*want, cpu_pos).max_abs << " m");
   // The sphere moved under the cloth: it did touch it (the colliders were not a no-op).
@@ -578,4 +581,33 @@ TEST_CASE("Per-frame parameters: two frames in flight changing dt, gravity, wind
   CHECK(diff(*after, *after_serial).bitwise);
   REQUIRE(host->wait_frames());
   CHECK(host->messages.load() == 0);
+}
+
+TEST_CASE("flip_normals: the normals buffer points the other way, the physics is unchanged (bitwise)") {
+  VKCLOTH_GPU_TEST_BEGIN(ctx);
+  auto topo = make_topology(12, 9, true); // horizontal: normals +z by default (the header's rule)
+  SimParams p;
+  p.wind.strength = 0.05; // wind reads the normal: F = Kw <n, u> n is even in n
+  p.wind.direction = {0.2, 0.1, 1.0};
+  GpuSolverOptions flipped;
+  flipped.flip_normals = true;
+  for (bool fused : {true, false}) {
+    GpuSolverOptions plain;
+    plain.fused = flipped.fused = fused;
+    auto a = GpuSolver::create(ctx, topo, p, plain);
+    auto b = GpuSolver::create(ctx, topo, p, flipped);
+    REQUIRE((a.ok() && b.ok()));
+    REQUIRE((a->simulate(15).ok() && b->simulate(15).ok()));
+    const auto xa = a->positions(), xb = b->positions(), na = a->normals(), nb = b->normals();
+    REQUIRE((xa && xb && na && nb));
+    CHECK(diff(*xa, *xb).bitwise);
+    double mean_z = 0.0;
+    bool opposite = true;
+    for (std::size_t k = 0; k < na->size(); ++k) {
+      mean_z += (*na)[k].z / double(na->size());
+      opposite = opposite && (*nb)[k] == -(*na)[k];
+    }
+    CHECK(opposite);
+    CHECK(mean_z > 0.9);
+  }
 }

@@ -42,6 +42,21 @@ struct ClothStiffness {
   double bend = 8.0;        ///< neighbours 2 apart, rest length = 2 spacings
 };
 
+/// The default texture coordinate of grid point (i, j): (i / (nx-1), j / (ny-1)) in float (0 on
+/// a side of one point).
+glm::vec2 default_grid_uv(std::uint32_t i, std::uint32_t j, std::uint32_t nx, std::uint32_t ny);
+
+/// A grid's texture coordinates as a map of the default ones (s, t) = (i / (nx-1), j / (ny-1)):
+/// uv = offset + s u_axis + t v_axis. The identity leaves the default; {offset {0, 1}, v_axis
+/// {0, -1}} flips v; {u_axis {0, 1}, v_axis {1, 0}} swaps u and v; {u_axis {4, 0}, v_axis {0, 4}}
+/// repeats the texture 4 times (with a repeating sampler).
+struct UvTransform {
+  glm::vec2 offset{0.0f, 0.0f};
+  glm::vec2 u_axis{1.0f, 0.0f};
+  glm::vec2 v_axis{0.0f, 1.0f};
+  bool operator==(const UvTransform&) const = default;
+};
+
 /// An nx x ny grid over a w x h rectangle; particle (i, j) sits at origin + i dx e_u + j dy e_v
 /// with dx = w/(nx-1), dy = h/(ny-1). A spring kind with zero stiffness is left out.
 struct ClothDesc {
@@ -61,6 +76,10 @@ struct ClothDesc {
   /// Pinned (i, j) cells; empty means the two top corners (0, ny-1) and (nx-1, ny-1).
   std::vector<std::array<std::uint32_t, 2>> pins;
   bool pin_default_corners = true; ///< when false and `pins` is empty, nothing is pinned
+  /// Texture coordinates: the default ones mapped by `uv_transform`, or, when `uvs` is not empty,
+  /// the caller's own, one per particle (j * nx + i), finite.
+  UvTransform uv_transform;
+  std::vector<glm::vec2> uvs;
 };
 
 /// Largest grid the builders accept (per side and in total): beyond this a scene is refused.

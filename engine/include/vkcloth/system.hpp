@@ -41,6 +41,8 @@ struct Particle {
 struct Grid {
   std::uint32_t nx = 0;
   std::uint32_t ny = 0;
+  /// Texture coordinates, one per particle; empty: (i / (nx-1), j / (ny-1)) (ClothTopology::uvs).
+  std::vector<glm::vec2> uvs;
 };
 
 /// The triangle surface of a cloth that is not a grid (a mesh, vkcloth/mesh.hpp): normals come

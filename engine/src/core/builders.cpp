@@ -97,6 +97,10 @@ Result<ParticleSystem> make_chain(const ChainDesc& d) {
   return sys;
 }
 
+glm::vec2 default_grid_uv(std::uint32_t i, std::uint32_t j, std::uint32_t nx, std::uint32_t ny) {
+  return {nx > 1 ? float(i) / float(nx - 1) : 0.0f, ny > 1 ? float(j) / float(ny - 1) : 0.0f};
+}
+
 Result<ParticleSystem> make_cloth(const ClothDesc& d) {
   if (d.nx < 1 || d.ny < 1 || d.nx > max_cloth_side || d.ny > max_cloth_side)
     return bad(fmt::format("cloth.resolution [{}, {}] is out of range: each side must be in 1..{}", d.nx,
@@ -142,7 +146,28 @@ Result<ParticleSystem> make_cloth(const ClothDesc& d) {
       d.orientation == ClothOrientation::vertical ? glm::dvec3{0, 0, 1} : glm::dvec3{0, 1, 0};
 
   ParticleSystem sys;
-  sys.grid = Grid{nx, ny};
+  sys.grid = Grid{nx, ny, {}};
+  if (!d.uvs.empty()) {
+    if (d.uvs.size() != count)
+      return bad(fmt::format("cloth uvs: {} texture coordinates for a {} x {} grid of {} particles",
+                             d.uvs.size(), nx, ny, count));
+    for (std::size_t k = 0; k < count; ++k)
+      if (!std::isfinite(d.uvs[k].x) || !std::isfinite(d.uvs[k].y))
+        return bad(fmt::format("cloth uvs: texture coordinate {} is not finite ({}, {})", k, d.uvs[k].x,
+                               d.uvs[k].y));
+    sys.grid->uvs = d.uvs;
+  } else if (d.uv_transform != UvTransform{}) {
+    const UvTransform& m = d.uv_transform;
+    for (const glm::vec2 a : {m.offset, m.u_axis, m.v_axis})
+      if (!std::isfinite(a.x) || !std::isfinite(a.y))
+        return bad("cloth uv_transform must be finite");
+    sys.grid->uvs.resize(count);
+    for (std::uint32_t j = 0; j < ny; ++j)
+      for (std::uint32_t i = 0; i < nx; ++i) {
+        const glm::vec2 st = default_grid_uv(i, j, nx, ny);
+        sys.grid->uvs[std::size_t(j) * nx + i] = m.offset + st.x * m.u_axis + st.y * m.v_axis;
+      }
+  }
   sys.particles.resize(count);
   for (std::uint32_t j = 0; j < ny; ++j)
     for (std::uint32_t i = 0; i < nx; ++i)

@@ -56,6 +56,8 @@ Result<void> ParticleSystem::validate() const {
     return bad(fmt::format("grid {} x {} does not match the {} particles", grid->nx, grid->ny, n));
   if (grid && surface)
     return bad("the particle system has both a grid and a surface; a cloth is one or the other");
+  if (grid && !grid->uvs.empty() && grid->uvs.size() != n)
+    return bad(fmt::format("the grid has {} uvs for {} particles (one each, or none)", grid->uvs.size(), n));
   if (surface) {
     if (surface->triangles.size() % 3 != 0)
       return bad(fmt::format("the surface's triangle list holds {} indices, not a multiple of 3",

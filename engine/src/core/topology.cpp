@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "vkcloth/topology.hpp"
 
+#include "vkcloth/builders.hpp"
+
 #include "stretch_topology.hpp"
 
 #include <algorithm>
@@ -203,8 +205,9 @@ Result<std::shared_ptr<const ClothTopology>> ClothTopology::create(const Particl
     // In float, as the GPU solver has always uploaded them (drawn images depend on these bits).
     for (std::uint32_t j = 0; j < ny; ++j)
       for (std::uint32_t i = 0; i < nx; ++i)
-        t->uvs_[std::size_t(j) * nx + i] =
-            glm::vec2(nx > 1 ? float(i) / float(nx - 1) : 0.0f, ny > 1 ? float(j) / float(ny - 1) : 0.0f);
+        t->uvs_[std::size_t(j) * nx + i] = default_grid_uv(i, j, nx, ny);
+    if (!s.grid->uvs.empty())
+      t->uvs_ = s.grid->uvs; // the caller's (ClothDesc::uvs, uv_transform)
     t->stencil_ = detect_stencil(*s.grid, t->edge_offsets(), t->edges_);
   } else if (s.surface) {
     t->triangles_ = s.surface->triangles;

@@ -81,7 +81,8 @@ std::vector<sh::InstanceParams> SolverBatch::packed_instance_params() const {
     ip.flags = (normals == Normals::grid ? VKCLOTH_FLAG_HAS_GRID : 0u) |
                (normals == Normals::fans ? VKCLOTH_FLAG_HAS_FANS : 0u) |
                (float(params.wind.strength) != 0.0f ? VKCLOTH_FLAG_WIND : 0u) |
-               (params.contact_inward_only ? 0u : VKCLOTH_FLAG_CONTACT_BOTH);
+               (params.contact_inward_only ? 0u : VKCLOTH_FLAG_CONTACT_BOTH) |
+               (options.flip_normals ? VKCLOTH_FLAG_FLIP_NORMALS : 0u);
     ip.integrator = static_cast<std::uint32_t>(params.integrator);
     ip.collider_first = first_collider;
     ip.collider_count = static_cast<std::uint32_t>(params.colliders.size());
@@ -556,8 +557,9 @@ Result<void> SolverBatch::create_buffers() {
       static_cast<sh::Flags*>(flags.mapped)[k] = sh::Flags{0, VKCLOTH_NO_BAD_STEP, VKCLOTH_NO_BAD_STEP, 0};
   }
   {
-    auto r = create_buffer(*ctx, size() * sizeof(sh::InstanceParams), small | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                           MemoryUse::host_upload, true, "instance parameters");
+    auto r =
+        create_buffer(*ctx, size() * sizeof(sh::InstanceParams), small | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                      MemoryUse::host_upload, true, "instance parameters");
     if (!r)
       return r.error();
     instances = std::move(*r);

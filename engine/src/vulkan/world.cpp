@@ -27,6 +27,22 @@ std::vector<std::uint32_t> grid_triangle_indices(std::uint32_t nx, std::uint32_t
   return idx;
 }
 
+std::vector<std::uint32_t> grid_triangle_strip_indices(std::uint32_t nx, std::uint32_t ny) {
+  std::vector<std::uint32_t> idx;
+  if (nx < 2 || ny < 2)
+    return idx;
+  idx.reserve(std::size_t(ny - 1) * (2 * nx + 1));
+  for (std::uint32_t j = 0; j + 1 < ny; ++j) {
+    if (j > 0)
+      idx.push_back(strip_restart_index);
+    // Upper point first: the strip's first triangle (c0, a0, c1) is the list's (a, d, c), the
+    // second (a0, a1, c1) its (a, b, d): same triangles, same counter-clockwise winding.
+    for (std::uint32_t i = 0; i < nx; ++i)
+      idx.insert(idx.end(), {(j + 1) * nx + i, j * nx + i});
+  }
+  return idx;
+}
+
 Result<std::unique_ptr<ClothWorld::Impl>> ClothWorld::Impl::create(const std::shared_ptr<Context::Impl>& ctx,
                                                                    WorldOptions options,
                                                                    const testing::SolverKnobs& knobs) {

@@ -51,6 +51,12 @@ struct GpuSolverOptions {
   /// needs no queue-family ownership transfer (it still needs a semaphore between the compute
   /// and the graphics submissions). Empty: VK_SHARING_MODE_EXCLUSIVE (see record_steps()).
   std::vector<std::uint32_t> sharing_queue_families;
+  /// The side the stored normals point to. Default (false): the side from which the triangles of
+  /// InstanceBuffers::indices wind counter-clockwise (right-hand rule; on a grid the direction of
+  /// cross(x(i+1,j) - x(i,j), x(i,j+1) - x(i,j)): +z for make_cloth's horizontal grid at rest, -y
+  /// for its vertical one). true: the opposite side (a host whose lit side is the other one).
+  /// Only the normals buffer changes; the physics does not (docs/embedding.md "Normals").
+  bool flip_normals = false;
 };
 
 /// Where an instance's per-particle data lives, for the host's own drawing: vec4 per particle
@@ -59,7 +65,10 @@ struct GpuSolverOptions {
 /// Instances of a ClothWorld batch share the buffers at different offsets.
 struct InstanceBuffers {
   VkBuffer positions = VK_NULL_HANDLE;
+  /// Unit normals pointing to the side from which `indices`' triangles wind counter-clockwise
+  /// (GpuSolverOptions::flip_normals: the other side); zero for chains.
   VkBuffer normals = VK_NULL_HANDLE;
+  /// Texture coordinates (vec4: u, v, 0, 0): ClothTopology::uvs() or InitialState::uvs.
   VkBuffer uvs = VK_NULL_HANDLE;
   VkDeviceSize offset = 0;
   VkDeviceSize stride = 16; ///< GpuSolver::stride

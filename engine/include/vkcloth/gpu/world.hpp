@@ -45,6 +45,16 @@ namespace vkcloth::gpu {
 /// a VK_INDEX_TYPE_UINT32 index buffer.
 std::vector<std::uint32_t> grid_triangle_indices(std::uint32_t nx, std::uint32_t ny);
 
+/// The restart index of grid_triangle_strip_indices (VK_INDEX_TYPE_UINT32's).
+inline constexpr std::uint32_t strip_restart_index = 0xFFFFFFFFu;
+
+/// The same triangles as grid_triangle_indices, with the same winding, as one triangle strip per
+/// row of quads separated by strip_restart_index: (ny - 1) (2 nx + 1) - 1 indices instead of
+/// 6 (nx - 1)(ny - 1). Draw with VK_PRIMITIVE_TOPOLOGY_TRIANGLE_STRIP and primitiveRestartEnable.
+/// For a host whose pipeline uses strips; upload it as its own index buffer (InstanceBuffers::
+/// indices is the list).
+std::vector<std::uint32_t> grid_triangle_strip_indices(std::uint32_t nx, std::uint32_t ny);
+
 struct WorldOptions {
   /// Options of every instance's solver (fused, staging, sharing_queue_families, ...).
   GpuSolverOptions solver;
