@@ -4,6 +4,8 @@
 
 #include "host_vulkan.hpp"
 
+#include <bit>
+
 #include <cstdio>
 #include <cstring>
 #include <vector>
@@ -115,6 +117,10 @@ std::unique_ptr<HostVulkan> HostVulkan::create(std::string& error) {
   fi.flags = VK_FENCE_CREATE_SIGNALED_BIT;
   for (VkFence& f : h->frame_fence)
     vkCreateFence(h->device, &fi, nullptr, &f);
+  VkSemaphoreCreateInfo si{};
+  si.sType = VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO;
+  for (VkSemaphore& s : h->semaphores)
+    vkCreateSemaphore(h->device, &si, nullptr, &s);
   return h;
 }
 
@@ -126,6 +132,13 @@ HostVulkan::~HostVulkan() {
     for (VkFence f : frame_fence)
       if (f)
         vkDestroyFence(device, f, nullptr);
+    if (scratch)
+      vkDestroyBuffer(device, scratch, nullptr);
+    if (scratch_memory)
+      vkFreeMemory(device, scratch_memory, nullptr);
+    for (VkSemaphore s : semaphores)
+      if (s)
+        vkDestroySemaphore(device, s, nullptr);
     if (pool)
       vkDestroyCommandPool(device, pool, nullptr);
     vkDestroyDevice(device, nullptr);
@@ -170,14 +183,46 @@ bool HostVulkan::begin_frame(std::uint32_t k) {
   return vkBeginCommandBuffer(frame_cmd[k], &bi) == VK_SUCCESS;
 }
 
-bool HostVulkan::submit_frame(std::uint32_t k) {
+bool HostVulkan::submit_frame(std::uint32_t k, VkSemaphore wait, VkPipelineStageFlags wait_stage,
+                              VkSemaphore signal) {
   if (vkEndCommandBuffer(frame_cmd[k]) != VK_SUCCESS)
     return false;
   VkSubmitInfo si{};
   si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
   si.commandBufferCount = 1;
   si.pCommandBuffers = &frame_cmd[k];
+  si.waitSemaphoreCount = wait ? 1 : 0;
+  si.pWaitSemaphores = &wait;
+  si.pWaitDstStageMask = &wait_stage;
+  si.signalSemaphoreCount = signal ? 1 : 0;
+  si.pSignalSemaphores = &signal;
   return vkQueueSubmit(queue, 1, &si, frame_fence[k]) == VK_SUCCESS;
+}
+
+bool HostVulkan::record_read(VkCommandBuffer cmd, VkBuffer src, VkDeviceSize bytes, VkDeviceSize at) {
+  constexpr VkDeviceSize capacity = 1 << 20;
+  if (at + bytes > capacity)
+    return false;
+  if (!scratch) {
+    VkBufferCreateInfo bi{};
+    bi.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
+    bi.size = capacity;
+    bi.usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+    if (vkCreateBuffer(device, &bi, nullptr, &scratch) != VK_SUCCESS)
+      return false;
+    VkMemoryRequirements req;
+    vkGetBufferMemoryRequirements(device, scratch, &req);
+    VkMemoryAllocateInfo ai{};
+    ai.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+    ai.allocationSize = req.size;
+    ai.memoryTypeIndex = std::uint32_t(std::countr_zero(req.memoryTypeBits)); // any type fits a copy target
+    if (vkAllocateMemory(device, &ai, nullptr, &scratch_memory) != VK_SUCCESS ||
+        vkBindBufferMemory(device, scratch, scratch_memory, 0) != VK_SUCCESS)
+      return false;
+  }
+  const VkBufferCopy region{0, at, bytes};
+  vkCmdCopyBuffer(cmd, src, scratch, 1, &region);
+  return true;
 }
 
 bool HostVulkan::wait_frames() {

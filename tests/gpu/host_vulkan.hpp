@@ -30,6 +30,8 @@ struct HostVulkan {
   static constexpr std::uint32_t frames_in_flight = 2;
   VkCommandBuffer frame_cmd[frames_in_flight] = {};
   VkFence frame_fence[frames_in_flight] = {};
+  /// Two binary semaphores for a compute -> graphics -> compute hand-over (submit_frame).
+  VkSemaphore semaphores[2] = {};
 
   /// Null with `error` set when no Vulkan 1.2 device with a compute queue (or no validation layer).
   static std::unique_ptr<HostVulkan> create(std::string& error);
@@ -45,8 +47,16 @@ struct HostVulkan {
   /// Waits for frame slot `k`'s previous submission (its fence), resets and begins its command
   /// buffer, as a renderer does at the start of a frame.
   bool begin_frame(std::uint32_t k);
-  /// Ends frame slot `k`'s command buffer and submits it WITHOUT waiting (its fence signals).
-  bool submit_frame(std::uint32_t k);
+  /// Ends frame slot `k`'s command buffer and submits it WITHOUT waiting (its fence signals);
+  /// optionally waiting on `wait` at `wait_stage` and signalling `signal`.
+  bool submit_frame(std::uint32_t k, VkSemaphore wait = VK_NULL_HANDLE, VkPipelineStageFlags wait_stage = 0,
+                    VkSemaphore signal = VK_NULL_HANDLE);
+  /// Records a copy of `bytes` from `src` into the host's scratch buffer at `at` (device memory,
+  /// created on first use, freed with the device): a stand-in for a draw that reads the cloth's
+  /// buffers (copies to one region from two frames must be ordered by the host, as any write).
+  bool record_read(VkCommandBuffer cmd, VkBuffer src, VkDeviceSize bytes, VkDeviceSize at);
+  VkBuffer scratch = VK_NULL_HANDLE;
+  VkDeviceMemory scratch_memory = VK_NULL_HANDLE;
   /// Waits for every frame slot's last submission.
   bool wait_frames();
   /// The host's device still works: creates and destroys a buffer, submits an empty command

@@ -11,6 +11,7 @@
 
 #include <array>
 #include <span>
+#include <vector>
 
 namespace vkcloth::gpu::barriers {
 
@@ -221,35 +222,21 @@ inline std::array<VkSubpassDependency, 2> offscreen_subpass_dependencies() {
   return dep;
 }
 
-/// Queue-family ownership transfer, RELEASE half (gpu_solver.hpp, record_steps(): separate compute
-/// and graphics families with EXCLUSIVE buffers). Recorded on the compute queue after the steps:
-/// the compute shader writes of `buffers` are made available and ownership leaves `compute_family`
-/// for `graphics_family`. The destination access is ignored for a release (BOTTOM_OF_PIPE, 0); the
-/// host signals a semaphore with this submission.
-inline void release_to_family(const VolkDeviceTable& vk, VkCommandBuffer cmd,
-                              std::span<const VkBuffer> buffers, std::uint32_t compute_family,
-                              std::uint32_t graphics_family) {
-  std::array<VkBufferMemoryBarrier, 8> b{};
-  std::uint32_t n = 0;
+/// One half of a queue-family ownership transfer of `buffers` (the drawn buffers, EXCLUSIVE
+/// sharing, compute and graphics families apart: docs/embedding.md section 6). The RELEASE half
+/// is recorded on the source family's queue after its last use (`stage` / `access`: that use;
+/// the destination scope is ignored, BOTTOM_OF_PIPE), the ACQUIRE half on the destination
+/// family's queue after waiting on the semaphore the release's submission signals (`stage` /
+/// `access`: the next use there; the source scope is ignored, TOP_OF_PIPE). Equal families make
+/// them plain barriers (one queue: the same recording order stays valid).
+inline void queue_transfer(const VolkDeviceTable& vk, VkCommandBuffer cmd, std::span<const VkBuffer> buffers,
+                           bool release, std::uint32_t src_family, std::uint32_t dst_family,
+                           VkPipelineStageFlags stage, VkAccessFlags access) {
+  std::vector<VkBufferMemoryBarrier> b;
   for (VkBuffer buf : buffers)
-    if (n < b.size())
-      b[n++] = buffer(buf, VK_ACCESS_SHADER_WRITE_BIT, 0, compute_family, graphics_family);
-  pipeline(vk, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, {b.data(), n},
-           {});
-}
-
-/// The ACQUIRE half, recorded on the graphics queue after waiting on that semaphore (wait stage
-/// VERTEX_INPUT): the same buffers and families, the writes made visible to vertex fetch. The
-/// source access is ignored for an acquire (TOP_OF_PIPE, 0): the semaphore orders the release.
-inline void acquire_from_family(const VolkDeviceTable& vk, VkCommandBuffer cmd,
-                                std::span<const VkBuffer> buffers, std::uint32_t compute_family,
-                                std::uint32_t graphics_family) {
-  std::array<VkBufferMemoryBarrier, 8> b{};
-  std::uint32_t n = 0;
-  for (VkBuffer buf : buffers)
-    if (n < b.size())
-      b[n++] = buffer(buf, 0, VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT, compute_family, graphics_family);
-  pipeline(vk, cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_VERTEX_INPUT_BIT, {b.data(), n}, {});
+    b.push_back(buffer(buf, release ? access : 0, release ? 0 : access, src_family, dst_family));
+  pipeline(vk, cmd, release ? stage : VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT,
+           release ? VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT : stage, b, {});
 }
 
 } // namespace vkcloth::gpu::barriers

@@ -87,6 +87,12 @@ const SimParams& GpuSolver::params() const {
 void GpuSolver::record_steps(VkCommandBuffer cmd, std::uint32_t steps) {
   impl_->world.record_steps(cmd, steps);
 }
+void GpuSolver::record_release(VkCommandBuffer cmd, const QueueTransfer& transfer) const {
+  impl_->world.record_release(cmd, transfer);
+}
+void GpuSolver::record_acquire(VkCommandBuffer cmd, const QueueTransfer& transfer) const {
+  impl_->world.record_acquire(cmd, transfer);
+}
 Result<void> GpuSolver::record_steps(VkCommandBuffer cmd, std::uint32_t steps, const StepParams& step) {
   VKCLOTH_TRY(impl_->world.set_step_params(impl_->id, step));
   impl_->world.record_steps(cmd, steps);

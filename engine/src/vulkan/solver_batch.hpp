@@ -10,6 +10,7 @@
 // triangles, uvs, particles); the world keys batches by the shared topology object.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -88,6 +89,8 @@ public:
   /// Instance `slot`'s buffers for drawing (the current positions: query after recording).
   InstanceBuffers buffers(std::uint32_t slot) const;
   std::uint32_t current_position_index() const { return parity; }
+  /// The buffers a host draws from: current positions, normals, uvs (queue-family transfers).
+  std::array<VkBuffer, 3> drawn_buffers() const { return {pos[parity].buffer, normal.buffer, uv.buffer}; }
   VkBuffer position_buffer(std::uint32_t index) const { return pos[index & 1u].buffer; }
   VkBuffer velocity_buffer() const { return vel.buffer; }
   const std::vector<glm::vec2>& uvs() const { return uvs_; }

@@ -314,6 +314,23 @@ void ClothWorld::record_barrier_to(VkCommandBuffer cmd, VkPipelineStageFlags dst
   barriers::after_steps(impl_->ctx->vk, cmd, dst_stage, dst_access);
 }
 
+void ClothWorld::Impl::record_queue_transfer(VkCommandBuffer cmd, const QueueTransfer& t,
+                                             bool release) const {
+  std::vector<VkBuffer> drawn;
+  for (const auto& [key, entry] : batches)
+    for (VkBuffer b : entry.solver->drawn_buffers())
+      drawn.push_back(b);
+  barriers::queue_transfer(ctx->vk, cmd, drawn, release, t.src_family, t.dst_family, t.stage, t.access);
+}
+
+void ClothWorld::record_release(VkCommandBuffer cmd, const QueueTransfer& transfer) const {
+  impl_->record_queue_transfer(cmd, transfer, true);
+}
+
+void ClothWorld::record_acquire(VkCommandBuffer cmd, const QueueTransfer& transfer) const {
+  impl_->record_queue_transfer(cmd, transfer, false);
+}
+
 Result<void> ClothWorld::simulate(std::uint64_t steps, std::uint32_t steps_per_submit) {
   return impl_->simulate(steps, steps_per_submit);
 }

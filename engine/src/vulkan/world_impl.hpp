@@ -61,6 +61,8 @@ struct ClothWorld::Impl {
   Result<void> rebuild(const BatchKey& key, const std::vector<InstanceId>& members,
                        const std::map<InstanceId, const InitialState*>& fresh);
   void record_steps(VkCommandBuffer cmd, std::uint32_t steps);
+  /// One half of a queue-family transfer of every batch's drawn buffers (QueueTransfer).
+  void record_queue_transfer(VkCommandBuffer cmd, const QueueTransfer& transfer, bool release) const;
   /// Records, submits and waits for `steps` steps, timed; then reads every batch's flags.
   Result<void> simulate(std::uint64_t steps, std::uint32_t steps_per_submit);
   /// Reads every batch's flags after the host's own submissions completed.

@@ -81,6 +81,23 @@ struct InstanceBuffers {
   std::uint32_t index_count = 0;
 };
 
+/// One half of a queue-family ownership transfer of the buffers a host draws from (current
+/// positions, normals, uvs), for compute and graphics queues of different families with
+/// EXCLUSIVE buffers (docs/embedding.md section 6 records a whole frame). Per frame:
+///   compute cmd, before record_steps: acquire {graphics -> compute, COMPUTE_SHADER, SHADER_READ |
+///   SHADER_WRITE} compute cmd, after record_steps:  release {compute -> graphics, COMPUTE_SHADER,
+///   SHADER_WRITE} graphics cmd, before drawing:     acquire {compute -> graphics, VERTEX_INPUT,
+///   VERTEX_ATTRIBUTE_READ} graphics cmd, after drawing:      release {graphics -> compute, VERTEX_INPUT, 0}
+/// each acquire after waiting on a semaphore signalled by the submission of its release (the
+/// first frame's first acquire is skipped: the buffers start on the Context's family).
+struct QueueTransfer {
+  std::uint32_t src_family = 0;
+  std::uint32_t dst_family = 0;
+  /// Release: the last use on src_family. Acquire: the next use on dst_family.
+  VkPipelineStageFlags stage = 0;
+  VkAccessFlags access = 0;
+};
+
 class GpuSolver {
 public:
   /// Validates `params` as CpuSolver::create does, checks the device limits BEFORE allocating
@@ -120,15 +137,10 @@ public:
   /// them (drawing the current positions and normals, copying), record the caller's barrier or
   /// call record_barrier_to(cmd, dst_stage, dst_access).
   ///
-  /// Different queue families for compute and graphics, with EXCLUSIVE buffers (the default):
-  /// after record_steps() the host records, on the compute queue's command buffer, a
-  /// VkBufferMemoryBarrier per buffer it reads (current positions, normals; uvs once) with
-  /// srcAccessMask = SHADER_WRITE, srcQueueFamilyIndex = compute family, dstQueueFamilyIndex =
-  /// graphics family (the RELEASE), submits it signalling a semaphore; the graphics submission
-  /// waits on that semaphore (dst stage VERTEX_INPUT) and records the same barriers with
-  /// dstAccessMask = VERTEX_ATTRIBUTE_READ (the ACQUIRE) before drawing; the next frame transfers
-  /// them back the same way before record_steps(). Or set GpuSolverOptions::sharing_queue_families
-  /// (CONCURRENT buffers): then only the semaphore and record_barrier_to() are needed.
+  /// Different queue families for compute and graphics: with EXCLUSIVE buffers (the default) the
+  /// drawn buffers change owner every frame (record_release / record_acquire, QueueTransfer); with
+  /// GpuSolverOptions::sharing_queue_families (CONCURRENT buffers) only semaphores are needed.
+  /// docs/embedding.md section 6 records a whole frame of each.
   void record_steps(VkCommandBuffer cmd, std::uint32_t steps);
   /// set_params(step.applied_to(params())), then record_steps(cmd, steps): this recording and the
   /// next ones step with the frame's dt, gravity, wind and colliders (race-free with frames in
@@ -139,6 +151,9 @@ public:
   /// Records the barrier that makes the last record_steps() writes visible to `dst_stage` /
   /// `dst_access` (e.g. VK_PIPELINE_STAGE_VERTEX_INPUT_BIT / VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT).
   void record_barrier_to(VkCommandBuffer cmd, VkPipelineStageFlags dst_stage, VkAccessFlags dst_access) const;
+  /// The two halves of a queue-family ownership transfer of the drawn buffers (QueueTransfer).
+  void record_release(VkCommandBuffer cmd, const QueueTransfer& transfer) const;
+  void record_acquire(VkCommandBuffer cmd, const QueueTransfer& transfer) const;
 
   /// Records, submits and waits for `steps` steps, `steps_per_submit` per command buffer; sums the
   /// GPU time of the submissions (last_gpu_ms). Checks the divergence flags after each submission:

@@ -108,6 +108,10 @@ public:
   void record_steps(VkCommandBuffer cmd, std::uint32_t steps);
   /// One barrier making every instance's last writes visible to `dst_stage` / `dst_access`.
   void record_barrier_to(VkCommandBuffer cmd, VkPipelineStageFlags dst_stage, VkAccessFlags dst_access) const;
+  /// The two halves of a queue-family ownership transfer of every instance's drawn buffers
+  /// (current positions, normals, uvs; QueueTransfer in gpu_solver.hpp).
+  void record_release(VkCommandBuffer cmd, const QueueTransfer& transfer) const;
+  void record_acquire(VkCommandBuffer cmd, const QueueTransfer& transfer) const;
 
   /// Records, submits and waits for `steps` steps of every instance (on the Context's queue),
   /// `steps_per_submit` per submission; then checks each instance's divergence flags
