@@ -84,11 +84,14 @@ public:
 
   /// Adds a cloth of `topology` (ClothTopology::create; instances of the same pointer share a
   /// batch) with `params`; validated as GpuSolver::create (errors name the parameter). Takes
-  /// effect from the next recording; no recorded work of this world may be pending.
+  /// effect from the next recording. Rebuilding the batch first waits for every earlier
+  /// submission on the Context's queue (recorded work submitted elsewhere: wait for it yourself);
+  /// command buffers recorded but not yet submitted must not be submitted after it.
   Result<InstanceId> add(std::shared_ptr<const ClothTopology> topology, SimParams params,
                          const InitialState& initial = {});
-  /// Removes an instance (its buffers are freed now: no recorded work of the world may be
-  /// pending); the others keep their state. ErrorCode::invalid_argument for an unknown id.
+  /// Removes an instance (its batch's buffers are replaced or freed now, after waiting for every
+  /// earlier submission on the Context's queue, as add()); the others keep their state.
+  /// ErrorCode::invalid_argument for an unknown id.
   Result<void> remove(InstanceId id);
   /// New parameters from the next recorded step. The values travel in that recording's command
   /// buffer (vkCmdUpdateBuffer), so changing them every frame with frames in flight is race-free.
