@@ -11,5 +11,10 @@ cmake --build --preset "$preset"
 extra=()
 # The package tests configure and build a consumer project against this build; under sanitizers
 # that consumer would need the same runtime flags, and packaging is covered by the release run.
-[[ $preset == asan ]] && extra=(-E '^package:')
+# The three longest GPU comparisons spend their time in lavapipe (not instrumented), and smaller
+# tests run the same host code: the release run keeps them, the sanitizer run skips them (~6 min
+# of a 2-core CI machine).
+heavy='implicit Euler matches the CPU implicit solver on the sample scenes|the stiff cloth is stable at dt = 0.02'
+heavy+='|compare passes on every sample scene'
+[[ $preset == asan ]] && extra=(-E "^package:|$heavy")
 ctest --preset "$preset" -j "$(nproc)" "${extra[@]}"
