@@ -47,9 +47,11 @@ int main() {
     return std::puts("no Vulkan 1.2 device with a graphics + compute queue"), 4;
   const float priority = 1.0f;
   VkDeviceQueueCreateInfo qci{.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO,
-                              .queueFamilyIndex = family, .queueCount = 1, .pQueuePriorities = &priority};
-  VkDeviceCreateInfo dci{.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, .queueCreateInfoCount = 1,
-                         .pQueueCreateInfos = &qci};
+                              .queueFamilyIndex = family,
+                              .queueCount = 1,
+                              .pQueuePriorities = &priority};
+  VkDeviceCreateInfo dci{
+      .sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, .queueCreateInfoCount = 1, .pQueueCreateInfos = &qci};
   VkDevice device;
   if (vkCreateDevice(gpu, &dci, nullptr, &device) != VK_SUCCESS)
     return std::puts("vkCreateDevice failed"), 1;
@@ -57,33 +59,42 @@ int main() {
   VkQueue queue;
   vkGetDeviceQueue(device, family, 0, &queue);
   VkCommandPoolCreateInfo pci{.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO,
-                              .flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT, .queueFamilyIndex = family};
+                              .flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT,
+                              .queueFamilyIndex = family};
   VkCommandPool pool;
   vkCreateCommandPool(device, &pci, nullptr, &pool);
-  VkCommandBufferAllocateInfo cai{.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO, .commandPool = pool,
-                                  .level = VK_COMMAND_BUFFER_LEVEL_PRIMARY, .commandBufferCount = 1};
+  VkCommandBufferAllocateInfo cai{.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
+                                  .commandPool = pool,
+                                  .level = VK_COMMAND_BUFFER_LEVEL_PRIMARY,
+                                  .commandBufferCount = 1};
   VkCommandBuffer cmd;
   vkAllocateCommandBuffers(device, &cai, &cmd);
 
   int status = 0;
   { // vkcloth objects live in this scope: destroyed before the device
-    vkcloth::gpu::HostHandles h{.instance = instance, .physical_device = gpu, .device = device,
-                                .queue_family = family, .queue = queue,
+    vkcloth::gpu::HostHandles h{.instance = instance,
+                                .physical_device = gpu,
+                                .device = device,
+                                .queue_family = family,
+                                .queue = queue,
                                 .get_instance_proc_addr = vkGetInstanceProcAddr};
     auto context = vkcloth::gpu::Context::adopt(h); // errors are values with a message
-    auto solver = context ? vkcloth::gpu::GpuSolver::create(*context, vkcloth::make_cloth({.nx = 32}).value(), {})
-                          : vkcloth::Result<vkcloth::gpu::GpuSolver>(context.error());
+    auto solver = context
+                      ? vkcloth::gpu::GpuSolver::create(*context, vkcloth::make_cloth({.nx = 32}).value(), {})
+                      : vkcloth::Result<vkcloth::gpu::GpuSolver>(context.error());
     if (!solver)
       status = std::printf("vkcloth: %s\n", solver.error().message.c_str()) > 0;
     for (int frame = 0; frame < 60 && status == 0; ++frame) {
       VkCommandBufferBeginInfo begin{.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
       vkBeginCommandBuffer(cmd, &begin);
-      const double frame_time = frame % 2 ? 1.0 / 60 : 1.0 / 50; // the host's frame timer: a new dt every frame
+      const double frame_time =
+          frame % 2 ? 1.0 / 60 : 1.0 / 50; // the host's frame timer: a new dt every frame
       if (!solver->record_steps(cmd, 2, {.dt = frame_time / 2}))
         status = 1;
       solver->record_barrier_to(cmd, VK_PIPELINE_STAGE_VERTEX_INPUT_BIT, VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT);
       vkEndCommandBuffer(cmd); // a renderer would draw solver->buffers() here
-      VkSubmitInfo submit{.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO, .commandBufferCount = 1, .pCommandBuffers = &cmd};
+      VkSubmitInfo submit{
+          .sType = VK_STRUCTURE_TYPE_SUBMIT_INFO, .commandBufferCount = 1, .pCommandBuffers = &cmd};
       vkQueueSubmit(queue, 1, &submit, VK_NULL_HANDLE);
       vkQueueWaitIdle(queue); // a real host waits on a fence of the frame in flight instead
     }

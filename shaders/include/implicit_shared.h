@@ -14,17 +14,17 @@
 namespace vkcloth::gpu::shared {
 #endif
 
-#define VKCLOTH_BINDING_IMPL_VF 22       // contact-filtered velocity (vec4)
-#define VKCLOTH_BINDING_IMPL_KS 23       // per CSR entry: K_s as 2 vec4 (xx yy zz xy | xz yz - -)
-#define VKCLOTH_BINDING_IMPL_DIAG_INV 24 // 1 / diag(A), zero for pinned particles (vec4)
-#define VKCLOTH_BINDING_IMPL_X 25        // CG solution dv (vec4)
-#define VKCLOTH_BINDING_IMPL_R 26        // residual
-#define VKCLOTH_BINDING_IMPL_Z 27        // preconditioned residual
-#define VKCLOTH_BINDING_IMPL_D 28        // search direction
-#define VKCLOTH_BINDING_IMPL_Q 29        // S A d
-#define VKCLOTH_BINDING_IMPL_PARTIALS 30 // one vec2 per workgroup: its partial dot products
-#define VKCLOTH_BINDING_IMPL_STATE 31    // CgState
-#define VKCLOTH_BINDING_IMPL_ARGS 32     // indirect dispatch arguments (CgArgs)
+#define VKCLOTH_BINDING_IMPL_VF 24       // contact-filtered velocity (vec4)
+#define VKCLOTH_BINDING_IMPL_KS 25       // per CSR entry: K_s as 2 vec4 (xx yy zz xy | xz yz - -)
+#define VKCLOTH_BINDING_IMPL_DIAG_INV 26 // 1 / diag(A), zero for pinned particles (vec4)
+#define VKCLOTH_BINDING_IMPL_X 27        // CG solution dv (vec4)
+#define VKCLOTH_BINDING_IMPL_R 28        // residual
+#define VKCLOTH_BINDING_IMPL_Z 29        // preconditioned residual
+#define VKCLOTH_BINDING_IMPL_D 30        // search direction
+#define VKCLOTH_BINDING_IMPL_Q 31        // S A d
+#define VKCLOTH_BINDING_IMPL_PARTIALS 32 // one vec2 per workgroup: its partial dot products
+#define VKCLOTH_BINDING_IMPL_STATE 33    // CgState
+#define VKCLOTH_BINDING_IMPL_ARGS 34     // indirect dispatch arguments (CgArgs)
 
 // implicit.comp passes (PushConstants::stage).
 #define VKCLOTH_IMPL_FORCE 0u     // normal, force, contact filtering -> FORCE_OUT, NORMAL, VF

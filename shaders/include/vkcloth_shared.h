@@ -51,7 +51,10 @@ struct vec4 {
   20 // StrainLink per strain link, in colour order (ClothTopology::strain_links)
 #define VKCLOTH_BINDING_TETHERS                                                                              \
   21 // TetherSlot, VKCLOTH_TETHERS_PER_PARTICLE per particle, euclidean then geodesic
-#define VKCLOTH_BINDING_COUNT 22
+#define VKCLOTH_BINDING_UV 22 // texture coordinates (vec4: u, v, 0, 0), read by vertices.comp
+#define VKCLOTH_BINDING_VERTICES                                                                             \
+  23 // interleaved Vertex per particle (GpuSolverOptions::interleaved_vertices)
+#define VKCLOTH_BINDING_COUNT 24
 
 // Set 1 (force.comp, fused.comp, strain_*.comp): POS_IN again, as an RGBA32F uniform texel buffer view,
 // PARTICLE as an RG32UI one (x: the mass's bits, y: pinned), and (fused.comp) VEL as RGBA32F and
@@ -129,6 +132,13 @@ struct InstanceParams {
   uint stretch_sweeps;  // stretch_limit.iterations: Provot sweeps per substep
 };
 
+/// One interleaved vertex (std430: 32 bytes): position xyz, normal xyz, uv, in the floats
+/// p.x p.y p.z n.x | n.y n.z u v (VKCLOTH_BINDING_VERTICES, vertices.comp).
+struct Vertex {
+  vec4 position_nx;
+  vec4 nyz_uv;
+};
+
 /// Per-particle constants (std430: 8 bytes).
 struct ParticleInfo {
   float mass;
@@ -188,6 +198,7 @@ static_assert(offsetof(InstanceParams, wind) == 32);
 static_assert(offsetof(InstanceParams, dt) == 48);
 static_assert(offsetof(InstanceParams, limit) == 64);
 static_assert(sizeof(ParticleInfo) == 8);
+static_assert(sizeof(Vertex) == 32);
 static_assert(sizeof(Edge) == 12);
 static_assert(sizeof(Edge) == VKCLOTH_EDGE_TEXELS * 4);
 static_assert(sizeof(FanEntry) == 8);

@@ -3,6 +3,7 @@
 // the host's own submission, the host's VkAllocationCallbacks, many cloths in a ClothWorld.
 #include "gpu_test_util.hpp"
 #include "host_vulkan.hpp"
+#include "vkcloth/gpu/testing.hpp"
 
 #include <cmath>
 #include <cstddef>
@@ -667,4 +668,47 @@ TEST_CASE("Queue-family hand-over in the documented order (one queue here): rele
   REQUIRE((want && got));
   CHECK(diff(*got, *want).bitwise);
   CHECK(host->messages.load() == 0);
+}
+
+TEST_CASE("interleaved_vertices: one 32-byte vertex per particle holds the current position, the "
+          "stored normal and the uv, in every integrator; the state is unchanged") {
+  VKCLOTH_GPU_TEST_BEGIN(ctx);
+  ClothDesc d;
+  d.nx = 9;
+  d.ny = 6;
+  d.uv_transform = UvTransform{{0.0f, 1.0f}, {2.0f, 0.0f}, {0.0f, -1.0f}}; // not the default uvs
+  auto topo = ClothTopology::create(make_cloth(d).value()).value();
+  for (Integrator integrator :
+       {Integrator::semi_implicit_euler, Integrator::rk4, Integrator::implicit_euler}) {
+    CAPTURE(to_string(integrator));
+    SimParams p;
+    p.integrator = integrator;
+    p.dt = 0.005;
+    p.wind.strength = 0.03;
+    GpuSolverOptions options;
+    options.interleaved_vertices = true;
+    options.flip_normals = true; // the vertices carry the normals as stored
+    auto gpu = GpuSolver::create(ctx, topo, p, options);
+    auto plain = GpuSolver::create(ctx, topo, p);
+    REQUIRE((gpu.ok() && plain.ok()));
+    REQUIRE((gpu->simulate(7, 3).ok() && plain->simulate(7, 3).ok())); // 3 recordings: 3 + 3 + 1 steps
+    const auto v = testing::read_vertices(*gpu);
+    const auto x = gpu->positions(), n = gpu->normals(), x_plain = plain->positions();
+    REQUIRE((v && x && n && x_plain));
+    CHECK(diff(*x, *x_plain).bitwise);
+    CHECK(gpu->buffers().vertices != VK_NULL_HANDLE);
+    CHECK(plain->buffers().vertices == VK_NULL_HANDLE);
+    REQUIRE(v->size() == 8 * x->size());
+    bool same = true;
+    for (std::size_t i = 0; i < x->size(); ++i) {
+      const float* w = v->data() + 8 * i;
+      const glm::vec2 uv = topo->uvs()[i];
+      same = same && glm::vec3(w[0], w[1], w[2]) == (*x)[i] && glm::vec3(w[3], w[4], w[5]) == (*n)[i] &&
+             glm::vec2(w[6], w[7]) == uv;
+    }
+    CHECK(same);
+  }
+  auto without = GpuSolver::create(ctx, topo, SimParams{});
+  REQUIRE(without.ok());
+  CHECK_FALSE(testing::read_vertices(*without).ok());
 }

@@ -179,3 +179,12 @@ InstanceBuffers GpuSolver::buffers() const {
 }
 
 } // namespace vkcloth::gpu
+
+namespace vkcloth::gpu::testing {
+
+Result<std::vector<float>> read_vertices(GpuSolver& solver) {
+  const GpuSolver::Impl& s = detail::Access::impl(solver);
+  return s.batch().read_vertices(s.slot());
+}
+
+} // namespace vkcloth::gpu::testing

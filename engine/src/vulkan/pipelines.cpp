@@ -12,6 +12,7 @@
 #include "vkcloth/shaders/implicit_reduce_comp_spv.hpp"
 #include "vkcloth/shaders/integrate_comp_spv.hpp"
 #include "vkcloth/shaders/strain_finish_comp_spv.hpp"
+#include "vkcloth/shaders/vertices_comp_spv.hpp"
 #include "vkcloth/shaders/strain_links_comp_spv.hpp"
 #include "vkcloth_shared.h"
 
@@ -41,6 +42,8 @@ ShaderCode code_of(PipelineRegistry::Shader s) {
     return {spirv::strain_links_comp_spv, "strain_links.comp"};
   case S::strain_finish:
     return {spirv::strain_finish_comp_spv, "strain_finish.comp"};
+  case S::vertices:
+    return {spirv::vertices_comp_spv, "vertices.comp"};
   }
   return {{}, "?"};
 }

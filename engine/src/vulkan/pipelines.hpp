@@ -23,10 +23,19 @@ std::span<const std::uint32_t> implicit_bindings();
 
 class PipelineRegistry {
 public:
-  enum class Shader { force, integrate, fused, implicit, implicit_reduce, strain_links, strain_finish };
+  enum class Shader {
+    force,
+    integrate,
+    fused,
+    implicit,
+    implicit_reduce,
+    strain_links,
+    strain_finish,
+    vertices
+  };
 
   /// Set 0 (storage buffers) and set 1 (texel views) of force/integrate/fused.comp and their
-  /// layout (strain_links/strain_finish.comp use it too, set 0 only).
+  /// layout (strain_links/strain_finish/vertices.comp use it too, set 0 only).
   struct SolverLayouts {
     VkDescriptorSetLayout storage = VK_NULL_HANDLE, texel = VK_NULL_HANDLE;
     VkPipelineLayout layout = VK_NULL_HANDLE;

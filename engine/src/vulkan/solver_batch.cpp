@@ -151,12 +151,13 @@ const Buffer& SolverBatch::buffer_of(Field field) const {
   return pos[parity];
 }
 
-Result<std::vector<glm::vec3>> SolverBatch::read(Field field, std::uint32_t slot) {
-  const Buffer& b = buffer_of(field);
+// `bytes` of `b` from byte `offset`: straight from mapped memory, or through a staging copy.
+Result<std::vector<float>> SolverBatch::read_floats(const Buffer& b, VkDeviceSize offset,
+                                                    VkDeviceSize bytes) {
   Buffer tmp; // staging, when `b` is not mapped
   if (!b.mapped) {
-    auto s = create_buffer(*ctx, slot_bytes(), VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUse::host_readback,
-                           true, "readback staging");
+    auto s = create_buffer(*ctx, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUse::host_readback, true,
+                           "readback staging");
     if (!s)
       return s.error();
     tmp = std::move(*s);
@@ -164,17 +165,33 @@ Result<std::vector<glm::vec3>> SolverBatch::read(Field field, std::uint32_t slot
   VKCLOTH_TRY(commands->submit_and_wait([&](VkCommandBuffer c) {
     barriers::before_readback(vk(), c);
     if (tmp.buffer) {
-      const VkBufferCopy region{slot_offset(slot), 0, slot_bytes()};
+      const VkBufferCopy region{offset, 0, bytes};
       vk().vkCmdCopyBuffer(c, b.buffer, tmp.buffer, 1, &region);
       barriers::transfer_to_host(vk(), c);
     }
   }));
-  const auto* src = tmp.buffer ? static_cast<const sh::vec4*>(tmp.mapped)
-                               : static_cast<const sh::vec4*>(b.mapped) + std::size_t(slot) * count;
+  const auto* src =
+      tmp.buffer ? static_cast<const char*>(tmp.mapped) : static_cast<const char*>(b.mapped) + offset;
+  std::vector<float> out(bytes / sizeof(float));
+  std::memcpy(out.data(), src, out.size() * sizeof(float));
+  return out;
+}
+
+Result<std::vector<glm::vec3>> SolverBatch::read(Field field, std::uint32_t slot) {
+  auto f = read_floats(buffer_of(field), slot_offset(slot), slot_bytes());
+  if (!f)
+    return f.error();
   std::vector<glm::vec3> out(count);
   for (std::uint32_t i = 0; i < count; ++i)
-    out[i] = glm::vec3(src[i].x, src[i].y, src[i].z);
+    out[i] = glm::vec3((*f)[4 * i], (*f)[4 * i + 1], (*f)[4 * i + 2]);
   return out;
+}
+
+Result<std::vector<float>> SolverBatch::read_vertices(std::uint32_t slot) {
+  if (!options.interleaved_vertices)
+    return make_error(ErrorCode::invalid_argument, "the solver was created without interleaved_vertices");
+  return read_floats(vertices, VkDeviceSize(slot) * count * sizeof(sh::Vertex),
+                     VkDeviceSize(count) * sizeof(sh::Vertex));
 }
 
 void SolverBatch::refresh_flags() {
@@ -211,6 +228,10 @@ void SolverBatch::carry_over(std::uint32_t slot, const Slot& old) {
 
 InstanceBuffers SolverBatch::buffers(std::uint32_t slot) const {
   InstanceBuffers b;
+  if (options.interleaved_vertices) {
+    b.vertices = vertices.buffer;
+    b.vertex_offset = VkDeviceSize(slot) * count * sizeof(sh::Vertex);
+  }
   b.positions = pos[parity].buffer;
   b.normals = normal.buffer;
   b.uvs = uv.buffer;
@@ -293,6 +314,20 @@ void SolverBatch::record(VkCommandBuffer c, std::uint32_t steps) {
         slot.time += slot.params.dt;
       }
   }
+  if (options.interleaved_vertices)
+    record_vertices(c);
+}
+
+// vertices.comp packs the current positions, the normals and the uvs into one Vertex per
+// particle, reading POS_IN of the set whose read index is the current one.
+void SolverBatch::record_vertices(VkCommandBuffer c) {
+  const auto& v = vk();
+  barriers::dispatch_to_dispatch(v, c); // the last pass's positions and normals -> this pass
+  v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, vertices_pipeline);
+  v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &sets[parity][0], 0, nullptr);
+  v.vkCmdPushConstants(c, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
+  v.vkCmdDispatch(c, groups_x, groups_y, size());
+  ++dispatches_;
 }
 
 void SolverBatch::record_copy_slot(VkCommandBuffer c, const SolverBatch& from, std::uint32_t from_slot,
@@ -527,7 +562,10 @@ Result<void> SolverBatch::create_buffers() {
       {&fans, std::max<VkDeviceSize>(fans_count * sizeof(sh::FanEntry), 16), "normal fans"},
       {&strain_links, std::max<VkDeviceSize>(strain_link_count() * sizeof(sh::StrainLink), 16),
        "strain links"},
-      {&tethers, 16, "tethers (none yet)"}};
+      {&tethers, 16, "tethers (none yet)"},
+      // GpuSolverOptions::interleaved_vertices: one Vertex (32 bytes) per particle; else one.
+      {&vertices, options.interleaved_vertices ? VkDeviceSize(size()) * n * sizeof(sh::Vertex) : 32,
+       "interleaved vertices"}};
   for (auto [b, bytes, what] : device_buffers) {
     auto r = create_buffer(*ctx, bytes, usage, MemoryUse::device, allow_map, what, families);
     if (!r)
@@ -625,6 +663,7 @@ Result<void> SolverBatch::upload_initial_state(const ClothTopology& topology,
       {&force_stage, nullptr, 0},
       {&vel_filt, nullptr, 0},
       {&normal, nullptr, 0},
+      {&vertices, nullptr, 0},
       {&stage_pos, nullptr, 0},
       {&stage_vel, nullptr, 0},
       {&acc_pos, nullptr, 0},

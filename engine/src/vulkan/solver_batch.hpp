@@ -86,6 +86,8 @@ public:
   void refresh_flags();
   /// One instance's entries of a per-particle buffer (submits, waits, copies).
   Result<std::vector<glm::vec3>> read(Field field, std::uint32_t slot);
+  /// One instance's interleaved vertices, 8 floats each (GpuSolverOptions::interleaved_vertices).
+  Result<std::vector<float>> read_vertices(std::uint32_t slot);
   /// Instance `slot`'s buffers for drawing (the current positions: query after recording).
   InstanceBuffers buffers(std::uint32_t slot) const;
   std::uint32_t current_position_index() const { return parity; }
@@ -132,6 +134,7 @@ private:
   // host-visible ones (per instance). Every object below is owned (resources.hpp): a new buffer
   // is one member here plus its creation.
   Buffer pos[2], vel, force, force_stage, vel_filt, normal, uv, stage_pos, stage_vel, acc_pos, acc_vel;
+  Buffer vertices; // GpuSolverOptions::interleaved_vertices (else one zeroed element)
   // The shared topology: particle constants, gather lists, normal fans (filled only for
   // Normals::fans, else one zeroed element), triangles (`indices`, for drawing).
   Buffer particle, offsets, edges, fan_offsets, fans, indices;
@@ -155,6 +158,7 @@ private:
   VkPipelineLayout layout = VK_NULL_HANDLE;
   VkPipeline force_pipeline = VK_NULL_HANDLE, integrate_pipeline = VK_NULL_HANDLE;
   VkPipeline strain_links_pipeline = VK_NULL_HANDLE, strain_finish_pipeline = VK_NULL_HANDLE;
+  VkPipeline vertices_pipeline = VK_NULL_HANDLE;
   // fused.comp variants, looked up when first needed (ensure_fused): [write_aux][colliders].
   // write_aux = 0 (SC_WRITE_AUX false: no force and normal stores) for every fused substep of a
   // recorded batch of steps but the last, since only the last one's forces and normals can be
@@ -203,6 +207,7 @@ private:
   VkDeviceSize slot_bytes() const { return VkDeviceSize(count) * GpuSolver::stride; }
   std::size_t strain_link_count() const { return strain_colours.empty() ? 0 : strain_colours.back(); }
   const Buffer& buffer_of(Field field) const;
+  Result<std::vector<float>> read_floats(const Buffer& b, VkDeviceSize offset, VkDeviceSize bytes);
 
   // Creation phases (create()), in order.
   Result<void> create_buffers();
@@ -216,6 +221,8 @@ private:
   Result<void> ensure_implicit();
   Result<void> ensure_fused();
   Result<void> ensure_tethers();
+  /// The interleaved vertex pass at the end of a recording (vertices.comp).
+  void record_vertices(VkCommandBuffer cmd);
   /// Stretch control after a substep's update (strain_links.comp sweeps, strain_finish.comp).
   void record_stretch(VkCommandBuffer cmd, std::uint32_t read);
   Result<void> ensure_collider_capacity();

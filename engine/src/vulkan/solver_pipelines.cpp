@@ -173,6 +173,12 @@ Result<void> SolverBatch::create_pipelines() {
   if (!sp)
     return sp.error();
   strain_finish_pipeline = *sp;
+  if (options.interleaved_vertices) {
+    auto vp = ctx->pipelines->pipeline(Shader::vertices, {});
+    if (!vp)
+      return vp.error();
+    vertices_pipeline = *vp;
+  }
   return {};
 }
 
@@ -239,6 +245,8 @@ Result<void> SolverBatch::write_sets() {
       by_binding[VKCLOTH_BINDING_FANS] = &fans;
       by_binding[VKCLOTH_BINDING_STRAIN_LINKS] = &strain_links;
       by_binding[VKCLOTH_BINDING_TETHERS] = &tethers;
+      by_binding[VKCLOTH_BINDING_UV] = &uv;
+      by_binding[VKCLOTH_BINDING_VERTICES] = &vertices;
       for (std::uint32_t b = 0; b < VKCLOTH_BINDING_COUNT; ++b, ++k) {
         infos[k] = VkDescriptorBufferInfo{by_binding[b]->buffer, 0, VK_WHOLE_SIZE};
         writes[k] = VkWriteDescriptorSet{};

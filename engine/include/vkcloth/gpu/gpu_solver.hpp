@@ -57,6 +57,11 @@ struct GpuSolverOptions {
   /// for its vertical one). true: the opposite side (a host whose lit side is the other one).
   /// Only the normals buffer changes; the physics does not (docs/embedding.md "Normals").
   bool flip_normals = false;
+  /// Also write InstanceBuffers::vertices: one interleaved vertex per particle (32 bytes: position
+  /// xyz at byte 0, normal xyz at 12, uv at 24; formats R32G32B32 / R32G32B32 / R32G32_SFLOAT),
+  /// for a host pipeline with one vertex binding. One extra dispatch at the end of every
+  /// recording; the buffer holds the state after it (zero before the first recording).
+  bool interleaved_vertices = false;
 };
 
 /// Where an instance's per-particle data lives, for the host's own drawing: vec4 per particle
@@ -79,6 +84,11 @@ struct InstanceBuffers {
   /// the vertex buffers at `offset`. Empty (index_count 0) for chains.
   VkBuffer indices = VK_NULL_HANDLE;
   std::uint32_t index_count = 0;
+  /// GpuSolverOptions::interleaved_vertices: the instance's interleaved vertices from byte
+  /// `vertex_offset`, `vertex_stride` apart (VK_NULL_HANDLE otherwise).
+  VkBuffer vertices = VK_NULL_HANDLE;
+  VkDeviceSize vertex_offset = 0;
+  static constexpr VkDeviceSize vertex_stride = 32;
 };
 
 /// One half of a queue-family ownership transfer of the buffers a host draws from (current

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <vector>
 
 #include "vkcloth/gpu/context.hpp"
 #include "vkcloth/gpu/gpu_solver.hpp"
@@ -46,6 +47,10 @@ Result<GpuSolver> create_solver(Context& context, const ParticleSystem& system, 
                                 const GpuSolverOptions& options = {}, const SolverKnobs& knobs = {});
 /// ClothWorld::create with knobs for every batch of the world.
 Result<ClothWorld> create_world(Context& context, WorldOptions options, const SolverKnobs& knobs);
+
+/// The solver's interleaved vertices (GpuSolverOptions::interleaved_vertices), 8 floats per
+/// particle as on the device (position xyz, normal xyz, uv), read back (submit, wait, copy).
+Result<std::vector<float>> read_vertices(GpuSolver& solver);
 
 /// Compute pipelines made so far on `context`: one per shader and specialisation (grid stencil,
 /// fused variant), shared by every solver and world batch of the Context.
