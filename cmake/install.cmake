@@ -9,6 +9,7 @@
 # consumer's link (tinyobjloader_double, tinygltf, meshoptimizer, Threads, dl): the config names
 # them through vkcloth::private_link, as CMake targets when their packages are there, else as
 # plain library names for the linker (-ltinygltf...). A shared libvkcloth needs none of them.
+# GLM's version at configure time is installed as vkcloth/glm_version.hpp (vkcloth/glm_abi.hpp).
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
@@ -18,6 +19,9 @@ install(TARGETS vkcloth EXPORT vkclothTargets
   RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
   INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/engine/include/vkcloth DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+# The generated public header (engine/CMakeLists.txt): the GLM version the library was built with.
+get_target_property(vkcloth_binary_dir vkcloth BINARY_DIR)
+install(FILES ${vkcloth_binary_dir}/include/vkcloth/glm_version.hpp DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/vkcloth)
 
 # The static library's private libraries, for the config: each as "package|target|library name".
 # The library name is the file name of the library the build used (libtinygltf.so -> tinygltf).
