@@ -1,7 +1,10 @@
 # SPDX-License-Identifier: MIT
 # ctest driver: install vkcloth from BUILD_DIR into a prefix, MOVE the prefix (the package must be
 # relocatable), then configure, build and run the consumer against it; or, with MODE=subdir,
-# build the consumer with add_subdirectory(SOURCE_DIR).
+# build the consumer with add_subdirectory(SOURCE_DIR). MODE=installed-minimal is `installed` with
+# only the packages the public headers need: find_package(vkcloth) must not look for fmt,
+# tinyobjloader, TinyGLTF, meshoptimizer (their libraries are linked by name) nor need
+# VulkanHeaders' CMake package (the headers alone do).
 set(work ${WORK_DIR}/${MODE})
 file(REMOVE_RECURSE ${work})
 file(MAKE_DIRECTORY ${work})
@@ -12,14 +15,20 @@ function(run)
   endif()
   message(STATUS "${out}")
 endfunction()
-if(MODE STREQUAL "installed")
+if(MODE MATCHES "^installed")
+  set(minimal "")
+  if(MODE STREQUAL "installed-minimal")
+    foreach(package fmt tinyobjloader TinyGLTF meshoptimizer VulkanHeaders)
+      list(APPEND minimal -DCMAKE_DISABLE_FIND_PACKAGE_${package}=ON)
+    endforeach()
+  endif()
   run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${work}/staged)
   file(RENAME ${work}/staged ${work}/moved)
   run(${CMAKE_COMMAND} -S ${SOURCE_DIR}/tests/consumer -B ${work}/build -G Ninja -DCMAKE_BUILD_TYPE=Release
-      -DCMAKE_PREFIX_PATH=${work}/moved)
+      -DCMAKE_PREFIX_PATH=${work}/moved ${minimal})
 else()
   run(${CMAKE_COMMAND} -S ${SOURCE_DIR}/tests/consumer -B ${work}/build -G Ninja -DCMAKE_BUILD_TYPE=Release
       -DVKCLOTH_SOURCE_DIR=${SOURCE_DIR})
 endif()
 run(${CMAKE_COMMAND} --build ${work}/build)
-run(${work}/build/consumer)
+run(${work}/build/consumer ${work})

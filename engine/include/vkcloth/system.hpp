@@ -11,6 +11,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "vkcloth/glm_abi.hpp" // the host's GLM must match the library's (a compile error otherwise)
 #include "vkcloth/result.hpp"
 
 namespace vkcloth {

@@ -9,14 +9,14 @@
 #include <system_error>
 
 #include <fmt/format.h>
-#include <stb/stb_image.h>
-#include <stb/stb_image_write.h>
+
+#include "stb.hpp"
 
 namespace vkcloth::render {
 
 namespace {
 
-/// The checks load_image and decode_image share, after stbi_info: `what` names the image
+/// The checks load_image and decode_image share, after stb::info: `what` names the image
 /// ("texture file 'cloth.png'", "texture 'flag.glb images[0]'").
 Result<void> check_size(const std::string& what, int w, int h, std::uint32_t max_side) {
   if (w <= 0 || h <= 0)
@@ -28,9 +28,9 @@ Result<void> check_size(const std::string& what, int w, int h, std::uint32_t max
 }
 
 /// Takes stb_image's RGBA pixels (freed here), or its failure reason.
-Result<Image> take_pixels(const std::string& what, stbi_uc* data, int w, int h) {
+Result<Image> take_pixels(const std::string& what, unsigned char* data, int w, int h) {
   if (!data) {
-    const char* why = stbi_failure_reason();
+    const char* why = stb::failure_reason();
     return make_error(ErrorCode::io,
                       fmt::format("{} could not be decoded ({})", what, why ? why : "corrupt data"));
   }
@@ -38,7 +38,7 @@ Result<Image> take_pixels(const std::string& what, stbi_uc* data, int w, int h) 
   img.width = std::uint32_t(w);
   img.height = std::uint32_t(h);
   img.rgba.assign(data, data + std::size_t(w) * std::size_t(h) * 4);
-  stbi_image_free(data);
+  stb::image_free(data);
   return img;
 }
 
@@ -52,14 +52,14 @@ Result<Image> load_image(const std::filesystem::path& path, std::uint32_t max_si
   if (std::filesystem::is_directory(path, ec))
     return make_error(ErrorCode::io, fmt::format("texture file '{}' is a directory, not an image", name));
   int w = 0, h = 0, comp = 0;
-  if (!stbi_info(name.c_str(), &w, &h, &comp)) {
-    const char* why = stbi_failure_reason();
+  if (!stb::info(name.c_str(), &w, &h, &comp)) {
+    const char* why = stb::failure_reason();
     return make_error(ErrorCode::io, fmt::format("texture file '{}' is not a readable PNG/JPEG image ({})",
                                                  name, why ? why : "unknown format"));
   }
   const std::string what = fmt::format("texture file '{}'", name);
   VKCLOTH_TRY(check_size(what, w, h, max_side));
-  return take_pixels(what, stbi_load(name.c_str(), &w, &h, &comp, 4), w, h);
+  return take_pixels(what, stb::load(name.c_str(), &w, &h, &comp, 4), w, h);
 }
 
 Result<Image> decode_image(std::span<const std::uint8_t> bytes, std::string_view source,
@@ -73,13 +73,13 @@ Result<Image> decode_image(std::span<const std::uint8_t> bytes, std::string_view
                                   bytes.size(), std::numeric_limits<int>::max()));
   const int len = static_cast<int>(bytes.size());
   int w = 0, h = 0, comp = 0;
-  if (!stbi_info_from_memory(bytes.data(), len, &w, &h, &comp)) {
-    const char* why = stbi_failure_reason();
+  if (!stb::info_from_memory(bytes.data(), len, &w, &h, &comp)) {
+    const char* why = stb::failure_reason();
     return make_error(ErrorCode::io, fmt::format("{} ({} bytes) is not a readable PNG/JPEG image ({})", what,
                                                  bytes.size(), why ? why : "unknown format"));
   }
   VKCLOTH_TRY(check_size(what, w, h, max_side));
-  return take_pixels(what, stbi_load_from_memory(bytes.data(), len, &w, &h, &comp, 4), w, h);
+  return take_pixels(what, stb::load_from_memory(bytes.data(), len, &w, &h, &comp, 4), w, h);
 }
 
 Result<void> write_png(const std::filesystem::path& path, const Image& image) {
@@ -88,7 +88,7 @@ Result<void> write_png(const std::filesystem::path& path, const Image& image) {
       image.rgba.size() != std::size_t(image.width) * image.height * 4)
     return make_error(ErrorCode::invalid_argument,
                       fmt::format("cannot write '{}': the image is empty or malformed", name));
-  if (!stbi_write_png(name.c_str(), int(image.width), int(image.height), 4, image.rgba.data(),
+  if (!stb::write_png(name.c_str(), int(image.width), int(image.height), 4, image.rgba.data(),
                       int(image.width * 4)))
     return make_error(
         ErrorCode::io,
