@@ -11,6 +11,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "vkcloth/glm_abi.hpp"
 #include "vkcloth/result.hpp"
 
 namespace vkcloth {

@@ -235,8 +235,9 @@ inline void queue_transfer(const VolkDeviceTable& vk, VkCommandBuffer cmd, std::
   std::vector<VkBufferMemoryBarrier> b;
   for (VkBuffer buf : buffers)
     b.push_back(buffer(buf, release ? access : 0, release ? 0 : access, src_family, dst_family));
-  pipeline(vk, cmd, release ? stage : VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT,
-           release ? VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT : stage, b, {});
+  constexpr VkPipelineStageFlags top = VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT,
+                                 bottom = VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT;
+  pipeline(vk, cmd, release ? stage : top, release ? bottom : stage, b, {});
 }
 
 } // namespace vkcloth::gpu::barriers
