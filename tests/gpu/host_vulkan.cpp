@@ -23,7 +23,7 @@ VKAPI_ATTR VkBool32 VKAPI_CALL on_message(VkDebugUtilsMessageSeverityFlagBitsEXT
 
 } // namespace
 
-std::unique_ptr<HostVulkan> HostVulkan::create(std::string& error) {
+std::unique_ptr<HostVulkan> HostVulkan::create(std::string& error, bool separate_compute) {
   if (volkInitialize() != VK_SUCCESS)
     return error = "no Vulkan loader", nullptr;
   auto h = std::make_unique<HostVulkan>();
@@ -75,29 +75,42 @@ std::unique_ptr<HostVulkan> HostVulkan::create(std::string& error) {
     vkGetPhysicalDeviceQueueFamilyProperties(pd, &nf, nullptr);
     std::vector<VkQueueFamilyProperties> fams(nf);
     vkGetPhysicalDeviceQueueFamilyProperties(pd, &nf, fams.data());
-    for (std::uint32_t f = 0; f < nf; ++f)
-      if ((fams[f].queueFlags & VK_QUEUE_COMPUTE_BIT) && (fams[f].queueFlags & VK_QUEUE_GRAPHICS_BIT) &&
-          !h->physical_device) {
-        h->physical_device = pd;
-        h->family = f;
-      }
+    constexpr VkQueueFlags both = VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT;
+    std::uint32_t graphics = nf, compute_only = nf;
+    for (std::uint32_t f = 0; f < nf; ++f) {
+      if ((fams[f].queueFlags & both) == both && graphics == nf)
+        graphics = f;
+      if ((fams[f].queueFlags & both) == VK_QUEUE_COMPUTE_BIT && compute_only == nf)
+        compute_only = f;
+    }
+    if (h->physical_device || graphics == nf || (separate_compute && compute_only == nf))
+      continue;
+    h->physical_device = pd;
+    h->family = separate_compute ? compute_only : graphics;
+    h->graphics_family = graphics;
   }
   if (!h->physical_device)
-    return error = "no Vulkan 1.2 device with a graphics + compute queue", nullptr;
+    return error = separate_compute
+                       ? "no Vulkan 1.2 device with a compute-only queue family beside a graphics one"
+                       : "no Vulkan 1.2 device with a graphics + compute queue",
+           nullptr;
   const float priority = 1.0f;
-  VkDeviceQueueCreateInfo qi{};
-  qi.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
-  qi.queueFamilyIndex = h->family;
-  qi.queueCount = 1;
-  qi.pQueuePriorities = &priority;
+  VkDeviceQueueCreateInfo qi[2]{};
+  for (std::uint32_t k = 0; k < 2; ++k) {
+    qi[k].sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
+    qi[k].queueFamilyIndex = k == 0 ? h->family : h->graphics_family;
+    qi[k].queueCount = 1;
+    qi[k].pQueuePriorities = &priority;
+  }
   VkDeviceCreateInfo di{};
   di.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
-  di.queueCreateInfoCount = 1;
-  di.pQueueCreateInfos = &qi;
+  di.queueCreateInfoCount = h->graphics_family == h->family ? 1 : 2;
+  di.pQueueCreateInfos = qi;
   if (vkCreateDevice(h->physical_device, &di, nullptr, &h->device) != VK_SUCCESS)
     return error = "vkCreateDevice failed", nullptr;
   volkLoadDevice(h->device);
   vkGetDeviceQueue(h->device, h->family, 0, &h->queue);
+  vkGetDeviceQueue(h->device, h->graphics_family, 0, &h->graphics_queue);
   VkCommandPoolCreateInfo cp{};
   cp.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
   cp.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
@@ -121,6 +134,14 @@ std::unique_ptr<HostVulkan> HostVulkan::create(std::string& error) {
   si.sType = VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO;
   for (VkSemaphore& s : h->semaphores)
     vkCreateSemaphore(h->device, &si, nullptr, &s);
+  if (h->graphics_family != h->family) {
+    cp.queueFamilyIndex = h->graphics_family;
+    vkCreateCommandPool(h->device, &cp, nullptr, &h->graphics_pool);
+  }
+  ca.commandPool = h->graphics_pool ? h->graphics_pool : h->pool;
+  ca.commandBufferCount = 1;
+  vkAllocateCommandBuffers(h->device, &ca, &h->graphics_cmd);
+  vkCreateFence(h->device, &fi, nullptr, &h->graphics_fence); // signalled, as the frame fences
   return h;
 }
 
@@ -132,6 +153,10 @@ HostVulkan::~HostVulkan() {
     for (VkFence f : frame_fence)
       if (f)
         vkDestroyFence(device, f, nullptr);
+    if (graphics_fence)
+      vkDestroyFence(device, graphics_fence, nullptr);
+    if (graphics_pool)
+      vkDestroyCommandPool(device, graphics_pool, nullptr);
     if (scratch)
       vkDestroyBuffer(device, scratch, nullptr);
     if (scratch_memory)
@@ -199,7 +224,7 @@ bool HostVulkan::submit_frame(std::uint32_t k, VkSemaphore wait, VkPipelineStage
   return vkQueueSubmit(queue, 1, &si, frame_fence[k]) == VK_SUCCESS;
 }
 
-bool HostVulkan::record_read(VkCommandBuffer cmd, VkBuffer src, VkDeviceSize bytes, VkDeviceSize at) {
+bool HostVulkan::record_read(VkCommandBuffer target, VkBuffer src, VkDeviceSize bytes, VkDeviceSize at) {
   constexpr VkDeviceSize capacity = 1 << 20;
   if (at + bytes > capacity)
     return false;
@@ -221,12 +246,39 @@ bool HostVulkan::record_read(VkCommandBuffer cmd, VkBuffer src, VkDeviceSize byt
       return false;
   }
   const VkBufferCopy region{0, at, bytes};
-  vkCmdCopyBuffer(cmd, src, scratch, 1, &region);
+  vkCmdCopyBuffer(target, src, scratch, 1, &region);
   return true;
 }
 
+bool HostVulkan::begin_graphics() {
+  if (vkWaitForFences(device, 1, &graphics_fence, VK_TRUE, UINT64_MAX) != VK_SUCCESS ||
+      vkResetFences(device, 1, &graphics_fence) != VK_SUCCESS ||
+      vkResetCommandBuffer(graphics_cmd, 0) != VK_SUCCESS)
+    return false;
+  VkCommandBufferBeginInfo bi{};
+  bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+  bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  return vkBeginCommandBuffer(graphics_cmd, &bi) == VK_SUCCESS;
+}
+
+bool HostVulkan::submit_graphics(VkSemaphore wait, VkPipelineStageFlags wait_stage, VkSemaphore signal) {
+  if (vkEndCommandBuffer(graphics_cmd) != VK_SUCCESS)
+    return false;
+  VkSubmitInfo si{};
+  si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
+  si.commandBufferCount = 1;
+  si.pCommandBuffers = &graphics_cmd;
+  si.waitSemaphoreCount = wait ? 1 : 0;
+  si.pWaitSemaphores = &wait;
+  si.pWaitDstStageMask = &wait_stage;
+  si.signalSemaphoreCount = signal ? 1 : 0;
+  si.pSignalSemaphores = &signal;
+  return vkQueueSubmit(graphics_queue, 1, &si, graphics_fence) == VK_SUCCESS;
+}
+
 bool HostVulkan::wait_frames() {
-  return vkWaitForFences(device, frames_in_flight, frame_fence, VK_TRUE, UINT64_MAX) == VK_SUCCESS;
+  return vkWaitForFences(device, frames_in_flight, frame_fence, VK_TRUE, UINT64_MAX) == VK_SUCCESS &&
+         vkWaitForFences(device, 1, &graphics_fence, VK_TRUE, UINT64_MAX) == VK_SUCCESS;
 }
 
 bool HostVulkan::still_usable() {

@@ -32,9 +32,19 @@ struct HostVulkan {
   VkFence frame_fence[frames_in_flight] = {};
   /// Two binary semaphores for a compute -> graphics -> compute hand-over (submit_frame).
   VkSemaphore semaphores[2] = {};
+  /// The graphics side of a hand-over: `family` itself, or with separate_compute a graphics
+  /// family apart from `family` (a compute-only one); its own queue, pool, command buffer and
+  /// fence (begin_graphics / submit_graphics).
+  std::uint32_t graphics_family = 0;
+  VkQueue graphics_queue = VK_NULL_HANDLE;
+  VkCommandPool graphics_pool = VK_NULL_HANDLE; // null: `pool` (one family)
+  VkCommandBuffer graphics_cmd = VK_NULL_HANDLE;
+  VkFence graphics_fence = VK_NULL_HANDLE;
 
-  /// Null with `error` set when no Vulkan 1.2 device with a compute queue (or no validation layer).
-  static std::unique_ptr<HostVulkan> create(std::string& error);
+  /// Null with `error` set when no Vulkan 1.2 device with a graphics + compute queue (or no
+  /// validation layer). `separate_compute`: `family` is a compute-only family and
+  /// `graphics_family` another one with graphics (null when no device has both).
+  static std::unique_ptr<HostVulkan> create(std::string& error, bool separate_compute = false);
   HostVulkan() = default;
   HostVulkan(const HostVulkan&) = delete;
   HostVulkan& operator=(const HostVulkan&) = delete;
@@ -54,9 +64,12 @@ struct HostVulkan {
   /// Records a copy of `bytes` from `src` into the host's scratch buffer at `at` (device memory,
   /// created on first use, freed with the device): a stand-in for a draw that reads the cloth's
   /// buffers (copies to one region from two frames must be ordered by the host, as any write).
-  bool record_read(VkCommandBuffer cmd, VkBuffer src, VkDeviceSize bytes, VkDeviceSize at);
+  bool record_read(VkCommandBuffer target, VkBuffer src, VkDeviceSize bytes, VkDeviceSize at);
   VkBuffer scratch = VK_NULL_HANDLE;
   VkDeviceMemory scratch_memory = VK_NULL_HANDLE;
+  /// begin_frame / submit_frame for graphics_cmd on graphics_queue.
+  bool begin_graphics();
+  bool submit_graphics(VkSemaphore wait, VkPipelineStageFlags wait_stage, VkSemaphore signal);
   /// Waits for every frame slot's last submission.
   bool wait_frames();
   /// The host's device still works: creates and destroys a buffer, submits an empty command

@@ -613,14 +613,13 @@ TEST_CASE("flip_normals: the normals buffer points the other way, the physics is
   }
 }
 
-TEST_CASE("Queue-family hand-over in the documented order (one queue here): release/acquire and "
-          "semaphores, validation-clean, the bits of a plain run") {
-  VKCLOTH_GPU_TEST_BEGIN(ctx);
-  std::string error;
-  auto host = host_or_skip(error);
-  if (!host)
-    return;
-  auto adopted = Context::adopt(handles_of(*host, nullptr));
+namespace {
+
+/// docs/embedding.md section 6, frame by frame: the compute side in frame_cmd[0] on `queue`
+/// (family), the graphics side in graphics_cmd on graphics_queue (graphics_family), a semaphore
+/// each way, a copy standing in for the draw; then the positions against a plain run.
+void hand_over(HostVulkan& host, Context& reference_ctx) {
+  auto adopted = Context::adopt(handles_of(host, nullptr));
   REQUIRE(adopted.ok());
   auto topo = make_topology(10, 8);
   SimParams p;
@@ -629,45 +628,76 @@ TEST_CASE("Queue-family hand-over in the documented order (one queue here): rele
   REQUIRE(world.ok());
   auto id = world->add(topo, p);
   REQUIRE(id.ok());
-  // docs/embedding.md section 6 with compute family == graphics family (lavapipe has one family;
-  // the same calls with two families are the ownership transfers).
-  const std::uint32_t compute = host->family, graphics = host->family;
-  VkSemaphore simulated = host->semaphores[0], drawn = host->semaphores[1];
+  const std::uint32_t compute = host.family, graphics = host.graphics_family;
+  VkSemaphore simulated = host.semaphores[0], drawn = host.semaphores[1];
   constexpr int frames = 6;
   for (int f = 0; f < frames; ++f) {
-    REQUIRE(host->begin_frame(0)); // the compute queue's command buffer
-    VkCommandBuffer c = host->frame_cmd[0];
+    REQUIRE(host.begin_frame(0)); // the compute queue's command buffer
+    VkCommandBuffer c = host.frame_cmd[0];
     if (f > 0) // the buffers come back from the graphics family
       world->record_acquire(c, {graphics, compute, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                                 VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT});
     world->record_steps(c, 3);
     world->record_release(
         c, {compute, graphics, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT});
-    REQUIRE(host->submit_frame(0, f > 0 ? drawn : VK_NULL_HANDLE, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                               simulated));
+    REQUIRE(host.submit_frame(0, f > 0 ? drawn : VK_NULL_HANDLE, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                              simulated));
 
-    REQUIRE(host->begin_frame(1)); // the graphics queue's command buffer
-    VkCommandBuffer g = host->frame_cmd[1];
+    REQUIRE(host.begin_graphics());
+    VkCommandBuffer g = host.graphics_cmd;
     // A renderer acquires for VERTEX_INPUT and draws; this host reads the buffers with a copy
     // (TRANSFER), so synchronization validation sees a real read after the compute writes.
     world->record_acquire(g,
                           {compute, graphics, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT});
     const InstanceBuffers b = world->buffers(*id).value();
     const VkDeviceSize bytes = b.count * b.stride, at = 2 * bytes * VkDeviceSize(f);
-    REQUIRE(host->record_read(g, b.positions, bytes, at)); // each frame its own regions
-    REQUIRE(host->record_read(g, b.normals, bytes, at + bytes));
+    REQUIRE(host.record_read(g, b.positions, bytes, at)); // each frame its own regions
+    REQUIRE(host.record_read(g, b.normals, bytes, at + bytes));
     world->record_release(g, {graphics, compute, VK_PIPELINE_STAGE_TRANSFER_BIT, 0});
-    REQUIRE(host->submit_frame(1, simulated, VK_PIPELINE_STAGE_TRANSFER_BIT, drawn));
+    REQUIRE(host.submit_graphics(simulated, VK_PIPELINE_STAGE_TRANSFER_BIT, drawn));
   }
-  REQUIRE(host->wait_frames());
-  auto plain = GpuSolver::create(ctx, topo, p);
+  REQUIRE(host.wait_frames());
+  if (compute != graphics) { // the last frame's buffers are the graphics family's: take them back
+    REQUIRE(host.begin_frame(0));
+    world->record_acquire(host.frame_cmd[0], {graphics, compute, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                                              VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT});
+    REQUIRE(host.submit_frame(0, drawn, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_NULL_HANDLE));
+    REQUIRE(host.wait_frames());
+  }
+  auto plain = GpuSolver::create(reference_ctx, topo, p);
   REQUIRE(plain.ok());
   REQUIRE(plain->simulate(3 * frames).ok());
   const auto want = plain->positions();
   const auto got = world->positions(*id);
   REQUIRE((want && got));
   CHECK(diff(*got, *want).bitwise);
-  CHECK(host->messages.load() == 0);
+  CHECK(host.messages.load() == 0);
+}
+
+} // namespace
+
+TEST_CASE("Queue-family hand-over in the documented order, one queue: release/acquire and "
+          "semaphores, validation-clean, the bits of a plain run") {
+  VKCLOTH_GPU_TEST_BEGIN(ctx);
+  std::string error;
+  auto host = host_or_skip(error);
+  if (!host)
+    return;
+  REQUIRE(host->graphics_family == host->family);
+  hand_over(*host, ctx);
+}
+
+TEST_CASE("Queue-family hand-over between a compute-only family and a graphics family (where a "
+          "device has both: not lavapipe)") {
+  VKCLOTH_GPU_TEST_BEGIN(ctx);
+  std::string error;
+  auto host = HostVulkan::create(error, true);
+  if (!host) { // lavapipe has one family: this runs on a GPU with a dedicated compute family
+    MESSAGE("skipped: " << error);
+    return;
+  }
+  REQUIRE(host->graphics_family != host->family);
+  hand_over(*host, ctx);
 }
 
 TEST_CASE("interleaved_vertices: one 32-byte vertex per particle holds the current position, the "
