@@ -11,6 +11,7 @@
 //   embedding_host [--out embedding.png] [--frames 40] [--validate]
 #include <volk.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -330,6 +331,12 @@ int main(int argc, char** argv) {
       VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
       bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
       CHECK_VK(vkBeginCommandBuffer(cmd, &bi));
+      // The host's per-frame input: a gusting wind on the third cloth. StepParams travel in this
+      // command buffer, so this is safe with frames in flight too (docs/embedding.md section 4).
+      Wind gust = gusty.wind;
+      gust.strength = 0.12 * (1.0 + 0.5 * std::sin(0.3 * frame));
+      if (auto r = world->set_step_params(*c, {.wind = gust}); !r)
+        return std::fprintf(stderr, "%s\n", r.error().message.c_str()), 1;
       world->record_steps(cmd, 2); // compute: both cloths, 2 steps
       world->record_barrier_to(cmd, VK_PIPELINE_STAGE_VERTEX_INPUT_BIT, VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT);
       const VkClearValue clears[2] = {{{{0.62f, 0.72f, 0.84f, 1.0f}}}, {{{1.0f, 0}}}};
