@@ -44,7 +44,7 @@ status=0
 test_result='"skipped"'
 if ((tests)); then
   log=$(mktemp)
-  if CI=true ctest --preset release -R '^gpu:|^sample:|^render:' -j "$(nproc)" >"$log" 2>&1; then
+  if CI=true ctest --preset release -R '^(gpu|samples?|render|quickstart):' -j "$(nproc)" >"$log" 2>&1; then
     test_result='"passed"'
   else
     test_result='"failed"'
