@@ -73,7 +73,8 @@ struct InstanceBuffers {
   /// Unit normals pointing to the side from which `indices`' triangles wind counter-clockwise
   /// (GpuSolverOptions::flip_normals: the other side); zero for chains.
   VkBuffer normals = VK_NULL_HANDLE;
-  /// Texture coordinates (vec4: u, v, 0, 0): ClothTopology::uvs() or InitialState::uvs.
+  /// Texture coordinates (vec4: u, v, 0, 0): ClothTopology::uvs() (a grid's: ClothDesc::uvs or
+  /// uv_transform; a mesh's: its file's).
   VkBuffer uvs = VK_NULL_HANDLE;
   VkDeviceSize offset = 0;
   VkDeviceSize stride = 16; ///< GpuSolver::stride
@@ -93,13 +94,13 @@ struct InstanceBuffers {
 
 /// One half of a queue-family ownership transfer of the buffers a host draws from (current
 /// positions, normals, uvs), for compute and graphics queues of different families with
-/// EXCLUSIVE buffers (docs/embedding.md section 6 records a whole frame). Per frame:
-///   compute cmd, before record_steps: acquire {graphics -> compute, COMPUTE_SHADER, SHADER_READ |
-///   SHADER_WRITE} compute cmd, after record_steps:  release {compute -> graphics, COMPUTE_SHADER,
-///   SHADER_WRITE} graphics cmd, before drawing:     acquire {compute -> graphics, VERTEX_INPUT,
-///   VERTEX_ATTRIBUTE_READ} graphics cmd, after drawing:      release {graphics -> compute, VERTEX_INPUT, 0}
-/// each acquire after waiting on a semaphore signalled by the submission of its release (the
-/// first frame's first acquire is skipped: the buffers start on the Context's family).
+/// EXCLUSIVE buffers (docs/embedding.md section 6 records a whole frame). Per frame, four halves:
+/// (1) compute cmd, before record_steps: acquire {graphics, compute, COMPUTE_SHADER, SHADER_READ |
+/// SHADER_WRITE}, skipped in the first frame (the buffers start on the Context's family);
+/// (2) compute cmd, after record_steps: release {compute, graphics, COMPUTE_SHADER, SHADER_WRITE};
+/// (3) graphics cmd, before drawing: acquire {compute, graphics, VERTEX_INPUT,
+/// VERTEX_ATTRIBUTE_READ}; (4) graphics cmd, after drawing: release {graphics, compute,
+/// VERTEX_INPUT, 0}. Each acquire's submission waits on a semaphore that its release's signals.
 struct QueueTransfer {
   std::uint32_t src_family = 0;
   std::uint32_t dst_family = 0;
