@@ -131,3 +131,51 @@ TEST_CASE("Context: a device filter that selects nothing leaves nothing behind a
   REQUIRE(gpu.ok());
   CHECK(gpu->simulate(5).ok());
 }
+
+TEST_CASE("GpuSolver: the interleaved vertices and the tethers are held to the storage limit too, "
+          "the error naming the buffer") {
+  VKCLOTH_GPU_TEST_BEGIN(ctx);
+  ChainDesc chain; // 20 masses below an anchor: 21 particles, 40 gather entries
+  chain.masses.assign(20, 0.1);
+  chain.stiffness.assign(20, 50.0);
+  chain.rest_lengths.assign(20, 0.05);
+  chain.positions.clear();
+  for (int k = 1; k <= 20; ++k)
+    chain.positions.push_back({0.0, 0.0, -0.05 * k});
+  auto system = make_chain(chain);
+  REQUIRE(system.ok());
+  auto topo = ClothTopology::create(*system);
+  REQUIRE(topo.ok());
+  const std::uint64_t n = (*topo)->size();
+  // Every other buffer fits in 600 bytes; the vertices need 32 n = 672, the tethers 64 n = 1344.
+  REQUIRE(std::max<std::uint64_t>(
+              {16 * n, (*topo)->edges().size() * 12, (*topo)->strain_links().size() * 12}) <= 600);
+  testing::SolverKnobs knobs;
+  knobs.max_storage_buffer_bytes = 600;
+  CHECK(testing::create_solver(ctx, *topo, SimParams{}, {}, knobs).ok());
+  GpuSolverOptions interleaved;
+  interleaved.interleaved_vertices = true;
+  auto refused = testing::create_solver(ctx, *topo, SimParams{}, interleaved, knobs);
+  REQUIRE_FALSE(refused.ok());
+  CHECK(refused.error().code == ErrorCode::unsupported);
+  CHECK(refused.error().message.find("interleaved vertices buffer needs 672 bytes") != std::string::npos);
+
+  knobs.max_storage_buffer_bytes = 700;
+  SimParams tethered;
+  tethered.stretch_limit.method = StretchLimit::Method::tethers;
+  auto no_room = testing::create_solver(ctx, *topo, tethered, {}, knobs);
+  REQUIRE_FALSE(no_room.ok());
+  CHECK(no_room.error().message.find("tethers buffer needs 1344 bytes") != std::string::npos);
+  // Asked for later (set_params): the same refusal, and the solver keeps working without them.
+  auto plain = testing::create_solver(ctx, *topo, SimParams{}, {}, knobs);
+  REQUIRE(plain.ok());
+  auto later = plain->set_params(tethered);
+  REQUIRE_FALSE(later.ok());
+  CHECK(later.error().message.find("tethers") != std::string::npos);
+  CHECK_FALSE(plain->params().stretch_limit.enabled()); // the old parameters stay
+  REQUIRE(plain->simulate(5).ok());
+  auto reference = GpuSolver::create(ctx, *topo, SimParams{});
+  REQUIRE(reference.ok());
+  REQUIRE(reference->simulate(5).ok());
+  CHECK(test::diff(*plain->positions(), *reference->positions()).bitwise);
+}

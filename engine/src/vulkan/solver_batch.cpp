@@ -10,6 +10,7 @@
 #include <limits>
 #include <optional>
 #include <tuple>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -26,6 +27,31 @@ namespace {
 
 std::string vec_str(glm::vec3 v) {
   return fmt::format("({:.4g}, {:.4g}, {:.4g})", double(v.x), double(v.y), double(v.z));
+}
+
+/// The largest storage buffer: the device's maxStorageBufferRange, or the testing knob below it.
+struct StorageLimit {
+  std::uint64_t bytes;
+  const char* source;
+};
+StorageLimit storage_limit(const Context::Impl& ctx, const testing::SolverKnobs& knobs) {
+  const std::uint64_t device = ctx.properties.limits.maxStorageBufferRange;
+  if (knobs.max_storage_buffer_bytes && knobs.max_storage_buffer_bytes < device)
+    return {knobs.max_storage_buffer_bytes, "testing::SolverKnobs::max_storage_buffer_bytes"};
+  return {device, "maxStorageBufferRange"};
+}
+
+/// A buffer of `items` x `per` bytes within the storage limit, else the error naming both.
+Result<void> check_buffer(const Context::Impl& ctx, const StorageLimit& limit, const char* what,
+                          std::uint64_t items, std::uint64_t per) {
+  if (items * per <= limit.bytes)
+    return {};
+  return make_error(
+      ErrorCode::unsupported,
+      fmt::format("the system is too large for device '{}': its {} buffer needs {} bytes ({} x {} "
+                  "bytes) but a storage buffer may hold at most {} bytes ({}); use fewer "
+                  "particles or fewer instances of one topology",
+                  ctx.name, what, items * per, items, per, limit.bytes, limit.source));
 }
 
 } // namespace
@@ -245,12 +271,17 @@ InstanceBuffers SolverBatch::buffers(std::uint32_t slot) const {
 }
 
 Result<void> SolverBatch::set_params(std::uint32_t slot, SimParams params) {
-  slots[slot].params = std::move(params);
+  SimParams previous = std::exchange(slots[slot].params, std::move(params));
   params_dirty = true;
-  VKCLOTH_TRY(ensure_collider_capacity());
-  VKCLOTH_TRY(ensure_implicit());
-  VKCLOTH_TRY(ensure_fused());
-  return ensure_tethers();
+  auto done = [&]() -> Result<void> {
+    VKCLOTH_TRY(ensure_collider_capacity());
+    VKCLOTH_TRY(ensure_implicit());
+    VKCLOTH_TRY(ensure_fused());
+    return ensure_tethers();
+  }();
+  if (!done) // e.g. no room for the tethers: the instance keeps stepping with its old parameters
+    slots[slot].params = std::move(previous);
+  return done;
 }
 
 // The tethers of both rest-length kinds (VKCLOTH_BINDING_TETHERS: euclidean, then geodesic),
@@ -261,6 +292,15 @@ Result<void> SolverBatch::ensure_tethers() {
     wanted = wanted || s.params.stretch_limit.tethers();
   if (!wanted || tethers_uploaded)
     return {};
+  // Two kinds x tethers_per_particle slots per particle, one RG32UI texel each: within the limits?
+  const std::uint64_t slots_n = 2ull * count * tethers_per_particle;
+  VKCLOTH_TRY(check_buffer(*ctx, storage_limit(*ctx, knobs), "tethers", slots_n, sizeof(sh::TetherSlot)));
+  if (slots_n > ctx->properties.limits.maxTexelBufferElements)
+    return make_error(ErrorCode::unsupported,
+                      fmt::format("the system is too large for device '{}': its tethers need {} texels in a "
+                                  "texel buffer view but the device allows {} (maxTexelBufferElements); use "
+                                  "fewer particles or stretch_limit.method provot",
+                                  ctx->name, slots_n, ctx->properties.limits.maxTexelBufferElements));
   VKCLOTH_TRY(commands->wait_for_earlier_work()); // write_sets() below: no recorded work may use the sets
   static_assert(VKCLOTH_TETHERS_PER_PARTICLE == tethers_per_particle && VKCLOTH_NO_TETHER == no_tether);
   std::vector<sh::TetherSlot> data;
@@ -445,37 +485,30 @@ struct DispatchGrid {
 };
 
 /// The device limits a batch of `batch` instances of `topology` must fit, checked before any
-/// allocation; errors name the buffer or dispatch and the limit.
+/// allocation; errors name the buffer or dispatch and the limit. (The tethers, made when first
+/// asked for, are checked then: ensure_tethers.)
 Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ClothTopology& topology,
-                                  std::uint64_t batch, const testing::SolverKnobs& knobs) {
+                                  std::uint64_t batch, const GpuSolverOptions& options,
+                                  const testing::SolverKnobs& knobs) {
   const bool fan_lists = SolverBatch::normals_of(topology, knobs) == SolverBatch::Normals::fans;
   const std::uint64_t n = topology.size();
   const VkPhysicalDeviceLimits& lim = ctx.properties.limits;
-  std::uint64_t max_bytes = lim.maxStorageBufferRange;
-  const bool overridden = knobs.max_storage_buffer_bytes && knobs.max_storage_buffer_bytes < max_bytes;
-  if (overridden)
-    max_bytes = knobs.max_storage_buffer_bytes;
+  const StorageLimit limit = storage_limit(ctx, knobs);
   const std::uint64_t edges_n = topology.edges().size();
   const std::uint64_t fans_n = fan_lists ? topology.fans().size() : 0;
+  const std::uint64_t links_n = topology.strain_links().size();
   const struct {
     const char* what;
-    std::uint64_t bytes;
-    std::uint64_t per;
     std::uint64_t items;
-  } needs[] = {{"per-particle (vec4)", batch * n * 16, 16, batch * n},
-               {"spring adjacency", edges_n * sizeof(sh::Edge), sizeof(sh::Edge), edges_n},
-               {"normal fans", fans_n * sizeof(sh::FanEntry), sizeof(sh::FanEntry), fans_n},
-               {"particle constants", n * sizeof(sh::ParticleInfo), sizeof(sh::ParticleInfo), n}};
+    std::uint64_t per;
+  } needs[] = {{"per-particle (vec4)", batch * n, 16},
+               {"spring adjacency", edges_n, sizeof(sh::Edge)},
+               {"normal fans", fans_n, sizeof(sh::FanEntry)},
+               {"particle constants", n, sizeof(sh::ParticleInfo)},
+               {"strain links", links_n, sizeof(sh::StrainLink)},
+               {"interleaved vertices", options.interleaved_vertices ? batch * n : 0, sizeof(sh::Vertex)}};
   for (const auto& need : needs)
-    if (need.bytes > max_bytes)
-      return make_error(
-          ErrorCode::unsupported,
-          fmt::format("the system is too large for device '{}': its {} buffer needs {} bytes ({} x {} "
-                      "bytes) but a storage buffer may hold at most {} bytes ({}); use fewer particles "
-                      "or fewer instances of one topology",
-                      ctx.name, need.what, need.bytes, need.items, need.per, max_bytes,
-                      overridden ? "testing::SolverKnobs::max_storage_buffer_bytes"
-                                 : "maxStorageBufferRange"));
+    VKCLOTH_TRY(check_buffer(ctx, limit, need.what, need.items, need.per));
   // Positions, velocities and particle constants are also read through texel buffer views (one
   // texel per particle of every instance).
   if (batch * n > lim.maxTexelBufferElements)
@@ -492,6 +525,7 @@ Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ClothTopology&
     std::uint64_t texels;
   } lists[] = {{"spring adjacency offsets", n + 1},
                {"spring adjacency", edges_n * VKCLOTH_EDGE_TEXELS},
+               {"strain links", links_n * 3}, // three R32UI texels each
                {"normal fan offsets", fan_lists ? n + 1 : 0},
                {"normal fans", fans_n}};
   for (const auto& list : lists)
@@ -723,7 +757,7 @@ SolverBatch::create(const std::shared_ptr<Context::Impl>& ctx, CommandContext& c
                     const std::vector<SlotState>& states) {
   for (SimParams& p : params)
     VKCLOTH_TRY(p.validate());
-  auto grid = check_limits(*ctx, topology, params.size(), knobs);
+  auto grid = check_limits(*ctx, topology, params.size(), options, knobs);
   if (!grid)
     return grid.error();
 
