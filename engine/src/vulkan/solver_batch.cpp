@@ -54,6 +54,19 @@ Result<void> check_buffer(const Context::Impl& ctx, const StorageLimit& limit, c
                   ctx.name, what, items * per, items, per, limit.bytes, limit.source));
 }
 
+/// A texel buffer view of `texels` texels within maxTexelBufferElements, else the error naming
+/// `what` and the limit, ending with `advice`.
+Result<void> check_texels(const Context::Impl& ctx, const char* what, std::uint64_t texels,
+                          const char* advice) {
+  const std::uint64_t max = ctx.properties.limits.maxTexelBufferElements;
+  if (texels <= max)
+    return {};
+  return make_error(ErrorCode::unsupported,
+                    fmt::format("the system is too large for device '{}': its {} need {} texels in a texel "
+                                "buffer view but the device allows {} (maxTexelBufferElements); {}",
+                                ctx.name, what, texels, max, advice));
+}
+
 } // namespace
 
 // The collider buffer holds every instance's colliders (InstanceParams::collider_first); more
@@ -216,8 +229,7 @@ Result<std::vector<glm::vec3>> SolverBatch::read(Field field, std::uint32_t slot
 Result<std::vector<float>> SolverBatch::read_vertices(std::uint32_t slot) {
   if (!options.interleaved_vertices)
     return make_error(ErrorCode::invalid_argument, "the solver was created without interleaved_vertices");
-  return read_floats(vertices, VkDeviceSize(slot) * count * sizeof(sh::Vertex),
-                     VkDeviceSize(count) * sizeof(sh::Vertex));
+  return read_floats(vertices, vertex_offset(slot), VkDeviceSize(count) * sizeof(sh::Vertex));
 }
 
 void SolverBatch::refresh_flags() {
@@ -256,7 +268,7 @@ InstanceBuffers SolverBatch::buffers(std::uint32_t slot) const {
   InstanceBuffers b;
   if (options.interleaved_vertices) {
     b.vertices = vertices.buffer;
-    b.vertex_offset = VkDeviceSize(slot) * count * sizeof(sh::Vertex);
+    b.vertex_offset = vertex_offset(slot);
   }
   b.positions = pos[parity].buffer;
   b.normals = normal.buffer;
@@ -295,16 +307,11 @@ Result<void> SolverBatch::ensure_tethers() {
   // Two kinds x tethers_per_particle slots per particle, one RG32UI texel each: within the limits?
   const std::uint64_t slots_n = 2ull * count * tethers_per_particle;
   VKCLOTH_TRY(check_buffer(*ctx, storage_limit(*ctx, knobs), "tethers", slots_n, sizeof(sh::TetherSlot)));
-  if (slots_n > ctx->properties.limits.maxTexelBufferElements)
-    return make_error(ErrorCode::unsupported,
-                      fmt::format("the system is too large for device '{}': its tethers need {} texels in a "
-                                  "texel buffer view but the device allows {} (maxTexelBufferElements); use "
-                                  "fewer particles or stretch_limit.method provot",
-                                  ctx->name, slots_n, ctx->properties.limits.maxTexelBufferElements));
+  VKCLOTH_TRY(check_texels(*ctx, "tethers", slots_n, "use fewer particles or stretch_limit.method provot"));
   VKCLOTH_TRY(commands->wait_for_earlier_work()); // write_sets() below: no recorded work may use the sets
   static_assert(VKCLOTH_TETHERS_PER_PARTICLE == tethers_per_particle && VKCLOTH_NO_TETHER == no_tether);
   std::vector<sh::TetherSlot> data;
-  data.reserve(2 * std::size_t(count) * tethers_per_particle);
+  data.reserve(slots_n);
   for (auto kind : {StretchLimit::TetherDistance::euclidean, StretchLimit::TetherDistance::geodesic})
     for (const Tether& t : batch_topology->tethers(kind))
       data.push_back({t.anchor, float(t.rest_length)});
@@ -529,12 +536,7 @@ Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ClothTopology&
                {"normal fan offsets", fan_lists ? n + 1 : 0},
                {"normal fans", fans_n}};
   for (const auto& list : lists)
-    if (list.texels > lim.maxTexelBufferElements)
-      return make_error(ErrorCode::unsupported,
-                        fmt::format("the system is too large for device '{}': its {} need {} texels in a "
-                                    "texel buffer view but the device allows {} (maxTexelBufferElements); "
-                                    "use fewer springs or particles",
-                                    ctx.name, list.what, list.texels, lim.maxTexelBufferElements));
+    VKCLOTH_TRY(check_texels(ctx, list.what, list.texels, "use fewer springs or particles"));
   const std::uint64_t groups = (n + VKCLOTH_WORKGROUP_SIZE - 1) / VKCLOTH_WORKGROUP_SIZE;
   std::uint64_t row = lim.maxComputeWorkGroupCount[0];
   if (knobs.max_workgroups_x)

@@ -205,6 +205,9 @@ private:
     return VkDeviceSize(slot) * count * GpuSolver::stride;
   }
   VkDeviceSize slot_bytes() const { return VkDeviceSize(count) * GpuSolver::stride; }
+  VkDeviceSize vertex_offset(std::uint32_t slot) const {
+    return VkDeviceSize(slot) * count * sizeof(shared::Vertex);
+  }
   std::size_t strain_link_count() const { return strain_colours.empty() ? 0 : strain_colours.back(); }
   const Buffer& buffer_of(Field field) const;
   Result<std::vector<float>> read_floats(const Buffer& b, VkDeviceSize offset, VkDeviceSize bytes);
