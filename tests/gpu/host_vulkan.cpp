@@ -175,22 +175,11 @@ HostVulkan::~HostVulkan() {
 }
 
 bool HostVulkan::begin() {
-  if (vkResetCommandBuffer(cmd, 0) != VK_SUCCESS)
-    return false;
-  VkCommandBufferBeginInfo bi{};
-  bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
-  bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  return vkBeginCommandBuffer(cmd, &bi) == VK_SUCCESS;
+  return begin_one_time(cmd);
 }
 
 bool HostVulkan::submit_and_wait() {
-  if (vkEndCommandBuffer(cmd) != VK_SUCCESS)
-    return false;
-  VkSubmitInfo si{};
-  si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
-  si.commandBufferCount = 1;
-  si.pCommandBuffers = &cmd;
-  if (vkQueueSubmit(queue, 1, &si, fence) != VK_SUCCESS)
+  if (!end_and_submit(queue, cmd, fence, VK_NULL_HANDLE, 0, VK_NULL_HANDLE))
     return false;
   const bool ok = vkWaitForFences(device, 1, &fence, VK_TRUE, UINT64_MAX) == VK_SUCCESS;
   vkResetFences(device, 1, &fence);
@@ -198,30 +187,12 @@ bool HostVulkan::submit_and_wait() {
 }
 
 bool HostVulkan::begin_frame(std::uint32_t k) {
-  if (vkWaitForFences(device, 1, &frame_fence[k], VK_TRUE, UINT64_MAX) != VK_SUCCESS ||
-      vkResetFences(device, 1, &frame_fence[k]) != VK_SUCCESS ||
-      vkResetCommandBuffer(frame_cmd[k], 0) != VK_SUCCESS)
-    return false;
-  VkCommandBufferBeginInfo bi{};
-  bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
-  bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  return vkBeginCommandBuffer(frame_cmd[k], &bi) == VK_SUCCESS;
+  return wait_and_reset(frame_fence[k]) && begin_one_time(frame_cmd[k]);
 }
 
 bool HostVulkan::submit_frame(std::uint32_t k, VkSemaphore wait, VkPipelineStageFlags wait_stage,
                               VkSemaphore signal) {
-  if (vkEndCommandBuffer(frame_cmd[k]) != VK_SUCCESS)
-    return false;
-  VkSubmitInfo si{};
-  si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
-  si.commandBufferCount = 1;
-  si.pCommandBuffers = &frame_cmd[k];
-  si.waitSemaphoreCount = wait ? 1 : 0;
-  si.pWaitSemaphores = &wait;
-  si.pWaitDstStageMask = &wait_stage;
-  si.signalSemaphoreCount = signal ? 1 : 0;
-  si.pSignalSemaphores = &signal;
-  return vkQueueSubmit(queue, 1, &si, frame_fence[k]) == VK_SUCCESS;
+  return end_and_submit(queue, frame_cmd[k], frame_fence[k], wait, wait_stage, signal);
 }
 
 bool HostVulkan::record_read(VkCommandBuffer target, VkBuffer src, VkDeviceSize bytes, VkDeviceSize at) {
@@ -251,29 +222,41 @@ bool HostVulkan::record_read(VkCommandBuffer target, VkBuffer src, VkDeviceSize 
 }
 
 bool HostVulkan::begin_graphics() {
-  if (vkWaitForFences(device, 1, &graphics_fence, VK_TRUE, UINT64_MAX) != VK_SUCCESS ||
-      vkResetFences(device, 1, &graphics_fence) != VK_SUCCESS ||
-      vkResetCommandBuffer(graphics_cmd, 0) != VK_SUCCESS)
+  return wait_and_reset(graphics_fence) && begin_one_time(graphics_cmd);
+}
+
+bool HostVulkan::submit_graphics(VkSemaphore wait, VkPipelineStageFlags wait_stage, VkSemaphore signal) {
+  return end_and_submit(graphics_queue, graphics_cmd, graphics_fence, wait, wait_stage, signal);
+}
+
+bool HostVulkan::wait_and_reset(VkFence f) {
+  return vkWaitForFences(device, 1, &f, VK_TRUE, UINT64_MAX) == VK_SUCCESS &&
+         vkResetFences(device, 1, &f) == VK_SUCCESS;
+}
+
+bool HostVulkan::begin_one_time(VkCommandBuffer c) {
+  if (vkResetCommandBuffer(c, 0) != VK_SUCCESS)
     return false;
   VkCommandBufferBeginInfo bi{};
   bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
   bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  return vkBeginCommandBuffer(graphics_cmd, &bi) == VK_SUCCESS;
+  return vkBeginCommandBuffer(c, &bi) == VK_SUCCESS;
 }
 
-bool HostVulkan::submit_graphics(VkSemaphore wait, VkPipelineStageFlags wait_stage, VkSemaphore signal) {
-  if (vkEndCommandBuffer(graphics_cmd) != VK_SUCCESS)
+bool HostVulkan::end_and_submit(VkQueue q, VkCommandBuffer c, VkFence f, VkSemaphore wait,
+                                VkPipelineStageFlags wait_stage, VkSemaphore signal) {
+  if (vkEndCommandBuffer(c) != VK_SUCCESS)
     return false;
   VkSubmitInfo si{};
   si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
   si.commandBufferCount = 1;
-  si.pCommandBuffers = &graphics_cmd;
+  si.pCommandBuffers = &c;
   si.waitSemaphoreCount = wait ? 1 : 0;
   si.pWaitSemaphores = &wait;
   si.pWaitDstStageMask = &wait_stage;
   si.signalSemaphoreCount = signal ? 1 : 0;
   si.pSignalSemaphores = &signal;
-  return vkQueueSubmit(graphics_queue, 1, &si, graphics_fence) == VK_SUCCESS;
+  return vkQueueSubmit(q, 1, &si, f) == VK_SUCCESS;
 }
 
 bool HostVulkan::wait_frames() {

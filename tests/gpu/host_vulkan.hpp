@@ -72,6 +72,12 @@ struct HostVulkan {
   bool submit_graphics(VkSemaphore wait, VkPipelineStageFlags wait_stage, VkSemaphore signal);
   /// Waits for every frame slot's last submission.
   bool wait_frames();
+  /// The shared steps of the calls above: wait for a fence and reset it; reset and begin a command
+  /// buffer for one submission; end it and submit it on `q` with an optional semaphore each way.
+  bool wait_and_reset(VkFence f);
+  static bool begin_one_time(VkCommandBuffer c);
+  static bool end_and_submit(VkQueue q, VkCommandBuffer c, VkFence f, VkSemaphore wait,
+                             VkPipelineStageFlags wait_stage, VkSemaphore signal);
   /// The host's device still works: creates and destroys a buffer, submits an empty command
   /// buffer and waits, vkDeviceWaitIdle.
   bool still_usable();
