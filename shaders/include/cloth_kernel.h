@@ -295,6 +295,51 @@ KFN precise vec3 implicit_rhs(vec3 f, vec3 kv, real h) {
   return r;
 }
 
+// Block-Jacobi preconditioner (docs/model.md "Implicit Euler"): P_p = A_pp, the particle's full
+// 3x3 diagonal block (1 + h mu) m I + h^2 sum_q K_pq, inverted once per step.
+KFN void add_block(INOUT(SpringBlock) sum, SpringBlock k) {
+  precise vec3 d = sum.diag + k.diag;
+  precise vec3 o = sum.off + k.off;
+  sum.diag = d;
+  sum.off = o;
+}
+KFN SpringBlock implicit_diagonal_block(real mu_h, real m, SpringBlock ksum, real h2) {
+  SpringBlock a;
+  a.diag = implicit_diagonal(mu_h, m, ksum.diag, h2);
+  precise vec3 o = ksum.off * h2;
+  a.off = o;
+  return a;
+}
+// The inverse of a symmetric positive definite block: adjugate over determinant (A_pp is SPD:
+// (1 + h mu) m > 0 plus a positive semi-definite sum, so det > 0).
+KFN SpringBlock invert_block(SpringBlock a) {
+  const real xx = a.diag.x, yy = a.diag.y, zz = a.diag.z;
+  const real xy = a.off.x, xz = a.off.y, yz = a.off.z;
+  precise real c_xx = yy * zz - yz * yz, c_yy = xx * zz - xz * xz, c_zz = xx * yy - xy * xy;
+  precise real c_xy = xz * yz - xy * zz, c_xz = xy * yz - xz * yy, c_yz = xy * xz - xx * yz;
+  precise real det = xx * c_xx + xy * c_xy;
+  det = det + xz * c_xz;
+  precise real inv = real(1) / det;
+  SpringBlock r;
+  precise vec3 d = vec3(c_xx, c_yy, c_zz) * inv;
+  precise vec3 o = vec3(c_xy, c_xz, c_yz) * inv;
+  r.diag = d;
+  r.off = o;
+  return r;
+}
+// |h m g|^2: a particle's share of the weight impulse, the scale CG's tolerance is relative to
+// when it exceeds |S b| (near equilibrium b tends to zero: implicit_euler.hpp).
+KFN precise real weight_impulse2(real h, real m, vec3 g) {
+  precise real hm = h * m;
+  precise real w = hm * hm * dot3(g, g);
+  return w;
+}
+// The warm start's residual b - S A x0 (x0: the previous solve's dv).
+KFN precise vec3 residual_of(vec3 b, vec3 ax) {
+  precise vec3 r = b - ax;
+  return r;
+}
+
 // ---- Divergence (docs/model.md "Divergence") -------------------------------------------
 
 // A particle has diverged when a component of x or v is NaN or inf, or |x_i| > limit.

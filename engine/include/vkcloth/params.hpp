@@ -27,8 +27,12 @@ enum class Integrator : std::uint32_t {
 
 /// What the last implicit solve achieved (zero for the explicit integrators).
 struct SolveStats {
-  std::uint32_t iterations = 0; ///< CG iterations of the last (sub)step
-  double residual = 0.0;        ///< |r| / |S b| at the end (0 when the right-hand side is 0)
+  std::uint32_t iterations = 0;       ///< CG iterations of the last (sub)step
+  double residual = 0.0;              ///< |r| / |S b| at the end (0 when the right-hand side is 0)
+  std::uint64_t total_iterations = 0; ///< CG iterations of every solve since the solver was made
+  std::uint64_t solves = 0;           ///< implicit (sub)steps solved since the solver was made
+  /// Mean CG iterations per solve (0 before the first).
+  double mean_iterations() const { return solves ? double(total_iterations) / double(solves) : 0.0; }
 };
 
 const char* to_string(Integrator integrator);

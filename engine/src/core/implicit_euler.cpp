@@ -30,8 +30,9 @@ template <typename Real> void CpuSolver<Real>::implicit_substep(const Real h) {
   auto& w = *implicit_;
   if (w.x.size() != n) {
     w.ks.assign(edges_.size(), {});
-    for (auto* v : {&w.vf, &w.diag_inv, &w.x, &w.r, &w.z, &w.d, &w.q})
-      v->assign(n, Vec3(0));
+    w.block_inv.assign(n, {});
+    for (auto* v : {&w.vf, &w.x, &w.b, &w.r, &w.z, &w.d, &w.q})
+      v->assign(n, Vec3(0)); // x = 0: the first solve starts cold
   }
   // 1. Forces and contact filtering as in the explicit step.
   pool_->for_each(pos_.size(), [&](std::size_t p) {
@@ -47,7 +48,8 @@ template <typename Real> void CpuSolver<Real>::implicit_substep(const Real h) {
   implicit_update(h);
 }
 
-// 2. Per-entry K_s, the Jacobi diagonal, b = h (f - h L v) filtered; r = b, z = P^-1 r, d = z.
+// 2. Per-entry K_s, the block-Jacobi preconditioner, b = h (f - h L v) filtered, and the warm
+// start's residual r = b - S A x0 (x0: the previous dv, read-only here); z = P^-1 r, d = z.
 template <typename Real> void CpuSolver<Real>::implicit_system(const Real h) {
   auto& w = *implicit_;
   const Real mu_h = Real(1) + h * Real(params_.damping); // M - h D = (1 + h mu) M
@@ -55,24 +57,27 @@ template <typename Real> void CpuSolver<Real>::implicit_system(const Real h) {
   pool_->for_each(pos_.size(), [&](std::size_t p) {
     const Vec3 x = pos_[p];
     const Vec3 vp = w.vf[p];
+    const Vec3 x0 = w.x[p];
     Vec3 lv(0);
-    Vec3 ksum(0);
+    Vec3 lx(0);
+    kernel::SpringBlock<Real> ksum{Vec3(0), Vec3(0)};
     for (std::uint32_t e = edge_offsets_[p]; e < edge_offsets_[p + 1]; ++e) {
       const Edge& s = edges_[e];
       const auto k = kernel::spring_block(pos_[s.other] - x, s.rest_length, s.stiffness);
       w.ks[e] = k;
       lv += kernel::apply_block(k, vp - w.vf[s.other]);
-      ksum += k.diag;
+      lx += kernel::apply_block(k, x0 - w.x[s.other]);
+      kernel::add_block(ksum, k);
     }
-    const Vec3 diag = kernel::implicit_diagonal(mu_h, mass_[p], ksum, h2);
-    w.x[p] = Vec3(0);
     if (pinned_[p]) {
-      w.diag_inv[p] = w.r[p] = w.z[p] = w.d[p] = Vec3(0);
+      w.block_inv[p] = {Vec3(0), Vec3(0)};
+      w.b[p] = w.r[p] = w.z[p] = w.d[p] = Vec3(0);
       return;
     }
-    w.diag_inv[p] = Vec3(1) / diag;
-    w.r[p] = kernel::implicit_rhs(force_[p], lv, h);
-    w.z[p] = w.r[p] * w.diag_inv[p];
+    w.block_inv[p] = kernel::invert_block(kernel::implicit_diagonal_block(mu_h, mass_[p], ksum, h2));
+    w.b[p] = kernel::implicit_rhs(force_[p], lv, h);
+    w.r[p] = kernel::residual_of(w.b[p], kernel::implicit_row(x0, mu_h, mass_[p], lx, h2));
+    w.z[p] = kernel::apply_block(w.block_inv[p], w.r[p]);
     w.d[p] = w.z[p];
   });
 }
@@ -82,12 +87,26 @@ template <typename Real> void CpuSolver<Real>::implicit_cg(const Real h) {
   auto& w = *implicit_;
   const Real mu_h = Real(1) + h * Real(params_.damping);
   const Real h2 = h * h;
-  Real rz = dot_all<Real>(w.r, w.z);
+  const Real bb = dot_all<Real>(w.b, w.b);
+  const Vec3 g{params_.gravity};
+  Real ww = Real(0); // |S h M g|^2, summed in particle order
+  for (std::size_t p = 0; p < pos_.size(); ++p)
+    if (!pinned_[p])
+      ww += kernel::weight_impulse2(h, mass_[p], g);
+  const Real ref2 = std::max(bb, ww);
   Real rr = dot_all<Real>(w.r, w.r);
-  const Real rr0 = rr;
+  if (!(rr <= bb)) { // the warm start is worse than none (or not finite): start from dv = 0
+    pool_->for_each(pos_.size(), [&](std::size_t p) {
+      w.x[p] = Vec3(0);
+      w.r[p] = w.b[p];
+      w.z[p] = w.d[p] = kernel::apply_block(w.block_inv[p], w.b[p]);
+    });
+    rr = bb;
+  }
+  Real rz = dot_all<Real>(w.r, w.z);
   const Real tol2 = Real(params_.cg_tolerance) * Real(params_.cg_tolerance);
   std::uint32_t it = 0;
-  while (it < params_.cg_max_iterations && !(rr <= tol2 * rr0)) {
+  while (it < params_.cg_max_iterations && !(rr <= tol2 * ref2)) {
     pool_->for_each(pos_.size(), [&](std::size_t p) { // q = S A d
       if (pinned_[p]) {
         w.q[p] = Vec3(0);
@@ -106,19 +125,21 @@ template <typename Real> void CpuSolver<Real>::implicit_cg(const Real h) {
     pool_->for_each(pos_.size(), [&](std::size_t p) {
       w.x[p] += w.d[p] * alpha;
       w.r[p] -= w.q[p] * alpha;
-      w.z[p] = w.r[p] * w.diag_inv[p];
+      w.z[p] = kernel::apply_block(w.block_inv[p], w.r[p]);
     });
     const Real rz_new = dot_all<Real>(w.r, w.z);
     rr = dot_all<Real>(w.r, w.r);
     const Real beta = rz_new / rz;
     rz = rz_new;
     ++it;
-    if (rr <= tol2 * rr0)
+    if (rr <= tol2 * ref2)
       break; // converged: d is not needed any more
     pool_->for_each(pos_.size(), [&](std::size_t p) { w.d[p] = w.z[p] + w.d[p] * beta; });
   }
   solve_.iterations = it;
-  solve_.residual = rr0 > Real(0) ? std::sqrt(double(rr) / double(rr0)) : 0.0;
+  solve_.residual = ref2 > Real(0) ? std::sqrt(double(rr) / double(ref2)) : 0.0;
+  solve_.total_iterations += it;
+  ++solve_.solves;
 }
 
 // 4. v' = v + dv, the inward part removed in contact; x' = x + h v', projected. Only particle p's
