@@ -3,8 +3,11 @@
 #extension GL_GOOGLE_include_directive : require
 // Implicit Euler passes (engine/src/core/implicit_euler.hpp for the method), one invocation per
 // particle; PushConstants::stage selects the pass (VKCLOTH_IMPL_*). The CG passes write one
-// partial dot-product pair per workgroup (fixed-shape shared-memory tree, no atomics) that
+// partial dot-product vec4 per workgroup (fixed-shape shared-memory tree, no atomics) that
 // implicit_reduce.comp sums in a fixed order: deterministic, but not the CPU's sequential order.
+// VKCLOTH_IMPL_SOLVE_FIRST / SOLVE instead run many CG iterations in ONE workgroup (each
+// invocation strides over the particles; workgroup barriers between the phases), for systems
+// small enough that the dispatches of the per-iteration passes cost more than their work.
 #include "implicit_shared.h"
 #include "common.glsl"
 #include "force_body.glsl"
@@ -15,41 +18,155 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_POS_OUT) writeonly buffer PosO
 layout(std430, set = 0, binding = VKCLOTH_BINDING_VEL) buffer VelBuf { vec4 vel[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_IMPL_VF) buffer VfBuf { vec4 vf[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_IMPL_KS) buffer KsBuf { vec4 ks[]; };
-layout(std430, set = 0, binding = VKCLOTH_BINDING_IMPL_DIAG_INV) buffer DiagBuf { vec4 diag_inv[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_IMPL_BLOCK_INV) buffer BlockInvBuf { vec4 block_inv[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_IMPL_X) buffer XBuf { vec4 cx[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_IMPL_R) buffer RBuf { vec4 cr[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_IMPL_Z) buffer ZBuf { vec4 cz[]; };
-layout(std430, set = 0, binding = VKCLOTH_BINDING_IMPL_D) buffer DBuf { vec4 cd[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_IMPL_D) coherent buffer DBuf { vec4 cd[]; }; // SOLVE: read by neighbours
 layout(std430, set = 0, binding = VKCLOTH_BINDING_IMPL_Q) buffer QBuf { vec4 cq[]; };
-layout(std430, set = 0, binding = VKCLOTH_BINDING_IMPL_PARTIALS) writeonly buffer PartialBuf { vec2 partials[]; };
-layout(std430, set = 0, binding = VKCLOTH_BINDING_IMPL_STATE) readonly buffer StateBuf { CgState cg; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_IMPL_PARTIALS) buffer PartialBuf { vec4 partials[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_IMPL_STATE) buffer StateBuf { CgState cg; }; // SOLVE writes it
 
 #include "finish.glsl"
 
-shared vec2 red[VKCLOTH_WORKGROUP_SIZE];
+shared vec4 red[VKCLOTH_WORKGROUP_SIZE];
 
-// Fixed-shape tree over the workgroup; every invocation must call it (uniform control flow).
-void workgroup_partial(vec2 value) {
+// Fixed-shape tree over the workgroup, the sum left in red[0]; every invocation must call it
+// (uniform control flow).
+void workgroup_tree(vec4 value) {
   const uint l = gl_LocalInvocationID.x;
   red[l] = value;
   barrier();
   for (uint s = VKCLOTH_WORKGROUP_SIZE / 2; s > 0u; s >>= 1) {
     if (l < s) {
-      precise vec2 t = red[l] + red[l + s];
+      precise vec4 t = red[l] + red[l + s];
       red[l] = t;
     }
     barrier();
   }
-  if (l == 0u) partials[gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x] = red[0];
+}
+void workgroup_partial(vec4 value) {
+  workgroup_tree(value);
+  if (gl_LocalInvocationID.x == 0u) partials[gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x] = red[0];
+}
+// The workgroup's sum, to every invocation (the last barrier: everyone has read red[0] before the
+// next call overwrites it).
+vec4 workgroup_sum(vec4 value) {
+  workgroup_tree(value);
+  const vec4 s = red[0];
+  barrier();
+  return s;
 }
 
-// Edge e's stiffness block, stored as two vec4: (xx yy zz xy), (xz yz 0 0).
-SpringBlock block_at(uint e) {
-  const vec4 a = ks[2u * e], b = ks[2u * e + 1u];
+// Edge e's stiffness block and particle p's P^-1, stored as two vec4: (xx yy zz xy), (xz yz 0 0).
+SpringBlock unpack_block(vec4 a, vec4 b) {
   SpringBlock s;
   s.diag = a.xyz;
   s.off = vec3(a.w, b.x, b.y);
   return s;
+}
+SpringBlock block_at(uint e) { return unpack_block(ks[2u * e], ks[2u * e + 1u]); }
+SpringBlock precond_at(uint p) { return unpack_block(block_inv[2u * p], block_inv[2u * p + 1u]); }
+void store_precond(uint p, SpringBlock s) {
+  block_inv[2u * p] = vec4(s.diag, s.off.x);
+  block_inv[2u * p + 1u] = vec4(s.off.y, s.off.z, 0.0, 0.0);
+}
+
+// q = S A d for particle p (zero for a pinned one).
+vec3 matvec_row(uint p, bool pinned, float mu_h, float h2) {
+  precise vec3 q = vec3(0.0);
+  if (!pinned) {
+    const vec3 dp = cd[p].xyz;
+    precise vec3 s = vec3(0.0);
+    const uint end = offsets[p + 1];
+    for (uint e = offsets[p]; e < end; ++e) s = s + apply_block(block_at(e), dp - cd[edges[e].other].xyz);
+    q = implicit_row(dp, mu_h, particle[p].mass, s, h2);
+  }
+  return q;
+}
+
+// x += alpha d, r -= alpha q, z = P^-1 r for particle p; returns (r.z, r.r, 0, 0).
+vec4 update_row(uint p, float alpha) {
+  precise vec3 x = cx[p].xyz + cd[p].xyz * alpha;
+  precise vec3 r = cr[p].xyz - cq[p].xyz * alpha;
+  const vec3 z = apply_block(precond_at(p), r);
+  cx[p] = vec4(x, 0.0);
+  cr[p] = vec4(r, 0.0);
+  cz[p] = vec4(z, 0.0);
+  return vec4(dot3(r, z), dot3(r, r), 0.0, 0.0);
+}
+
+// VKCLOTH_IMPL_SOLVE_FIRST / SOLVE: up to pc.nx CG iterations of implicit_euler.hpp in ONE
+// workgroup, continuing from CgState (SOLVE_FIRST starts from SYSTEM's partials). The host
+// bounds pc.nx so that no invocation runs more than ~30 000 loop iterations per dispatch:
+// llvmpipe (Mesa 22.3) ends any loop after 65 535 iterations of an invocation, silently.
+// The sums: each invocation adds its particles in order, then the fixed tree. Control flow is
+// uniform (every invocation computes the same scalars from red[0]); the loop has one exit, at
+// the top. cd is the only array read across particles (neighbours' d in the matvec): written,
+// then memoryBarrierBuffer + barrier before it is read.
+void solve_in_one_workgroup(bool first, float mu_h, float h2) {
+  const uint l = gl_LocalInvocationID.x;
+  const uint n = pc.count;
+  const float tol2 = pc.c_next;
+  float rz, rr, ref2;
+  uint it;
+  if (first) {
+    precise vec4 acc = vec4(0.0);
+    for (uint i = l; i < pc.pad1; i += VKCLOTH_WORKGROUP_SIZE) acc = acc + partials[i]; // SYSTEM's
+    const vec4 init = workgroup_sum(acc);
+    rz = init.x;
+    rr = init.y;
+    ref2 = max(init.z, init.w); // max(|S b|^2, |S h M g|^2): implicit_euler.hpp
+    it = 0u;
+  } else {
+    if (cg.done != 0u) return; // uniform: converged in an earlier dispatch
+    rz = cg.rz;
+    rr = cg.rr;
+    ref2 = cg.ref2;
+    it = cg.iterations;
+  }
+  const uint it_start = it;
+  bool done = rr <= tol2 * ref2 || it >= pc.pad0;
+  uint budget = pc.nx;
+  while (!done && budget > 0u) {
+    precise float dq_l = 0.0;
+    for (uint p = l; p < n; p += VKCLOTH_WORKGROUP_SIZE) {
+      const vec3 q = matvec_row(p, particle[p].pinned != 0u, mu_h, h2);
+      cq[p] = vec4(q, 0.0);
+      dq_l = dq_l + dot3(cd[p].xyz, q);
+    }
+    const float dq = workgroup_sum(vec4(dq_l, 0.0, 0.0, 0.0)).x;
+    const bool descends = dq > 0.0; // else stop, as the CPU does (an SPD A: only at d = 0)
+    const float alpha = descends ? rz / dq : 0.0;
+    precise vec4 upd = vec4(0.0);
+    if (descends)
+      for (uint p = l; p < n; p += VKCLOTH_WORKGROUP_SIZE) upd = upd + update_row(p, alpha);
+    const vec4 sums = workgroup_sum(upd);
+    if (descends) {
+      const float beta = sums.x / rz;
+      rz = sums.x;
+      rr = sums.y;
+      ++it;
+      for (uint p = l; p < n; p += VKCLOTH_WORKGROUP_SIZE) {
+        precise vec3 d = cz[p].xyz + cd[p].xyz * beta;
+        cd[p] = vec4(d, 0.0);
+      }
+    }
+    done = !descends || rr <= tol2 * ref2 || it >= pc.pad0;
+    --budget;
+    memoryBarrierBuffer(); // the new d, before the neighbours' matvec reads it
+    barrier();             // (and every read of cg above, before invocation 0 rewrites it)
+  }
+  if (first) barrier(); // the loop may not have run: the partials' readers before the writes below
+  if (l == 0u) {
+    cg.rz = rz;
+    cg.rr = rr;
+    cg.ref2 = ref2;
+    cg.iterations = it;
+    cg.total_iterations = cg.total_iterations + (it - it_start);
+    if (first) cg.solves = cg.solves + 1u;
+    cg.done = done ? 1u : 0u;
+  }
 }
 
 void main() {
@@ -74,12 +191,18 @@ void main() {
   }
   if (mode == VKCLOTH_IMPL_SYSTEM) {
     if (frozen()) return; // uniform
-    vec2 part = vec2(0.0);
+    vec4 part = vec4(0.0);
     if (live) {
       const vec3 x = pos_in[p].xyz;
       const vec3 vp = vf[p].xyz;
+      const bool warm = cg.solves != 0u; // else x is not written yet: x0 = 0
+      const vec3 x0 = warm ? cx[p].xyz : vec3(0.0);
+      if (!warm) cx[p] = vec4(0.0); // neighbours read cx only when warm: no race
       precise vec3 lv = vec3(0.0);
-      precise vec3 ksum = vec3(0.0);
+      precise vec3 lx = vec3(0.0);
+      SpringBlock ksum;
+      ksum.diag = vec3(0.0);
+      ksum.off = vec3(0.0);
       const uint end = offsets[p + 1];
       for (uint e = offsets[p]; e < end; ++e) {
         const Edge s = edges[e];
@@ -87,55 +210,49 @@ void main() {
         ks[2u * e] = vec4(k.diag, k.off.x);
         ks[2u * e + 1u] = vec4(k.off.y, k.off.z, 0.0, 0.0);
         lv = lv + apply_block(k, vp - vf[s.other].xyz);
-        ksum = ksum + k.diag;
+        lx = lx + apply_block(k, x0 - (warm ? cx[s.other].xyz : vec3(0.0)));
+        add_block(ksum, k);
       }
-      const vec3 diag = implicit_diagonal(mu_h, particle[p].mass, ksum, h2);
-      cx[p] = vec4(0.0);
       if (pinned) {
-        diag_inv[p] = cr[p] = cz[p] = cd[p] = vec4(0.0);
+        SpringBlock zero;
+        zero.diag = vec3(0.0);
+        zero.off = vec3(0.0);
+        store_precond(p, zero);
+        cr[p] = cz[p] = cd[p] = vec4(0.0);
       } else {
-        precise vec3 di = vec3(1.0) / diag;
-        const vec3 r = implicit_rhs(force_out[p].xyz, lv, h);
-        precise vec3 z = r * di;
-        diag_inv[p] = vec4(di, 0.0);
+        const float m = particle[p].mass;
+        const SpringBlock pinv = invert_block(implicit_diagonal_block(mu_h, m, ksum, h2));
+        const vec3 b = implicit_rhs(force_out[p].xyz, lv, h);
+        const vec3 r = residual_of(b, implicit_row(x0, mu_h, m, lx, h2));
+        const vec3 z = apply_block(pinv, r);
+        store_precond(p, pinv);
         cr[p] = vec4(r, 0.0);
         cz[p] = vec4(z, 0.0);
         cd[p] = vec4(z, 0.0);
-        part = vec2(dot3(r, z), dot3(r, r));
+        part = vec4(dot3(r, z), dot3(r, r), dot3(b, b), weight_impulse2(h, m, ip.gravity_damping.xyz));
       }
     }
     workgroup_partial(part);
     return;
   }
   if (mode == VKCLOTH_IMPL_MATVEC) {
-    vec2 part = vec2(0.0);
+    vec4 part = vec4(0.0);
     if (live) {
-      precise vec3 q = vec3(0.0);
-      const vec3 dp = cd[p].xyz;
-      if (!pinned) {
-        precise vec3 s = vec3(0.0);
-        const uint end = offsets[p + 1];
-        for (uint e = offsets[p]; e < end; ++e) s = s + apply_block(block_at(e), dp - cd[edges[e].other].xyz);
-        q = implicit_row(dp, mu_h, particle[p].mass, s, h2);
-      }
+      const vec3 q = matvec_row(p, pinned, mu_h, h2);
       cq[p] = vec4(q, 0.0);
-      part = vec2(dot3(dp, q), 0.0);
+      part = vec4(dot3(cd[p].xyz, q), 0.0, 0.0, 0.0);
     }
     workgroup_partial(part);
     return;
   }
+  if (mode == VKCLOTH_IMPL_SOLVE_FIRST || mode == VKCLOTH_IMPL_SOLVE) {
+    if (frozen()) return; // uniform
+    solve_in_one_workgroup(mode == VKCLOTH_IMPL_SOLVE_FIRST, mu_h, h2);
+    return;
+  }
   if (mode == VKCLOTH_IMPL_UPDATE) {
-    vec2 part = vec2(0.0);
-    if (live) {
-      const float alpha = cg.alpha;
-      precise vec3 x = cx[p].xyz + cd[p].xyz * alpha;
-      precise vec3 r = cr[p].xyz - cq[p].xyz * alpha;
-      precise vec3 z = r * diag_inv[p].xyz;
-      cx[p] = vec4(x, 0.0);
-      cr[p] = vec4(r, 0.0);
-      cz[p] = vec4(z, 0.0);
-      part = vec2(dot3(r, z), dot3(r, r));
-    }
+    vec4 part = vec4(0.0);
+    if (live) part = update_row(p, cg.alpha);
     workgroup_partial(part);
     return;
   }

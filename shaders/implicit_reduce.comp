@@ -10,37 +10,38 @@
 
 layout(local_size_x = VKCLOTH_WORKGROUP_SIZE) in;
 layout(push_constant) uniform PushBlock { PushConstants pc; };
-layout(std430, set = 0, binding = VKCLOTH_BINDING_IMPL_PARTIALS) readonly buffer PartialBuf { vec2 partials[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_IMPL_PARTIALS) readonly buffer PartialBuf { vec4 partials[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_IMPL_STATE) buffer StateBuf { CgState cg; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_IMPL_ARGS) writeonly buffer ArgBuf { CgArgs args; };
 
-shared vec2 red[VKCLOTH_WORKGROUP_SIZE];
+shared vec4 red[VKCLOTH_WORKGROUP_SIZE];
 
 void main() {
   const uint l = gl_LocalInvocationID.x;
-  precise vec2 s = vec2(0.0);
+  precise vec4 s = vec4(0.0);
   for (uint i = l; i < pc.pad1; i += VKCLOTH_WORKGROUP_SIZE) s = s + partials[i];
   red[l] = s;
   barrier();
   for (uint k = VKCLOTH_WORKGROUP_SIZE / 2; k > 0u; k >>= 1) {
     if (l < k) {
-      precise vec2 t = red[l] + red[l + k];
+      precise vec4 t = red[l] + red[l + k];
       red[l] = t;
     }
     barrier();
   }
   if (l != 0u) return;
-  const vec2 sum = red[0];
+  const vec4 sum = red[0];
   const float tol2 = pc.c_next;
   bool done = cg.done != 0u;
   if (pc.stage == VKCLOTH_REDUCE_INIT) {
     cg.rz = sum.x;
     cg.rr = sum.y;
-    cg.rr0 = sum.y;
+    cg.ref2 = max(sum.z, sum.w); // max(|S b|^2, |S h M g|^2): implicit_euler.hpp
     cg.alpha = 0.0;
     cg.beta = 0.0;
     cg.iterations = 0u;
-    done = sum.y <= tol2 * sum.y;
+    cg.solves = cg.solves + 1u;
+    done = sum.y <= tol2 * cg.ref2;
   } else if (pc.stage == VKCLOTH_REDUCE_ALPHA) {
     if (!(sum.x > 0.0))
       done = true;
@@ -51,7 +52,8 @@ void main() {
     cg.rz = sum.x;
     cg.rr = sum.y;
     cg.iterations = cg.iterations + 1u;
-    done = sum.y <= tol2 * cg.rr0 || cg.iterations >= pc.pad0;
+    cg.total_iterations = cg.total_iterations + 1u;
+    done = sum.y <= tol2 * cg.ref2 || cg.iterations >= pc.pad0;
   }
   cg.done = done ? 1u : 0u;
   args.particle_x = done ? 0u : cg.groups_x;

@@ -14,45 +14,50 @@
 namespace vkcloth::gpu::shared {
 #endif
 
-#define VKCLOTH_BINDING_IMPL_VF 24       // contact-filtered velocity (vec4)
-#define VKCLOTH_BINDING_IMPL_KS 25       // per CSR entry: K_s as 2 vec4 (xx yy zz xy | xz yz - -)
-#define VKCLOTH_BINDING_IMPL_DIAG_INV 26 // 1 / diag(A), zero for pinned particles (vec4)
-#define VKCLOTH_BINDING_IMPL_X 27        // CG solution dv (vec4)
-#define VKCLOTH_BINDING_IMPL_R 28        // residual
-#define VKCLOTH_BINDING_IMPL_Z 29        // preconditioned residual
-#define VKCLOTH_BINDING_IMPL_D 30        // search direction
-#define VKCLOTH_BINDING_IMPL_Q 31        // S A d
-#define VKCLOTH_BINDING_IMPL_PARTIALS 32 // one vec2 per workgroup: its partial dot products
+#define VKCLOTH_BINDING_IMPL_VF 24 // contact-filtered velocity (vec4)
+#define VKCLOTH_BINDING_IMPL_KS 25 // per CSR entry: K_s as 2 vec4 (xx yy zz xy | xz yz - -)
+#define VKCLOTH_BINDING_IMPL_BLOCK_INV                                                                       \
+  26                              // P^-1: inverse diagonal block of A, 2 vec4 (xx yy zz xy | xz yz - -)
+#define VKCLOTH_BINDING_IMPL_X 27 // CG solution dv (vec4), kept between solves (warm start)
+#define VKCLOTH_BINDING_IMPL_R 28 // residual
+#define VKCLOTH_BINDING_IMPL_Z 29 // preconditioned residual
+#define VKCLOTH_BINDING_IMPL_D 30 // search direction
+#define VKCLOTH_BINDING_IMPL_Q 31 // S A d
+#define VKCLOTH_BINDING_IMPL_PARTIALS 32 // one vec4 per workgroup: its partial dot products
 #define VKCLOTH_BINDING_IMPL_STATE 33    // CgState
 #define VKCLOTH_BINDING_IMPL_ARGS 34     // indirect dispatch arguments (CgArgs)
 
 // implicit.comp passes (PushConstants::stage).
-#define VKCLOTH_IMPL_FORCE 0u     // normal, force, contact filtering -> FORCE_OUT, NORMAL, VF
-#define VKCLOTH_IMPL_SYSTEM 1u    // K_s per entry, diag, b -> r, z, d; partials (r.z, r.r)
-#define VKCLOTH_IMPL_MATVEC 2u    // q = S A d; partials (d.q, 0)
-#define VKCLOTH_IMPL_UPDATE 3u    // x += alpha d, r -= alpha q, z = P^-1 r; partials (r.z, r.r)
-#define VKCLOTH_IMPL_DIRECTION 4u // d = z + beta d
-#define VKCLOTH_IMPL_FINISH 5u    // v' = v + x, contacts, x' = x + h v', projection, flags
+#define VKCLOTH_IMPL_FORCE 0u // normal, force, contact filtering -> FORCE_OUT, NORMAL, VF
+#define VKCLOTH_IMPL_SYSTEM                                                                                  \
+  1u // K_s per entry, P^-1, b, r = b - S A x0 -> r, z, d; partials (r.z, r.r, b.b, w.w)
+#define VKCLOTH_IMPL_MATVEC 2u      // q = S A d; partials (d.q, 0, 0, 0)
+#define VKCLOTH_IMPL_UPDATE 3u      // x += alpha d, r -= alpha q, z = P^-1 r; partials (r.z, r.r, 0, 0)
+#define VKCLOTH_IMPL_DIRECTION 4u   // d = z + beta d
+#define VKCLOTH_IMPL_FINISH 5u      // v' = v + x, contacts, x' = x + h v', projection, flags
+#define VKCLOTH_IMPL_SOLVE_FIRST 6u // ONE workgroup: INIT's sums, then up to nx CG iterations
+#define VKCLOTH_IMPL_SOLVE 7u       // ONE workgroup: up to nx more CG iterations (until done)
 // implicit_reduce.comp modes (PushConstants::stage).
-#define VKCLOTH_REDUCE_INIT 0u  // rz, rr, rr0 from SYSTEM's partials
+#define VKCLOTH_REDUCE_INIT 0u  // rz, rr, ref2 from SYSTEM's partials; solves + 1
 #define VKCLOTH_REDUCE_ALPHA 1u // alpha = rz / d.q (stop if d.q <= 0)
 #define VKCLOTH_REDUCE_BETA 2u  // beta = rz_new / rz, iterations + 1, convergence test
 // Repurposed PushConstants fields (unused by the implicit passes otherwise):
-//   c_next = cg_tolerance^2, pad0 = cg_max_iterations, pad1 = number of partials (workgroups).
+//   c_next = cg_tolerance^2, pad0 = cg_max_iterations, pad1 = number of partials (workgroups);
+//   SOLVE_FIRST / SOLVE: nx = the dispatch's iteration budget (the CG loop needs no grid size).
 
-/// CG scalars, written only by implicit_reduce.comp (one invocation).
+/// CG scalars, written only by implicit_reduce.comp or the SOLVE pass (one invocation).
 struct CgState {
   float rz;
   float rr;
-  float rr0;
+  float ref2; // the tolerance's reference: max(|S b|^2, |S h M g|^2)
   float alpha;
   float beta;
   uint done; // 1: converged / stopped; the remaining passes are dispatched with zero groups
   uint iterations;
-  uint pad0;
-  uint groups_x; // the particle passes' dispatch size (set by the host at creation)
+  uint total_iterations; // over every solve since creation (wraps at 2^32)
+  uint groups_x;         // the particle passes' dispatch size (set by the host at creation)
   uint groups_y;
-  uint pad1;
+  uint solves; // solves since creation; 0: no dv to warm-start from yet
   uint pad2;
 };
 

@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "barriers.hpp"
+#include "implicit_gpu.hpp"
 #include "vkcloth/gpu/gpu_solver.hpp"
 #include "vkcloth/gpu/testing.hpp"
 #include "world_impl.hpp"
@@ -167,6 +168,9 @@ VkBuffer GpuSolver::uv_buffer() const {
 }
 SolveStats GpuSolver::last_solve() const {
   return impl_->batch().last_solve();
+}
+bool GpuSolver::implicit_one_workgroup() const {
+  return impl_->batch().implicit_one_workgroup();
 }
 double GpuSolver::last_gpu_ms() const {
   return impl_->w().last_ms;

@@ -21,12 +21,13 @@ namespace sh = shared;
 Result<std::unique_ptr<ImplicitGpu>> ImplicitGpu::create(const std::shared_ptr<Context::Impl>& ctx,
                                                          std::uint32_t count, std::uint64_t entries,
                                                          std::uint32_t groups_x, std::uint32_t groups_y,
-                                                         bool allow_map) {
+                                                         std::uint32_t one_workgroup_budget, bool allow_map) {
   std::unique_ptr<ImplicitGpu> s(new ImplicitGpu());
   s->ctx_ = ctx;
   s->count_ = count;
   s->groups_x_ = groups_x;
   s->groups_y_ = groups_y;
+  s->budget_ = one_workgroup_budget;
   VKCLOTH_TRY(s->create_buffers(entries, allow_map));
   VKCLOTH_TRY(s->create_pipelines());
   return s;
@@ -39,14 +40,14 @@ Result<void> ImplicitGpu::create_buffers(std::uint64_t entries, bool allow_map) 
   const std::uint64_t groups = std::uint64_t(groups_x_) * groups_y_;
   const std::tuple<Buffer*, VkDeviceSize, const char*> device_buffers[] = {
       {&vf_, vec4_bytes, "implicit: filtered velocities"},
-      {&diag_inv_, vec4_bytes, "implicit: Jacobi diagonal"},
+      {&block_inv_, 2 * vec4_bytes, "implicit: block-Jacobi preconditioner"},
       {&x_, vec4_bytes, "implicit: CG x"},
       {&r_, vec4_bytes, "implicit: CG r"},
       {&z_, vec4_bytes, "implicit: CG z"},
       {&d_, vec4_bytes, "implicit: CG d"},
       {&q_, vec4_bytes, "implicit: CG q"},
       {&ks_, std::max<VkDeviceSize>(entries * 32, 32), "implicit: spring blocks"},
-      {&partials_, std::max<VkDeviceSize>(groups * 8, 16), "implicit: partial sums"}};
+      {&partials_, std::max<VkDeviceSize>(groups * 16, 16), "implicit: partial sums"}};
   for (auto [b, bytes, what] : device_buffers) {
     auto r = create_buffer(ctx, bytes, usage, MemoryUse::device, allow_map, what);
     if (!r)
@@ -165,8 +166,8 @@ Result<void> ImplicitGpu::write_sets(const ImplicitInputs& in) {
       case VKCLOTH_BINDING_IMPL_KS:
         b = ks_.buffer;
         break;
-      case VKCLOTH_BINDING_IMPL_DIAG_INV:
-        b = diag_inv_.buffer;
+      case VKCLOTH_BINDING_IMPL_BLOCK_INV:
+        b = block_inv_.buffer;
         break;
       case VKCLOTH_BINDING_IMPL_X:
         b = x_.buffer;
@@ -217,6 +218,8 @@ std::uint32_t ImplicitGpu::record_substep(VkCommandBuffer c, std::uint32_t read,
   std::uint32_t dispatches = 0;
   VkPipeline bound = VK_NULL_HANDLE;
   const VkPipeline pass_pipe = pass_, reduce_pipe = reduce_; // raw handles, for the lambda's comparisons
+  constexpr int solve = -2, direct = -1, particles = offsetof(sh::CgArgs, particle_x),
+                reduce = offsetof(sh::CgArgs, reduce_x);
   auto pass = [&](VkPipeline pipe, std::uint32_t stage, int indirect_offset) {
     if (need_barrier)
       barriers::implicit_pass(v, c); // previous pass -> this one (RAW, WAR, indirect args)
@@ -230,15 +233,23 @@ std::uint32_t ImplicitGpu::record_substep(VkCommandBuffer c, std::uint32_t read,
     v.vkCmdPushConstants(c, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
     if (indirect_offset >= 0)
       v.vkCmdDispatchIndirect(c, args_.buffer, VkDeviceSize(indirect_offset));
-    else if (pipe == reduce_pipe)
-      v.vkCmdDispatch(c, 1, 1, 1);
+    else if (pipe == reduce_pipe || indirect_offset == solve)
+      v.vkCmdDispatch(c, 1, 1, 1); // one workgroup
     else
       v.vkCmdDispatch(c, groups_x_, groups_y_, 1);
   };
-  constexpr int direct = -1, particles = offsetof(sh::CgArgs, particle_x),
-                reduce = offsetof(sh::CgArgs, reduce_x);
   pass(pass_pipe, VKCLOTH_IMPL_FORCE, direct);
   pass(pass_pipe, VKCLOTH_IMPL_SYSTEM, direct);
+  if (budget_ > 0) {
+    const std::uint32_t nx = pc.nx;
+    pc.nx = budget_; // SOLVE's iteration budget (implicit_shared.h)
+    pass(pass_pipe, VKCLOTH_IMPL_SOLVE_FIRST, solve);
+    for (std::uint32_t it = budget_; it < params.cg_max_iterations; it += budget_)
+      pass(pass_pipe, VKCLOTH_IMPL_SOLVE, solve);
+    pc.nx = nx;
+    pass(pass_pipe, VKCLOTH_IMPL_FINISH, direct);
+    return dispatches;
+  }
   pass(reduce_pipe, VKCLOTH_REDUCE_INIT, direct);
   for (std::uint32_t it = 0; it < params.cg_max_iterations; ++it) {
     pass(pass_pipe, VKCLOTH_IMPL_MATVEC, particles);
@@ -251,12 +262,24 @@ std::uint32_t ImplicitGpu::record_substep(VkCommandBuffer c, std::uint32_t read,
   return dispatches;
 }
 
+std::uint32_t ImplicitGpu::iteration_budget(std::uint32_t count, std::uint32_t max_degree) {
+  // Per CG iteration, an invocation loops ceil(count / 64) times in each of the matvec (plus
+  // its springs), update and direction loops, 2 x 6 times in the two tree sums, once outside;
+  // SOLVE_FIRST adds the partials' loop (<= ceil(count / 64) too).
+  const std::uint64_t rows = (std::uint64_t(count) + VKCLOTH_WORKGROUP_SIZE - 1) / VKCLOTH_WORKGROUP_SIZE;
+  const std::uint64_t per_iteration = rows * (3 + std::uint64_t(max_degree)) + 13;
+  const std::uint64_t room = rows < 30000 ? 30000 - rows : 0;
+  return std::uint32_t(std::min<std::uint64_t>(room / per_iteration, 1024)); // 0: too large
+}
+
 SolveStats ImplicitGpu::stats() const {
   sh::CgState s{};
   std::memcpy(&s, state_.mapped, sizeof(s));
   SolveStats r;
   r.iterations = s.iterations;
-  r.residual = s.rr0 > 0.0f ? std::sqrt(double(s.rr) / double(s.rr0)) : 0.0;
+  r.residual = s.ref2 > 0.0f ? std::sqrt(double(s.rr) / double(s.ref2)) : 0.0;
+  r.total_iterations = s.total_iterations;
+  r.solves = s.solves;
   return r;
 }
 

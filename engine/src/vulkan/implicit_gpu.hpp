@@ -1,16 +1,21 @@
 // SPDX-License-Identifier: MIT
 // The implicit-Euler step on Vulkan (internal to GpuSolver): the CPU reference's linearised
 // backward Euler + PCG (engine/src/core/implicit_euler.hpp) as compute passes, recorded without a
-// CPU round trip per iteration. Per substep:
+// CPU round trip per iteration. Per substep, either (per_iteration)
 //
 //   FORCE -> SYSTEM -> reduce(INIT) -> cg_max_iterations x [ MATVEC -> reduce(ALPHA) -> UPDATE
 //          -> reduce(BETA) -> DIRECTION ] -> FINISH
 //
-// one barrier between consecutive passes (barriers::implicit_pass). Every reduce rewrites the
-// indirect dispatch arguments of the CG passes and of the next reduce: zero groups once converged,
-// so the iterations left are empty dispatches. Dot products: a fixed-shape tree per workgroup, then
-// one workgroup sums the partials in a fixed order (deterministic; not the CPU's sequential sum,
-// hence results equal the CPU's to rounding, not bit for bit).
+// where every reduce rewrites the indirect dispatch arguments of the CG passes and of the next
+// reduce (zero groups once converged, so the iterations left are empty dispatches), or
+// (one_workgroup, small systems)
+//
+//   FORCE -> SYSTEM -> SOLVE_FIRST -> ceil(cg_max_iterations / K) - 1 x SOLVE -> FINISH
+//
+// where each SOLVE is one workgroup running up to K iterations (iteration_budget) and an empty
+// one once converged; one barrier between consecutive passes (barriers::implicit_pass). Dot products: a
+// fixed-shape tree per workgroup, then one workgroup sums the partials in a fixed order (deterministic; not
+// the CPU's sequential sum, hence results equal the CPU's to rounding, not bit for bit).
 #pragma once
 
 #include <cstdint>
@@ -34,7 +39,12 @@ public:
   static Result<std::unique_ptr<ImplicitGpu>> create(const std::shared_ptr<Context::Impl>& ctx,
                                                      std::uint32_t count, std::uint64_t entries,
                                                      std::uint32_t groups_x, std::uint32_t groups_y,
-                                                     bool allow_map);
+                                                     std::uint32_t one_workgroup_budget, bool allow_map);
+  /// CG iterations one workgroup may run in one dispatch for `count` particles of at most
+  /// `max_degree` springs: about 30 000 loop iterations per invocation, half of llvmpipe's
+  /// silent cap on one loop (65 535); 0 when even one iteration would not fit. 0 in create():
+  /// the per-iteration passes instead.
+  static std::uint32_t iteration_budget(std::uint32_t count, std::uint32_t max_degree);
   ImplicitGpu(const ImplicitGpu&) = delete;
   ImplicitGpu& operator=(const ImplicitGpu&) = delete;
 
@@ -45,6 +55,7 @@ public:
   /// first pass. Returns the number of dispatches recorded.
   std::uint32_t record_substep(VkCommandBuffer cmd, std::uint32_t read, shared::PushConstants pc,
                                const SimParams& params, bool first);
+  bool one_workgroup() const { return budget_ > 0; }
   /// The last completed solve (host-visible state; valid once the recorded work finished).
   SolveStats stats() const;
 
@@ -52,7 +63,8 @@ private:
   ImplicitGpu() = default;
   std::shared_ptr<Context::Impl> ctx_;
   std::uint32_t count_ = 0, groups_x_ = 1, groups_y_ = 1;
-  Buffer vf_, ks_, diag_inv_, x_, r_, z_, d_, q_, partials_, state_, args_;
+  std::uint32_t budget_ = 0; ///< CG iterations per SOLVE dispatch; 0: per-iteration passes
+  Buffer vf_, ks_, block_inv_, x_, r_, z_, d_, q_, partials_, state_, args_;
   DescriptorPool pool_;
   VkDescriptorSet sets_[2] = {};
   // The Context's (PipelineRegistry), shared by every implicit batch.

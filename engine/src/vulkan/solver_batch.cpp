@@ -334,7 +334,26 @@ Result<void> SolverBatch::ensure_tethers() {
 Result<void> SolverBatch::ensure_implicit() {
   if (family().integrator != Integrator::implicit_euler || implicit)
     return {};
-  auto r = ImplicitGpu::create(ctx, count, edges_count, groups_x, groups_y, !knobs.force_staging);
+  using D = GpuSolverOptions::CgDispatch;
+  std::uint32_t max_degree = 0;
+  const auto offsets = batch_topology->edge_offsets();
+  for (std::size_t p = 0; p + 1 < offsets.size(); ++p)
+    max_degree = std::max(max_degree, offsets[p + 1] - offsets[p]);
+  const std::uint32_t budget = ImplicitGpu::iteration_budget(count, max_degree);
+  if (options.cg_dispatch == D::one_workgroup && budget == 0)
+    return make_error(
+        ErrorCode::unsupported,
+        fmt::format("GpuSolverOptions::cg_dispatch = one_workgroup: {} particles with up to {} springs "
+                    "each are too many for one workgroup; use automatic or per_iteration",
+                    count, max_degree));
+  // automatic: one workgroup only where it was measured to win (lavapipe, docs/performance.md);
+  // a GPU runs a single workgroup on one of its many compute units.
+  const bool cpu_device = ctx->properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+  const bool one_workgroup = options.cg_dispatch == D::one_workgroup ||
+                             (options.cg_dispatch == D::automatic && cpu_device && budget > 0 &&
+                              count <= implicit_one_workgroup_max_particles);
+  auto r = ImplicitGpu::create(ctx, count, edges_count, groups_x, groups_y, one_workgroup ? budget : 0,
+                               !knobs.force_staging);
   if (!r)
     return r.error();
   implicit = std::move(*r);

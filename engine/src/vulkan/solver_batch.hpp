@@ -97,6 +97,7 @@ public:
   VkBuffer velocity_buffer() const { return vel.buffer; }
   const std::vector<glm::vec2>& uvs() const { return uvs_; }
   SolveStats last_solve() const { return implicit ? implicit->stats() : SolveStats{}; }
+  bool implicit_one_workgroup() const { return implicit && implicit->one_workgroup(); }
   bool uses_staging() const { return staging; }
 
   /// Where the force pass takes the vertex normals from (one choice per batch: its topology's).

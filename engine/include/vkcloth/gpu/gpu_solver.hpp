@@ -62,7 +62,19 @@ struct GpuSolverOptions {
   /// for a host pipeline with one vertex binding. One extra dispatch at the end of every
   /// recording; the buffer holds the state after it (zero before the first recording).
   bool interleaved_vertices = false;
+  /// implicit_euler: where the CG iterations run. `one_workgroup`: one workgroup runs dozens of
+  /// iterations per dispatch (a few dispatches per substep instead of 3 + 5 per iteration; each
+  /// iteration costs more, since one workgroup does all the work); an error (unsupported) for a
+  /// cloth too large for one workgroup. `per_iteration`: every iteration's passes over all
+  /// particles. `automatic`: one_workgroup on a CPU-type device (lavapipe) up to
+  /// implicit_one_workgroup_max_particles particles, per_iteration otherwise
+  /// (docs/performance.md "Implicit Euler").
+  enum class CgDispatch { automatic, one_workgroup, per_iteration };
+  CgDispatch cg_dispatch = CgDispatch::automatic;
 };
+
+/// CgDispatch::automatic's limit for one_workgroup (measured on lavapipe: docs/performance.md).
+inline constexpr std::uint32_t implicit_one_workgroup_max_particles = 16384;
 
 /// Where an instance's per-particle data lives, for the host's own drawing: vec4 per particle
 /// (w = 1 for positions), `stride` bytes apart, `count` particles from byte `offset` of each buffer.
@@ -208,9 +220,13 @@ public:
   /// The buffers above for drawing (offset 0); query again after every record_steps().
   InstanceBuffers buffers() const;
 
-  /// implicit_euler: CG iterations and relative residual of the last completed substep's solve
-  /// (read from host-visible memory: valid once the recorded work has finished).
+  /// implicit_euler: CG iterations and relative residual of the last completed substep's solve,
+  /// and the iterations and solves since creation (read from host-visible memory: valid once the
+  /// recorded work has finished).
   SolveStats last_solve() const;
+  /// implicit_euler: whether the CG iterations run in one workgroup (GpuSolverOptions::cg_dispatch);
+  /// false before the first implicit step and for the other integrators.
+  bool implicit_one_workgroup() const;
 
   /// GPU time of the last simulate() (sum over its submissions, timestamps), in milliseconds;
   /// negative when the queue has no timestamp support.
