@@ -40,8 +40,11 @@ struct BenchOptions {
   double compute_gflops = 192.0;
   std::string json;
   std::string variants = "fused,two_pass"; // Vulkan layouts to time (RK4 and implicit: always one)
-  std::string mesh;    // also time this mesh (OBJ / glTF): reordered, in file order, and shuffled
-  std::string stretch; // also time each grid with stretch_limit {method: this, max_strain 0.1, 4 sweeps}
+  std::string mesh;      // also time this mesh (OBJ / glTF): reordered, in file order, and shuffled
+  std::string stretch;   // also time each grid with stretch_limit {method: this, max_strain 0.1, 4 sweeps}
+  std::string stiffness; // "S,H,B": the grid's structural, shear and bend stiffness (default 40,8,8)
+  std::optional<double> cloth_mass; // kg, the whole grid's (default: 0.05 kg per particle at 64 x 64)
+  std::string cg_dispatch = "auto"; // implicit on Vulkan: auto | one_workgroup | per_iteration | both
 };
 
 /// The benchmark scene at n x n: a 1 m x 1 m vertical cloth hanging from its two top corners, in
@@ -54,12 +57,30 @@ struct BenchScene {
   SimParams params;
 };
 
-Result<BenchScene> bench_scene(std::uint32_t n, Integrator integrator, double dt) {
+/// "S,H,B" -> the three stiffnesses, each finite and >= 0.
+Result<void> parse_stiffness(const std::string& text, ClothStiffness& out) {
+  double v[3];
+  char tail = 0;
+  if (std::sscanf(text.c_str(), "%lf,%lf,%lf%c", &v[0], &v[1], &v[2], &tail) != 3 ||
+      !(std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2])) || v[0] < 0 || v[1] < 0 ||
+      v[2] < 0)
+    return make_error(
+        ErrorCode::invalid_argument,
+        fmt::format("--stiffness: '{}' is not three stiffnesses >= 0 (N/m), e.g. 10000,2000,2000", text));
+  out.structural = v[0];
+  out.shear = v[1];
+  out.bend = v[2];
+  return {};
+}
+
+Result<BenchScene> bench_scene(std::uint32_t n, Integrator integrator, double dt, const BenchOptions& o) {
   ClothDesc d;
   d.nx = n;
   d.ny = n;
   d.size = {1.0, 1.0};
-  d.particle_mass = 0.05 * 4096.0 / (double(n) * double(n));
+  d.particle_mass = o.cloth_mass.value_or(0.05 * 4096.0) / (double(n) * double(n));
+  if (!o.stiffness.empty())
+    VKCLOTH_TRY(parse_stiffness(o.stiffness, d.stiffness));
   auto sys = make_cloth(d);
   if (!sys)
     return sys.error();
@@ -161,6 +182,8 @@ Cost cost_of(const std::string& variant, Integrator integrator, double s, bool g
 }
 
 struct Row {
+  std::string cg_dispatch; // implicit on Vulkan: "one_workgroup" or "per_iteration"
+  double cg_per_step = 0;  // implicit_euler: mean CG iterations per step over the timed steps
   std::string backend, variant;
   std::uint32_t size = 0;
   std::size_t particles = 0, springs = 0;
@@ -176,6 +199,12 @@ struct Row {
   std::string order;               // mesh rows: "meshopt", "file" or "shuffled"
   Cost cost;
 };
+
+/// Mean CG iterations per solve between two snapshots of a solver's statistics.
+double cg_per_step(const SolveStats& before, const SolveStats& after) {
+  const std::uint64_t solves = after.solves - before.solves;
+  return solves ? double(after.total_iterations - before.total_iterations) / double(solves) : 0.0;
+}
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -195,6 +224,7 @@ Result<Row> bench_cpu(const BenchScene& sc, std::uint32_t n, const BenchOptions&
   if (!s)
     return s.error();
   VKCLOTH_TRY(s->run(o.warmup));
+  const SolveStats before = s->last_solve();
   std::vector<double> wall;
   for (unsigned r = 0; r < o.reps; ++r) {
     const auto t0 = Clock::now();
@@ -206,20 +236,24 @@ Result<Row> bench_cpu(const BenchScene& sc, std::uint32_t n, const BenchOptions&
   row.variant = "cpu";
   row.integrator = to_string(sc.params.integrator);
   row.cg_iterations = s->last_solve().iterations;
+  row.cg_per_step = cg_per_step(before, s->last_solve());
   row.threads = s->threads();
   row.size = n;
   row.wall_ms = median(wall);
   return row;
 }
 
-Result<Row> bench_vulkan(gpu::Context& ctx, const BenchScene& sc, std::uint32_t n, bool fused,
-                         const BenchOptions& o) {
+Result<Row>
+bench_vulkan(gpu::Context& ctx, const BenchScene& sc, std::uint32_t n, bool fused, const BenchOptions& o,
+             gpu::GpuSolverOptions::CgDispatch cg = gpu::GpuSolverOptions::CgDispatch::automatic) {
   gpu::GpuSolverOptions go;
   go.fused = fused;
+  go.cg_dispatch = cg;
   auto s = gpu::GpuSolver::create(ctx, sc.system, sc.params, go);
   if (!s)
     return s.error();
   VKCLOTH_TRY(s->simulate(o.warmup, o.steps_per_submit));
+  const SolveStats before = s->last_solve();
   std::vector<double> wall, gpu_ms;
   for (unsigned r = 0; r < o.reps; ++r) {
     const auto t0 = Clock::now();
@@ -234,6 +268,9 @@ Result<Row> bench_vulkan(gpu::Context& ctx, const BenchScene& sc, std::uint32_t 
                                                                    : "two_pass";
   row.integrator = to_string(sc.params.integrator);
   row.cg_iterations = s->last_solve().iterations;
+  row.cg_per_step = cg_per_step(before, s->last_solve());
+  if (sc.params.integrator == Integrator::implicit_euler)
+    row.cg_dispatch = s->implicit_one_workgroup() ? "one_workgroup" : "per_iteration";
   row.size = n;
   row.wall_ms = median(wall);
   row.gpu_ms = median(gpu_ms);
@@ -363,8 +400,12 @@ int bench_command(const BenchOptions& o) {
       fans = double((*t)->fans().size()) / double(sc.system.size());
     }
     auto add = [&](Result<Row> r) -> int {
-      if (!r && r.error().code == ErrorCode::unsupported) { // too large for this device: note it, go on
-        fmt::print("note: {} n = {}: {}\n", scene, n, r.error().message);
+      const bool baseline = implicit && sc.params.integrator != Integrator::implicit_euler;
+      if (!r &&
+          (r.error().code == ErrorCode::unsupported || // too large for this device: note it, go on
+           (baseline && r.error().code == ErrorCode::diverged))) { // the explicit baseline at a stiff dt
+        fmt::print("note: {} n = {} ({}): {}\n", scene, n, to_string(sc.params.integrator),
+                   r.error().message);
         return exit_ok;
       }
       if (!r)
@@ -388,9 +429,18 @@ int bench_command(const BenchOptions& o) {
     const bool two_pass = o.variants.find("two_pass") != std::string::npos;
     const bool rk4 = sc.params.integrator == Integrator::rk4;
     const bool imp = sc.params.integrator == Integrator::implicit_euler;
-    if (fused || rk4 || imp)
+    using D = gpu::GpuSolverOptions::CgDispatch;
+    if (imp && o.cg_dispatch != "auto") { // the CG loop's two layouts, forced
+      for (const char* name : {"one_workgroup", "per_iteration"})
+        if (o.cg_dispatch == name || o.cg_dispatch == "both")
+          if (int e = add(
+                  bench_vulkan(*ctx, sc, n, true, o,
+                               std::string(name) == "one_workgroup" ? D::one_workgroup : D::per_iteration)))
+            return e;
+    } else if (fused || rk4 || imp) {
       if (int e = add(bench_vulkan(*ctx, sc, n, true, o)))
         return e;
+    }
     if (two_pass && !rk4 && !imp)
       if (int e = add(bench_vulkan(*ctx, sc, n, false, o)))
         return e;
@@ -403,13 +453,13 @@ int bench_command(const BenchOptions& o) {
     return exit_ok;
   };
   for (std::uint32_t n : *sizes) {
-    auto sc = bench_scene(n, *integrator, dt);
+    auto sc = bench_scene(n, *integrator, dt, o);
     if (!sc)
       return report(sc.error());
     if (int e = time_scene(*sc, n, "grid", ""))
       return e;
     if (!o.stretch.empty()) { // the same grid with stretch control, for its cost ratio
-      auto limited = bench_scene(n, *integrator, dt);
+      auto limited = bench_scene(n, *integrator, dt, o);
       if (!limited)
         return report(limited.error());
       limited->params.stretch_limit.method = *parse_stretch_method(o.stretch);
@@ -417,7 +467,7 @@ int bench_command(const BenchOptions& o) {
         return e;
     }
     if (implicit) { // the explicit baseline at the same size and dt, for the cost ratio
-      auto base = bench_scene(n, Integrator::semi_implicit_euler, dt);
+      auto base = bench_scene(n, Integrator::semi_implicit_euler, dt, o);
       if (!base)
         return report(base.error());
       if (int e = time_scene(*base, n, "grid", ""))
@@ -484,6 +534,9 @@ int bench_command(const BenchOptions& o) {
     j["integrator"] = r.integrator;
     if (r.integrator == "implicit_euler") {
       j["cg_iterations_last_step"] = r.cg_iterations;
+      j["cg_iterations_per_step"] = r.cg_per_step;
+      if (!r.cg_dispatch.empty())
+        j["cg_dispatch"] = r.cg_dispatch;
       for (const Row& e : rows) // the semi-implicit baseline of the same backend and size
         if (e.backend == r.backend && e.size == r.size && e.integrator == "semi_implicit_euler")
           j["implicit_over_explicit"] = r.wall_ms / e.wall_ms;
@@ -524,10 +577,11 @@ int bench_command(const BenchOptions& o) {
       for (const Row& e : rows)
         if (e.backend == r.backend && e.size == r.size && e.integrator == "semi_implicit_euler")
           fmt::print(
-              "{} n = {}: implicit step {:.4f} ms vs semi-implicit {:.4f} ms: {:.1f}x the explicit cost "
-              "({} CG iterations in the last step)\n",
-              r.backend, r.size, r.wall_ms / double(r.steps), e.wall_ms / double(e.steps),
-              r.wall_ms / e.wall_ms, r.cg_iterations);
+              "{}{} n = {}: implicit step {:.4f} ms vs semi-implicit {:.4f} ms: {:.1f}x the explicit cost "
+              "({:.1f} CG iterations per step, {} in the last step)\n",
+              r.backend, r.cg_dispatch.empty() ? "" : " (" + r.cg_dispatch + ")", r.size,
+              r.wall_ms / double(r.steps), e.wall_ms / double(e.steps), r.wall_ms / e.wall_ms, r.cg_per_step,
+              r.cg_iterations);
   for (const Row& r : rows)
     if (const Row* g = r.scene == "mesh" ? nearest_grid(rows, r) : nullptr)
       fmt::print(
@@ -616,6 +670,18 @@ void add_bench_command(CLI::App& app, int* exit) {
          "Also time each grid with stretch control (tethers, provot or both; max_strain 0.1, 4 sweeps) "
          "against the plain step")
       ->check(CLI::IsMember({"tethers", "provot", "both"}));
+  cmd->add_option(
+      "--stiffness", opt->stiffness,
+      "Structural, shear and bend stiffness of the grid in N/m, e.g. 10000,2000,2000 (default 40,8,8)");
+  cmd->add_option("--cloth-mass", opt->cloth_mass,
+                  "Mass of the whole grid in kg (default: 0.05 kg per particle of a 64 x 64 grid, 204.8 kg)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option(
+         "--cg-dispatch", opt->cg_dispatch,
+         "implicit_euler on Vulkan: where the CG iterations run (auto: GpuSolverOptions' default; both: "
+         "one row each)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"auto", "one_workgroup", "per_iteration", "both"}));
   cmd->add_option("--json", opt->json, "Also write the results as JSON to FILE (keys: docs/performance.md)");
   cmd->footer(exit_codes_footer);
   cmd->callback([opt, exit] { *exit = bench_command(*opt); });

@@ -319,8 +319,10 @@ int run_command(const RunOptions& opt) {
   const SolveStats cg = backend.last_solve();
   if (scene->params.integrator == Integrator::implicit_euler)
     fmt::print(
-        "implicit_euler: last solve {} CG iterations, relative residual {:.3g} (tolerance {:g}, cap {})\n",
-        cg.iterations, cg.residual, scene->params.cg_tolerance, scene->params.cg_max_iterations);
+        "implicit_euler: last solve {} CG iterations, relative residual {:.3g} (tolerance {:g}, cap {}); "
+        "{:.1f} CG iterations per solve over the run ({} solves)\n",
+        cg.iterations, cg.residual, scene->params.cg_tolerance, scene->params.cg_max_iterations,
+        cg.mean_iterations(), cg.solves);
   std::optional<StrainStats> end_strain;
   if (track_strain) {
     auto s = strain_of_pos();
@@ -350,10 +352,12 @@ int run_command(const RunOptions& opt) {
     doc["simulated_time"] = backend.time();
     doc["wall_s"] = wall;
     doc["max_displacement"] = max_disp;
-    doc["implicit_euler"] =
-        scene->params.integrator == Integrator::implicit_euler
-            ? nlohmann::json{{"cg_iterations", cg.iterations}, {"cg_residual", cg.residual}}
-            : nlohmann::json(nullptr);
+    doc["implicit_euler"] = scene->params.integrator == Integrator::implicit_euler
+                                ? nlohmann::json{{"cg_iterations", cg.iterations},
+                                                 {"cg_residual", cg.residual},
+                                                 {"cg_iterations_mean", cg.mean_iterations()},
+                                                 {"cg_solves", cg.solves}}
+                                : nlohmann::json(nullptr);
     if (end_strain) {
       const auto ends = [&](std::uint32_t k) {
         const Spring& sp = scene->system.springs[k];
