@@ -24,8 +24,8 @@ gpu::BackendChoice resolve_backend(std::optional<gpu::Backend> requested, const 
   return {*requested, fmt::format("--backend {} on {}", gpu::to_string(*requested), context.device_name())};
 }
 
-Result<DrawnCloth> DrawnCloth::create(gpu::Backend backend, gpu::Context& context, const ParticleSystem& system,
-                                      const SimParams& params) {
+Result<DrawnCloth> DrawnCloth::create(gpu::Backend backend, gpu::Context& context,
+                                      const ParticleSystem& system, const SimParams& params) {
   DrawnCloth d;
   d.context_ = &context;
   if (backend == gpu::Backend::vulkan) {
@@ -66,8 +66,9 @@ Result<gpu::InstanceBuffers> DrawnCloth::record_frame(VkCommandBuffer cmd, std::
   return host_->upload(slot, cpu_->positions(), cpu_->normals());
 }
 
-Result<render::Image> DrawnCloth::render(render::OffscreenTarget& target, const render::ClothRenderer& renderer,
-                                         const render::Camera& camera, std::uint32_t steps) {
+Result<render::Image> DrawnCloth::render(render::OffscreenTarget& target,
+                                         const render::ClothRenderer& renderer, const render::Camera& camera,
+                                         std::uint32_t steps) {
   if (gpu_)
     return target.render(*gpu_, renderer, camera, steps);
   VKCLOTH_TRY(cpu_->run(steps));

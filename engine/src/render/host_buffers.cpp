@@ -70,7 +70,8 @@ Result<HostClothBuffers> HostClothBuffers::create(gpu::Context& context, const C
   return HostClothBuffers(std::move(impl));
 }
 
-Result<gpu::InstanceBuffers> HostClothBuffers::upload(std::uint32_t slot, std::span<const glm::vec3> positions,
+Result<gpu::InstanceBuffers> HostClothBuffers::upload(std::uint32_t slot,
+                                                      std::span<const glm::vec3> positions,
                                                       std::span<const glm::vec3> normals) {
   Impl& s = *impl_;
   if (positions.size() != s.count || normals.size() != s.count)
