@@ -2,9 +2,13 @@
 // The samples' shared loop. The offscreen path uses only the engine's API (OffscreenTarget); the
 // window path records each frame itself into the window, swapchain and present render pass of
 // vkcloth_host_window, as a host application embedding vkcloth would (a condensed `vkcloth view`).
+// Both simulate on the backend --backend names (host::DrawnCloth; auto: the GPU solver on a GPU,
+// the CPU solver on a CPU Vulkan device such as lavapipe, gpu::choose_backend).
 #include "sample_app.hpp"
 
 #include "vkcloth_host_window/window.hpp" // first of the Vulkan headers: it brings volk
+
+#include "vkcloth_host_window/drawn_cloth.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -14,7 +18,6 @@
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
 
-#include "vkcloth/gpu/gpu_solver.hpp"
 #include "vkcloth/render/cloth_renderer.hpp"
 #include "vkcloth/render/offscreen.hpp"
 
@@ -44,7 +47,12 @@ int run_offscreen(const vkcloth::Scene& scene, const Options& o) {
   auto ctx = gpu::Context::create(co);
   if (!ctx)
     return fail(ctx.error());
-  auto solver = gpu::GpuSolver::create(*ctx, scene.system, scene.params);
+  auto requested = host::parse_backend(o.backend);
+  if (!requested)
+    return fail(requested.error());
+  const gpu::BackendChoice choice = host::resolve_backend(*requested, *ctx);
+  fmt::print("backend: {} ({})\n", gpu::to_string(choice.backend), choice.reason);
+  auto solver = host::DrawnCloth::create(choice.backend, *ctx, scene.system, scene.params);
   if (!solver)
     return fail(solver.error());
   auto target = render::OffscreenTarget::create(*ctx, o.width, o.height);
@@ -52,7 +60,7 @@ int run_offscreen(const vkcloth::Scene& scene, const Options& o) {
     return fail(target.error());
   render::RendererOptions ro;
   ro.render_pass = target->render_pass();
-  auto renderer = render::ClothRenderer::create(*ctx, *solver, *solver->topology(), ro);
+  auto renderer = render::ClothRenderer::create(*ctx, solver->params(), *solver->topology(), ro);
   if (!renderer)
     return fail(renderer.error());
   const render::Camera camera = render::Camera::frame(render::scene_bounds(scene.system, scene.params),
@@ -62,8 +70,9 @@ int run_offscreen(const vkcloth::Scene& scene, const Options& o) {
   const std::uint32_t frames = o.frames ? o.frames : 60;
   const std::uint32_t steps = o.steps_per_frame ? o.steps_per_frame : default_steps_per_frame(scene);
   for (std::uint32_t f = 0; f < frames; ++f) {
-    // One submission: `steps` steps, the compute -> vertex barrier, the draw, the readback.
-    auto img = target->render(*solver, *renderer, camera, f == 0 ? 0 : steps);
+    // Vulkan: one submission (the steps, the compute -> vertex barrier, the draw, the readback);
+    // CPU: the steps, the upload of positions and normals, then the draw and readback.
+    auto img = solver->render(*target, *renderer, camera, f == 0 ? 0 : steps);
     if (!img)
       return fail(img.error());
     const auto path = o.out / fmt::format("{}_{:04}.png", scene.name, f);
@@ -134,12 +143,16 @@ int run_window(const vkcloth::Scene& scene, const Options& o) {
   if (!w.create_render_pass())
     return fail(make_error(ErrorCode::vulkan, "vkCreateRenderPass failed"));
 
-  auto solver = gpu::GpuSolver::create(w.context(), scene.system, scene.params);
+  auto requested = host::parse_backend(o.backend);
+  if (!requested)
+    return fail(requested.error());
+  const gpu::BackendChoice choice = host::resolve_backend(*requested, w.context());
+  auto solver = host::DrawnCloth::create(choice.backend, w.context(), scene.system, scene.params);
   if (!solver)
     return fail(solver.error());
   render::RendererOptions ro;
   ro.render_pass = w.render_pass();
-  auto renderer = render::ClothRenderer::create(w.context(), *solver, *solver->topology(), ro);
+  auto renderer = render::ClothRenderer::create(w.context(), solver->params(), *solver->topology(), ro);
   if (!renderer)
     return fail(renderer.error());
   if (!w.create_frame_resources())
@@ -153,6 +166,7 @@ int run_window(const vkcloth::Scene& scene, const Options& o) {
   const std::uint32_t steps = o.steps_per_frame ? o.steps_per_frame : default_steps_per_frame(scene);
   fmt::print("{} on {}: drag orbits, wheel zooms, space pauses, R resets, Esc quits\n", scene.name,
              w.context().device_name());
+  fmt::print("backend: {} ({})\n", gpu::to_string(choice.backend), choice.reason);
   std::uint64_t frame = 0;
   while (!glfwWindowShouldClose(w.glfw()) && (!o.frames || frame < o.frames)) {
     glfwPollEvents();
@@ -162,7 +176,7 @@ int run_window(const vkcloth::Scene& scene, const Options& o) {
         return fail(r.error());
     if (in.reset) { // a fresh solver from the initial state (nothing is pending: the wait above)
       in.reset = false;
-      auto s = gpu::GpuSolver::create(w.context(), scene.system, scene.params);
+      auto s = host::DrawnCloth::create(choice.backend, w.context(), scene.system, scene.params);
       if (!s)
         return fail(s.error());
       *solver = std::move(*s);
@@ -187,12 +201,13 @@ int run_window(const vkcloth::Scene& scene, const Options& o) {
     if (!*next)
       continue; // out of date: recreated next time round
     const host::Frame& f = **next;
-    if (!in.paused)
-      solver->record_steps(f.cmd, steps);
-    // The compute -> graphics barrier: the steps' positions and normals, visible to the vertex fetch.
-    solver->record_barrier_to(f.cmd, VK_PIPELINE_STAGE_VERTEX_INPUT_BIT, VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT);
+    // Vulkan: the steps and the compute -> graphics barrier (positions and normals visible to the
+    // vertex fetch). CPU: the steps, then the upload into a slot no frame still reads (the wait above).
+    auto buffers = solver->record_frame(f.cmd, in.paused ? 0 : steps, std::uint32_t(frame));
+    if (!buffers)
+      return fail(buffers.error());
     w.begin_render_pass(f, renderer->palette().background);
-    renderer->record_draw(f.cmd, *solver, cam, f.extent);
+    renderer->record_draw(f.cmd, *buffers, cam, f.extent);
     if (!w.end_render_pass_and_submit(f))
       return fail(make_error(ErrorCode::vulkan, "vkQueueSubmit failed"));
     if (auto r = w.present(f); !r)
@@ -216,6 +231,8 @@ int run_window(const vkcloth::Scene& scene, const Options& o) {
              "  --steps-per-frame K  solver steps between frames (default: about real time at 60 fps)\n"
              "  --out DIR            where the PNG frames and plots go (default ./out)\n"
              "  --size WxH           image or window size (default 800x600)\n"
+             "  --backend NAME       auto (default: the GPU solver on a GPU, the CPU solver on a CPU Vulkan\n"
+             "                       device such as lavapipe, where it is faster), cpu or vulkan\n"
              "{}"
              "  --help               this text\n"
              "Environment: VKCLOTH_VALIDATION=1 enables the Vulkan validation layer, VKCLOTH_DEVICE picks a "
@@ -266,6 +283,12 @@ Options parse_args(int argc, char** argv, const std::string& about, const std::s
         std::exit(2);
       }
       o.width = w, o.height = h;
+    } else if (a == "--backend") {
+      o.backend = value(i);
+      if (auto b = vkcloth::host::parse_backend(o.backend); !b) {
+        fmt::print(stderr, "error: {}\n", b.error().message);
+        std::exit(2);
+      }
     } else if (a == "--preset" && !presets_help.empty())
       o.preset = value(i);
     else {

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // `vkcloth render` as a separate process: texture errors (exit 2, the file named), --video
-// without ffmpeg, PNG outputs, a chain scene.
+// without ffmpeg, PNG outputs, a chain scene, --backend (auto, the default, against vulkan).
 #include <doctest/doctest.h>
 
 #include <sys/wait.h>
@@ -16,6 +16,7 @@
 
 #include "vkcloth/builders.hpp"
 #include "vkcloth/export.hpp"
+#include "render_test_util.hpp"
 #include "vkcloth/render/image.hpp"
 
 namespace fs = std::filesystem;
@@ -162,4 +163,54 @@ TEST_CASE("render: a glTF mesh scene is drawn with the file's base-colour textur
     greenish += img->rgba[k + 1] > 2 * img->rgba[k] && img->rgba[k + 1] > 2 * img->rgba[k + 2];
   // The cloth fills a good part of the frame (framed on the scene); the fabric default has no such green.
   CHECK(greenish > img->rgba.size() / 4 / 10);
+}
+
+TEST_CASE(
+    "render: --backend auto is the default and on lavapipe picks the CPU solver drawing the GPU's frame") {
+  // `devices` names the backend auto picks on the selected device, and why.
+  const Outcome dev = run_vkcloth("devices_auto", "devices");
+  if (device_missing(dev))
+    return;
+  REQUIRE_MESSAGE(dev.code == 0, dev.err);
+  const bool cpu_device = dev.out.find("(cpu, Vulkan") != std::string::npos;
+  const std::string picked = cpu_device ? "cpu" : "vulkan";
+  CHECK_MESSAGE(dev.out.find("auto backend there: " + picked) != std::string::npos, dev.out);
+  CHECK_MESSAGE(dev.out.find("auto backend: " + picked + ": ") != std::string::npos, dev.out);
+  if (cpu_device)
+    CHECK_MESSAGE(dev.out.find("CPU implementation of Vulkan") != std::string::npos, dev.out);
+
+  const std::string args = "render " + scenes + "/cloth_on_sphere.json --steps 16 --size 160x120 --out ";
+  const fs::path by_default = tmp_dir() / "backend_default.png", by_auto = tmp_dir() / "backend_auto.png",
+                 by_vulkan = tmp_dir() / "backend_vulkan.png";
+  const Outcome d = run_vkcloth("backend_default", args + by_default.string(), "VKCLOTH_VALIDATION=1");
+  const Outcome a =
+      run_vkcloth("backend_auto", args + by_auto.string() + " --backend auto", "VKCLOTH_VALIDATION=1");
+  const Outcome v =
+      run_vkcloth("backend_vulkan", args + by_vulkan.string() + " --backend vulkan", "VKCLOTH_VALIDATION=1");
+  for (const Outcome* o : {&d, &a, &v}) {
+    REQUIRE_MESSAGE(o->code == 0, o->err);
+    CHECK_MESSAGE(o->err.find("alidation") == std::string::npos, o->err);
+  }
+  CHECK_MESSAGE(d.out.find("backend: " + picked + " (") != std::string::npos, d.out);
+  CHECK_MESSAGE(a.out.find("backend: " + picked + " (") != std::string::npos, a.out);
+  CHECK_MESSAGE(v.out.find("backend: vulkan (--backend vulkan on ") != std::string::npos, v.out);
+  auto id = vkcloth::render::load_image(by_default), ia = vkcloth::render::load_image(by_auto),
+       iv = vkcloth::render::load_image(by_vulkan);
+  REQUIRE(id);
+  REQUIRE(ia);
+  REQUIRE(iv);
+  CHECK(id->rgba == ia->rgba);
+  // The same frame on both backends: bit for bit on lavapipe (the CPU solver reproduces the GPU's
+  // semi-implicit Euler exactly), else within the golden-image metric.
+  if (cpu_device)
+    CHECK(ia->rgba == iv->rgba);
+  CHECK(vkcloth::render::test::compare(*ia, *iv).fraction < vkcloth::render::test::golden_max_fraction);
+}
+
+TEST_CASE("render: an unknown --backend is exit 2 naming the accepted values") {
+  const Outcome o =
+      run_vkcloth("backend_bad", "render " + scenes + "/cloth_on_sphere.json --backend gpu --out " +
+                                     (tmp_dir() / "never.png").string());
+  CHECK(o.code == 2);
+  CHECK_MESSAGE(o.err.find("auto,cpu,vulkan") != std::string::npos, o.err);
 }

@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: MIT
-// `vkcloth devices`: the Vulkan devices the loader reports, and which one a solver would take.
+// `vkcloth devices`: the Vulkan devices the loader reports, which one a solver would take, and the
+// backend `--backend auto` (render, view, the samples) picks on each, with the reason.
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "vkcloth/gpu/backend_choice.hpp"
 #include "vkcloth/gpu/context.hpp"
 
 namespace vkcloth::cli {
@@ -32,6 +34,10 @@ int devices_command() {
     fmt::print("{}: {} ({}, Vulkan {}.{}){}\n", d.index, d.name, type_name(d.type),
                VK_API_VERSION_MAJOR(d.api_version), VK_API_VERSION_MINOR(d.api_version),
                d.usable ? "" : " - not usable (needs Vulkan 1.2 and compute)");
+    if (d.usable) {
+      const gpu::BackendChoice c = gpu::choose_backend(d.type, d.name);
+      fmt::print("   auto backend: {}: {}\n", gpu::to_string(c.backend), c.reason);
+    }
     usable += d.usable;
   }
   if (usable == 0)
@@ -43,6 +49,8 @@ int devices_command() {
   if (!context)
     return report(context.error());
   fmt::print("selected: {} (set VKCLOTH_DEVICE to a name or an index to choose)\n", context->device_name());
+  fmt::print("auto backend there: {} (render, view and the samples; --backend cpu | vulkan to choose)\n",
+             gpu::to_string(gpu::choose_backend(*context).backend));
   return exit_ok;
 }
 

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
-// `vkcloth render`: simulate a scene on the GPU and draw it offscreen to PNG files (one frame, or
-// a numbered sequence), optionally assembled into a video with ffmpeg. No display needed.
+// `vkcloth render`: simulate a scene and draw it offscreen to PNG files (one frame, or a numbered
+// sequence), optionally assembled into a video with ffmpeg. No display needed. The simulation runs
+// where --backend says (auto: the GPU solver on a GPU, the CPU solver on lavapipe; DrawnCloth).
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -13,6 +14,7 @@
 
 #include "commands.hpp"
 #include "render_common.hpp"
+#include "vkcloth_host_window/drawn_cloth.hpp"
 #include "vkcloth/render/cloth_renderer.hpp"
 #include "vkcloth/render/offscreen.hpp"
 #include "vkcloth/scene.hpp"
@@ -30,6 +32,7 @@ struct RenderOptions {
   std::string frames_dir;
   std::uint64_t every = 10;
   std::string video;
+  std::string backend = "auto";
 };
 
 bool have_ffmpeg() {
@@ -63,6 +66,9 @@ int render_command(const RenderOptions& opt) {
                                  "--frames DIR still writes the PNG sequence",
                                  opt.video)));
   }
+  auto requested = host::parse_backend(opt.backend);
+  if (!requested)
+    return report(requested.error());
   auto scene = opt.args.load();
   if (!scene)
     return report(scene.error());
@@ -83,14 +89,17 @@ int render_command(const RenderOptions& opt) {
   auto context = gpu::Context::create(render_context_options());
   if (!context)
     return report(context.error());
-  auto solver = gpu::GpuSolver::create(*context, scene->system, scene->params);
+  const gpu::BackendChoice choice = host::resolve_backend(*requested, *context);
+  fmt::print("backend: {} ({})\n", gpu::to_string(choice.backend), choice.reason);
+  auto solver = host::DrawnCloth::create(choice.backend, *context, scene->system, scene->params);
   if (!solver)
     return report(solver.error());
   auto target = render::OffscreenTarget::create(*context, size->first, size->second);
   if (!target)
     return report(target.error());
   ro.render_pass = target->render_pass();
-  auto renderer = render::ClothRenderer::create(*context, *solver, *solver->topology(), std::move(ro));
+  auto renderer =
+      render::ClothRenderer::create(*context, solver->params(), *solver->topology(), std::move(ro));
   if (!renderer)
     return report(renderer.error());
   if (!renderer->draws_cloth())
@@ -111,7 +120,7 @@ int render_command(const RenderOptions& opt) {
           ErrorCode::io, fmt::format("cannot create the frames directory {}: {}", frames_dir, ec.message())));
     const std::uint64_t every = std::max<std::uint64_t>(opt.every, 1);
     for (std::uint64_t done = 0;;) {
-      auto img = target->render(*solver, *renderer, *camera, 0);
+      auto img = solver->render(*target, *renderer, *camera);
       if (!img)
         return report(img.error());
       const std::string path = fmt::format("{}/frame_{:05}.png", frames_dir, written++);
@@ -136,7 +145,7 @@ int render_command(const RenderOptions& opt) {
         return report(r.error());
       done += 4096;
     }
-    auto img = target->render(*solver, *renderer, *camera, static_cast<std::uint32_t>(total - done));
+    auto img = solver->render(*target, *renderer, *camera, static_cast<std::uint32_t>(total - done));
     if (!img)
       return report(img.error());
     if (auto w = render::write_png(opt.out, *img); !w)
@@ -145,7 +154,7 @@ int render_command(const RenderOptions& opt) {
                solver->time(), size->first, size->second, opt.out);
   }
   if (!opt.out.empty() && !frames_dir.empty()) {
-    auto img = target->render(*solver, *renderer, *camera, 0);
+    auto img = solver->render(*target, *renderer, *camera);
     if (!img)
       return report(img.error());
     if (auto w = render::write_png(opt.out, *img); !w)
@@ -177,8 +186,7 @@ int render_command(const RenderOptions& opt) {
 void add_render_command(CLI::App& app, int* exit) {
   auto opt = std::make_shared<RenderOptions>();
   CLI::App* cmd = app.add_subcommand(
-      "render",
-      "Simulate a scene on the GPU and render it offscreen to PNG (one frame, a sequence, or a video)");
+      "render", "Simulate a scene and render it offscreen to PNG (one frame, a sequence, or a video)");
   cmd->footer(exit_codes_footer);
   add_scene_options(*cmd, opt->args);
   cmd->add_option("--out", opt->out, "PNG file of the state after the scene's steps");
@@ -195,6 +203,7 @@ void add_render_command(CLI::App& app, int* exit) {
   cmd->add_option("--every", opt->every, "K for --frames / --video (default 10)")->check(CLI::PositiveNumber);
   cmd->add_option("--video", opt->video,
                   "Assemble the frames into FILE.mp4 or FILE.gif with ffmpeg (must be installed)");
+  add_draw_backend_option(*cmd, opt->backend);
   cmd->callback([opt, exit] { *exit = render_command(*opt); });
 }
 

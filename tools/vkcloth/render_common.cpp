@@ -60,4 +60,12 @@ gpu::ContextOptions render_context_options() {
   return o;
 }
 
+void add_draw_backend_option(CLI::App& cmd, std::string& backend) {
+  cmd.add_option("--backend", backend,
+                 "Where the simulation runs: auto (default: the GPU solver on a GPU, the CPU solver on a CPU "
+                 "Vulkan device such as lavapipe, where it is faster; `vkcloth devices` says which and why), "
+                 "cpu (CpuSolver, positions and normals uploaded for each frame) or vulkan (the GPU solver)")
+      ->check(CLI::IsMember({"auto", "cpu", "vulkan"}));
+}
+
 } // namespace vkcloth::cli

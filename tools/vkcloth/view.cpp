@@ -1,12 +1,14 @@
 // SPDX-License-Identifier: MIT
-// `vkcloth view`: an interactive window (GLFW + a Vulkan swapchain) drawing the GPU solver live.
+// `vkcloth view`: an interactive window (GLFW + a Vulkan swapchain) drawing the simulation live,
+// on the backend --backend names (auto: the GPU solver on a GPU, the CPU solver on lavapipe).
 // Mouse: left-drag orbits, or drags the particle under the cursor (the report's hand lifting the
 // cloth); wheel zooms. Keys: space pause, S / right arrow single step, R reset, W wind on/off,
 // Esc quit. --frames N quits by itself after N frames; --screenshot FILE saves the last frame.
 //
 // The window, swapchain and present render pass are vkcloth_host_window's (shared with the
 // samples); the mouse and keys are view_input's. This file sets them up and records each frame:
-// the held particle, the solver's steps, the barrier to the draw, the draw.
+// the held particle, the solver's steps, the barrier to the draw (or, on the CPU backend, the steps
+// and the upload of positions and normals: host::DrawnCloth), the draw.
 #include "view_input.hpp" // first: brings volk (through vkcloth_host_window) before other Vulkan headers
 
 #include <algorithm>
@@ -18,9 +20,7 @@
 
 #include "commands.hpp"
 #include "render_common.hpp"
-#include "vkcloth/gpu/gpu_solver.hpp"
 #include "vkcloth/render/cloth_renderer.hpp"
-#include "vkcloth/render/interaction.hpp"
 #include "vkcloth/render/offscreen.hpp"
 #include "vkcloth/scene.hpp"
 
@@ -34,6 +34,7 @@ struct ViewOptions {
   std::uint64_t frames = 0; ///< 0: until closed
   std::string screenshot;
   std::uint32_t steps_per_frame = 0; ///< 0: about real time at 60 frames per second
+  std::string backend = "auto";
 };
 
 class Viewer {
@@ -49,7 +50,8 @@ private:
 
   host::Window window_; // first: destroyed last (it owns the Context the rest was created on)
   std::optional<Scene> scene_;
-  std::optional<gpu::GpuSolver> solver_;
+  gpu::Backend backend_ = gpu::Backend::vulkan;
+  std::optional<host::DrawnCloth> solver_;
   std::optional<render::ClothRenderer> renderer_;
   render::Image texture_;
   Input input_;
@@ -58,6 +60,7 @@ private:
   bool wind_on_ = false;
   Wind base_wind_;
   std::uint32_t steps_per_frame_ = 1;
+  std::uint32_t upload_slot_ = 0; // the CPU backend's HostClothBuffers slot, one per frame
 };
 
 Viewer::~Viewer() {
@@ -93,7 +96,7 @@ Result<void> Viewer::reset_solver() {
   solver_.reset();
   SimParams p = scene_->params;
   p.wind = wind_on_ ? base_wind_ : Wind{0.0, base_wind_.direction};
-  auto s = gpu::GpuSolver::create(window_.context(), scene_->system, p);
+  auto s = host::DrawnCloth::create(backend_, window_.context(), scene_->system, p);
   if (!s)
     return s.error();
   solver_.emplace(std::move(*s));
@@ -127,19 +130,18 @@ Result<void> Viewer::draw_frame() {
   if (!*next)
     return {}; // out of date: recreated next frame
   const host::Frame& f = **next;
-  if (hold_.particle)
-    render::record_hold_particle(window_.context(), f.cmd, *solver_, *hold_.particle, hold_.position);
-  if (!input_.paused) {
-    solver_->record_steps(f.cmd, steps_per_frame_);
-  } else if (input_.step_once) {
-    solver_->record_steps(f.cmd, 1);
-  }
+  const std::uint32_t steps = !input_.paused ? steps_per_frame_ : input_.step_once ? 1u : 0u;
   input_.step_once = false;
-  // THE compute -> graphics barrier: this frame's compute writes of positions and normals become
-  // visible to the vertex fetch of the draws (VERTEX_INPUT / VERTEX_ATTRIBUTE_READ).
-  solver_->record_barrier_to(f.cmd, VK_PIPELINE_STAGE_VERTEX_INPUT_BIT, VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT);
+  std::optional<host::HeldParticle> held;
+  if (hold_.particle)
+    held = host::HeldParticle{*hold_.particle, hold_.position};
+  // The held particle, the steps and THE compute -> graphics barrier (GPU), or the steps and the
+  // upload of positions and normals (CPU; wait_last_frame above freed every slot).
+  auto buffers = solver_->record_frame(f.cmd, steps, upload_slot_++, held);
+  if (!buffers)
+    return buffers.error();
   window_.begin_render_pass(f, renderer_->palette().background);
-  renderer_->record_draw(f.cmd, *solver_, orbit_.camera(), f.extent);
+  renderer_->record_draw(f.cmd, *buffers, orbit_.camera(), f.extent);
   VKCLOTH_TRY(window_.end_render_pass_and_submit(f));
   return window_.present(f);
 }
@@ -154,10 +156,11 @@ Result<void> Viewer::save_screenshot(const std::string& path, std::uint64_t fram
   render::RendererOptions so;
   so.render_pass = target->render_pass();
   so.texture = texture_;
-  auto shot_renderer = render::ClothRenderer::create(window_.context(), *solver_, *solver_->topology(), so);
+  auto shot_renderer =
+      render::ClothRenderer::create(window_.context(), solver_->params(), *solver_->topology(), so);
   if (!shot_renderer)
     return shot_renderer.error();
-  auto img = target->render(*solver_, *shot_renderer, orbit_.camera(), 0);
+  auto img = solver_->render(*target, *shot_renderer, orbit_.camera(), 0);
   if (!img)
     return img.error();
   VKCLOTH_TRY(render::write_png(path, *img));
@@ -169,6 +172,9 @@ int Viewer::run(const ViewOptions& opt) {
   auto size = parse_size(opt.size);
   if (!size)
     return report(size.error());
+  auto requested = host::parse_backend(opt.backend);
+  if (!requested)
+    return report(requested.error());
   auto scene = opt.args.load();
   if (!scene)
     return report(scene.error());
@@ -186,6 +192,8 @@ int Viewer::run(const ViewOptions& opt) {
   }
   if (auto r = open_window(size->first, size->second); !r)
     return report(r.error());
+  const gpu::BackendChoice choice = host::resolve_backend(*requested, window_.context());
+  backend_ = choice.backend;
   const Wind& w = scene_->params.wind;
   wind_on_ = w.strength != 0.0;
   base_wind_ = wind_on_ ? w : Wind{0.05, glm::dvec3(1.0, 0.0, 0.0)};
@@ -194,7 +202,7 @@ int Viewer::run(const ViewOptions& opt) {
   render::RendererOptions ro;
   ro.render_pass = window_.render_pass();
   ro.texture = texture_;
-  auto rend = render::ClothRenderer::create(window_.context(), *solver_, *solver_->topology(), ro);
+  auto rend = render::ClothRenderer::create(window_.context(), solver_->params(), *solver_->topology(), ro);
   if (!rend)
     return report(rend.error());
   renderer_.emplace(std::move(*rend));
@@ -212,6 +220,7 @@ int Viewer::run(const ViewOptions& opt) {
       "vkcloth view: {} on {} — drag: orbit / move a particle, wheel: zoom, space: pause, S: step, R: reset, "
       "W: wind, Esc: quit\n",
       scene_->name, window_.context().device_name());
+  fmt::print("backend: {} ({})\n", gpu::to_string(choice.backend), choice.reason);
 
   std::uint64_t frame = 0;
   while (!glfwWindowShouldClose(window_.glfw())) {
@@ -240,7 +249,7 @@ int Viewer::run(const ViewOptions& opt) {
 void add_view_command(CLI::App& app, int* exit) {
   auto opt = std::make_shared<ViewOptions>();
   CLI::App* cmd =
-      app.add_subcommand("view", "Open a window and watch the GPU simulation live (orbit, pause, step, "
+      app.add_subcommand("view", "Open a window and watch the simulation live (orbit, pause, step, "
                                  "reset, wind, drag a particle)");
   cmd->footer(exit_codes_footer);
   add_scene_options(*cmd, opt->args);
@@ -252,6 +261,7 @@ void add_view_command(CLI::App& app, int* exit) {
   cmd->add_option("--screenshot", opt->screenshot, "Save the last frame as a PNG on exit");
   cmd->add_option("--steps-per-frame", opt->steps_per_frame,
                   "Solver steps per frame (default: about real time at 60 fps)");
+  add_draw_backend_option(*cmd, opt->backend);
   cmd->callback([opt, exit] {
     Viewer viewer;
     *exit = viewer.run(*opt);

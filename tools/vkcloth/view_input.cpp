@@ -96,7 +96,7 @@ render::Camera Orbit::camera() const {
   return c;
 }
 
-void apply_mouse(Input& input, Orbit& orbit, Hold& hold, gpu::GpuSolver& solver, host::Window& window) {
+void apply_mouse(Input& input, Orbit& orbit, Hold& hold, host::DrawnCloth& solver, host::Window& window) {
   const render::Camera cam = orbit.camera();
   const VkExtent2D extent = window.extent(); // 0 x 0 while minimised: nothing to pick in
   if (input.scroll != 0.0) {

@@ -11,7 +11,7 @@
 
 #include <glm/vec3.hpp>
 
-#include "vkcloth/gpu/gpu_solver.hpp"
+#include "vkcloth_host_window/drawn_cloth.hpp"
 #include "vkcloth/render/camera.hpp"
 
 namespace vkcloth::cli {
@@ -43,6 +43,6 @@ struct Hold {
 
 /// Wheel: zoom. Left press: picks the particle nearest to the cursor's ray; dragging moves it in the
 /// plane through it facing the camera, or orbits when nothing was picked. Release lets go.
-void apply_mouse(Input& input, Orbit& orbit, Hold& hold, gpu::GpuSolver& solver, host::Window& window);
+void apply_mouse(Input& input, Orbit& orbit, Hold& hold, host::DrawnCloth& solver, host::Window& window);
 
 } // namespace vkcloth::cli

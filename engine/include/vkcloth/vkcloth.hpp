@@ -11,5 +11,6 @@
 #include "vkcloth/system.hpp"
 #include "vkcloth/topology.hpp"
 #include "vkcloth/scene.hpp"
+#include "vkcloth/gpu/backend_choice.hpp"
 #include "vkcloth/gpu/gpu_solver.hpp"
 #include "vkcloth/gpu/world.hpp"

@@ -21,6 +21,9 @@ struct OffscreenTarget::Impl {
   gpu::CommandContext commands;
 
   Result<void> create_render_pass(VkFormat color_format);
+  void record_draw_and_readback(VkCommandBuffer c, const ClothRenderer& renderer,
+                                const gpu::InstanceBuffers& buffers, const Camera& camera) const;
+  Image read_image() const;
 };
 
 Result<OffscreenTarget> OffscreenTarget::create(gpu::Context& context, std::uint32_t width,
@@ -140,11 +143,47 @@ std::uint32_t OffscreenTarget::height() const {
   return impl_->height;
 }
 
+// The render pass (cleared to the renderer's background) drawing `buffers`, then the copy of the
+// colour image to the readback buffer and the barrier to the host's read.
+void OffscreenTarget::Impl::record_draw_and_readback(VkCommandBuffer c, const ClothRenderer& renderer,
+                                                     const gpu::InstanceBuffers& buffers,
+                                                     const Camera& camera) const {
+  const auto& v = ctx->vk;
+  const glm::vec3 bg = renderer.palette().background;
+  VkClearValue clears[2]{};
+  clears[0].color = {{bg.r, bg.g, bg.b, 1.0f}};
+  clears[1].depthStencil = {1.0f, 0};
+  VkRenderPassBeginInfo rb{};
+  rb.sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO;
+  rb.renderPass = render_pass;
+  rb.framebuffer = framebuffer;
+  rb.renderArea = {{0, 0}, {width, height}};
+  rb.clearValueCount = 2;
+  rb.pClearValues = clears;
+  v.vkCmdBeginRenderPass(c, &rb, VK_SUBPASS_CONTENTS_INLINE);
+  renderer.record_draw(c, buffers, camera, {width, height});
+  v.vkCmdEndRenderPass(c); // subpass dependency: colour writes -> transfer read, TRANSFER_SRC layout
+  VkBufferImageCopy region{};
+  region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+  region.imageExtent = {width, height, 1};
+  v.vkCmdCopyImageToBuffer(c, color.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback.buffer, 1, &region);
+  // The copy's writes -> visible to the host's read of the mapped readback buffer.
+  gpu::barriers::transfer_to_host(v, c);
+}
+
+Image OffscreenTarget::Impl::read_image() const {
+  Image img;
+  img.width = width;
+  img.height = height;
+  img.rgba.resize(std::size_t(width) * height * 4);
+  std::memcpy(img.rgba.data(), readback.mapped, img.rgba.size());
+  return img;
+}
+
 Result<Image> OffscreenTarget::render(gpu::GpuSolver& solver, const ClothRenderer& renderer,
                                       const Camera& camera, std::uint32_t steps,
                                       const std::function<void(VkCommandBuffer)>& before_steps) {
   Impl& s = *impl_;
-  const auto& v = s.ctx->vk;
   VKCLOTH_TRY(s.commands.submit_and_wait([&](VkCommandBuffer c) {
     if (before_steps)
       before_steps(c);
@@ -152,36 +191,21 @@ Result<Image> OffscreenTarget::render(gpu::GpuSolver& solver, const ClothRendere
     // THE compute -> graphics barrier: the steps' shader writes of positions[current] and normals
     // become visible to the vertex fetch of the draws below (VERTEX_INPUT / VERTEX_ATTRIBUTE_READ).
     solver.record_barrier_to(c, VK_PIPELINE_STAGE_VERTEX_INPUT_BIT, VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT);
-    const glm::vec3 bg = renderer.palette().background;
-    VkClearValue clears[2]{};
-    clears[0].color = {{bg.r, bg.g, bg.b, 1.0f}};
-    clears[1].depthStencil = {1.0f, 0};
-    VkRenderPassBeginInfo rb{};
-    rb.sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO;
-    rb.renderPass = s.render_pass;
-    rb.framebuffer = s.framebuffer;
-    rb.renderArea = {{0, 0}, {s.width, s.height}};
-    rb.clearValueCount = 2;
-    rb.pClearValues = clears;
-    v.vkCmdBeginRenderPass(c, &rb, VK_SUBPASS_CONTENTS_INLINE);
-    renderer.record_draw(c, solver, camera, {s.width, s.height});
-    v.vkCmdEndRenderPass(c); // subpass dependency: colour writes -> transfer read, TRANSFER_SRC layout
-    VkBufferImageCopy region{};
-    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-    region.imageExtent = {s.width, s.height, 1};
-    v.vkCmdCopyImageToBuffer(c, s.color.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, s.readback.buffer, 1,
-                             &region);
-    // The copy's writes -> visible to the host's read of the mapped readback buffer.
-    gpu::barriers::transfer_to_host(v, c);
+    s.record_draw_and_readback(c, renderer, solver.buffers(), camera);
   }));
   if (steps)
     VKCLOTH_TRY(solver.check_divergence());
-  Image img;
-  img.width = s.width;
-  img.height = s.height;
-  img.rgba.resize(std::size_t(s.width) * s.height * 4);
-  std::memcpy(img.rgba.data(), s.readback.mapped, img.rgba.size());
-  return img;
+  return s.read_image();
+}
+
+Result<Image> OffscreenTarget::render(const gpu::InstanceBuffers& buffers, const ClothRenderer& renderer,
+                                      const Camera& camera) {
+  Impl& s = *impl_;
+  // No barrier before the draws: the buffers are the host's (HostClothBuffers), written before
+  // this submission, which makes host-coherent writes visible to all of its commands.
+  VKCLOTH_TRY(s.commands.submit_and_wait(
+      [&](VkCommandBuffer c) { s.record_draw_and_readback(c, renderer, buffers, camera); }));
+  return s.read_image();
 }
 
 } // namespace vkcloth::render

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Draws a GpuSolver's cloth (or chain) and its colliders with Vulkan graphics, straight from the
 // solver's buffers: positions[current], normals and uvs are bound as vertex buffers (vec4, stride
-// 16); nothing goes through the CPU. It records into the caller's command buffer, inside the
+// 16); nothing goes through the CPU. (A CPU solver's state is drawn the same way from
+// HostClothBuffers, host_buffers.hpp.) It records into the caller's command buffer, inside the
 // caller's render pass (a VkRenderPass subpass with one colour and one depth attachment), so an
 // engine can embed it, or ignore it and bind the same buffers itself.
 //

@@ -39,6 +39,10 @@ public:
   Result<Image> render(gpu::GpuSolver& solver, const ClothRenderer& renderer, const Camera& camera,
                        std::uint32_t steps = 0,
                        const std::function<void(VkCommandBuffer)>& before_steps = {});
+  /// Draws `buffers` as they are (no steps, no barrier: e.g. HostClothBuffers::upload()'s, filled
+  /// by the host before this call), submits, waits, returns the frame.
+  Result<Image> render(const gpu::InstanceBuffers& buffers, const ClothRenderer& renderer,
+                       const Camera& camera);
 
   struct Impl; ///< internal (engine/src/render)
 
