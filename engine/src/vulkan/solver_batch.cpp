@@ -428,7 +428,7 @@ void SolverBatch::record_stretch(VkCommandBuffer c, std::uint32_t read) {
       spc.stage = sweep;
       spc.pad0 = strain_colours[k];
       spc.pad1 = strain_colours[k + 1] - strain_colours[k];
-      const std::uint32_t groups = (spc.pad1 + VKCLOTH_WORKGROUP_SIZE - 1) / VKCLOTH_WORKGROUP_SIZE;
+      const std::uint32_t groups = (spc.pad1 + workgroup - 1) / workgroup;
       const std::uint32_t gx = std::min(groups, groups_x), gy = (groups + gx - 1) / gx;
       v.vkCmdPushConstants(c, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(spc), &spc);
       barriers::dispatch_to_dispatch(v, c); // the previous pass or colour -> this colour
@@ -496,7 +496,7 @@ struct DispatchGrid {
 /// asked for, are checked then: ensure_tethers.)
 Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ClothTopology& topology,
                                   std::uint64_t batch, const GpuSolverOptions& options,
-                                  const testing::SolverKnobs& knobs) {
+                                  const testing::SolverKnobs& knobs, std::uint32_t workgroup) {
   const bool fan_lists = SolverBatch::normals_of(topology, knobs) == SolverBatch::Normals::fans;
   const std::uint64_t n = topology.size();
   const VkPhysicalDeviceLimits& lim = ctx.properties.limits;
@@ -537,7 +537,7 @@ Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ClothTopology&
                {"normal fans", fans_n}};
   for (const auto& list : lists)
     VKCLOTH_TRY(check_texels(ctx, list.what, list.texels, "use fewer springs or particles"));
-  const std::uint64_t groups = (n + VKCLOTH_WORKGROUP_SIZE - 1) / VKCLOTH_WORKGROUP_SIZE;
+  const std::uint64_t groups = (n + workgroup - 1) / workgroup;
   std::uint64_t row = lim.maxComputeWorkGroupCount[0];
   if (knobs.max_workgroups_x)
     row = std::min<std::uint64_t>(row, knobs.max_workgroups_x);
@@ -548,7 +548,7 @@ Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ClothTopology&
         ErrorCode::unsupported,
         fmt::format("the system is too large for device '{}': {} particles need {} workgroups of {} but "
                     "the device dispatches at most {} x {}",
-                    ctx.name, n, groups, VKCLOTH_WORKGROUP_SIZE, lim.maxComputeWorkGroupCount[0],
+                    ctx.name, n, groups, workgroup, lim.maxComputeWorkGroupCount[0],
                     lim.maxComputeWorkGroupCount[1]));
   if (batch == 0 || batch > lim.maxComputeWorkGroupCount[2])
     return make_error(
@@ -759,7 +759,11 @@ SolverBatch::create(const std::shared_ptr<Context::Impl>& ctx, CommandContext& c
                     const std::vector<SlotState>& states) {
   for (SimParams& p : params)
     VKCLOTH_TRY(p.validate());
-  auto grid = check_limits(*ctx, topology, params.size(), options, knobs);
+  auto chosen =
+      resolve_layout(*ctx, options, !params.empty() && params[0].integrator == Integrator::implicit_euler);
+  if (!chosen)
+    return chosen.error();
+  auto grid = check_limits(*ctx, topology, params.size(), options, knobs, chosen->workgroup_size);
   if (!grid)
     return grid.error();
 
@@ -781,6 +785,8 @@ SolverBatch::create(const std::shared_ptr<Context::Impl>& ctx, CommandContext& c
   s.strain_colours.assign(topology.strain_colour_offsets().begin(), topology.strain_colour_offsets().end());
   s.groups_x = grid->x;
   s.groups_y = grid->y;
+  s.access = chosen->access;
+  s.workgroup = chosen->workgroup_size;
   if (const auto& g = topology.grid()) {
     s.nx = s.pc.nx = g->nx;
     s.ny = s.pc.ny = g->ny;
