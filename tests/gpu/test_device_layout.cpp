@@ -138,8 +138,8 @@ void check_variants(Context& ctx, LayoutScene scene, std::initializer_list<Integ
         continue; // RK4 is always two-pass: `fused` changes nothing
       GpuSolverOptions o;
       o.fused = fused;
-      const std::string mode =
-          fmt::format("{} {}", to_string(integrator), fused && integrator != Integrator::rk4 ? "fused" : "two-pass");
+      const std::string mode = fmt::format("{} {}", to_string(integrator),
+                                           fused && integrator != Integrator::rk4 ? "fused" : "two-pass");
       o.buffer_access = BufferAccess::texel_views;
       const auto texel = run_gpu(ctx, scene, o, reference, mode + ", texel views");
       o.buffer_access = BufferAccess::storage_buffers;
@@ -147,7 +147,8 @@ void check_variants(Context& ctx, LayoutScene scene, std::initializer_list<Integ
       CHECK_MESSAGE(diff(texel, storage).bitwise, "texel views and storage buffers differ: " << mode);
       for (std::uint32_t size : {32u, 128u}) {
         o.workgroup_size = size;
-        const auto sized = run_gpu(ctx, scene, o, reference, fmt::format("{}, storage, workgroup {}", mode, size));
+        const auto sized =
+            run_gpu(ctx, scene, o, reference, fmt::format("{}, storage, workgroup {}", mode, size));
         CHECK_MESSAGE(diff(texel, sized).bitwise, "workgroup " << size << " differs: " << mode);
       }
       o.workgroup_size = 0;
@@ -168,8 +169,9 @@ TEST_CASE("choose_layout: a CPU device reads through texel views with the compil
 }
 
 TEST_CASE("choose_layout: a GPU reads storage buffers in workgroups of whole subgroups") {
-  for (VkPhysicalDeviceType type : {VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU, VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU,
-                                    VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU, VK_PHYSICAL_DEVICE_TYPE_OTHER})
+  for (VkPhysicalDeviceType type :
+       {VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU, VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU,
+        VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU, VK_PHYSICAL_DEVICE_TYPE_OTHER})
     for (std::uint32_t sub : {8u, 16u, 32u, 64u, 128u}) {
       CAPTURE(type);
       CAPTURE(sub);
@@ -203,8 +205,9 @@ TEST_CASE("BufferAccess spellings round-trip") {
 TEST_CASE("device_layout of the test device (lavapipe: a CPU device, texel views)") {
   VKCLOTH_GPU_TEST_BEGIN(ctx);
   const DeviceLayout l = device_layout(ctx);
-  MESSAGE(ctx.device_name() << ": " << std::string(to_string(l.access)) << ", workgroups of " << l.workgroup_size
-                            << ", subgroups of " << l.subgroup_size << " (" << l.reason << ")");
+  MESSAGE(ctx.device_name() << ": " << std::string(to_string(l.access)) << ", workgroups of "
+                            << l.workgroup_size << ", subgroups of " << l.subgroup_size << " (" << l.reason
+                            << ")");
   CHECK(l.access != BufferAccess::automatic);
   CHECK(l.subgroup_size > 0);
   CHECK(l.workgroup_size <= ctx.limits().maxComputeWorkGroupInvocations);
@@ -216,7 +219,8 @@ TEST_CASE("device_layout of the test device (lavapipe: a CPU device, texel views
 
 TEST_CASE("Texel views and storage buffers give the same bits: grid with stencil, colliders, wind") {
   VKCLOTH_GPU_TEST_BEGIN(ctx);
-  check_variants(ctx, grid_scene(), {Integrator::semi_implicit_euler, Integrator::explicit_euler, Integrator::rk4});
+  check_variants(ctx, grid_scene(),
+                 {Integrator::semi_implicit_euler, Integrator::explicit_euler, Integrator::rk4});
 }
 
 TEST_CASE("Texel views and storage buffers give the same bits: mesh cloth") {

@@ -61,7 +61,7 @@ DeviceLayout choose_layout(const VkPhysicalDeviceProperties& properties, std::ui
                            properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU     ? "discrete"
                            : properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU ? "integrated"
                            : properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU    ? "virtual"
-                                                                                              : "other",
+                                                                                             : "other",
                            sub, subgroup_size ? "" : " (unknown, taken as 32)", size, max_size);
   return out;
 }
