@@ -307,7 +307,8 @@ Result<void> SolverBatch::ensure_tethers() {
   // Two kinds x tethers_per_particle slots per particle, one RG32UI texel each: within the limits?
   const std::uint64_t slots_n = 2ull * count * tethers_per_particle;
   VKCLOTH_TRY(check_buffer(*ctx, storage_limit(*ctx, knobs), "tethers", slots_n, sizeof(sh::TetherSlot)));
-  VKCLOTH_TRY(check_texels(*ctx, "tethers", slots_n, "use fewer particles or stretch_limit.method provot"));
+  if (access == BufferAccess::texel_views) // the storage builds make no texel views
+    VKCLOTH_TRY(check_texels(*ctx, "tethers", slots_n, "use fewer particles or stretch_limit.method provot"));
   VKCLOTH_TRY(commands->wait_for_earlier_work()); // write_sets() below: no recorded work may use the sets
   static_assert(VKCLOTH_TETHERS_PER_PARTICLE == tethers_per_particle && VKCLOTH_NO_TETHER == no_tether);
   std::vector<sh::TetherSlot> data;
@@ -496,7 +497,9 @@ struct DispatchGrid {
 /// asked for, are checked then: ensure_tethers.)
 Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ClothTopology& topology,
                                   std::uint64_t batch, const GpuSolverOptions& options,
-                                  const testing::SolverKnobs& knobs, std::uint32_t workgroup) {
+                                  const testing::SolverKnobs& knobs, const DeviceLayout& layout) {
+  const std::uint32_t workgroup = layout.workgroup_size;
+  const bool texel = layout.access == BufferAccess::texel_views; // the storage builds make no texel views
   const bool fan_lists = SolverBatch::normals_of(topology, knobs) == SolverBatch::Normals::fans;
   const std::uint64_t n = topology.size();
   const VkPhysicalDeviceLimits& lim = ctx.properties.limits;
@@ -518,7 +521,7 @@ Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ClothTopology&
     VKCLOTH_TRY(check_buffer(ctx, limit, need.what, need.items, need.per));
   // Positions, velocities and particle constants are also read through texel buffer views (one
   // texel per particle of every instance).
-  if (batch * n > lim.maxTexelBufferElements)
+  if (texel && batch * n > lim.maxTexelBufferElements)
     return make_error(
         ErrorCode::unsupported,
         fmt::format("the system is too large for device '{}': {} particles ({} instances of {}) need "
@@ -536,7 +539,8 @@ Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ClothTopology&
                {"normal fan offsets", fan_lists ? n + 1 : 0},
                {"normal fans", fans_n}};
   for (const auto& list : lists)
-    VKCLOTH_TRY(check_texels(ctx, list.what, list.texels, "use fewer springs or particles"));
+    if (texel)
+      VKCLOTH_TRY(check_texels(ctx, list.what, list.texels, "use fewer springs or particles"));
   const std::uint64_t groups = (n + workgroup - 1) / workgroup;
   std::uint64_t row = lim.maxComputeWorkGroupCount[0];
   if (knobs.max_workgroups_x)
@@ -763,7 +767,7 @@ SolverBatch::create(const std::shared_ptr<Context::Impl>& ctx, CommandContext& c
       resolve_layout(*ctx, options, !params.empty() && params[0].integrator == Integrator::implicit_euler);
   if (!chosen)
     return chosen.error();
-  auto grid = check_limits(*ctx, topology, params.size(), options, knobs, chosen->workgroup_size);
+  auto grid = check_limits(*ctx, topology, params.size(), options, knobs, *chosen);
   if (!grid)
     return grid.error();
 

@@ -74,7 +74,8 @@ Result<void> SolverBatch::init_pipelines() {
   texel_layout = layouts->texel;
   layout = layouts->layout;
   VKCLOTH_TRY(create_descriptor_sets());
-  VKCLOTH_TRY(create_texel_views());
+  if (access == BufferAccess::texel_views) // the storage builds leave set 1 bound but unwritten, unused
+    VKCLOTH_TRY(create_texel_views());
   return create_pipelines();
 }
 
@@ -141,6 +142,8 @@ Result<void> SolverBatch::create_texel_views() {
 // The tethers' view (again when ensure_tethers() replaces the buffer), then every texel set.
 Result<void> SolverBatch::create_tethers_view() {
   static_assert(sizeof(sh::TetherSlot) == 8, "one RG32UI texel per TetherSlot");
+  if (access != BufferAccess::texel_views)
+    return {}; // no views (init_pipelines)
   auto r = create_buffer_view(*ctx, tethers.buffer, VK_FORMAT_R32G32_UINT, "tethers");
   if (!r)
     return r.error();

@@ -25,7 +25,8 @@ class Context;
 enum class BufferAccess : std::uint8_t {
   automatic,      ///< the device's choice (choose_layout)
   texel_views,    ///< uniform texel buffer views (set 1): the *_texel builds of the shaders
-  storage_buffers ///< std430 storage buffers (set 0 only): the *_storage builds
+  storage_buffers ///< std430 storage buffers (set 0 only): the *_storage builds; no texel views are
+                  ///< made, so maxTexelBufferElements does not limit the batch
 };
 
 /// "auto", "texel" or "storage" (the CLI's spelling).
