@@ -7,7 +7,6 @@
 #include "vkcloth_shared.h"
 #define VKCLOTH_PC_COPY
 #include "common.glsl"
-#define VKCLOTH_POS_TEXEL
 #include "force_body.glsl"
 
 layout(std430, set = 0, binding = VKCLOTH_BINDING_VEL_IN) readonly buffer VelIn { vec4 vel_in[]; };

@@ -13,7 +13,6 @@
 #include "vkcloth_shared.h"
 #define VKCLOTH_PC_COPY
 #include "common.glsl"
-#define VKCLOTH_POS_TEXEL
 #include "force_body.glsl"
 
 layout(std430, set = 0, binding = VKCLOTH_BINDING_FORCE_OUT) writeonly buffer ForceOut { vec4 force_out[]; };
@@ -32,9 +31,17 @@ layout(constant_id = 40) const bool SC_WRITE_AUX = true;
 // the positions (force_body.glsl pos_at): on llvmpipe an SSBO load is a per-lane loop even at a
 // constant offset. Each invocation reads its own velocity before it stores it, and any flags value
 // this dispatch can see gives the same frozen() answer (older steps' values are visible through
-// the barrier; this step's own writes are >= pc.step).
+// the barrier; this step's own writes are >= pc.step). The *_storage build loads them from VEL and
+// FLAGS themselves.
+#ifdef VKCLOTH_TEXEL_VIEWS
 layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_VEL) uniform samplerBuffer vel_texel;
 layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_FLAGS) uniform usamplerBuffer flags_texel;
+vec3 vel_now(uint g) { return texelFetch(vel_texel, int(g)).xyz; }
+bool frozen_now() { return texelFetch(flags_texel, int(inst * 4u + 1u)).x < pc.step; }
+#else
+vec3 vel_now(uint g) { return vel[g].xyz; }
+bool frozen_now() { return frozen(); }
+#endif
 
 void main() {
   begin_instance();
@@ -46,8 +53,8 @@ void main() {
   // separate copy cost a masked per-lane load and store loop in every step. finish() re-checks the
   // frozen state, which is the bad step's output: the same particles, no flag changes.
   // frozen(): Flags[inst].first_bad_step (4 words per Flags) < this step
-  const bool fr = texelFetch(flags_texel, int(inst * 4u + 1u)).x < pc.step;
-  const vec3 v0 = texelFetch(vel_texel, int(g)).xyz;
+  const bool fr = frozen_now();
+  const vec3 v0 = vel_now(g);
   vec3 vf = v0;
   vec3 f, nrm;
   particle_force(p, vf, f, nrm);

@@ -11,7 +11,13 @@
 #include "common.glsl"
 #include "strain_texel.glsl"
 
+#ifdef VKCLOTH_TEXEL_VIEWS
 layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_TETHERS) uniform usamplerBuffer tethers_texel;
+uvec2 tether_at(uint s) { return texelFetch(tethers_texel, int(s)).xy; }
+#else
+layout(std430, set = 0, binding = VKCLOTH_BINDING_TETHERS) readonly buffer TetherBuf { TetherSlot tethers[]; };
+uvec2 tether_at(uint s) { return uvec2(tethers[s].anchor, floatBitsToUint(tethers[s].rest_length)); }
+#endif
 
 void main() {
   begin_instance();
@@ -30,7 +36,7 @@ void main() {
     const uint first =
         ((ip.stretch & VKCLOTH_STRETCH_GEODESIC) != 0u ? pc.count + p : p) * VKCLOTH_TETHERS_PER_PARTICLE;
     for (uint k = 0u; k < VKCLOTH_TETHERS_PER_PARTICLE; ++k) {
-      const uvec2 t = texelFetch(tethers_texel, int(first + k)).xy; // TetherSlot: anchor, rest length
+      const uvec2 t = tether_at(first + k); // TetherSlot: anchor, rest length
       if (t.x == VKCLOTH_NO_TETHER) break;
       vec3 d;
       if (tether_move(x, pos_now(t.x), stretch_bound(uintBitsToFloat(t.y), ip.max_strain), d)) {

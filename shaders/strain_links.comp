@@ -12,16 +12,26 @@
 #include "common.glsl"
 #include "strain_texel.glsl"
 
+#ifdef VKCLOTH_TEXEL_VIEWS
 layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_STRAIN_LINKS) uniform usamplerBuffer links_texel;
+StrainLink link_at(uint l) {
+  const int t = 3 * int(l); // StrainLink as 3 R32UI texels
+  return StrainLink(texelFetch(links_texel, t).x, texelFetch(links_texel, t + 1).x,
+                    uintBitsToFloat(texelFetch(links_texel, t + 2).x));
+}
+#else
+layout(std430, set = 0, binding = VKCLOTH_BINDING_STRAIN_LINKS) readonly buffer LinkBuf { StrainLink links[]; };
+StrainLink link_at(uint l) { return links[l]; }
+#endif
 
 void main() {
   begin_instance();
   const uint k = particle_index(); // the link within its colour
   if (k >= pc.pad1 || (ip.stretch & VKCLOTH_STRETCH_PROVOT) == 0u || pc.stage >= ip.stretch_sweeps || frozen_now())
     return;
-  const int t = 3 * int(pc.pad0 + k); // StrainLink as 3 R32UI texels
-  const uint a = texelFetch(links_texel, t).x, b = texelFetch(links_texel, t + 1).x;
-  const float rest = uintBitsToFloat(texelFetch(links_texel, t + 2).x);
+  const StrainLink link = link_at(pc.pad0 + k);
+  const uint a = link.a, b = link.b;
+  const float rest = link.rest_length;
   vec3 xa = pos_now(a), xb = pos_now(b);
   vec3 da, db;
   if (!provot_link(xa, xb, pinned_at(a), pinned_at(b), stretch_bound(rest, ip.max_strain), da, db))

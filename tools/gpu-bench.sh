@@ -3,6 +3,7 @@
 # For a user with a real GPU: builds vkcloth (release preset), runs the GPU test suite under the
 # Khronos validation layer with synchronization validation (CI=true: no device is a failure, not a
 # skip), then times the Vulkan solver with `vkcloth bench`: explicit fused Euler up to 4096 x 4096
+# with both buffer accesses (texel views, storage buffers; alternated, each result's `layout` key)
 # and implicit Euler at 256 x 256. Writes ONE JSON file: the device, the CPU, the test outcome and
 # both bench results (their keys: docs/performance.md).
 #
@@ -21,7 +22,7 @@ for arg in "$@"; do
   --quick) quick=1 ;;
   --skip-tests) tests=0 ;;
   -h | --help)
-    sed -n '2,14p' "$0"
+    sed -n '2,15p' "$0"
     exit 0
     ;;
   -*)
@@ -63,7 +64,7 @@ fi
 explicit=$(mktemp)
 implicit=$(mktemp)
 trap 'rm -f "$explicit" "$implicit"' EXIT
-"$cli" bench --backend vulkan --sizes "$sizes" --steps "$steps" --reps "$reps" --variants fused \
+"$cli" bench --backend vulkan --sizes "$sizes" --steps "$steps" --reps "$reps" --variants fused --layout texel,storage \
   --json "$explicit" || status=1
 "$cli" bench --backend vulkan --sizes "$implicit_size" --steps "$steps" --reps "$reps" \
   --integrator implicit_euler --json "$implicit" || status=1

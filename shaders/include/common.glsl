@@ -5,7 +5,14 @@
 #ifndef VKCLOTH_COMMON_GLSL
 #define VKCLOTH_COMMON_GLSL
 
+#ifdef VKCLOTH_WORKGROUP_SPEC
+// The workgroup size as a specialisation constant (DeviceLayout::workgroup_size; id 43,
+// pipelines.hpp kWorkgroupSizeConstant), VKCLOTH_WORKGROUP_SIZE unless the host sets it. Nothing
+// in these shaders sizes an array with it; implicit*.comp (shared-memory trees) keep the constant.
+layout(local_size_x = VKCLOTH_WORKGROUP_SIZE, local_size_x_id = 43) in;
+#else
 layout(local_size_x = VKCLOTH_WORKGROUP_SIZE) in;
+#endif
 
 #ifdef VKCLOTH_PC_COPY
 // The shader copies the push constants into `pc` before any branch (main: pc = pc_block): llvmpipe
@@ -33,10 +40,11 @@ uint inst;
 uint base;
 InstanceParams ip;
 
-#ifdef VKCLOTH_PC_COPY
-// The same shaders (force.comp, fused.comp, integrate.comp) read the instance parameters through
-// an RGBA32UI texel view (set 1): on llvmpipe an SSBO load is a per-lane loop even at an index
-// that is the same for the whole workgroup; a texel fetch is one vectorised call.
+#if defined(VKCLOTH_PC_COPY) && defined(VKCLOTH_TEXEL_VIEWS)
+// The same shaders (force.comp, fused.comp, integrate.comp, strain_*.comp) in their *_texel builds
+// read the instance parameters through an RGBA32UI texel view (set 1): on llvmpipe an SSBO load is
+// a per-lane loop even at an index that is the same for the whole workgroup; a texel fetch is one
+// vectorised call. Their *_storage builds load instances[inst] (DeviceLayout picks the build).
 layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_INSTANCES) uniform usamplerBuffer instances_texel;
 #endif
 
@@ -48,7 +56,7 @@ vec4 normal_output(vec3 nrm) {
 
 void begin_instance() {
   inst = gl_WorkGroupID.z;
-#ifdef VKCLOTH_PC_COPY
+#if defined(VKCLOTH_PC_COPY) && defined(VKCLOTH_TEXEL_VIEWS)
   pc = pc_block; // before any branch (see above)
   base = inst * pc.count;
   const int t = int(inst) * 5; // sizeof(InstanceParams) / 16
@@ -70,6 +78,9 @@ void begin_instance() {
   ip.stretch = e.z;
   ip.stretch_sweeps = e.w;
 #else
+#ifdef VKCLOTH_PC_COPY
+  pc = pc_block;
+#endif
   base = inst * pc.count;
   ip = instances[inst];
 #endif
@@ -77,7 +88,7 @@ void begin_instance() {
 
 // Particle index within the instance: 1-D, with a second grid dimension when one row of workgroups is not enough.
 uint particle_index() {
-  return gl_WorkGroupID.y * gl_NumWorkGroups.x * uint(VKCLOTH_WORKGROUP_SIZE) + gl_GlobalInvocationID.x;
+  return gl_WorkGroupID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x + gl_GlobalInvocationID.x;
 }
 
 // A step after the first diverged one leaves the state as it was after the bad step (like the

@@ -3,7 +3,7 @@
 // pass per Euler step) and implicit.comp: vertex normal from the grid fan or the topology's fan
 // lists, spring gather in the topology's order, gravity, damping, wind, then contact filtering;
 // each formula from cloth_kernel.h, which the CPU reference compiles too. Reads POS_IN (all
-// particles), OFFSETS, EDGES, FAN_OFFSETS, FANS, PARTICLE (with VKCLOTH_POS_TEXEL
+// particles), OFFSETS, EDGES, FAN_OFFSETS, FANS, PARTICLE (with VKCLOTH_TEXEL_VIEWS
 // through set 1's texel views, see below).
 #ifndef VKCLOTH_FORCE_BODY_GLSL
 #define VKCLOTH_FORCE_BODY_GLSL
@@ -12,14 +12,16 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_POS_IN) readonly buffer PosIn 
 
 // pos_at(q) = pos_in[base + q].xyz (this instance's particle q; q indexes the shared topology),
 // mass_at(p) = particle[p].mass, pinned_at(p) = particle[p].pinned != 0.
-// With VKCLOTH_POS_TEXEL (force.comp, fused.comp) they read the same buffers through uniform
-// texel buffer views (set 1): llvmpipe (Mesa 22.x) turns an SSBO load into a per-lane loop with a
-// bounds check and a branch per component, a texel fetch into one vectorised gather of the 8
-// lanes' texels. A 32-bit texel fetch is a copy: same bits.
+// With VKCLOTH_TEXEL_VIEWS (the *_texel builds of force.comp and fused.comp, shaders/CMakeLists.txt;
+// chosen per device by DeviceLayout) they read the same buffers through uniform texel buffer views
+// (set 1): llvmpipe (Mesa 22.x) turns an SSBO load into a per-lane loop with a bounds check and a
+// branch per component, a texel fetch into one vectorised gather of the 8 lanes' texels. A 32-bit
+// texel fetch is a copy: same bits. Without it (the *_storage builds, implicit.comp), plain std430
+// loads: what a GPU with a real memory path wants.
 // The topology's lists the same way: offsets_at(p) = offsets[p], edge_at(e) = edges[e],
 // fan_offsets_at(p) = fan_offsets[p], fan_at(t) = fans[t] (the mesh path: CSR gather, fan normal).
 // EDGES is viewed as R32UI, 3 texels per 12-byte Edge (no RGB32 texel format is mandatory).
-#ifdef VKCLOTH_POS_TEXEL
+#ifdef VKCLOTH_TEXEL_VIEWS
 layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_POS_IN) uniform samplerBuffer pos_in_texel;
 layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_PARTICLE) uniform usamplerBuffer particle_texel;
 layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_OFFSETS) uniform usamplerBuffer offsets_texel;

@@ -10,7 +10,7 @@ endif()
 message(STATUS "${out}")
 file(READ "${OUT}" doc)
 foreach(key schema scene integrator dt steps warmup reps steps_per_submit ceilings host_threads vulkan_device
-            vulkan_skipped results)
+            vulkan_layout vulkan_skipped results)
   string(JSON type ERROR_VARIABLE e TYPE "${doc}" ${key})
   if(e)
     message(FATAL_ERROR "bench JSON: missing key '${key}': ${e}")
@@ -27,7 +27,8 @@ endif()
 math(EXPR last "${n} - 1")
 set(vulkan_rows 0)
 foreach(i RANGE ${last})
-  foreach(key backend variant size instances particles springs threads steps reps wall_ms gpu_ms ms_per_step gpu_ms_per_step
+  foreach(key backend variant layout workgroup_size size instances particles springs threads steps reps wall_ms gpu_ms
+              ms_per_step gpu_ms_per_step
               particle_steps_per_s bytes_per_particle_step flops_per_particle_step achieved_gbps memory_fraction
               achieved_gflops compute_fraction)
     string(JSON type ERROR_VARIABLE e TYPE "${doc}" results ${i} ${key})

@@ -11,6 +11,8 @@
 #include <optional>
 #include <sstream>
 #include <thread>
+#include <tuple>
+#include <utility>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -19,6 +21,7 @@
 #include "vkcloth/builders.hpp"
 #include "vkcloth/cpu_solver.hpp"
 #include "vkcloth/gpu/gpu_solver.hpp"
+#include "vkcloth/gpu/layout.hpp"
 #include "vkcloth/gpu/world.hpp"
 #include "vkcloth/mesh.hpp"
 
@@ -40,6 +43,8 @@ struct BenchOptions {
   double compute_gflops = 192.0;
   std::string json;
   std::string variants = "fused,two_pass"; // Vulkan layouts to time (RK4 and implicit: always one)
+  std::string layout = "auto";             // Vulkan buffer access(es): auto, texel, storage, comma-separated
+  std::uint32_t workgroup = 0;             // Vulkan workgroup size (0: the device's choice)
   std::string mesh;      // also time this mesh (OBJ / glTF): reordered, in file order, and shuffled
   std::string stretch;   // also time each grid with stretch_limit {method: this, max_strain 0.1, 4 sweeps}
   std::string stiffness; // "S,H,B": the grid's structural, shear and bend stiffness (default 40,8,8)
@@ -197,6 +202,8 @@ struct Row {
   std::uint32_t instances = 1;     // cloths stepped together (ClothWorld rows)
   std::string scene = "grid";      // "grid" (n x n) or "mesh" (--mesh)
   std::string order;               // mesh rows: "meshopt", "file" or "shuffled"
+  std::string layout;              // Vulkan rows: the buffer access that ran ("texel" | "storage")
+  std::uint32_t workgroup = 0;     // Vulkan rows: the workgroup size that ran
   Cost cost;
 };
 
@@ -243,11 +250,22 @@ Result<Row> bench_cpu(const BenchScene& sc, std::uint32_t n, const BenchOptions&
   return row;
 }
 
+/// The buffer access and workgroup size a solver created with `go` runs on `ctx` (DeviceLayout).
+std::pair<std::string, std::uint32_t> layout_of(gpu::Context& ctx, const gpu::GpuSolverOptions& go,
+                                                bool implicit) {
+  const gpu::DeviceLayout d = gpu::device_layout(ctx);
+  const gpu::BufferAccess a = go.buffer_access == gpu::BufferAccess::automatic ? d.access : go.buffer_access;
+  return {gpu::to_string(a), implicit ? 64u : go.workgroup_size ? go.workgroup_size : d.workgroup_size};
+}
+
 Result<Row>
-bench_vulkan(gpu::Context& ctx, const BenchScene& sc, std::uint32_t n, bool fused, const BenchOptions& o,
+bench_vulkan(gpu::Context& ctx, const BenchScene& sc, std::uint32_t n, bool fused, gpu::BufferAccess access,
+             const BenchOptions& o,
              gpu::GpuSolverOptions::CgDispatch cg = gpu::GpuSolverOptions::CgDispatch::automatic) {
   gpu::GpuSolverOptions go;
   go.fused = fused;
+  go.buffer_access = access;
+  go.workgroup_size = o.workgroup;
   go.cg_dispatch = cg;
   auto s = gpu::GpuSolver::create(ctx, sc.system, sc.params, go);
   if (!s)
@@ -274,6 +292,8 @@ bench_vulkan(gpu::Context& ctx, const BenchScene& sc, std::uint32_t n, bool fuse
   row.size = n;
   row.wall_ms = median(wall);
   row.gpu_ms = median(gpu_ms);
+  std::tie(row.layout, row.workgroup) =
+      layout_of(ctx, go, sc.params.integrator == Integrator::implicit_euler);
   return row;
 }
 
@@ -281,8 +301,11 @@ bench_vulkan(gpu::Context& ctx, const BenchScene& sc, std::uint32_t n, bool fuse
 /// batched (one shared topology: one dispatch per pass for all) or not (a topology prepared for
 /// each: every cloth its own dispatches, as separate solvers recorded into one command buffer).
 Result<Row> bench_world(gpu::Context& ctx, const BenchScene& sc, std::uint32_t n, bool batched,
-                        const BenchOptions& o) {
-  auto w = gpu::ClothWorld::create(ctx);
+                        gpu::BufferAccess access, const BenchOptions& o) {
+  gpu::WorldOptions wo;
+  wo.solver.buffer_access = access;
+  wo.solver.workgroup_size = o.workgroup;
+  auto w = gpu::ClothWorld::create(ctx, wo);
   if (!w)
     return w.error();
   auto shared = ClothTopology::create(sc.system);
@@ -308,6 +331,8 @@ Result<Row> bench_world(gpu::Context& ctx, const BenchScene& sc, std::uint32_t n
   row.size = n;
   row.instances = o.instances;
   row.wall_ms = median(wall);
+  std::tie(row.layout, row.workgroup) =
+      layout_of(ctx, wo.solver, sc.params.integrator == Integrator::implicit_euler);
   return row;
 }
 
@@ -343,7 +368,7 @@ const Row* nearest_grid(const std::vector<Row>& rows, const Row& mesh) {
   const Row* best = nullptr;
   for (const Row& g : rows)
     if (g.scene == "grid" && g.backend == mesh.backend && g.variant == mesh.variant &&
-        g.integrator == mesh.integrator && g.instances == 1 &&
+        g.layout == mesh.layout && g.integrator == mesh.integrator && g.instances == 1 &&
         (!best || std::abs(double(g.particles) - double(mesh.particles)) <
                       std::abs(double(best->particles) - double(mesh.particles))))
       best = &g;
@@ -385,6 +410,23 @@ int bench_command(const BenchOptions& o) {
     else
       vulkan_note = c.error().message;
   }
+
+  std::vector<gpu::BufferAccess> layouts; // --layout, in order
+  {
+    std::stringstream ss(o.layout);
+    std::string item;
+    while (std::getline(ss, item, ','))
+      if (auto a = gpu::parse_buffer_access(item))
+        layouts.push_back(*a);
+      else
+        return report(make_error(ErrorCode::invalid_argument,
+                                 fmt::format("--layout: '{}' is not auto, texel or storage", item)));
+    if (layouts.empty())
+      return report(make_error(ErrorCode::invalid_argument, "--layout: give auto, texel, storage or a list"));
+  }
+  std::optional<gpu::DeviceLayout> device_layout;
+  if (ctx)
+    device_layout = gpu::device_layout(*ctx);
 
   std::vector<Row> rows;
   const bool implicit = *integrator == Integrator::implicit_euler;
@@ -429,26 +471,35 @@ int bench_command(const BenchOptions& o) {
     const bool two_pass = o.variants.find("two_pass") != std::string::npos;
     const bool rk4 = sc.params.integrator == Integrator::rk4;
     const bool imp = sc.params.integrator == Integrator::implicit_euler;
+    // Each variant once per --layout entry, back to back (alternated: a machine whose speed drifts
+    // during the run affects both layouts alike). Implicit with --cg-dispatch other than auto: the
+    // CG loop's two dispatch layouts, forced.
     using D = gpu::GpuSolverOptions::CgDispatch;
-    if (imp && o.cg_dispatch != "auto") { // the CG loop's two layouts, forced
-      for (const char* name : {"one_workgroup", "per_iteration"})
-        if (o.cg_dispatch == name || o.cg_dispatch == "both")
-          if (int e = add(
-                  bench_vulkan(*ctx, sc, n, true, o,
-                               std::string(name) == "one_workgroup" ? D::one_workgroup : D::per_iteration)))
-            return e;
-    } else if (fused || rk4 || imp) {
-      if (int e = add(bench_vulkan(*ctx, sc, n, true, o)))
-        return e;
-    }
+    if (fused || rk4 || imp)
+      for (gpu::BufferAccess access : layouts) {
+        if (imp && o.cg_dispatch != "auto") {
+          for (const char* name : {"one_workgroup", "per_iteration"})
+            if (o.cg_dispatch == name || o.cg_dispatch == "both")
+              if (int e = add(bench_vulkan(*ctx, sc, n, true, access, o,
+                                           std::string(name) == "one_workgroup" ? D::one_workgroup
+                                                                                : D::per_iteration)))
+                return e;
+          continue;
+        }
+        if (int e = add(bench_vulkan(*ctx, sc, n, true, access, o)))
+          return e;
+      }
     if (two_pass && !rk4 && !imp)
-      if (int e = add(bench_vulkan(*ctx, sc, n, false, o)))
-        return e;
+      for (gpu::BufferAccess access : layouts)
+        if (int e = add(bench_vulkan(*ctx, sc, n, false, access, o)))
+          return e;
     if (o.instances > 1 && scene == "grid") { // many cloths: one batch vs one dispatch chain per cloth
-      if (int e = add(bench_world(*ctx, sc, n, true, o)))
-        return e;
-      if (int e = add(bench_world(*ctx, sc, n, false, o)))
-        return e;
+      for (gpu::BufferAccess access : layouts) {
+        if (int e = add(bench_world(*ctx, sc, n, true, access, o)))
+          return e;
+        if (int e = add(bench_world(*ctx, sc, n, false, access, o)))
+          return e;
+      }
     }
     return exit_ok;
   };
@@ -495,7 +546,8 @@ int bench_command(const BenchOptions& o) {
   fmt::print("ceilings: memory {:g} GB/s, compute {:g} GFLOP/s (--memory-gbps, --compute-gflops)\n",
              o.memory_gbps, o.compute_gflops);
   if (ctx)
-    fmt::print("vulkan device: {}\n", ctx->device_name());
+    fmt::print("vulkan device: {}\nvulkan layout: {} (the device's choice: {})\n", ctx->device_name(),
+               o.layout, device_layout->reason);
   if (!vulkan_note.empty())
     fmt::print("vulkan: skipped ({})\n", vulkan_note);
   if (o.instances > 1)
@@ -508,9 +560,9 @@ int bench_command(const BenchOptions& o) {
         "stretch rows: n x n with stretch_limit {{method: {}, max_strain: 0.1, iterations: 4}} (n column: "
         "n+{})\n",
         o.stretch, o.stretch);
-  fmt::print("{:<7} {:<9} {:>8} {:>8} {:>3} {:>9} {:>9} {:>9} {:>6} {:>7} {:>5} {:>6} {:>8} {:>5}\n",
-             "backend", "variant", "n", "particles", "thr", "ms/step", "gpu ms", "M p-st/s", "B/p-st", "GB/s",
-             "%mem", "fl/pst", "GFLOP/s", "%cmp");
+  fmt::print("{:<7} {:<9} {:<11} {:>8} {:>8} {:>3} {:>9} {:>9} {:>9} {:>6} {:>7} {:>5} {:>6} {:>8} {:>5}\n",
+             "backend", "variant", "layout", "n", "particles", "thr", "ms/step", "gpu ms", "M p-st/s",
+             "B/p-st", "GB/s", "%mem", "fl/pst", "GFLOP/s", "%cmp");
   nlohmann::json results = nlohmann::json::array();
   for (const Row& r : rows) {
     const double ms_step = r.wall_ms / double(r.steps);
@@ -519,9 +571,9 @@ int bench_command(const BenchOptions& o) {
     const double gflops = rate * r.cost.flops * 1e-9;
     const double gpu_step = r.gpu_ms >= 0 ? r.gpu_ms / double(r.steps) : -1.0;
     fmt::print(
-        "{:<7} {:<9} {:>8} {:>8} {:>3} {:>9.4f} {:>9} {:>9.1f} {:>6.0f} {:>7.2f} {:>4.0f}% {:>6.0f} {:>8.2f} "
-        "{:>4.1f}%\n",
-        r.backend, r.variant,
+        "{:<7} {:<9} {:<11} {:>8} {:>8} {:>3} {:>9.4f} {:>9} {:>9.1f} {:>6.0f} {:>7.2f} {:>4.0f}% {:>6.0f} "
+        "{:>8.2f} {:>4.1f}%\n",
+        r.backend, r.variant, r.layout.empty() ? "-" : fmt::format("{}/{}", r.layout, r.workgroup),
         r.scene == "grid"      ? fmt::format("{}", r.size)
         : r.scene == "stretch" ? fmt::format("{}+{}", r.size, r.order)
                                : r.order,
@@ -531,6 +583,8 @@ int bench_command(const BenchOptions& o) {
     nlohmann::json j;
     j["backend"] = r.backend;
     j["variant"] = r.variant;
+    j["layout"] = r.layout.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.layout);
+    j["workgroup_size"] = r.layout.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.workgroup);
     j["integrator"] = r.integrator;
     if (r.integrator == "implicit_euler") {
       j["cg_iterations_last_step"] = r.cg_iterations;
@@ -609,6 +663,11 @@ int bench_command(const BenchOptions& o) {
     doc["ceilings"] = {{"memory_gbps", o.memory_gbps}, {"compute_gflops", o.compute_gflops}};
     doc["host_threads"] = std::thread::hardware_concurrency();
     doc["vulkan_device"] = ctx ? nlohmann::json(ctx->device_name()) : nlohmann::json(nullptr);
+    doc["vulkan_layout"] = device_layout ? nlohmann::json{{"access", gpu::to_string(device_layout->access)},
+                                                          {"workgroup_size", device_layout->workgroup_size},
+                                                          {"subgroup_size", device_layout->subgroup_size},
+                                                          {"reason", device_layout->reason}}
+                                         : nlohmann::json(nullptr);
     doc["vulkan_skipped"] = vulkan_note.empty() ? nlohmann::json(nullptr) : nlohmann::json(vulkan_note);
     doc["results"] = std::move(results);
     std::ofstream f(o.json);
@@ -661,6 +720,14 @@ void add_bench_command(CLI::App& app, int* exit) {
                    ? std::string()
                    : std::string("expected fused, two_pass or fused,two_pass");
       });
+  cmd->add_option(
+         "--layout", opt->layout,
+         "Vulkan: how the shaders read their buffers: auto (the device's choice), texel, storage, or "
+         "a list (texel,storage: each Vulkan row once per entry, alternated)")
+      ->capture_default_str();
+  cmd->add_option("--workgroup", opt->workgroup,
+                  "Vulkan: invocations per workgroup (0: the device's choice; implicit Euler: always 64)")
+      ->capture_default_str();
   cmd->add_option("--mesh", opt->mesh,
                   "Also time the cloth made from this OBJ / glTF mesh, with its particles renumbered by "
                   "meshoptimizer, in the file's order and shuffled, against the grid of nearest size")

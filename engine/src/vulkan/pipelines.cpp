@@ -6,14 +6,19 @@
 #include <fmt/format.h>
 
 #include "implicit_shared.h"
-#include "vkcloth/shaders/force_comp_spv.hpp"
-#include "vkcloth/shaders/fused_comp_spv.hpp"
+#include "vkcloth/shaders/force_storage_comp_spv.hpp"
+#include "vkcloth/shaders/force_texel_comp_spv.hpp"
+#include "vkcloth/shaders/fused_storage_comp_spv.hpp"
+#include "vkcloth/shaders/fused_texel_comp_spv.hpp"
 #include "vkcloth/shaders/implicit_comp_spv.hpp"
 #include "vkcloth/shaders/implicit_reduce_comp_spv.hpp"
-#include "vkcloth/shaders/integrate_comp_spv.hpp"
-#include "vkcloth/shaders/strain_finish_comp_spv.hpp"
+#include "vkcloth/shaders/integrate_storage_comp_spv.hpp"
+#include "vkcloth/shaders/integrate_texel_comp_spv.hpp"
+#include "vkcloth/shaders/strain_finish_storage_comp_spv.hpp"
+#include "vkcloth/shaders/strain_finish_texel_comp_spv.hpp"
+#include "vkcloth/shaders/strain_links_storage_comp_spv.hpp"
+#include "vkcloth/shaders/strain_links_texel_comp_spv.hpp"
 #include "vkcloth/shaders/vertices_comp_spv.hpp"
-#include "vkcloth/shaders/strain_links_comp_spv.hpp"
 #include "vkcloth_shared.h"
 
 namespace vkcloth::gpu {
@@ -25,27 +30,41 @@ struct ShaderCode {
   const char* name;
 };
 
-ShaderCode code_of(PipelineRegistry::Shader s) {
+/// The build of `s` for `access` (shaders/CMakeLists.txt: *_texel with VKCLOTH_TEXEL_VIEWS,
+/// *_storage without; shaders with one build ignore `access`).
+ShaderCode code_of(PipelineRegistry::Shader s, BufferAccess access) {
   using S = PipelineRegistry::Shader;
+  const bool texel = access != BufferAccess::storage_buffers;
   switch (s) {
   case S::force:
-    return {spirv::force_comp_spv, "force.comp"};
+    return texel ? ShaderCode{spirv::force_texel_comp_spv, "force.comp (texel views)"}
+                 : ShaderCode{spirv::force_storage_comp_spv, "force.comp (storage buffers)"};
   case S::integrate:
-    return {spirv::integrate_comp_spv, "integrate.comp"};
+    return texel ? ShaderCode{spirv::integrate_texel_comp_spv, "integrate.comp (texel views)"}
+                 : ShaderCode{spirv::integrate_storage_comp_spv, "integrate.comp (storage buffers)"};
   case S::fused:
-    return {spirv::fused_comp_spv, "fused.comp"};
+    return texel ? ShaderCode{spirv::fused_texel_comp_spv, "fused.comp (texel views)"}
+                 : ShaderCode{spirv::fused_storage_comp_spv, "fused.comp (storage buffers)"};
   case S::implicit:
     return {spirv::implicit_comp_spv, "implicit.comp"};
   case S::implicit_reduce:
     return {spirv::implicit_reduce_comp_spv, "implicit_reduce.comp"};
   case S::strain_links:
-    return {spirv::strain_links_comp_spv, "strain_links.comp"};
+    return texel ? ShaderCode{spirv::strain_links_texel_comp_spv, "strain_links.comp (texel views)"}
+                 : ShaderCode{spirv::strain_links_storage_comp_spv, "strain_links.comp (storage buffers)"};
   case S::strain_finish:
-    return {spirv::strain_finish_comp_spv, "strain_finish.comp"};
+    return texel ? ShaderCode{spirv::strain_finish_texel_comp_spv, "strain_finish.comp (texel views)"}
+                 : ShaderCode{spirv::strain_finish_storage_comp_spv, "strain_finish.comp (storage buffers)"};
   case S::vertices:
     return {spirv::vertices_comp_spv, "vertices.comp"};
   }
   return {{}, "?"};
+}
+
+/// Shaders compiled in one build only.
+bool single_build(PipelineRegistry::Shader s) {
+  using S = PipelineRegistry::Shader;
+  return s == S::implicit || s == S::implicit_reduce || s == S::vertices;
 }
 
 /// The storage bindings of implicit.comp / implicit_reduce.comp (implicit_shared.h).
@@ -138,22 +157,30 @@ Result<PipelineRegistry::ImplicitLayouts> PipelineRegistry::implicit_layouts_loc
   return ImplicitLayouts{implicit_set_, implicit_layout_};
 }
 
-Result<VkShaderModule> PipelineRegistry::module_locked(Shader shader) {
-  if (auto it = modules_.find(shader); it != modules_.end())
+Result<VkShaderModule> PipelineRegistry::module_locked(Shader shader, BufferAccess access) {
+  if (auto it = modules_.find({shader, access}); it != modules_.end())
     return it->second.get();
-  const ShaderCode c = code_of(shader);
+  const ShaderCode c = code_of(shader, access);
   auto m = create_shader_module(ctx_, c.code, c.name);
   if (!m)
     return m.error();
-  return modules_.emplace(shader, std::move(*m)).first->second.get();
+  return modules_.emplace(std::pair{shader, access}, std::move(*m)).first->second.get();
 }
 
-Result<VkPipeline> PipelineRegistry::pipeline(Shader shader, std::span<const std::uint32_t> constants) {
+Result<VkPipeline> PipelineRegistry::pipeline(Shader shader, std::span<const std::uint32_t> constants,
+                                              Variant variant) {
+  const bool implicit = shader == Shader::implicit || shader == Shader::implicit_reduce;
+  if (single_build(shader))
+    variant.access = BufferAccess::texel_views; // one module, whatever was asked
+  if (variant.access == BufferAccess::automatic)
+    variant.access = device_layout(ctx_).access;
+  if (implicit || variant.workgroup_size == VKCLOTH_WORKGROUP_SIZE)
+    variant.workgroup_size = 0; // implicit*.comp size shared arrays with the compiled size
   const std::lock_guard lock(mutex_);
-  std::pair<Shader, std::vector<std::uint32_t>> key{shader, {constants.begin(), constants.end()}};
+  std::tuple<Shader, Variant, std::vector<std::uint32_t>> key{
+      shader, variant, {constants.begin(), constants.end()}};
   if (auto it = pipelines_.find(key); it != pipelines_.end())
     return it->second.get();
-  const bool implicit = shader == Shader::implicit || shader == Shader::implicit_reduce;
   VkPipelineLayout layout = VK_NULL_HANDLE;
   if (implicit) {
     auto l = implicit_layouts_locked();
@@ -166,15 +193,22 @@ Result<VkPipeline> PipelineRegistry::pipeline(Shader shader, std::span<const std
       return l.error();
     layout = l->layout;
   }
-  auto m = module_locked(shader);
+  auto m = module_locked(shader, variant.access);
   if (!m)
     return m.error();
+  // Constants 0..size-1, then the workgroup size (kWorkgroupSizeConstant) when it is not the compiled one.
+  std::vector<std::uint32_t> words(constants.begin(), constants.end());
   std::vector<VkSpecializationMapEntry> entries(constants.size());
   for (std::uint32_t k = 0; k < entries.size(); ++k)
     entries[k] = VkSpecializationMapEntry{k, k * 4, 4};
+  if (variant.workgroup_size) {
+    static_assert(kWorkgroupSizeConstant >= 43, "after the solver's constants 0..42");
+    entries.push_back({kWorkgroupSizeConstant, static_cast<std::uint32_t>(words.size() * 4), 4});
+    words.push_back(variant.workgroup_size);
+  }
   const VkSpecializationInfo spec{static_cast<std::uint32_t>(entries.size()), entries.data(),
-                                  constants.size_bytes(), constants.data()};
-  const char* name = code_of(shader).name;
+                                  words.size() * sizeof(std::uint32_t), words.data()};
+  const char* name = code_of(shader, variant.access).name;
   VkComputePipelineCreateInfo ci{};
   ci.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
   ci.stage = VkPipelineShaderStageCreateInfo{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
@@ -183,7 +217,7 @@ Result<VkPipeline> PipelineRegistry::pipeline(Shader shader, std::span<const std
                                              VK_SHADER_STAGE_COMPUTE_BIT,
                                              *m,
                                              "main",
-                                             constants.empty() ? nullptr : &spec};
+                                             entries.empty() ? nullptr : &spec};
   ci.layout = layout;
   Pipeline p;
   VKCLOTH_VK_TRY(

@@ -9,10 +9,12 @@
 #pragma once
 
 #include "resources.hpp"
+#include "vkcloth/gpu/layout.hpp"
 
 #include <map>
 #include <mutex>
 #include <span>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -20,6 +22,22 @@ namespace vkcloth::gpu {
 
 /// The storage bindings of implicit.comp / implicit_reduce.comp, in descriptor-write order.
 std::span<const std::uint32_t> implicit_bindings();
+
+/// choose_layout() for `ctx`'s device (layout.cpp).
+DeviceLayout device_layout(const Context::Impl& ctx);
+
+/// The specialisation constant of the workgroup size (common.glsl local_size_x_id), beyond the
+/// solver's constants 0..42 (solver_pipelines.cpp).
+inline constexpr std::uint32_t kWorkgroupSizeConstant = 43;
+
+/// Which build of a shader and its workgroup size (DeviceLayout). force, integrate, fused and
+/// strain_* have a *_texel and a *_storage build; the others one build, `access` ignored.
+/// `workgroup_size` 0: the compiled VKCLOTH_WORKGROUP_SIZE (implicit*.comp: always).
+struct ShaderVariant {
+  BufferAccess access = BufferAccess::texel_views;
+  std::uint32_t workgroup_size = 0;
+  auto operator<=>(const ShaderVariant&) const = default;
+};
 
 class PipelineRegistry {
 public:
@@ -54,9 +72,11 @@ public:
 
   Result<SolverLayouts> solver_layouts();
   Result<ImplicitLayouts> implicit_layouts();
+  using Variant = ShaderVariant;
   /// The pipeline of `shader` specialised with `constants` (ids 0..size-1, 32 bits each; empty:
-  /// none), created on first request; its layout is solver_layouts() or implicit_layouts().
-  Result<VkPipeline> pipeline(Shader shader, std::span<const std::uint32_t> constants);
+  /// none) and, when `variant.workgroup_size` is set, constant kWorkgroupSizeConstant; created on
+  /// first request; its layout is solver_layouts() or implicit_layouts().
+  Result<VkPipeline> pipeline(Shader shader, std::span<const std::uint32_t> constants, Variant variant = {});
   /// The Context's pipeline cache (VK_NULL_HANDLE when it could not be made: caching is optional).
   VkPipelineCache cache();
   /// Compute pipelines made so far (testing::pipeline_count).
@@ -69,7 +89,7 @@ private:
   Result<SolverLayouts> solver_layouts_locked();
   Result<ImplicitLayouts> implicit_layouts_locked();
   VkPipelineCache cache_locked();
-  Result<VkShaderModule> module_locked(Shader shader);
+  Result<VkShaderModule> module_locked(Shader shader, BufferAccess access);
 
   Context::Impl& ctx_;
   std::mutex mutex_; // several solvers may be created on one Context from different threads
@@ -77,8 +97,8 @@ private:
   bool cache_tried_ = false;
   DescriptorSetLayout solver_storage_, solver_texel_, implicit_set_;
   PipelineLayout solver_layout_, implicit_layout_;
-  std::map<Shader, ShaderModule> modules_;
-  std::map<std::pair<Shader, std::vector<std::uint32_t>>, Pipeline> pipelines_;
+  std::map<std::pair<Shader, BufferAccess>, ShaderModule> modules_;
+  std::map<std::tuple<Shader, Variant, std::vector<std::uint32_t>>, Pipeline> pipelines_;
 };
 
 } // namespace vkcloth::gpu

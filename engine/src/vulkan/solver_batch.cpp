@@ -307,7 +307,8 @@ Result<void> SolverBatch::ensure_tethers() {
   // Two kinds x tethers_per_particle slots per particle, one RG32UI texel each: within the limits?
   const std::uint64_t slots_n = 2ull * count * tethers_per_particle;
   VKCLOTH_TRY(check_buffer(*ctx, storage_limit(*ctx, knobs), "tethers", slots_n, sizeof(sh::TetherSlot)));
-  VKCLOTH_TRY(check_texels(*ctx, "tethers", slots_n, "use fewer particles or stretch_limit.method provot"));
+  if (access == BufferAccess::texel_views) // the storage builds make no texel views
+    VKCLOTH_TRY(check_texels(*ctx, "tethers", slots_n, "use fewer particles or stretch_limit.method provot"));
   VKCLOTH_TRY(commands->wait_for_earlier_work()); // write_sets() below: no recorded work may use the sets
   static_assert(VKCLOTH_TETHERS_PER_PARTICLE == tethers_per_particle && VKCLOTH_NO_TETHER == no_tether);
   std::vector<sh::TetherSlot> data;
@@ -447,7 +448,7 @@ void SolverBatch::record_stretch(VkCommandBuffer c, std::uint32_t read) {
       spc.stage = sweep;
       spc.pad0 = strain_colours[k];
       spc.pad1 = strain_colours[k + 1] - strain_colours[k];
-      const std::uint32_t groups = (spc.pad1 + VKCLOTH_WORKGROUP_SIZE - 1) / VKCLOTH_WORKGROUP_SIZE;
+      const std::uint32_t groups = (spc.pad1 + workgroup - 1) / workgroup;
       const std::uint32_t gx = std::min(groups, groups_x), gy = (groups + gx - 1) / gx;
       v.vkCmdPushConstants(c, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(spc), &spc);
       barriers::dispatch_to_dispatch(v, c); // the previous pass or colour -> this colour
@@ -515,7 +516,9 @@ struct DispatchGrid {
 /// asked for, are checked then: ensure_tethers.)
 Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ClothTopology& topology,
                                   std::uint64_t batch, const GpuSolverOptions& options,
-                                  const testing::SolverKnobs& knobs) {
+                                  const testing::SolverKnobs& knobs, const DeviceLayout& layout) {
+  const std::uint32_t workgroup = layout.workgroup_size;
+  const bool texel = layout.access == BufferAccess::texel_views; // the storage builds make no texel views
   const bool fan_lists = SolverBatch::normals_of(topology, knobs) == SolverBatch::Normals::fans;
   const std::uint64_t n = topology.size();
   const VkPhysicalDeviceLimits& lim = ctx.properties.limits;
@@ -537,7 +540,7 @@ Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ClothTopology&
     VKCLOTH_TRY(check_buffer(ctx, limit, need.what, need.items, need.per));
   // Positions, velocities and particle constants are also read through texel buffer views (one
   // texel per particle of every instance).
-  if (batch * n > lim.maxTexelBufferElements)
+  if (texel && batch * n > lim.maxTexelBufferElements)
     return make_error(
         ErrorCode::unsupported,
         fmt::format("the system is too large for device '{}': {} particles ({} instances of {}) need "
@@ -555,8 +558,9 @@ Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ClothTopology&
                {"normal fan offsets", fan_lists ? n + 1 : 0},
                {"normal fans", fans_n}};
   for (const auto& list : lists)
-    VKCLOTH_TRY(check_texels(ctx, list.what, list.texels, "use fewer springs or particles"));
-  const std::uint64_t groups = (n + VKCLOTH_WORKGROUP_SIZE - 1) / VKCLOTH_WORKGROUP_SIZE;
+    if (texel)
+      VKCLOTH_TRY(check_texels(ctx, list.what, list.texels, "use fewer springs or particles"));
+  const std::uint64_t groups = (n + workgroup - 1) / workgroup;
   std::uint64_t row = lim.maxComputeWorkGroupCount[0];
   if (knobs.max_workgroups_x)
     row = std::min<std::uint64_t>(row, knobs.max_workgroups_x);
@@ -567,7 +571,7 @@ Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ClothTopology&
         ErrorCode::unsupported,
         fmt::format("the system is too large for device '{}': {} particles need {} workgroups of {} but "
                     "the device dispatches at most {} x {}",
-                    ctx.name, n, groups, VKCLOTH_WORKGROUP_SIZE, lim.maxComputeWorkGroupCount[0],
+                    ctx.name, n, groups, workgroup, lim.maxComputeWorkGroupCount[0],
                     lim.maxComputeWorkGroupCount[1]));
   if (batch == 0 || batch > lim.maxComputeWorkGroupCount[2])
     return make_error(
@@ -778,7 +782,11 @@ SolverBatch::create(const std::shared_ptr<Context::Impl>& ctx, CommandContext& c
                     const std::vector<SlotState>& states) {
   for (SimParams& p : params)
     VKCLOTH_TRY(p.validate());
-  auto grid = check_limits(*ctx, topology, params.size(), options, knobs);
+  auto chosen =
+      resolve_layout(*ctx, options, !params.empty() && params[0].integrator == Integrator::implicit_euler);
+  if (!chosen)
+    return chosen.error();
+  auto grid = check_limits(*ctx, topology, params.size(), options, knobs, *chosen);
   if (!grid)
     return grid.error();
 
@@ -800,6 +808,8 @@ SolverBatch::create(const std::shared_ptr<Context::Impl>& ctx, CommandContext& c
   s.strain_colours.assign(topology.strain_colour_offsets().begin(), topology.strain_colour_offsets().end());
   s.groups_x = grid->x;
   s.groups_y = grid->y;
+  s.access = chosen->access;
+  s.workgroup = chosen->workgroup_size;
   if (const auto& g = topology.grid()) {
     s.nx = s.pc.nx = g->nx;
     s.ny = s.pc.ny = g->ny;

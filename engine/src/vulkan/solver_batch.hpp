@@ -98,6 +98,14 @@ public:
   const std::vector<glm::vec2>& uvs() const { return uvs_; }
   SolveStats last_solve() const { return implicit ? implicit->stats() : SolveStats{}; }
   bool implicit_one_workgroup() const { return implicit && implicit->one_workgroup(); }
+  /// The buffer access and workgroup size this batch's shaders use (resolve_layout).
+  BufferAccess buffer_access() const { return access; }
+  std::uint32_t workgroup_size() const { return workgroup; }
+  /// GpuSolverOptions::buffer_access and workgroup_size, or the device's choice (device_layout)
+  /// where they are left to it; implicit Euler batches keep the compiled workgroup size (its
+  /// reductions' shared arrays). ErrorCode::unsupported for a workgroup size the device refuses.
+  static Result<DeviceLayout> resolve_layout(const Context::Impl& ctx, const GpuSolverOptions& options,
+                                             bool implicit);
   bool uses_staging() const { return staging; }
 
   /// Where the force pass takes the vertex normals from (one choice per batch: its topology's).
@@ -130,6 +138,8 @@ private:
   std::uint32_t nx = 0, ny = 0;
   Normals normals = Normals::none;
   bool staging = false;
+  BufferAccess access = BufferAccess::texel_views;  // which build of the shaders (never automatic)
+  std::uint32_t workgroup = VKCLOTH_WORKGROUP_SIZE; // invocations per workgroup (specialised)
 
   // Per-particle vec4 buffers (slots() x count entries), then the shared topology, then the small
   // host-visible ones (per instance). Every object below is owned (resources.hpp): a new buffer

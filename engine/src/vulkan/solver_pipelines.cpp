@@ -5,6 +5,7 @@
 // solver_batch.cpp.
 #include "resources.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <cstring>
@@ -39,6 +40,30 @@ std::array<std::uint32_t, 43> solver_constants(const SolverBatch::Stencil& st, b
 
 } // namespace
 
+Result<DeviceLayout> SolverBatch::resolve_layout(const Context::Impl& ctx, const GpuSolverOptions& options,
+                                                 bool implicit) {
+  const bool decided = options.buffer_access != BufferAccess::automatic && options.workgroup_size != 0;
+  DeviceLayout out = decided ? DeviceLayout{} : device_layout(ctx);
+  if (options.buffer_access != BufferAccess::automatic)
+    out.access = options.buffer_access;
+  if (options.workgroup_size != 0) {
+    const VkPhysicalDeviceLimits& lim = ctx.properties.limits;
+    if (options.workgroup_size > lim.maxComputeWorkGroupSize[0] ||
+        options.workgroup_size > lim.maxComputeWorkGroupInvocations)
+      return make_error(
+          ErrorCode::unsupported,
+          fmt::format("GpuSolverOptions::workgroup_size {} is larger than device '{}' allows ({} "
+                      "invocations: maxComputeWorkGroupSize[0] {}, maxComputeWorkGroupInvocations {})",
+                      options.workgroup_size, ctx.name,
+                      std::min(lim.maxComputeWorkGroupSize[0], lim.maxComputeWorkGroupInvocations),
+                      lim.maxComputeWorkGroupSize[0], lim.maxComputeWorkGroupInvocations));
+    out.workgroup_size = options.workgroup_size;
+  }
+  if (implicit)
+    out.workgroup_size = VKCLOTH_WORKGROUP_SIZE; // implicit*.comp: shared arrays of this size
+  return out;
+}
+
 // The Context's layouts (set 0: storage buffers, set 1: texel views), then this batch's sets and
 // views, then the Context's pipelines for this batch's stencil.
 Result<void> SolverBatch::init_pipelines() {
@@ -49,7 +74,8 @@ Result<void> SolverBatch::init_pipelines() {
   texel_layout = layouts->texel;
   layout = layouts->layout;
   VKCLOTH_TRY(create_descriptor_sets());
-  VKCLOTH_TRY(create_texel_views());
+  if (access == BufferAccess::texel_views) // the storage builds leave set 1 bound but unwritten, unused
+    VKCLOTH_TRY(create_texel_views());
   return create_pipelines();
 }
 
@@ -116,6 +142,8 @@ Result<void> SolverBatch::create_texel_views() {
 // The tethers' view (again when ensure_tethers() replaces the buffer), then every texel set.
 Result<void> SolverBatch::create_tethers_view() {
   static_assert(sizeof(sh::TetherSlot) == 8, "one RG32UI texel per TetherSlot");
+  if (access != BufferAccess::texel_views)
+    return {}; // no views (init_pipelines)
   auto r = create_buffer_view(*ctx, tethers.buffer, VK_FORMAT_R32G32_UINT, "tethers");
   if (!r)
     return r.error();
@@ -153,28 +181,30 @@ Result<void> SolverBatch::create_tethers_view() {
 }
 
 // force.comp (specialised with the grid stencil and the fan switch; contact loops kept, the
-// default) and integrate.comp, from the Context's registry.
+// default), integrate.comp, the stretch passes and vertices.comp, from the Context's registry, in
+// the batch's build (texel views or storage buffers) and workgroup size (resolve_layout).
 Result<void> SolverBatch::create_pipelines() {
   using Shader = PipelineRegistry::Shader;
   const auto constants = solver_constants(stencil, true, true, normals == Normals::fans);
-  auto fp = ctx->pipelines->pipeline(Shader::force, constants);
+  const PipelineRegistry::Variant variant{access, workgroup};
+  auto fp = ctx->pipelines->pipeline(Shader::force, constants, variant);
   if (!fp)
     return fp.error();
   force_pipeline = *fp;
-  auto ip = ctx->pipelines->pipeline(Shader::integrate, {});
+  auto ip = ctx->pipelines->pipeline(Shader::integrate, {}, variant);
   if (!ip)
     return ip.error();
   integrate_pipeline = *ip;
-  auto lp = ctx->pipelines->pipeline(Shader::strain_links, {});
+  auto lp = ctx->pipelines->pipeline(Shader::strain_links, {}, variant);
   if (!lp)
     return lp.error();
   strain_links_pipeline = *lp;
-  auto sp = ctx->pipelines->pipeline(Shader::strain_finish, {});
+  auto sp = ctx->pipelines->pipeline(Shader::strain_finish, {}, variant);
   if (!sp)
     return sp.error();
   strain_finish_pipeline = *sp;
   if (options.interleaved_vertices) {
-    auto vp = ctx->pipelines->pipeline(Shader::vertices, {});
+    auto vp = ctx->pipelines->pipeline(Shader::vertices, {}, variant);
     if (!vp)
       return vp.error();
     vertices_pipeline = *vp;
@@ -190,7 +220,7 @@ Result<void> SolverBatch::ensure_fused() {
     return {};
   for (std::uint32_t aux = 0; aux < 2; ++aux) {
     const auto constants = solver_constants(stencil, aux != 0, col != 0, normals == Normals::fans);
-    auto p = ctx->pipelines->pipeline(PipelineRegistry::Shader::fused, constants);
+    auto p = ctx->pipelines->pipeline(PipelineRegistry::Shader::fused, constants, {access, workgroup});
     if (!p)
       return p.error();
     fused_pipes[aux][col] = *p;

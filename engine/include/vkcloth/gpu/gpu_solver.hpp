@@ -31,6 +31,7 @@
 #include <vulkan/vulkan_core.h>
 
 #include "vkcloth/gpu/context.hpp"
+#include "vkcloth/gpu/layout.hpp"
 #include "vkcloth/params.hpp"
 #include "vkcloth/result.hpp"
 #include "vkcloth/system.hpp"
@@ -62,6 +63,17 @@ struct GpuSolverOptions {
   /// for a host pipeline with one vertex binding. One extra dispatch at the end of every
   /// recording; the buffer holds the state after it (zero before the first recording).
   bool interleaved_vertices = false;
+  /// How the shaders read positions, velocities, particle constants, instance parameters and the
+  /// topology's lists (layout.hpp): `automatic` (default) takes the device's choice
+  /// (device_layout(): texel views on a CPU device such as lavapipe, storage buffers on a GPU);
+  /// texel_views / storage_buffers force one. Same bits either way; only the speed differs.
+  BufferAccess buffer_access = BufferAccess::automatic;
+  /// Invocations per workgroup of the per-particle passes; 0 (default): the device's choice
+  /// (DeviceLayout::workgroup_size: 64 on lavapipe, a multiple of the subgroup size on a GPU).
+  /// At most maxComputeWorkGroupSize[0] and maxComputeWorkGroupInvocations (else
+  /// ErrorCode::unsupported). Implicit Euler always uses 64 (its reductions are sized for it).
+  /// Same bits for any size: every particle is computed by one invocation alone.
+  std::uint32_t workgroup_size = 0;
   /// implicit_euler: where the CG iterations run. `one_workgroup`: one workgroup runs dozens of
   /// iterations per dispatch (a few dispatches per substep instead of 3 + 5 per iteration; each
   /// iteration costs more, since one workgroup does all the work); an error (unsupported) for a
