@@ -176,6 +176,10 @@ TEST_CASE(
   const std::string picked = cpu_device ? "cpu" : "vulkan";
   CHECK_MESSAGE(dev.out.find("auto backend there: " + picked) != std::string::npos, dev.out);
   CHECK_MESSAGE(dev.out.find("auto backend: " + picked + ": ") != std::string::npos, dev.out);
+  // ... and the solver's per-device layout there (gpu::device_layout).
+  CHECK_MESSAGE(dev.out.find(std::string("solver layout there: ") + (cpu_device ? "texel" : "storage")) !=
+                    std::string::npos,
+                dev.out);
   if (cpu_device)
     CHECK_MESSAGE(dev.out.find("CPU implementation of Vulkan") != std::string::npos, dev.out);
 

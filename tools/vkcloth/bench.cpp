@@ -255,7 +255,9 @@ std::pair<std::string, std::uint32_t> layout_of(gpu::Context& ctx, const gpu::Gp
                                                 bool implicit) {
   const gpu::DeviceLayout d = gpu::device_layout(ctx);
   const gpu::BufferAccess a = go.buffer_access == gpu::BufferAccess::automatic ? d.access : go.buffer_access;
-  return {gpu::to_string(a), implicit ? 64u : go.workgroup_size ? go.workgroup_size : d.workgroup_size};
+  if (implicit) // implicit.comp reads storage buffers in workgroups of 64 on every device
+    return {gpu::to_string(gpu::BufferAccess::storage_buffers), 64u};
+  return {gpu::to_string(a), go.workgroup_size ? go.workgroup_size : d.workgroup_size};
 }
 
 Result<Row>
@@ -656,6 +658,8 @@ int bench_command(const BenchOptions& o) {
     doc["mesh"] = o.mesh.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.mesh);
     doc["integrator"] = o.integrator;
     doc["dt"] = dt;
+    doc["stiffness"] = o.stiffness.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.stiffness);
+    doc["cloth_mass"] = o.cloth_mass ? nlohmann::json(*o.cloth_mass) : nlohmann::json(nullptr);
     doc["steps"] = o.steps;
     doc["warmup"] = o.warmup;
     doc["reps"] = o.reps;

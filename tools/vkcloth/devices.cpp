@@ -1,11 +1,13 @@
 // SPDX-License-Identifier: MIT
 // `vkcloth devices`: the Vulkan devices the loader reports, which one a solver would take, and the
-// backend `--backend auto` (render, view, the samples) picks on each, with the reason.
+// backend `--backend auto` (render, view, the samples) picks on each, with the reason, and the
+// solver's per-device layout (buffer access, workgroup size) on the selected one.
 #include <fmt/format.h>
 
 #include "commands.hpp"
 #include "vkcloth/gpu/backend_choice.hpp"
 #include "vkcloth/gpu/context.hpp"
+#include "vkcloth/gpu/layout.hpp"
 
 namespace vkcloth::cli {
 namespace {
@@ -51,6 +53,10 @@ int devices_command() {
   fmt::print("selected: {} (set VKCLOTH_DEVICE to a name or an index to choose)\n", context->device_name());
   fmt::print("auto backend there: {} (render, view and the samples; --backend cpu | vulkan to choose)\n",
              gpu::to_string(gpu::choose_backend(*context).backend));
+  const gpu::DeviceLayout layout = gpu::device_layout(*context);
+  fmt::print("solver layout there: {} reads, workgroups of {} ({}; GpuSolverOptions::buffer_access and "
+             "workgroup_size to choose)\n",
+             gpu::to_string(layout.access), layout.workgroup_size, layout.reason);
   return exit_ok;
 }
 

@@ -85,8 +85,9 @@ struct GpuSolverOptions {
   CgDispatch cg_dispatch = CgDispatch::automatic;
 };
 
-/// CgDispatch::automatic's limit for one_workgroup (measured on lavapipe: docs/performance.md).
-inline constexpr std::uint32_t implicit_one_workgroup_max_particles = 16384;
+/// CgDispatch::automatic's limit for one_workgroup, measured on lavapipe (docs/performance.md):
+/// 1.2x faster than per_iteration at 48 x 48, 0.9x at 96 x 96.
+inline constexpr std::uint32_t implicit_one_workgroup_max_particles = 4096;
 
 /// Where an instance's per-particle data lives, for the host's own drawing: vec4 per particle
 /// (w = 1 for positions), `stride` bytes apart, `count` particles from byte `offset` of each buffer.
@@ -237,7 +238,7 @@ public:
   /// recorded work has finished).
   SolveStats last_solve() const;
   /// implicit_euler: whether the CG iterations run in one workgroup (GpuSolverOptions::cg_dispatch);
-  /// false before the first implicit step and for the other integrators.
+  /// chosen when the solver is made (or its integrator becomes implicit_euler); false for the others.
   bool implicit_one_workgroup() const;
 
   /// GPU time of the last simulate() (sum over its submissions, timestamps), in milliseconds;
