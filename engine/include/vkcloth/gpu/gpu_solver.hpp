@@ -86,8 +86,8 @@ struct GpuSolverOptions {
 };
 
 /// CgDispatch::automatic's limit for one_workgroup, measured on lavapipe (docs/performance.md):
-/// 1.2x faster than per_iteration at 48 x 48, 0.9x at 96 x 96.
-inline constexpr std::uint32_t implicit_one_workgroup_max_particles = 4096;
+/// 1.3x faster than per_iteration at 16 x 16, even at 32 x 32, slower from 48 x 48 on (idle).
+inline constexpr std::uint32_t implicit_one_workgroup_max_particles = 1024;
 
 /// Where an instance's per-particle data lives, for the host's own drawing: vec4 per particle
 /// (w = 1 for positions), `stride` bytes apart, `count` particles from byte `offset` of each buffer.
