@@ -49,6 +49,7 @@ struct BenchOptions {
   std::string stretch;   // also time each grid with stretch_limit {method: this, max_strain 0.1, 4 sweeps}
   std::string stiffness; // "S,H,B": the grid's structural, shear and bend stiffness (default 40,8,8)
   std::optional<double> cloth_mass; // kg, the whole grid's (default: 0.05 kg per particle at 64 x 64)
+  double wind = 2.0; // m/s^2 on a particle facing the wind (the wind force scales with the mass)
   std::string cg_dispatch = "auto"; // implicit on Vulkan: auto | one_workgroup | per_iteration | both
 };
 
@@ -92,7 +93,7 @@ Result<BenchScene> bench_scene(std::uint32_t n, Integrator integrator, double dt
   SimParams p;
   p.integrator = integrator;
   p.dt = dt;
-  p.wind.strength = 2.0 * d.particle_mass; // ~2 m/s^2 on a cloth facing the wind
+  p.wind.strength = o.wind * d.particle_mass; // ~2 m/s^2 on a cloth facing the wind
   p.wind.direction = {0.3, 1.0, 0.1};
   VKCLOTH_TRY(p.validate());
   return BenchScene{std::move(*sys), p};
@@ -660,6 +661,7 @@ int bench_command(const BenchOptions& o) {
     doc["dt"] = dt;
     doc["stiffness"] = o.stiffness.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.stiffness);
     doc["cloth_mass"] = o.cloth_mass ? nlohmann::json(*o.cloth_mass) : nlohmann::json(nullptr);
+    doc["wind"] = o.wind;
     doc["steps"] = o.steps;
     doc["warmup"] = o.warmup;
     doc["reps"] = o.reps;
@@ -744,6 +746,10 @@ void add_bench_command(CLI::App& app, int* exit) {
   cmd->add_option(
       "--stiffness", opt->stiffness,
       "Structural, shear and bend stiffness of the grid in N/m, e.g. 10000,2000,2000 (default 40,8,8)");
+  cmd->add_option("--wind", opt->wind,
+                  "Grid rows: the wind's acceleration of a particle facing it, in m/s^2 (0: no wind)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option("--cloth-mass", opt->cloth_mass,
                   "Mass of the whole grid in kg (default: 0.05 kg per particle of a 64 x 64 grid, 204.8 kg)")
       ->check(CLI::PositiveNumber);
