@@ -2,10 +2,10 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 // Implicit Euler passes (engine/src/core/implicit_euler.hpp for the method), one invocation per
-// particle; PushConstants::stage selects the pass (VKCLOTH_IMPL_*). The CG passes write one
-// partial dot-product vec4 per workgroup (fixed-shape shared-memory tree, no atomics) that
-// implicit_reduce.comp sums in a fixed order: deterministic, but not the CPU's sequential order.
-// VKCLOTH_IMPL_SOLVE_FIRST / SOLVE instead run many CG iterations in ONE workgroup (each
+// particle; PushConstants::stage selects the pass (VKCLOTH_IMPL_*). The reducing passes write one
+// partial dot-product vec4 per workgroup (fixed-shape shared-memory tree), and the last workgroup
+// to finish sums them in a fixed order (finish_reduction): deterministic, but not the CPU's
+// sequential order; no dispatch of its own. VKCLOTH_IMPL_SOLVE instead runs many CG iterations in ONE workgroup (each
 // invocation strides over the particles; workgroup barriers between the phases), for systems
 // small enough that the dispatches of the per-iteration passes cost more than their work.
 #include "implicit_shared.h"
@@ -24,12 +24,15 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_IMPL_R) buffer RBuf { vec4 cr[
 layout(std430, set = 0, binding = VKCLOTH_BINDING_IMPL_Z) buffer ZBuf { vec4 cz[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_IMPL_D) coherent buffer DBuf { vec4 cd[]; }; // SOLVE: read by neighbours
 layout(std430, set = 0, binding = VKCLOTH_BINDING_IMPL_Q) buffer QBuf { vec4 cq[]; };
-layout(std430, set = 0, binding = VKCLOTH_BINDING_IMPL_PARTIALS) buffer PartialBuf { vec4 partials[]; };
-layout(std430, set = 0, binding = VKCLOTH_BINDING_IMPL_STATE) buffer StateBuf { CgState cg; }; // SOLVE writes it
+// partials and cg: read and written across workgroups within one dispatch (finish_reduction).
+layout(std430, set = 0, binding = VKCLOTH_BINDING_IMPL_PARTIALS) coherent buffer PartialBuf { vec4 partials[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_IMPL_STATE) coherent buffer StateBuf { CgState cg; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_IMPL_ARGS) writeonly buffer ArgBuf { CgArgs args; };
 
 #include "finish.glsl"
 
 shared vec4 red[VKCLOTH_WORKGROUP_SIZE];
+shared bool last_to_arrive;
 
 // Fixed-shape tree over the workgroup, the sum left in red[0]; every invocation must call it
 // (uniform control flow).
@@ -56,6 +59,58 @@ vec4 workgroup_sum(vec4 value) {
   const vec4 s = red[0];
   barrier();
   return s;
+}
+
+// The end of a reducing pass (uniform control flow): this workgroup's partial, then the arrival
+// count; the last workgroup to arrive sums every partial in a fixed order (invocation l adds
+// partials l, l + 64, ..., then the tree: the order the separate reduce pass had) and updates the
+// CG scalars and the indirect arguments of the next passes (zero groups once done). Its partial
+// write is made visible before its arrival (memoryBarrierBuffer), and the last one reads the
+// others' after seeing every arrival; the others have read cg before arriving.
+void finish_reduction(vec4 part, uint pass) {
+  const uint l = gl_LocalInvocationID.x;
+  const uint groups = gl_NumWorkGroups.x * gl_NumWorkGroups.y;
+  workgroup_partial(part);
+  if (l == 0u) {
+    memoryBarrierBuffer();
+    last_to_arrive = atomicAdd(cg.arrived, 1u) + 1u == groups;
+  }
+  barrier();
+  if (!last_to_arrive) return; // uniform within the workgroup
+  memoryBarrierBuffer();
+  precise vec4 acc = vec4(0.0);
+  for (uint i = l; i < groups; i += VKCLOTH_WORKGROUP_SIZE) acc = acc + partials[i];
+  const vec4 sum = workgroup_sum(acc);
+  if (l != 0u) return;
+  const float tol2 = pc.c_next;
+  bool done = cg.done != 0u;
+  if (pass == VKCLOTH_IMPL_SYSTEM) {
+    cg.rz = sum.x;
+    cg.rr = sum.y;
+    cg.ref2 = max(sum.z, sum.w); // max(|S b|^2, |S h M g|^2): implicit_euler.hpp
+    cg.alpha = 0.0;
+    cg.beta = 0.0;
+    cg.iterations = 0u;
+    cg.solves = cg.solves + 1u;
+    done = sum.y <= tol2 * cg.ref2;
+  } else if (pass == VKCLOTH_IMPL_MATVEC) {
+    if (!(sum.x > 0.0))
+      done = true; // an SPD A gives d.q <= 0 only at d = 0
+    else
+      cg.alpha = cg.rz / sum.x;
+  } else { // VKCLOTH_IMPL_UPDATE
+    cg.beta = sum.x / cg.rz;
+    cg.rz = sum.x;
+    cg.rr = sum.y;
+    cg.iterations = cg.iterations + 1u;
+    cg.total_iterations = cg.total_iterations + 1u;
+    done = sum.y <= tol2 * cg.ref2 || cg.iterations >= pc.pad0;
+  }
+  cg.done = done ? 1u : 0u;
+  cg.arrived = 0u; // for the next reducing pass
+  args.particle_x = done ? 0u : cg.groups_x;
+  args.particle_y = done ? 0u : cg.groups_y;
+  args.particle_z = done ? 0u : 1u;
 }
 
 // Edge e's stiffness block and particle p's P^-1, stored as two vec4: (xx yy zz xy), (xz yz 0 0).
@@ -96,35 +151,22 @@ vec4 update_row(uint p, float alpha) {
   return vec4(dot3(r, z), dot3(r, r), 0.0, 0.0);
 }
 
-// VKCLOTH_IMPL_SOLVE_FIRST / SOLVE: up to pc.nx CG iterations of implicit_euler.hpp in ONE
-// workgroup, continuing from CgState (SOLVE_FIRST starts from SYSTEM's partials). The host
-// bounds pc.nx so that no invocation runs more than ~30 000 loop iterations per dispatch:
-// llvmpipe (Mesa 22.3) ends any loop after 65 535 iterations of an invocation, silently.
+// VKCLOTH_IMPL_SOLVE: up to pc.nx CG iterations of implicit_euler.hpp in ONE workgroup,
+// continuing from CgState (SYSTEM's reduction starts each solve). The host bounds pc.nx so that
+// no invocation runs more than ~30 000 loop iterations per dispatch: llvmpipe (Mesa 22.3) ends
+// any loop after 65 535 iterations of an invocation, silently.
 // The sums: each invocation adds its particles in order, then the fixed tree. Control flow is
 // uniform (every invocation computes the same scalars from red[0]); the loop has one exit, at
 // the top. cd is the only array read across particles (neighbours' d in the matvec): written,
 // then memoryBarrierBuffer + barrier before it is read.
-void solve_in_one_workgroup(bool first, float mu_h, float h2) {
+void solve_in_one_workgroup(float mu_h, float h2) {
   const uint l = gl_LocalInvocationID.x;
   const uint n = pc.count;
   const float tol2 = pc.c_next;
-  float rz, rr, ref2;
-  uint it;
-  if (first) {
-    precise vec4 acc = vec4(0.0);
-    for (uint i = l; i < pc.pad1; i += VKCLOTH_WORKGROUP_SIZE) acc = acc + partials[i]; // SYSTEM's
-    const vec4 init = workgroup_sum(acc);
-    rz = init.x;
-    rr = init.y;
-    ref2 = max(init.z, init.w); // max(|S b|^2, |S h M g|^2): implicit_euler.hpp
-    it = 0u;
-  } else {
-    if (cg.done != 0u) return; // uniform: converged in an earlier dispatch
-    rz = cg.rz;
-    rr = cg.rr;
-    ref2 = cg.ref2;
-    it = cg.iterations;
-  }
+  if (cg.done != 0u) return; // uniform: converged (or nothing to solve)
+  float rz = cg.rz, rr = cg.rr;
+  const float ref2 = cg.ref2;
+  uint it = cg.iterations;
   const uint it_start = it;
   bool done = rr <= tol2 * ref2 || it >= pc.pad0;
   uint budget = pc.nx;
@@ -157,14 +199,11 @@ void solve_in_one_workgroup(bool first, float mu_h, float h2) {
     memoryBarrierBuffer(); // the new d, before the neighbours' matvec reads it
     barrier();             // (and every read of cg above, before invocation 0 rewrites it)
   }
-  if (first) barrier(); // the loop may not have run: the partials' readers before the writes below
-  if (l == 0u) {
+  if (l == 0u) { // after the loop's barriers: every invocation has read cg above
     cg.rz = rz;
     cg.rr = rr;
-    cg.ref2 = ref2;
     cg.iterations = it;
     cg.total_iterations = cg.total_iterations + (it - it_start);
-    if (first) cg.solves = cg.solves + 1u;
     cg.done = done ? 1u : 0u;
   }
 }
@@ -190,9 +229,8 @@ void main() {
     return;
   }
   if (mode == VKCLOTH_IMPL_SYSTEM) {
-    if (frozen()) return; // uniform
-    vec4 part = vec4(0.0);
-    if (live) {
+    vec4 part = vec4(0.0); // frozen: no solve (zero sums: done), but the reduction still runs
+    if (live && !frozen()) {
       const vec3 x = pos_in[p].xyz;
       const vec3 vp = vf[p].xyz;
       const bool warm = cg.solves != 0u; // else x is not written yet: x0 = 0
@@ -232,7 +270,7 @@ void main() {
         part = vec4(dot3(r, z), dot3(r, r), dot3(b, b), weight_impulse2(h, m, ip.gravity_damping.xyz));
       }
     }
-    workgroup_partial(part);
+    finish_reduction(part, VKCLOTH_IMPL_SYSTEM);
     return;
   }
   if (mode == VKCLOTH_IMPL_MATVEC) {
@@ -242,18 +280,17 @@ void main() {
       cq[p] = vec4(q, 0.0);
       part = vec4(dot3(cd[p].xyz, q), 0.0, 0.0, 0.0);
     }
-    workgroup_partial(part);
+    finish_reduction(part, VKCLOTH_IMPL_MATVEC);
     return;
   }
-  if (mode == VKCLOTH_IMPL_SOLVE_FIRST || mode == VKCLOTH_IMPL_SOLVE) {
-    if (frozen()) return; // uniform
-    solve_in_one_workgroup(mode == VKCLOTH_IMPL_SOLVE_FIRST, mu_h, h2);
+  if (mode == VKCLOTH_IMPL_SOLVE) {
+    solve_in_one_workgroup(mu_h, h2); // frozen: SYSTEM's reduction left done = 1
     return;
   }
   if (mode == VKCLOTH_IMPL_UPDATE) {
     vec4 part = vec4(0.0);
     if (live) part = update_row(p, cg.alpha);
-    workgroup_partial(part);
+    finish_reduction(part, VKCLOTH_IMPL_UPDATE);
     return;
   }
   if (!live) return;

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Declarations shared by the implicit-Euler shaders (implicit.comp, implicit_reduce.comp) and the
+// Declarations shared by the implicit-Euler shader (implicit.comp) and the
 // C++ side (engine/src/vulkan/implicit_gpu.cpp). The implicit passes use their own descriptor set
 // layout: the main layout's bindings they need (same numbers, same buffers, vkcloth_shared.h)
 // plus the CG buffers below. The implicit passes run batches of one instance. Push constants: the main
@@ -23,29 +23,30 @@ namespace vkcloth::gpu::shared {
 #define VKCLOTH_BINDING_IMPL_Z 29 // preconditioned residual
 #define VKCLOTH_BINDING_IMPL_D 30 // search direction
 #define VKCLOTH_BINDING_IMPL_Q 31 // S A d
-#define VKCLOTH_BINDING_IMPL_PARTIALS 32 // one vec4 per workgroup: its partial dot products
+#define VKCLOTH_BINDING_IMPL_PARTIALS 32 // one vec4 per workgroup: its partial dot products (coherent)
 #define VKCLOTH_BINDING_IMPL_STATE 33    // CgState
 #define VKCLOTH_BINDING_IMPL_ARGS 34     // indirect dispatch arguments (CgArgs)
 
-// implicit.comp passes (PushConstants::stage).
+// implicit.comp passes (PushConstants::stage). SYSTEM, MATVEC and UPDATE end with a reduction:
+// every workgroup writes its partial sums, and the LAST workgroup to arrive (CgState::arrived)
+// sums them all in a fixed order and updates the CG scalars and the indirect arguments.
 #define VKCLOTH_IMPL_FORCE 0u // normal, force, contact filtering -> FORCE_OUT, NORMAL, VF
 #define VKCLOTH_IMPL_SYSTEM                                                                                  \
-  1u // K_s per entry, P^-1, b, r = b - S A x0 -> r, z, d; partials (r.z, r.r, b.b, w.w)
-#define VKCLOTH_IMPL_MATVEC 2u      // q = S A d; partials (d.q, 0, 0, 0)
-#define VKCLOTH_IMPL_UPDATE 3u      // x += alpha d, r -= alpha q, z = P^-1 r; partials (r.z, r.r, 0, 0)
-#define VKCLOTH_IMPL_DIRECTION 4u   // d = z + beta d
-#define VKCLOTH_IMPL_FINISH 5u      // v' = v + x, contacts, x' = x + h v', projection, flags
-#define VKCLOTH_IMPL_SOLVE_FIRST 6u // ONE workgroup: INIT's sums, then up to nx CG iterations
-#define VKCLOTH_IMPL_SOLVE 7u       // ONE workgroup: up to nx more CG iterations (until done)
-// implicit_reduce.comp modes (PushConstants::stage).
-#define VKCLOTH_REDUCE_INIT 0u  // rz, rr, ref2 from SYSTEM's partials; solves + 1
-#define VKCLOTH_REDUCE_ALPHA 1u // alpha = rz / d.q (stop if d.q <= 0)
-#define VKCLOTH_REDUCE_BETA 2u  // beta = rz_new / rz, iterations + 1, convergence test
+  1u // K_s per entry, P^-1, b, r = b - S A x0 -> r, z, d; partials (r.z, r.r, b.b, w.w);
+     // last workgroup: rz, rr, ref2, solves + 1, done?
+#define VKCLOTH_IMPL_MATVEC                                                                                  \
+  2u // q = S A d; partials (d.q); last workgroup: alpha = rz / d.q (done if d.q <= 0)
+#define VKCLOTH_IMPL_UPDATE                                                                                  \
+  3u                              // x += alpha d, r -= alpha q, z = P^-1 r; partials (r.z, r.r);
+                                  // last workgroup: beta, iterations + 1, done = converged or cap
+#define VKCLOTH_IMPL_DIRECTION 4u // d = z + beta d
+#define VKCLOTH_IMPL_FINISH 5u    // v' = v + x, contacts, x' = x + h v', projection, flags
+#define VKCLOTH_IMPL_SOLVE 6u     // ONE workgroup: up to nx more CG iterations (until done)
 // Repurposed PushConstants fields (unused by the implicit passes otherwise):
-//   c_next = cg_tolerance^2, pad0 = cg_max_iterations, pad1 = number of partials (workgroups);
-//   SOLVE_FIRST / SOLVE: nx = the dispatch's iteration budget (the CG loop needs no grid size).
+//   c_next = cg_tolerance^2, pad0 = cg_max_iterations;
+//   SOLVE: nx = the dispatch's iteration budget (the CG loop needs no grid size).
 
-/// CG scalars, written only by implicit_reduce.comp or the SOLVE pass (one invocation).
+/// CG scalars, written only by the last workgroup of a reducing pass or by SOLVE (one invocation).
 struct CgState {
   float rz;
   float rr;
@@ -57,20 +58,20 @@ struct CgState {
   uint total_iterations; // over every solve since creation (wraps at 2^32)
   uint groups_x;         // the particle passes' dispatch size (set by the host at creation)
   uint groups_y;
-  uint solves; // solves since creation; 0: no dv to warm-start from yet
-  uint pad2;
+  uint solves;  // solves since creation; 0: no dv to warm-start from yet
+  uint arrived; // workgroups of the current reducing pass done so far (the last one resets it)
 };
 
-/// Indirect dispatch arguments, rewritten by every reduce: zero groups once `done`.
+/// Indirect dispatch arguments of the per-particle CG passes, rewritten by every reduction:
+/// zero groups once `done`.
 struct CgArgs {
-  uint particle_x, particle_y, particle_z, pad0; // the per-particle CG passes
-  uint reduce_x, reduce_y, reduce_z, pad1;       // the next reduce
+  uint particle_x, particle_y, particle_z, pad0;
 };
 
 #ifdef __cplusplus
 static_assert(VKCLOTH_BINDING_IMPL_VF == VKCLOTH_BINDING_COUNT); // right after the main layout's bindings
 static_assert(sizeof(CgState) == 48);
-static_assert(sizeof(CgArgs) == 32);
+static_assert(sizeof(CgArgs) == 16);
 } // namespace vkcloth::gpu::shared
 #endif
 

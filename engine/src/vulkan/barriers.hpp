@@ -120,10 +120,11 @@ inline void after_host_edit(const VolkDeviceTable& vk, VkCommandBuffer cmd) {
 namespace vkcloth::gpu::barriers {
 
 /// Between two passes of the implicit step (implicit_gpu.hpp): like dispatch_to_dispatch, and the
-/// reduce pass's writes of the indirect dispatch arguments become visible to the next indirect
-/// dispatches' argument reads (DRAW_INDIRECT stage). The WAR on those arguments (read by an
-/// earlier dispatch, rewritten by a later reduce) is covered because DRAW_INDIRECT is logically
-/// earlier than COMPUTE_SHADER in the source scope.
+/// writes of the indirect dispatch arguments (by a reducing pass's last workgroup) become visible
+/// to the next indirect dispatches' argument reads (DRAW_INDIRECT stage). The WAR on those
+/// arguments (read by an earlier dispatch, rewritten by a later pass) is covered because
+/// DRAW_INDIRECT is logically earlier than COMPUTE_SHADER in the source scope; a pass that
+/// rewrites the arguments it was dispatched with read them before any of its invocations ran.
 inline void implicit_pass(const VolkDeviceTable& vk, VkCommandBuffer cmd) {
   memory(vk, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
          VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,

@@ -103,10 +103,6 @@ Result<void> ImplicitGpu::create_pipelines() {
   if (!pp)
     return pp.error();
   pass_ = *pp;
-  auto rp = ctx.pipelines->pipeline(PipelineRegistry::Shader::implicit_reduce, {});
-  if (!rp)
-    return rp.error();
-  reduce_ = *rp;
   return {};
 }
 
@@ -212,53 +208,41 @@ std::uint32_t ImplicitGpu::record_substep(VkCommandBuffer c, std::uint32_t read,
   const float tol = float(params.cg_tolerance);
   pc.c_next = tol * tol; // as CpuSolver<float>: Real(tol) * Real(tol)
   pc.pad0 = params.cg_max_iterations;
-  pc.pad1 = groups_x_ * groups_y_;
   v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &sets_[read], 0, nullptr);
+  v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, pass_);
   bool need_barrier = !first;
   std::uint32_t dispatches = 0;
-  VkPipeline bound = VK_NULL_HANDLE;
-  const VkPipeline pass_pipe = pass_, reduce_pipe = reduce_; // raw handles, for the lambda's comparisons
-  constexpr int solve = -2, direct = -1, particles = offsetof(sh::CgArgs, particle_x),
-                reduce = offsetof(sh::CgArgs, reduce_x);
-  auto pass = [&](VkPipeline pipe, std::uint32_t stage, int indirect_offset) {
+  enum class Groups { all, one, indirect }; // every particle's group; one workgroup; CgArgs
+  auto pass = [&](std::uint32_t stage, Groups groups) {
     if (need_barrier)
       barriers::implicit_pass(v, c); // previous pass -> this one (RAW, WAR, indirect args)
     need_barrier = true;
-    if (pipe != bound) {
-      v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, pipe);
-      bound = pipe;
-    }
     pc.stage = stage;
     ++dispatches;
     v.vkCmdPushConstants(c, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
-    if (indirect_offset >= 0)
-      v.vkCmdDispatchIndirect(c, args_.buffer, VkDeviceSize(indirect_offset));
-    else if (pipe == reduce_pipe || indirect_offset == solve)
-      v.vkCmdDispatch(c, 1, 1, 1); // one workgroup
+    if (groups == Groups::indirect)
+      v.vkCmdDispatchIndirect(c, args_.buffer, 0);
+    else if (groups == Groups::one)
+      v.vkCmdDispatch(c, 1, 1, 1);
     else
       v.vkCmdDispatch(c, groups_x_, groups_y_, 1);
   };
-  pass(pass_pipe, VKCLOTH_IMPL_FORCE, direct);
-  pass(pass_pipe, VKCLOTH_IMPL_SYSTEM, direct);
+  pass(VKCLOTH_IMPL_FORCE, Groups::all);
+  pass(VKCLOTH_IMPL_SYSTEM, Groups::all); // its last workgroup starts the solve (rz, rr, ref2)
   if (budget_ > 0) {
     const std::uint32_t nx = pc.nx;
     pc.nx = budget_; // SOLVE's iteration budget (implicit_shared.h)
-    pass(pass_pipe, VKCLOTH_IMPL_SOLVE_FIRST, solve);
-    for (std::uint32_t it = budget_; it < params.cg_max_iterations; it += budget_)
-      pass(pass_pipe, VKCLOTH_IMPL_SOLVE, solve);
+    for (std::uint32_t it = 0; it < params.cg_max_iterations; it += budget_)
+      pass(VKCLOTH_IMPL_SOLVE, Groups::one);
     pc.nx = nx;
-    pass(pass_pipe, VKCLOTH_IMPL_FINISH, direct);
-    return dispatches;
+  } else {
+    for (std::uint32_t it = 0; it < params.cg_max_iterations; ++it) {
+      pass(VKCLOTH_IMPL_MATVEC, Groups::indirect); // + alpha (its last workgroup)
+      pass(VKCLOTH_IMPL_UPDATE, Groups::indirect); // + beta, convergence
+      pass(VKCLOTH_IMPL_DIRECTION, Groups::indirect);
+    }
   }
-  pass(reduce_pipe, VKCLOTH_REDUCE_INIT, direct);
-  for (std::uint32_t it = 0; it < params.cg_max_iterations; ++it) {
-    pass(pass_pipe, VKCLOTH_IMPL_MATVEC, particles);
-    pass(reduce_pipe, VKCLOTH_REDUCE_ALPHA, reduce);
-    pass(pass_pipe, VKCLOTH_IMPL_UPDATE, particles);
-    pass(reduce_pipe, VKCLOTH_REDUCE_BETA, reduce);
-    pass(pass_pipe, VKCLOTH_IMPL_DIRECTION, particles);
-  }
-  pass(pass_pipe, VKCLOTH_IMPL_FINISH, direct);
+  pass(VKCLOTH_IMPL_FINISH, Groups::all);
   return dispatches;
 }
 

@@ -3,19 +3,19 @@
 // backward Euler + PCG (engine/src/core/implicit_euler.hpp) as compute passes, recorded without a
 // CPU round trip per iteration. Per substep, either (per_iteration)
 //
-//   FORCE -> SYSTEM -> reduce(INIT) -> cg_max_iterations x [ MATVEC -> reduce(ALPHA) -> UPDATE
-//          -> reduce(BETA) -> DIRECTION ] -> FINISH
+//   FORCE -> SYSTEM -> cg_max_iterations x [ MATVEC -> UPDATE -> DIRECTION ] -> FINISH
 //
-// where every reduce rewrites the indirect dispatch arguments of the CG passes and of the next
-// reduce (zero groups once converged, so the iterations left are empty dispatches), or
-// (one_workgroup, small systems)
+// where SYSTEM, MATVEC and UPDATE end with their reduction: the last workgroup to finish sums the
+// partials (INIT, alpha, beta and the convergence test) and rewrites the indirect dispatch
+// arguments of the CG passes (zero groups once converged, so the iterations left are empty
+// dispatches): 3 dispatches per iteration, or (one_workgroup, small systems)
 //
-//   FORCE -> SYSTEM -> SOLVE_FIRST -> ceil(cg_max_iterations / K) - 1 x SOLVE -> FINISH
+//   FORCE -> SYSTEM -> ceil(cg_max_iterations / K) x SOLVE -> FINISH
 //
 // where each SOLVE is one workgroup running up to K iterations (iteration_budget) and an empty
-// one once converged; one barrier between consecutive passes (barriers::implicit_pass). Dot products: a
-// fixed-shape tree per workgroup, then one workgroup sums the partials in a fixed order (deterministic; not
-// the CPU's sequential sum, hence results equal the CPU's to rounding, not bit for bit).
+// one once converged; one barrier between consecutive passes (barriers::implicit_pass). Dot
+// products: a fixed-shape tree per workgroup, then the partials in a fixed order (deterministic;
+// not the CPU's sequential sum, hence results equal the CPU's to rounding, not bit for bit).
 #pragma once
 
 #include <cstdint>
@@ -70,7 +70,7 @@ private:
   // The Context's (PipelineRegistry), shared by every implicit batch.
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
-  VkPipeline pass_ = VK_NULL_HANDLE, reduce_ = VK_NULL_HANDLE;
+  VkPipeline pass_ = VK_NULL_HANDLE;
 
   Result<void> create_buffers(std::uint64_t entries, bool allow_map);
   Result<void> create_pipelines();

@@ -11,7 +11,6 @@
 #include "vkcloth/shaders/fused_storage_comp_spv.hpp"
 #include "vkcloth/shaders/fused_texel_comp_spv.hpp"
 #include "vkcloth/shaders/implicit_comp_spv.hpp"
-#include "vkcloth/shaders/implicit_reduce_comp_spv.hpp"
 #include "vkcloth/shaders/integrate_storage_comp_spv.hpp"
 #include "vkcloth/shaders/integrate_texel_comp_spv.hpp"
 #include "vkcloth/shaders/strain_finish_storage_comp_spv.hpp"
@@ -47,8 +46,6 @@ ShaderCode code_of(PipelineRegistry::Shader s, BufferAccess access) {
                  : ShaderCode{spirv::fused_storage_comp_spv, "fused.comp (storage buffers)"};
   case S::implicit:
     return {spirv::implicit_comp_spv, "implicit.comp"};
-  case S::implicit_reduce:
-    return {spirv::implicit_reduce_comp_spv, "implicit_reduce.comp"};
   case S::strain_links:
     return texel ? ShaderCode{spirv::strain_links_texel_comp_spv, "strain_links.comp (texel views)"}
                  : ShaderCode{spirv::strain_links_storage_comp_spv, "strain_links.comp (storage buffers)"};
@@ -64,10 +61,10 @@ ShaderCode code_of(PipelineRegistry::Shader s, BufferAccess access) {
 /// Shaders compiled in one build only.
 bool single_build(PipelineRegistry::Shader s) {
   using S = PipelineRegistry::Shader;
-  return s == S::implicit || s == S::implicit_reduce || s == S::vertices;
+  return s == S::implicit || s == S::vertices;
 }
 
-/// The storage bindings of implicit.comp / implicit_reduce.comp (implicit_shared.h).
+/// The storage bindings of implicit.comp (implicit_shared.h).
 constexpr std::uint32_t kImplicitBindings[] = {
     VKCLOTH_BINDING_POS_IN,         VKCLOTH_BINDING_FORCE_OUT,  VKCLOTH_BINDING_NORMAL,
     VKCLOTH_BINDING_POS_OUT,        VKCLOTH_BINDING_VEL,        VKCLOTH_BINDING_PARTICLE,
@@ -169,7 +166,7 @@ Result<VkShaderModule> PipelineRegistry::module_locked(Shader shader, BufferAcce
 
 Result<VkPipeline> PipelineRegistry::pipeline(Shader shader, std::span<const std::uint32_t> constants,
                                               Variant variant) {
-  const bool implicit = shader == Shader::implicit || shader == Shader::implicit_reduce;
+  const bool implicit = shader == Shader::implicit;
   if (single_build(shader))
     variant.access = BufferAccess::texel_views; // one module, whatever was asked
   if (variant.access == BufferAccess::automatic)

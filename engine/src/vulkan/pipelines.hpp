@@ -20,7 +20,7 @@
 
 namespace vkcloth::gpu {
 
-/// The storage bindings of implicit.comp / implicit_reduce.comp, in descriptor-write order.
+/// The storage bindings of implicit.comp, in descriptor-write order.
 std::span<const std::uint32_t> implicit_bindings();
 
 /// choose_layout() for `ctx`'s device (layout.cpp).
@@ -41,16 +41,7 @@ struct ShaderVariant {
 
 class PipelineRegistry {
 public:
-  enum class Shader {
-    force,
-    integrate,
-    fused,
-    implicit,
-    implicit_reduce,
-    strain_links,
-    strain_finish,
-    vertices
-  };
+  enum class Shader { force, integrate, fused, implicit, strain_links, strain_finish, vertices };
 
   /// Set 0 (storage buffers) and set 1 (texel views) of force/integrate/fused.comp and their
   /// layout (strain_links/strain_finish/vertices.comp use it too, set 0 only).
@@ -58,7 +49,7 @@ public:
     VkDescriptorSetLayout storage = VK_NULL_HANDLE, texel = VK_NULL_HANDLE;
     VkPipelineLayout layout = VK_NULL_HANDLE;
   };
-  /// The one set of implicit.comp / implicit_reduce.comp and its layout.
+  /// The one set of implicit.comp and its layout.
   struct ImplicitLayouts {
     VkDescriptorSetLayout set = VK_NULL_HANDLE;
     VkPipelineLayout layout = VK_NULL_HANDLE;

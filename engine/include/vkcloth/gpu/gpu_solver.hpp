@@ -6,9 +6,10 @@
 // Per step (Euler):      fused(positions[read] -> positions[write]) -> swap   (GpuSolverOptions::fused)
 //                   or   force(positions[read]) -> integrate(-> positions[write]) -> swap
 // Per step (RK4):        4 x (force(stage input) -> integrate(stage k)); the last writes positions[write]
-// Per step (implicit):   force -> system -> reduce -> cg_max_iterations x (matvec -> reduce -> update
-//                        -> reduce -> direction, indirect: empty once converged) -> finish
-//                        (implicit_gpu.hpp); every scheme repeats its passes `substeps` times per step
+// Per step (implicit):   force -> system -> cg_max_iterations x (matvec -> update -> direction,
+//                        indirect: empty once converged; the sums in each pass's last workgroup),
+//                        or a few one-workgroup CG dispatches (GpuSolverOptions::cg_dispatch)
+//                        -> finish (implicit_gpu.hpp); every scheme repeats its passes `substeps` times
 //
 // Buffers (device-local storage buffers, vec4 per particle, w unused; positions have w = 1):
 // positions[2] (ping-pong), velocities, forces, normals (unit, zero for chains; fused Euler
