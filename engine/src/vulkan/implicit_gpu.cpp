@@ -249,7 +249,7 @@ std::uint32_t ImplicitGpu::record_substep(VkCommandBuffer c, std::uint32_t read,
 std::uint32_t ImplicitGpu::iteration_budget(std::uint32_t count, std::uint32_t max_degree) {
   // Per CG iteration, an invocation loops ceil(count / 64) times in each of the matvec (plus
   // its springs), update and direction loops, 2 x 6 times in the two tree sums, once outside;
-  // SOLVE_FIRST adds the partials' loop (<= ceil(count / 64) too).
+  // `rows` more are left as margin.
   const std::uint64_t rows = (std::uint64_t(count) + VKCLOTH_WORKGROUP_SIZE - 1) / VKCLOTH_WORKGROUP_SIZE;
   const std::uint64_t per_iteration = rows * (3 + std::uint64_t(max_degree)) + 13;
   const std::uint64_t room = rows < 30000 ? 30000 - rows : 0;
