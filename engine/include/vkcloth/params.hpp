@@ -4,11 +4,13 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include <glm/mat3x3.hpp>
 #include <glm/vec3.hpp>
 
 #include "vkcloth/glm_abi.hpp"
@@ -38,19 +40,56 @@ struct SolveStats {
 const char* to_string(Integrator integrator);
 std::optional<Integrator> parse_integrator(std::string_view name);
 
-/// A collider: a plane {p : n.p = offset} (outside where n.p > offset) or a sphere.
+class ColliderMesh; // vkcloth/collider_mesh.hpp: a static triangle mesh and its bounding-volume hierarchy
+
+/// A collider (docs/model.md "Collisions", docs/scene-format.md "colliders"): a shape, its friction and
+/// its motion. Every shape has the report's semantics: within 2 eps of the surface the inward parts of
+/// v and F go; after the update a point inside is put back at surface + eps.
+///
+/// The fields give the collider's pose now. A moving collider (linear_velocity, angular_velocity
+/// about its centre) is advanced by the solver at the start of every substep (posed_at(h)), so a
+/// solver's params().colliders is always where its colliders are; a host animating a collider sets
+/// its pose and velocity every frame (StepParams::colliders). Friction and the normal response are
+/// relative to the surface's velocity.
 struct Collider {
-  enum class Type : std::uint32_t { plane = 0, sphere = 1 };
+  enum class Type : std::uint32_t { plane = 0, sphere = 1, capsule = 2, box = 3, mesh = 4 };
   Type type = Type::plane;
   glm::dvec3 normal{0.0, 0.0, 1.0}; ///< plane: unit outward normal (normalised by validate())
   double offset = 0.0;              ///< plane: n.p on the surface
-  glm::dvec3 center{0.0};           ///< sphere
-  double radius = 0.0;              ///< sphere
+  glm::dvec3 center{0.0};           ///< sphere, box: centre; mesh: where the mesh's origin is
+  double radius = 0.0;              ///< sphere, capsule
+  glm::dvec3 a{0.0}, b{0.0};        ///< capsule: the segment's ends (a == b: a sphere)
+  glm::dvec3 half_extents{0.0};     ///< box: > 0 each
+  /// box, mesh: orientation, its columns the body's axes in the world (rotation_from_degrees).
+  glm::dmat3 rotation{1.0};
+  /// mesh: the triangles in the mesh's own frame (already scaled), with their hierarchy.
+  std::shared_ptr<const ColliderMesh> mesh;
+  double thickness = 0.0; ///< mesh: a point closer than this to a triangle is in contact (> 0)
+  /// Coulomb friction: kinetic coefficient (>= 0; 0: frictionless, the report's model) ...
+  double friction = 0.0;
+  /// ... and static coefficient (>= friction; negative: the same as `friction`).
+  double static_friction = -1.0;
+  glm::dvec3 linear_velocity{0.0};  ///< m/s
+  glm::dvec3 angular_velocity{0.0}; ///< rad/s about centre() (a plane takes linear velocity only)
 
-  static Collider plane(glm::dvec3 normal, double offset) { return {Type::plane, normal, offset, {}, 0.0}; }
-  static Collider sphere(glm::dvec3 center, double radius) {
-    return {Type::sphere, {0, 0, 1}, 0.0, center, radius};
-  }
+  static Collider plane(glm::dvec3 normal, double offset);
+  static Collider sphere(glm::dvec3 center, double radius);
+  static Collider capsule(glm::dvec3 a, glm::dvec3 b, double radius);
+  static Collider box(glm::dvec3 center, glm::dvec3 half_extents, glm::dmat3 rotation = glm::dmat3(1.0));
+  static Collider triangle_mesh(std::shared_ptr<const ColliderMesh> mesh, glm::dvec3 origin, glm::dmat3 rotation,
+                                double thickness);
+  /// R = Rz Ry Rx from angles in degrees (x applied first: the mesh_transform convention).
+  static glm::dmat3 rotation_from_degrees(glm::dvec3 degrees);
+
+  /// The point angular_velocity turns about: the centre (capsule: the middle of a b; plane: the
+  /// point of the plane nearest the origin).
+  glm::dvec3 centre() const;
+  /// static_friction, or friction when static_friction < 0.
+  double static_coefficient() const { return static_friction < 0.0 ? friction : static_friction; }
+  bool moving() const { return linear_velocity != glm::dvec3(0.0) || angular_velocity != glm::dvec3(0.0); }
+  /// This collider `seconds` later: moved by linear_velocity * seconds and turned by angular_velocity
+  /// * seconds about centre() (Rodrigues, in double); velocities and friction unchanged.
+  Collider posed_at(double seconds) const;
 };
 
 /// Wind F = Kw <n, u_w> n on each cloth vertex, n its unit normal, u_w the unit wind direction.

@@ -5,6 +5,9 @@
 #include <fmt/format.h>
 
 #include <glm/geometric.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "vkcloth/collider_mesh.hpp"
 
 namespace vkcloth {
 namespace {
@@ -19,7 +22,168 @@ Error bad(std::string message) {
   return make_error(ErrorCode::invalid_argument, std::move(message));
 }
 
+bool positive(double x) {
+  return std::isfinite(x) && x > 0.0;
+}
+
+// One collider's fields (the message names `at`.field and the value); normalises a plane's normal.
+Result<void> validate_collider(Collider& c, const std::string& at) {
+  const auto vec = [&](const char* key, glm::dvec3 v) -> Result<void> {
+    if (!finite(v))
+      return bad(fmt::format("{}.{} must be finite, got {}", at, key, str(v)));
+    return {};
+  };
+  switch (c.type) {
+  case Collider::Type::plane: {
+    VKCLOTH_TRY(vec("normal", c.normal));
+    const double len = glm::length(c.normal);
+    if (!(len > 0.0))
+      return bad(fmt::format("{}.normal must be non-zero, got {}", at, str(c.normal)));
+    c.normal /= len;
+    if (!std::isfinite(c.offset))
+      return bad(fmt::format("{}.offset must be finite, got {}", at, c.offset));
+    if (c.angular_velocity != glm::dvec3(0.0))
+      return bad(fmt::format("{}.angular_velocity: a plane cannot turn (it takes linear_velocity only), got {}",
+                             at, str(c.angular_velocity)));
+    break;
+  }
+  case Collider::Type::sphere:
+    VKCLOTH_TRY(vec("center", c.center));
+    if (!positive(c.radius))
+      return bad(fmt::format("{}.radius must be finite and > 0, got {}", at, c.radius));
+    break;
+  case Collider::Type::capsule:
+    VKCLOTH_TRY(vec("a", c.a));
+    VKCLOTH_TRY(vec("b", c.b));
+    if (!positive(c.radius))
+      return bad(fmt::format("{}.radius must be finite and > 0, got {}", at, c.radius));
+    break;
+  case Collider::Type::box:
+    VKCLOTH_TRY(vec("center", c.center));
+    if (!positive(c.half_extents.x) || !positive(c.half_extents.y) || !positive(c.half_extents.z))
+      return bad(fmt::format("{}.half_extents must be finite and > 0, got {}", at, str(c.half_extents)));
+    break;
+  case Collider::Type::mesh:
+    VKCLOTH_TRY(vec("center", c.center));
+    if (!c.mesh)
+      return bad(fmt::format("{}: a mesh collider needs its mesh (ColliderMesh::create)", at));
+    if (!positive(c.thickness))
+      return bad(fmt::format("{}.thickness must be finite and > 0, got {}", at, c.thickness));
+    break;
+  default:
+    return bad(fmt::format("{}.type is unknown ({})", at, std::uint32_t(c.type)));
+  }
+  for (int col = 0; col < 3; ++col)
+    VKCLOTH_TRY(vec("rotation", c.rotation[col]));
+  if (c.type == Collider::Type::box || c.type == Collider::Type::mesh) {
+    // R's columns must be an orthonormal right-handed frame (within float rounding).
+    const glm::dmat3 e = glm::transpose(c.rotation) * c.rotation;
+    double off = std::abs(glm::determinant(c.rotation) - 1.0);
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        off = std::max(off, std::abs(e[i][j] - (i == j ? 1.0 : 0.0)));
+    if (!(off < 1e-6))
+      return bad(fmt::format("{}.rotation must be a rotation matrix (orthonormal, determinant 1); it is off by {}",
+                             at, off));
+  }
+  if (!std::isfinite(c.friction) || c.friction < 0.0)
+    return bad(fmt::format("{}.friction must be finite and >= 0, got {}", at, c.friction));
+  if (!std::isfinite(c.static_friction))
+    return bad(fmt::format("{}.static_friction must be finite, got {}", at, c.static_friction));
+  if (c.static_friction >= 0.0 && c.static_friction < c.friction)
+    return bad(fmt::format("{}.static_friction must be >= friction ({}), got {}", at, c.friction,
+                           c.static_friction));
+  VKCLOTH_TRY(vec("linear_velocity", c.linear_velocity));
+  VKCLOTH_TRY(vec("angular_velocity", c.angular_velocity));
+  return {};
+}
+
 } // namespace
+
+Collider Collider::plane(glm::dvec3 normal, double offset) {
+  Collider c;
+  c.type = Type::plane;
+  c.normal = normal;
+  c.offset = offset;
+  return c;
+}
+
+Collider Collider::sphere(glm::dvec3 center, double radius) {
+  Collider c;
+  c.type = Type::sphere;
+  c.center = center;
+  c.radius = radius;
+  return c;
+}
+
+Collider Collider::capsule(glm::dvec3 a, glm::dvec3 b, double radius) {
+  Collider c;
+  c.type = Type::capsule;
+  c.a = a;
+  c.b = b;
+  c.radius = radius;
+  return c;
+}
+
+Collider Collider::box(glm::dvec3 center, glm::dvec3 half_extents, glm::dmat3 rotation) {
+  Collider c;
+  c.type = Type::box;
+  c.center = center;
+  c.half_extents = half_extents;
+  c.rotation = rotation;
+  return c;
+}
+
+Collider Collider::triangle_mesh(std::shared_ptr<const ColliderMesh> mesh, glm::dvec3 origin, glm::dmat3 rotation,
+                                 double thickness) {
+  Collider c;
+  c.type = Type::mesh;
+  c.mesh = std::move(mesh);
+  c.center = origin;
+  c.rotation = rotation;
+  c.thickness = thickness;
+  return c;
+}
+
+glm::dmat3 Collider::rotation_from_degrees(glm::dvec3 degrees) {
+  glm::dmat4 r(1.0);
+  r = glm::rotate(r, glm::radians(degrees.z), glm::dvec3(0, 0, 1));
+  r = glm::rotate(r, glm::radians(degrees.y), glm::dvec3(0, 1, 0));
+  r = glm::rotate(r, glm::radians(degrees.x), glm::dvec3(1, 0, 0));
+  return glm::dmat3(r);
+}
+
+glm::dvec3 Collider::centre() const {
+  switch (type) {
+  case Type::plane:
+    return normal * offset;
+  case Type::capsule:
+    return (a + b) * 0.5;
+  default:
+    return center;
+  }
+}
+
+Collider Collider::posed_at(double seconds) const {
+  Collider c = *this;
+  if (!moving() || seconds == 0.0)
+    return c;
+  const glm::dvec3 shift = linear_velocity * seconds;
+  if (type == Type::plane) { // a plane slides within itself: only its offset along n changes
+    c.offset = offset + glm::dot(normal, shift);
+    return c;
+  }
+  const glm::dvec3 pivot = centre();
+  glm::dmat3 turn(1.0);
+  const double angle = glm::length(angular_velocity) * seconds;
+  if (angle != 0.0)
+    turn = glm::dmat3(glm::rotate(glm::dmat4(1.0), angle, glm::normalize(angular_velocity)));
+  c.center = pivot + shift + turn * (center - pivot);
+  c.a = pivot + shift + turn * (a - pivot);
+  c.b = pivot + shift + turn * (b - pivot);
+  c.rotation = turn * rotation;
+  return c;
+}
 
 const char* to_string(Integrator integrator) {
   switch (integrator) {
@@ -114,26 +278,8 @@ Result<void> SimParams::validate() {
         fmt::format("stretch_limit.max_strain must be finite and > 0, got {}", stretch_limit.max_strain));
   if (stretch_limit.iterations < 1 || stretch_limit.iterations > 100)
     return bad(fmt::format("stretch_limit.iterations must be in 1..100, got {}", stretch_limit.iterations));
-  for (std::size_t k = 0; k < colliders.size(); ++k) {
-    Collider& c = colliders[k];
-    if (c.type == Collider::Type::plane) {
-      if (!finite(c.normal))
-        return bad(fmt::format("colliders[{}].normal must be finite, got {}", k, str(c.normal)));
-      const double len = glm::length(c.normal);
-      if (!(len > 0.0))
-        return bad(fmt::format("colliders[{}].normal must be non-zero, got {}", k, str(c.normal)));
-      c.normal /= len;
-      if (!std::isfinite(c.offset))
-        return bad(fmt::format("colliders[{}].offset must be finite, got {}", k, c.offset));
-    } else if (c.type == Collider::Type::sphere) {
-      if (!finite(c.center))
-        return bad(fmt::format("colliders[{}].center must be finite, got {}", k, str(c.center)));
-      if (!std::isfinite(c.radius) || c.radius <= 0.0)
-        return bad(fmt::format("colliders[{}].radius must be finite and > 0, got {}", k, c.radius));
-    } else {
-      return bad(fmt::format("colliders[{}].type is unknown", k));
-    }
-  }
+  for (std::size_t k = 0; k < colliders.size(); ++k)
+    VKCLOTH_TRY(validate_collider(colliders[k], fmt::format("colliders[{}]", k)));
   return {};
 }
 

@@ -1,0 +1,134 @@
+// SPDX-License-Identifier: MIT
+// ColliderMesh: the triangles of a mesh collider and a bounding-volume hierarchy over them
+// (median split along the longest axis of the triangles' centroids, at most leaf_size triangles per
+// leaf, children adjacent), walked by cloth_kernel.h mesh_closest on both backends.
+#include "vkcloth/collider_mesh.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include <fmt/format.h>
+#include <glm/geometric.hpp>
+
+#include "vkcloth/mesh.hpp"
+
+namespace vkcloth {
+namespace {
+
+struct Builder {
+  std::vector<ColliderMesh::Triangle> tris;
+  std::vector<glm::vec3> centroid;
+  std::vector<std::uint32_t> order;
+  std::vector<ColliderMesh::Node> nodes;
+  std::uint32_t depth = 0;
+
+  // Fills node `at` with the triangles order[begin .. end) and, when there are too many for a leaf,
+  // appends its two children (adjacent) and fills them.
+  void build(std::uint32_t at, std::uint32_t begin, std::uint32_t end, std::uint32_t level) {
+    depth = std::max(depth, level);
+    glm::vec3 lo(INFINITY), hi(-INFINITY), clo(INFINITY), chi(-INFINITY);
+    for (std::uint32_t k = begin; k < end; ++k) {
+      const ColliderMesh::Triangle& t = tris[order[k]];
+      lo = glm::min(glm::min(lo, t.a), glm::min(t.b, t.c));
+      hi = glm::max(glm::max(hi, t.a), glm::max(t.b, t.c));
+      clo = glm::min(clo, centroid[order[k]]);
+      chi = glm::max(chi, centroid[order[k]]);
+    }
+    nodes[at].lo = lo;
+    nodes[at].hi = hi;
+    if (end - begin <= ColliderMesh::leaf_size) {
+      nodes[at].first = begin; // triangles are written in `order` afterwards
+      nodes[at].count = end - begin;
+      return;
+    }
+    const glm::vec3 extent = chi - clo;
+    const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
+    const std::uint32_t mid = begin + (end - begin) / 2;
+    // Median by centroid, ties by index: the same tree on every machine.
+    std::nth_element(order.begin() + begin, order.begin() + mid, order.begin() + end,
+                     [&](std::uint32_t a, std::uint32_t b) {
+                       return centroid[a][axis] < centroid[b][axis] ||
+                              (centroid[a][axis] == centroid[b][axis] && a < b);
+                     });
+    const auto left = static_cast<std::uint32_t>(nodes.size());
+    nodes.resize(nodes.size() + 2);
+    nodes[at].first = left;
+    nodes[at].count = 0;
+    build(left, begin, mid, level + 1);
+    build(left + 1, mid, end, level + 1);
+  }
+};
+
+Error bad(const std::string& name, const std::string& what) {
+  return Error{ErrorCode::invalid_argument, fmt::format("mesh collider {}: {}", name, what)};
+}
+
+} // namespace
+
+Result<std::shared_ptr<const ColliderMesh>> ColliderMesh::create(std::span<const glm::dvec3> positions,
+                                                                  std::span<const std::uint32_t> triangles,
+                                                                  std::string name) {
+  if (triangles.size() % 3 != 0)
+    return bad(name, fmt::format("{} triangle indices is not a multiple of 3", triangles.size()));
+  for (std::size_t v = 0; v < positions.size(); ++v)
+    for (int k = 0; k < 3; ++k)
+      if (!std::isfinite(positions[v][k]))
+        return bad(name, fmt::format("vertex {} is not finite ({}, {}, {})", v, positions[v].x, positions[v].y,
+                                     positions[v].z));
+  Builder b;
+  std::uint32_t dropped = 0;
+  for (std::size_t t = 0; t + 2 < triangles.size(); t += 3) {
+    glm::vec3 corner[3];
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t i = triangles[t + std::size_t(k)];
+      if (i >= positions.size())
+        return bad(name, fmt::format("triangle {} uses vertex {} but there are {} vertices", t / 3, i,
+                                     positions.size()));
+      corner[k] = glm::vec3(positions[i]);
+    }
+    if (glm::length(glm::cross(corner[1] - corner[0], corner[2] - corner[0])) == 0.0f) {
+      ++dropped; // no normal, no area: nothing to collide with
+      continue;
+    }
+    b.tris.push_back({corner[0], 0.0f, corner[1], 0.0f, corner[2], 0.0f});
+    b.centroid.push_back((corner[0] + corner[1] + corner[2]) / 3.0f);
+  }
+  if (b.tris.empty())
+    return bad(name, triangles.empty() ? std::string("it has no triangles")
+                                       : fmt::format("all of its {} triangles have zero area", dropped));
+  if (b.tris.size() > (std::size_t{1} << 28))
+    return bad(name, fmt::format("{} triangles are too many (at most 2^28)", b.tris.size()));
+  b.order.resize(b.tris.size());
+  std::iota(b.order.begin(), b.order.end(), 0u);
+  b.nodes.resize(1);
+  b.nodes.reserve(2 * b.tris.size() / leaf_size + 2);
+  b.build(0, 0, static_cast<std::uint32_t>(b.tris.size()), 1);
+  auto mesh = std::make_shared<ColliderMesh>();
+  mesh->triangles_.reserve(b.tris.size());
+  for (const std::uint32_t i : b.order)
+    mesh->triangles_.push_back(b.tris[i]);
+  mesh->nodes_ = std::move(b.nodes);
+  mesh->name_ = std::move(name);
+  mesh->depth_ = b.depth;
+  mesh->dropped_ = dropped;
+  return std::shared_ptr<const ColliderMesh>(std::move(mesh));
+}
+
+Result<std::shared_ptr<const ColliderMesh>> ColliderMesh::from_mesh(const Mesh& mesh, double scale,
+                                                                    std::string name) {
+  if (!std::isfinite(scale) || scale <= 0.0)
+    return bad(name, fmt::format("scale must be finite and > 0, got {}", scale));
+  std::vector<glm::dvec3> positions(mesh.positions.size());
+  for (std::size_t v = 0; v < positions.size(); ++v)
+    positions[v] = mesh.positions[v] * scale;
+  std::vector<std::uint32_t> tris;
+  for (std::size_t f = 0; f < mesh.face_count(); ++f) {
+    const std::uint32_t first = mesh.face_offsets[f], end = mesh.face_offsets[f + 1];
+    for (std::uint32_t k = first + 1; k + 1 < end; ++k) // a fan around the face's first corner
+      tris.insert(tris.end(), {mesh.indices[first], mesh.indices[k], mesh.indices[k + 1]});
+  }
+  return create(positions, tris, std::move(name));
+}
+
+} // namespace vkcloth
