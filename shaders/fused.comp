@@ -64,10 +64,11 @@ void main() {
   }
 
   const bool pinned = pinned_at(p);
-  vec3 x = pos_at(p);
+  const vec3 x0 = pos_at(p);
+  vec3 x = x0;
   vec3 v = vf;
   if (!pinned && !fr)
     euler_update(ip.integrator == VKCLOTH_INTEGRATOR_SEMI_IMPLICIT_EULER, x, v, f, mass_at(p), ip.dt);
   if (fr) v = v0;
-  finish(p, pinned || fr, x, v);
+  finish(p, pinned || fr, x0, x, v);
 }

@@ -8,6 +8,7 @@
 // sequential order; no dispatch of its own. VKCLOTH_IMPL_SOLVE instead runs many CG iterations in ONE workgroup (each
 // invocation strides over the particles; workgroup barriers between the phases), for systems
 // small enough that the dispatches of the per-iteration passes cost more than their work.
+#define VKCLOTH_FRICTION_AFTER_SOLVE // force_body.glsl: friction once, in the FINISH pass
 #include "implicit_shared.h"
 #include "common.glsl"
 #include "force_body.glsl"
@@ -306,17 +307,20 @@ void main() {
   }
   const vec3 x0 = pos_in[p].xyz;
   if (pinned) {
-    finish(p, true, x0, vel[p].xyz);
+    finish(p, true, x0, x0, vel[p].xyz);
     return;
   }
   precise vec3 v = vf[p].xyz + cx[p].xyz;
   const bool both = (ip.flags & VKCLOTH_FLAG_CONTACT_BOTH) != 0u;
-  for (uint c = 0u; c < ip.collider_count; ++c) { // the contact filter on the new velocity only
+  const float h_over_m = h / particle[p].mass;
+  for (uint c = 0u; c < ip.collider_count; ++c) { // the contact response on the new velocity, friction too
+    const ColliderShape s = collider_shape(c);
     float dist;
     vec3 n;
-    collider_at(c, x0, dist, n);
-    if (dist < ip.band) remove_inward(v, n, both);
+    collider_contact(0u, s, x0, x0, ip.band, dist, n);
+    vec3 no_force = vec3(0.0);
+    contact_response(v, no_force, s, x0, n, dist, ip.band, both, h_over_m);
   }
   precise vec3 x = x0 + v * h;
-  finish(p, false, x, v);
+  finish(p, false, x0, x, v);
 }

@@ -42,7 +42,7 @@ void main() {
     vec3 x = x0;
     vec3 v = vf;
     if (!pinned) euler_update(ip.integrator == VKCLOTH_INTEGRATOR_SEMI_IMPLICIT_EULER, x, v, f, m, ip.dt);
-    finish(p, pinned, x, v);
+    finish(p, pinned, x0, x, v);
     return;
   }
 
@@ -66,5 +66,5 @@ void main() {
     x = rk4_finish(x0, sp, ip.w6);
     v = rk4_finish(v0, sv, ip.w6);
   }
-  finish(p, pinned, x, v);
+  finish(p, pinned, x0, x, v);
 }

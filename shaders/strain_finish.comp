@@ -45,10 +45,8 @@ void main() {
       }
     }
   } else {
-    for (uint c = 0u; c < ip.collider_count; ++c) {
-      const Collider col = colliders[ip.collider_first + c];
-      project_out(col.type, col.shape.xyz, col.shape.w, ip.eps, x, v);
-    }
+    for (uint c = 0u; c < ip.collider_count; ++c)
+      project_out(0u, collider_shape(c), ip.eps, x, x, v); // side: where the stretch control left it
     moved = true;
   }
   if (!moved) return;

@@ -10,12 +10,15 @@
 //   variable, so the shader compiler may neither reassociate nor fuse it into an FMA (the C++
 //   side builds with -ffp-contract=off; `precise` is empty there).
 // - Literals are `real(...)`: a bare 2.0 would be a double in C++.
-// - Pure functions of values: no buffer, no loop over particles or colliders. Each caller
+// - Pure functions of values: no buffer (a mesh collider's hierarchy is read through the including
+//   file's accessors), no loop over particles or colliders. Each caller
 //   gathers its inputs its own way (texel fetches, std::vector) and loops itself.
 //
 // Provided by the including file: real, vec3, uint, KFN (function prefix: `inline` in C++),
-// OUT(T) / INOUT(T) (out / inout parameters: T& in C++), precise, sqrt, abs, max, and
-// all_finite(vec3) (no component is NaN or inf). Constants: vkcloth_shared.h.
+// OUT(T) / INOUT(T) (out / inout parameters: T& in C++), precise, sqrt, abs, min, max, and
+// all_finite(vec3) (no component is NaN or inf); for mesh colliders MESH_DATA_PARAM / MESH_DATA
+// (the mesh buffers: a dummy uint in GLSL, whose buffers are global), mesh_node and mesh_triangle.
+// Constants: vkcloth_shared.h.
 // No include guard: kernel.hpp includes this file once per precision, in two namespaces.
 
 // ---- Vector helpers ----------------------------------------------------------------------------
@@ -79,21 +82,220 @@ KFN precise vec3 add_body_forces(vec3 springs, real m, vec3 v, vec3 gravity, rea
 
 // ---- Contacts (docs/model.md "Collisions") ----------------------------------------------------
 
-// Signed distance of p to a collider and the collider's outward unit normal there. Plane
-// {n.p = offset}: (a, b) = (n, offset); sphere: (a, b) = (centre, radius).
-KFN void collider_contact(uint type, vec3 a, real b, vec3 p, OUT(real) distance, OUT(vec3) normal) {
-  if (type == VKCLOTH_COLLIDER_PLANE) {
-    precise real d = dot3(a, p) - b;
+// A collider as the kernel takes it, in the solver's precision, at its pose for this substep
+// (the host advances moving colliders: vkcloth::Collider::posed_at). GLSL: common.glsl
+// collider_shape(); C++: kernel.hpp kernel_shape().
+struct ColliderShape {
+  uint type; // VKCLOTH_COLLIDER_*
+  vec3 a;    // plane: unit normal; sphere, box, mesh: centre (mesh: its origin); capsule: end a
+  real b;    // plane: offset; sphere, capsule: radius; mesh: thickness
+  vec3 c;    // capsule: end b; box: half extents
+  vec3 ax;   // box, mesh: the body's axes in the world (columns of its rotation)
+  vec3 ay;
+  vec3 az;
+  uint mesh_root; // mesh: its root node and first triangle in the mesh buffers
+  uint mesh_tri0;
+  bool moving;   // the surface moves: velocity, spin and pivot apply
+  vec3 velocity; // linear velocity
+  vec3 spin;     // angular velocity about pivot
+  vec3 pivot;
+  real mu_k; // Coulomb friction: kinetic and static coefficients (0, 0: frictionless)
+  real mu_s;
+};
+
+// The velocity of the collider's surface at p.
+KFN precise vec3 surface_velocity(ColliderShape s, vec3 p) {
+  precise vec3 v = s.velocity + cross3(s.spin, p - s.pivot);
+  return v;
+}
+
+// p in the body frame of a box or mesh (R^T (p - centre)), and a body-frame direction back in the world.
+KFN precise vec3 to_body(ColliderShape s, vec3 p) {
+  precise vec3 r = p - s.a;
+  return vec3(dot3(s.ax, r), dot3(s.ay, r), dot3(s.az, r));
+}
+KFN precise vec3 to_world_dir(ColliderShape s, vec3 d) {
+  precise vec3 w = s.ax * d.x + s.ay * d.y;
+  w = w + s.az * d.z;
+  return w;
+}
+
+// The closest point of triangle (a, b, c) to p (Ericson, Real-Time Collision Detection, 5.1.5).
+KFN precise vec3 closest_on_triangle(vec3 p, vec3 a, vec3 b, vec3 c) {
+  precise vec3 ab = b - a, ac = c - a, ap = p - a;
+  precise real d1 = dot3(ab, ap), d2 = dot3(ac, ap);
+  if (d1 <= real(0) && d2 <= real(0))
+    return a;
+  precise vec3 bp = p - b;
+  precise real d3 = dot3(ab, bp), d4 = dot3(ac, bp);
+  if (d3 >= real(0) && d4 <= d3)
+    return b;
+  precise real vc = d1 * d4 - d3 * d2;
+  if (vc <= real(0) && d1 >= real(0) && d3 <= real(0)) {
+    precise real v = d1 / (d1 - d3);
+    precise vec3 q = a + ab * v;
+    return q;
+  }
+  precise vec3 cp = p - c;
+  precise real d5 = dot3(ab, cp), d6 = dot3(ac, cp);
+  if (d6 >= real(0) && d5 <= d6)
+    return c;
+  precise real vb = d5 * d2 - d1 * d6;
+  if (vb <= real(0) && d2 >= real(0) && d6 <= real(0)) {
+    precise real w = d2 / (d2 - d6);
+    precise vec3 q = a + ac * w;
+    return q;
+  }
+  precise real va = d3 * d6 - d5 * d4;
+  precise real e43 = d4 - d3, e56 = d5 - d6;
+  if (va <= real(0) && e43 >= real(0) && e56 >= real(0)) {
+    precise real w = e43 / (e43 + e56);
+    precise vec3 q = b + (c - b) * w;
+    return q;
+  }
+  precise real denom = real(1) / ((va + vb) + vc);
+  precise real v = vb * denom, w = vc * denom;
+  precise vec3 q = a + ab * v;
+  q = q + ac * w;
+  return q;
+}
+
+// The triangle of a mesh collider nearest to q (body frame) within `reach`: its closest point and
+// unit normal. Walks the bounding-volume hierarchy depth first, nearer-or-equal boxes only, in
+// a fixed order, so both backends pick the same triangle. The including file provides
+// mesh_node(MESH_DATA, i, lo, first, hi, count) and mesh_triangle(MESH_DATA, i, a, b, c)
+// (vkcloth::ColliderMesh's Node and Triangle); MESH_DATA_PARAM declares MESH_DATA.
+#define VKCLOTH_MESH_STACK 32
+KFN bool mesh_closest(MESH_DATA_PARAM, uint root, uint tri0, vec3 q, real reach, OUT(vec3) closest,
+                      OUT(vec3) normal) {
+  closest = q;
+  normal = vec3(real(0), real(0), real(1));
+  precise real best = reach * reach;
+  bool found = false;
+  uint stack[VKCLOTH_MESH_STACK];
+  uint top = 1u;
+  stack[0] = 0u;
+  while (top > 0u) {
+    top = top - 1u;
+    vec3 lo, hi;
+    uint first, count;
+    mesh_node(MESH_DATA, root + stack[top], lo, first, hi, count);
+    precise vec3 out_lo = lo - q, out_hi = q - hi;
+    precise vec3 gap = max(max(out_lo, out_hi), vec3(real(0)));
+    if (dot3(gap, gap) > best)
+      continue;
+    if (count == 0u) { // the first child is walked first
+      stack[top] = first + 1u;
+      stack[top + 1u] = first;
+      top = top + 2u;
+      continue;
+    }
+    for (uint t = first; t < first + count; ++t) {
+      vec3 ta, tb, tc;
+      mesh_triangle(MESH_DATA, tri0 + t, ta, tb, tc);
+      precise vec3 cp = closest_on_triangle(q, ta, tb, tc);
+      precise vec3 d = q - cp;
+      precise real d2 = dot3(d, d);
+      if (d2 < best) {
+        best = d2;
+        closest = cp;
+        normal = unit_or_zero(cross3(tb - ta, tc - ta));
+        found = true;
+      }
+    }
+  }
+  return found;
+}
+
+// Signed distance of p to a collider's surface (negative inside; a mesh: to the shell `thickness`
+// around its triangles) and the outward unit normal there. A mesh's side is the side of the
+// nearest triangle that `p_side` is on (where the particle came from), so a particle that crossed
+// a thin mesh within one step is still pushed back to its side (its distance: the depth below the
+// triangle's plane plus the thickness). Farther than `reach` from a mesh's shell: distance = reach
+// (no contact). Plane {n.p = offset}; sphere; capsule: the segment
+// a-c swept by the radius; box: edges and corners included.
+KFN void collider_contact(MESH_DATA_PARAM, ColliderShape s, vec3 p, vec3 p_side, real reach,
+                          OUT(real) distance, OUT(vec3) normal) {
+  if (s.type == VKCLOTH_COLLIDER_PLANE) {
+    precise real d = dot3(s.a, p) - s.b;
     distance = d;
-    normal = a;
+    normal = s.a;
     return;
   }
-  precise vec3 r = p - a;
+  if (s.type == VKCLOTH_COLLIDER_SPHERE) {
+    precise vec3 r = p - s.a;
+    precise real len = sqrt(dot3(r, r));
+    precise vec3 n = len > real(0) ? r / len : vec3(real(0), real(0), real(1)); // at the centre: push up
+    precise real d = len - s.b;
+    distance = d;
+    normal = n;
+    return;
+  }
+  if (s.type == VKCLOTH_COLLIDER_CAPSULE) {
+    precise vec3 axis = s.c - s.a;
+    precise real len2 = dot3(axis, axis);
+    precise real t = len2 > real(0) ? dot3(p - s.a, axis) / len2 : real(0);
+    t = min(max(t, real(0)), real(1));
+    precise vec3 r = p - (s.a + axis * t);
+    precise real len = sqrt(dot3(r, r));
+    precise vec3 n = len > real(0) ? r / len : vec3(real(0), real(0), real(1));
+    precise real d = len - s.b;
+    distance = d;
+    normal = n;
+    return;
+  }
+  precise vec3 q = to_body(s, p);
+  if (s.type == VKCLOTH_COLLIDER_BOX) {
+    precise vec3 over = abs(q) - s.c; // > 0 along the axes where q is beyond a face
+    precise vec3 out_part = max(over, vec3(real(0)));
+    precise real out_len = sqrt(dot3(out_part, out_part));
+    precise vec3 sgn = vec3(q.x < real(0) ? real(-1) : real(1), q.y < real(0) ? real(-1) : real(1),
+                            q.z < real(0) ? real(-1) : real(1));
+    if (out_len > real(0)) { // outside: towards the nearest face, edge or corner
+      precise vec3 nb = (out_part * sgn) / out_len;
+      distance = out_len;
+      normal = to_world_dir(s, nb);
+      return;
+    }
+    // Inside: out through the nearest face.
+    vec3 nb = vec3(sgn.x, real(0), real(0));
+    precise real d = over.x;
+    if (over.y > d) {
+      d = over.y;
+      nb = vec3(real(0), sgn.y, real(0));
+    }
+    if (over.z > d) {
+      d = over.z;
+      nb = vec3(real(0), real(0), sgn.z);
+    }
+    distance = d;
+    normal = to_world_dir(s, nb);
+    return;
+  }
+  // VKCLOTH_COLLIDER_MESH
+  vec3 cp, tn;
+  distance = reach;
+  normal = vec3(real(0), real(0), real(1));
+  if (!mesh_closest(MESH_DATA, s.mesh_root, s.mesh_tri0, q, s.b + reach, cp, tn))
+    return;
+  precise vec3 r = q - cp;
   precise real len = sqrt(dot3(r, r));
-  precise vec3 n = len > real(0) ? r / len : vec3(real(0), real(0), real(1)); // at the centre: push up
-  precise real d = len - b;
+  precise real side = dot3(to_body(s, p_side) - cp, tn) < real(0) ? real(-1) : real(1);
+  precise vec3 side_n = tn * side;
+  precise real along = dot3(r, side_n);
+  precise vec3 across = r - side_n * along; // beyond an edge: its offset in the triangle's plane
+  if (along < real(0) && dot3(across, across) <= s.b * s.b) {
+    // Crossed to the other side through the triangle (or within the shell of its edge): back out
+    // on the side it came from.
+    precise real d = along - s.b;
+    distance = d;
+    normal = to_world_dir(s, side_n);
+    return;
+  }
+  precise vec3 nb = len > real(0) ? r / len : side_n;
+  precise real d = len - s.b;
   distance = d;
-  normal = n;
+  normal = to_world_dir(s, nb);
 }
 
 // Removes the part of `w` along n that points into the collider (<w, n> < 0); with `both`
@@ -115,24 +317,80 @@ KFN void contact_filter(INOUT(vec3) v, INOUT(vec3) f, vec3 n, real distance, rea
   remove_inward(f, n, both);
 }
 
+// Coulomb friction on the relative velocity w and the force f once their inward normal parts are
+// gone; j: the normal impulse per unit mass of this substep (the inward velocity removed plus
+// h / m times the inward force removed). The tangential velocity the substep would end with,
+// slip = w_t + (h / m) f_t, is cancelled when |slip| <= mu_s j (static: w_t and f_t go) and
+// otherwise shortened by mu_k j (kinetic: w_t and f_t scaled by the same factor).
+KFN void coulomb_friction(INOUT(vec3) w, INOUT(vec3) f, vec3 n, real j, real mu_k, real mu_s, real h_over_m) {
+  precise vec3 wt = w - n * dot3(w, n);
+  precise vec3 ft = f - n * dot3(f, n);
+  precise vec3 slip = wt + ft * h_over_m;
+  precise real slip_len = sqrt(dot3(slip, slip));
+  precise real hold = mu_s * j;
+  precise real k = slip_len > hold ? mu_k * j / slip_len : real(1);
+  precise vec3 nw = w - wt * k;
+  precise vec3 nf = f - ft * k;
+  w = nw;
+  f = nf;
+}
+
+// The contact response of one collider for particle x with velocity v and force f (mass m,
+// substep h: h_over_m = h / m): the report's filter relative to the collider's surface velocity,
+// then friction. A still, frictionless collider is exactly contact_filter (the report's model).
+KFN void contact_response(INOUT(vec3) v, INOUT(vec3) f, ColliderShape s, vec3 x, vec3 n, real distance,
+                          real band, bool both, real h_over_m) {
+  if (!s.moving && s.mu_s == real(0) && s.mu_k == real(0)) {
+    contact_filter(v, f, n, distance, band, both);
+    return;
+  }
+  if (!(distance < band))
+    return;
+  precise vec3 vs = s.moving ? surface_velocity(s, x) : vec3(real(0));
+  precise vec3 w = v - vs;
+  precise real wn = dot3(w, n), fn = dot3(f, n);
+  remove_inward(w, n, both);
+  remove_inward(f, n, both);
+  precise real j = max(-wn, real(0)) + max(-fn, real(0)) * h_over_m;
+  coulomb_friction(w, f, n, j, s.mu_k, s.mu_s, h_over_m);
+  precise vec3 nv = w + vs;
+  v = nv;
+}
+
 // Eq. 5 / eq. 6: a point inside a collider goes back to its surface + eps, and loses its
-// inward velocity.
-KFN void project_out(uint type, vec3 a, real b, real eps, INOUT(vec3) x, INOUT(vec3) v) {
+// inward velocity (relative to the surface's). p_side: where the particle came from (a mesh's side).
+// A mesh is searched as far as the particle moved, so that one that crossed it within the step
+// is found even when it ended farther than the thickness beyond.
+KFN void project_out(MESH_DATA_PARAM, ColliderShape s, real eps, vec3 p_side, INOUT(vec3) x, INOUT(vec3) v) {
   real distance;
   vec3 n;
-  collider_contact(type, a, b, x, distance, n);
+  precise vec3 moved = x - p_side;
+  precise real reach = s.type == VKCLOTH_COLLIDER_MESH ? sqrt(dot3(moved, moved)) : real(0);
+  collider_contact(MESH_DATA, s, x, p_side, reach, distance, n);
   if (!(distance < real(0)))
     return;
-  if (type == VKCLOTH_COLLIDER_PLANE) {
+  if (s.type == VKCLOTH_COLLIDER_PLANE) {
     precise real back = eps - distance;
     precise vec3 t = x + n * back;
     x = t;
+  } else if (s.type == VKCLOTH_COLLIDER_SPHERE) {
+    precise real r = s.b + eps;
+    precise vec3 t = s.a + n * r;
+    x = t;
   } else {
-    precise real r = b + eps;
-    precise vec3 t = a + n * r;
+    precise real back = eps - distance;
+    precise vec3 t = x + n * back;
     x = t;
   }
-  remove_inward(v, n, false);
+  if (!s.moving) {
+    remove_inward(v, n, false);
+    return;
+  }
+  precise vec3 vs = surface_velocity(s, x);
+  precise vec3 w = v - vs;
+  remove_inward(w, n, false);
+  precise vec3 nv = w + vs;
+  v = nv;
 }
 
 // ---- Stretch control (docs/model.md "Stretch control") ----------------------------------------

@@ -31,6 +31,8 @@ layout(constant_id = 41) const bool SC_COLLIDERS = true;
 
 layout(std430, set = 0, binding = VKCLOTH_BINDING_PARTICLE) readonly buffer ParticleBuf { ParticleInfo particle[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_COLLIDERS) readonly buffer ColliderBuf { Collider colliders[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_MESH_NODES) readonly buffer MeshNodeBuf { MeshNode mesh_nodes[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_MESH_TRIS) readonly buffer MeshTriBuf { MeshTriangle mesh_tris[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_FLAGS) buffer FlagBuf { Flags flags[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_INSTANCES) readonly buffer InstanceBuf { InstanceParams instances[]; };
 
@@ -106,12 +108,44 @@ bool all_finite(vec3 v) {
   const uvec3 bits = floatBitsToUint(v) & 0x7f800000u; // exponent all ones: inf or NaN
   return all(notEqual(bits, uvec3(0x7f800000u)));
 }
+// Mesh colliders' hierarchies and triangles: global buffers, so MESH_DATA is a dummy argument.
+#define MESH_DATA_PARAM uint mesh_data
+#define MESH_DATA mesh_data
+void mesh_node(uint unused, uint i, out vec3 lo, out uint first, out vec3 hi, out uint count) {
+  const MeshNode n = mesh_nodes[i];
+  lo = n.lo_first.xyz;
+  first = floatBitsToUint(n.lo_first.w);
+  hi = n.hi_count.xyz;
+  count = floatBitsToUint(n.hi_count.w);
+}
+void mesh_triangle(uint unused, uint i, out vec3 a, out vec3 b, out vec3 c) {
+  const MeshTriangle t = mesh_tris[i];
+  a = t.a.xyz;
+  b = t.b.xyz;
+  c = t.c.xyz;
+}
 #include "cloth_kernel.h"
 
-// Signed distance to the instance's collider c and its outward unit normal.
-void collider_at(uint c, vec3 p, out float distance, out vec3 normal) {
+// The instance's collider c as the kernel takes it (the host packed kernel_shape<float>).
+ColliderShape collider_shape(uint c) {
   const Collider col = colliders[ip.collider_first + c];
-  collider_contact(col.type, col.shape.xyz, col.shape.w, p, distance, normal);
+  ColliderShape s;
+  s.type = col.type;
+  s.a = col.shape.xyz;
+  s.b = col.shape.w;
+  s.c = col.end_b.xyz;
+  s.ax = col.axis_x.xyz;
+  s.ay = col.axis_y.xyz;
+  s.az = col.axis_z.xyz;
+  s.mesh_root = col.mesh_root;
+  s.mesh_tri0 = col.mesh_tri0;
+  s.moving = col.moving != 0u;
+  s.velocity = col.velocity.xyz;
+  s.spin = col.spin.xyz;
+  s.pivot = col.pivot.xyz;
+  s.mu_k = col.velocity.w;
+  s.mu_s = col.spin.w;
+  return s;
 }
 
 #endif

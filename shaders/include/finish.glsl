@@ -5,16 +5,15 @@
 #ifndef VKCLOTH_FINISH_GLSL
 #define VKCLOTH_FINISH_GLSL
 
-// Projects particle p of this instance out of every collider (cloth_kernel.h project_out), writes
-// the new state and flags a divergence (the step and the smallest bad particle).
-void finish(uint p, bool pinned, vec3 x_in, vec3 v_in) {
+// Projects particle p of this instance out of every collider (cloth_kernel.h project_out; `side`:
+// its position at the start of the step, a mesh's side), writes the new state and flags a
+// divergence (the step and the smallest bad particle).
+void finish(uint p, bool pinned, vec3 side, vec3 x_in, vec3 v_in) {
   vec3 x = x_in;
   vec3 v = v_in;
   if (!pinned) {
-    for (uint c = 0u; c < (SC_COLLIDERS ? ip.collider_count : 0u); ++c) {
-      const Collider col = colliders[ip.collider_first + c];
-      project_out(col.type, col.shape.xyz, col.shape.w, ip.eps, x, v);
-    }
+    for (uint c = 0u; c < (SC_COLLIDERS ? ip.collider_count : 0u); ++c)
+      project_out(0u, collider_shape(c), ip.eps, side, x, v);
   }
   pos_out[base + p] = vec4(x, 1.0);
   vel[base + p] = vec4(v, 0.0);

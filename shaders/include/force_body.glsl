@@ -207,14 +207,21 @@ void particle_force(uint p, inout vec3 v_io, out vec3 f_out, out vec3 nrm_out) {
   f = add_body_forces(f, m, v, ip.gravity_damping.xyz, ip.gravity_damping.w, (ip.flags & VKCLOTH_FLAG_WIND) != 0u,
                       nrm, ip.wind.xyz, ip.wind.w);
 
-  // Contacts: inside the 2 eps band, remove only the parts of v and F pointing into the collider.
+  // Contacts: inside the 2 eps band, remove only the parts of v and F pointing into the collider
+  // (relative to its surface), then friction.
   if (!pinned_at(p)) {
     const bool both = (ip.flags & VKCLOTH_FLAG_CONTACT_BOTH) != 0u;
+    precise float h_over_m = ip.dt / m;
     for (uint c = 0u; c < (SC_COLLIDERS ? ip.collider_count : 0u); ++c) {
+      ColliderShape s = collider_shape(c);
+#ifdef VKCLOTH_FRICTION_AFTER_SOLVE
+      s.mu_k = 0.0; // implicit.comp: friction once, on the solved velocity (FINISH)
+      s.mu_s = 0.0;
+#endif
       float dist;
       vec3 n;
-      collider_at(c, x, dist, n);
-      contact_filter(v, f, n, dist, ip.band, both);
+      collider_contact(0u, s, x, x, ip.band, dist, n);
+      contact_response(v, f, s, x, n, dist, ip.band, both, h_over_m);
     }
   }
 

@@ -54,7 +54,9 @@ struct vec4 {
 #define VKCLOTH_BINDING_UV 22 // texture coordinates (vec4: u, v, 0, 0), read by vertices.comp
 #define VKCLOTH_BINDING_VERTICES                                                                             \
   23 // interleaved Vertex per particle (GpuSolverOptions::interleaved_vertices)
-#define VKCLOTH_BINDING_COUNT 24
+#define VKCLOTH_BINDING_MESH_NODES 24 // MeshNode: every mesh collider's hierarchy (Collider::mesh_root)
+#define VKCLOTH_BINDING_MESH_TRIS 25  // MeshTriangle: their triangles in leaf order (Collider::mesh_tri0)
+#define VKCLOTH_BINDING_COUNT 26
 
 // Set 1 (force.comp, fused.comp, strain_*.comp): POS_IN again, as an RGBA32F uniform texel buffer view,
 // PARTICLE as an RG32UI one (x: the mass's bits, y: pinned), and (fused.comp) VEL as RGBA32F and
@@ -96,6 +98,9 @@ struct vec4 {
 // Collider::type (the vkcloth::Collider::Type values; engine/src/core/kernel.hpp asserts it).
 #define VKCLOTH_COLLIDER_PLANE 0u
 #define VKCLOTH_COLLIDER_SPHERE 1u
+#define VKCLOTH_COLLIDER_CAPSULE 2u
+#define VKCLOTH_COLLIDER_BOX 3u
+#define VKCLOTH_COLLIDER_MESH 4u
 
 // Flags::first_bad_step before anything diverged.
 #define VKCLOTH_NO_BAD_STEP 0xffffffffu
@@ -172,13 +177,34 @@ struct TetherSlot {
   float rest_length;
 };
 
-/// A plane {n.p = offset} (shape = (n, offset)) or a sphere (shape = (centre, radius)).
+/// A collider at its pose for the next substep (cloth_kernel.h ColliderShape; std430: 144 bytes).
 struct Collider {
-  vec4 shape;
-  uint type;
-  uint pad0;
-  uint pad1;
-  uint pad2;
+  vec4 shape;     // plane: (n, offset); sphere: (centre, radius); capsule: (a, radius); box: (centre, 0);
+                  // mesh: (origin, thickness)
+  uint type;      // VKCLOTH_COLLIDER_*
+  uint moving;    // 1: velocity, spin and pivot apply
+  uint mesh_root; // mesh: its root in MESH_NODES
+  uint mesh_tri0; // mesh: its first triangle in MESH_TRIS
+  vec4 end_b;     // capsule: (b, 0); box: (half extents, 0)
+  vec4 axis_x;    // box, mesh: the body's axes in the world (the rotation's columns)
+  vec4 axis_y;
+  vec4 axis_z;
+  vec4 velocity; // xyz: linear velocity; w: kinetic friction
+  vec4 spin;     // xyz: angular velocity; w: static friction
+  vec4 pivot;    // xyz: the point spin turns about
+};
+
+/// A node of a mesh collider's hierarchy (vkcloth::ColliderMesh::Node; std430: 32 bytes).
+struct MeshNode {
+  vec4 lo_first; // xyz: box min; w: the bits of `first` (leaf: first triangle; inner: first child)
+  vec4 hi_count; // xyz: box max; w: the bits of `count` (0: inner node)
+};
+
+/// A mesh collider's triangle (vkcloth::ColliderMesh::Triangle; std430: 48 bytes).
+struct MeshTriangle {
+  vec4 a;
+  vec4 b;
+  vec4 c;
 };
 
 /// Divergence flags of one instance, written with integer atomics (finish.glsl).
@@ -205,8 +231,11 @@ static_assert(sizeof(FanEntry) == 8);
 static_assert(sizeof(StrainLink) == 12);
 static_assert(sizeof(TetherSlot) == 8);
 static_assert(offsetof(InstanceParams, max_strain) == 68);
-static_assert(sizeof(Collider) == 32);
+static_assert(sizeof(Collider) == 144);
 static_assert(offsetof(Collider, type) == 16);
+static_assert(offsetof(Collider, end_b) == 32);
+static_assert(sizeof(MeshNode) == 32);
+static_assert(sizeof(MeshTriangle) == 48);
 static_assert(sizeof(Flags) == 16);
 static_assert(sizeof(vec4) == 16);
 } // namespace vkcloth::gpu::shared

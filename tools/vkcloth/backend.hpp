@@ -37,6 +37,8 @@ public:
   /// Steps taken so far, and the simulated time step_index() * dt.
   virtual std::uint64_t step_index() const = 0;
   virtual double time() const = 0;
+  /// The colliders where they are now (moving ones advance with every substep).
+  virtual std::vector<Collider> colliders() const = 0;
   /// implicit_euler: the last substep's CG iterations and relative residual.
   virtual SolveStats last_solve() const { return {}; }
 };

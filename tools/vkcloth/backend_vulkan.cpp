@@ -38,6 +38,7 @@ public:
   std::uint64_t step_index() const override { return solver_.step_index(); }
   SolveStats last_solve() const override { return solver_.last_solve(); }
   double time() const override { return solver_.time(); }
+  std::vector<Collider> colliders() const override { return solver_.params().colliders; }
 
 private:
   gpu::Context context_; // declared first: destroyed after the solver

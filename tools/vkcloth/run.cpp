@@ -82,6 +82,14 @@ void write_trace_rows(std::FILE* f, std::uint64_t step, double time, const std::
                file_vertex(system, k), p[k].x, p[k].y, p[k].z, v[k].x, v[k].y, v[k].z);
 }
 
+/// The contact quality over a run (`vkcloth run` on a scene with colliders).
+constexpr std::uint64_t no_step = ~std::uint64_t{0};
+struct ContactTrack {
+  PenetrationStats deepest;     ///< the deepest sampled penetration ...
+  std::uint64_t step = no_step; ///< ... and its step
+  double calm_speed = 0.0;      ///< the largest free-particle speed over the last second
+};
+
 struct RunOptions {
   SceneArgs args;
   std::string trace; ///< empty: no trace
@@ -93,6 +101,7 @@ struct RunOptions {
   std::string obj_frames;                    ///< a directory; empty: none
   std::optional<std::uint64_t> export_every; ///< K for both; unset: 1
   std::uint64_t strain_every = 1;            ///< K for "over the run" of the structural strain
+  std::uint64_t contact_every = 1;           ///< K for the contact quality (scenes with colliders)
   std::string json;                          ///< the summary as JSON; empty: none
 };
 
@@ -241,6 +250,26 @@ int run_command(const RunOptions& opt) {
   const bool track_strain = strain0->count > 0; // chains (and K_struct = 0) have no structural spring
   const std::uint64_t strain_every = std::max<std::uint64_t>(opt.strain_every, 1);
   StrainTrack strain{*strain0, 0};
+  // Contact quality (scenes with colliders): the deepest penetration after any sampled step, and
+  // the largest speed over the run's last second (the jitter of a cloth that should be at rest).
+  const bool track_contact = !scene->params.colliders.empty();
+  const std::uint64_t contact_every = std::max<std::uint64_t>(opt.contact_every, 1);
+  const auto last_second_steps = static_cast<std::uint64_t>(std::ceil(1.0 / scene->params.dt - 1e-9));
+  const std::uint64_t calm_from = total > last_second_steps ? total - last_second_steps : 0;
+  ContactTrack contact;
+  const auto sample_contact = [&]() -> Result<void> {
+    const auto colliders = backend.colliders();
+    auto depth = penetration(scene->system, colliders, pos);
+    if (!depth)
+      return depth.error();
+    if (depth->depth > contact.deepest.depth || contact.step == no_step) {
+      contact.deepest = *depth;
+      contact.step = backend.step_index();
+    }
+    if (backend.step_index() > calm_from)
+      contact.calm_speed = std::max(contact.calm_speed, max_free_speed(scene->system, vel));
+    return {};
+  };
   const std::vector<std::uint32_t> order = file_order(scene->system);
   if (trace)
     write_trace_rows(trace.get(), 0, backend.time(), pos, vel, scene->system, order);
@@ -262,6 +291,8 @@ int run_command(const RunOptions& opt) {
         next = std::min(next, next_multiple(done, frames.every()));
       if (track_strain)
         next = std::min(next, next_multiple(done, strain_every));
+      if (track_contact)
+        next = std::min(next, next_multiple(done, contact_every));
       next = std::min(next, total);
       if (auto r = backend.step(next - done); !r) {
         if (trace)
@@ -273,10 +304,14 @@ int run_command(const RunOptions& opt) {
       done = next;
       const bool trace_due = trace && done % every == 0;
       const bool frame_due = frames.enabled() && done % frames.every() == 0;
-      if (trace_due || frame_due) {
+      const bool contact_due = track_contact && (done % contact_every == 0 || done == total);
+      if (trace_due || frame_due || contact_due) {
         if (auto r = read(); !r)
           return report(r.error());
       }
+      if (contact_due)
+        if (auto r = sample_contact(); !r)
+          return report(r.error());
       if (track_strain && (done % strain_every == 0 || done == total)) {
         // From `pos` when it was just read; else the backend reads the positions only.
         auto s = trace_due || frame_due ? strain_of_pos() : backend.strain(scene->system);
@@ -338,6 +373,13 @@ int run_command(const RunOptions& opt) {
         file_vertex(scene->system, sp.b), strain.run.max, strain.run_step,
         strain_every > 1 ? fmt::format(", sampled every {} steps", strain_every) : "");
   }
+  if (track_contact)
+    fmt::print(
+        "contact: deepest penetration {:.3g} m (particle {}, collider {}, step {}; contact_epsilon {:g}{}), "
+        "largest speed over the last second {:.3g} m/s\n",
+        contact.deepest.depth, file_vertex(scene->system, contact.deepest.particle), contact.deepest.collider,
+        contact.step, scene->params.contact_epsilon,
+        contact_every > 1 ? fmt::format(", sampled every {} steps", contact_every) : "", contact.calm_speed);
   if (json) {
     nlohmann::json doc;
     doc["schema"] = "vkcloth-run/1";
@@ -375,6 +417,17 @@ int run_command(const RunOptions& opt) {
     } else {
       doc["max_structural_strain"] = nullptr;
     }
+    doc["contact"] =
+        track_contact
+            ? nlohmann::json{{"max_penetration", contact.deepest.depth},
+                             {"penetration_particle", file_vertex(scene->system, contact.deepest.particle)},
+                             {"penetration_collider", contact.deepest.collider},
+                             {"penetration_step", contact.step},
+                             {"contact_epsilon", scene->params.contact_epsilon},
+                             {"max_speed_last_second", contact.calm_speed},
+                             {"last_second_from_step", calm_from},
+                             {"every", contact_every}}
+            : nlohmann::json(nullptr);
     fmt::print(json.get(), "{}\n", doc.dump(2));
     if (std::fflush(json.get()) != 0 || std::ferror(json.get()))
       return report(make_error(ErrorCode::io, "writing the JSON file failed (disk full?)"));
@@ -408,6 +461,11 @@ void add_run_command(CLI::App& app, int* exit) {
          "Write one OBJ per exported frame into DIR (created): frame_00000.obj, frame_00001.obj, ...")
       ->type_name("DIR");
   cmd->add_option("--positions", opt->positions, "Write the final positions to a CSV file: particle,x,y,z");
+  cmd->add_option(
+         "--contact-every", opt->contact_every,
+         "Scenes with colliders: measure the penetration (and, over the last second, the largest "
+         "particle speed) every K-th and the last step (default 1; on Vulkan each reads the state back)")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--strain-every", opt->strain_every,
                   "Cloths: take the largest structural strain over the run from step 0, every K-th and the "
                   "last step (default 1: every step; on Vulkan each one reads the positions back)")

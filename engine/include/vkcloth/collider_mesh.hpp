@@ -48,11 +48,11 @@ public:
   /// frame; positions are rounded to float once, here, for both backends). Zero-area triangles are
   /// dropped. ErrorCode::invalid_argument, naming `name` and the value, for no triangles, an index
   /// out of range, or a vertex that is not finite.
-  static Result<std::shared_ptr<const ColliderMesh>> create(std::span<const glm::dvec3> positions,
-                                                            std::span<const std::uint32_t> triangles,
-                                                            std::string name);
+  static Result<std::shared_ptr<const ColliderMesh>>
+  create(std::span<const glm::dvec3> positions, std::span<const std::uint32_t> triangles, std::string name);
   /// The same from a polygon mesh (read_mesh): faces fan-triangulated, positions scaled by `scale`.
-  static Result<std::shared_ptr<const ColliderMesh>> from_mesh(const Mesh& mesh, double scale, std::string name);
+  static Result<std::shared_ptr<const ColliderMesh>> from_mesh(const Mesh& mesh, double scale,
+                                                               std::string name);
 
   std::span<const Node> nodes() const { return nodes_; }
   /// In leaf order (Node::first indexes this).

@@ -38,6 +38,7 @@ namespace detail {
 class ThreadPool;
 template <typename Real> struct ImplicitWorkspace;
 template <typename Real> struct RowArgs;
+template <typename Real> struct ContactShapes;
 } // namespace detail
 
 struct CpuSolverOptions {
@@ -112,8 +113,12 @@ private:
   Vec3 force_at(std::span<const Vec3> pos, std::span<const Vec3> vel, std::size_t p) const;
   /// normal_at + force_at for particle p: writes normal_[p], returns the force.
   Vec3 normal_force_at(std::span<const Vec3> pos, std::span<const Vec3> vel, std::size_t p);
-  void contact_at(Vec3 pos, Vec3& vel, Vec3& force) const;
-  void project_at(Vec3& pos, Vec3& vel) const;
+  // Contacts (cloth_kernel.h contact_response / project_out) with every collider at this substep's
+  // pose; h_over_m: substep / mass (friction's impulse); side: where the particle came from.
+  void contact_at(Vec3 pos, Vec3& vel, Vec3& force, Real h_over_m, bool friction = true) const;
+  void project_at(Vec3 side, Vec3& pos, Vec3& vel) const;
+  void prepare_colliders();
+  void advance_colliders(double h);
   Result<void> check_finite() const;
   void substep(Real h);
   // Explicit / semi-implicit Euler: contacts, update and projection of particle p with force f
@@ -178,6 +183,7 @@ private:
   double time_ = 0.0;
   std::unique_ptr<detail::ThreadPool> pool_;
   std::unique_ptr<detail::ImplicitWorkspace<Real>> implicit_; // created by the first implicit step
+  std::unique_ptr<detail::ContactShapes<Real>> contacts_;     // this substep's colliders (prepare_colliders)
   SolveStats solve_;
 };
 

@@ -4,10 +4,12 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <span>
 
 #include <glm/vec3.hpp>
 
+#include "vkcloth/params.hpp"
 #include "vkcloth/result.hpp"
 #include "vkcloth/system.hpp"
 
@@ -28,5 +30,24 @@ struct StrainStats {
 /// count is not the particle count or a spring's end is out of range.
 Result<StrainStats> structural_strain(const ParticleSystem& system, std::span<const glm::vec3> positions);
 Result<StrainStats> structural_strain(const ParticleSystem& system, std::span<const glm::dvec3> positions);
+
+/// How deep the free particles are inside the colliders (docs/model.md "Collisions": after a step
+/// no particle should be deeper than contact_epsilon).
+struct PenetrationStats {
+  /// max over free particles and colliders of -(signed distance), computed in double with
+  /// cloth_kernel.h's collider_contact (a mesh: from the particle's own side); <= 0 when every
+  /// particle is outside (-eps for a cloth resting at surface + eps). -inf without colliders.
+  double depth = -std::numeric_limits<double>::infinity();
+  std::uint32_t particle = 0; ///< the first particle reaching `depth`
+  std::uint32_t collider = 0; ///< and the collider
+};
+
+/// Penetration of `positions` (one per particle) into `colliders` at their current pose (a
+/// solver's params().colliders). ErrorCode::invalid_argument when the counts differ.
+Result<PenetrationStats> penetration(const ParticleSystem& system, std::span<const Collider> colliders,
+                                     std::span<const glm::dvec3> positions);
+
+/// The largest |v| of the free particles (0 for none): the jitter of a cloth that should be at rest.
+double max_free_speed(const ParticleSystem& system, std::span<const glm::dvec3> velocities);
 
 } // namespace vkcloth

@@ -76,8 +76,8 @@ struct Collider {
   static Collider sphere(glm::dvec3 center, double radius);
   static Collider capsule(glm::dvec3 a, glm::dvec3 b, double radius);
   static Collider box(glm::dvec3 center, glm::dvec3 half_extents, glm::dmat3 rotation = glm::dmat3(1.0));
-  static Collider triangle_mesh(std::shared_ptr<const ColliderMesh> mesh, glm::dvec3 origin, glm::dmat3 rotation,
-                                double thickness);
+  static Collider triangle_mesh(std::shared_ptr<const ColliderMesh> mesh, glm::dvec3 origin,
+                                glm::dmat3 rotation, double thickness);
   /// R = Rz Ry Rx from angles in degrees (x applied first: the mesh_transform convention).
   static glm::dmat3 rotation_from_degrees(glm::dvec3 degrees);
 

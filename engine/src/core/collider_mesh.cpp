@@ -67,15 +67,15 @@ Error bad(const std::string& name, const std::string& what) {
 } // namespace
 
 Result<std::shared_ptr<const ColliderMesh>> ColliderMesh::create(std::span<const glm::dvec3> positions,
-                                                                  std::span<const std::uint32_t> triangles,
-                                                                  std::string name) {
+                                                                 std::span<const std::uint32_t> triangles,
+                                                                 std::string name) {
   if (triangles.size() % 3 != 0)
     return bad(name, fmt::format("{} triangle indices is not a multiple of 3", triangles.size()));
   for (std::size_t v = 0; v < positions.size(); ++v)
     for (int k = 0; k < 3; ++k)
       if (!std::isfinite(positions[v][k]))
-        return bad(name, fmt::format("vertex {} is not finite ({}, {}, {})", v, positions[v].x, positions[v].y,
-                                     positions[v].z));
+        return bad(name, fmt::format("vertex {} is not finite ({}, {}, {})", v, positions[v].x,
+                                     positions[v].y, positions[v].z));
   Builder b;
   std::uint32_t dropped = 0;
   for (std::size_t t = 0; t + 2 < triangles.size(); t += 3) {

@@ -21,22 +21,18 @@
 // is built with -ffp-contract=off, so the compiler does not fuse the kernel's expressions.
 
 namespace vkcloth {
+
+namespace detail {
+/// The colliders as the kernel takes them at this substep's pose, and their meshes.
+template <typename Real> struct ContactShapes {
+  std::vector<kernel::ColliderShape<Real>> shapes;
+  std::vector<kernel::MeshData> meshes;
+};
+} // namespace detail
+
 namespace {
 
 using detail::RowArgs;
-
-/// A collider as cloth_kernel.h takes it: a plane as (normal, offset), a sphere as (centre, radius).
-template <typename Real> struct KernelCollider {
-  std::uint32_t type;
-  glm::vec<3, Real> a;
-  Real b;
-};
-template <typename Real> KernelCollider<Real> kernel_collider(const Collider& c) {
-  using V = glm::vec<3, Real>;
-  if (c.type == Collider::Type::plane)
-    return {std::uint32_t(c.type), V{c.normal}, Real(c.offset)};
-  return {std::uint32_t(c.type), V{c.center}, Real(c.radius)};
-}
 
 /// check_finite's test, branch-free (vectorisable OR-reduction over flat arrays of n3 components):
 /// nonzero when a component is not finite (c - c != 0 for inf and NaN) or a position has |x| > limit
@@ -208,24 +204,53 @@ typename CpuSolver<Real>::Vec3 CpuSolver<Real>::force_at(std::span<const Vec3> p
                                  kw != Real(0), normal_[p], Vec3{params_.wind.direction}, kw);
 }
 
-template <typename Real> void CpuSolver<Real>::contact_at(Vec3 pos, Vec3& vel, Vec3& force) const {
-  const Real band = Real(2) * Real(params_.contact_epsilon);
-  const bool both = !params_.contact_inward_only; // Figure 12's variant: outward parts go too
+// The colliders at their pose for this substep, as the kernel takes them (kernel_shape: the
+// conversion the GPU solver uses too); a mesh collider's hierarchy is walked in place.
+template <typename Real> void CpuSolver<Real>::prepare_colliders() {
+  if (!contacts_)
+    contacts_ = std::make_unique<detail::ContactShapes<Real>>();
+  auto& shapes = contacts_->shapes;
+  auto& meshes = contacts_->meshes;
+  shapes.clear();
+  meshes.clear();
   for (const Collider& c : params_.colliders) {
-    const KernelCollider<Real> k = kernel_collider<Real>(c);
-    Real distance;
-    Vec3 normal;
-    kernel::collider_contact(k.type, k.a, k.b, pos, distance, normal);
-    kernel::contact_filter(vel, force, normal, distance, band, both);
+    shapes.push_back(kernel::kernel_shape<Real>(c));
+    kernel::MeshData m;
+    if (c.mesh) {
+      m.nodes = c.mesh->nodes().data();
+      m.triangles = c.mesh->triangles().data();
+    }
+    meshes.push_back(m);
   }
 }
 
-template <typename Real> void CpuSolver<Real>::project_at(Vec3& pos, Vec3& vel) const {
-  const Real eps = Real(params_.contact_epsilon);
-  for (const Collider& c : params_.colliders) {
-    const KernelCollider<Real> k = kernel_collider<Real>(c);
-    kernel::project_out(k.type, k.a, k.b, eps, pos, vel);
+// Moving colliders advance by the substep h (in double, as the GPU solver's host side does).
+template <typename Real> void CpuSolver<Real>::advance_colliders(double h) {
+  for (Collider& c : params_.colliders)
+    if (c.moving())
+      c = c.posed_at(h);
+}
+
+template <typename Real>
+void CpuSolver<Real>::contact_at(Vec3 pos, Vec3& vel, Vec3& force, Real h_over_m, bool friction) const {
+  const Real band = Real(2) * Real(params_.contact_epsilon);
+  const bool both = !params_.contact_inward_only; // Figure 12's variant: outward parts go too
+  const auto& shapes = contacts_->shapes;
+  for (std::size_t k = 0; k < shapes.size(); ++k) {
+    kernel::ColliderShape<Real> s = shapes[k];
+    if (!friction)
+      s.mu_k = s.mu_s = Real(0);
+    Real distance;
+    Vec3 normal;
+    kernel::collider_contact(contacts_->meshes[k], s, pos, pos, band, distance, normal);
+    kernel::contact_response(vel, force, s, pos, normal, distance, band, both, h_over_m);
   }
+}
+
+template <typename Real> void CpuSolver<Real>::project_at(Vec3 side, Vec3& pos, Vec3& vel) const {
+  const Real eps = Real(params_.contact_epsilon);
+  for (std::size_t k = 0; k < contacts_->shapes.size(); ++k)
+    kernel::project_out(contacts_->meshes[k], contacts_->shapes[k], eps, side, pos, vel);
 }
 
 template <typename Real> Result<void> CpuSolver<Real>::check_finite() const {
@@ -251,9 +276,12 @@ template <typename Real> Result<void> CpuSolver<Real>::check_finite() const {
 template <typename Real> Result<void> CpuSolver<Real>::step() {
   // integrator.substeps = k: k substeps of dt / k (bit-identical to k steps with dt / k).
   const std::uint32_t k = params_.substeps;
-  const Real h = Real(k == 1 ? params_.dt : params_.dt / double(k));
-  for (std::uint32_t s = 0; s < k; ++s)
-    substep(h);
+  const double h = k == 1 ? params_.dt : params_.dt / double(k);
+  for (std::uint32_t s = 0; s < k; ++s) {
+    prepare_colliders();
+    substep(Real(h));
+    advance_colliders(h);
+  }
   ++step_;
   time_ += params_.dt;
   if (swept_finite_)
@@ -343,7 +371,7 @@ template <typename Real> void CpuSolver<Real>::limit_stretch(const Real h) {
   if (!params_.colliders.empty())
     pool_->for_each(pos_.size(), [&](std::size_t p) {
       if (!pinned_[p]) {
-        project_at(pos_[p], vel_[p]);
+        project_at(pos_[p], pos_[p], vel_[p]);
         moved(p);
       }
     });
@@ -358,11 +386,11 @@ void CpuSolver<Real>::euler_finish(std::size_t p, Vec3 f, const Real h, const bo
     return;
   }
   Vec3 v = vel_[p];
-  contact_at(pos_[p], v, f);
+  contact_at(pos_[p], v, f, h / mass_[p]);
   force_[p] = f;
   Vec3 x = pos_[p];
   kernel::euler_update(semi, x, v, f, mass_[p], h);
-  project_at(x, v);
+  project_at(pos_[p], x, v);
   pos_next_[p] = x;
   vel_[p] = v; // only particle p reads its own velocity: updating in place is safe
 }
@@ -531,7 +559,7 @@ template <typename Real> void CpuSolver<Real>::rk4_substep(const Real h) {
     pool_->for_each(pos_.size(), [&](std::size_t p) {
       Vec3 f = normal_force_at(stage_pos_, stage_vel_, p);
       if (!pinned_[p])
-        contact_at(stage_pos_[p], stage_vel_[p], f);
+        contact_at(stage_pos_[p], stage_vel_[p], f, h / mass_[p]);
       if (st == 0)
         force_[p] = f;
       kernel::rk4_derivative(pinned_[p] != 0, stage_vel_[p], f, mass_[p], k_pos_[st][p], k_vel_[st][p]);
@@ -546,9 +574,10 @@ template <typename Real> void CpuSolver<Real>::rk4_substep(const Real h) {
       dp = kernel::rk4_accumulate(st, dp, k_pos_[st][p]);
       dv = kernel::rk4_accumulate(st, dv, k_vel_[st][p]);
     }
+    const Vec3 start = pos_[p];
     pos_[p] = kernel::rk4_finish(pos_[p], dp, w);
     vel_[p] = kernel::rk4_finish(vel_[p], dv, w);
-    project_at(pos_[p], vel_[p]);
+    project_at(start, pos_[p], vel_[p]);
   });
 }
 

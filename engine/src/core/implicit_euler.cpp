@@ -38,8 +38,8 @@ template <typename Real> void CpuSolver<Real>::implicit_substep(const Real h) {
   pool_->for_each(pos_.size(), [&](std::size_t p) {
     Vec3 f = normal_force_at(pos_, vel_, p);
     Vec3 v = vel_[p];
-    if (!pinned_[p])
-      contact_at(pos_[p], v, f);
+    if (!pinned_[p]) // friction once, on the new velocity (implicit_update)
+      contact_at(pos_[p], v, f, h / mass_[p], false);
     force_[p] = f;
     w.vf[p] = v;
   });
@@ -151,9 +151,10 @@ template <typename Real> void CpuSolver<Real>::implicit_update(const Real h) {
       return; // stays put, velocity zero
     Vec3 v = w.vf[p] + w.x[p];
     Vec3 no_force(0);
-    contact_at(pos_[p], v, no_force); // inward normal part of v' (the whole part if !inward_only)
+    // The inward normal part of v' (the whole part if !inward_only) and friction.
+    contact_at(pos_[p], v, no_force, h / mass_[p]);
     Vec3 x = pos_[p] + v * h;
-    project_at(x, v);
+    project_at(pos_[p], x, v);
     pos_[p] = x;
     vel_[p] = v;
   });

@@ -13,12 +13,16 @@
 
 #include <glm/vec3.hpp>
 
+#include "vkcloth/collider_mesh.hpp"
 #include "vkcloth/params.hpp"
 #include "vkcloth_shared.h"
 
 // The shader constants the kernel compares against are the C++ enums' values.
 static_assert(VKCLOTH_COLLIDER_PLANE == std::uint32_t(vkcloth::Collider::Type::plane));
 static_assert(VKCLOTH_COLLIDER_SPHERE == std::uint32_t(vkcloth::Collider::Type::sphere));
+static_assert(VKCLOTH_COLLIDER_CAPSULE == std::uint32_t(vkcloth::Collider::Type::capsule));
+static_assert(VKCLOTH_COLLIDER_BOX == std::uint32_t(vkcloth::Collider::Type::box));
+static_assert(VKCLOTH_COLLIDER_MESH == std::uint32_t(vkcloth::Collider::Type::mesh));
 static_assert(VKCLOTH_INTEGRATOR_EXPLICIT_EULER == std::uint32_t(vkcloth::Integrator::explicit_euler));
 static_assert(VKCLOTH_INTEGRATOR_SEMI_IMPLICIT_EULER ==
               std::uint32_t(vkcloth::Integrator::semi_implicit_euler));
@@ -28,6 +32,8 @@ static_assert(VKCLOTH_INTEGRATOR_RK4 == std::uint32_t(vkcloth::Integrator::rk4))
 #define OUT(T) T&
 #define INOUT(T) T&
 #define precise
+#define MESH_DATA_PARAM const MeshData& mesh_data
+#define MESH_DATA mesh_data
 
 namespace vkcloth::kernel {
 
@@ -35,9 +41,30 @@ namespace vkcloth::kernel {
 using uint = std::uint32_t;
 using std::abs;
 using std::max;
+using std::min;
 using std::sqrt;
 template <typename V> bool all_finite(V v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+/// A mesh collider's hierarchy and triangles (ColliderMesh's arrays, read in place), and the
+/// accessors cloth_kernel.h mesh_closest walks them with (float, converted to the solver's precision).
+struct MeshData {
+  const ColliderMesh::Node* nodes = nullptr;
+  const ColliderMesh::Triangle* triangles = nullptr;
+};
+template <typename V> void mesh_node(const MeshData& m, uint i, V& lo, uint& first, V& hi, uint& count) {
+  const ColliderMesh::Node& n = m.nodes[i];
+  lo = V(n.lo);
+  hi = V(n.hi);
+  first = n.first;
+  count = n.count;
+}
+template <typename V> void mesh_triangle(const MeshData& m, uint i, V& a, V& b, V& c) {
+  const ColliderMesh::Triangle& t = m.triangles[i];
+  a = V(t.a);
+  b = V(t.b);
+  c = V(t.c);
 }
 
 namespace f32 {
@@ -58,6 +85,56 @@ using namespace f64;
 /// The kernel's SpringBlock of precision Real.
 template <typename Real>
 using SpringBlock = std::conditional_t<std::is_same_v<Real, float>, f32::SpringBlock, f64::SpringBlock>;
+/// The kernel's ColliderShape of precision Real.
+template <typename Real>
+using ColliderShape = std::conditional_t<std::is_same_v<Real, float>, f32::ColliderShape, f64::ColliderShape>;
+
+/// A collider as the kernel takes it, every double field cast once to Real: the one conversion
+/// both backends use (CpuSolver; the GPU solver packs kernel_shape<float> into its Collider
+/// buffer), so the CPU float solver and the GPU see the same values. mesh_root / mesh_tri0: where
+/// the collider's mesh starts in the buffers the caller walks (0 when it walks the mesh in place).
+template <typename Real>
+kernel::ColliderShape<Real> kernel_shape(const Collider& c, std::uint32_t mesh_root = 0,
+                                         std::uint32_t mesh_tri0 = 0) {
+  using V = glm::vec<3, Real>;
+  kernel::ColliderShape<Real> s{};
+  s.type = std::uint32_t(c.type);
+  switch (c.type) {
+  case Collider::Type::plane:
+    s.a = V(c.normal);
+    s.b = Real(c.offset);
+    break;
+  case Collider::Type::sphere:
+    s.a = V(c.center);
+    s.b = Real(c.radius);
+    break;
+  case Collider::Type::capsule:
+    s.a = V(c.a);
+    s.b = Real(c.radius);
+    s.c = V(c.b);
+    break;
+  case Collider::Type::box:
+    s.a = V(c.center);
+    s.c = V(c.half_extents);
+    break;
+  case Collider::Type::mesh:
+    s.a = V(c.center);
+    s.b = Real(c.thickness);
+    break;
+  }
+  s.ax = V(c.rotation[0]);
+  s.ay = V(c.rotation[1]);
+  s.az = V(c.rotation[2]);
+  s.mesh_root = mesh_root;
+  s.mesh_tri0 = mesh_tri0;
+  s.moving = c.moving();
+  s.velocity = V(c.linear_velocity);
+  s.spin = V(c.angular_velocity);
+  s.pivot = V(c.centre());
+  s.mu_k = Real(c.friction);
+  s.mu_s = Real(c.static_coefficient());
+  return s;
+}
 
 } // namespace vkcloth::kernel
 
@@ -65,3 +142,5 @@ using SpringBlock = std::conditional_t<std::is_same_v<Real, float>, f32::SpringB
 #undef OUT
 #undef INOUT
 #undef precise
+#undef MESH_DATA_PARAM
+#undef MESH_DATA

@@ -1,10 +1,13 @@
 // SPDX-License-Identifier: MIT
 #include "vkcloth/measure.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
+
+#include "kernel.hpp"
 
 namespace vkcloth {
 namespace {
@@ -44,6 +47,40 @@ Result<StrainStats> structural_strain(const ParticleSystem& system, std::span<co
 
 Result<StrainStats> structural_strain(const ParticleSystem& system, std::span<const glm::dvec3> positions) {
   return structural_strain_impl(system, positions);
+}
+
+Result<PenetrationStats> penetration(const ParticleSystem& system, std::span<const Collider> colliders,
+                                     std::span<const glm::dvec3> positions) {
+  if (positions.size() != system.size())
+    return make_error(ErrorCode::invalid_argument, fmt::format("penetration: {} positions for {} particles",
+                                                               positions.size(), system.size()));
+  PenetrationStats stats;
+  for (std::uint32_t c = 0; c < colliders.size(); ++c) {
+    const auto shape = kernel::kernel_shape<double>(colliders[c]);
+    kernel::MeshData mesh;
+    if (colliders[c].mesh) {
+      mesh.nodes = colliders[c].mesh->nodes().data();
+      mesh.triangles = colliders[c].mesh->triangles().data();
+    }
+    for (std::uint32_t p = 0; p < positions.size(); ++p) {
+      if (system.particles[p].pinned)
+        continue;
+      double distance;
+      glm::dvec3 normal;
+      kernel::collider_contact(mesh, shape, positions[p], positions[p], 1.0, distance, normal);
+      if (-distance > stats.depth)
+        stats = {-distance, p, c};
+    }
+  }
+  return stats;
+}
+
+double max_free_speed(const ParticleSystem& system, std::span<const glm::dvec3> velocities) {
+  double m = 0.0;
+  for (std::size_t p = 0; p < velocities.size() && p < system.size(); ++p)
+    if (!system.particles[p].pinned)
+      m = std::max(m, glm::length(velocities[p]));
+  return m;
 }
 
 } // namespace vkcloth

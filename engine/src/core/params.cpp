@@ -43,8 +43,9 @@ Result<void> validate_collider(Collider& c, const std::string& at) {
     if (!std::isfinite(c.offset))
       return bad(fmt::format("{}.offset must be finite, got {}", at, c.offset));
     if (c.angular_velocity != glm::dvec3(0.0))
-      return bad(fmt::format("{}.angular_velocity: a plane cannot turn (it takes linear_velocity only), got {}",
-                             at, str(c.angular_velocity)));
+      return bad(
+          fmt::format("{}.angular_velocity: a plane cannot turn (it takes linear_velocity only), got {}", at,
+                      str(c.angular_velocity)));
     break;
   }
   case Collider::Type::sphere:
@@ -83,8 +84,8 @@ Result<void> validate_collider(Collider& c, const std::string& at) {
       for (int j = 0; j < 3; ++j)
         off = std::max(off, std::abs(e[i][j] - (i == j ? 1.0 : 0.0)));
     if (!(off < 1e-6))
-      return bad(fmt::format("{}.rotation must be a rotation matrix (orthonormal, determinant 1); it is off by {}",
-                             at, off));
+      return bad(fmt::format(
+          "{}.rotation must be a rotation matrix (orthonormal, determinant 1); it is off by {}", at, off));
   }
   if (!std::isfinite(c.friction) || c.friction < 0.0)
     return bad(fmt::format("{}.friction must be finite and >= 0, got {}", at, c.friction));
@@ -134,8 +135,8 @@ Collider Collider::box(glm::dvec3 center, glm::dvec3 half_extents, glm::dmat3 ro
   return c;
 }
 
-Collider Collider::triangle_mesh(std::shared_ptr<const ColliderMesh> mesh, glm::dvec3 origin, glm::dmat3 rotation,
-                                 double thickness) {
+Collider Collider::triangle_mesh(std::shared_ptr<const ColliderMesh> mesh, glm::dvec3 origin,
+                                 glm::dmat3 rotation, double thickness) {
   Collider c;
   c.type = Type::mesh;
   c.mesh = std::move(mesh);

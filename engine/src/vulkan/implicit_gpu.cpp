@@ -156,6 +156,12 @@ Result<void> ImplicitGpu::write_sets(const ImplicitInputs& in) {
       case VKCLOTH_BINDING_FANS:
         b = in.fans;
         break;
+      case VKCLOTH_BINDING_MESH_NODES:
+        b = in.mesh_nodes;
+        break;
+      case VKCLOTH_BINDING_MESH_TRIS:
+        b = in.mesh_tris;
+        break;
       case VKCLOTH_BINDING_IMPL_VF:
         b = vf_.buffer;
         break;

@@ -31,7 +31,7 @@ namespace vkcloth::gpu {
 /// implicit passes run batches of one instance (the CG reductions are per instance).
 struct ImplicitInputs {
   VkBuffer pos[2], vel, force, normal, particle, offsets, edges, colliders, flags, instances, fan_offsets,
-      fans;
+      fans, mesh_nodes, mesh_tris;
 };
 
 class ImplicitGpu {

@@ -14,6 +14,7 @@
 
 #include <fmt/format.h>
 
+#include "../core/kernel.hpp"
 #include "barriers.hpp"
 #include "implicit_gpu.hpp"
 #include "vkcloth/gpu/world.hpp"
@@ -93,19 +94,105 @@ Result<void> SolverBatch::ensure_collider_capacity() {
   return {};
 }
 
+// Every distinct mesh of the batch's colliders, uploaded once; a new set of meshes replaces the
+// buffers and rewrites the descriptor sets (recorded work that may read the old ones is waited for).
+Result<void> SolverBatch::ensure_mesh_buffers() {
+  std::vector<std::shared_ptr<const ColliderMesh>> wanted;
+  for (const Slot& slot : slots)
+    for (const Collider& c : slot.params.colliders)
+      if (c.mesh && std::find(wanted.begin(), wanted.end(), c.mesh) == wanted.end())
+        wanted.push_back(c.mesh);
+  if (mesh_nodes.buffer && wanted == meshes)
+    return {};
+  std::vector<ColliderMesh::Node> nodes;
+  std::vector<ColliderMesh::Triangle> tris;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> starts;
+  for (const auto& m : wanted) {
+    starts.emplace_back(static_cast<std::uint32_t>(nodes.size()), static_cast<std::uint32_t>(tris.size()));
+    nodes.insert(nodes.end(), m->nodes().begin(), m->nodes().end());
+    tris.insert(tris.end(), m->triangles().begin(), m->triangles().end());
+  }
+  static_assert(sizeof(ColliderMesh::Node) == sizeof(sh::MeshNode) &&
+                sizeof(ColliderMesh::Triangle) == sizeof(sh::MeshTriangle));
+  const StorageLimit limit = storage_limit(*ctx, knobs);
+  VKCLOTH_TRY(check_buffer(*ctx, limit, "mesh collider hierarchy", nodes.size(), sizeof(sh::MeshNode)));
+  VKCLOTH_TRY(check_buffer(*ctx, limit, "mesh collider triangles", tris.size(), sizeof(sh::MeshTriangle)));
+  if (mesh_nodes.buffer)
+    VKCLOTH_TRY(commands->wait_for_earlier_work());
+  Buffer new_nodes, new_tris;
+  const struct {
+    Buffer* dst;
+    VkDeviceSize bytes;
+    const char* name;
+  } made[] = {
+      {&new_nodes, std::max<std::size_t>(nodes.size(), 1) * sizeof(sh::MeshNode), "mesh nodes"},
+      {&new_tris, std::max<std::size_t>(tris.size(), 1) * sizeof(sh::MeshTriangle), "mesh triangles"}};
+  for (const auto& m : made) {
+    auto b =
+        create_buffer(*ctx, m.bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                      MemoryUse::device, !knobs.force_staging, m.name);
+    if (!b)
+      return b.error();
+    *m.dst = std::move(*b);
+  }
+  mesh_nodes = std::move(new_nodes);
+  mesh_tris = std::move(new_tris);
+  const Upload up[] = {
+      {&mesh_nodes, nodes.empty() ? nullptr : nodes.data(), nodes.size() * sizeof(sh::MeshNode)},
+      {&mesh_tris, tris.empty() ? nullptr : tris.data(), tris.size() * sizeof(sh::MeshTriangle)}};
+  VKCLOTH_TRY(upload(up));
+  meshes = std::move(wanted);
+  mesh_starts = std::move(starts);
+  if (sets[0][0])
+    VKCLOTH_TRY(write_sets());
+  return {};
+}
+
+// Each collider as the kernel takes it (kernel_shape<float>: CpuSolver<float>'s conversion).
 std::vector<sh::Collider> SolverBatch::packed_colliders() const {
   std::vector<sh::Collider> out;
   for (const Slot& slot : slots)
     for (const Collider& c : slot.params.colliders) {
+      std::pair<std::uint32_t, std::uint32_t> start{0, 0};
+      if (c.mesh)
+        start = mesh_starts[std::size_t(std::find(meshes.begin(), meshes.end(), c.mesh) - meshes.begin())];
+      const auto k = kernel::kernel_shape<float>(c, start.first, start.second);
+      const auto v4 = [](glm::vec3 v, float w) { return sh::vec4{v.x, v.y, v.z, w}; };
       sh::Collider g{};
-      g.type = static_cast<std::uint32_t>(c.type);
-      if (c.type == Collider::Type::plane)
-        g.shape = {float(c.normal.x), float(c.normal.y), float(c.normal.z), float(c.offset)};
-      else
-        g.shape = {float(c.center.x), float(c.center.y), float(c.center.z), float(c.radius)};
+      g.shape = v4(k.a, k.b);
+      g.type = k.type;
+      g.moving = k.moving ? 1u : 0u;
+      g.mesh_root = k.mesh_root;
+      g.mesh_tri0 = k.mesh_tri0;
+      g.end_b = v4(k.c, 0.0f);
+      g.axis_x = v4(k.ax, 0.0f);
+      g.axis_y = v4(k.ay, 0.0f);
+      g.axis_z = v4(k.az, 0.0f);
+      g.velocity = v4(k.velocity, k.mu_k);
+      g.spin = v4(k.spin, k.mu_s);
+      g.pivot = v4(k.pivot, 0.0f);
       out.push_back(g);
     }
   return out;
+}
+
+bool SolverBatch::any_moving_colliders() const {
+  for (const Slot& s : slots)
+    for (const Collider& c : s.params.colliders)
+      if (c.moving())
+        return true;
+  return false;
+}
+
+void SolverBatch::record_collider_motion(VkCommandBuffer c, double h) {
+  for (Slot& s : slots)
+    for (Collider& col : s.params.colliders)
+      if (col.moving())
+        col = col.posed_at(h);
+  const auto packed = packed_colliders();
+  barriers::before_host_edit(vk(), c); // the substep's reads of the colliders finish first (WAR)
+  vk().vkCmdUpdateBuffer(c, colliders.buffer, 0, packed.size() * sizeof(sh::Collider), packed.data());
+  barriers::transfer_to_compute(vk(), c); // the new poses -> the next substep's passes
 }
 
 std::vector<sh::InstanceParams> SolverBatch::packed_instance_params() const {
@@ -287,6 +374,7 @@ Result<void> SolverBatch::set_params(std::uint32_t slot, SimParams params) {
   params_dirty = true;
   auto done = [&]() -> Result<void> {
     VKCLOTH_TRY(ensure_collider_capacity());
+    VKCLOTH_TRY(ensure_mesh_buffers());
     VKCLOTH_TRY(ensure_implicit());
     VKCLOTH_TRY(ensure_fused());
     return ensure_tethers();
@@ -369,10 +457,14 @@ void SolverBatch::record(VkCommandBuffer c, std::uint32_t steps) {
   bool first = true;
   for (std::uint32_t s = 0; s < steps; ++s) {
     pc.step = static_cast<std::uint32_t>(recorded + 1); // 1-based number of the step being computed
+    const bool moving = any_moving_colliders();
+    const double h = family().substeps == 1 ? family().dt : family().dt / double(family().substeps);
     for (std::uint32_t k = 0; k < family().substeps; ++k) {
       record_substep(c, first, s + 1 == steps && k + 1 == family().substeps);
       first = false;
       parity ^= 1u; // positions[read ^ 1] now holds the new state
+      if (moving)
+        record_collider_motion(c, h);
     }
     ++recorded;
     for (Slot& slot : slots)
@@ -661,7 +753,8 @@ Result<void> SolverBatch::create_buffers() {
       return r.error();
     instances = std::move(*r);
   }
-  return ensure_collider_capacity();
+  VKCLOTH_TRY(ensure_collider_capacity());
+  return ensure_mesh_buffers();
 }
 
 // Initial state of every instance, converted as CpuSolver<float>::create converts it, and the

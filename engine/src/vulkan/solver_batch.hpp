@@ -162,6 +162,12 @@ private:
   // parameters (written by the host at creation, then by vkCmdUpdateBuffer in record()).
   Buffer colliders, flags, instances;
   std::uint32_t collider_capacity = 0;
+  // Mesh colliders: every distinct ColliderMesh of the batch's colliders, their hierarchies and
+  // triangles one after the other (one zeroed element of each when there is none); `meshes` holds
+  // them alive, `mesh_starts` their first node and first triangle (Collider::mesh_root, mesh_tri0).
+  Buffer mesh_nodes, mesh_tris;
+  std::vector<std::shared_ptr<const ColliderMesh>> meshes;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> mesh_starts;
   bool params_dirty = false; // set_params() since the last record(): record_params_update() due
 
   // Layouts and pipelines: the Context's (PipelineRegistry, pipelines.hpp), shared by every batch.
@@ -240,7 +246,12 @@ private:
   /// Stretch control after a substep's update (strain_links.comp sweeps, strain_finish.comp).
   void record_stretch(VkCommandBuffer cmd, std::uint32_t read);
   Result<void> ensure_collider_capacity();
+  Result<void> ensure_mesh_buffers();
   std::vector<shared::Collider> packed_colliders() const;
+  bool any_moving_colliders() const;
+  /// After a substep of `h` seconds: moving colliders advance (Collider::posed_at, as CpuSolver
+  /// does) and the new poses are recorded into the collider buffer for the next substep.
+  void record_collider_motion(VkCommandBuffer cmd, double h);
   std::vector<shared::InstanceParams> packed_instance_params() const;
   void write_params_now();
   void record_params_update(VkCommandBuffer cmd);

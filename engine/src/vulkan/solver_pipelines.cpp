@@ -277,6 +277,8 @@ Result<void> SolverBatch::write_sets() {
       by_binding[VKCLOTH_BINDING_TETHERS] = &tethers;
       by_binding[VKCLOTH_BINDING_UV] = &uv;
       by_binding[VKCLOTH_BINDING_VERTICES] = &vertices;
+      by_binding[VKCLOTH_BINDING_MESH_NODES] = &mesh_nodes;
+      by_binding[VKCLOTH_BINDING_MESH_TRIS] = &mesh_tris;
       for (std::uint32_t b = 0; b < VKCLOTH_BINDING_COUNT; ++b, ++k) {
         infos[k] = VkDescriptorBufferInfo{by_binding[b]->buffer, 0, VK_WHOLE_SIZE};
         writes[k] = VkWriteDescriptorSet{};
@@ -302,7 +304,9 @@ Result<void> SolverBatch::write_sets() {
                                  flags.buffer,
                                  instances.buffer,
                                  fan_offsets.buffer,
-                                 fans.buffer});
+                                 fans.buffer,
+                                 mesh_nodes.buffer,
+                                 mesh_tris.buffer});
   return {};
 }
 

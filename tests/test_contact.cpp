@@ -1,0 +1,261 @@
+// SPDX-License-Identifier: MIT
+// Contact beyond the report (docs/model.md "Collisions"): Coulomb friction against its closed
+// forms, moving colliders, and the capsule, box and mesh shapes, on every backend (CPU float,
+// CPU double, Vulkan with validation), plus the shapes' distances from cloth_kernel.h itself.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <glm/geometric.hpp>
+
+#include "kernel.hpp"
+#include "sim_backends.hpp"
+
+using namespace vkcloth;
+using namespace vkcloth::test;
+
+namespace {
+
+constexpr double g = 9.81;
+
+/// A single free particle (a 1 x 1 cloth) at `pos` with velocity `vel`.
+ParticleSystem particle(glm::dvec3 pos, glm::dvec3 vel) {
+  ClothDesc d;
+  d.nx = d.ny = 1;
+  d.pin_default_corners = false;
+  auto sys = make_cloth(d);
+  REQUIRE(sys.ok());
+  sys->particles[0].position = pos;
+  sys->particles[0].velocity = vel;
+  return *sys;
+}
+
+SimParams gravity_only() {
+  SimParams p;
+  p.damping = 0.0;
+  return p;
+}
+
+Collider with_friction(Collider c, double kinetic, double stat = -1.0) {
+  c.friction = kinetic;
+  c.static_friction = stat;
+  return c;
+}
+
+/// A small closed mesh: a tetrahedron with its base on z = 0, apex up, faces outward.
+std::shared_ptr<const ColliderMesh> tetrahedron() {
+  const glm::dvec3 v[] = {{-0.4, -0.3, 0.0}, {0.4, -0.3, 0.0}, {0.0, 0.4, 0.0}, {0.0, 0.0, 0.5}};
+  const std::uint32_t t[] = {0, 2, 1, 0, 1, 3, 1, 2, 3, 2, 0, 3};
+  auto m = ColliderMesh::create(v, t, "tetrahedron");
+  REQUIRE(m.ok());
+  return *m;
+}
+
+/// An open square sheet of 2 n^2 triangles at z = 0, side `size`, centred on the origin.
+std::shared_ptr<const ColliderMesh> sheet(int n, double size) {
+  std::vector<glm::dvec3> v;
+  std::vector<std::uint32_t> t;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i)
+      v.push_back({size * (double(i) / n - 0.5), size * (double(j) / n - 0.5), 0.0});
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const auto a = std::uint32_t(j * (n + 1) + i), b = a + 1, c = a + std::uint32_t(n + 1), d = c + 1;
+      t.insert(t.end(), {a, b, d, a, d, c});
+    }
+  auto m = ColliderMesh::create(v, t, "sheet");
+  REQUIRE(m.ok());
+  return *m;
+}
+
+/// The signed distance of p to a collider (cloth_kernel.h in double; p_side = p).
+double distance_to(const Collider& c, glm::dvec3 p) {
+  kernel::MeshData md;
+  if (c.mesh) {
+    md.nodes = c.mesh->nodes().data();
+    md.triangles = c.mesh->triangles().data();
+  }
+  double d;
+  glm::dvec3 n;
+  kernel::collider_contact(md, kernel::kernel_shape<double>(c), p, p, 1.0, d, n);
+  return d;
+}
+
+} // namespace
+
+TEST_CASE("kernel: box, capsule and mesh distances and normals, edges and corners included") {
+  const Collider box = Collider::box({1, 2, 3}, {0.5, 0.25, 1.0}, Collider::rotation_from_degrees({0, 0, 90}));
+  // The box turned 90 degrees about z: its x half extent (0.5) lies along world y.
+  CHECK(distance_to(box, {1, 2.5 + 0.1, 3}) == doctest::Approx(0.1));
+  CHECK(distance_to(box, {1 + 0.25 + 0.2, 2, 3}) == doctest::Approx(0.2));
+  CHECK(distance_to(box, {1, 2, 3 + 0.9}) == doctest::Approx(-0.1)); // inside: nearest face
+  // Beyond a corner: the distance to the corner, the normal along the diagonal.
+  const glm::dvec3 corner{1 + 0.25, 2 + 0.5, 3 + 1.0};
+  CHECK(distance_to(box, corner + glm::dvec3{0.3, 0.4, 1.2}) == doctest::Approx(1.3));
+  // Beyond an edge (x and z out, y within).
+  CHECK(distance_to(box, {1 + 0.25 + 0.3, 2, 3 + 1.0 + 0.4}) == doctest::Approx(0.5));
+
+  const Collider capsule = Collider::capsule({0, 0, 0}, {0, 0, 2}, 0.25);
+  CHECK(distance_to(capsule, {1, 0, 1}) == doctest::Approx(0.75));      // beside the segment
+  CHECK(distance_to(capsule, {0, 0.6, 2.8}) == doctest::Approx(0.75));  // beyond end b: a sphere cap
+  CHECK(distance_to(capsule, {0, 0.1, -0.1}) < 0.0);                    // inside cap a
+  const Collider degenerate = Collider::capsule({1, 1, 1}, {1, 1, 1}, 0.5); // a == b: a sphere
+  CHECK(distance_to(degenerate, {1, 1, 2}) == doctest::Approx(0.5));
+
+  Collider tet = Collider::triangle_mesh(tetrahedron(), {0, 0, 1}, glm::dmat3(1.0), 0.01);
+  CHECK(distance_to(tet, {0, 0, 1 - 0.1}) == doctest::Approx(0.09)); // below the base
+  CHECK(distance_to(tet, {0, 0, 1 + 0.5 + 0.2}) == doctest::Approx(0.19)); // above the apex
+  CHECK(distance_to(tet, {5, 5, 5}) == doctest::Approx(1.0)); // beyond reach: "no contact"
+}
+
+TEST_CASE("kernel: a mesh remembers the side a particle came from (a thin sheet is not crossed)") {
+  const Collider s = Collider::triangle_mesh(sheet(4, 2.0), {0, 0, 0}, glm::dmat3(1.0), 0.01);
+  kernel::MeshData md{s.mesh->nodes().data(), s.mesh->triangles().data()};
+  const auto shape = kernel::kernel_shape<double>(s);
+  // From above to 0.3 m below within one step: pushed back above, to thickness + eps.
+  glm::dvec3 x{0.1, 0.2, -0.3}, v{0, 0, -15};
+  kernel::project_out(md, shape, 1e-3, glm::dvec3{0.1, 0.2, 0.005}, x, v);
+  CHECK(x.z == doctest::Approx(0.011));
+  CHECK(v.z == 0.0);
+  // From below, the same sheet pushes the other way.
+  glm::dvec3 y{0.1, 0.2, 0.004}, w{0, 0, 1};
+  kernel::project_out(md, shape, 1e-3, glm::dvec3{0.1, 0.2, -0.02}, y, w);
+  CHECK(y.z == doctest::Approx(-0.011));
+  CHECK(w.z == 0.0);
+  // Past the sheet's edge, out of reach of its shell: left alone.
+  glm::dvec3 z{1.5, 0.0, -0.2}, u{0, 0, -1};
+  kernel::project_out(md, shape, 1e-3, glm::dvec3{1.5, 0.0, 0.1}, z, u);
+  CHECK(z.z == -0.2);
+}
+
+TEST_CASE("kinetic friction slows a sliding particle by mu_k g h per step and stops it") {
+  // A particle resting on the floor (within the 2 eps band) sliding at 1 m/s: the floor removes the
+  // weight's impulse g h, so friction takes mu_k g h off the speed each step until the speed left is
+  // below mu_s g h, when the particle stops; x = h sum (1 - n mu_k g h) over the sliding steps.
+  ValidationScope validation;
+  SimParams p = gravity_only();
+  const double mu = 0.5, h = p.dt;
+  p.colliders = {with_friction(Collider::plane({0, 0, 1}, 0.0), mu)};
+  for (Backend b : backends()) {
+    CAPTURE(to_string(b));
+    const double tol = is_float(b) ? 2e-6 : 1e-12;
+    auto s = make_sim(b, particle({0, 0, 0.001}, {1.0, 0, 0}), p);
+    REQUIRE(s->run(5).ok());
+    CHECK(std::abs(s->velocity(0).x - (1.0 - 5 * mu * g * h)) < tol);
+    REQUIRE(s->run(15).ok());
+    CHECK(s->velocity(0).x == 0.0);
+    double travelled = 0.0;
+    for (int n = 1; 1.0 - (n - 1) * mu * g * h > mu * g * h; ++n)
+      travelled += h * (1.0 - n * mu * g * h);
+    CHECK(std::abs(s->position(0).x - travelled) < 10 * tol);
+    CHECK(std::abs(s->position(0).z - 0.001) < tol); // stayed on the floor
+  }
+}
+
+TEST_CASE("static friction holds on a slope when tan(theta) <= mu_s; kinetic friction sets the slide") {
+  // A slope with tan(theta) = 0.5: a particle at rest stays with mu_s = 0.6, and with mu = 0.4
+  // accelerates at g (sin theta - mu_k cos theta) along it.
+  ValidationScope validation;
+  const double theta = std::atan(0.5);
+  const glm::dvec3 n{-std::sin(theta), 0.0, std::cos(theta)}; // rising towards +x
+  const glm::dvec3 down_slope{-std::cos(theta), 0.0, -std::sin(theta)};
+  const glm::dvec3 start = n * 0.001;
+  for (Backend b : backends()) {
+    CAPTURE(to_string(b));
+    SimParams p = gravity_only();
+    p.colliders = {with_friction(Collider::plane(n, 0.0), 0.5, 0.6)};
+    {
+      auto s = make_sim(b, particle(start, {0, 0, 0}), p);
+      REQUIRE(s->run(100).ok());
+      CHECK(glm::length(s->position(0) - start) < 1e-6);
+      CHECK(glm::length(s->velocity(0)) < 1e-6); // rounding of the normal split only
+    }
+    p.colliders = {with_friction(Collider::plane(n, 0.0), 0.4)};
+    {
+      auto s = make_sim(b, particle(start, {0, 0, 0}), p);
+      REQUIRE(s->run(50).ok());
+      const double expected = 50 * p.dt * g * (std::sin(theta) - 0.4 * std::cos(theta));
+      CHECK(glm::dot(s->velocity(0), down_slope) == doctest::Approx(expected).epsilon(1e-5));
+      CHECK(std::abs(glm::dot(s->velocity(0), n)) < 1e-5); // along the slope, not into it
+    }
+  }
+}
+
+TEST_CASE("a moving box carries a resting particle; a frictionless one slides under it") {
+  // Friction acts on the velocity relative to the surface: with mu = 1 the particle picks up the
+  // box's 0.3 m/s within two steps (kinetic, then static) and keeps it; with mu = 0 it stays put.
+  ValidationScope validation;
+  for (Backend b : backends()) {
+    CAPTURE(to_string(b));
+    SimParams p = gravity_only();
+    Collider box = Collider::box({0, 0, -0.5}, {5, 5, 0.5});
+    box.linear_velocity = {0.3, 0, 0};
+    p.colliders = {with_friction(box, 1.0)};
+    auto s = make_sim(b, particle({0, 0, 0.001}, {0, 0, 0}), p);
+    REQUIRE(s->run(20).ok());
+    CHECK(s->velocity(0).x == doctest::Approx(0.3).epsilon(1e-6));
+    CHECK(s->position(0).x == doctest::Approx(0.3 * 20 * p.dt).epsilon(0.05));
+    CHECK(std::abs(s->position(0).z - 0.001) < 1e-6);
+    p.colliders = {box};
+    auto f = make_sim(b, particle({0, 0, 0.001}, {0, 0, 0}), p);
+    REQUIRE(f->run(20).ok());
+    CHECK(f->velocity(0).x == 0.0);
+  }
+}
+
+TEST_CASE("a spinning sphere carries a particle on its top along its surface velocity") {
+  // omega = (0, 2, 0) about the centre: the top of a 0.5 m sphere moves at omega x r = (1, 0, 0).
+  ValidationScope validation;
+  for (Backend b : backends()) {
+    CAPTURE(to_string(b));
+    SimParams p = gravity_only();
+    Collider ball = with_friction(Collider::sphere({0, 0, 0}, 0.5), 1.0);
+    ball.angular_velocity = {0, 2, 0};
+    p.colliders = {ball};
+    auto s = make_sim(b, particle({0, 0, 0.501}, {0, 0, 0}), p);
+    REQUIRE(s->run(5).ok());
+    CHECK(s->velocity(0).x > 0.8);
+    CHECK(s->position(0).x > 0.02);
+    CHECK(glm::length(s->position(0)) >= 0.5);
+  }
+}
+
+TEST_CASE("cloth dropped on a capsule, a turned box and a mesh: no particle ever deeper than eps") {
+  ValidationScope validation;
+  ClothDesc d;
+  d.nx = d.ny = 15;
+  d.orientation = ClothOrientation::horizontal;
+  d.origin = {-0.5, -0.5, 0.6};
+  d.pin_default_corners = false;
+  auto sys = make_cloth(d);
+  REQUIRE(sys.ok());
+  const Collider shapes[] = {
+      Collider::capsule({-0.6, 0.1, 0.2}, {0.6, -0.1, 0.3}, 0.15),
+      Collider::box({0.05, 0, 0.2}, {0.2, 0.3, 0.2}, Collider::rotation_from_degrees({10, 20, 30})),
+      Collider::triangle_mesh(tetrahedron(), {0.05, 0.02, 0.0}, Collider::rotation_from_degrees({0, 0, 15}),
+                              0.01)};
+  for (const Collider& shape : shapes) {
+    CAPTURE(int(shape.type));
+    for (Backend b : backends()) {
+      CAPTURE(to_string(b));
+      SimParams p;
+      p.substeps = 2;
+      p.colliders = {with_friction(shape, 0.3)};
+      auto s = make_sim(b, *sys, p);
+      double deepest = std::numeric_limits<double>::infinity();
+      int touching = 0;
+      for (int block = 0; block < 40; ++block) {
+        REQUIRE(s->run(5).ok());
+        for (const glm::dvec3& x : s->positions()) {
+          const double dist = distance_to(shape, x);
+          deepest = std::min(deepest, dist);
+          touching += dist < 2 * p.contact_epsilon;
+        }
+      }
+      CHECK(deepest >= -p.contact_epsilon);
+      CHECK(touching > 50); // it did land on the shape
+    }
+  }
+}
