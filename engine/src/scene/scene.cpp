@@ -227,13 +227,7 @@ Result<std::optional<Material>> read_material(const json& cloth) {
 }
 
 Result<void> read_mesh_transform(const json& cloth, MeshTransform& t) {
-  SCENE_TRY_ASSIGN(obj, sd::read_object(cloth, "cloth", "mesh_transform"));
-  if (!obj)
-    return {};
-  VKCLOTH_TRY(sd::check_keys(*obj, "cloth.mesh_transform", {"translate", "rotate_deg", "scale"}));
-  VKCLOTH_TRY(sd::read(*obj, "cloth.mesh_transform", "translate", t.translate));
-  VKCLOTH_TRY(sd::read(*obj, "cloth.mesh_transform", "rotate_deg", t.rotate_deg));
-  return sd::read(*obj, "cloth.mesh_transform", "scale", t.scale);
+  return sd::read_transform(cloth, "cloth", "mesh_transform", t.translate, t.rotate_deg, t.scale);
 }
 
 Result<void> read_mesh_pins(const json& cloth, MeshClothDesc& d) {
