@@ -13,6 +13,11 @@
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
+
+#include "vkcloth/collider_mesh.hpp"
+#include "vkcloth/scene.hpp"
+
 using namespace vkcloth::test;
 
 TEST_CASE("cli: bad scene files exit 2 and stderr names the key") {
@@ -43,6 +48,57 @@ TEST_CASE("cli: bad scene files exit 2 and stderr names the key") {
   const Outcome bad_set = run_cli("bad_set", "run " + sample("spring.json") + " --set integrator.dt.x=1");
   CHECK(bad_set.code == 2);
   CHECK(bad_set.err.find("integrator.dt.x") != std::string::npos);
+}
+
+TEST_CASE("cli: bad colliders (issue 15) exit 2 and stderr names the key, the file and the line") {
+  const fs::path dir = tmp_dir() / "cli_colliders";
+  fs::create_directories(dir);
+  std::ofstream(dir / "broken.obj") << "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 9\n";
+  struct Bad {
+    const char* name;
+    const char* colliders;
+    std::vector<std::string> needles;
+  };
+  const Bad cases[] = {
+      {"friction.json", R"({"type": "plane", "friction": -0.2})", {"colliders[0].friction", "-0.2"}},
+      {"static.json",
+       R"({"type": "plane", "friction": 0.5, "static_friction": 0.1})",
+       {"colliders[0].static_friction", "0.1"}},
+      {"box.json",
+       R"({"type": "box", "center": [0, 0, 0], "half_extents": [1, 0, 1]})",
+       {"colliders[0].half_extents", "[1, 0, 1]"}},
+      {"capsule.json",
+       R"({"type": "capsule", "a": [0, 0, 0], "b": [0, 0, 1], "radius": 0})",
+       {"colliders[0].radius", "got 0"}},
+      {"velocity.json",
+       R"({"type": "plane", "linear_velocity": [0, 0, 1e999]})",
+       {"colliders[0].linear_velocity[2]"}},
+      {"thickness.json", R"({"type": "mesh", "path": "broken.obj"})", {"colliders[0].thickness is required"}},
+      {"nomesh.json",
+       R"({"type": "mesh", "path": "meshes/none.obj", "thickness": 0.01})",
+       {"colliders[0].path", "meshes/none.obj", "no such mesh file"}},
+      {"badmesh.json",
+       R"({"type": "mesh", "path": "broken.obj", "thickness": 0.01})",
+       {"colliders[0].path", "broken.obj:4: face index 9 is out of range"}},
+  };
+  for (const Bad& b : cases) {
+    CAPTURE(b.name);
+    std::ofstream(dir / b.name) << R"({"system": "cloth", "colliders": [)" << b.colliders << "]}";
+    for (const char* command : {"run", "info"}) {
+      CAPTURE(command);
+      const Outcome o = run_cli(std::string("bad_collider_") + command + "_" + b.name,
+                                std::string(command) + " " + quote((dir / b.name).string()));
+      CHECK(o.code == 2);
+      for (const std::string& n : b.needles)
+        CHECK_MESSAGE(o.err.find(n) != std::string::npos, "'" << n << "' not in: " << o.err);
+      CHECK(o.out.empty());
+    }
+  }
+  // An override that makes a good scene bad.
+  const Outcome set =
+      run_cli("bad_collider_set", "run " + sample("cloth_on_sphere.json") + " --set colliders.0.friction=-1");
+  CHECK(set.code == 2);
+  CHECK(set.err.find("colliders[0].friction") != std::string::npos);
 }
 
 TEST_CASE("cli: the single spring settles at the static sag L0 + mg/K below the anchor") {
@@ -124,6 +180,42 @@ TEST_CASE("cli: info prints the parsed scene") {
   CHECK(o.out.find("structural") != std::string::npos);
   CHECK(o.out.find("shear") == std::string::npos); // switched off by the override
   CHECK(o.out.find("semi_implicit_euler") != std::string::npos);
+}
+
+TEST_CASE("cli: info prints each collider: shape, friction, velocities; a mesh's triangles and depth") {
+  const fs::path dir = tmp_dir() / "cli_info_colliders";
+  fs::create_directories(dir);
+  std::ofstream(dir / "scene.json") << R"({"system": "cloth", "colliders": [
+      {"type": "plane", "offset": -1, "friction": 0.4, "static_friction": 0.6, "linear_velocity": [0.5, 0, 0]},
+      {"type": "sphere", "center": [0, 0, 0], "radius": 0.3},
+      {"type": "capsule", "a": [0, 0, 0], "b": [1, 0, 0], "radius": 0.1, "angular_velocity": [0, 0, 2]},
+      {"type": "box", "center": [0, 0, -1], "half_extents": [2, 1, 0.5], "rotation_deg": [10, -20, 30]},
+      {"type": "mesh", "path": ")" << VKCLOTH_SCENES_DIR
+                                    << R"(/../meshes/tablecloth.obj", "thickness": 0.005,
+       "friction": 0.3, "transform": {"translate": [0, 0, 0.5], "rotate_deg": [0, 0, 90], "scale": 2}}]})";
+  auto scene = vkcloth::load_scene_file(dir / "scene.json");
+  REQUIRE_MESSAGE(scene.ok(), scene.error().message);
+  const auto& mesh = *scene->params.colliders[4].mesh;
+  const Outcome o = run_cli("info_colliders", "info " + quote((dir / "scene.json").string()));
+  REQUIRE(o.code == 0);
+  const std::string expected[] = {
+      "colliders   5\n",
+      "  [0] plane   normal [0, 0, 1], offset -1\n      friction 0.4 (static 0.6), linear_velocity [0.5, 0, "
+      "0] m/s, "
+      "angular_velocity [0, 0, 0] rad/s\n",
+      "  [1] sphere  center [0, 0, 0], radius 0.3\n      friction 0 (static 0), at rest\n",
+      "  [2] capsule a [0, 0, 0], b [1, 0, 0], radius 0.1\n      friction 0 (static 0), linear_velocity [0, "
+      "0, 0] m/s, "
+      "angular_velocity [0, 0, 2] rad/s\n",
+      "  [3] box     center [0, 0, -1], half_extents [2, 1, 0.5], rotation_deg [10, -20, 30]\n",
+      fmt::format(
+          "  [4] mesh    {}/../meshes/tablecloth.obj: 384 triangles, hierarchy depth {}; origin [0, 0, 0.5], "
+          "rotation_deg [0, 0, 90], thickness 0.005\n      friction 0.3 (static 0.3), at rest\n",
+          VKCLOTH_SCENES_DIR, mesh.depth()),
+  };
+  for (const std::string& e : expected)
+    CHECK_MESSAGE(o.out.find(e) != std::string::npos, "'" << e << "' not in: " << o.out);
+  CHECK(mesh.depth() > 1);
 }
 
 // ---- The Vulkan backend through the CLI (lavapipe in CI, with the validation layer on) ----

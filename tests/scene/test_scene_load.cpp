@@ -3,10 +3,13 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
+#include "vkcloth/collider_mesh.hpp"
 #include "vkcloth/vkcloth.hpp"
 
 using namespace vkcloth;
@@ -221,4 +224,178 @@ TEST_CASE("contact_inward_only: defaults to true (report §4), reads a boolean, 
   auto bad = parse_scene(R"({"system": "chain", "contact_inward_only": 1})", "t.json");
   REQUIRE_FALSE(bad.ok());
   CHECK(bad.error().message.find("contact_inward_only") != std::string::npos);
+}
+
+// ---- Issue 15: capsule, box and mesh colliders, friction, moving colliders ----
+
+namespace {
+
+/// A unit cube centred on the origin (6 quads, 12 triangles), written to tmp/<dir>/meshes/cube.obj
+/// (each test its own <dir>: ctest runs them in parallel).
+std::filesystem::path write_cube(const std::string& dir) {
+  const std::filesystem::path d = std::filesystem::path(VKCLOTH_TEST_TMP) / dir / "meshes";
+  std::filesystem::create_directories(d);
+  std::ofstream(d / "cube.obj") << "v -0.5 -0.5 -0.5\nv 0.5 -0.5 -0.5\nv 0.5 0.5 -0.5\nv -0.5 0.5 -0.5\n"
+                                   "v -0.5 -0.5 0.5\nv 0.5 -0.5 0.5\nv 0.5 0.5 0.5\nv -0.5 0.5 0.5\n"
+                                   "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
+  return d / "cube.obj";
+}
+
+/// Parses `text` as if it were the file tmp/<dir>/scene.json (relative mesh paths start there).
+Scene load_in_tmp(const std::string& dir, const std::string& text, std::vector<std::string> overrides = {}) {
+  auto s =
+      parse_scene(text, (std::filesystem::path(VKCLOTH_TEST_TMP) / dir / "scene.json").string(), overrides);
+  if (!s)
+    FAIL("unexpected error: " << s.error().message);
+  return std::move(*s);
+}
+
+bool same(const glm::dmat3& a, const glm::dmat3& b) {
+  for (int c = 0; c < 3; ++c)
+    for (int r = 0; r < 3; ++r)
+      if (std::abs(a[c][r] - b[c][r]) > 1e-15)
+        return false;
+  return true;
+}
+
+} // namespace
+
+TEST_CASE("colliders: capsule and box keys are read, rotation_deg through rotation_from_degrees") {
+  const Scene s = load_ok(R"({"system": "cloth", "colliders": [
+      {"type": "capsule", "a": [0, 0, 0.2], "b": [1, 0, 0.2], "radius": 0.1},
+      {"type": "capsule", "a": [0.5, 0.5, 0], "b": [0.5, 0.5, 0], "radius": 0.25},
+      {"type": "box", "center": [0, 0, -1], "half_extents": [2, 1, 0.5], "rotation_deg": [10, -20, 30]},
+      {"type": "box", "center": [3, 0, 0], "half_extents": [0.1, 0.2, 0.3]}]})");
+  REQUIRE(s.params.colliders.size() == 4);
+  const Collider& cap = s.params.colliders[0];
+  CHECK(cap.type == Collider::Type::capsule);
+  CHECK(cap.a == glm::dvec3(0, 0, 0.2));
+  CHECK(cap.b == glm::dvec3(1, 0, 0.2));
+  CHECK(cap.radius == 0.1);
+  CHECK(s.params.colliders[1].a == s.params.colliders[1].b); // a == b: a sphere, allowed
+  const Collider& box = s.params.colliders[2];
+  CHECK(box.type == Collider::Type::box);
+  CHECK(box.center == glm::dvec3(0, 0, -1));
+  CHECK(box.half_extents == glm::dvec3(2, 1, 0.5));
+  CHECK(same(box.rotation, Collider::rotation_from_degrees({10, -20, 30})));
+  CHECK(same(s.params.colliders[3].rotation, glm::dmat3(1.0))); // rotation_deg defaults to [0, 0, 0]
+}
+
+TEST_CASE("colliders: friction and velocities on every type, with their defaults") {
+  const Scene s = load_ok(R"({"system": "cloth", "colliders": [
+      {"type": "plane", "offset": -1, "friction": 0.4, "static_friction": 0.6, "linear_velocity": [0.5, 0, 0]},
+      {"type": "sphere", "center": [0, 0, 0], "radius": 0.3, "friction": 0.2,
+       "linear_velocity": [0, 0, 0.1], "angular_velocity": [0, 0, 3.14]},
+      {"type": "capsule", "a": [0, 0, 0], "b": [1, 0, 0], "radius": 0.1, "friction": 0.3, "static_friction": 0.3},
+      {"type": "box", "center": [0, 0, 0], "half_extents": [1, 1, 1], "angular_velocity": [1, 0, 0]}]})");
+  const auto& c = s.params.colliders;
+  REQUIRE(c.size() == 4);
+  CHECK(c[0].friction == 0.4);
+  CHECK(c[0].static_friction == 0.6);
+  CHECK(c[0].linear_velocity == glm::dvec3(0.5, 0, 0));
+  CHECK(c[0].angular_velocity == glm::dvec3(0.0));
+  CHECK(c[1].friction == 0.2);
+  CHECK(c[1].static_coefficient() == 0.2); // static_friction absent: the same as friction
+  CHECK(c[1].linear_velocity == glm::dvec3(0, 0, 0.1));
+  CHECK(c[1].angular_velocity == glm::dvec3(0, 0, 3.14));
+  CHECK(c[1].moving());
+  CHECK(c[2].static_coefficient() == 0.3); // static == kinetic is allowed
+  CHECK(c[3].friction == 0.0);             // default: frictionless, the report's model
+  CHECK(c[3].static_coefficient() == 0.0);
+  CHECK(c[3].linear_velocity == glm::dvec3(0.0));
+  CHECK(c[3].angular_velocity == glm::dvec3(1, 0, 0));
+  // The colliders of the report's samples keep the report's model: no friction, at rest.
+  auto sphere = load_scene_file(std::filesystem::path(VKCLOTH_SCENES_DIR) / "cloth_on_sphere.json");
+  REQUIRE(sphere.ok());
+  for (const Collider& k : sphere->params.colliders) {
+    CHECK(k.friction == 0.0);
+    CHECK_FALSE(k.moving());
+  }
+}
+
+TEST_CASE("colliders: a mesh collider reads its file relative to the scene, with its transform") {
+  const std::string abs = write_cube("mesh_load").string();
+  const Scene s = load_in_tmp("mesh_load", R"({"system": "cloth", "colliders": [
+      {"type": "mesh", "path": "meshes/cube.obj", "thickness": 0.01, "friction": 0.5,
+       "transform": {"translate": [1, 2, 3], "rotate_deg": [0, 0, 90], "scale": 2}},
+      {"type": "mesh", "path": "meshes/cube.obj", "thickness": 0.02}]})");
+  REQUIRE(s.params.colliders.size() == 2);
+  const Collider& m = s.params.colliders[0];
+  CHECK(m.type == Collider::Type::mesh);
+  REQUIRE(m.mesh);
+  CHECK(m.mesh->name() == "meshes/cube.obj");
+  CHECK(m.mesh->triangles().size() == 12); // 6 quads, fan-triangulated
+  CHECK(m.mesh->depth() >= 2);             // 12 triangles, at most 4 per leaf
+  // The scale is baked into the triangles (mesh frame), translate and rotate_deg are the pose.
+  CHECK(m.mesh->nodes()[0].lo == glm::vec3(-1.0f));
+  CHECK(m.mesh->nodes()[0].hi == glm::vec3(1.0f));
+  CHECK(m.center == glm::dvec3(1, 2, 3));
+  CHECK(same(m.rotation, Collider::rotation_from_degrees({0, 0, 90})));
+  CHECK(m.thickness == 0.01);
+  CHECK(m.friction == 0.5);
+  const Collider& plain = s.params.colliders[1];
+  REQUIRE(plain.mesh);
+  CHECK(plain.mesh->nodes()[0].hi == glm::vec3(0.5f)); // transform absent: scale 1, ...
+  CHECK(plain.center == glm::dvec3(0.0));              // ... the origin, ...
+  CHECK(same(plain.rotation, glm::dmat3(1.0)));        // ... no rotation
+  CHECK(plain.thickness == 0.02);
+  CHECK(s.warnings.empty());
+
+  // The same file at the same scale is built once and shared; an absolute path works too.
+  const Scene t = load_in_tmp("mesh_load", R"({"system": "chain", "colliders": [
+      {"type": "mesh", "path": "meshes/cube.obj", "thickness": 0.01},
+      {"type": "mesh", "path": ")" + abs + R"(", "thickness": 0.01},
+      {"type": "mesh", "path": "meshes/cube.obj", "thickness": 0.01, "transform": {"scale": 3}}]})");
+  REQUIRE(t.params.colliders.size() == 3);
+  CHECK(t.params.colliders[0].mesh == t.params.colliders[1].mesh);
+  CHECK(t.params.colliders[0].mesh != t.params.colliders[2].mesh);
+
+  // A sample mesh (OBJ) from a scene in samples/scenes/, as cloth.mesh would find it.
+  auto table = parse_scene(
+      R"({"system": "chain", "colliders": [{"type": "mesh", "path": "../meshes/tablecloth.obj", "thickness": 0.005}]})",
+      std::string(VKCLOTH_SCENES_DIR) + "/table_collider.json");
+  REQUIRE_MESSAGE(table.ok(), table.error().message);
+  REQUIRE(table->params.colliders[0].mesh);
+  CHECK(table->params.colliders[0].mesh->triangles().size() == 384);
+}
+
+TEST_CASE("colliders: a mesh with zero-area triangles loads with a warning that counts them") {
+  const std::filesystem::path d = std::filesystem::path(VKCLOTH_TEST_TMP) / "mesh_flat" / "meshes";
+  std::filesystem::create_directories(d);
+  std::ofstream(d / "flat.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nf 1 2 3\nf 1 2 4\n";
+  const Scene s = load_in_tmp(
+      "mesh_flat",
+      R"({"system": "chain", "colliders": [{"type": "mesh", "path": "meshes/flat.obj", "thickness": 0.01}]})");
+  REQUIRE(s.params.colliders[0].mesh);
+  CHECK(s.params.colliders[0].mesh->triangles().size() == 1);
+  REQUIRE(s.warnings.size() == 1);
+  CHECK(s.warnings[0] == "colliders[0]: dropped 1 zero-area triangle of meshes/flat.obj");
+}
+
+TEST_CASE("colliders: overrides reach the new keys and the new types") {
+  write_cube("mesh_overrides");
+  const std::string base = R"({"system": "cloth", "colliders": [
+      {"type": "sphere", "center": [0, 0, 0], "radius": 1},
+      {"type": "mesh", "path": "meshes/cube.obj", "thickness": 0.01}]})";
+  const Scene s =
+      load_in_tmp("mesh_overrides", base,
+                  {"colliders.0.friction=0.4", "colliders[0].static_friction=0.7",
+                   "colliders.0.linear_velocity=[0,0,-0.5]", "colliders.0.angular_velocity=[0,0,2]",
+                   "colliders.1.transform.scale=2", "colliders.1.transform.translate=[0,0,1]",
+                   R"(colliders.2={"type":"capsule","a":[0,0,0],"b":[0,1,0],"radius":0.2})",
+                   R"(colliders.3={"type":"box","center":[0,0,0],"half_extents":[1,1,1]})",
+                   "colliders.3.rotation_deg=[0,0,45]", "colliders.2.radius=0.3"});
+  const auto& c = s.params.colliders;
+  REQUIRE(c.size() == 4);
+  CHECK(c[0].friction == 0.4);
+  CHECK(c[0].static_friction == 0.7);
+  CHECK(c[0].linear_velocity == glm::dvec3(0, 0, -0.5));
+  CHECK(c[0].angular_velocity == glm::dvec3(0, 0, 2));
+  REQUIRE(c[1].mesh);
+  CHECK(c[1].mesh->nodes()[0].hi == glm::vec3(1.0f)); // transform created by the override, scale 2
+  CHECK(c[1].center == glm::dvec3(0, 0, 1));
+  CHECK(c[2].type == Collider::Type::capsule);
+  CHECK(c[2].radius == 0.3);
+  CHECK(c[3].type == Collider::Type::box);
+  CHECK(same(c[3].rotation, Collider::rotation_from_degrees({0, 0, 45})));
 }

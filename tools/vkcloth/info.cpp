@@ -1,10 +1,13 @@
 // SPDX-License-Identifier: MIT
 // `vkcloth info`: what a scene file turns into, for checking a scene before running it.
+#include <algorithm>
 #include <array>
+#include <cmath>
 
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "vkcloth/collider_mesh.hpp"
 #include "vkcloth/scene.hpp"
 
 namespace vkcloth::cli {
@@ -12,6 +15,49 @@ namespace {
 
 std::string vec(glm::dvec3 v) {
   return fmt::format("[{:g}, {:g}, {:g}]", v.x, v.y, v.z);
+}
+
+// R = Rz Ry Rx (Collider::rotation_from_degrees) back to [rx, ry, rz] in degrees (ry in [-90, 90]).
+glm::dvec3 rotation_degrees(const glm::dmat3& r) {
+  const auto at = [&](int row, int col) { return r[col][row]; }; // glm is column-major
+  const double deg = 180.0 / 3.14159265358979323846;
+  const double ry = std::asin(std::clamp(-at(2, 0), -1.0, 1.0));
+  glm::dvec3 d = std::abs(at(2, 0)) > 1.0 - 1e-12 // gimbal lock: rx and rz turn about one axis; all in rx
+                     ? glm::dvec3(std::atan2(-at(1, 2), at(1, 1)), ry, 0.0)
+                     : glm::dvec3(std::atan2(at(2, 1), at(2, 2)), ry, std::atan2(at(1, 0), at(0, 0)));
+  for (int k = 0; k < 3; ++k) // rounding residue (and -0) prints as 0
+    d[k] = std::abs(d[k] * deg) < 1e-9 ? 0.0 : d[k] * deg;
+  return d;
+}
+
+void print_collider(std::size_t k, const Collider& c) {
+  switch (c.type) {
+  case Collider::Type::plane:
+    fmt::print("  [{}] plane   normal {}, offset {:g}\n", k, vec(c.normal), c.offset);
+    break;
+  case Collider::Type::sphere:
+    fmt::print("  [{}] sphere  center {}, radius {:g}\n", k, vec(c.center), c.radius);
+    break;
+  case Collider::Type::capsule:
+    fmt::print("  [{}] capsule a {}, b {}, radius {:g}\n", k, vec(c.a), vec(c.b), c.radius);
+    break;
+  case Collider::Type::box:
+    fmt::print("  [{}] box     center {}, half_extents {}, rotation_deg {}\n", k, vec(c.center),
+               vec(c.half_extents), vec(rotation_degrees(c.rotation)));
+    break;
+  case Collider::Type::mesh:
+    fmt::print(
+        "  [{}] mesh    {}: {} triangles, hierarchy depth {}; origin {}, rotation_deg {}, thickness {:g}\n",
+        k, c.mesh ? c.mesh->name() : "?", c.mesh ? c.mesh->triangles().size() : 0,
+        c.mesh ? c.mesh->depth() : 0, vec(c.center), vec(rotation_degrees(c.rotation)), c.thickness);
+    break;
+  }
+  fmt::print("      friction {:g} (static {:g})", c.friction, c.static_coefficient());
+  if (c.moving())
+    fmt::print(", linear_velocity {} m/s, angular_velocity {} rad/s\n", vec(c.linear_velocity),
+               vec(c.angular_velocity));
+  else
+    fmt::print(", at rest\n");
 }
 
 int info_command(const SceneArgs& opt) {
@@ -51,13 +97,8 @@ int info_command(const SceneArgs& opt) {
   fmt::print("gravity     {} m/s^2\ndamping     {:g} 1/s\n", vec(p.gravity), p.damping);
   fmt::print("wind        strength {:g}, direction {}\n", p.wind.strength, vec(p.wind.direction));
   fmt::print("colliders   {}\n", p.colliders.size());
-  for (std::size_t k = 0; k < p.colliders.size(); ++k) {
-    const Collider& c = p.colliders[k];
-    if (c.type == Collider::Type::plane)
-      fmt::print("  [{}] plane  normal {}, offset {:g}\n", k, vec(c.normal), c.offset);
-    else
-      fmt::print("  [{}] sphere center {}, radius {:g}\n", k, vec(c.center), c.radius);
-  }
+  for (std::size_t k = 0; k < p.colliders.size(); ++k)
+    print_collider(k, p.colliders[k]);
   fmt::print("contact_epsilon {:g} m, divergence_limit {:g} m\n", p.contact_epsilon, p.divergence_limit);
   return exit_ok;
 }

@@ -55,6 +55,14 @@ Result<void> check_keys(const json& obj, std::string_view path,
   return {};
 }
 
+Result<void> require_keys(const json& obj, std::string_view path,
+                          std::initializer_list<std::string_view> keys, std::string_view what) {
+  for (std::string_view k : keys)
+    if (!obj.contains(std::string(k)))
+      return shape_error(fmt::format("{} is required for {}", join(path, k), what));
+  return {};
+}
+
 Result<const json*> read_object(const json& obj, std::string_view path, const char* key) {
   auto it = obj.find(key);
   if (it == obj.end())
@@ -173,6 +181,20 @@ Result<void> read(const json& obj, std::string_view path, const char* key, glm::
     out[k] = *x;
   }
   return {};
+}
+
+Result<void> read_transform(const json& obj, std::string_view path, const char* key, glm::dvec3& translate,
+                            glm::dvec3& rotate_deg, double& scale) {
+  auto t = read_object(obj, path, key);
+  if (!t)
+    return t.error();
+  if (!*t)
+    return {};
+  const std::string p = join(path, key);
+  VKCLOTH_TRY(check_keys(**t, p, {"translate", "rotate_deg", "scale"}));
+  VKCLOTH_TRY(read(**t, p, "translate", translate));
+  VKCLOTH_TRY(read(**t, p, "rotate_deg", rotate_deg));
+  return read(**t, p, "scale", scale);
 }
 
 Result<void> read(const json& obj, std::string_view path, const char* key, std::vector<double>& out) {

@@ -29,6 +29,10 @@ Error shape_error(std::string message);
 /// Errors on the first key of `obj` not in `allowed`, naming its full path.
 Result<void> check_keys(const json& obj, std::string_view path,
                         std::initializer_list<std::string_view> allowed);
+/// Errors on the first of `keys` that `obj` lacks: "colliders[0].radius is required for a sphere"
+/// (`what` = "a sphere").
+Result<void> require_keys(const json& obj, std::string_view path,
+                          std::initializer_list<std::string_view> keys, std::string_view what);
 
 /// Readers: absent key -> `out` keeps its default. Wrong type or non-finite -> error.
 /// `obj` must be an object.
@@ -39,6 +43,11 @@ Result<void> read(const json& obj, std::string_view path, const char* key, std::
 Result<void> read(const json& obj, std::string_view path, const char* key, bool& out);
 Result<void> read(const json& obj, std::string_view path, const char* key, glm::dvec3& out);
 Result<void> read(const json& obj, std::string_view path, const char* key, glm::dvec2& out);
+/// A placement (docs/scene-format.md `cloth.mesh_transform`): obj[key] = {"translate": [x,y,z],
+/// "rotate_deg": [rx,ry,rz], "scale": s}, each optional; absent keys keep `translate`, `rotate_deg`,
+/// `scale` as they are. Only shapes and finiteness are checked here (the caller checks scale > 0).
+Result<void> read_transform(const json& obj, std::string_view path, const char* key, glm::dvec3& translate,
+                            glm::dvec3& rotate_deg, double& scale);
 /// A number or an array of numbers (a single number becomes a one-element array).
 Result<void> read(const json& obj, std::string_view path, const char* key, std::vector<double>& out);
 

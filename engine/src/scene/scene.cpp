@@ -5,6 +5,8 @@
 
 #include <fstream>
 #include <limits>
+#include <map>
+#include <memory>
 #include <new>
 #include <sstream>
 
@@ -14,6 +16,7 @@
 #include "json_read.hpp"
 #include "overrides.hpp"
 #include "vkcloth/builders.hpp"
+#include "vkcloth/collider_mesh.hpp"
 #include "vkcloth/material.hpp"
 
 namespace vkcloth {
@@ -115,41 +118,145 @@ Result<void> read_stretch_limit(const json& doc, SimParams& params) {
                      sl.tether_distance);
 }
 
-Result<void> read_colliders(const json& doc, SimParams& params) {
+/// A file a scene names ("cloth.mesh", "colliders[k].path"): relative to the scene file's directory,
+/// or absolute.
+std::filesystem::path scene_relative(const std::string& file, const std::filesystem::path& scene_dir) {
+  const std::filesystem::path p(file);
+  return p.is_absolute() ? p : scene_dir / p;
+}
+
+constexpr const char* collider_types = R"("plane", "sphere", "capsule", "box" or "mesh")";
+
+/// The keys every collider takes besides its shape's: friction and motion.
+#define VKCLOTH_COLLIDER_COMMON_KEYS                                                                         \
+  "type", "friction", "static_friction", "linear_velocity", "angular_velocity"
+
+Result<void> read_collider_common(const json& c, const std::string& path, Collider& col) {
+  VKCLOTH_TRY(sd::read(c, path, "friction", col.friction));
+  if (c.contains("static_friction")) {
+    double mu_s = 0.0;
+    VKCLOTH_TRY(sd::read(c, path, "static_friction", mu_s));
+    // Collider::static_friction < 0 means "the same as friction"; a scene says that by omitting the
+    // key, so a negative value here is a mistake. >= friction is validate()'s check.
+    if (mu_s < 0.0)
+      return make_error(ErrorCode::invalid_argument,
+                        fmt::format("{}.static_friction must be >= 0 and >= friction (omit it to use "
+                                    "friction), got {}",
+                                    path, mu_s));
+    col.static_friction = mu_s;
+  }
+  VKCLOTH_TRY(sd::read(c, path, "linear_velocity", col.linear_velocity));
+  return sd::read(c, path, "angular_velocity", col.angular_velocity);
+}
+
+/// Mesh files already read for this scene, by resolved path and scale (a mesh used twice is built once).
+using ColliderMeshCache = std::map<std::pair<std::string, double>, std::shared_ptr<const ColliderMesh>>;
+
+/// {"type": "mesh", "path": ..., "transform": {...}, "thickness": t}: the file read with read_mesh(),
+/// scaled into a ColliderMesh; translate is where its origin goes, rotate_deg its rotation. Sets the
+/// shape's fields of `col` (its friction and motion are left as they are).
+Result<void> read_mesh_collider(const json& c, const std::string& path,
+                                const std::filesystem::path& scene_dir, ColliderMeshCache& cache,
+                                std::vector<std::string>& warnings, Collider& col) {
+  VKCLOTH_TRY(sd::require_keys(c, path, {"path", "thickness"}, "a mesh collider"));
+  std::string file;
+  VKCLOTH_TRY(sd::read(c, path, "path", file));
+  glm::dvec3 translate{0.0}, rotate_deg{0.0};
+  double scale = 1.0, thickness = 0.0;
+  VKCLOTH_TRY(sd::read_transform(c, path, "transform", translate, rotate_deg, scale));
+  VKCLOTH_TRY(sd::read(c, path, "thickness", thickness));
+  // Checked before the file is read (validate() would say the same after).
+  if (!(scale > 0.0))
+    return make_error(ErrorCode::invalid_argument,
+                      fmt::format("{}.transform.scale must be finite and > 0, got {}", path, scale));
+  if (!(thickness > 0.0))
+    return make_error(ErrorCode::invalid_argument,
+                      fmt::format("{}.thickness must be finite and > 0, got {}", path, thickness));
+  const std::filesystem::path where = scene_relative(file, scene_dir);
+  std::shared_ptr<const ColliderMesh>& shape = cache[{where.string(), scale}];
+  if (!shape) {
+    // The reader's message names the file and the line (or the glTF element); the key goes first.
+    const auto wrap = [&](const Error& e) {
+      return Error{e.code, fmt::format("{}.path: {}", path, e.message), e.vk_result};
+    };
+    auto mesh = read_mesh(where);
+    if (!mesh)
+      return wrap(mesh.error());
+    auto built = ColliderMesh::from_mesh(*mesh, scale, file);
+    if (!built)
+      return wrap(built.error());
+    shape = std::move(*built);
+    if (const std::uint32_t dropped = shape->dropped_triangles())
+      warnings.push_back(fmt::format("{}: dropped {} zero-area triangle{} of {}", path, dropped,
+                                     dropped == 1 ? "" : "s", file));
+  }
+  col.type = Collider::Type::mesh;
+  col.mesh = shape;
+  col.center = translate;
+  col.rotation = Collider::rotation_from_degrees(rotate_deg);
+  col.thickness = thickness;
+  return {};
+}
+
+/// "colliders": each a shape (docs/scene-format.md "colliders") with friction and motion. Shapes and
+/// required keys are checked here, ranges by SimParams::validate().
+Result<void> read_colliders(const json& doc, const std::filesystem::path& scene_dir, Scene& scene) {
   SCENE_TRY_ASSIGN(arr, sd::read_array(doc, "", "colliders"));
   if (!arr)
     return {};
+  ColliderMeshCache meshes;
   for (std::size_t k = 0; k < arr->size(); ++k) {
     const json& c = (*arr)[k];
     const std::string path = fmt::format("colliders[{}]", k);
     if (!c.is_object())
       return sd::shape_error(fmt::format("{} must be an object, got {}", path, sd::show(c)));
     if (!c.contains("type"))
-      return sd::shape_error(fmt::format("{}.type is required (\"plane\" or \"sphere\")", path));
+      return sd::shape_error(fmt::format("{}.type is required ({})", path, collider_types));
     std::string type;
     VKCLOTH_TRY(sd::read(c, path, "type", type));
     Collider col;
     if (type == "plane") {
-      VKCLOTH_TRY(sd::check_keys(c, path, {"type", "normal", "offset"}));
+      VKCLOTH_TRY(sd::check_keys(c, path, {VKCLOTH_COLLIDER_COMMON_KEYS, "normal", "offset"}));
       col = Collider::plane({0.0, 0.0, 1.0}, 0.0);
       VKCLOTH_TRY(sd::read(c, path, "normal", col.normal));
       VKCLOTH_TRY(sd::read(c, path, "offset", col.offset));
     } else if (type == "sphere") {
-      VKCLOTH_TRY(sd::check_keys(c, path, {"type", "center", "radius"}));
-      for (const char* key : {"center", "radius"})
-        if (!c.contains(key))
-          return sd::shape_error(fmt::format("{}.{} is required for a sphere", path, key));
+      VKCLOTH_TRY(sd::check_keys(c, path, {VKCLOTH_COLLIDER_COMMON_KEYS, "center", "radius"}));
+      VKCLOTH_TRY(sd::require_keys(c, path, {"center", "radius"}, "a sphere"));
       col = Collider::sphere({}, 0.0);
       VKCLOTH_TRY(sd::read(c, path, "center", col.center));
       VKCLOTH_TRY(sd::read(c, path, "radius", col.radius));
+    } else if (type == "capsule") {
+      VKCLOTH_TRY(sd::check_keys(c, path, {VKCLOTH_COLLIDER_COMMON_KEYS, "a", "b", "radius"}));
+      VKCLOTH_TRY(sd::require_keys(c, path, {"a", "b", "radius"}, "a capsule"));
+      col = Collider::capsule({}, {}, 0.0);
+      VKCLOTH_TRY(sd::read(c, path, "a", col.a));
+      VKCLOTH_TRY(sd::read(c, path, "b", col.b));
+      VKCLOTH_TRY(sd::read(c, path, "radius", col.radius));
+    } else if (type == "box") {
+      VKCLOTH_TRY(
+          sd::check_keys(c, path, {VKCLOTH_COLLIDER_COMMON_KEYS, "center", "half_extents", "rotation_deg"}));
+      VKCLOTH_TRY(sd::require_keys(c, path, {"center", "half_extents"}, "a box"));
+      glm::dvec3 center{0.0}, half_extents{0.0}, rotation_deg{0.0};
+      VKCLOTH_TRY(sd::read(c, path, "center", center));
+      VKCLOTH_TRY(sd::read(c, path, "half_extents", half_extents));
+      VKCLOTH_TRY(sd::read(c, path, "rotation_deg", rotation_deg));
+      col = Collider::box(center, half_extents, Collider::rotation_from_degrees(rotation_deg));
+    } else if (type == "mesh") {
+      VKCLOTH_TRY(sd::check_keys(c, path, {VKCLOTH_COLLIDER_COMMON_KEYS, "path", "transform", "thickness"}));
     } else {
       return sd::shape_error(
-          fmt::format("{}.type must be \"plane\" or \"sphere\", got {}", path, sd::show(c["type"])));
+          fmt::format("{}.type must be {}, got {}", path, collider_types, sd::show(c["type"])));
     }
-    params.colliders.push_back(col);
+    VKCLOTH_TRY(read_collider_common(c, path, col));
+    if (type == "mesh") // the file last, once every other key of this collider is known to be well formed
+      VKCLOTH_TRY(read_mesh_collider(c, path, scene_dir, meshes, scene.warnings, col));
+    scene.params.colliders.push_back(std::move(col));
   }
   return {};
 }
+
+#undef VKCLOTH_COLLIDER_COMMON_KEYS
 
 Result<ParticleSystem> read_chain(const json& doc) {
   ChainDesc d;
@@ -227,13 +334,7 @@ Result<std::optional<Material>> read_material(const json& cloth) {
 }
 
 Result<void> read_mesh_transform(const json& cloth, MeshTransform& t) {
-  SCENE_TRY_ASSIGN(obj, sd::read_object(cloth, "cloth", "mesh_transform"));
-  if (!obj)
-    return {};
-  VKCLOTH_TRY(sd::check_keys(*obj, "cloth.mesh_transform", {"translate", "rotate_deg", "scale"}));
-  VKCLOTH_TRY(sd::read(*obj, "cloth.mesh_transform", "translate", t.translate));
-  VKCLOTH_TRY(sd::read(*obj, "cloth.mesh_transform", "rotate_deg", t.rotate_deg));
-  return sd::read(*obj, "cloth.mesh_transform", "scale", t.scale);
+  return sd::read_transform(cloth, "cloth", "mesh_transform", t.translate, t.rotate_deg, t.scale);
 }
 
 Result<void> read_mesh_pins(const json& cloth, MeshClothDesc& d) {
@@ -291,8 +392,7 @@ Result<void> read_mesh_cloth(const json& cloth, const std::filesystem::path& sce
   VKCLOTH_TRY(read_stiffness(cloth, d.stiffness));
   VKCLOTH_TRY(read_mesh_pins(cloth, d));
 
-  const std::filesystem::path path =
-      std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : scene_dir / file;
+  const std::filesystem::path path = scene_relative(file, scene_dir);
   auto mesh = read_mesh(path);
   if (!mesh)
     return mesh.error();
@@ -300,7 +400,7 @@ Result<void> read_mesh_cloth(const json& cloth, const std::filesystem::path& sce
   if (!made)
     return Error{made.error().code, fmt::format("{}: {}", path.string(), made.error().message), 0};
   scene.system = std::move(made->system);
-  scene.warnings = std::move(made->warnings);
+  scene.warnings.insert(scene.warnings.end(), made->warnings.begin(), made->warnings.end());
   scene.texture = std::move(mesh->texture);
   return {};
 }
@@ -399,7 +499,8 @@ Result<Scene> build_scene(const json& doc, std::string_view source_name) {
     scene.params.damping = material->damping;
   }
   VKCLOTH_TRY(read_wind(doc, scene.params));
-  VKCLOTH_TRY(read_colliders(doc, scene.params));
+  const std::filesystem::path scene_dir = std::filesystem::path(source_name).parent_path();
+  VKCLOTH_TRY(read_colliders(doc, scene_dir, scene));
   VKCLOTH_TRY(read_stretch_limit(doc, scene.params));
   VKCLOTH_TRY(sd::read(doc, "", "contact_epsilon", scene.params.contact_epsilon));
   VKCLOTH_TRY(sd::read(doc, "", "divergence_limit", scene.params.divergence_limit));
@@ -408,7 +509,7 @@ Result<Scene> build_scene(const json& doc, std::string_view source_name) {
 
   if (const json* cloth = kind == "cloth" && doc.contains("cloth") ? &doc["cloth"] : nullptr;
       cloth && cloth->is_object() && cloth->contains("mesh")) {
-    VKCLOTH_TRY(read_mesh_cloth(*cloth, std::filesystem::path(source_name).parent_path(), material, scene));
+    VKCLOTH_TRY(read_mesh_cloth(*cloth, scene_dir, material, scene));
     return scene;
   }
   auto system = kind == "chain" ? read_chain(doc) : read_cloth(doc, material);
