@@ -206,6 +206,8 @@ int run_window(const vkcloth::Scene& scene, const Options& o) {
     auto buffers = solver->record_frame(f.cmd, in.paused ? 0 : steps, std::uint32_t(frame));
     if (!buffers)
       return fail(buffers.error());
+    if (auto r = renderer->set_colliders(solver->params().colliders); !r) // where the steps left them
+      return fail(r.error());
     w.begin_render_pass(f, renderer->palette().background);
     renderer->record_draw(f.cmd, *buffers, cam, f.extent);
     if (!w.end_render_pass_and_submit(f))

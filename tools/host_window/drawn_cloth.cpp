@@ -66,12 +66,12 @@ Result<gpu::InstanceBuffers> DrawnCloth::record_frame(VkCommandBuffer cmd, std::
   return host_->upload(slot, cpu_->positions(), cpu_->normals());
 }
 
-Result<render::Image> DrawnCloth::render(render::OffscreenTarget& target,
-                                         const render::ClothRenderer& renderer, const render::Camera& camera,
-                                         std::uint32_t steps) {
+Result<render::Image> DrawnCloth::render(render::OffscreenTarget& target, render::ClothRenderer& renderer,
+                                         const render::Camera& camera, std::uint32_t steps) {
   if (gpu_)
-    return target.render(*gpu_, renderer, camera, steps);
+    return target.render(*gpu_, renderer, camera, steps); // draws the solver's colliders as they are
   VKCLOTH_TRY(cpu_->run(steps));
+  VKCLOTH_TRY(renderer.set_colliders(cpu_->params().colliders)); // where the steps left them
   // Slot 0 every time: render() waits for its submission, so nothing still reads it.
   auto buffers = host_->upload(0, cpu_->positions(), cpu_->normals());
   if (!buffers)

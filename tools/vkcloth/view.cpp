@@ -140,6 +140,7 @@ Result<void> Viewer::draw_frame() {
   auto buffers = solver_->record_frame(f.cmd, steps, upload_slot_++, held);
   if (!buffers)
     return buffers.error();
+  VKCLOTH_TRY(renderer_->set_colliders(solver_->params().colliders)); // where the steps left them
   window_.begin_render_pass(f, renderer_->palette().background);
   renderer_->record_draw(f.cmd, *buffers, orbit_.camera(), f.extent);
   VKCLOTH_TRY(window_.end_render_pass_and_submit(f));

@@ -9,6 +9,8 @@
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 
+#include "vkcloth/collider_mesh.hpp"
+
 namespace vkcloth::render {
 
 float Bounds::radius() const {
@@ -26,13 +28,39 @@ Bounds scene_bounds(const ParticleSystem& system, const SimParams& params) {
   if (system.particles.empty())
     add(glm::vec3(0.0f));
   const glm::vec3 c = b.center();
+  // A box [center - e, center + e] around a point with half extents e.
+  const auto add_box = [&](glm::dvec3 center, glm::dvec3 e) {
+    add(glm::vec3(center - e));
+    add(glm::vec3(center + e));
+  };
   for (const Collider& k : params.colliders) {
-    if (k.type == Collider::Type::sphere) {
-      add(glm::vec3(k.center) - float(k.radius));
-      add(glm::vec3(k.center) + float(k.radius));
-    } else {
+    switch (k.type) {
+    case Collider::Type::plane: {
       const glm::vec3 n = glm::normalize(glm::vec3(k.normal));
       add(c - (glm::dot(n, c) - float(k.offset)) * n);
+      break;
+    }
+    case Collider::Type::sphere:
+      add_box(k.center, glm::dvec3(k.radius));
+      break;
+    case Collider::Type::capsule:
+      add_box(k.a, glm::dvec3(k.radius));
+      add_box(k.b, glm::dvec3(k.radius));
+      break;
+    case Collider::Type::box: {
+      // The rotated box's extent along world axis i: sum over its axes j of |R_ij| h_j.
+      glm::dmat3 abs_r;
+      for (int j = 0; j < 3; ++j)
+        abs_r[j] = glm::abs(k.rotation[j]);
+      add_box(k.center, abs_r * k.half_extents);
+      break;
+    }
+    case Collider::Type::mesh:
+      if (k.mesh)
+        for (const ColliderMesh::Triangle& t : k.mesh->triangles())
+          for (const glm::vec3& p : {t.a, t.b, t.c})
+            add(glm::vec3(k.center + k.rotation * glm::dvec3(p)));
+      break;
     }
   }
   return b;

@@ -5,18 +5,23 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
+#include <glm/ext/matrix_transform.hpp>
 #include <glm/geometric.hpp>
+#include <glm/mat3x3.hpp>
 #include <glm/mat4x4.hpp>
 #include <glm/vec4.hpp>
 
 #include "../vulkan/barriers.hpp"
 #include "../vulkan/pipelines.hpp"
-#include "vkcloth/render/cloth_renderer.hpp"
+#include "vkcloth/collider_mesh.hpp"
 #include "vkcloth/gpu/world.hpp"
+#include "vkcloth/render/cloth_renderer.hpp"
 #include "vkcloth/shaders/render/cloth_frag_spv.hpp"
 #include "vkcloth/shaders/render/cloth_vert_spv.hpp"
 #include "vkcloth/shaders/render/line_frag_spv.hpp"
@@ -33,15 +38,16 @@ namespace {
 
 /// The shaders' push constants (shaders/render/render_common.glsl).
 struct DrawConstants {
-  glm::mat4 view_proj;
-  glm::vec4 eye;
-  glm::vec4 light;  // xyz towards the light, w ambient
-  glm::vec4 color;  // mesh colour or the cloth's back tint
-  glm::vec4 params; // x mode, y checker cell, z instance scale
+  glm::mat4 view_proj; // the draw's frame -> clip (a collider's: times its rigid pose)
+  glm::vec4 eye;       // xyz in the draw's frame, w checker cell
+  glm::vec4 light;     // xyz towards the light (draw's frame), w ambient
+  glm::vec4 color;     // mesh colour or the cloth's back tint, w mode
+  glm::vec4 shape;     // mesh.vert: xyz vertex scale, w capsule half length
 };
 static_assert(sizeof(DrawConstants) == 128, "push constants must fit the guaranteed 128 bytes");
 
-/// Mesh vertex: position (w: checker u) and normal (w: checker v), as mesh.vert reads them.
+/// Mesh vertex: position (w: checker u, or a capsule vertex's end) and normal (w: checker v), as
+/// mesh.vert reads them.
 struct MeshVertex {
   glm::vec4 pos;
   glm::vec4 normal;
@@ -53,10 +59,12 @@ struct MeshRange {
   glm::vec3 color{1.0f};
 };
 
+constexpr float pi = 3.14159265358979f;
+
+/// A sphere of radius `r` around `c`, `slices` around z and `stacks` from pole to pole.
 void add_sphere(std::vector<MeshVertex>& v, std::vector<std::uint32_t>& idx, glm::vec3 c, float r,
                 std::uint32_t slices, std::uint32_t stacks) {
   const auto base = static_cast<std::uint32_t>(v.size());
-  const float pi = 3.14159265358979f;
   for (std::uint32_t j = 0; j <= stacks; ++j) {
     const float th = pi * float(j) / float(stacks);
     for (std::uint32_t i = 0; i <= slices; ++i) {
@@ -72,21 +80,161 @@ void add_sphere(std::vector<MeshVertex>& v, std::vector<std::uint32_t>& idx, glm
     }
 }
 
-/// A plane collider drawn as a square of half side `half` around the point of the plane nearest
-/// to `around`; checker coordinates in the w components (mesh.vert).
-void add_plane(std::vector<MeshVertex>& v, std::vector<std::uint32_t>& idx, glm::vec3 n, float offset,
-               glm::vec3 around, float half) {
-  // Drawn a hair below the surface: cloth resting at offset + eps never z-fights with it.
-  const glm::vec3 centre = around - (glm::dot(n, around) - offset + 1e-3f) * n;
+/// A unit-radius capsule along z of length 0: a unit sphere cut at its equator, whose upper
+/// half's vertices carry w = +1 and lower half's w = -1, the equator in both. mesh.vert moves each
+/// half by +-pc.shape.w along z, which opens the strip between the two equators into the
+/// cylinder (its normals, the equator's, are already horizontal).
+void add_unit_capsule(std::vector<MeshVertex>& v, std::vector<std::uint32_t>& idx, std::uint32_t slices,
+                      std::uint32_t half_stacks) {
+  const auto base = static_cast<std::uint32_t>(v.size());
+  const std::uint32_t rings = 2 * (half_stacks + 1); // each half: pole .. equator
+  for (std::uint32_t ring = 0; ring < rings; ++ring) {
+    const bool upper = ring <= half_stacks;
+    const std::uint32_t j = upper ? ring : ring - 1; // the equator (j = half_stacks) twice
+    const float th = pi * float(j) / float(2 * half_stacks);
+    for (std::uint32_t i = 0; i <= slices; ++i) {
+      const float ph = 2.0f * pi * float(i) / float(slices);
+      const glm::vec3 n(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th));
+      v.push_back({glm::vec4(n, upper ? 1.0f : -1.0f), glm::vec4(n, 0.0f)});
+    }
+  }
+  for (std::uint32_t ring = 0; ring + 1 < rings; ++ring)
+    for (std::uint32_t i = 0; i < slices; ++i) {
+      const std::uint32_t a = base + ring * (slices + 1) + i, b = a + slices + 1;
+      idx.insert(idx.end(), {a, b, a + 1, a + 1, b, b + 1});
+    }
+}
+
+/// The box [-1, 1]^3: 6 faces of 4 vertices with the face's normal (flat shading: each face lit
+/// on its own, so the edges show), 12 triangles.
+void add_unit_box(std::vector<MeshVertex>& v, std::vector<std::uint32_t>& idx) {
+  for (int axis = 0; axis < 3; ++axis)
+    for (float side : {-1.0f, 1.0f}) {
+      glm::vec3 n(0.0f), t(0.0f), s(0.0f);
+      n[axis] = side;
+      t[(axis + 1) % 3] = 1.0f;
+      s[(axis + 2) % 3] = 1.0f;
+      const auto base = static_cast<std::uint32_t>(v.size());
+      for (int q = 0; q < 4; ++q) {
+        const float u = (q == 1 || q == 2) ? 1.0f : -1.0f, w = q >= 2 ? 1.0f : -1.0f;
+        v.push_back({glm::vec4(n + u * t + w * s, 0.0f), glm::vec4(n, 0.0f)});
+      }
+      idx.insert(idx.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+    }
+}
+
+/// A mesh collider's triangles in its own frame, three vertices each with the face normal.
+void add_collider_mesh(std::vector<MeshVertex>& v, std::vector<std::uint32_t>& idx,
+                       const ColliderMesh& mesh) {
+  for (const ColliderMesh::Triangle& t : mesh.triangles()) {
+    const glm::vec3 c = glm::cross(t.b - t.a, t.c - t.a);
+    const float len = glm::length(c);
+    const glm::vec3 n = len > 0.0f ? c / len : glm::vec3(0.0f, 0.0f, 1.0f);
+    const auto base = static_cast<std::uint32_t>(v.size());
+    for (const glm::vec3& p : {t.a, t.b, t.c})
+      v.push_back({glm::vec4(p, 0.0f), glm::vec4(n, 0.0f)});
+    idx.insert(idx.end(), {base, base + 1, base + 2});
+  }
+}
+
+/// Unit tangents t, s with (t, s, n) right-handed, as the floor square is laid out.
+glm::mat3 plane_frame(glm::vec3 n) {
   const glm::vec3 t =
       glm::normalize(glm::cross(n, std::abs(n.z) < 0.9f ? glm::vec3(0, 0, 1) : glm::vec3(1, 0, 0)));
-  const glm::vec3 s = glm::cross(n, t);
+  return glm::mat3(t, glm::cross(n, t), n);
+}
+
+/// Where the floor square of a plane (unit normal n, offset) is centred: the point of the plane
+/// nearest to `around`, a hair below the surface (cloth resting at offset + eps never z-fights
+/// with it).
+glm::vec3 plane_centre(glm::vec3 n, float offset, glm::vec3 around) {
+  return around - (glm::dot(n, around) - offset + 1e-3f) * n;
+}
+
+/// A plane collider drawn as a square of half side `half` around `centre` (plane_centre);
+/// checker coordinates in the w components (mesh.vert).
+void add_plane(std::vector<MeshVertex>& v, std::vector<std::uint32_t>& idx, glm::vec3 n, glm::vec3 centre,
+               float half) {
+  const glm::mat3 f = plane_frame(n);
   const auto base = static_cast<std::uint32_t>(v.size());
   for (int q = 0; q < 4; ++q) {
     const float u = (q == 1 || q == 2) ? half : -half, w = q >= 2 ? half : -half;
-    v.push_back({glm::vec4(centre + u * t + w * s, u + half), glm::vec4(n, w + half)});
+    v.push_back({glm::vec4(centre + u * f[0] + w * f[1], u + half), glm::vec4(n, w + half)});
   }
   idx.insert(idx.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+}
+
+/// A collider's draw: its mesh in the shared buffers and what create() built it from.
+struct ColliderDraw {
+  Collider::Type type = Collider::Type::plane;
+  MeshRange range;
+  const ColliderMesh* mesh = nullptr; ///< mesh: the ColliderMesh whose triangles `range` holds
+  glm::vec3 plane_normal{0.0f};       ///< plane: the square's normal, as built (world) ...
+  glm::vec3 plane_centre{0.0f};       ///< ... and its centre
+  glm::vec3 around{0.0f};             ///< plane: the point the square is centred under
+};
+
+/// A draw's rigid pose (its frame -> world) and mesh.vert's shape (vertex scale, capsule half length).
+struct Pose {
+  glm::dmat4 model{1.0};
+  glm::vec4 shape{1.0f, 1.0f, 1.0f, 0.0f};
+};
+
+/// The collider shapes a cloth rests on are drawn slightly inside the true surface. Particles rest
+/// at the surface + eps, but the flat cloth triangles between them cut chords through a curved
+/// surface (a sag of h^2 / 8r for a spacing h over radius r): a sphere or capsule drawn at full
+/// size would poke through a coarse cloth draped on it, so both are drawn 5% thinner. A box's
+/// faces are flat (no chords): drawn 1 mm inside, like the floor, so cloth lying on a face never
+/// z-fights with it.
+constexpr double round_shrink = 0.95;
+constexpr double box_inset = 1e-3;
+
+/// Where `k` is now, for the draw `d` built from the create()-time collider of the same type.
+Pose pose_of(const ColliderDraw& d, const Collider& k) {
+  Pose p;
+  switch (k.type) {
+  case Collider::Type::plane: {
+    // Built in the world; a plane moved along (or turned from) its create()-time normal is the same
+    // square carried onto the new plane: the old centre to the new, the old frame onto the new.
+    const glm::vec3 n = glm::normalize(glm::vec3(k.normal));
+    const glm::vec3 c = plane_centre(n, float(k.offset), d.around);
+    if (n == d.plane_normal && c == d.plane_centre)
+      return p; // where it was built: the identity
+    const glm::dmat3 turn =
+        glm::dmat3(plane_frame(n)) * glm::transpose(glm::dmat3(plane_frame(d.plane_normal)));
+    p.model = glm::translate(glm::dmat4(1.0), glm::dvec3(c)) * glm::dmat4(turn) *
+              glm::translate(glm::dmat4(1.0), -glm::dvec3(d.plane_centre));
+    return p;
+  }
+  case Collider::Type::sphere:
+    p.model = glm::translate(glm::dmat4(1.0), k.center);
+    p.shape = glm::vec4(glm::vec3(float(k.radius * round_shrink)), 0.0f);
+    return p;
+  case Collider::Type::capsule: {
+    // The unit capsule lies along z: turn z onto b - a (any turn about the axis will do) and put
+    // its middle at (a + b) / 2. a == b: a sphere (half length 0).
+    const glm::dvec3 axis = k.b - k.a;
+    const double length = glm::length(axis);
+    const glm::dvec3 z = length > 0.0 ? axis / length : glm::dvec3(0.0, 0.0, 1.0);
+    const glm::dvec3 x =
+        glm::normalize(glm::cross(std::abs(z.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0), z));
+    p.model = glm::dmat4(glm::dvec4(x, 0.0), glm::dvec4(glm::cross(z, x), 0.0), glm::dvec4(z, 0.0),
+                         glm::dvec4((k.a + k.b) * 0.5, 1.0));
+    p.shape = glm::vec4(glm::vec3(float(k.radius * round_shrink)), float(0.5 * length));
+    return p;
+  }
+  case Collider::Type::box: {
+    const glm::dvec3 h = glm::max(k.half_extents - box_inset, 0.9 * k.half_extents);
+    p.model = glm::translate(glm::dmat4(1.0), k.center) * glm::dmat4(k.rotation);
+    p.shape = glm::vec4(glm::vec3(h), 0.0f);
+    return p;
+  }
+  case Collider::Type::mesh:
+    // Drawn as it is: the cloth rests `thickness` away from its triangles.
+    p.model = glm::translate(glm::dmat4(1.0), k.center) * glm::dmat4(k.rotation);
+    return p;
+  }
+  return p;
 }
 
 } // namespace
@@ -101,8 +249,9 @@ struct ClothRenderer::Impl {
   Buffer cloth_index; // the topology's triangles (grid or mesh), or chain springs as a line list
   std::uint32_t cloth_index_count = 0;
   Buffer mesh_vertices, mesh_index, zero_instance;
-  std::vector<MeshRange> colliders;
-  MeshRange unit_sphere; // chain masses (instanced at the solver's positions)
+  std::vector<ColliderDraw> draws; // one per create()-time collider
+  std::vector<Collider> colliders; // their poses now (create(), set_colliders())
+  MeshRange unit_sphere;           // chain masses (instanced at the solver's positions)
 
   gpu::ImageResource texture;
   gpu::Sampler sampler;
@@ -129,6 +278,13 @@ struct ClothRenderer::Impl {
   Result<void> upload_texture(const Image& img);
   Result<void> create_texture_set();
   Result<void> build_pipelines(const RendererOptions& o);
+  /// The colliders' draws, each at its pose in `now` (same index; one whose type or mesh is not
+  /// the create()-time one there, or missing, is not drawn).
+  void record_colliders(VkCommandBuffer cmd, const Camera& camera, float aspect,
+                        std::span<const Collider> now) const;
+  /// record_draw: the colliders at `now`, then the cloth or chain from `buffers`.
+  void record(VkCommandBuffer cmd, const gpu::InstanceBuffers& buffers, std::span<const Collider> now,
+              const Camera& camera, VkExtent2D extent) const;
 };
 
 Result<void> ClothRenderer::Impl::build_geometry(const ClothTopology& topology, const SimParams& params,
@@ -149,28 +305,73 @@ Result<void> ClothRenderer::Impl::build_geometry(const ClothTopology& topology, 
     return ci.error();
   cloth_index = std::move(*ci);
 
-  // Colliders, in world space; the floor is a square around the scene's centre.
+  // Colliders: each shape once in its own frame (record_draw poses it); the floor is a square
+  // in the world around the scene's centre.
   const Bounds b = scene_bounds(system, params);
   const float half = o.floor_half_size > 0.0f ? o.floor_half_size : std::max(1.0f, 1.6f * b.radius());
   std::vector<MeshVertex> verts;
   std::vector<std::uint32_t> midx;
-  for (const Collider& k : params.colliders) {
+  std::optional<MeshRange> sphere, capsule, box;
+  std::vector<std::pair<const ColliderMesh*, MeshRange>> meshes;
+  // `add` appends one shape's triangles and returns their range.
+  const auto shape = [&](auto&& add) {
     MeshRange r;
     r.first = static_cast<std::uint32_t>(midx.size());
-    if (k.type == Collider::Type::sphere) {
-      // Drawn 5% smaller: the cloth's particles rest on the true surface, but its flat triangles
-      // between them cut chords through it (sag h^2 / 8r); a coarse grid would show the sphere
-      // poking through.
-      add_sphere(verts, midx, glm::vec3(k.center), float(k.radius) * 0.95f, 48, 24);
-      r.color = palette.sphere;
-    } else {
-      add_plane(verts, midx, glm::normalize(glm::vec3(k.normal)), float(k.offset), b.center(), half);
-      r.mode = 1.0f;
-      r.cell = half / 5.0f;
-      r.color = palette.floor;
-    }
+    add();
     r.count = static_cast<std::uint32_t>(midx.size()) - r.first;
-    colliders.push_back(r);
+    return r;
+  };
+  for (const Collider& k : params.colliders) {
+    ColliderDraw d;
+    d.type = k.type;
+    switch (k.type) {
+    case Collider::Type::plane: {
+      d.plane_normal = glm::normalize(glm::vec3(k.normal));
+      d.around = b.center();
+      d.plane_centre = plane_centre(d.plane_normal, float(k.offset), d.around);
+      d.range = shape([&] { add_plane(verts, midx, d.plane_normal, d.plane_centre, half); });
+      d.range.mode = 1.0f;
+      d.range.cell = half / 5.0f;
+      d.range.color = palette.floor;
+      break;
+    }
+    case Collider::Type::sphere:
+      if (!sphere)
+        sphere = shape([&] { add_sphere(verts, midx, glm::vec3(0.0f), 1.0f, 48, 24); });
+      d.range = *sphere;
+      d.range.color = palette.sphere;
+      break;
+    case Collider::Type::capsule:
+      if (!capsule)
+        capsule = shape([&] { add_unit_capsule(verts, midx, 48, 12); });
+      d.range = *capsule;
+      d.range.color = palette.capsule;
+      break;
+    case Collider::Type::box:
+      if (!box)
+        box = shape([&] { add_unit_box(verts, midx); });
+      d.range = *box;
+      d.range.color = palette.box;
+      break;
+    case Collider::Type::mesh: {
+      if (!k.mesh)
+        return make_error(ErrorCode::invalid_argument,
+                          fmt::format("collider {} is a mesh without its ColliderMesh", colliders.size()));
+      d.mesh = k.mesh.get();
+      auto known =
+          std::find_if(meshes.begin(), meshes.end(), [&](const auto& m) { return m.first == d.mesh; });
+      if (known == meshes.end())
+        known = meshes.emplace(meshes.end(), d.mesh, shape([&] { add_collider_mesh(verts, midx, *k.mesh); }));
+      d.range = known->second;
+      d.range.color = palette.mesh;
+      break;
+    }
+    default:
+      return make_error(ErrorCode::invalid_argument, fmt::format("collider {} has an unknown type ({})",
+                                                                 colliders.size(), std::uint32_t(k.type)));
+    }
+    draws.push_back(d);
+    colliders.push_back(k);
   }
   unit_sphere.first = static_cast<std::uint32_t>(midx.size());
   add_sphere(verts, midx, glm::vec3(0.0f), 1.0f, 16, 8);
@@ -475,41 +676,92 @@ bool ClothRenderer::draws_cloth() const {
   return impl_->surface;
 }
 
+Result<void> ClothRenderer::set_colliders(std::span<const Collider> colliders) {
+  Impl& s = *impl_;
+  if (colliders.size() != s.draws.size())
+    return make_error(
+        ErrorCode::invalid_argument,
+        fmt::format("set_colliders: {} colliders, but the renderer was created with {} (create a "
+                    "renderer for a different collider list)",
+                    colliders.size(), s.draws.size()));
+  for (std::size_t i = 0; i < colliders.size(); ++i) {
+    const ColliderDraw& d = s.draws[i];
+    if (colliders[i].type != d.type)
+      return make_error(ErrorCode::invalid_argument,
+                        fmt::format("set_colliders: collider {} is of type {}, but was {} at create()", i,
+                                    std::uint32_t(colliders[i].type), std::uint32_t(d.type)));
+    if (d.type == Collider::Type::mesh && colliders[i].mesh.get() != d.mesh)
+      return make_error(ErrorCode::invalid_argument,
+                        fmt::format("set_colliders: collider {} is a different mesh ('{}') from the one at "
+                                    "create(): a renderer draws the meshes it was created with",
+                                    i, colliders[i].mesh ? colliders[i].mesh->name() : std::string("none")));
+  }
+  s.colliders.assign(colliders.begin(), colliders.end());
+  return {};
+}
+
+void ClothRenderer::Impl::record_colliders(VkCommandBuffer cmd, const Camera& camera, float aspect,
+                                           std::span<const Collider> now) const {
+  const auto& v = ctx->vk;
+  constexpr VkShaderStageFlags stages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
+  // One mesh buffer for every shape, one zero instance offset.
+  v.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, mesh_pipeline);
+  v.vkCmdBindIndexBuffer(cmd, mesh_index.buffer, 0, VK_INDEX_TYPE_UINT32);
+  const VkBuffer bufs[2] = {mesh_vertices.buffer, zero_instance.buffer};
+  const VkDeviceSize offs[2] = {0, 0};
+  v.vkCmdBindVertexBuffers(cmd, 0, 2, bufs, offs);
+  const glm::mat4 view_proj = camera.view_projection(aspect);
+  const glm::dvec3 light(glm::normalize(palette.light_dir)); // as the world-frame draws have it
+  DrawConstants pc{};
+  for (std::size_t i = 0; i < draws.size() && i < now.size(); ++i) {
+    const ColliderDraw& d = draws[i];
+    if (now[i].type != d.type || (d.type == Collider::Type::mesh && now[i].mesh.get() != d.mesh))
+      continue; // not the collider this draw was built for
+    const Pose p = pose_of(d, now[i]);
+    // The draw's frame is the collider's: clip from it, the eye and the light in it (the inverse
+    // of a rigid pose: R^T (x - t)).
+    const glm::dmat3 r(p.model);
+    const glm::dvec3 t(p.model[3]);
+    pc.view_proj = view_proj * glm::mat4(p.model);
+    pc.eye = glm::vec4(glm::transpose(r) * (glm::dvec3(camera.eye) - t), d.range.cell);
+    pc.light = glm::vec4(glm::transpose(r) * light, palette.ambient);
+    pc.color = glm::vec4(d.range.color, d.range.mode);
+    pc.shape = p.shape;
+    v.vkCmdPushConstants(cmd, layout, stages, 0, sizeof(pc), &pc);
+    v.vkCmdDrawIndexed(cmd, d.range.count, 1, d.range.first, 0, 0);
+  }
+}
+
 void ClothRenderer::record_draw(VkCommandBuffer cmd, const gpu::GpuSolver& solver, const Camera& camera,
                                 VkExtent2D extent) const {
-  record_draw(cmd, solver.buffers(), camera, extent);
+  impl_->record(cmd, solver.buffers(), solver.params().colliders, camera, extent);
 }
 
 void ClothRenderer::record_draw(VkCommandBuffer cmd, const gpu::InstanceBuffers& buffers,
                                 const Camera& camera, VkExtent2D extent) const {
-  const Impl& s = *impl_;
+  impl_->record(cmd, buffers, impl_->colliders, camera, extent);
+}
+
+void ClothRenderer::Impl::record(VkCommandBuffer cmd, const gpu::InstanceBuffers& buffers,
+                                 std::span<const Collider> now, const Camera& camera,
+                                 VkExtent2D extent) const {
+  const Impl& s = *this;
   const auto& v = s.ctx->vk;
   const VkViewport viewport{0.0f, 0.0f, float(extent.width), float(extent.height), 0.0f, 1.0f};
   const VkRect2D scissor{{0, 0}, extent};
   v.vkCmdSetViewport(cmd, 0, 1, &viewport);
   v.vkCmdSetScissor(cmd, 0, 1, &scissor);
+  const float aspect = float(extent.width) / float(std::max(extent.height, 1u));
   DrawConstants pc{};
-  pc.view_proj = camera.view_projection(float(extent.width) / float(std::max(extent.height, 1u)));
+  pc.view_proj = camera.view_projection(aspect);
   pc.eye = glm::vec4(camera.eye, 1.0f);
   pc.light = glm::vec4(glm::normalize(s.palette.light_dir), s.palette.ambient);
+  pc.shape = glm::vec4(1.0f, 1.0f, 1.0f, 0.0f);
   constexpr VkShaderStageFlags stages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
   const VkDeviceSize at = buffers.offset; // this instance's first particle (ClothWorld batches)
   const VkBuffer positions = buffers.positions;
 
-  // Colliders: world-space meshes, one zero instance offset.
-  v.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.mesh_pipeline);
-  v.vkCmdBindIndexBuffer(cmd, s.mesh_index.buffer, 0, VK_INDEX_TYPE_UINT32);
-  {
-    const VkBuffer bufs[2] = {s.mesh_vertices.buffer, s.zero_instance.buffer};
-    const VkDeviceSize offs[2] = {0, 0};
-    v.vkCmdBindVertexBuffers(cmd, 0, 2, bufs, offs);
-  }
-  for (const MeshRange& r : s.colliders) {
-    pc.color = glm::vec4(r.color, 1.0f);
-    pc.params = glm::vec4(r.mode, r.cell, 1.0f, 0.0f);
-    v.vkCmdPushConstants(cmd, s.layout, stages, 0, sizeof(pc), &pc);
-    v.vkCmdDrawIndexed(cmd, r.count, 1, r.first, 0, 0);
-  }
+  record_colliders(cmd, camera, aspect, now);
 
   if (s.surface) {
     // The cloth: the solver's current positions, normals and uvs as vertex buffers.
@@ -523,15 +775,14 @@ void ClothRenderer::record_draw(VkCommandBuffer cmd, const gpu::InstanceBuffers&
     const bool solver_indices = buffers.indices && buffers.index_count == s.cloth_index_count;
     v.vkCmdBindIndexBuffer(cmd, solver_indices ? buffers.indices : s.cloth_index.buffer, 0,
                            VK_INDEX_TYPE_UINT32);
-    pc.color = glm::vec4(s.palette.back_tint, 1.0f);
-    pc.params = glm::vec4(0.0f, 1.0f, 1.0f, 0.0f);
+    pc.color = glm::vec4(s.palette.back_tint, 0.0f);
     v.vkCmdPushConstants(cmd, s.layout, stages, 0, sizeof(pc), &pc);
     v.vkCmdDrawIndexed(cmd, s.cloth_index_count, 1, 0, 0, 0);
     return;
   }
   // A chain: springs as lines, masses as small spheres instanced at the current positions.
-  pc.color = glm::vec4(s.palette.chain, 1.0f);
-  pc.params = glm::vec4(0.0f, 1.0f, s.mass_radius, 0.0f);
+  pc.color = glm::vec4(s.palette.chain, 0.0f);
+  pc.shape = glm::vec4(glm::vec3(s.mass_radius), 0.0f);
   if (s.cloth_index_count) {
     v.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.line_pipeline);
     v.vkCmdBindVertexBuffers(cmd, 0, 1, &positions, &at);

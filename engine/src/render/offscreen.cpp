@@ -2,6 +2,7 @@
 #include "render_internal.hpp"
 
 #include <cstring>
+#include <functional>
 
 #include <fmt/format.h>
 
@@ -21,8 +22,9 @@ struct OffscreenTarget::Impl {
   gpu::CommandContext commands;
 
   Result<void> create_render_pass(VkFormat color_format);
+  /// The render pass around `draw` (the renderer's record_draw), then the readback.
   void record_draw_and_readback(VkCommandBuffer c, const ClothRenderer& renderer,
-                                const gpu::InstanceBuffers& buffers, const Camera& camera) const;
+                                const std::function<void(VkExtent2D)>& draw) const;
   Image read_image() const;
 };
 
@@ -143,11 +145,10 @@ std::uint32_t OffscreenTarget::height() const {
   return impl_->height;
 }
 
-// The render pass (cleared to the renderer's background) drawing `buffers`, then the copy of the
+// The render pass (cleared to the renderer's background) with the draws, then the copy of the
 // colour image to the readback buffer and the barrier to the host's read.
 void OffscreenTarget::Impl::record_draw_and_readback(VkCommandBuffer c, const ClothRenderer& renderer,
-                                                     const gpu::InstanceBuffers& buffers,
-                                                     const Camera& camera) const {
+                                                     const std::function<void(VkExtent2D)>& draw) const {
   const auto& v = ctx->vk;
   const glm::vec3 bg = renderer.palette().background;
   VkClearValue clears[2]{};
@@ -161,7 +162,7 @@ void OffscreenTarget::Impl::record_draw_and_readback(VkCommandBuffer c, const Cl
   rb.clearValueCount = 2;
   rb.pClearValues = clears;
   v.vkCmdBeginRenderPass(c, &rb, VK_SUBPASS_CONTENTS_INLINE);
-  renderer.record_draw(c, buffers, camera, {width, height});
+  draw({width, height});
   v.vkCmdEndRenderPass(c); // subpass dependency: colour writes -> transfer read, TRANSFER_SRC layout
   VkBufferImageCopy region{};
   region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
@@ -191,7 +192,9 @@ Result<Image> OffscreenTarget::render(gpu::GpuSolver& solver, const ClothRendere
     // THE compute -> graphics barrier: the steps' shader writes of positions[current] and normals
     // become visible to the vertex fetch of the draws below (VERTEX_INPUT / VERTEX_ATTRIBUTE_READ).
     solver.record_barrier_to(c, VK_PIPELINE_STAGE_VERTEX_INPUT_BIT, VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT);
-    s.record_draw_and_readback(c, renderer, solver.buffers(), camera);
+    // The solver's colliders where these steps leave them.
+    s.record_draw_and_readback(c, renderer,
+                               [&](VkExtent2D e) { renderer.record_draw(c, solver, camera, e); });
   }));
   if (steps)
     VKCLOTH_TRY(solver.check_divergence());
@@ -203,8 +206,10 @@ Result<Image> OffscreenTarget::render(const gpu::InstanceBuffers& buffers, const
   Impl& s = *impl_;
   // No barrier before the draws: the buffers are the host's (HostClothBuffers), written before
   // this submission, which makes host-coherent writes visible to all of its commands.
-  VKCLOTH_TRY(s.commands.submit_and_wait(
-      [&](VkCommandBuffer c) { s.record_draw_and_readback(c, renderer, buffers, camera); }));
+  VKCLOTH_TRY(s.commands.submit_and_wait([&](VkCommandBuffer c) {
+    s.record_draw_and_readback(c, renderer,
+                               [&](VkExtent2D e) { renderer.record_draw(c, buffers, camera, e); });
+  }));
   return s.read_image();
 }
 

@@ -56,11 +56,13 @@ public:
   /// need, then the buffers to draw. Vulkan: all recorded into `cmd`, ending with THE compute ->
   /// vertex barrier. CPU: the steps run now, on the host, and the state is uploaded into slot
   /// `slot` (the frame that last drew from that slot must have finished); nothing is recorded.
-  /// A CPU divergence is returned here; the GPU's by check_divergence().
+  /// A CPU divergence is returned here; the GPU's by check_divergence(). Draw the colliders where
+  /// the steps left them: renderer.set_colliders(params().colliders) before record_draw.
   Result<gpu::InstanceBuffers> record_frame(VkCommandBuffer cmd, std::uint32_t steps, std::uint32_t slot,
                                             const std::optional<HeldParticle>& held = {});
-  /// Offscreen: `steps` steps, then the frame drawn, read back (one submission on the GPU).
-  Result<render::Image> render(render::OffscreenTarget& target, const render::ClothRenderer& renderer,
+  /// Offscreen: `steps` steps, then the frame drawn, read back (one submission on the GPU); the
+  /// colliders where the steps left them (CPU: renderer.set_colliders(params().colliders)).
+  Result<render::Image> render(render::OffscreenTarget& target, render::ClothRenderer& renderer,
                                const render::Camera& camera, std::uint32_t steps = 0);
   /// `steps` steps, waited for (no drawing).
   Result<void> simulate(std::uint64_t steps);

@@ -22,8 +22,10 @@ struct Bounds {
   float radius() const; ///< half the diagonal
 };
 
-/// The particles' initial positions and the sphere colliders (planes are unbounded: the point of
-/// each plane under the particles' centre is included, so the floor is in view).
+/// The particles' initial positions and the colliders where `params` has them: spheres, capsules
+/// (both ends' spheres), boxes (their rotated corners' axis-aligned box) and meshes (their
+/// vertices, posed). Planes are unbounded: the point of each plane under the particles' centre is
+/// included, so the floor is in view.
 Bounds scene_bounds(const ParticleSystem& system, const SimParams& params);
 
 struct Camera {

@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: MIT
 // Draws a GpuSolver's cloth (or chain) and its colliders with Vulkan graphics, straight from the
 // solver's buffers: positions[current], normals and uvs are bound as vertex buffers (vec4, stride
-// 16); nothing goes through the CPU. (A CPU solver's state is drawn the same way from
-// HostClothBuffers, host_buffers.hpp.) It records into the caller's command buffer, inside the
+// 16); nothing goes through the CPU. Each collider is drawn where it is at record time (its pose
+// is pushed with its draw), so a moving collider moves with the cloth. (A CPU solver's state is drawn the
+// same way from HostClothBuffers, host_buffers.hpp.) It records into the caller's command buffer, inside the
 // caller's render pass (a VkRenderPass subpass with one colour and one depth attachment), so an
 // engine can embed it, or ignore it and bind the same buffers itself.
 //
@@ -23,6 +24,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 
 #include <glm/vec3.hpp>
 #include <vulkan/vulkan_core.h>
@@ -30,6 +32,7 @@
 #include "vkcloth/gpu/context.hpp"
 #include "vkcloth/gpu/gpu_solver.hpp"
 #include "vkcloth/mesh.hpp"
+#include "vkcloth/params.hpp"
 #include "vkcloth/render/camera.hpp"
 #include "vkcloth/render/image.hpp"
 #include "vkcloth/result.hpp"
@@ -62,6 +65,9 @@ struct RendererOptions {
 struct Palette {
   glm::vec3 background{0.62f, 0.72f, 0.84f}; ///< clear colour suggested to callers
   glm::vec3 sphere{0.85f, 0.25f, 0.18f};     ///< sphere colliders: brick red
+  glm::vec3 capsule{0.18f, 0.60f, 0.48f};    ///< capsule colliders: teal
+  glm::vec3 box{0.88f, 0.62f, 0.16f};        ///< box colliders: ochre
+  glm::vec3 mesh{0.52f, 0.36f, 0.78f};       ///< mesh colliders: violet
   glm::vec3 floor{0.80f, 0.80f, 0.74f};      ///< floor checker: light cells (dark = 0.55x)
   glm::vec3 back_tint{0.55f, 0.62f, 0.95f};  ///< multiplies the texture on the cloth's back side
   glm::vec3 chain{0.20f, 0.20f, 0.22f};      ///< chain springs (lines) and masses
@@ -72,8 +78,9 @@ struct Palette {
 class ClothRenderer {
 public:
   /// Builds the pipelines for `options.render_pass`, the index buffer (the topology's triangles,
-  /// or a chain's springs as lines), the collider meshes (from solver.params().colliders) and the
-  /// texture (decoded first when `options.encoded_texture` is set). `topology` must be the solver's
+  /// or a chain's springs as lines), the collider meshes (from solver.params().colliders: each
+  /// shape once, in its own frame; a mesh collider's triangles with face normals) and the texture
+  /// (decoded first when `options.encoded_texture` is set). `topology` must be the solver's
   /// (solver.topology()). The Context's queue family must support graphics
   /// (ContextOptions::require_graphics): ErrorCode::unsupported otherwise.
   static Result<ClothRenderer> create(gpu::Context& context, const gpu::GpuSolver& solver,
@@ -90,15 +97,28 @@ public:
   /// Command buffers that recorded draws must have finished executing.
   ~ClothRenderer();
 
-  /// Records the draws (floor, spheres, then the cloth or chain) inside the caller's render pass,
+  /// Records the draws (colliders, then the cloth or chain) inside the caller's render pass,
   /// with viewport and scissor set to `extent`. The solver's barrier (see the header comment)
-  /// must already be recorded.
+  /// must already be recorded. The colliders are drawn at solver.params().colliders, their pose
+  /// now (after the steps recorded so far). The renderer draws the colliders create() saw: one
+  /// whose type (or mesh) at its index is no longer that, or that is no longer in the list, is
+  /// not drawn; one added since is not either (create a renderer for the new list).
   void record_draw(VkCommandBuffer cmd, const gpu::GpuSolver& solver, const Camera& camera,
                    VkExtent2D extent) const;
-  /// The same from an instance's buffers (ClothWorld::buffers(id), or GpuSolver::buffers()):
-  /// query them after the last record_steps() (the current positions buffer alternates).
+  /// The same from an instance's buffers (ClothWorld::buffers(id), GpuSolver::buffers(),
+  /// HostClothBuffers::upload()): query them after the last record_steps() (the current positions
+  /// buffer alternates). The colliders are drawn at the poses of the last set_colliders() (at
+  /// first, those create() was given).
   void record_draw(VkCommandBuffer cmd, const gpu::InstanceBuffers& buffers, const Camera& camera,
                    VkExtent2D extent) const;
+  /// The colliders' poses for the next record_draw(cmd, buffers, ...) recordings: call it every
+  /// frame with the solver's current colliders (world.params(id)->colliders,
+  /// CpuSolver::params().colliders) when they move. The poses go into each recording's push
+  /// constants, so command buffers already recorded (frames in flight) keep theirs. `colliders`
+  /// must be the create()-time list re-posed: the same count, each of the same type (a mesh
+  /// collider with the same ColliderMesh); sizes may change (radius, capsule ends,
+  /// half_extents). ErrorCode::invalid_argument naming the index otherwise, nothing changed.
+  Result<void> set_colliders(std::span<const Collider> colliders);
 
   const Palette& palette() const;
   /// True when the topology has a surface (a cloth is drawn); false: masses and springs.

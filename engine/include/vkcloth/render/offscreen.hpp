@@ -33,14 +33,16 @@ public:
   std::uint32_t height() const;
 
   /// Records `steps` solver steps, the one compute -> vertex barrier, the render pass (cleared to
-  /// the renderer's background) with the draws, and the copy to the readback buffer; submits,
+  /// the renderer's background) with the draws (the colliders where the steps leave them:
+  /// ClothRenderer::record_draw(cmd, solver, ...)), and the copy to the readback buffer; submits,
   /// waits, checks the solver's divergence flags (ErrorCode::diverged), returns the frame.
   /// `before_steps`, when set, records the caller's own commands first (e.g. record_hold_particle).
   Result<Image> render(gpu::GpuSolver& solver, const ClothRenderer& renderer, const Camera& camera,
                        std::uint32_t steps = 0,
                        const std::function<void(VkCommandBuffer)>& before_steps = {});
   /// Draws `buffers` as they are (no steps, no barrier: e.g. HostClothBuffers::upload()'s, filled
-  /// by the host before this call), submits, waits, returns the frame.
+  /// by the host before this call), with the colliders of the renderer's last set_colliders(),
+  /// submits, waits, returns the frame.
   Result<Image> render(const gpu::InstanceBuffers& buffers, const ClothRenderer& renderer,
                        const Camera& camera);
 
