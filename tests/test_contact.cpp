@@ -86,7 +86,8 @@ double distance_to(const Collider& c, glm::dvec3 p) {
 } // namespace
 
 TEST_CASE("kernel: box, capsule and mesh distances and normals, edges and corners included") {
-  const Collider box = Collider::box({1, 2, 3}, {0.5, 0.25, 1.0}, Collider::rotation_from_degrees({0, 0, 90}));
+  const Collider box =
+      Collider::box({1, 2, 3}, {0.5, 0.25, 1.0}, Collider::rotation_from_degrees({0, 0, 90}));
   // The box turned 90 degrees about z: its x half extent (0.5) lies along world y.
   CHECK(distance_to(box, {1, 2.5 + 0.1, 3}) == doctest::Approx(0.1));
   CHECK(distance_to(box, {1 + 0.25 + 0.2, 2, 3}) == doctest::Approx(0.2));
@@ -98,16 +99,16 @@ TEST_CASE("kernel: box, capsule and mesh distances and normals, edges and corner
   CHECK(distance_to(box, {1 + 0.25 + 0.3, 2, 3 + 1.0 + 0.4}) == doctest::Approx(0.5));
 
   const Collider capsule = Collider::capsule({0, 0, 0}, {0, 0, 2}, 0.25);
-  CHECK(distance_to(capsule, {1, 0, 1}) == doctest::Approx(0.75));      // beside the segment
-  CHECK(distance_to(capsule, {0, 0.6, 2.8}) == doctest::Approx(0.75));  // beyond end b: a sphere cap
-  CHECK(distance_to(capsule, {0, 0.1, -0.1}) < 0.0);                    // inside cap a
+  CHECK(distance_to(capsule, {1, 0, 1}) == doctest::Approx(0.75));          // beside the segment
+  CHECK(distance_to(capsule, {0, 0.6, 2.8}) == doctest::Approx(0.75));      // beyond end b: a sphere cap
+  CHECK(distance_to(capsule, {0, 0.1, -0.1}) < 0.0);                        // inside cap a
   const Collider degenerate = Collider::capsule({1, 1, 1}, {1, 1, 1}, 0.5); // a == b: a sphere
   CHECK(distance_to(degenerate, {1, 1, 2}) == doctest::Approx(0.5));
 
   Collider tet = Collider::triangle_mesh(tetrahedron(), {0, 0, 1}, glm::dmat3(1.0), 0.01);
-  CHECK(distance_to(tet, {0, 0, 1 - 0.1}) == doctest::Approx(0.09)); // below the base
+  CHECK(distance_to(tet, {0, 0, 1 - 0.1}) == doctest::Approx(0.09));       // below the base
   CHECK(distance_to(tet, {0, 0, 1 + 0.5 + 0.2}) == doctest::Approx(0.19)); // above the apex
-  CHECK(distance_to(tet, {5, 5, 5}) == doctest::Approx(1.0)); // beyond reach: "no contact"
+  CHECK(distance_to(tet, {5, 5, 5}) == doctest::Approx(1.0));              // beyond reach: "no contact"
 }
 
 TEST_CASE("kernel: a mesh remembers the side a particle came from (a thin sheet is not crossed)") {
