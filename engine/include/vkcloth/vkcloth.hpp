@@ -3,6 +3,7 @@
 #pragma once
 
 #include "vkcloth/builders.hpp"
+#include "vkcloth/collider_mesh.hpp"
 #include "vkcloth/material.hpp"
 #include "vkcloth/cpu_solver.hpp"
 #include "vkcloth/measure.hpp"

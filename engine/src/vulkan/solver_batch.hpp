@@ -63,6 +63,8 @@ public:
   std::uint32_t size() const { return static_cast<std::uint32_t>(slots.size()); }
   std::uint32_t particle_count() const { return count; }
   const Slot& slot(std::uint32_t k) const { return slots[k]; }
+  /// A collider of some instance moves: the record advances it after every substep.
+  bool any_moving_colliders() const;
   /// New parameters for one instance (validated by the caller; same family and substeps), recorded
   /// into the next record() (race-free with recorded work pending); looks up (never re-creates)
   /// the pipelines they need. More colliders than the batch has room for, or the first tethers,
@@ -248,7 +250,6 @@ private:
   Result<void> ensure_collider_capacity();
   Result<void> ensure_mesh_buffers();
   std::vector<shared::Collider> packed_colliders() const;
-  bool any_moving_colliders() const;
   /// After a substep of `h` seconds: moving colliders advance (Collider::posed_at, as CpuSolver
   /// does) and the new poses are recorded into the collider buffer for the next substep.
   void record_collider_motion(VkCommandBuffer cmd, double h);
