@@ -2,6 +2,7 @@
 // structural_strain (vkcloth/measure.hpp): closed-form strains of stretched and edited grids.
 #include <doctest/doctest.h>
 
+#include <limits>
 #include <vector>
 
 #include "vkcloth/vkcloth.hpp"
@@ -117,4 +118,28 @@ TEST_CASE("structural strain ignores shear, bend and chain springs, and bad size
   REQUIRE_FALSE(bad.ok());
   CHECK(bad.error().code == ErrorCode::invalid_argument);
   CHECK(bad.error().message.find("15 positions for 16 particles") != std::string::npos);
+}
+
+TEST_CASE("penetration and max_free_speed: depths inside each collider, pinned particles left out") {
+  ClothDesc d;
+  d.nx = 3;
+  d.ny = 1;
+  d.pin_default_corners = false;
+  auto s = make_cloth(d);
+  REQUIRE(s.ok());
+  s->particles[2].pinned = true;
+  const std::vector<Collider> colliders = {Collider::plane({0, 0, 1}, 0.0), Collider::sphere({5, 0, 0}, 1.0)};
+  // Particle 0 0.02 below the floor, particle 1 0.3 inside the sphere, the pinned one deeper still.
+  const std::vector<glm::dvec3> x = {{0, 0, -0.02}, {5.7, 0, 0.0}, {5, 0, 0.5}};
+  auto p = penetration(*s, colliders, x);
+  REQUIRE(p.ok());
+  CHECK(p->depth == doctest::Approx(0.3));
+  CHECK(p->particle == 1);
+  CHECK(p->collider == 1);
+  auto outside = penetration(*s, colliders, std::vector<glm::dvec3>{{0, 0, 0.5}, {0, 0, 0.25}, {0, 0, -1}});
+  REQUIRE(outside.ok());
+  CHECK(outside->depth == doctest::Approx(-0.25)); // the nearest free particle is 0.25 outside
+  CHECK(penetration(*s, {}, x)->depth == -std::numeric_limits<double>::infinity());
+  CHECK(penetration(*s, colliders, std::vector<glm::dvec3>(2)).error().code == ErrorCode::invalid_argument);
+  CHECK(max_free_speed(*s, std::vector<glm::dvec3>{{3, 4, 0}, {0, 1, 0}, {100, 0, 0}}) == 5.0);
 }

@@ -29,7 +29,8 @@ ParticleSystem falling_cloth() {
 }
 
 std::shared_ptr<const ColliderMesh> pyramid() {
-  const glm::dvec3 v[] = {{-0.3, -0.3, 0.0}, {0.3, -0.3, 0.0}, {0.3, 0.3, 0.0}, {-0.3, 0.3, 0.0}, {0, 0, 0.3}};
+  const glm::dvec3 v[] = {
+      {-0.3, -0.3, 0.0}, {0.3, -0.3, 0.0}, {0.3, 0.3, 0.0}, {-0.3, 0.3, 0.0}, {0, 0, 0.3}};
   const std::uint32_t t[] = {0, 2, 1, 0, 3, 2, 0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 4};
   auto m = ColliderMesh::create(v, t, "pyramid");
   REQUIRE(m.ok());
@@ -45,7 +46,8 @@ std::vector<std::pair<std::string, std::vector<Collider>>> contact_scenes() {
   box.friction = 0.4;
   box.static_friction = 0.6;
   box.angular_velocity = {0, 0, 1.5};
-  Collider mesh = Collider::triangle_mesh(pyramid(), {0.05, 0, 0}, Collider::rotation_from_degrees({0, 0, 30}), 0.01);
+  Collider mesh =
+      Collider::triangle_mesh(pyramid(), {0.05, 0, 0}, Collider::rotation_from_degrees({0, 0, 30}), 0.01);
   mesh.friction = 0.3;
   Collider spinning = Collider::sphere({0, 0, 0.2}, 0.2);
   spinning.friction = 0.8;
@@ -64,7 +66,8 @@ TEST_CASE("GPU matches CPU with capsule, box and mesh colliders, friction and mo
   VKCLOTH_GPU_TEST_BEGIN(ctx);
   const ParticleSystem sys = falling_cloth();
   for (const auto& [name, colliders] : contact_scenes())
-    for (Integrator integrator : {Integrator::semi_implicit_euler, Integrator::rk4, Integrator::implicit_euler})
+    for (Integrator integrator :
+         {Integrator::semi_implicit_euler, Integrator::rk4, Integrator::implicit_euler})
       for (std::uint32_t substeps : {1u, 2u}) {
         CAPTURE(name);
         CAPTURE(to_string(integrator));
@@ -86,7 +89,8 @@ TEST_CASE("GPU matches CPU with capsule, box and mesh colliders, friction and mo
         for (const glm::vec3& x : *gp)
           lowest = std::min(lowest, double(x.z));
         MESSAGE(fmt::format("{:<18} {:<20} substeps {} max|dp| = {:.3g}{} (lowest point {:.3f} m)", name,
-                            to_string(integrator), substeps, d.max_abs, d.bitwise ? " (bitwise)" : "", lowest));
+                            to_string(integrator), substeps, d.max_abs, d.bitwise ? " (bitwise)" : "",
+                            lowest));
         CHECK(lowest < 0.44); // it fell and met the collider
         // Implicit Euler is not bit for bit (its CG sums in another order: test_gpu_implicit.cpp);
         // contact and friction (static or kinetic by a threshold) amplify that rounding, so there
