@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "../gpu/gpu_test_util.hpp"
@@ -74,6 +75,19 @@ inline std::filesystem::path out_dir() {
   std::filesystem::path d(VKCLOTH_RENDER_OUT);
   std::filesystem::create_directories(d);
   return d;
+}
+
+/// The pixel of world point `p` in a w x h image through `cam`, REQUIREd inside with a 3-pixel margin.
+inline std::pair<std::uint32_t, std::uint32_t> pixel_in(const Camera& cam, glm::vec3 p, std::uint32_t w,
+                                                        std::uint32_t h) {
+  auto q = cam.project(p, w, h);
+  REQUIRE(q);
+  INFO("point (" << p.x << ", " << p.y << ", " << p.z << ") -> pixel (" << q->x << ", " << q->y << ")");
+  REQUIRE(q->x >= 3.0f);
+  REQUIRE(q->y >= 3.0f);
+  REQUIRE(q->x < float(w) - 3.0f);
+  REQUIRE(q->y < float(h) - 3.0f);
+  return {std::uint32_t(q->x), std::uint32_t(q->y)};
 }
 
 inline glm::vec3 rgb(const Image& img, std::uint32_t x, std::uint32_t y) {

@@ -79,14 +79,8 @@ struct Probe {
 };
 
 Probe pixel_of(const Camera& cam, glm::vec3 p) {
-  auto q = cam.project(p, W, H);
-  REQUIRE(q);
-  INFO("point (" << p.x << ", " << p.y << ", " << p.z << ") -> pixel (" << q->x << ", " << q->y << ")");
-  REQUIRE(q->x >= 3.0f);
-  REQUIRE(q->y >= 3.0f);
-  REQUIRE(q->x < float(W) - 3.0f);
-  REQUIRE(q->y < float(H) - 3.0f);
-  return {std::uint32_t(q->x), std::uint32_t(q->y)};
+  const auto [x, y] = pixel_in(cam, p, W, H);
+  return {x, y};
 }
 
 glm::vec3 colour_of(const Palette& pal, Collider::Type t) {

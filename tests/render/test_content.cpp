@@ -16,14 +16,7 @@ constexpr std::uint32_t W = 200, H = 150;
 
 /// Pixel of `p`, REQUIREd inside the image with a margin.
 std::pair<std::uint32_t, std::uint32_t> pixel_of(const Camera& cam, glm::vec3 p) {
-  auto q = cam.project(p, W, H);
-  REQUIRE(q);
-  INFO("point (" << p.x << ", " << p.y << ", " << p.z << ") -> pixel (" << q->x << ", " << q->y << ")");
-  REQUIRE(q->x >= 3.0f);
-  REQUIRE(q->y >= 3.0f);
-  REQUIRE(q->x < float(W) - 3.0f);
-  REQUIRE(q->y < float(H) - 3.0f);
-  return {std::uint32_t(q->x), std::uint32_t(q->y)};
+  return pixel_in(cam, p, W, H);
 }
 
 /// Where the segment eye -> p crosses the flat initial cloth (z = 0.8, |x|,|y| <= 0.5).

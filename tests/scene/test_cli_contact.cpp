@@ -25,9 +25,9 @@ TEST_CASE("cli: run reports the deepest penetration and the last second's larges
   REQUIRE(scene.ok());
   const int steps = 80; // dt = 0.02: the last second is steps 31..80
   const fs::path trace = tmp_dir() / "contact_trace.csv", json = tmp_dir() / "contact.json";
-  const Outcome o = run_cli("contact", "run " + sample("cloth_on_sphere.json") + " --steps " +
-                                           std::to_string(steps) + " --trace '" + trace.string() +
-                                           "' --json '" + json.string() + "'");
+  const Outcome o =
+      run_cli("contact", "run " + sample("cloth_on_sphere.json") + " --steps " + std::to_string(steps) +
+                             " --trace '" + trace.string() + "' --json '" + json.string() + "'");
   REQUIRE(o.code == 0);
   CHECK(o.out.find("contact: deepest penetration") != std::string::npos);
   const std::string text = slurp(json);
@@ -62,7 +62,7 @@ TEST_CASE("cli: run reports the deepest penetration and the last second's larges
   // The trace prints 9 significant digits.
   CHECK(c["max_penetration"].get<double>() == doctest::Approx(deepest).epsilon(1e-6).scale(1e-6));
   CHECK(c["max_speed_last_second"].get<double>() == doctest::Approx(calm).epsilon(1e-6));
-  CHECK(deepest <= scene->params.contact_epsilon); // and the run kept the report's bound
+  CHECK(deepest <= scene->params.contact_epsilon);     // and the run kept the report's bound
   CHECK(deepest > -2 * scene->params.contact_epsilon); // the cloth did reach the sphere
 
   // A scene without colliders has no contact summary.
