@@ -191,7 +191,7 @@ void SolverBatch::record_collider_motion(VkCommandBuffer c, double h) {
         col = col.posed_at(h);
   const auto packed = packed_colliders();
   barriers::before_host_edit(vk(), c); // the substep's reads of the colliders finish first (WAR)
-  vk().vkCmdUpdateBuffer(c, colliders.buffer, 0, packed.size() * sizeof(sh::Collider), packed.data());
+  record_buffer_update(c, colliders, packed.data(), packed.size() * sizeof(sh::Collider));
   barriers::transfer_to_compute(vk(), c); // the new poses -> the next substep's passes
 }
 
@@ -250,17 +250,19 @@ void SolverBatch::record_params_update(VkCommandBuffer c) {
   if (!params_dirty)
     return;
   barriers::before_host_edit(vk(), c); // earlier steps' reads of the parameters finish first
-  const auto update = [&](const Buffer& dst, const void* data, std::size_t bytes) {
-    constexpr std::size_t max_update = 65536; // vkCmdUpdateBuffer's limit per call
-    for (std::size_t at = 0; at < bytes; at += max_update)
-      vk().vkCmdUpdateBuffer(c, dst.buffer, at, std::min(max_update, bytes - at),
-                             static_cast<const char*>(data) + at);
-  };
   const auto ip = packed_instance_params();
-  update(instances, ip.data(), ip.size() * sizeof(sh::InstanceParams));
+  record_buffer_update(c, instances, ip.data(), ip.size() * sizeof(sh::InstanceParams));
   const auto col = packed_colliders();
-  update(colliders, col.data(), col.size() * sizeof(sh::Collider));
+  record_buffer_update(c, colliders, col.data(), col.size() * sizeof(sh::Collider));
   params_dirty = false; // before_steps() next makes the transfer writes visible to the dispatches
+}
+
+void SolverBatch::record_buffer_update(VkCommandBuffer c, const Buffer& dst, const void* data,
+                                       std::size_t bytes) const {
+  constexpr std::size_t max_update = 65536; // vkCmdUpdateBuffer's limit per call
+  for (std::size_t at = 0; at < bytes; at += max_update)
+    vk().vkCmdUpdateBuffer(c, dst.buffer, at, std::min(max_update, bytes - at),
+                           static_cast<const char*>(data) + at);
 }
 
 const Buffer& SolverBatch::buffer_of(Field field) const {

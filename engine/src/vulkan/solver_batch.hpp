@@ -256,6 +256,9 @@ private:
   std::vector<shared::InstanceParams> packed_instance_params() const;
   void write_params_now();
   void record_params_update(VkCommandBuffer cmd);
+  /// vkCmdUpdateBuffer of `bytes` from the start of `dst`, in pieces of at most 64 KiB (its limit).
+  void record_buffer_update(VkCommandBuffer cmd, const Buffer& dst, const void* data,
+                            std::size_t bytes) const;
   Result<void> upload_initial_state(const ClothTopology& topology, const std::vector<SlotState>& states);
   struct Upload {
     Buffer* dst;
