@@ -77,16 +77,16 @@ inline std::filesystem::path out_dir() {
   return d;
 }
 
-/// The pixel of world point `p` in a w x h image through `cam`, REQUIREd inside with a 3-pixel margin.
+/// The pixel of world point `p` in a w x h image through `cam`, REQUIREd inside with a margin.
 inline std::pair<std::uint32_t, std::uint32_t> pixel_in(const Camera& cam, glm::vec3 p, std::uint32_t w,
-                                                        std::uint32_t h) {
+                                                        std::uint32_t h, float margin = 3.0f) {
   auto q = cam.project(p, w, h);
   REQUIRE(q);
   INFO("point (" << p.x << ", " << p.y << ", " << p.z << ") -> pixel (" << q->x << ", " << q->y << ")");
-  REQUIRE(q->x >= 3.0f);
-  REQUIRE(q->y >= 3.0f);
-  REQUIRE(q->x < float(w) - 3.0f);
-  REQUIRE(q->y < float(h) - 3.0f);
+  REQUIRE(q->x >= margin);
+  REQUIRE(q->y >= margin);
+  REQUIRE(q->x < float(w) - margin);
+  REQUIRE(q->y < float(h) - margin);
   return {std::uint32_t(q->x), std::uint32_t(q->y)};
 }
 

@@ -99,14 +99,8 @@ MeshRig make_mesh_rig(gpu::Context& ctx, RendererOptions ro = {}) {
 }
 
 glm::vec3 pixel_at(const Image& img, const Camera& cam, glm::vec3 p) {
-  auto q = cam.project(p, W, H);
-  REQUIRE(q);
-  INFO("point (" << p.x << ", " << p.y << ", " << p.z << ") -> pixel (" << q->x << ", " << q->y << ")");
-  REQUIRE(q->x >= 2.0f);
-  REQUIRE(q->y >= 2.0f);
-  REQUIRE(q->x < float(W) - 2.0f);
-  REQUIRE(q->y < float(H) - 2.0f);
-  return rgb(img, std::uint32_t(q->x), std::uint32_t(q->y));
+  const auto [x, y] = pixel_in(cam, p, W, H, 2.0f);
+  return rgb(img, x, y);
 }
 
 /// A PNG file's bytes, written by write_png.
