@@ -227,6 +227,7 @@ void main() {
     force_out[p] = vec4(f, 0.0);
     normal_out[p] = normal_output(nrm);
     vf[p] = vec4(v, 0.0);
+    vf[pc.count + p] = vec4(contact_removed_force, 0.0); // friction's impulse in FINISH
     return;
   }
   if (mode == VKCLOTH_IMPL_SYSTEM) {
@@ -313,13 +314,16 @@ void main() {
   precise vec3 v = vf[p].xyz + cx[p].xyz;
   const bool both = (ip.flags & VKCLOTH_FLAG_CONTACT_BOTH) != 0u;
   const float h_over_m = h / particle[p].mass;
-  for (uint c = 0u; c < ip.collider_count; ++c) { // the contact response on the new velocity, friction too
+  // The contact response on the new velocity, friction too: its normal impulse counts the force
+  // the FORCE pass's filter removed, what one collider takes of it not counted again by the next
+  // (CPU: implicit_update).
+  vec3 removed = vf[pc.count + p].xyz;
+  for (uint c = 0u; c < ip.collider_count; ++c) {
     const ColliderShape s = collider_shape(c);
     float dist;
     vec3 n;
     collider_contact(0u, s, x0, x0, ip.band, dist, n);
-    vec3 no_force = vec3(0.0);
-    contact_response(v, no_force, s, x0, n, dist, ip.band, both, h_over_m);
+    contact_response(v, removed, s, x0, n, dist, ip.band, both, h_over_m);
   }
   precise vec3 x = x0 + v * h;
   finish(p, false, x0, x, v);

@@ -162,6 +162,11 @@ vec3 fan_normal(uint p) {
   return unit_or_zero(sum);
 }
 
+#ifdef VKCLOTH_FRICTION_AFTER_SOLVE
+// implicit.comp: the force the contact filter removed from this particle (F - filtered F).
+vec3 contact_removed_force = vec3(0.0);
+#endif
+
 // Force on particle p (index within the instance) after contacts (f), its velocity after contacts (v, in: the state velocity)
 // and its unit normal (nrm).
 void particle_force(uint p, inout vec3 v_io, out vec3 f_out, out vec3 nrm_out) {
@@ -209,6 +214,9 @@ void particle_force(uint p, inout vec3 v_io, out vec3 f_out, out vec3 nrm_out) {
 
   // Contacts: inside the 2 eps band, remove only the parts of v and F pointing into the collider
   // (relative to its surface), then friction.
+#ifdef VKCLOTH_FRICTION_AFTER_SOLVE
+  const vec3 unfiltered = f;
+#endif
   if (!pinned_at(p)) {
     const bool both = (ip.flags & VKCLOTH_FLAG_CONTACT_BOTH) != 0u;
     precise float h_over_m = ip.dt / m;
@@ -224,6 +232,9 @@ void particle_force(uint p, inout vec3 v_io, out vec3 f_out, out vec3 nrm_out) {
       contact_response(v, f, s, x, n, dist, ip.band, both, h_over_m);
     }
   }
+#ifdef VKCLOTH_FRICTION_AFTER_SOLVE
+  contact_removed_force = unfiltered - f;
+#endif
 
   f_out = f;
   v_io = v;

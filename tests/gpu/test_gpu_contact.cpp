@@ -80,33 +80,40 @@ TEST_CASE("GPU matches CPU with capsule, box and mesh colliders, friction and mo
         auto gpu = GpuSolver::create(ctx, sys, p);
         REQUIRE(cpu.ok());
         REQUIRE_MESSAGE(gpu.ok(), (gpu.ok() ? "" : gpu.error().message));
-        REQUIRE(cpu->run(100).ok());
-        REQUIRE(gpu->simulate(100, 64).ok()); // two recordings of several steps each
+        // Implicit Euler is not bit for bit (its CG sums in another order: test_gpu_implicit.cpp):
+        // the two drift apart by ~1e-6 m over the steps, and once a particle sits at a contact
+        // threshold (the 2 eps band, static or kinetic friction) that rounding decides which side
+        // it takes, a jump of up to mu g h^2 at one particle on one backend only, whenever it
+        // happens to come. So implicit Euler is compared over the fall and the first contacts (50
+        // steps, 1e-4 m), then both run on and must keep every particle out of the colliders.
+        const bool implicit = integrator == Integrator::implicit_euler;
+        const std::uint32_t steps = implicit ? 50 : 100;
+        REQUIRE(cpu->run(steps).ok());
+        REQUIRE(gpu->simulate(steps, 32).ok()); // several recordings of several steps each
         auto gp = gpu->positions();
         REQUIRE(gp.ok());
         const Diff d = diff(*gp, cpu->positions());
         double lowest = 1e9;
         for (const glm::vec3& x : *gp)
           lowest = std::min(lowest, double(x.z));
-        MESSAGE(fmt::format("{:<18} {:<20} substeps {} max|dp| = {:.3g}{} (lowest point {:.3f} m)", name,
-                            to_string(integrator), substeps, d.max_abs, d.bitwise ? " (bitwise)" : "",
-                            lowest));
+        MESSAGE(fmt::format(
+            "{:<18} {:<20} substeps {} max|dp| = {:.3g}{} after {} steps (lowest point {:.3f} m)", name,
+            to_string(integrator), substeps, d.max_abs, d.bitwise ? " (bitwise)" : "", steps, lowest));
         CHECK(lowest < 0.44); // it fell and met the collider
-        // Implicit Euler is not bit for bit (its CG sums in another order: test_gpu_implicit.cpp);
-        // contact and friction (static or kinetic by a threshold) amplify that rounding, so there
-        // the GPU must stay within 1e-4 m or 3x the CPU's own float-vs-double spread.
-        double bound = tolerance;
-        if (integrator == Integrator::implicit_euler) {
-          auto ref = CpuSolver<double>::create(sys, p);
-          REQUIRE(ref.ok());
-          REQUIRE(ref->run(100).ok());
-          double spread = 0.0;
-          for (std::size_t k = 0; k < sys.size(); ++k)
-            spread = std::max(spread, glm::length(glm::dvec3(cpu->positions()[k]) - ref->positions()[k]));
-          bound = std::max(1e-4, 3.0 * spread);
-          MESSAGE(fmt::format("  implicit: CPU float vs double {:.3g} m, bound {:.3g} m", spread, bound));
+        CHECK(d.max_abs <= (implicit ? 1e-4 : tolerance));
+        if (implicit) {
+          REQUIRE(cpu->run(50).ok());
+          REQUIRE(gpu->simulate(50, 32).ok());
+          gp = gpu->positions();
+          REQUIRE(gp.ok());
+          const std::vector<glm::dvec3> gpu_x(gp->begin(), gp->end()),
+              cpu_x(cpu->positions().begin(), cpu->positions().end());
+          for (const auto* x : {&gpu_x, &cpu_x}) {
+            auto depth = penetration(sys, gpu->params().colliders, *x);
+            REQUIRE(depth.ok());
+            CHECK(depth->depth <= p.contact_epsilon);
+          }
         }
-        CHECK(d.max_abs <= bound);
         // Both advanced the moving colliders the same way (the same host code).
         for (std::size_t k = 0; k < colliders.size(); ++k) {
           CHECK(gpu->params().colliders[k].center == cpu->params().colliders[k].center);

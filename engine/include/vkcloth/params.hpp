@@ -47,7 +47,8 @@ class ColliderMesh; // vkcloth/collider_mesh.hpp: a static triangle mesh and its
 /// v and F go; after the update a point inside is put back at surface + eps.
 ///
 /// The fields give the collider's pose now. A moving collider (linear_velocity, angular_velocity
-/// about its centre) is advanced by the solver after every substep (posed_at(h)), so a
+/// about its centre) is advanced by the solver before every substep (posed_at(h): a substep meets it where
+/// it is at the substep's end), so a
 /// solver's params().colliders is always where its colliders are; a host animating a collider sets
 /// its pose and velocity every frame (StepParams::colliders). Friction and the normal response are
 /// relative to the surface's velocity.

@@ -278,9 +278,9 @@ template <typename Real> Result<void> CpuSolver<Real>::step() {
   const std::uint32_t k = params_.substeps;
   const double h = k == 1 ? params_.dt : params_.dt / double(k);
   for (std::uint32_t s = 0; s < k; ++s) {
+    advance_colliders(h); // a substep meets the colliders where they are at its end
     prepare_colliders();
     substep(Real(h));
-    advance_colliders(h);
   }
   ++step_;
   time_ += params_.dt;

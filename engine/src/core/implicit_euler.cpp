@@ -31,17 +31,19 @@ template <typename Real> void CpuSolver<Real>::implicit_substep(const Real h) {
   if (w.x.size() != n) {
     w.ks.assign(edges_.size(), {});
     w.block_inv.assign(n, {});
-    for (auto* v : {&w.vf, &w.x, &w.b, &w.r, &w.z, &w.d, &w.q})
+    for (auto* v : {&w.vf, &w.fc, &w.x, &w.b, &w.r, &w.z, &w.d, &w.q})
       v->assign(n, Vec3(0)); // x = 0: the first solve starts cold
   }
   // 1. Forces and contact filtering as in the explicit step.
   pool_->for_each(pos_.size(), [&](std::size_t p) {
     Vec3 f = normal_force_at(pos_, vel_, p);
+    const Vec3 unfiltered = f;
     Vec3 v = vel_[p];
     if (!pinned_[p]) // friction once, on the new velocity (implicit_update)
       contact_at(pos_[p], v, f, h / mass_[p], false);
     force_[p] = f;
     w.vf[p] = v;
+    w.fc[p] = unfiltered - f;
   });
   implicit_system(h);
   implicit_cg(h);
@@ -150,9 +152,11 @@ template <typename Real> void CpuSolver<Real>::implicit_update(const Real h) {
     if (pinned_[p])
       return; // stays put, velocity zero
     Vec3 v = w.vf[p] + w.x[p];
-    Vec3 no_force(0);
-    // The inward normal part of v' (the whole part if !inward_only) and friction.
-    contact_at(pos_[p], v, no_force, h / mass_[p]);
+    // The inward normal part of v' (the whole part if !inward_only) and friction, whose normal
+    // impulse also counts the force the filter removed before the solve (w.fc: e.g. the weight of
+    // a cloth resting on a table, which the solve never saw).
+    Vec3 removed = w.fc[p];
+    contact_at(pos_[p], v, removed, h / mass_[p]);
     Vec3 x = pos_[p] + v * h;
     project_at(pos_[p], x, v);
     pos_[p] = x;

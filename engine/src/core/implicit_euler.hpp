@@ -48,6 +48,8 @@ template <typename Real> struct ImplicitWorkspace {
   /// Per CSR entry: the spring's stiffness block K_s (cloth_kernel.h spring_block).
   std::vector<kernel::SpringBlock<Real>> ks;
   std::vector<Vec3> vf; ///< contact-filtered velocity
+  /// The force the contact filter removed (F - filtered F): friction's normal impulse after the solve.
+  std::vector<Vec3> fc;
   /// P^-1: the inverse of A's diagonal block, zero for pinned particles (the filter S).
   std::vector<kernel::SpringBlock<Real>> block_inv;
   std::vector<Vec3> x; ///< dv: kept from one solve to the next (the warm start)

@@ -39,7 +39,7 @@ Result<void> ImplicitGpu::create_buffers(std::uint64_t entries, bool allow_map) 
   const VkDeviceSize vec4_bytes = std::max<VkDeviceSize>(VkDeviceSize(count_) * 16, 16);
   const std::uint64_t groups = std::uint64_t(groups_x_) * groups_y_;
   const std::tuple<Buffer*, VkDeviceSize, const char*> device_buffers[] = {
-      {&vf_, vec4_bytes, "implicit: filtered velocities"},
+      {&vf_, 2 * vec4_bytes, "implicit: filtered velocities, then the forces the filter removed"},
       {&block_inv_, 2 * vec4_bytes, "implicit: block-Jacobi preconditioner"},
       {&x_, vec4_bytes, "implicit: CG x"},
       {&r_, vec4_bytes, "implicit: CG r"},

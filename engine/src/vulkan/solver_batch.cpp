@@ -190,9 +190,9 @@ void SolverBatch::record_collider_motion(VkCommandBuffer c, double h) {
       if (col.moving())
         col = col.posed_at(h);
   const auto packed = packed_colliders();
-  barriers::before_host_edit(vk(), c); // the substep's reads of the colliders finish first (WAR)
+  barriers::before_host_edit(vk(), c); // the last substep's reads of the colliders finish first (WAR)
   record_buffer_update(c, colliders, packed.data(), packed.size() * sizeof(sh::Collider));
-  barriers::transfer_to_compute(vk(), c); // the new poses -> the next substep's passes
+  barriers::transfer_to_compute(vk(), c); // the new poses -> this substep's passes
 }
 
 std::vector<sh::InstanceParams> SolverBatch::packed_instance_params() const {
@@ -462,11 +462,11 @@ void SolverBatch::record(VkCommandBuffer c, std::uint32_t steps) {
     const bool moving = any_moving_colliders();
     const double h = family().substeps == 1 ? family().dt : family().dt / double(family().substeps);
     for (std::uint32_t k = 0; k < family().substeps; ++k) {
+      if (moving) // a substep meets the colliders where they are at its end (as CpuSolver::step)
+        record_collider_motion(c, h);
       record_substep(c, first, s + 1 == steps && k + 1 == family().substeps);
       first = false;
       parity ^= 1u; // positions[read ^ 1] now holds the new state
-      if (moving)
-        record_collider_motion(c, h);
     }
     ++recorded;
     for (Slot& slot : slots)

@@ -250,8 +250,8 @@ private:
   Result<void> ensure_collider_capacity();
   Result<void> ensure_mesh_buffers();
   std::vector<shared::Collider> packed_colliders() const;
-  /// After a substep of `h` seconds: moving colliders advance (Collider::posed_at, as CpuSolver
-  /// does) and the new poses are recorded into the collider buffer for the next substep.
+  /// Before a substep of `h` seconds: moving colliders advance to where they are at its end
+  /// (Collider::posed_at, as CpuSolver does) and the new poses are recorded into the collider buffer.
   void record_collider_motion(VkCommandBuffer cmd, double h);
   std::vector<shared::InstanceParams> packed_instance_params() const;
   void write_params_now();
