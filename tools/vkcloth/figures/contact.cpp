@@ -98,27 +98,31 @@ Result<ContactRun> simulate_sample(const Gallery& G, Drawing& d, const std::stri
       run.diverged = r.error().message;
       break;
     }
+    const bool calm = done + 1 > calm_from; // in the last second: the speeds are wanted too
     std::vector<glm::dvec3> next;
     if (cpu) {
       next = to_d(cpu->positions());
-      vel = to_d(cpu->velocities());
+      if (calm)
+        vel = to_d(cpu->velocities());
       colliders = cpu->params().colliders;
     } else {
       auto p = gpu->positions();
-      auto v = gpu->velocities();
       if (!p)
         return p.error();
-      if (!v)
-        return v.error();
       next = to_d(*p);
-      vel = to_d(*v);
+      if (calm) {
+        auto v = gpu->velocities();
+        if (!v)
+          return v.error();
+        vel = to_d(*v);
+      }
       colliders = gpu->params().colliders;
     }
     auto depth = penetration(run.scene.system, colliders, next);
     if (!depth)
       return depth.error();
     c.max_penetration = std::max(c.max_penetration, depth->depth);
-    if (done + 1 > calm_from)
+    if (calm)
       c.calm_speed = std::max(c.calm_speed, max_free_speed(run.scene.system, vel));
     if (track_turn)
       c.turn += mean_turn(pos, next, axis_point);
