@@ -161,11 +161,12 @@ void check_contact_physics(const nlohmann::json& m) {
   CHECK(num(s8["carried_turn"]) < 1.05 * num(s8["sphere_turn"]));
   CHECK(num(s8["on_sphere_fraction"]) > 0.1);
   CHECK(std::abs(num(s0["carried_turn"])) < 0.1 * num(s0["sphere_turn"]));
-  // The flag: its pinned edge stays, the wind blows it along -y, and part of it lies on the pole.
+  // The flag: its pinned edge stays, the wind blows it along -y, and part of it lies on the pole
+  // (15 % of its points within 5 mm of the surface; none at the start, the pins are 1 cm off).
   const auto& f = c["flag_on_pole"];
   CHECK(num(f["pin_drift"]) < 1e-6);
-  CHECK(num(f["mean_displacement_along_wind"]) > 0.05);
-  CHECK(num(f["on_pole_fraction"]) > 0.02);
+  CHECK(num(f["mean_displacement_along_wind"]) > 0.02);
+  CHECK(num(f["on_pole_fraction"]) > 0.05);
   // The cloth rests on the meshes: its highest point on the chair's back (top at z = 0.9 m) and on
   // the knot (top at z = 0.72 m), above the floor.
   CHECK(num(c["cloth_on_mesh"]["max_z"]) > 0.85);

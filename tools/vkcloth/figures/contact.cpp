@@ -363,9 +363,9 @@ Result<void> shapes_figure(Gallery& G, Drawing& d, nlohmann::json& M) {
       G, d, runs, labels, "contact_shapes.png", "Capsule and mesh colliders: a flag, a chair, a torus knot",
       "Left: samples/scenes/flag_on_pole.json, a 0.6 x 0.4 m flag (16 x 11) pinned along its edge 1 cm "
       "from a pole (a capsule, r = 3 cm, friction 0.5), blown against it by the wind (K_w = 0.01 along -y), "
-      "dt = 0.01 s in 4 substeps, after 4 s: part of it wraps round the pole, the rest trails behind "
-      "(on_pole_fraction: the points within "
-      "5 mm of its surface). Middle: cloth_on_mesh.json, a 1 x 1 m cloth (20 x 20) dropped onto the chair "
+      "dt = 0.01 s in 4 substeps, after 4 s: it wraps round the pole (on_pole_fraction: the points "
+      "within 5 mm of its surface; none at the start). Middle: cloth_on_mesh.json, a 1 x 1 m cloth (20 x 20) "
+      "dropped onto the chair "
       "of samples/meshes/chair.obj (a mesh collider: six closed boxes, 72 triangles, thickness 5 mm, "
       "friction 0.5), dt = 0.01 s in 4 substeps, after 4 s. Right: the same cloth on the (2, 3) torus knot "
       "of samples/meshes/torus_knot.obj (1 920 triangles; --set colliders.0.path=../meshes/torus_knot.obj "
