@@ -119,6 +119,62 @@ void check_cloth_physics(const nlohmann::json& m) {
   CHECK(num(c["presets"]["silk"]["min_z"]) < num(c["presets"]["leather"]["min_z"])); // limp hangs lower
 }
 
+/// The contact figures' numbers (issue 15): friction holds what the frictionless contact lets go,
+/// a spinning sphere carries its cloth only through friction, and no sample ever has a particle
+/// deeper than contact_epsilon inside a collider after a step.
+void check_contact_physics(const nlohmann::json& m) {
+  const auto& c = m["contact"];
+  auto num = [](const nlohmann::json& j) { return j.get<double>(); };
+  const nlohmann::json runs[] = {c["tablecloth"]["0.6"], c["tablecloth"]["0"], c["sphere"]["0"],
+                                 c["sphere"]["0.6"],     c["spinning"]["0.8"], c["spinning"]["0"],
+                                 c["flag_on_pole"],      c["cloth_on_mesh"],   c["cloth_on_torus_knot"]};
+  for (const auto& r : runs) {
+    CAPTURE(r.dump());
+    CHECK_FALSE(r["diverged"].get<bool>());
+    CHECK(num(r["max_penetration"]) <= num(r["contact_epsilon"]));
+    CHECK(num(r["min_z"]) > -1e-6); // nothing under the floor
+  }
+  // The tablecloth: with friction 0.6 it stays on the table (none of it on the floor, a third lying
+  // on the top, its centre where it landed) and comes to rest; without friction the 0.41 m overhang
+  // pulls it off onto the floor.
+  const auto& t6 = c["tablecloth"]["0.6"];
+  const auto& t0 = c["tablecloth"]["0"];
+  CHECK(num(t6["held_fraction"]) > 0.9);
+  CHECK(num(t6["on_top_fraction"]) > 0.25);
+  CHECK(num(t6["centre_slide"]) < 0.01);
+  CHECK(num(t6["max_speed_last_second"]) < 1e-3);
+  CHECK(num(t0["held_fraction"]) < 0.5);
+  CHECK(num(t0["on_top_fraction"]) < 0.05);
+  CHECK(num(t0["centre_slide"]) > 0.3);
+  // The report's cloth on the sphere (top at z = 0.6 m): off onto the floor without friction, on
+  // the sphere with friction 0.6.
+  CHECK(num(c["sphere"]["0"]["max_z"]) < 0.1);
+  CHECK(num(c["sphere"]["0.6"]["max_z"]) > 0.5);
+  CHECK(num(c["sphere"]["0.6"]["on_sphere_fraction"]) > 0.2);
+  // The spinning sphere turns counter-clockwise seen from above (angular velocity +z): with friction
+  // the cloth turns the same way, by most of the sphere's turn, and no further; without, it is not
+  // carried (and slides off).
+  const auto& s8 = c["spinning"]["0.8"];
+  const auto& s0 = c["spinning"]["0"];
+  REQUIRE(num(s8["sphere_turn"]) > 0.0);
+  CHECK(num(s8["carried_turn"]) > 0.5 * num(s8["sphere_turn"]));
+  CHECK(num(s8["carried_turn"]) < 1.05 * num(s8["sphere_turn"]));
+  CHECK(num(s8["on_sphere_fraction"]) > 0.1);
+  CHECK(std::abs(num(s0["carried_turn"])) < 0.1 * num(s0["sphere_turn"]));
+  // The flag: its pinned edge stays, the wind blows it along -y, and part of it lies on the pole
+  // (15 % of its points within 5 mm of the surface; none at the start, the pins are 1 cm off).
+  const auto& f = c["flag_on_pole"];
+  CHECK(num(f["pin_drift"]) < 1e-6);
+  CHECK(num(f["mean_displacement_along_wind"]) > 0.02);
+  CHECK(num(f["on_pole_fraction"]) > 0.05);
+  // The cloth rests on the meshes: its highest point on the chair's back (top at z = 0.9 m) and on
+  // the knot (top at z = 0.72 m), above the floor.
+  CHECK(num(c["cloth_on_mesh"]["max_z"]) > 0.85);
+  CHECK(num(c["cloth_on_mesh"]["triangles"]) == 72);
+  CHECK(num(c["cloth_on_torus_knot"]["max_z"]) > 0.65);
+  CHECK(num(c["cloth_on_torus_knot"]["triangles"]) == 1920);
+}
+
 /// The render golden-image metric (tests/render/render_test_util.hpp): a pixel differs when a
 /// channel differs by more than 8; the images match when under 0.5% of the pixels differ.
 double differing_fraction(const fs::path& a, const fs::path& b) {
@@ -160,16 +216,19 @@ TEST_CASE("vkcloth figures (cpu): the gallery and the physics behind it") {
   REQUIRE_MESSAGE(o.code == 0, o.err);
   CHECK(o.err.find("validation") == std::string::npos);
   CHECK(o.err.find("figures: cloth Figure 7") != std::string::npos); // progress per figure
+  CHECK(o.err.find("figures: contact tablecloth") != std::string::npos);
   check_gallery(out);
   const auto m = nlohmann::json::parse(slurp(out / "figures.json"));
   check_spring_physics(m);
   check_cloth_physics(m);
+  check_contact_physics(m);
   check_stability_map(m);
   if (have_vulkan_device())
     for (const char* f :
          {"cloth_k_struct.png", "cloth_k_shear.png", "cloth_k_bend.png", "cloth_wind.png",
           "cloth_contact.png", "cloth_collisions.png", "cloth_no_structural.png", "cloth_gpu.png",
-          "cloth_meshes.png", "cloth_strain_limit.png", "cloth_resolution.png", "cloth_presets.png"})
+          "cloth_meshes.png", "cloth_strain_limit.png", "cloth_resolution.png", "cloth_presets.png",
+          "contact_tablecloth.png", "contact_sphere.png", "contact_spinning.png", "contact_shapes.png"})
       CHECK_MESSAGE(fs::exists(out / f), f);
 }
 
@@ -186,6 +245,7 @@ TEST_CASE("vkcloth figures --backend vulkan: the same physics on the GPU, zero v
   const auto m = nlohmann::json::parse(slurp(out / "figures.json"));
   check_spring_physics(m);
   check_cloth_physics(m);
+  check_contact_physics(m);
   // The same pictures as the CPU backend, within the golden-image threshold.
   const fs::path cpu = tmp_dir() / "figures_vulkan_cpu_reference";
   fs::remove_all(cpu);
@@ -193,7 +253,8 @@ TEST_CASE("vkcloth figures --backend vulkan: the same physics on the GPU, zero v
   REQUIRE_MESSAGE(oc.code == 0, oc.err);
   for (const char* f :
        {"cloth_k_struct.png", "cloth_k_shear.png", "cloth_k_bend.png", "cloth_wind.png", "cloth_contact.png",
-        "cloth_collisions.png", "cloth_no_structural.png", "cloth_meshes.png", "cloth_strain_limit.png"}) {
+        "cloth_collisions.png", "cloth_no_structural.png", "cloth_meshes.png", "cloth_strain_limit.png",
+        "contact_tablecloth.png", "contact_sphere.png", "contact_spinning.png", "contact_shapes.png"}) {
     const std::string file = f;
     CAPTURE(file);
     CHECK(differing_fraction(out / file, cpu / file) < 0.005);

@@ -18,6 +18,7 @@
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 
+#include "cloth_drawing.hpp"
 #include "figures.hpp"
 #include "image_grid.hpp"
 #include "vkcloth/cpu_solver.hpp"
@@ -29,56 +30,29 @@
 #include "vkcloth/scene.hpp"
 
 namespace vkcloth::figures {
-namespace {
 
-/// A finished simulation: the final state and (when drawing is possible) a GpuSolver holding it.
-struct Run {
-  Scene scene;
-  ParticleSystem drawn; ///< the system the drawing solver was created from
-  std::vector<glm::dvec3> initial, pos;
-  std::string diverged; ///< the error message when the run blew up (the state is the last good one)
-  std::optional<gpu::GpuSolver> gpu;
-};
-
-Scene cloth_scene(const ClothDesc& d, SimParams p, std::string name) {
-  Scene s;
-  s.name = std::move(name);
-  s.system = *make_cloth(d); // valid by construction
-  (void)p.validate();
-  s.params = std::move(p);
-  return s;
+Result<void> open_drawing(const Gallery& G, Drawing& d, std::string_view group) {
+  if (G.quick)
+    d.w = 240, d.h = 180;
+  gpu::ContextOptions o;
+  o.require_graphics = true;
+  auto ctx = gpu::Context::create(o);
+  if (ctx) {
+    d.ctx.emplace(std::move(*ctx));
+    auto t = render::OffscreenTarget::create(*d.ctx, d.w, d.h);
+    if (!t)
+      return t.error();
+    d.target.emplace(std::move(*t));
+  } else if (G.backend == "vulkan" || ctx.error().code != ErrorCode::no_device) {
+    return ctx.error();
+  } else {
+    d.unavailable = ctx.error().message;
+    fmt::print(stderr,
+               "figures: no Vulkan device ({}): the {} numbers are computed, the {} pictures are skipped\n",
+               d.unavailable, group, group);
+  }
+  return {};
 }
-
-/// The report's cloth: 10 x 10 points over 1 x 1, 0.05 kg per point, hanging (vertical) from its
-/// two top corners, or horizontal at height z with nothing pinned.
-ClothDesc hanging(double ks, double ksh, double kb) {
-  ClothDesc d;
-  d.origin = {-0.5, 0.0, 0.5};
-  d.stiffness = {ks, ksh, kb};
-  return d;
-}
-ClothDesc horizontal(double z, double ks = 40, double ksh = 8, double kb = 8) {
-  ClothDesc d;
-  d.orientation = ClothOrientation::horizontal;
-  d.origin = {-0.5, -0.5, z};
-  d.stiffness = {ks, ksh, kb};
-  d.pin_default_corners = false;
-  return d;
-}
-
-SimParams params(double dt = 0.02) {
-  SimParams p;
-  p.dt = dt;
-  p.damping = 0.5;
-  return p;
-}
-
-struct Drawing {
-  std::optional<gpu::Context> ctx;
-  std::string unavailable; ///< why nothing is drawn (no device)
-  std::uint32_t w = 400, h = 300;
-  std::optional<render::OffscreenTarget> target;
-};
 
 Result<gpu::GpuSolver> display_solver(gpu::Context& ctx, Run& run) {
   run.drawn = run.scene.system;
@@ -164,8 +138,7 @@ render::Camera tighten(render::Camera c, const render::Bounds& b, float aspect) 
 
 /// One camera for all panels of a figure: framed tightly on the union of their final states and
 /// (with `with_spheres`) their spheres.
-render::Camera frame(const std::vector<const Run*>& runs, float aspect, glm::vec3 from,
-                     bool with_spheres = true) {
+render::Camera frame(const std::vector<const Run*>& runs, float aspect, glm::vec3 from, bool with_spheres) {
   render::Bounds b{glm::vec3(1e30f), glm::vec3(-1e30f)};
   for (const Run* r : runs) {
     for (const glm::dvec3& p : r->pos)
@@ -190,18 +163,25 @@ Result<render::Image> draw(Drawing& d, Run& run, const render::Camera& cam) {
   return d.target->render(*run.gpu, *rend, cam, 0);
 }
 
-/// Renders the runs as one labelled grid (when a device is there) and adds it to the gallery.
 Result<void> grid_figure(Gallery& G, Drawing& d, std::vector<Run>& runs,
                          const std::vector<std::string>& labels, const std::string& file,
                          const std::string& section, const std::string& title, const std::string& caption,
-                         glm::vec3 from = {0.9f, -1.6f, 1.0f}, bool with_spheres = true,
-                         std::size_t columns = 0) {
+                         glm::vec3 from, bool with_spheres, std::size_t columns) {
   if (!d.ctx)
     return {};
   std::vector<const Run*> all;
   for (const Run& r : runs)
     all.push_back(&r);
-  const render::Camera cam = frame(all, float(d.w) / float(d.h), from, with_spheres);
+  return grid_figure(G, d, runs, labels, file, section, title, caption,
+                     frame(all, float(d.w) / float(d.h), from, with_spheres), columns);
+}
+
+Result<void> grid_figure(Gallery& G, Drawing& d, std::vector<Run>& runs,
+                         const std::vector<std::string>& labels, const std::string& file,
+                         const std::string& section, const std::string& title, const std::string& caption,
+                         const render::Camera& cam, std::size_t columns) {
+  if (!d.ctx)
+    return {};
   std::vector<Panel> panels;
   for (std::size_t i = 0; i < runs.size(); ++i) {
     auto img = draw(d, runs[i], cam);
@@ -212,20 +192,6 @@ Result<void> grid_figure(Gallery& G, Drawing& d, std::vector<Run>& runs,
   VKCLOTH_TRY(render::write_png(G.dir / file, compose_grid(panels, title, columns)));
   G.figures.push_back({file, section, title, caption});
   return {};
-}
-
-// --- the numbers behind the pictures ------------------------------------------------------------
-
-std::size_t at(const Grid& g, std::uint32_t i, std::uint32_t j) {
-  return std::size_t(j) * g.nx + i;
-}
-
-/// Largest downward displacement of a particle since the start (m).
-double sag(const Run& r) {
-  double s = 0.0;
-  for (std::size_t i = 0; i < r.pos.size(); ++i)
-    s = std::max(s, r.initial[i].z - r.pos[i].z);
-  return s;
 }
 
 /// Height of the lowest particle (m).
@@ -240,6 +206,55 @@ double min_z(const Run& r) {
 double max_strain(const Run& r) {
   auto s = structural_strain(r.scene.system, r.pos);
   return s ? s->max : std::nan("");
+}
+
+namespace {
+
+Scene cloth_scene(const ClothDesc& d, SimParams p, std::string name) {
+  Scene s;
+  s.name = std::move(name);
+  s.system = *make_cloth(d); // valid by construction
+  (void)p.validate();
+  s.params = std::move(p);
+  return s;
+}
+
+/// The report's cloth: 10 x 10 points over 1 x 1, 0.05 kg per point, hanging (vertical) from its
+/// two top corners, or horizontal at height z with nothing pinned.
+ClothDesc hanging(double ks, double ksh, double kb) {
+  ClothDesc d;
+  d.origin = {-0.5, 0.0, 0.5};
+  d.stiffness = {ks, ksh, kb};
+  return d;
+}
+ClothDesc horizontal(double z, double ks = 40, double ksh = 8, double kb = 8) {
+  ClothDesc d;
+  d.orientation = ClothOrientation::horizontal;
+  d.origin = {-0.5, -0.5, z};
+  d.stiffness = {ks, ksh, kb};
+  d.pin_default_corners = false;
+  return d;
+}
+
+SimParams params(double dt = 0.02) {
+  SimParams p;
+  p.dt = dt;
+  p.damping = 0.5;
+  return p;
+}
+
+// --- the numbers behind the pictures ------------------------------------------------------------
+
+std::size_t at(const Grid& g, std::uint32_t i, std::uint32_t j) {
+  return std::size_t(j) * g.nx + i;
+}
+
+/// Largest downward displacement of a particle since the start (m).
+double sag(const Run& r) {
+  double s = 0.0;
+  for (std::size_t i = 0; i < r.pos.size(); ++i)
+    s = std::max(s, r.initial[i].z - r.pos[i].z);
+  return s;
 }
 
 /// Mean over the grid's quads of |d1 - d2| / mean(d1, d2), d1 and d2 its two diagonals: zero for a
@@ -486,28 +501,7 @@ Result<void> presets_figure(Gallery& G, Drawing& d, nlohmann::json& M) {
 
 Result<void> cloth_figures(Gallery& G) {
   Drawing d;
-  if (G.quick)
-    d.w = 240, d.h = 180;
-  {
-    gpu::ContextOptions o;
-    o.require_graphics = true;
-    auto ctx = gpu::Context::create(o);
-    if (ctx) {
-      d.ctx.emplace(std::move(*ctx));
-      auto t = render::OffscreenTarget::create(*d.ctx, d.w, d.h);
-      if (!t)
-        return t.error();
-      d.target.emplace(std::move(*t));
-    } else if (G.backend == "vulkan" || ctx.error().code != ErrorCode::no_device) {
-      return ctx.error();
-    } else {
-      d.unavailable = ctx.error().message;
-      fmt::print(stderr,
-                 "figures: no Vulkan device ({}): the cloth numbers are computed, the cloth pictures "
-                 "are skipped\n",
-                 d.unavailable);
-    }
-  }
+  VKCLOTH_TRY(open_drawing(G, d, "cloth"));
   auto& M = G.metrics["cloth"];
   const auto clock0 = std::chrono::steady_clock::now();
   auto progress = [&](const std::string& what) {

@@ -36,6 +36,8 @@ int figures_command(const FiguresOptions& opt) {
              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   if (auto r = figures::cloth_figures(gallery); !r)
     return report(r.error());
+  if (auto r = figures::contact_figures(gallery); !r)
+    return report(r.error());
   if (auto r = figures::stability_figures(gallery); !r)
     return report(r.error());
   if (auto r = gallery.write_index(); !r)
@@ -60,10 +62,10 @@ void add_figures_command(CLI::App& app, int* exit) {
       "the material figures (three resolutions, presets over the sphere) always the CPU solver");
   cmd->add_flag("--quick", opt->quick,
                 "Smaller cloth pictures (240x180 panels instead of 400x300); same numbers");
-  cmd->add_option(
-         "--samples", opt->samples,
-         "The samples directory holding scenes/ and meshes/ for the mesh figure (default: the source "
-         "tree's)")
+  cmd->add_option("--samples", opt->samples,
+                  "The samples directory holding scenes/ and meshes/ for the mesh and contact figures "
+                  "(default: the source "
+                  "tree's)")
       ->capture_default_str();
   cmd->callback([opt, exit] { *exit = figures_command(*opt); });
 }

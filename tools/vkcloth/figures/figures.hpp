@@ -28,7 +28,8 @@ struct Gallery {
   std::vector<Figure> figures;
   nlohmann::json metrics = nlohmann::json::object(); ///< the numbers behind the pictures
   bool quick = false; ///< --quick: smaller cloth pictures (same physics, same numbers)
-  std::filesystem::path samples = VKCLOTH_SAMPLES_DIR; ///< --samples: scenes/ and meshes/ of the mesh figure
+  std::filesystem::path samples =
+      VKCLOTH_SAMPLES_DIR; ///< --samples: scenes/ and meshes/ of the mesh and contact figures
 
   Result<void> write_text(const std::string& file, const std::string& text) const;
   Result<void> write_index() const; ///< index.html and figures.json
@@ -54,6 +55,12 @@ Result<void> spring_figures(Gallery& gallery);
 /// material presets over the sphere: labelled image grids (rendered offscreen; skipped without a Vulkan
 /// device on the CPU backend, the numbers are computed either way) and metrics["cloth"].
 Result<void> cloth_figures(Gallery& gallery);
+/// Contact that holds (issue 15): samples/scenes/{tablecloth_on_table (friction 0.6 and 0),
+/// cloth_on_sphere and cloth_on_sphere_friction, cloth_on_rotating_sphere (friction 0.8 and 0),
+/// flag_on_pole, cloth_on_mesh (the chair, and the torus knot by an override)}.json, each run to its
+/// end on G.backend with the contact measured after every step: image grids (contact.cpp) and
+/// metrics["contact"].
+Result<void> contact_figures(Gallery& gallery);
 /// The (K_struct, dt) stability map of semi-implicit Euler, RK4 and implicit Euler (stability.cpp).
 Result<void> stability_figures(Gallery& gallery);
 
