@@ -190,6 +190,8 @@ private:
   BufferView pos_views[3];
   BufferView particle_view, vel_view, flags_view, instances_view;
   BufferView offsets_view, edges_view, fan_offsets_view, fans_view, strain_links_view, tethers_view;
+  // The collider buffer and the mesh buffers (replaced when they grow: create_buffer_views again).
+  BufferView colliders_view, mesh_nodes_view, mesh_tris_view;
   VkDescriptorSet texel_sets[3] = {};
   CommandContext* commands = nullptr; // the owner's (ClothWorld): uploads, readbacks
   std::uint32_t groups_x = 1, groups_y = 1;
@@ -235,7 +237,7 @@ private:
   Result<void> init_pipelines();
   Result<void> create_descriptor_sets();
   Result<void> create_texel_views();
-  Result<void> create_tethers_view();
+  Result<void> create_buffer_views();
   Result<void> create_pipelines();
   Result<void> write_sets();
   Result<void> ensure_implicit();

@@ -136,18 +136,32 @@ Result<void> SolverBatch::create_texel_views() {
       return r.error();
     *view.view = std::move(*r);
   }
-  return create_tethers_view();
+  return create_buffer_views();
 }
 
-// The tethers' view (again when ensure_tethers() replaces the buffer), then every texel set.
-Result<void> SolverBatch::create_tethers_view() {
+// The views of the buffers that are replaced while the batch lives (again whenever one is:
+// ensure_tethers, ensure_collider_capacity, ensure_mesh_buffers): the tethers, the colliders and
+// the mesh colliders' nodes and triangles; then every texel set.
+Result<void> SolverBatch::create_buffer_views() {
   static_assert(sizeof(sh::TetherSlot) == 8, "one RG32UI texel per TetherSlot");
-  if (access != BufferAccess::texel_views)
-    return {}; // no views (init_pipelines)
-  auto r = create_buffer_view(*ctx, tethers.buffer, VK_FORMAT_R32G32_UINT, "tethers");
-  if (!r)
-    return r.error();
-  tethers_view = std::move(*r);
+  static_assert(sizeof(sh::MeshNode) == 2 * 16 && sizeof(sh::MeshTriangle) == 3 * 16);
+  if (access != BufferAccess::texel_views || !texel_sets[0])
+    return {}; // no views (init_pipelines), or not yet (create_buffers: create_texel_views makes them)
+  const struct {
+    const Buffer* buffer;
+    VkFormat format;
+    BufferView* view;
+    const char* what;
+  } views[4] = {{&tethers, VK_FORMAT_R32G32_UINT, &tethers_view, "tethers"},
+                {&colliders, VK_FORMAT_R32G32B32A32_UINT, &colliders_view, "colliders"},
+                {&mesh_nodes, VK_FORMAT_R32G32B32A32_UINT, &mesh_nodes_view, "mesh collider nodes"},
+                {&mesh_tris, VK_FORMAT_R32G32B32A32_UINT, &mesh_tris_view, "mesh collider triangles"}};
+  for (const auto& view : views) {
+    auto r = create_buffer_view(*ctx, view.buffer->buffer, view.format, view.what);
+    if (!r)
+      return r.error();
+    *view.view = std::move(*r);
+  }
   const std::pair<const BufferView*, std::uint32_t> shared_views[VKCLOTH_TEXEL_BINDING_COUNT - 1] = {
       {&particle_view, VKCLOTH_TEXEL_BINDING_PARTICLE},
       {&vel_view, VKCLOTH_TEXEL_BINDING_VEL},
@@ -158,7 +172,10 @@ Result<void> SolverBatch::create_tethers_view() {
       {&fan_offsets_view, VKCLOTH_TEXEL_BINDING_FAN_OFFSETS},
       {&fans_view, VKCLOTH_TEXEL_BINDING_FANS},
       {&strain_links_view, VKCLOTH_TEXEL_BINDING_STRAIN_LINKS},
-      {&tethers_view, VKCLOTH_TEXEL_BINDING_TETHERS}};
+      {&tethers_view, VKCLOTH_TEXEL_BINDING_TETHERS},
+      {&colliders_view, VKCLOTH_TEXEL_BINDING_COLLIDERS},
+      {&mesh_nodes_view, VKCLOTH_TEXEL_BINDING_MESH_NODES},
+      {&mesh_tris_view, VKCLOTH_TEXEL_BINDING_MESH_TRIS}};
   std::array<VkWriteDescriptorSet, VKCLOTH_TEXEL_BINDING_COUNT * 3> writes{};
   std::size_t w = 0;
   auto write = [&](VkDescriptorSet set, std::uint32_t binding, const BufferView& view) {
