@@ -24,10 +24,14 @@ PushConstants pc;
 layout(push_constant) uniform PushBlock { PushConstants pc; };
 #endif
 
-// False: no instance of the batch has colliders (every ip.collider_count == 0), the contact loops
-// compiled out. llvmpipe runs a loop body once even when no invocation enters it, per-lane collider
-// loads included (GpuSolver creates fused.comp with and without; the other shaders keep the default).
-layout(constant_id = 41) const bool SC_COLLIDERS = true;
+// Bit t set: some instance of the batch may have a collider of type t (VKCLOTH_COLLIDER_*); 0: none
+// has colliders (every ip.collider_count == 0), the contact loops compiled out. llvmpipe runs a
+// loop body once even when no invocation enters it, per-lane collider loads included, and every
+// branch of the kernel's switch over the shapes (collider_contact: VKCLOTH_COLLIDER_PRESENT), so
+// the absent shapes' code is compiled out too (GpuSolver specialises fused.comp with the batch's
+// types; the other shaders keep the default: every type).
+layout(constant_id = 41) const uint SC_COLLIDER_TYPES = VKCLOTH_COLLIDER_ALL_TYPES;
+const bool SC_COLLIDERS = SC_COLLIDER_TYPES != 0u;
 
 layout(std430, set = 0, binding = VKCLOTH_BINDING_PARTICLE) readonly buffer ParticleBuf { ParticleInfo particle[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_COLLIDERS) readonly buffer ColliderBuf { Collider colliders[]; };
@@ -147,6 +151,7 @@ void mesh_triangle(uint unused, uint i, out vec3 a, out vec3 b, out vec3 c) {
   c = t.c.xyz;
 }
 #endif
+#define VKCLOTH_COLLIDER_PRESENT(type) ((SC_COLLIDER_TYPES & (1u << (type))) != 0u)
 #include "cloth_kernel.h"
 
 // The instance's collider c as the kernel takes it (the host packed kernel_shape<float>).

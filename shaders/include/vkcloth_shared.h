@@ -107,6 +107,7 @@ struct vec4 {
 #define VKCLOTH_COLLIDER_CAPSULE 2u
 #define VKCLOTH_COLLIDER_BOX 3u
 #define VKCLOTH_COLLIDER_MESH 4u
+#define VKCLOTH_COLLIDER_ALL_TYPES 0x1fu // bit t for every type t above (SC_COLLIDER_TYPES)
 
 // Flags::first_bad_step before anything diverged.
 #define VKCLOTH_NO_BAD_STEP 0xffffffffu

@@ -578,8 +578,7 @@ void SolverBatch::record_update(VkCommandBuffer c, bool first, bool last) {
   const bool rk4 = family().integrator == Integrator::rk4;
   if (options.fused && !rk4) {
     // One dispatch per (sub)step (fused.comp); the descriptor set alternates with the parity.
-    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE,
-                        fused_pipes[last ? 1 : 0][any_colliders() ? 1 : 0]);
+    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, fused_pipes[last ? 1 : 0][collider_types()]);
     pc.stage = 0;
     const VkDescriptorSet bound_sets[2] = {sets[read][0], texel_sets[read]};
     v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 2, bound_sets, 0, nullptr);

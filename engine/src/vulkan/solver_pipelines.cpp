@@ -25,15 +25,15 @@ namespace {
 
 /// The specialisation constants of force.comp and fused.comp, as 32-bit words by constant_id:
 /// 0..39 the grid stencil (force_body.glsl), 40 SC_WRITE_AUX (fused.comp only; force.comp has no
-/// constant 40, and an entry for an id a shader lacks is ignored), 41 SC_COLLIDERS (common.glsl),
-/// 42 SC_FANS (force_body.glsl), each a VkBool32.
-std::array<std::uint32_t, 43> solver_constants(const SolverBatch::Stencil& st, bool write_aux, bool colliders,
-                                               bool fans) {
+/// constant 40, and an entry for an id a shader lacks is ignored), 41 SC_COLLIDER_TYPES (common.glsl:
+/// a mask of collider types), 42 SC_FANS (force_body.glsl); 40 and 42 are VkBool32s.
+std::array<std::uint32_t, 43> solver_constants(const SolverBatch::Stencil& st, bool write_aux,
+                                               std::uint32_t collider_types, bool fans) {
   static_assert(sizeof(SolverBatch::Stencil) == 40 * 4);
   std::array<std::uint32_t, 43> words{};
   std::memcpy(words.data(), &st, sizeof(st));
   words[40] = write_aux ? 1u : 0u;
-  words[41] = colliders ? 1u : 0u;
+  words[41] = collider_types;
   words[42] = fans ? 1u : 0u;
   return words;
 }
@@ -202,7 +202,8 @@ Result<void> SolverBatch::create_buffer_views() {
 // the batch's build (texel views or storage buffers) and workgroup size (resolve_layout).
 Result<void> SolverBatch::create_pipelines() {
   using Shader = PipelineRegistry::Shader;
-  const auto constants = solver_constants(stencil, true, true, normals == Normals::fans);
+  const auto constants =
+      solver_constants(stencil, true, VKCLOTH_COLLIDER_ALL_TYPES, normals == Normals::fans);
   const PipelineRegistry::Variant variant{access, workgroup};
   auto fp = ctx->pipelines->pipeline(Shader::force, constants, variant);
   if (!fp)
@@ -229,18 +230,18 @@ Result<void> SolverBatch::create_pipelines() {
   return {};
 }
 
-// The fused.comp variants the current parameters need ([0] and [1] x colliders in the batch or
-// not); the registry makes each variant once per Context.
+// The fused.comp variants the current parameters need ([0] and [1] x the collider types in the
+// batch); the registry makes each variant once per Context.
 Result<void> SolverBatch::ensure_fused() {
-  const std::uint32_t col = any_colliders() ? 1u : 0u;
-  if (!options.fused || (fused_pipes[0][col] && fused_pipes[1][col]))
+  const std::uint32_t types = collider_types();
+  if (!options.fused || (fused_pipes[0][types] && fused_pipes[1][types]))
     return {};
   for (std::uint32_t aux = 0; aux < 2; ++aux) {
-    const auto constants = solver_constants(stencil, aux != 0, col != 0, normals == Normals::fans);
+    const auto constants = solver_constants(stencil, aux != 0, types, normals == Normals::fans);
     auto p = ctx->pipelines->pipeline(PipelineRegistry::Shader::fused, constants, {access, workgroup});
     if (!p)
       return p.error();
-    fused_pipes[aux][col] = *p;
+    fused_pipes[aux][types] = *p;
   }
   return {};
 }
