@@ -562,16 +562,38 @@ TEST_CASE_TEMPLATE("the SIMD row kernels (AVX2, AVX-512) give the shared referen
   }
   SimParams p;
   p.wind = {0.07, {0.2, 1, 0.1}};
-  for (int colliders = 0; colliders < 2; ++colliders)
+  // Colliders 2 and 3 (the SIMD finish, row_kernel_simd.inl simd_finish): every shape it takes,
+  // each cutting through the cloth from the first step (projections) with particles in the band
+  // around it: a turned, spinning box with friction; a capsule with static > kinetic friction; a
+  // plane moving along itself with friction; a still, frictionless sphere (the report's filter);
+  // 3: the same with contact_inward_only false (Figure 12's variant).
+  auto friction = [](Collider c, double kinetic, double stat) {
+    c.friction = kinetic;
+    c.static_friction = stat;
+    return c;
+  };
+  Collider box =
+      Collider::box({0.2, 0.05, 0.8}, {0.15, 0.06, 0.1}, Collider::rotation_from_degrees({10, 20, 30}));
+  box.angular_velocity = {0, 0, 0.7};
+  Collider floor = Collider::plane({0, 1, 0}, -0.002);
+  floor.linear_velocity = {0.1, 0, 0};
+  const std::vector<Collider> shapes = {
+      friction(box, 0.4, -1.0),
+      friction(Collider::capsule({-0.4, 0.02, 1.2}, {0.0, -0.03, 1.0}, 0.05), 0.3, 0.5),
+      friction(floor, 0.5, -1.0), Collider::sphere({-0.2, 0.1, 0.7}, 0.12)};
+  for (int colliders = 0; colliders < 4; ++colliders)
     for (Integrator integ : {Integrator::explicit_euler, Integrator::semi_implicit_euler}) {
       CAPTURE(to_string(integ));
       CAPTURE(colliders);
       p.integrator = integ;
       p.dt = integ == Integrator::explicit_euler ? 0.004 : 0.02;
+      p.contact_inward_only = colliders != 3;
       if (colliders == 0)
         p.colliders.clear();
-      else
+      else if (colliders == 1)
         p.colliders = {Collider::sphere({0, 0.2, 0.2}, 0.3)};
+      else
+        p.colliders = shapes;
       for (unsigned threads : {1u, 2u}) {
         CAPTURE(threads);
         const auto scalar = run_with_isa<Real>("scalar", sys, p, threads, 40);

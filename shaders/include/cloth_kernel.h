@@ -17,7 +17,10 @@
 // Provided by the including file: real, vec3, uint, KFN (function prefix: `inline` in C++),
 // OUT(T) / INOUT(T) (out / inout parameters: T& in C++), precise, sqrt, abs, min, max, and
 // all_finite(vec3) (no component is NaN or inf); for mesh colliders MESH_DATA_PARAM / MESH_DATA
-// (the mesh buffers: a dummy uint in GLSL, whose buffers are global), mesh_node and mesh_triangle.
+// (the mesh buffers: a dummy uint in GLSL, whose buffers are global), mesh_node and mesh_triangle;
+// VKCLOTH_COLLIDER_PRESENT(type): false only when no collider of that type can reach the caller
+// (C++: always true; GLSL: a specialisation constant, so that the absent shapes' code is compiled
+// out, since llvmpipe runs every branch of a non-uniform `if`). It changes no result.
 // Constants: vkcloth_shared.h.
 // No include guard: kernel.hpp includes this file once per precision, in two namespaces.
 
@@ -216,13 +219,13 @@ KFN bool mesh_closest(MESH_DATA_PARAM, uint root, uint tri0, vec3 q, real reach,
 // a-c swept by the radius; box: edges and corners included.
 KFN void collider_contact(MESH_DATA_PARAM, ColliderShape s, vec3 p, vec3 p_side, real reach,
                           OUT(real) distance, OUT(vec3) normal) {
-  if (s.type == VKCLOTH_COLLIDER_PLANE) {
+  if (VKCLOTH_COLLIDER_PRESENT(VKCLOTH_COLLIDER_PLANE) && s.type == VKCLOTH_COLLIDER_PLANE) {
     precise real d = dot3(s.a, p) - s.b;
     distance = d;
     normal = s.a;
     return;
   }
-  if (s.type == VKCLOTH_COLLIDER_SPHERE) {
+  if (VKCLOTH_COLLIDER_PRESENT(VKCLOTH_COLLIDER_SPHERE) && s.type == VKCLOTH_COLLIDER_SPHERE) {
     precise vec3 r = p - s.a;
     precise real len = sqrt(dot3(r, r));
     precise vec3 n = len > real(0) ? r / len : vec3(real(0), real(0), real(1)); // at the centre: push up
@@ -231,7 +234,7 @@ KFN void collider_contact(MESH_DATA_PARAM, ColliderShape s, vec3 p, vec3 p_side,
     normal = n;
     return;
   }
-  if (s.type == VKCLOTH_COLLIDER_CAPSULE) {
+  if (VKCLOTH_COLLIDER_PRESENT(VKCLOTH_COLLIDER_CAPSULE) && s.type == VKCLOTH_COLLIDER_CAPSULE) {
     precise vec3 axis = s.c - s.a;
     precise real len2 = dot3(axis, axis);
     precise real t = len2 > real(0) ? dot3(p - s.a, axis) / len2 : real(0);
@@ -245,7 +248,7 @@ KFN void collider_contact(MESH_DATA_PARAM, ColliderShape s, vec3 p, vec3 p_side,
     return;
   }
   precise vec3 q = to_body(s, p);
-  if (s.type == VKCLOTH_COLLIDER_BOX) {
+  if (VKCLOTH_COLLIDER_PRESENT(VKCLOTH_COLLIDER_BOX) && s.type == VKCLOTH_COLLIDER_BOX) {
     precise vec3 over = abs(q) - s.c; // > 0 along the axes where q is beyond a face
     precise vec3 out_part = max(over, vec3(real(0)));
     precise real out_len = sqrt(dot3(out_part, out_part));
@@ -276,7 +279,8 @@ KFN void collider_contact(MESH_DATA_PARAM, ColliderShape s, vec3 p, vec3 p_side,
   vec3 cp, tn;
   distance = reach;
   normal = vec3(real(0), real(0), real(1));
-  if (!mesh_closest(MESH_DATA, s.mesh_root, s.mesh_tri0, q, s.b + reach, cp, tn))
+  if (!VKCLOTH_COLLIDER_PRESENT(VKCLOTH_COLLIDER_MESH) ||
+      !mesh_closest(MESH_DATA, s.mesh_root, s.mesh_tri0, q, s.b + reach, cp, tn))
     return;
   precise vec3 r = q - cp;
   precise real len = sqrt(dot3(r, r));

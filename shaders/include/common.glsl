@@ -24,10 +24,14 @@ PushConstants pc;
 layout(push_constant) uniform PushBlock { PushConstants pc; };
 #endif
 
-// False: no instance of the batch has colliders (every ip.collider_count == 0), the contact loops
-// compiled out. llvmpipe runs a loop body once even when no invocation enters it, per-lane collider
-// loads included (GpuSolver creates fused.comp with and without; the other shaders keep the default).
-layout(constant_id = 41) const bool SC_COLLIDERS = true;
+// Bit t set: some instance of the batch may have a collider of type t (VKCLOTH_COLLIDER_*); 0: none
+// has colliders (every ip.collider_count == 0), the contact loops compiled out. llvmpipe runs a
+// loop body once even when no invocation enters it, per-lane collider loads included, and every
+// branch of the kernel's switch over the shapes (collider_contact: VKCLOTH_COLLIDER_PRESENT), so
+// the absent shapes' code is compiled out too (GpuSolver specialises fused.comp with the batch's
+// types; the other shaders keep the default: every type).
+layout(constant_id = 41) const uint SC_COLLIDER_TYPES = VKCLOTH_COLLIDER_ALL_TYPES;
+const bool SC_COLLIDERS = SC_COLLIDER_TYPES != 0u;
 
 layout(std430, set = 0, binding = VKCLOTH_BINDING_PARTICLE) readonly buffer ParticleBuf { ParticleInfo particle[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_COLLIDERS) readonly buffer ColliderBuf { Collider colliders[]; };
@@ -109,8 +113,30 @@ bool all_finite(vec3 v) {
   return all(notEqual(bits, uvec3(0x7f800000u)));
 }
 // Mesh colliders' hierarchies and triangles: global buffers, so MESH_DATA is a dummy argument.
+// The *_texel builds read them, and the colliders, through RGBA32UI texel views (set 1) instead:
+// on llvmpipe each SSBO load below is a per-lane loop (the collider's 36 words for every particle
+// and collider, twice per step), a texel fetch one vectorised call; a 32-bit texel is a copy of
+// the word, uintBitsToFloat gives its float back: same bits.
 #define MESH_DATA_PARAM uint mesh_data
 #define MESH_DATA mesh_data
+#if defined(VKCLOTH_PC_COPY) && defined(VKCLOTH_TEXEL_VIEWS)
+layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_COLLIDERS) uniform usamplerBuffer colliders_texel;
+layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_MESH_NODES) uniform usamplerBuffer mesh_nodes_texel;
+layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_MESH_TRIS) uniform usamplerBuffer mesh_tris_texel;
+void mesh_node(uint unused, uint i, out vec3 lo, out uint first, out vec3 hi, out uint count) {
+  const uvec4 l = texelFetch(mesh_nodes_texel, int(2u * i)), h = texelFetch(mesh_nodes_texel, int(2u * i + 1u));
+  lo = uintBitsToFloat(l.xyz);
+  first = l.w;
+  hi = uintBitsToFloat(h.xyz);
+  count = h.w;
+}
+void mesh_triangle(uint unused, uint i, out vec3 a, out vec3 b, out vec3 c) {
+  const int t = int(3u * i);
+  a = uintBitsToFloat(texelFetch(mesh_tris_texel, t).xyz);
+  b = uintBitsToFloat(texelFetch(mesh_tris_texel, t + 1).xyz);
+  c = uintBitsToFloat(texelFetch(mesh_tris_texel, t + 2).xyz);
+}
+#else
 void mesh_node(uint unused, uint i, out vec3 lo, out uint first, out vec3 hi, out uint count) {
   const MeshNode n = mesh_nodes[i];
   lo = n.lo_first.xyz;
@@ -124,10 +150,34 @@ void mesh_triangle(uint unused, uint i, out vec3 a, out vec3 b, out vec3 c) {
   b = t.b.xyz;
   c = t.c.xyz;
 }
+#endif
+#define VKCLOTH_COLLIDER_PRESENT(type) ((SC_COLLIDER_TYPES & (1u << (type))) != 0u)
 #include "cloth_kernel.h"
 
 // The instance's collider c as the kernel takes it (the host packed kernel_shape<float>).
 ColliderShape collider_shape(uint c) {
+#if defined(VKCLOTH_PC_COPY) && defined(VKCLOTH_TEXEL_VIEWS)
+  const int t = int(VKCLOTH_COLLIDER_TEXELS * (ip.collider_first + c)); // the Collider's 16-byte rows, in order
+  const uvec4 shape = texelFetch(colliders_texel, t), head = texelFetch(colliders_texel, t + 1);
+  const uvec4 velocity = texelFetch(colliders_texel, t + 6), spin = texelFetch(colliders_texel, t + 7);
+  ColliderShape s;
+  s.type = head.x;
+  s.a = uintBitsToFloat(shape.xyz);
+  s.b = uintBitsToFloat(shape.w);
+  s.c = uintBitsToFloat(texelFetch(colliders_texel, t + 2).xyz);
+  s.ax = uintBitsToFloat(texelFetch(colliders_texel, t + 3).xyz);
+  s.ay = uintBitsToFloat(texelFetch(colliders_texel, t + 4).xyz);
+  s.az = uintBitsToFloat(texelFetch(colliders_texel, t + 5).xyz);
+  s.mesh_root = head.z;
+  s.mesh_tri0 = head.w;
+  s.moving = head.y != 0u;
+  s.velocity = uintBitsToFloat(velocity.xyz);
+  s.spin = uintBitsToFloat(spin.xyz);
+  s.pivot = uintBitsToFloat(texelFetch(colliders_texel, t + 8).xyz);
+  s.mu_k = uintBitsToFloat(velocity.w);
+  s.mu_s = uintBitsToFloat(spin.w);
+  return s;
+#else
   const Collider col = colliders[ip.collider_first + c];
   ColliderShape s;
   s.type = col.type;
@@ -146,6 +196,7 @@ ColliderShape collider_shape(uint c) {
   s.mu_k = col.velocity.w;
   s.mu_s = col.spin.w;
   return s;
+#endif
 }
 
 #endif

@@ -61,7 +61,9 @@ struct vec4 {
 // Set 1 (force.comp, fused.comp, strain_*.comp): POS_IN again, as an RGBA32F uniform texel buffer view,
 // PARTICLE as an RG32UI one (x: the mass's bits, y: pinned), and (fused.comp) VEL as RGBA32F and
 // FLAGS as R32UI; INSTANCES as RGBA32UI (common.glsl begin_instance); the topology's lists
-// (force_body.glsl offsets_at, edge_at, fan_offsets_at, fan_at) as R32UI / RG32UI views.
+// (force_body.glsl offsets_at, edge_at, fan_offsets_at, fan_at) as R32UI / RG32UI views; the
+// colliders and the mesh colliders' nodes and triangles as RGBA32UI (common.glsl collider_shape,
+// mesh_node, mesh_triangle).
 #define VKCLOTH_TEXEL_BINDING_POS_IN 0
 #define VKCLOTH_TEXEL_BINDING_PARTICLE 1
 #define VKCLOTH_TEXEL_BINDING_VEL 2
@@ -73,8 +75,12 @@ struct vec4 {
 #define VKCLOTH_TEXEL_BINDING_FANS 8         // FANS as RG32UI, one texel per FanEntry
 #define VKCLOTH_TEXEL_BINDING_STRAIN_LINKS 9 // STRAIN_LINKS as R32UI, 3 texels per StrainLink
 #define VKCLOTH_TEXEL_BINDING_TETHERS 10     // TETHERS as RG32UI, one texel per TetherSlot
-#define VKCLOTH_TEXEL_BINDING_COUNT 11
-#define VKCLOTH_EDGE_TEXELS 3 // 32-bit words per Edge (static_assert below)
+#define VKCLOTH_TEXEL_BINDING_COLLIDERS 11   // COLLIDERS as RGBA32UI, VKCLOTH_COLLIDER_TEXELS per Collider
+#define VKCLOTH_TEXEL_BINDING_MESH_NODES 12  // MESH_NODES as RGBA32UI, 2 texels per MeshNode
+#define VKCLOTH_TEXEL_BINDING_MESH_TRIS 13   // MESH_TRIS as RGBA32UI, 3 texels per MeshTriangle
+#define VKCLOTH_TEXEL_BINDING_COUNT 14
+#define VKCLOTH_EDGE_TEXELS 3     // 32-bit words per Edge (static_assert below)
+#define VKCLOTH_COLLIDER_TEXELS 9 // 16-byte texels per Collider (static_assert below)
 
 // InstanceParams::flags bits.
 #define VKCLOTH_FLAG_HAS_GRID 1u      // the topology is a grid: rebuild normals from the grid fan
@@ -101,6 +107,7 @@ struct vec4 {
 #define VKCLOTH_COLLIDER_CAPSULE 2u
 #define VKCLOTH_COLLIDER_BOX 3u
 #define VKCLOTH_COLLIDER_MESH 4u
+#define VKCLOTH_COLLIDER_ALL_TYPES 0x1fu // bit t for every type t above (SC_COLLIDER_TYPES)
 
 // Flags::first_bad_step before anything diverged.
 #define VKCLOTH_NO_BAD_STEP 0xffffffffu
@@ -232,6 +239,7 @@ static_assert(sizeof(StrainLink) == 12);
 static_assert(sizeof(TetherSlot) == 8);
 static_assert(offsetof(InstanceParams, max_strain) == 68);
 static_assert(sizeof(Collider) == 144);
+static_assert(sizeof(Collider) == VKCLOTH_COLLIDER_TEXELS * 16);
 static_assert(offsetof(Collider, type) == 16);
 static_assert(offsetof(Collider, end_b) == 32);
 static_assert(sizeof(MeshNode) == 32);

@@ -4,6 +4,7 @@
 // and compute ceilings. Bytes and flops per particle-step are counted from the kernels (the
 // counting is documented in docs/performance.md). A table for people, --json for tools.
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -19,10 +20,12 @@
 
 #include "commands.hpp"
 #include "vkcloth/builders.hpp"
+#include "vkcloth/collider_mesh.hpp"
 #include "vkcloth/cpu_solver.hpp"
 #include "vkcloth/gpu/gpu_solver.hpp"
 #include "vkcloth/gpu/layout.hpp"
 #include "vkcloth/gpu/world.hpp"
+#include "vkcloth/measure.hpp"
 #include "vkcloth/mesh.hpp"
 
 namespace vkcloth::cli {
@@ -51,6 +54,7 @@ struct BenchOptions {
   std::optional<double> cloth_mass; // kg, the whole grid's (default: 0.05 kg per particle at 64 x 64)
   double wind = 2.0; // m/s^2 on a particle facing the wind (the wind force scales with the mass)
   std::string cg_dispatch = "auto"; // implicit on Vulkan: auto | one_workgroup | per_iteration | both
+  std::string contact;              // also time the contact scenes (issue 15): table | mesh | both
 };
 
 /// The benchmark scene at n x n: a 1 m x 1 m vertical cloth hanging from its two top corners, in
@@ -140,6 +144,191 @@ Result<BenchScene> mesh_bench_scene(const Mesh& file, const std::string& order, 
   return BenchScene{std::move(cloth->system), p};
 }
 
+// ---- Contact scenes (issue 15) -----------------------------------------------------------------
+
+/// A cloth resting on colliders, and what the contact rows report about it. `params` has the
+/// colliders; the baseline row times the same system with params.colliders cleared.
+struct ContactScene {
+  std::string name; // "table" | "mesh"
+  std::uint32_t n = 0;
+  ParticleSystem system;
+  SimParams params;
+  std::vector<std::string> kinds; // the colliders' types, in order
+  std::uint32_t triangles = 0;    // a mesh collider's triangles (0 for the table)
+};
+
+constexpr double contact_friction = 0.6; // kinetic = static, every collider of the contact scenes
+constexpr std::uint32_t sphere_frequency =
+    22; // the mesh scene's geodesic sphere: 20 x 22^2 = 9 680 triangles
+
+/// The bench's horizontal n x n cloth (1 m x 1 m centred on the z axis, no pins, no wind), with the
+/// grid rows' per-particle mass scaling (m = 0.05 kg * 4096 / n^2, or --cloth-mass) and stiffness:
+/// the contact scenes move its particles onto their colliders (the springs keep the flat grid's rest
+/// lengths).
+Result<BenchScene> horizontal_cloth(std::uint32_t n, Integrator integrator, double dt,
+                                    const BenchOptions& o) {
+  ClothDesc d;
+  d.nx = n;
+  d.ny = n;
+  d.size = {1.0, 1.0};
+  d.orientation = ClothOrientation::horizontal;
+  d.origin = {-0.5, -0.5, 0.0};
+  d.pin_default_corners = false;
+  d.particle_mass = o.cloth_mass.value_or(0.05 * 4096.0) / (double(n) * double(n));
+  if (!o.stiffness.empty())
+    VKCLOTH_TRY(parse_stiffness(o.stiffness, d.stiffness));
+  auto sys = make_cloth(d);
+  if (!sys)
+    return sys.error();
+  SimParams p;
+  p.integrator = integrator;
+  p.dt = dt;
+  return BenchScene{std::move(*sys), p};
+}
+
+Collider with_contact_friction(Collider c) {
+  c.friction = contact_friction;
+  return c;
+}
+
+/// A 256 x 256 tablecloth on a table: a box 0.5 m wide (x), 1.2 m long (y) and 0.2 m high standing
+/// on the floor plane z = 0, both with friction 0.6. The cloth starts draped, at rest: flat on the
+/// top at eps above it over |x| <= 0.25 + eps, then down both long sides at eps from them, and its
+/// last 5 cm along the floor at eps above it (each grid line across the table keeps its length; only
+/// the bend springs across the two folds start compressed). Every particle starts within 2 eps of a
+/// collider, so the timed steps are contact steps from the first on.
+Result<ContactScene> table_scene(Integrator integrator, double dt, const BenchOptions& o) {
+  constexpr std::uint32_t n = 256;
+  auto cloth = horizontal_cloth(n, integrator, dt, o);
+  if (!cloth)
+    return cloth.error();
+  SimParams p = cloth->params;
+  const double eps = p.contact_epsilon, half_width = 0.25, height = 0.2;
+  p.colliders = {
+      with_contact_friction(Collider::box({0.0, 0.0, 0.5 * height}, {half_width, 0.6, 0.5 * height})),
+      with_contact_friction(Collider::plane({0.0, 0.0, 1.0}, 0.0))};
+  VKCLOTH_TRY(p.validate());
+  const double side = half_width + eps, top = height + eps,
+               drop = height; // the path at eps from the surfaces
+  for (Particle& q : cloth->system.particles) {
+    const double s = std::abs(q.position.x), sign = q.position.x < 0.0 ? -1.0 : 1.0;
+    if (s <= side) {
+      q.position.z = top;
+    } else if (s <= side + drop) {
+      q.position.x = sign * side;
+      q.position.z = top - (s - side);
+    } else {
+      q.position.x = sign * (side + (s - side - drop));
+      q.position.z = eps;
+    }
+  }
+  return ContactScene{"table", n, std::move(cloth->system), std::move(p), {"box", "plane"}, 0};
+}
+
+/// A geodesic sphere: the icosahedron's faces each cut into frequency^2 triangles, their corners
+/// pushed onto the sphere of `radius` about the origin; 20 frequency^2 triangles, counter-clockwise
+/// seen from outside. Computed in double from fixed constants: the same mesh every run.
+Result<std::shared_ptr<const ColliderMesh>> geodesic_sphere(std::uint32_t frequency, double radius) {
+  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
+  const std::array<glm::dvec3, 12> ico = {{{-1, t, 0},
+                                           {1, t, 0},
+                                           {-1, -t, 0},
+                                           {1, -t, 0},
+                                           {0, -1, t},
+                                           {0, 1, t},
+                                           {0, -1, -t},
+                                           {0, 1, -t},
+                                           {t, 0, -1},
+                                           {t, 0, 1},
+                                           {-t, 0, -1},
+                                           {-t, 0, 1}}};
+  const std::array<std::uint32_t, 60> faces = {
+      0, 11, 5, 0, 5, 1, 0, 1, 7, 0, 7, 10, 0, 10, 11, 1, 5, 9, 5, 11, 4,  11, 10, 2,  10, 7, 6, 7, 1, 8,
+      3, 9,  4, 3, 4, 2, 3, 2, 6, 3, 6, 8,  3, 8,  9,  4, 9, 5, 2, 4,  11, 6,  2,  10, 8,  6, 7, 9, 8, 1};
+  std::vector<glm::dvec3> positions;
+  std::vector<std::uint32_t> triangles;
+  const std::uint32_t f = frequency;
+  for (std::size_t k = 0; k < faces.size(); k += 3) {
+    glm::dvec3 a = ico[faces[k]], b = ico[faces[k + 1]], c = ico[faces[k + 2]];
+    if (glm::dot(glm::cross(b - a, c - a), a + b + c) < 0.0)
+      std::swap(b, c); // outward
+    // Point (i, j) of the face, i + j <= f, at index base + row offset + j.
+    const auto first = std::uint32_t(positions.size());
+    auto at = [&](std::uint32_t i, std::uint32_t j) {
+      return first + i * (f + 1) - i * (i - 1) / 2 + j; // rows i = 0.. have f + 1, f, ... points
+    };
+    for (std::uint32_t i = 0; i <= f; ++i)
+      for (std::uint32_t j = 0; i + j <= f; ++j)
+        positions.push_back(radius *
+                            glm::normalize(a + (b - a) * (double(i) / f) + (c - a) * (double(j) / f)));
+    for (std::uint32_t i = 0; i < f; ++i)
+      for (std::uint32_t j = 0; i + j < f; ++j) {
+        triangles.insert(triangles.end(), {at(i, j), at(i + 1, j), at(i, j + 1)});
+        if (i + j + 1 < f)
+          triangles.insert(triangles.end(), {at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
+      }
+  }
+  return ColliderMesh::create(positions, triangles,
+                              fmt::format("geodesic sphere ({} triangles)", 20 * f * f));
+}
+
+/// A 64 x 64 cloth draped on a mesh collider: a geodesic sphere of radius 0.6 m (frequency 22:
+/// 9 680 triangles, ~3 cm edges, a 13-level hierarchy), thickness 5 mm, friction 0.6, centred at
+/// (0, 0, 0.6). The cloth starts at rest wrapped around its top at eps outside the shell: the grid
+/// point at (x, y) from the cloth's centre goes to the point of the sphere of radius 0.6 +
+/// thickness + eps at the arc length |(x, y)| from its top, towards (x, y) (the azimuthal
+/// equidistant map: the grid lines through the centre keep their lengths, the others start
+/// compressed, up to 21 % at the corners, 67 degrees from the top). Every particle starts within
+/// 2 eps of the shell (the faces lie within 0.23 mm inside the sphere through their corners); as
+/// the heavy cloth settles, its border slides and lifts off (particles_in_contact_end).
+Result<ContactScene> mesh_scene(Integrator integrator, double dt, const BenchOptions& o) {
+  constexpr std::uint32_t n = 64;
+  constexpr double radius = 0.6, thickness = 0.005;
+  auto cloth = horizontal_cloth(n, integrator, dt, o);
+  if (!cloth)
+    return cloth.error();
+  auto sphere = geodesic_sphere(sphere_frequency, radius);
+  if (!sphere)
+    return sphere.error();
+  SimParams p = cloth->params;
+  const glm::dvec3 centre{0.0, 0.0, radius};
+  p.colliders = {with_contact_friction(Collider::triangle_mesh(*sphere, centre, glm::dmat3(1.0), thickness))};
+  VKCLOTH_TRY(p.validate());
+  const double r = radius + thickness + p.contact_epsilon;
+  for (Particle& q : cloth->system.particles) {
+    const double x = q.position.x, y = q.position.y, d = std::sqrt(x * x + y * y), angle = d / r;
+    const glm::dvec3 dir = d > 0.0
+                               ? glm::dvec3(std::sin(angle) * x / d, std::sin(angle) * y / d, std::cos(angle))
+                               : glm::dvec3(0, 0, 1);
+    q.position = centre + r * dir;
+  }
+  const auto triangles = std::uint32_t((*sphere)->triangles().size());
+  return ContactScene{"mesh", n, std::move(cloth->system), std::move(p), {"mesh"}, triangles};
+}
+
+/// Free particles within 2 contact_epsilon of a collider (signed distance below the solvers' contact
+/// band), measured in double with cloth_kernel.h's distance (vkcloth::penetration, one particle at a
+/// time; a mesh: from the particle's own side).
+Result<std::size_t> particles_in_contact(const ContactScene& sc, std::span<const glm::dvec3> positions) {
+  ClothDesc d;
+  d.nx = d.ny = 1;
+  d.pin_default_corners = false;
+  auto one = make_cloth(d);
+  if (!one)
+    return one.error();
+  std::size_t count = 0;
+  const double band = 2.0 * sc.params.contact_epsilon;
+  for (std::size_t k = 0; k < positions.size(); ++k) {
+    if (sc.system.particles[k].pinned)
+      continue;
+    auto depth = penetration(*one, sc.params.colliders, positions.subspan(k, 1));
+    if (!depth)
+      return depth.error();
+    count += -depth->depth < band;
+  }
+  return count;
+}
+
 /// Bytes and flops per particle-step counted from the kernels (docs/performance.md, "Counting").
 /// `s` is the mean number of springs per particle (gather-list entries / particles).
 struct Cost {
@@ -205,6 +394,10 @@ struct Row {
   std::string order;               // mesh rows: "meshopt", "file" or "shuffled"
   std::string layout;              // Vulkan rows: the buffer access that ran ("texel" | "storage")
   std::uint32_t workgroup = 0;     // Vulkan rows: the workgroup size that ran
+  std::string contact;             // contact rows: "table" | "mesh" (scene "contact" or "contact_free")
+  std::size_t in_contact_start = 0, in_contact_end = 0; // scene "contact": particles within 2 eps
+  std::vector<std::string> colliders;                   // scene "contact": their types
+  std::uint32_t collider_triangles = 0;                 // scene "contact": a mesh collider's
   Cost cost;
 };
 
@@ -339,6 +532,108 @@ Result<Row> bench_world(gpu::Context& ctx, const BenchScene& sc, std::uint32_t n
   return row;
 }
 
+/// The particles of `positions` (in float) in double, for particles_in_contact.
+std::vector<glm::dvec3> to_double(std::span<const glm::vec3> positions) {
+  return {positions.begin(), positions.end()};
+}
+
+/// Times a contact scene (k = 1) and the same cloth without colliders (k = 0), in alternation: both
+/// warm up, then repetition r runs `steps` steps of the bare cloth, then `steps` of the cloth on
+/// its colliders, so that a machine whose speed drifts (other jobs on its cores) slows both alike.
+/// `run(k, steps)` advances solver k; `gpu_ms(k)` is its last GPU time (-1: none); `count()` the
+/// particles in contact on solver 1 now. Returns the two rows (bare, then with colliders) with
+/// their medians.
+template <typename Run, typename GpuMs, typename Count>
+Result<std::array<Row, 2>> alternate_contact(const BenchOptions& o, Run run, GpuMs gpu_ms, Count count) {
+  for (int k = 0; k < 2; ++k)
+    VKCLOTH_TRY(run(k, o.warmup));
+  std::array<Row, 2> rows;
+  auto start = count();
+  if (!start)
+    return start.error();
+  std::array<std::vector<double>, 2> wall, gpu;
+  for (unsigned r = 0; r < o.reps; ++r)
+    for (int k = 0; k < 2; ++k) {
+      const auto t0 = Clock::now();
+      VKCLOTH_TRY(run(k, o.steps));
+      wall[k].push_back(ms_since(t0));
+      gpu[k].push_back(gpu_ms(k));
+    }
+  auto end = count();
+  if (!end)
+    return end.error();
+  for (int k = 0; k < 2; ++k) {
+    rows[k].wall_ms = median(wall[k]);
+    rows[k].gpu_ms = median(gpu[k]);
+    rows[k].scene = k ? "contact" : "contact_free";
+  }
+  rows[1].in_contact_start = *start;
+  rows[1].in_contact_end = *end;
+  return rows;
+}
+
+Result<std::array<Row, 2>> bench_cpu_contact(const ContactScene& sc, const BenchOptions& o) {
+  CpuSolverOptions co;
+  co.threads = o.threads;
+  SimParams bare = sc.params;
+  bare.colliders.clear();
+  auto s0 = CpuSolver<float>::create(sc.system, bare, co);
+  if (!s0)
+    return s0.error();
+  auto s1 = CpuSolver<float>::create(sc.system, sc.params, co);
+  if (!s1)
+    return s1.error();
+  std::array<CpuSolver<float>*, 2> s = {&*s0, &*s1};
+  auto rows = alternate_contact(
+      o, [&](int k, std::uint64_t steps) { return s[k]->run(steps); }, [](int) { return -1.0; },
+      [&] { return particles_in_contact(sc, to_double(s1->positions())); });
+  if (!rows)
+    return rows.error();
+  for (Row& r : *rows) {
+    r.backend = "cpu";
+    r.variant = "cpu";
+    r.threads = s1->threads();
+  }
+  return rows;
+}
+
+Result<std::array<Row, 2>> bench_vulkan_contact(gpu::Context& ctx, const ContactScene& sc, bool fused,
+                                                gpu::BufferAccess access, const BenchOptions& o) {
+  gpu::GpuSolverOptions go;
+  go.fused = fused;
+  go.buffer_access = access;
+  go.workgroup_size = o.workgroup;
+  SimParams bare = sc.params;
+  bare.colliders.clear();
+  auto s0 = gpu::GpuSolver::create(ctx, sc.system, bare, go);
+  if (!s0)
+    return s0.error();
+  auto s1 = gpu::GpuSolver::create(ctx, sc.system, sc.params, go);
+  if (!s1)
+    return s1.error();
+  std::array<gpu::GpuSolver*, 2> s = {&*s0, &*s1};
+  auto rows = alternate_contact(
+      o, [&](int k, std::uint64_t steps) { return s[k]->simulate(steps, o.steps_per_submit); },
+      [&](int k) { return s[k]->last_gpu_ms(); },
+      [&]() -> Result<std::size_t> {
+        auto x = s1->positions();
+        if (!x)
+          return x.error();
+        return particles_in_contact(sc, to_double(*x));
+      });
+  if (!rows)
+    return rows.error();
+  const Integrator integrator = sc.params.integrator;
+  for (Row& r : *rows) {
+    r.backend = "vulkan";
+    r.variant = integrator == Integrator::implicit_euler ? "implicit"
+                : fused && integrator != Integrator::rk4 ? "fused"
+                                                         : "two_pass";
+    std::tie(r.layout, r.workgroup) = layout_of(ctx, go, integrator == Integrator::implicit_euler);
+  }
+  return rows;
+}
+
 Result<std::vector<std::uint32_t>> parse_sizes(const std::string& text) {
   std::vector<std::uint32_t> out;
   std::stringstream ss(text);
@@ -376,6 +671,16 @@ const Row* nearest_grid(const std::vector<Row>& rows, const Row& mesh) {
                       std::abs(double(best->particles) - double(mesh.particles))))
       best = &g;
   return best;
+}
+
+/// The bare-cloth row timed with a contact row (its colliders removed; same backend, variant,
+/// layout and integrator): the contact phase is quoted against it.
+const Row* contact_free_of(const std::vector<Row>& rows, const Row& r) {
+  for (const Row& e : rows)
+    if (e.scene == "contact_free" && e.contact == r.contact && e.backend == r.backend &&
+        e.variant == r.variant && e.layout == r.layout && e.integrator == r.integrator)
+      return &e;
+  return nullptr;
 }
 
 int bench_command(const BenchOptions& o) {
@@ -541,6 +846,57 @@ int bench_command(const BenchOptions& o) {
     }
   }
 
+  if (!o.contact.empty()) { // the contact scenes, each timed against the same cloth without colliders
+    for (const std::string name : {"table", "mesh"}) {
+      if (o.contact != name && o.contact != "both")
+        continue;
+      auto sc = name == "table" ? table_scene(*integrator, dt, o) : mesh_scene(*integrator, dt, o);
+      if (!sc)
+        return report(sc.error());
+      const double s = double(sc->system.adjacency.refs.size()) / double(sc->system.size());
+      auto add = [&](Result<std::array<Row, 2>> pair) -> int {
+        if (!pair && pair.error().code == ErrorCode::unsupported) { // too large for this device
+          fmt::print("note: contact {} ({}): {}\n", name, to_string(sc->params.integrator),
+                     pair.error().message);
+          return exit_ok;
+        }
+        if (!pair)
+          return report(pair.error());
+        for (Row& r : *pair) {
+          r.integrator = to_string(sc->params.integrator);
+          r.size = sc->n;
+          r.particles = sc->system.size();
+          r.springs = sc->system.springs.size();
+          r.steps = o.steps;
+          r.reps = o.reps;
+          r.contact = name;
+          if (r.scene == "contact") {
+            r.colliders = sc->kinds;
+            r.collider_triangles = sc->triangles;
+          }
+          r.cost = cost_of(r.variant, sc->params.integrator, s, true, 0.0, false, o.steps_per_submit);
+          rows.push_back(r);
+        }
+        return exit_ok;
+      };
+      if (o.backend != "vulkan")
+        if (int e = add(bench_cpu_contact(*sc, o)))
+          return e;
+      if (!ctx)
+        continue;
+      const bool rk4 = *integrator == Integrator::rk4;
+      const bool imp = *integrator == Integrator::implicit_euler;
+      if (o.variants.find("fused") != std::string::npos || rk4 || imp)
+        for (gpu::BufferAccess access : layouts)
+          if (int e = add(bench_vulkan_contact(*ctx, *sc, true, access, o)))
+            return e;
+      if (o.variants.find("two_pass") != std::string::npos && !rk4 && !imp)
+        for (gpu::BufferAccess access : layouts)
+          if (int e = add(bench_vulkan_contact(*ctx, *sc, false, access, o)))
+            return e;
+    }
+  }
+
   // Table for people.
   fmt::print(
       "vkcloth bench: hanging cloth n x n (3 spring kinds, 2 pins, wind), {}, dt {:g} s, {} steps x {} reps "
@@ -563,6 +919,12 @@ int bench_command(const BenchOptions& o) {
         "stretch rows: n x n with stretch_limit {{method: {}, max_strain: 0.1, iterations: 4}} (n column: "
         "n+{})\n",
         o.stretch, o.stretch);
+  if (!o.contact.empty())
+    fmt::print(
+        "contact rows: n+table: 256 x 256 cloth draped on a box (0.5 x 1.2 x 0.2 m) on the floor plane; "
+        "n+mesh: 64 x 64 cloth draped on a {}-triangle geodesic sphere (mesh collider); friction "
+        "{:g}; no wind; n free: the same cloth without colliders (n column)\n",
+        20 * sphere_frequency * sphere_frequency, contact_friction);
   fmt::print("{:<7} {:<9} {:<11} {:>8} {:>8} {:>3} {:>9} {:>9} {:>9} {:>6} {:>7} {:>5} {:>6} {:>8} {:>5}\n",
              "backend", "variant", "layout", "n", "particles", "thr", "ms/step", "gpu ms", "M p-st/s",
              "B/p-st", "GB/s", "%mem", "fl/pst", "GFLOP/s", "%cmp");
@@ -577,9 +939,11 @@ int bench_command(const BenchOptions& o) {
         "{:<7} {:<9} {:<11} {:>8} {:>8} {:>3} {:>9.4f} {:>9} {:>9.1f} {:>6.0f} {:>7.2f} {:>4.0f}% {:>6.0f} "
         "{:>8.2f} {:>4.1f}%\n",
         r.backend, r.variant, r.layout.empty() ? "-" : fmt::format("{}/{}", r.layout, r.workgroup),
-        r.scene == "grid"      ? fmt::format("{}", r.size)
-        : r.scene == "stretch" ? fmt::format("{}+{}", r.size, r.order)
-                               : r.order,
+        r.scene == "grid"           ? fmt::format("{}", r.size)
+        : r.scene == "stretch"      ? fmt::format("{}+{}", r.size, r.order)
+        : r.scene == "contact"      ? fmt::format("{}+{}", r.size, r.contact)
+        : r.scene == "contact_free" ? fmt::format("{} free", r.size)
+                                    : r.order,
         r.particles, r.backend == "cpu" ? fmt::format("{}", r.threads) : "-", ms_step,
         gpu_step >= 0 ? fmt::format("{:.4f}", gpu_step) : "-", rate * 1e-6, r.cost.bytes, gbps,
         100.0 * gbps / o.memory_gbps, r.cost.flops, gflops, 100.0 * gflops / o.compute_gflops);
@@ -595,7 +959,8 @@ int bench_command(const BenchOptions& o) {
       if (!r.cg_dispatch.empty())
         j["cg_dispatch"] = r.cg_dispatch;
       for (const Row& e : rows) // the semi-implicit baseline of the same backend and size
-        if (e.backend == r.backend && e.size == r.size && e.integrator == "semi_implicit_euler")
+        if (e.backend == r.backend && e.size == r.size && e.integrator == "semi_implicit_euler" &&
+            r.contact.empty() && e.contact.empty())
           j["implicit_over_explicit"] = r.wall_ms / e.wall_ms;
     }
     j["size"] = r.size;
@@ -609,6 +974,19 @@ int bench_command(const BenchOptions& o) {
       j["stretch_method"] = r.order;
       if (const Row* g = nearest_grid(rows, r))
         j["stretch_over_plain"] = per_particle_step(r) / per_particle_step(*g);
+    }
+    if (r.scene == "contact" || r.scene == "contact_free") {
+      j["contact"] = r.contact;
+      if (r.scene == "contact") {
+        j["colliders"] = r.colliders;
+        j["collider_triangles"] =
+            r.collider_triangles ? nlohmann::json(r.collider_triangles) : nlohmann::json(nullptr);
+        j["friction"] = contact_friction;
+        j["particles_in_contact_start"] = r.in_contact_start;
+        j["particles_in_contact_end"] = r.in_contact_end;
+        if (const Row* f = contact_free_of(rows, r))
+          j["contact_phase_fraction"] = (r.wall_ms - f->wall_ms) / f->wall_ms;
+      }
     }
     j["instances"] = r.instances;
     j["particles"] = r.particles;
@@ -630,9 +1008,10 @@ int bench_command(const BenchOptions& o) {
     results.push_back(std::move(j));
   }
   for (const Row& r : rows)
-    if (r.integrator == "implicit_euler")
+    if (r.integrator == "implicit_euler" && r.contact.empty())
       for (const Row& e : rows)
-        if (e.backend == r.backend && e.size == r.size && e.integrator == "semi_implicit_euler")
+        if (e.backend == r.backend && e.size == r.size && e.integrator == "semi_implicit_euler" &&
+            e.contact.empty())
           fmt::print(
               "{}{} n = {}: implicit step {:.4f} ms vs semi-implicit {:.4f} ms: {:.1f}x the explicit cost "
               "({:.1f} CG iterations per step, {} in the last step)\n",
@@ -652,6 +1031,14 @@ int bench_command(const BenchOptions& o) {
           "ms)\n",
           r.backend, r.variant, r.size, r.order, 100.0 * (per_particle_step(r) / per_particle_step(*g) - 1.0),
           r.wall_ms / double(r.steps), g->wall_ms / double(g->steps));
+  for (const Row& r : rows)
+    if (const Row* f = r.scene == "contact" ? contact_free_of(rows, r) : nullptr)
+      fmt::print(
+          "{} {} {} ({} x {}): the contact phase costs {:.0f} % of the step without colliders ({:.4f} vs "
+          "{:.4f} ms); {} of {} particles within 2 eps of a collider before the timed steps, {} after\n",
+          r.backend, r.variant, r.contact, r.size, r.size, 100.0 * (r.wall_ms - f->wall_ms) / f->wall_ms,
+          r.wall_ms / double(r.steps), f->wall_ms / double(f->steps), r.in_contact_start, r.particles,
+          r.in_contact_end);
   if (!o.json.empty()) {
     nlohmann::json doc;
     doc["schema"] = "vkcloth-bench/1";
@@ -662,6 +1049,7 @@ int bench_command(const BenchOptions& o) {
     doc["stiffness"] = o.stiffness.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.stiffness);
     doc["cloth_mass"] = o.cloth_mass ? nlohmann::json(*o.cloth_mass) : nlohmann::json(nullptr);
     doc["wind"] = o.wind;
+    doc["contact"] = o.contact.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.contact);
     doc["steps"] = o.steps;
     doc["warmup"] = o.warmup;
     doc["reps"] = o.reps;
@@ -743,6 +1131,12 @@ void add_bench_command(CLI::App& app, int* exit) {
          "Also time each grid with stretch control (tethers, provot or both; max_strain 0.1, 4 sweeps) "
          "against the plain step")
       ->check(CLI::IsMember({"tethers", "provot", "both"}));
+  cmd->add_option(
+         "--contact", opt->contact,
+         "Also time the contact scenes (issue 15): a 256 x 256 cloth on a table (box on a floor plane), "
+         "a 64 x 64 cloth on a ~10 000-triangle mesh sphere, or both; each against the same cloth "
+         "without colliders, alternated")
+      ->check(CLI::IsMember({"table", "mesh", "both"}));
   cmd->add_option(
       "--stiffness", opt->stiffness,
       "Structural, shear and bend stiffness of the grid in N/m, e.g. 10000,2000,2000 (default 40,8,8)");

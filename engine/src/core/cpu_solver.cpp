@@ -23,10 +23,12 @@
 namespace vkcloth {
 
 namespace detail {
-/// The colliders as the kernel takes them at this substep's pose, and their meshes.
+/// The colliders as the kernel takes them at this substep's pose, and their meshes; the same values
+/// for the SIMD finish of the grid rows (row_kernel.hpp FinishShape), empty when a collider is a mesh.
 template <typename Real> struct ContactShapes {
   std::vector<kernel::ColliderShape<Real>> shapes;
   std::vector<kernel::MeshData> meshes;
+  std::vector<FinishShape<Real>> finish;
 };
 } // namespace detail
 
@@ -211,8 +213,11 @@ template <typename Real> void CpuSolver<Real>::prepare_colliders() {
     contacts_ = std::make_unique<detail::ContactShapes<Real>>();
   auto& shapes = contacts_->shapes;
   auto& meshes = contacts_->meshes;
+  auto& finish = contacts_->finish;
   shapes.clear();
   meshes.clear();
+  finish.clear();
+  bool any_mesh = false;
   for (const Collider& c : params_.colliders) {
     shapes.push_back(kernel::kernel_shape<Real>(c));
     kernel::MeshData m;
@@ -221,6 +226,30 @@ template <typename Real> void CpuSolver<Real>::prepare_colliders() {
       m.triangles = c.mesh->triangles().data();
     }
     meshes.push_back(m);
+    any_mesh = any_mesh || c.type == Collider::Type::mesh;
+  }
+  for (std::size_t k = 0; !any_mesh && k < shapes.size(); ++k) {
+    const kernel::ColliderShape<Real>& s = shapes[k];
+    auto put = [](Real* out, glm::vec<3, Real> v) {
+      out[0] = v.x;
+      out[1] = v.y;
+      out[2] = v.z;
+    };
+    detail::FinishShape<Real> f{};
+    f.type = s.type;
+    f.moving = s.moving;
+    put(f.a, s.a);
+    f.b = s.b;
+    put(f.c, s.c);
+    put(f.ax, s.ax);
+    put(f.ay, s.ay);
+    put(f.az, s.az);
+    put(f.velocity, s.velocity);
+    put(f.spin, s.spin);
+    put(f.pivot, s.pivot);
+    f.mu_k = s.mu_k;
+    f.mu_s = s.mu_s;
+    finish.push_back(f);
   }
 }
 
@@ -465,6 +494,30 @@ template <typename Real> detail::RowArgs<Real> CpuSolver<Real>::row_args(const R
 // next one; one fork-join per substep (sweep + finite check).
 template <typename Real> void CpuSolver<Real>::row_sweep(const Real h, const bool semi) {
   const RowArgs<Real> ra = row_args(h, semi);
+  // With colliders, none of them a mesh: the kernel's forces go through the SIMD finish (contacts,
+  // update, projection: row_kernel_simd.inl simd_finish), the remainders through euler_finish.
+  detail::FinishArgs<Real> fa{};
+  const bool simd_finish = !ra.integrate && simd_ != 0 && !contacts_->finish.empty();
+  if (simd_finish) {
+    fa.px = ra.px;
+    fa.py = ra.py;
+    fa.pz = ra.pz;
+    fa.vel = &vel_[0].x;
+    fa.force = &force_[0].x;
+    fa.mass = mass_.data();
+    fa.pinned = pinned_.data();
+    fa.pos_next = &pos_next_[0].x;
+    fa.sx_next = ra.sx_next;
+    fa.sy_next = ra.sy_next;
+    fa.sz_next = ra.sz_next;
+    fa.shapes = contacts_->finish.data();
+    fa.shape_count = static_cast<std::uint32_t>(contacts_->finish.size());
+    fa.band = Real(2) * Real(params_.contact_epsilon); // contact_at's band and project_at's eps
+    fa.eps = Real(params_.contact_epsilon);
+    fa.dt = h;
+    fa.both = !params_.contact_inward_only;
+    fa.semi = semi;
+  }
   const std::int64_t gnx = ra.nx, gny = topology_->grid()->ny;
   Real* const pn = &pos_next_[0].x;
   Real* const vn = &vel_[0].x;
@@ -489,7 +542,12 @@ template <typename Real> void CpuSolver<Real>::row_sweep(const Real h, const boo
 #endif
     std::int64_t unchecked = done;
     if (!ra.integrate) { // the SIMD kernels' forces go through the contacts here
-      for (std::int64_t q = q0; q < done; ++q)
+      std::int64_t finished = q0;
+#if VKCLOTH_ROW_SIMD
+      if (simd_finish)
+        finished = simd_ == 2 ? detail::finish_avx512(fa, q0, done) : detail::finish_avx2(fa, q0, done);
+#endif
+      for (std::int64_t q = finished; q < done; ++q)
         finish(q, force_[std::size_t(q)]);
       unchecked = q0;
     }

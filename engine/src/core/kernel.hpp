@@ -34,6 +34,7 @@ static_assert(VKCLOTH_INTEGRATOR_RK4 == std::uint32_t(vkcloth::Integrator::rk4))
 #define precise
 #define MESH_DATA_PARAM const MeshData& mesh_data
 #define MESH_DATA mesh_data
+#define VKCLOTH_COLLIDER_PRESENT(type) true
 
 namespace vkcloth::kernel {
 

@@ -35,6 +35,40 @@ template <typename Real> struct RowArgs {
   bool wind, integrate, semi;
 };
 
+/// A collider as the SIMD finish takes it: kernel::ColliderShape<Real>'s values, copied as they are
+/// (cpu_solver.cpp), for the plane, sphere, capsule and box (VKCLOTH_COLLIDER_* 0..3; a mesh
+/// collider keeps the per-particle reference).
+template <typename Real> struct FinishShape {
+  std::uint32_t type;
+  bool moving;
+  Real a[3], b, c[3], ax[3], ay[3], az[3], velocity[3], spin[3], pivot[3], mu_k, mu_s;
+};
+
+/// The rest of a grid substep after the row kernel's forces when there are colliders (the kernel
+/// ran without integrating): CpuSolver::euler_finish for W particles at a time, i.e. each
+/// collider's contact response on the velocity and the force (cloth_kernel.h collider_contact,
+/// contact_response), the Euler update, then each collider's projection (project_out).
+template <typename Real> struct FinishArgs {
+  const Real *px, *py, *pz; // positions at the start of the substep, SoA
+  Real* vel;                // velocities, AoS, updated in place
+  Real* force;              // AoS: the kernel's forces in, the forces after contacts out
+  const Real* mass;
+  const std::uint8_t* pinned;
+  Real* pos_next;                    // AoS
+  Real *sx_next, *sy_next, *sz_next; // SoA
+  const FinishShape<Real>* shapes;
+  std::uint32_t shape_count;
+  Real band, eps, dt; // 2 contact_epsilon, contact_epsilon, the substep
+  bool both, semi;    // !contact_inward_only; semi-implicit Euler
+};
+
+// Each processes whole vectors from q0 and returns where it stopped (q1 minus the remainder, which
+// the caller finishes through the per-particle reference). No finite check (the caller's).
+std::int64_t finish_avx512(const FinishArgs<float>& a, std::int64_t q0, std::int64_t q1);
+std::int64_t finish_avx512(const FinishArgs<double>& a, std::int64_t q0, std::int64_t q1);
+std::int64_t finish_avx2(const FinishArgs<float>& a, std::int64_t q0, std::int64_t q1);
+std::int64_t finish_avx2(const FinishArgs<double>& a, std::int64_t q0, std::int64_t q1);
+
 // Each processes whole vectors from q0 and returns where it stopped (q1 minus the remainder,
 // fewer than one vector, which the caller runs through the per-particle reference). When integrating, each
 // also applies check_finite's test to the positions and velocities it wrote and sets `bad` if one

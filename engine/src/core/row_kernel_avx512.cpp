@@ -105,4 +105,10 @@ std::int64_t row_kernel_avx512(const RowArgs<float>& a, std::int64_t q0, std::in
 std::int64_t row_kernel_avx512(const RowArgs<double>& a, std::int64_t q0, std::int64_t q1, bool& bad) {
   return simd_dispatch<IsaD>(a, q0, q1, bad);
 }
+std::int64_t finish_avx512(const FinishArgs<float>& a, std::int64_t q0, std::int64_t q1) {
+  return simd_finish<IsaF>(a, q0, q1);
+}
+std::int64_t finish_avx512(const FinishArgs<double>& a, std::int64_t q0, std::int64_t q1) {
+  return simd_finish<IsaD>(a, q0, q1);
+}
 } // namespace vkcloth::detail

@@ -253,6 +253,246 @@ std::int64_t simd_dispatch(const vkcloth::detail::RowArgs<typename T::Real>& a, 
   }
 }
 
+// ---- Contacts: the finish of a grid substep with colliders (FinishArgs) -----------------------
+// The second optimised copy of the shared kernel: cloth_kernel.h collider_contact (plane, sphere,
+// capsule, box), remove_inward, contact_filter, coulomb_friction, contact_response, surface_velocity,
+// project_out and euler_update, as CpuSolver::euler_finish calls them, W particles per vector. The
+// collider's type is the same for every lane (a switch per collider); each `if` on a per-particle
+// value becomes a select between values computed for every lane, each expression written in the
+// kernel's order (glm's min, max and abs: (y < x) ? y : x, (x < y) ? y : x, x >= 0 ? x : -x).
+// tests/test_cloth.cpp "the SIMD row kernels ... give the shared reference's bits" covers it.
+
+template <typename T> struct V3 { typename T::V x, y, z; };
+
+#define VKCLOTH_AI inline __attribute__((always_inline))
+
+template <typename T> VKCLOTH_AI V3<T> bc3(const typename T::Real* p) {
+  return {bc<T>(p[0]), bc<T>(p[1]), bc<T>(p[2])};
+}
+template <typename T> VKCLOTH_AI V3<T> operator+(V3<T> a, V3<T> b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+template <typename T> VKCLOTH_AI V3<T> operator-(V3<T> a, V3<T> b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+template <typename T> VKCLOTH_AI V3<T> operator*(V3<T> a, typename T::V s) {
+  return {a.x * s, a.y * s, a.z * s};
+}
+template <typename T> VKCLOTH_AI V3<T> operator/(V3<T> a, typename T::V s) {
+  return {a.x / s, a.y / s, a.z / s};
+}
+template <typename T> VKCLOTH_AI V3<T> sel(typename T::M m, V3<T> a, V3<T> b) {
+  return {m ? a.x : b.x, m ? a.y : b.y, m ? a.z : b.z};
+}
+// dot3: a.x b.x + a.y b.y, then + a.z b.z.
+template <typename T> VKCLOTH_AI typename T::V dot(V3<T> a, V3<T> b) {
+  const typename T::V r = a.x * b.x + a.y * b.y;
+  return r + a.z * b.z;
+}
+// cross3 in glm::cross's order.
+template <typename T> VKCLOTH_AI V3<T> cross(V3<T> x, V3<T> y) {
+  return {x.y * y.z - y.y * x.z, x.z * y.x - y.z * x.x, x.x * y.y - y.x * x.y};
+}
+// glm's scalar max(x, y) = (x < y) ? y : x, lane by lane.
+template <typename T> VKCLOTH_AI typename T::V vmax(typename T::V x, typename T::V y) {
+  return x < y ? y : x;
+}
+template <typename T> VKCLOTH_AI typename T::V vmin(typename T::V x, typename T::V y) {
+  return y < x ? y : x;
+}
+
+// Some lane of m is set (a branch that skips work whose result every lane would drop).
+template <typename T> VKCLOTH_AI bool any(typename T::M m) {
+  bool r = false;
+  for (int l = 0; l < T::W; ++l)
+    r = r || m[l] != 0;
+  return r;
+}
+
+// surface_velocity: velocity + cross3(spin, p - pivot).
+template <typename T>
+VKCLOTH_AI V3<T> surface_velocity_v(const vkcloth::detail::FinishShape<typename T::Real>& s, V3<T> p) {
+  return bc3<T>(s.velocity) + cross<T>(bc3<T>(s.spin), p - bc3<T>(s.pivot));
+}
+
+// collider_contact for a plane, sphere, capsule or box (0..3): the signed distance and the normal.
+// The normal only when some lane's distance is below `wanted` (the caller uses it nowhere else):
+// returns false, normal unset, when none is.
+template <typename T>
+VKCLOTH_AI bool collider_contact_v(const vkcloth::detail::FinishShape<typename T::Real>& s, V3<T> p,
+                                   typename T::V wanted, typename T::V& distance, V3<T>& normal) {
+  using Real = typename T::Real;
+  using V = typename T::V;
+  using M = typename T::M;
+  const V zero = V{}, one = bc<T>(Real(1));
+  const V3<T> a = bc3<T>(s.a);
+  if (s.type == 0) { // plane
+    distance = dot<T>(a, p) - bc<T>(s.b);
+    normal = a;
+    return any<T>(distance < wanted);
+  }
+  if (s.type == 1 || s.type == 2) { // sphere; capsule: the segment's nearest point first
+    V3<T> r = p - a;
+    if (s.type == 2) {
+      const Real axis[3] = {s.c[0] - s.a[0], s.c[1] - s.a[1], s.c[2] - s.a[2]};
+      Real len2 = axis[0] * axis[0] + axis[1] * axis[1];
+      len2 = len2 + axis[2] * axis[2];
+      const V3<T> ax = bc3<T>(axis);
+      V t = zero;
+      if (len2 > Real(0))
+        t = dot<T>(p - a, ax) / bc<T>(len2);
+      t = vmin<T>(vmax<T>(t, zero), one);
+      r = p - (a + ax * t);
+    }
+    const V len = T::sqrt(dot<T>(r, r));
+    distance = len - bc<T>(s.b);
+    if (!any<T>(distance < wanted))
+      return false;
+    const M pos = len > zero;
+    normal = sel<T>(pos, r / len, V3<T>{zero, zero, one});
+    return true;
+  }
+  // box: q = R^T (p - centre)
+  const V3<T> ax = bc3<T>(s.ax), ay = bc3<T>(s.ay), az = bc3<T>(s.az);
+  const V3<T> r = p - a;
+  const V3<T> q{dot<T>(ax, r), dot<T>(ay, r), dot<T>(az, r)};
+  const V3<T> c = bc3<T>(s.c);
+  const V3<T> aq{q.x >= zero ? q.x : -q.x, q.y >= zero ? q.y : -q.y, q.z >= zero ? q.z : -q.z};
+  const V3<T> over = aq - c;
+  const V3<T> out{vmax<T>(over.x, zero), vmax<T>(over.y, zero), vmax<T>(over.z, zero)};
+  const V out_len = T::sqrt(dot<T>(out, out));
+  const M outside = out_len > zero;
+  // Inside: out through the nearest face (x, then y if deeper, then z).
+  V d = over.x;
+  const M y_deeper = over.y > d;
+  d = y_deeper ? over.y : d;
+  const M z_deeper = over.z > d;
+  d = z_deeper ? over.z : d;
+  distance = outside ? out_len : d;
+  if (!any<T>(distance < wanted))
+    return false;
+  const V3<T> sgn{q.x < zero ? -one : one, q.y < zero ? -one : one, q.z < zero ? -one : one};
+  const V3<T> nb_out{(out.x * sgn.x) / out_len, (out.y * sgn.y) / out_len, (out.z * sgn.z) / out_len};
+  V3<T> nb_in{sgn.x, zero, zero};
+  nb_in = sel<T>(y_deeper, V3<T>{zero, sgn.y, zero}, nb_in);
+  nb_in = sel<T>(z_deeper, V3<T>{zero, zero, sgn.z}, nb_in);
+  const V3<T> nb = sel<T>(outside, nb_out, nb_in);
+  // to_world_dir: ax nb.x + ay nb.y, then + az nb.z.
+  normal = (ax * nb.x + ay * nb.y) + az * nb.z;
+  return true;
+}
+
+// remove_inward on the lanes of `active`: w loses its part along n when <w, n> < 0 (or != 0 with `both`).
+template <typename T> VKCLOTH_AI void remove_inward_v(V3<T>& w, V3<T> n, bool both, typename T::M active) {
+  const typename T::V zero{};
+  const typename T::V wn = dot<T>(w, n);
+  typename T::M cond = wn < zero;
+  if (both)
+    cond = cond | (wn != zero);
+  w = sel<T>(active & cond, w - n * wn, w);
+}
+
+template <typename T>
+std::int64_t simd_finish(const vkcloth::detail::FinishArgs<typename T::Real>& a, std::int64_t q0,
+                         std::int64_t q1) {
+  using Real = typename T::Real;
+  using V = typename T::V;
+  using M = typename T::M;
+  constexpr int W = T::W;
+  const V zero{};
+  const V dt = bc<T>(a.dt), band = bc<T>(a.band), eps = bc<T>(a.eps);
+  const M all = zero == zero;
+  std::int64_t q = q0;
+  for (; q + W <= q1; q += W) {
+    const V3<T> x0{ld<T>(a.px + q), ld<T>(a.py + q), ld<T>(a.pz + q)};
+    V fx, fy, fz, vx, vy, vz;
+    T::load3(a.force + 3 * q, fx, fy, fz);
+    T::load3(a.vel + 3 * q, vx, vy, vz);
+    const V3<T> f0{fx, fy, fz}, v0{vx, vy, vz};
+    const V m = ld<T>(a.mass + q);
+    const V h_over_m = dt / m;
+    V3<T> v = v0, f = f0;
+    // contact_at: each collider's response at the substep's start position.
+    for (std::uint32_t k = 0; k < a.shape_count; ++k) {
+      const vkcloth::detail::FinishShape<Real>& s = a.shapes[k];
+      V distance;
+      V3<T> n;
+      if (!collider_contact_v<T>(s, x0, band, distance, n))
+        continue; // no lane in contact with this collider: nothing changes
+      const M in_band = distance < band;
+      if (!s.moving && s.mu_s == Real(0) && s.mu_k == Real(0)) { // contact_filter
+        remove_inward_v<T>(v, n, a.both, in_band);
+        remove_inward_v<T>(f, n, a.both, in_band);
+        continue;
+      }
+      const V3<T> vs = s.moving ? surface_velocity_v<T>(s, x0) : V3<T>{zero, zero, zero};
+      V3<T> w = v - vs, g = f;
+      const V wn = dot<T>(w, n), fn = dot<T>(g, n);
+      remove_inward_v<T>(w, n, a.both, all);
+      remove_inward_v<T>(g, n, a.both, all);
+      const V j = vmax<T>(-wn, zero) + vmax<T>(-fn, zero) * h_over_m;
+      // coulomb_friction
+      const V3<T> wt = w - n * dot<T>(w, n);
+      const V3<T> ft = g - n * dot<T>(g, n);
+      const V3<T> slip = wt + ft * h_over_m;
+      const V slip_len = T::sqrt(dot<T>(slip, slip));
+      const V hold = bc<T>(s.mu_s) * j;
+      const V kinetic = bc<T>(s.mu_k) * j / slip_len;
+      const V kf = slip_len > hold ? kinetic : bc<T>(Real(1));
+      const V3<T> nw = w - wt * kf;
+      const V3<T> nf = g - ft * kf;
+      v = sel<T>(in_band, nw + vs, v);
+      f = sel<T>(in_band, nf, f);
+    }
+    // euler_update
+    const V3<T> acc = f / m;
+    V3<T> x, u;
+    if (a.semi) {
+      u = v + acc * dt;
+      x = x0 + u * dt;
+    } else {
+      x = x0 + v * dt;
+      u = v + acc * dt;
+    }
+    // project_at: each collider's projection of the new position.
+    for (std::uint32_t k = 0; k < a.shape_count; ++k) {
+      const vkcloth::detail::FinishShape<Real>& s = a.shapes[k];
+      V distance;
+      V3<T> n;
+      if (!collider_contact_v<T>(s, x, zero, distance, n))
+        continue; // no lane inside this collider: nothing moves
+      const M inside = distance < zero;
+      V3<T> xp;
+      if (s.type == 1) {
+        const Real r = s.b + a.eps;
+        xp = bc3<T>(s.a) + n * bc<T>(r);
+      } else {
+        const V back = eps - distance;
+        xp = x + n * back;
+      }
+      x = sel<T>(inside, xp, x);
+      if (!s.moving) {
+        remove_inward_v<T>(u, n, false, inside);
+        continue;
+      }
+      const V3<T> vs = surface_velocity_v<T>(s, x);
+      V3<T> w = u - vs;
+      remove_inward_v<T>(w, n, false, all);
+      u = sel<T>(inside, w + vs, u);
+    }
+    const M pin = T::pinmask(a.pinned + q);
+    const V3<T> xo = sel<T>(pin, x0, x), vo = sel<T>(pin, v0, u), fo = sel<T>(pin, f0, f);
+    T::store3(a.force + 3 * q, fo.x, fo.y, fo.z);
+    T::store3(a.pos_next + 3 * q, xo.x, xo.y, xo.z);
+    T::store3(a.vel + 3 * q, vo.x, vo.y, vo.z);
+    __builtin_memcpy(a.sx_next + q, &xo.x, sizeof(V));
+    __builtin_memcpy(a.sy_next + q, &xo.y, sizeof(V));
+    __builtin_memcpy(a.sz_next + q, &xo.z, sizeof(V));
+  }
+  return q;
+}
+#undef VKCLOTH_AI
+
 // Generic AoS <-> SoA and pin mask by lanes (the ISA files specialise the hot float cases).
 template <typename Real, typename V, typename M, int W> struct IsaGeneric {
   static void load3(const Real* p, V& x, V& y, V& z) {

@@ -111,11 +111,13 @@ Result<PipelineRegistry::SolverLayouts> PipelineRegistry::solver_layouts_locked(
     auto sl = create_compute_set_layout(ctx_, storage, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, "solver");
     if (!sl)
       return sl.error();
-    const std::uint32_t texel[] = {
-        VKCLOTH_TEXEL_BINDING_POS_IN,       VKCLOTH_TEXEL_BINDING_PARTICLE,    VKCLOTH_TEXEL_BINDING_VEL,
-        VKCLOTH_TEXEL_BINDING_FLAGS,        VKCLOTH_TEXEL_BINDING_INSTANCES,   VKCLOTH_TEXEL_BINDING_OFFSETS,
-        VKCLOTH_TEXEL_BINDING_EDGES,        VKCLOTH_TEXEL_BINDING_FAN_OFFSETS, VKCLOTH_TEXEL_BINDING_FANS,
-        VKCLOTH_TEXEL_BINDING_STRAIN_LINKS, VKCLOTH_TEXEL_BINDING_TETHERS};
+    const std::uint32_t texel[] = {VKCLOTH_TEXEL_BINDING_POS_IN,     VKCLOTH_TEXEL_BINDING_PARTICLE,
+                                   VKCLOTH_TEXEL_BINDING_VEL,        VKCLOTH_TEXEL_BINDING_FLAGS,
+                                   VKCLOTH_TEXEL_BINDING_INSTANCES,  VKCLOTH_TEXEL_BINDING_OFFSETS,
+                                   VKCLOTH_TEXEL_BINDING_EDGES,      VKCLOTH_TEXEL_BINDING_FAN_OFFSETS,
+                                   VKCLOTH_TEXEL_BINDING_FANS,       VKCLOTH_TEXEL_BINDING_STRAIN_LINKS,
+                                   VKCLOTH_TEXEL_BINDING_TETHERS,    VKCLOTH_TEXEL_BINDING_COLLIDERS,
+                                   VKCLOTH_TEXEL_BINDING_MESH_NODES, VKCLOTH_TEXEL_BINDING_MESH_TRIS};
     static_assert(std::size(texel) == VKCLOTH_TEXEL_BINDING_COUNT);
     auto tl =
         create_compute_set_layout(ctx_, texel, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, "solver texel views");

@@ -82,13 +82,19 @@ Result<void> SolverBatch::ensure_collider_capacity() {
   if (colliders.buffer)
     VKCLOTH_TRY(commands->wait_for_earlier_work());
   const std::uint32_t cap = std::max<std::uint32_t>(n, 4);
+  if (access == BufferAccess::texel_views) // the *_texel builds read the colliders through a view
+    VKCLOTH_TRY(
+        check_texels(*ctx, "colliders", std::uint64_t(cap) * VKCLOTH_COLLIDER_TEXELS, "use fewer colliders"));
   auto b = create_buffer(*ctx, cap * sizeof(sh::Collider),
-                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                             VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT,
                          MemoryUse::host_upload, true, "colliders");
   if (!b)
     return b.error();
+  colliders_view.reset(); // before the buffer it views
   colliders = std::move(*b);
   collider_capacity = cap;
+  VKCLOTH_TRY(create_buffer_views());
   if (sets[0][0])
     VKCLOTH_TRY(write_sets());
   return {};
@@ -117,6 +123,12 @@ Result<void> SolverBatch::ensure_mesh_buffers() {
   const StorageLimit limit = storage_limit(*ctx, knobs);
   VKCLOTH_TRY(check_buffer(*ctx, limit, "mesh collider hierarchy", nodes.size(), sizeof(sh::MeshNode)));
   VKCLOTH_TRY(check_buffer(*ctx, limit, "mesh collider triangles", tris.size(), sizeof(sh::MeshTriangle)));
+  if (access == BufferAccess::texel_views) { // the *_texel builds read them through views
+    VKCLOTH_TRY(
+        check_texels(*ctx, "mesh collider nodes", 2ull * nodes.size(), "use a mesh of fewer triangles"));
+    VKCLOTH_TRY(
+        check_texels(*ctx, "mesh collider triangles", 3ull * tris.size(), "use a mesh of fewer triangles"));
+  }
   if (mesh_nodes.buffer)
     VKCLOTH_TRY(commands->wait_for_earlier_work());
   Buffer new_nodes, new_tris;
@@ -128,13 +140,16 @@ Result<void> SolverBatch::ensure_mesh_buffers() {
       {&new_nodes, std::max<std::size_t>(nodes.size(), 1) * sizeof(sh::MeshNode), "mesh nodes"},
       {&new_tris, std::max<std::size_t>(tris.size(), 1) * sizeof(sh::MeshTriangle), "mesh triangles"}};
   for (const auto& m : made) {
-    auto b =
-        create_buffer(*ctx, m.bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                      MemoryUse::device, !knobs.force_staging, m.name);
+    auto b = create_buffer(*ctx, m.bytes,
+                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                               VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT,
+                           MemoryUse::device, !knobs.force_staging, m.name);
     if (!b)
       return b.error();
     *m.dst = std::move(*b);
   }
+  mesh_nodes_view.reset(); // before the buffers they view
+  mesh_tris_view.reset();
   mesh_nodes = std::move(new_nodes);
   mesh_tris = std::move(new_tris);
   const Upload up[] = {
@@ -143,6 +158,7 @@ Result<void> SolverBatch::ensure_mesh_buffers() {
   VKCLOTH_TRY(upload(up));
   meshes = std::move(wanted);
   mesh_starts = std::move(starts);
+  VKCLOTH_TRY(create_buffer_views());
   if (sets[0][0])
     VKCLOTH_TRY(write_sets());
   return {};
@@ -418,7 +434,7 @@ Result<void> SolverBatch::ensure_tethers() {
   const Upload up[] = {{&tethers, data.data(), bytes}};
   VKCLOTH_TRY(upload(up));
   tethers_uploaded = true;
-  VKCLOTH_TRY(create_tethers_view());
+  VKCLOTH_TRY(create_buffer_views());
   return write_sets();
 }
 
@@ -564,8 +580,7 @@ void SolverBatch::record_update(VkCommandBuffer c, bool first, bool last) {
   const bool rk4 = family().integrator == Integrator::rk4;
   if (options.fused && !rk4) {
     // One dispatch per (sub)step (fused.comp); the descriptor set alternates with the parity.
-    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE,
-                        fused_pipes[last ? 1 : 0][any_colliders() ? 1 : 0]);
+    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, fused_pipes[last ? 1 : 0][collider_types()]);
     pc.stage = 0;
     const VkDescriptorSet bound_sets[2] = {sets[read][0], texel_sets[read]};
     v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 2, bound_sets, 0, nullptr);

@@ -178,11 +178,12 @@ private:
   VkPipeline force_pipeline = VK_NULL_HANDLE, integrate_pipeline = VK_NULL_HANDLE;
   VkPipeline strain_links_pipeline = VK_NULL_HANDLE, strain_finish_pipeline = VK_NULL_HANDLE;
   VkPipeline vertices_pipeline = VK_NULL_HANDLE;
-  // fused.comp variants, looked up when first needed (ensure_fused): [write_aux][colliders].
+  // fused.comp variants, looked up when first needed (ensure_fused): [write_aux][collider types].
   // write_aux = 0 (SC_WRITE_AUX false: no force and normal stores) for every fused substep of a
   // recorded batch of steps but the last, since only the last one's forces and normals can be
-  // observed; colliders = 0 (SC_COLLIDERS false: no contact loops) while no instance has colliders.
-  VkPipeline fused_pipes[2][2] = {};
+  // observed; collider types (SC_COLLIDER_TYPES: bit t for a collider of type t in some instance)
+  // 0, no contact loops, while no instance has colliders; absent shapes' code compiled out.
+  VkPipeline fused_pipes[2][VKCLOTH_COLLIDER_ALL_TYPES + 1] = {};
   DescriptorPool pool;
   VkDescriptorSet sets[2][2] = {}; // [positions read index][0: state input, 1: RK4 stage input]
   // Set 1 of force.comp / fused.comp: POS_IN as an RGBA32F uniform texel buffer (force_body.glsl
@@ -192,6 +193,8 @@ private:
   BufferView pos_views[3];
   BufferView particle_view, vel_view, flags_view, instances_view;
   BufferView offsets_view, edges_view, fan_offsets_view, fans_view, strain_links_view, tethers_view;
+  // The collider buffer and the mesh buffers (replaced when they grow: create_buffer_views again).
+  BufferView colliders_view, mesh_nodes_view, mesh_tris_view;
   VkDescriptorSet texel_sets[3] = {};
   CommandContext* commands = nullptr; // the owner's (ClothWorld): uploads, readbacks
   std::uint32_t groups_x = 1, groups_y = 1;
@@ -219,6 +222,14 @@ private:
         return true;
     return false;
   }
+  /// Bit t (VKCLOTH_COLLIDER_*) for each collider type some instance has; 0 without colliders.
+  std::uint32_t collider_types() const {
+    std::uint32_t types = 0;
+    for (const Slot& s : slots)
+      for (const Collider& c : s.params.colliders)
+        types |= 1u << std::uint32_t(c.type);
+    return types;
+  }
   const DeviceFns& vk() const { return ctx->vk; }
   VkDeviceSize slot_offset(std::uint32_t slot) const {
     return VkDeviceSize(slot) * count * GpuSolver::stride;
@@ -237,7 +248,7 @@ private:
   Result<void> init_pipelines();
   Result<void> create_descriptor_sets();
   Result<void> create_texel_views();
-  Result<void> create_tethers_view();
+  Result<void> create_buffer_views();
   Result<void> create_pipelines();
   Result<void> write_sets();
   Result<void> ensure_implicit();

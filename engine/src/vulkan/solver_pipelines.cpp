@@ -25,15 +25,15 @@ namespace {
 
 /// The specialisation constants of force.comp and fused.comp, as 32-bit words by constant_id:
 /// 0..39 the grid stencil (force_body.glsl), 40 SC_WRITE_AUX (fused.comp only; force.comp has no
-/// constant 40, and an entry for an id a shader lacks is ignored), 41 SC_COLLIDERS (common.glsl),
-/// 42 SC_FANS (force_body.glsl), each a VkBool32.
-std::array<std::uint32_t, 43> solver_constants(const SolverBatch::Stencil& st, bool write_aux, bool colliders,
-                                               bool fans) {
+/// constant 40, and an entry for an id a shader lacks is ignored), 41 SC_COLLIDER_TYPES (common.glsl:
+/// a mask of collider types), 42 SC_FANS (force_body.glsl); 40 and 42 are VkBool32s.
+std::array<std::uint32_t, 43> solver_constants(const SolverBatch::Stencil& st, bool write_aux,
+                                               std::uint32_t collider_types, bool fans) {
   static_assert(sizeof(SolverBatch::Stencil) == 40 * 4);
   std::array<std::uint32_t, 43> words{};
   std::memcpy(words.data(), &st, sizeof(st));
   words[40] = write_aux ? 1u : 0u;
-  words[41] = colliders ? 1u : 0u;
+  words[41] = collider_types;
   words[42] = fans ? 1u : 0u;
   return words;
 }
@@ -136,18 +136,32 @@ Result<void> SolverBatch::create_texel_views() {
       return r.error();
     *view.view = std::move(*r);
   }
-  return create_tethers_view();
+  return create_buffer_views();
 }
 
-// The tethers' view (again when ensure_tethers() replaces the buffer), then every texel set.
-Result<void> SolverBatch::create_tethers_view() {
+// The views of the buffers that are replaced while the batch lives (again whenever one is:
+// ensure_tethers, ensure_collider_capacity, ensure_mesh_buffers): the tethers, the colliders and
+// the mesh colliders' nodes and triangles; then every texel set.
+Result<void> SolverBatch::create_buffer_views() {
   static_assert(sizeof(sh::TetherSlot) == 8, "one RG32UI texel per TetherSlot");
-  if (access != BufferAccess::texel_views)
-    return {}; // no views (init_pipelines)
-  auto r = create_buffer_view(*ctx, tethers.buffer, VK_FORMAT_R32G32_UINT, "tethers");
-  if (!r)
-    return r.error();
-  tethers_view = std::move(*r);
+  static_assert(sizeof(sh::MeshNode) == 2 * 16 && sizeof(sh::MeshTriangle) == 3 * 16);
+  if (access != BufferAccess::texel_views || !texel_sets[0])
+    return {}; // no views (init_pipelines), or not yet (create_buffers: create_texel_views makes them)
+  const struct {
+    const Buffer* buffer;
+    VkFormat format;
+    BufferView* view;
+    const char* what;
+  } views[4] = {{&tethers, VK_FORMAT_R32G32_UINT, &tethers_view, "tethers"},
+                {&colliders, VK_FORMAT_R32G32B32A32_UINT, &colliders_view, "colliders"},
+                {&mesh_nodes, VK_FORMAT_R32G32B32A32_UINT, &mesh_nodes_view, "mesh collider nodes"},
+                {&mesh_tris, VK_FORMAT_R32G32B32A32_UINT, &mesh_tris_view, "mesh collider triangles"}};
+  for (const auto& view : views) {
+    auto r = create_buffer_view(*ctx, view.buffer->buffer, view.format, view.what);
+    if (!r)
+      return r.error();
+    *view.view = std::move(*r);
+  }
   const std::pair<const BufferView*, std::uint32_t> shared_views[VKCLOTH_TEXEL_BINDING_COUNT - 1] = {
       {&particle_view, VKCLOTH_TEXEL_BINDING_PARTICLE},
       {&vel_view, VKCLOTH_TEXEL_BINDING_VEL},
@@ -158,7 +172,10 @@ Result<void> SolverBatch::create_tethers_view() {
       {&fan_offsets_view, VKCLOTH_TEXEL_BINDING_FAN_OFFSETS},
       {&fans_view, VKCLOTH_TEXEL_BINDING_FANS},
       {&strain_links_view, VKCLOTH_TEXEL_BINDING_STRAIN_LINKS},
-      {&tethers_view, VKCLOTH_TEXEL_BINDING_TETHERS}};
+      {&tethers_view, VKCLOTH_TEXEL_BINDING_TETHERS},
+      {&colliders_view, VKCLOTH_TEXEL_BINDING_COLLIDERS},
+      {&mesh_nodes_view, VKCLOTH_TEXEL_BINDING_MESH_NODES},
+      {&mesh_tris_view, VKCLOTH_TEXEL_BINDING_MESH_TRIS}};
   std::array<VkWriteDescriptorSet, VKCLOTH_TEXEL_BINDING_COUNT * 3> writes{};
   std::size_t w = 0;
   auto write = [&](VkDescriptorSet set, std::uint32_t binding, const BufferView& view) {
@@ -185,7 +202,8 @@ Result<void> SolverBatch::create_tethers_view() {
 // the batch's build (texel views or storage buffers) and workgroup size (resolve_layout).
 Result<void> SolverBatch::create_pipelines() {
   using Shader = PipelineRegistry::Shader;
-  const auto constants = solver_constants(stencil, true, true, normals == Normals::fans);
+  const auto constants =
+      solver_constants(stencil, true, VKCLOTH_COLLIDER_ALL_TYPES, normals == Normals::fans);
   const PipelineRegistry::Variant variant{access, workgroup};
   auto fp = ctx->pipelines->pipeline(Shader::force, constants, variant);
   if (!fp)
@@ -212,18 +230,18 @@ Result<void> SolverBatch::create_pipelines() {
   return {};
 }
 
-// The fused.comp variants the current parameters need ([0] and [1] x colliders in the batch or
-// not); the registry makes each variant once per Context.
+// The fused.comp variants the current parameters need ([0] and [1] x the collider types in the
+// batch); the registry makes each variant once per Context.
 Result<void> SolverBatch::ensure_fused() {
-  const std::uint32_t col = any_colliders() ? 1u : 0u;
-  if (!options.fused || (fused_pipes[0][col] && fused_pipes[1][col]))
+  const std::uint32_t types = collider_types();
+  if (!options.fused || (fused_pipes[0][types] && fused_pipes[1][types]))
     return {};
   for (std::uint32_t aux = 0; aux < 2; ++aux) {
-    const auto constants = solver_constants(stencil, aux != 0, col != 0, normals == Normals::fans);
+    const auto constants = solver_constants(stencil, aux != 0, types, normals == Normals::fans);
     auto p = ctx->pipelines->pipeline(PipelineRegistry::Shader::fused, constants, {access, workgroup});
     if (!p)
       return p.error();
-    fused_pipes[aux][col] = *p;
+    fused_pipes[aux][types] = *p;
   }
   return {};
 }
