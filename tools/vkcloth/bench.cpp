@@ -83,7 +83,9 @@ Result<void> parse_stiffness(const std::string& text, ClothStiffness& out) {
   return {};
 }
 
-Result<BenchScene> bench_scene(std::uint32_t n, Integrator integrator, double dt, const BenchOptions& o) {
+/// The bench's n x n grid, 1 m x 1 m: m = 0.05 kg * 4096 / n^2 per particle (or --cloth-mass over the
+/// whole grid) and --stiffness.
+Result<ClothDesc> bench_grid(std::uint32_t n, const BenchOptions& o) {
   ClothDesc d;
   d.nx = n;
   d.ny = n;
@@ -91,6 +93,14 @@ Result<BenchScene> bench_scene(std::uint32_t n, Integrator integrator, double dt
   d.particle_mass = o.cloth_mass.value_or(0.05 * 4096.0) / (double(n) * double(n));
   if (!o.stiffness.empty())
     VKCLOTH_TRY(parse_stiffness(o.stiffness, d.stiffness));
+  return d;
+}
+
+Result<BenchScene> bench_scene(std::uint32_t n, Integrator integrator, double dt, const BenchOptions& o) {
+  auto grid = bench_grid(n, o);
+  if (!grid)
+    return grid.error();
+  const ClothDesc& d = *grid;
   auto sys = make_cloth(d);
   if (!sys)
     return sys.error();
@@ -167,16 +177,13 @@ constexpr std::uint32_t sphere_frequency =
 /// lengths).
 Result<BenchScene> horizontal_cloth(std::uint32_t n, Integrator integrator, double dt,
                                     const BenchOptions& o) {
-  ClothDesc d;
-  d.nx = n;
-  d.ny = n;
-  d.size = {1.0, 1.0};
+  auto grid = bench_grid(n, o);
+  if (!grid)
+    return grid.error();
+  ClothDesc& d = *grid;
   d.orientation = ClothOrientation::horizontal;
   d.origin = {-0.5, -0.5, 0.0};
   d.pin_default_corners = false;
-  d.particle_mass = o.cloth_mass.value_or(0.05 * 4096.0) / (double(n) * double(n));
-  if (!o.stiffness.empty())
-    VKCLOTH_TRY(parse_stiffness(o.stiffness, d.stiffness));
   auto sys = make_cloth(d);
   if (!sys)
     return sys.error();
