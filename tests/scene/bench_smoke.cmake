@@ -1,13 +1,18 @@
 # SPDX-License-Identifier: MIT
 # `vkcloth bench --json` smoke test: runs at tiny sizes and checks that the JSON parses and carries
 # the documented keys (docs/performance.md). No timing is asserted.
-execute_process(COMMAND "${VKCLOTH}" bench --backend all --sizes 16,32 --steps 20 --warmup 2 --reps 1 --instances 3
-                        --json "${OUT}"
-                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-if(NOT rc EQUAL 0)
-  message(FATAL_ERROR "vkcloth bench exited ${rc}: ${err}")
-endif()
-message(STATUS "${out}")
+
+# Runs `vkcloth bench ARGN`: fails naming `what` unless it exits 0; its standard output in `out`.
+function(run_bench what)
+  execute_process(COMMAND "${VKCLOTH}" bench ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "vkcloth bench${what} exited ${rc}: ${err}")
+  endif()
+  message(STATUS "${out}")
+  set(out "${out}" PARENT_SCOPE)
+endfunction()
+
+run_bench("" --backend all --sizes 16,32 --steps 20 --warmup 2 --reps 1 --instances 3 --json "${OUT}")
 file(READ "${OUT}" doc)
 foreach(key schema scene integrator dt steps warmup reps steps_per_submit ceilings host_threads vulkan_device
             vulkan_layout vulkan_skipped results)
@@ -59,14 +64,8 @@ endif()
 
 # Implicit Euler on the stiff cloth (issue 18): --stiffness, --cloth-mass and both CG dispatch
 # layouts; the explicit baseline diverges at this dt and is left out with a note.
-execute_process(COMMAND "${VKCLOTH}" bench --backend all --integrator implicit_euler --sizes 12 --dt 0.02
-                        --stiffness 10000,2000,2000 --cloth-mass 0.5 --wind 0 --cg-dispatch both --steps 3 --warmup 1
-                        --reps 1 --json "${OUT}.implicit.json"
-                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-if(NOT rc EQUAL 0)
-  message(FATAL_ERROR "vkcloth bench (implicit) exited ${rc}: ${err}")
-endif()
-message(STATUS "${out}")
+run_bench(" (implicit)" --backend all --integrator implicit_euler --sizes 12 --dt 0.02 --stiffness 10000,2000,2000
+          --cloth-mass 0.5 --wind 0 --cg-dispatch both --steps 3 --warmup 1 --reps 1 --json "${OUT}.implicit.json")
 if(NOT out MATCHES "note: grid n = 12 \\(semi_implicit_euler\\): simulation diverged")
   message(FATAL_ERROR "bench (implicit): no note for the diverging explicit baseline")
 endif()
@@ -99,13 +98,8 @@ endif()
 # Contact rows (issue 15): the tablecloth on a box and a floor plane, the cloth on a mesh sphere,
 # each with its bare baseline; the contact rows quote the contact phase against it and count the
 # particles in contact (all of them start in contact). No timing is asserted.
-execute_process(COMMAND "${VKCLOTH}" bench --backend all --sizes 4 --contact both --variants fused --steps 2 --warmup 1
-                        --reps 1 --json "${OUT}.contact.json"
-                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-if(NOT rc EQUAL 0)
-  message(FATAL_ERROR "vkcloth bench (contact) exited ${rc}: ${err}")
-endif()
-message(STATUS "${out}")
+run_bench(" (contact)" --backend all --sizes 4 --contact both --variants fused --steps 2 --warmup 1 --reps 1
+          --json "${OUT}.contact.json")
 file(READ "${OUT}.contact.json" doc)
 string(JSON top_contact GET "${doc}" contact)
 if(NOT top_contact STREQUAL "both")

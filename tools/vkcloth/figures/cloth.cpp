@@ -208,6 +208,11 @@ double max_strain(const Run& r) {
   return s ? s->max : std::nan("");
 }
 
+void Progress::operator()(std::string_view what) const {
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  fmt::print(stderr, "figures: {} {} ({:.1f} s)\n", group_, what, s);
+}
+
 namespace {
 
 Scene cloth_scene(const ClothDesc& d, SimParams p, std::string name) {
@@ -503,11 +508,7 @@ Result<void> cloth_figures(Gallery& G) {
   Drawing d;
   VKCLOTH_TRY(open_drawing(G, d, "cloth"));
   auto& M = G.metrics["cloth"];
-  const auto clock0 = std::chrono::steady_clock::now();
-  auto progress = [&](const std::string& what) {
-    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock0).count();
-    fmt::print(stderr, "figures: cloth {} ({:.1f} s)\n", what, s);
-  };
+  const Progress progress("cloth");
   const std::string sec3 = "Cloth springs (report §3, Figures 5-9)";
   const std::string sec4 = "Collisions and wind (report §4, Figures 11-13)";
   const std::string note =

@@ -3,12 +3,14 @@
 // the offscreen drawing set-up, and the labelled image grid drawn from the runs.
 #pragma once
 
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -79,5 +81,16 @@ Result<void> grid_figure(Gallery& G, Drawing& d, std::vector<Run>& runs,
 double min_z(const Run& r);
 /// Largest structural strain (|x_b - x_a| - L0) / L0 of the final state (vkcloth/measure.hpp).
 double max_strain(const Run& r);
+
+/// Prints "figures: <group> <what> (<seconds since construction> s)" to stderr, one call per figure.
+class Progress {
+public:
+  explicit Progress(std::string group) : group_(std::move(group)) {}
+  void operator()(std::string_view what) const;
+
+private:
+  std::string group_;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
 
 } // namespace vkcloth::figures

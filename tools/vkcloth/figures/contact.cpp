@@ -381,11 +381,7 @@ Result<void> contact_figures(Gallery& G) {
   Drawing d;
   VKCLOTH_TRY(open_drawing(G, d, "contact"));
   auto& M = G.metrics["contact"];
-  const auto clock0 = std::chrono::steady_clock::now();
-  auto progress = [&](const std::string& what) {
-    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock0).count();
-    fmt::print(stderr, "figures: contact {} ({:.1f} s)\n", what, s);
-  };
+  const Progress progress("contact");
   progress("tablecloth on the table, friction 0.6 / 0");
   VKCLOTH_TRY(tablecloth_figure(G, d, M));
   progress("cloth on the sphere, friction 0 / 0.6");
