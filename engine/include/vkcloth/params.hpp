@@ -15,6 +15,7 @@
 
 #include "vkcloth/glm_abi.hpp"
 #include "vkcloth/result.hpp"
+#include "vkcloth/system.hpp"
 
 namespace vkcloth {
 
@@ -125,6 +126,21 @@ std::optional<StretchLimit::Method> parse_stretch_method(std::string_view name);
 const char* to_string(StretchLimit::TetherDistance distance);
 std::optional<StretchLimit::TetherDistance> parse_tether_distance(std::string_view name);
 
+/// Self-collision (docs/model.md "Self-collision"): off by default (the report's model). After each
+/// substep's update (and stretch control), particles closer than `thickness` to each other are
+/// pushed apart to that distance, unless they were already that close in the rest state (NvCloth's
+/// rest-position filter: neighbours joined by short springs never collide). Pairs come from a
+/// spatial hash of cells `thickness` wide, rebuilt every substep; `iterations` Jacobi passes each
+/// move every particle by the mean of its pairs' corrections (mass-weighted, Coulomb friction on the
+/// relative tangential velocity), and the moves update the velocities (v += dx / h). The colliders'
+/// projection follows. Check a thickness against a cloth with check_self_collision().
+struct SelfCollision {
+  bool enabled = false;
+  double thickness = 0.01;      ///< m, > 0: the distance kept between particles not that close at rest
+  double friction = 0.2;        ///< >= 0: Coulomb coefficient between touching layers
+  std::uint32_t iterations = 2; ///< 1..16 Jacobi passes per substep
+};
+
 struct SimParams {
   Integrator integrator = Integrator::semi_implicit_euler;
   double dt = 0.02;
@@ -149,11 +165,20 @@ struct SimParams {
   /// A position with a coordinate |x_i| > this, or a non-finite position or velocity, is a blow-up
   /// (docs/model.md "Divergence").
   double divergence_limit = 1e4;
-  StretchLimit stretch_limit; ///< off by default
+  StretchLimit stretch_limit;   ///< off by default
+  SelfCollision self_collision; ///< off by default
 
   /// Checks every field (finite, in range) and normalises directions. The message names the field.
   Result<void> validate();
 };
+
+/// A self-collision thickness against a cloth's spring lengths (structural springs; all springs
+/// when it has none): an error (ErrorCode::invalid_argument naming self_collision.thickness) when it
+/// is more than 10 x their mean rest length, since every particle would then touch most of the
+/// cloth; otherwise the warnings, e.g. a thickness below half the smallest rest length (a triangle
+/// can then pass between two particles). Nothing to check when self-collision is off.
+Result<std::vector<std::string>> check_self_collision(const SelfCollision& self,
+                                                      const ParticleSystem& system);
 
 /// What a host changes every frame (its frame time, its wind, its animated colliders), applied
 /// from the next recorded step: GpuSolver::record_steps(cmd, steps, step), ClothWorld::

@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: MIT
 #include "vkcloth/params.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <fmt/format.h>
 
 #include <glm/geometric.hpp>
@@ -281,7 +283,47 @@ Result<void> SimParams::validate() {
     return bad(fmt::format("stretch_limit.iterations must be in 1..100, got {}", stretch_limit.iterations));
   for (std::size_t k = 0; k < colliders.size(); ++k)
     VKCLOTH_TRY(validate_collider(colliders[k], fmt::format("colliders[{}]", k)));
+  if (!std::isfinite(self_collision.thickness) || self_collision.thickness <= 0.0)
+    return bad(fmt::format("self_collision.thickness must be finite and > 0 (metres), got {}",
+                           self_collision.thickness));
+  if (!std::isfinite(self_collision.friction) || self_collision.friction < 0.0)
+    return bad(
+        fmt::format("self_collision.friction must be finite and >= 0, got {}", self_collision.friction));
+  if (self_collision.iterations < 1 || self_collision.iterations > 16)
+    return bad(fmt::format("self_collision.iterations must be in 1..16, got {}", self_collision.iterations));
   return {};
+}
+
+Result<std::vector<std::string>> check_self_collision(const SelfCollision& self,
+                                                      const ParticleSystem& system) {
+  std::vector<std::string> warnings;
+  if (!self.enabled)
+    return warnings;
+  bool structural = false;
+  for (const Spring& s : system.springs)
+    structural = structural || s.kind == SpringKind::structural;
+  double sum = 0.0, smallest = std::numeric_limits<double>::infinity();
+  std::size_t n = 0;
+  for (const Spring& s : system.springs)
+    if ((!structural || s.kind == SpringKind::structural) && s.rest_length > 0.0) {
+      sum += s.rest_length;
+      smallest = std::min(smallest, s.rest_length);
+      ++n;
+    }
+  if (n == 0)
+    return warnings; // no spring lengths to compare with (free particles)
+  const double mean = sum / double(n);
+  if (self.thickness > 10.0 * mean)
+    return bad(fmt::format("self_collision.thickness {} m is more than 10 x the mean rest length of the "
+                           "cloth's {} springs ({:.4g} m): every particle would touch most of the cloth; "
+                           "use a thickness near the particle spacing",
+                           self.thickness, structural ? "structural springs" : "springs", mean));
+  if (self.thickness < 0.5 * smallest)
+    warnings.push_back(fmt::format("self_collision.thickness {} m is below half the smallest rest length "
+                                   "({:.4g} m): a triangle can pass between two particles; a thickness "
+                                   "of at least {:.4g} m closes the gaps",
+                                   self.thickness, smallest, 1.42 * mean));
+  return warnings;
 }
 
 SimParams StepParams::applied_to(SimParams params) const {
