@@ -5,7 +5,8 @@
 // pc.stage 0, before Provot's sweeps: the particle's tethers in slot order (cloth_kernel.h
 // tether_move, apply_correction; anchors are pinned, so no invocation writes what another
 // reads); pc.stage 1, after the sweeps: the colliders' projection again (a correction may have
-// pulled the particle into one).
+// pulled the particle into one); pc.stage 2, after self-collision (self_collision.comp): the same
+// projection.
 #include "vkcloth_shared.h"
 #define VKCLOTH_PC_COPY
 #include "common.glsl"
@@ -22,11 +23,13 @@ uvec2 tether_at(uint s) { return uvec2(tethers[s].anchor, floatBitsToUint(tether
 void main() {
   begin_instance();
   const uint p = particle_index();
-  if (p >= pc.count || ip.stretch == 0u)
+  if (p >= pc.count)
     return;
   const bool tether_pass = pc.stage == 0u;
-  if ((tether_pass ? (ip.stretch & VKCLOTH_STRETCH_TETHERS) == 0u : ip.collider_count == 0u) || pinned_at(p) ||
-      frozen_now())
+  // Stage 1 projects after stretch control, stage 2 after self-collision: each only where it ran.
+  const bool ran = pc.stage == 1u ? ip.stretch != 0u : (ip.flags & VKCLOTH_FLAG_SELF_COLLISION) != 0u;
+  if ((tether_pass ? (ip.stretch & VKCLOTH_STRETCH_TETHERS) == 0u : ip.collider_count == 0u || !ran) ||
+      pinned_at(p) || frozen_now())
     return;
   vec3 x = pos_now(p);
   vec3 v = vel_now(p);

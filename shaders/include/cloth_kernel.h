@@ -18,6 +18,8 @@
 // OUT(T) / INOUT(T) (out / inout parameters: T& in C++), precise, sqrt, abs, min, max, and
 // all_finite(vec3) (no component is NaN or inf); for mesh colliders MESH_DATA_PARAM / MESH_DATA
 // (the mesh buffers: a dummy uint in GLSL, whose buffers are global), mesh_node and mesh_triangle;
+// floor; for self_collide (only where SELF_DATA_PARAM is defined) SELF_DATA_PARAM / SELF_DATA,
+// self_range, self_sorted and self_particle;
 // VKCLOTH_COLLIDER_PRESENT(type): false only when no collider of that type can reach the caller
 // (C++: always true; GLSL: a specialisation constant, so that the absent shapes' code is compiled
 // out, since llvmpipe runs every branch of a non-uniform `if`). It changes no result.
@@ -451,6 +453,116 @@ KFN bool tether_move(vec3 x, vec3 anchor, real bound, OUT(vec3) d) {
   d = m;
   return true;
 }
+
+// ---- Self-collision (docs/model.md "Self-collision") ------------------------------------------
+
+// One coordinate of the spatial hash's cell of x: floor(x / cell), inv_cell = 1 / cell. Beyond
+// +-1e9 cells (a diverged state, NaN) it is cell 0, so that the conversion to int is defined on both
+// sides; the divergence check reports such a state.
+KFN int self_cell(real x, real inv_cell) {
+  precise real c = floor(x * inv_cell);
+  if (!(c >= real(-1.0e9) && c <= real(1.0e9)))
+    c = real(0);
+  return int(c);
+}
+
+// The hash-table bucket of cell (i, j, k) (Teschner et al. 2003's primes), wrapped to the table:
+// mask = its size - 1, a power of two.
+KFN uint self_bucket(int i, int j, int k, uint mask) {
+  return ((uint(i) * 73856093u) ^ (uint(j) * 19349663u) ^ (uint(k) * 83492791u)) & mask;
+}
+KFN uint self_bucket_of(vec3 x, real inv_cell, uint mask) {
+  return self_bucket(self_cell(x.x, inv_cell), self_cell(x.y, inv_cell), self_cell(x.z, inv_cell), mask);
+}
+
+// 1 / m, or 0 for a pinned particle (it takes no share of a correction).
+KFN precise real inverse_mass(real m, bool pinned) {
+  precise real w = pinned ? real(0) : real(1) / m;
+  return w;
+}
+
+// Whether x and xq (rest positions rx, rxq) are a self-collision pair: closer than the thickness
+// now (and not at one point, which has no direction) but not that close at rest (the rest-position
+// filter of NvCloth: neighbours joined by short springs never collide).
+KFN bool self_pair(vec3 x, vec3 xq, vec3 rx, vec3 rxq, real thickness2) {
+  precise vec3 u = x - xq;
+  precise real d2 = dot3(u, u);
+  precise vec3 r = rx - rxq;
+  precise real r2 = dot3(r, r);
+  return d2 < thickness2 && d2 > real(0) && !(r2 < thickness2);
+}
+
+// Adds p's part of one pair's correction to dx: along n = (x - xq) / |x - xq| the pair moves apart
+// to the thickness, p by its inverse-mass share w / (w + wq); across n the slip of the relative
+// velocity over the substep, h |v_t|, is cancelled up to mu times the depth (Coulomb: all of it
+// within mu depth, static; mu depth of it beyond, kinetic; Macklin et al. 2014, eq. 24).
+KFN void self_contact(INOUT(vec3) dx, vec3 x, vec3 v, real w, vec3 xq, vec3 vq, real wq, real thickness,
+                      real mu, real h) {
+  precise vec3 u = x - xq;
+  precise real d = sqrt(dot3(u, u));
+  precise vec3 n = u / d;
+  precise real share = w / (w + wq);
+  precise real depth = thickness - d;
+  precise vec3 rv = v - vq;
+  precise vec3 vt = rv - n * dot3(rv, n);
+  precise real slip = h * sqrt(dot3(vt, vt));
+  precise real cap = mu * depth;
+  precise real kept = slip > cap ? cap / slip : real(1); // the part of the slip friction removes
+  precise vec3 t = dx + n * (depth * share);
+  t = t - vt * (h * kept * share);
+  dx = t;
+}
+
+#ifdef SELF_DATA_PARAM // the includer provides the table (C++: kernel.hpp; GLSL: self_collision.comp)
+// Particle p's move (Jacobi: the mean of its pairs' corrections, so that a particle pressed from
+// many sides does not overshoot): every particle q in the 27 cells around p's, bucket by bucket in
+// a fixed order (a bucket two cells share is visited once), each bucket's particles in increasing
+// index. Provided by the including file: self_range(SELF_DATA, bucket, first, stop) (the bucket's
+// entries of the sorted table), self_sorted(SELF_DATA, i) (its particle), self_particle(SELF_DATA,
+// q, x, v, w, rest). Both backends build the same table, so they sum the same pairs in the same order.
+KFN precise vec3 self_collide(SELF_DATA_PARAM, uint p, vec3 x, vec3 v, real w, vec3 rx, real thickness,
+                              real inv_cell, uint mask, real mu, real h) {
+  precise real t2 = thickness * thickness;
+  const int ci = self_cell(x.x, inv_cell);
+  const int cj = self_cell(x.y, inv_cell);
+  const int ck = self_cell(x.z, inv_cell);
+  uint seen[27];
+  uint nseen = 0u;
+  precise vec3 sum = vec3(real(0));
+  uint pairs = 0u;
+  for (int dk = -1; dk <= 1; ++dk)
+    for (int dj = -1; dj <= 1; ++dj)
+      for (int di = -1; di <= 1; ++di) {
+        const uint b = self_bucket(ci + di, cj + dj, ck + dk, mask);
+        bool dup = false;
+        for (uint s = 0u; s < nseen; ++s)
+          dup = dup || seen[s] == b;
+        if (dup)
+          continue;
+        seen[nseen] = b;
+        nseen += 1u;
+        uint first;
+        uint stop;
+        self_range(SELF_DATA, b, first, stop);
+        for (uint i = first; i < stop; ++i) {
+          const uint q = self_sorted(SELF_DATA, i);
+          if (q == p)
+            continue;
+          vec3 xq;
+          vec3 vq;
+          vec3 rq;
+          real wq;
+          self_particle(SELF_DATA, q, xq, vq, wq, rq);
+          if (self_pair(x, xq, rx, rq, t2)) {
+            self_contact(sum, x, v, w, xq, vq, wq, thickness, mu, h);
+            pairs += 1u;
+          }
+        }
+      }
+  precise vec3 mean = pairs > 0u ? sum / real(pairs) : vec3(real(0));
+  return mean;
+}
+#endif
 
 // ---- Integrators (docs/model.md "Integrators") ------------------------------------------------
 

@@ -88,6 +88,8 @@ struct vec4 {
 #define VKCLOTH_FLAG_CONTACT_BOTH 4u  // contacts remove the whole normal part (Figure 12 variant)
 #define VKCLOTH_FLAG_HAS_FANS 8u      // a surface that is not a grid: normals from FAN_OFFSETS / FANS
 #define VKCLOTH_FLAG_FLIP_NORMALS 16u // store -n in the normals buffer (GpuSolverOptions::flip_normals)
+#define VKCLOTH_FLAG_SELF_COLLISION                                                                          \
+  32u // self-collision on (self_collision.comp; strain_finish.comp's stage 2)
 
 // InstanceParams::stretch bits (SimParams::stretch_limit).
 #define VKCLOTH_STRETCH_PROVOT 1u       // Provot sweeps over the strain links (strain_links.comp)

@@ -16,6 +16,8 @@
 //                velocity removed; pinned particles are left where they are
 //   6. stretch   stretch_limit on: Provot sweeps over the strain links colour by colour, then the
 //                tethers, then the projection again; the moves update the velocities (v += dx / h)
+//   6b. self     self_collision on: the spatial hash, then Jacobi passes pushing apart particles
+//                closer than the thickness (v += dx / h), then the projection again
 //   7. check     NaN/inf or |p| > divergence_limit -> Error{diverged} naming the step and time
 #pragma once
 
@@ -39,6 +41,7 @@ class ThreadPool;
 template <typename Real> struct ImplicitWorkspace;
 template <typename Real> struct RowArgs;
 template <typename Real> struct ContactShapes;
+template <typename Real> struct SelfCollisionGrid;
 } // namespace detail
 
 struct CpuSolverOptions {
@@ -135,6 +138,8 @@ private:
   void implicit_update(Real h);
   // Stretch control after a substep (docs/model.md "Stretch control").
   void limit_stretch(Real h);
+  // Self-collision after that (self_collision.cpp; docs/model.md "Self-collision").
+  void self_collide(Real h);
 
   /// A gather-list entry in the solver's precision (ClothTopology::edges() converted once).
   struct Edge {
@@ -184,6 +189,7 @@ private:
   std::unique_ptr<detail::ThreadPool> pool_;
   std::unique_ptr<detail::ImplicitWorkspace<Real>> implicit_; // created by the first implicit step
   std::unique_ptr<detail::ContactShapes<Real>> contacts_;     // this substep's colliders (prepare_colliders)
+  std::unique_ptr<detail::SelfCollisionGrid<Real>> self_;     // created by the first self-collision substep
   SolveStats solve_;
 };
 

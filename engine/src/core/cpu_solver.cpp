@@ -14,6 +14,7 @@
 #include "implicit_euler.hpp"
 #include "kernel.hpp"
 #include "row_kernel.hpp"
+#include "self_collision.hpp"
 #include "thread_pool.hpp"
 
 // Every per-particle formula comes from shaders/include/cloth_kernel.h (kernel.hpp), the source
@@ -338,6 +339,8 @@ template <typename Real> void CpuSolver<Real>::substep(const Real h) {
   }
   if (params_.stretch_limit.enabled())
     limit_stretch(h);
+  if (params_.self_collision.enabled)
+    self_collide(h);
 }
 
 // The tethers first (anchors are pinned: every particle's tethers are independent of the

@@ -35,12 +35,15 @@ static_assert(VKCLOTH_INTEGRATOR_RK4 == std::uint32_t(vkcloth::Integrator::rk4))
 #define MESH_DATA_PARAM const MeshData& mesh_data
 #define MESH_DATA mesh_data
 #define VKCLOTH_COLLIDER_PRESENT(type) true
+#define SELF_DATA_PARAM const SelfData& self_data
+#define SELF_DATA self_data
 
 namespace vkcloth::kernel {
 
 // What cloth_kernel.h expects besides real and vec3; the nested namespaces below find these.
 using uint = std::uint32_t;
 using std::abs;
+using std::floor;
 using std::max;
 using std::min;
 using std::sqrt;
@@ -68,20 +71,58 @@ template <typename V> void mesh_triangle(const MeshData& m, uint i, V& a, V& b, 
   c = V(t.c);
 }
 
+/// Self-collision's spatial hash as cloth_kernel.h self_collide walks it, in the solver's precision:
+/// the table (`start`: each bucket's first entry, size + 1 of them; `sorted`: the particles, by bucket
+/// and then index) and the particles' state, read in place (CpuSolver::self_collide).
+template <typename Real> struct SelfDataT {
+  const std::uint32_t* start = nullptr;
+  const std::uint32_t* sorted = nullptr;
+  const glm::vec<3, Real>* pos = nullptr;
+  const glm::vec<3, Real>* vel = nullptr;
+  const Real* inv_mass = nullptr;
+  const glm::vec<3, Real>* rest = nullptr;
+};
+template <typename Real> void self_range(const SelfDataT<Real>& d, uint b, uint& first, uint& stop) {
+  first = d.start[b];
+  stop = d.start[b + 1];
+}
+template <typename Real> uint self_sorted(const SelfDataT<Real>& d, uint i) {
+  return d.sorted[i];
+}
+template <typename Real, typename V>
+void self_particle(const SelfDataT<Real>& d, uint q, V& x, V& v, Real& w, V& rest) {
+  x = d.pos[q];
+  v = d.vel[q];
+  w = d.inv_mass[q];
+  rest = d.rest[q];
+}
+
 namespace f32 {
 using real = float;
 using vec3 = glm::vec3;
+using SelfData = SelfDataT<float>;
 #include "cloth_kernel.h"
 } // namespace f32
 
 namespace f64 {
 using real = double;
 using vec3 = glm::dvec3;
+using SelfData = SelfDataT<double>;
 #include "cloth_kernel.h"
 } // namespace f64
 
 using namespace f32;
 using namespace f64;
+
+/// Buckets of self-collision's hash table for `count` particles: a power of two, at least the count
+/// and a whole number of the GPU scan's blocks (VKCLOTH_SELF_SCAN_BLOCK), the same on both
+/// backends (the table decides which cells share a bucket, so the order pairs are summed in).
+inline std::uint32_t self_table_size(std::uint32_t count) {
+  std::uint32_t t = 512;
+  while (t < count)
+    t *= 2;
+  return t;
+}
 
 /// The kernel's SpringBlock of precision Real.
 template <typename Real>

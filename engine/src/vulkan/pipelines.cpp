@@ -6,11 +6,13 @@
 #include <fmt/format.h>
 
 #include "implicit_shared.h"
+#include "self_collision_shared.h"
 #include "vkcloth/shaders/force_storage_comp_spv.hpp"
 #include "vkcloth/shaders/force_texel_comp_spv.hpp"
 #include "vkcloth/shaders/fused_storage_comp_spv.hpp"
 #include "vkcloth/shaders/fused_texel_comp_spv.hpp"
 #include "vkcloth/shaders/implicit_comp_spv.hpp"
+#include "vkcloth/shaders/self_collision_comp_spv.hpp"
 #include "vkcloth/shaders/integrate_storage_comp_spv.hpp"
 #include "vkcloth/shaders/integrate_texel_comp_spv.hpp"
 #include "vkcloth/shaders/strain_finish_storage_comp_spv.hpp"
@@ -54,6 +56,8 @@ ShaderCode code_of(PipelineRegistry::Shader s, BufferAccess access) {
                  : ShaderCode{spirv::strain_finish_storage_comp_spv, "strain_finish.comp (storage buffers)"};
   case S::vertices:
     return {spirv::vertices_comp_spv, "vertices.comp"};
+  case S::self_collision:
+    return {spirv::self_collision_comp_spv, "self_collision.comp"};
   }
   return {{}, "?"};
 }
@@ -61,7 +65,7 @@ ShaderCode code_of(PipelineRegistry::Shader s, BufferAccess access) {
 /// Shaders compiled in one build only.
 bool single_build(PipelineRegistry::Shader s) {
   using S = PipelineRegistry::Shader;
-  return s == S::implicit || s == S::vertices;
+  return s == S::implicit || s == S::vertices || s == S::self_collision;
 }
 
 /// The storage bindings of implicit.comp (implicit_shared.h).
@@ -76,10 +80,22 @@ constexpr std::uint32_t kImplicitBindings[] = {
     VKCLOTH_BINDING_IMPL_PARTIALS,  VKCLOTH_BINDING_IMPL_STATE, VKCLOTH_BINDING_IMPL_ARGS,
     VKCLOTH_BINDING_MESH_NODES,     VKCLOTH_BINDING_MESH_TRIS};
 
+/// The storage bindings of self_collision.comp (self_collision_shared.h).
+constexpr std::uint32_t kSelfCollisionBindings[] = {
+    VKCLOTH_BINDING_POS_OUT,     VKCLOTH_BINDING_VEL,         VKCLOTH_BINDING_PARTICLE,
+    VKCLOTH_BINDING_FLAGS,       VKCLOTH_BINDING_INSTANCES,   VKCLOTH_BINDING_SELF_PARAMS,
+    VKCLOTH_BINDING_SELF_REST,   VKCLOTH_BINDING_SELF_COUNTS, VKCLOTH_BINDING_SELF_STARTS,
+    VKCLOTH_BINDING_SELF_BLOCKS, VKCLOTH_BINDING_SELF_BUCKET, VKCLOTH_BINDING_SELF_SORTED,
+    VKCLOTH_BINDING_SELF_DELTA};
+
 } // namespace
 
 std::span<const std::uint32_t> implicit_bindings() {
   return kImplicitBindings;
+}
+
+std::span<const std::uint32_t> self_collision_bindings() {
+  return kSelfCollisionBindings;
 }
 
 VkPipelineCache PipelineRegistry::cache() {
@@ -137,24 +153,30 @@ Result<PipelineRegistry::SolverLayouts> PipelineRegistry::solver_layouts_locked(
 
 Result<PipelineRegistry::ImplicitLayouts> PipelineRegistry::implicit_layouts() {
   const std::lock_guard lock(mutex_);
-  return implicit_layouts_locked();
+  return single_set_layouts_locked(kImplicitBindings, "implicit", implicit_set_, implicit_layout_);
 }
 
-Result<PipelineRegistry::ImplicitLayouts> PipelineRegistry::implicit_layouts_locked() {
-  if (!implicit_layout_) {
-    auto sl =
-        create_compute_set_layout(ctx_, kImplicitBindings, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, "implicit");
+Result<PipelineRegistry::ImplicitLayouts> PipelineRegistry::self_collision_layouts() {
+  const std::lock_guard lock(mutex_);
+  return single_set_layouts_locked(kSelfCollisionBindings, "self-collision", self_set_, self_layout_);
+}
+
+Result<PipelineRegistry::ImplicitLayouts>
+PipelineRegistry::single_set_layouts_locked(std::span<const std::uint32_t> bindings, const char* name,
+                                            DescriptorSetLayout& set, PipelineLayout& layout) {
+  if (!layout) {
+    auto sl = create_compute_set_layout(ctx_, bindings, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, name);
     if (!sl)
       return sl.error();
     const VkDescriptorSetLayout sets[1] = {*sl};
-    auto pl = create_pipeline_layout(ctx_, sets, VK_SHADER_STAGE_COMPUTE_BIT, sizeof(shared::PushConstants),
-                                     "implicit");
+    auto pl =
+        create_pipeline_layout(ctx_, sets, VK_SHADER_STAGE_COMPUTE_BIT, sizeof(shared::PushConstants), name);
     if (!pl)
       return pl.error();
-    implicit_set_ = std::move(*sl);
-    implicit_layout_ = std::move(*pl);
+    set = std::move(*sl);
+    layout = std::move(*pl);
   }
-  return ImplicitLayouts{implicit_set_, implicit_layout_};
+  return ImplicitLayouts{set, layout};
 }
 
 Result<VkShaderModule> PipelineRegistry::module_locked(Shader shader, BufferAccess access) {
@@ -169,21 +191,25 @@ Result<VkShaderModule> PipelineRegistry::module_locked(Shader shader, BufferAcce
 
 Result<VkPipeline> PipelineRegistry::pipeline(Shader shader, std::span<const std::uint32_t> constants,
                                               Variant variant) {
-  const bool implicit = shader == Shader::implicit;
+  const bool implicit = shader == Shader::implicit, self = shader == Shader::self_collision;
   if (single_build(shader))
     variant.access = BufferAccess::texel_views; // one module, whatever was asked
   if (variant.access == BufferAccess::automatic)
     variant.access = device_layout(ctx_).access;
-  if (implicit || variant.workgroup_size == VKCLOTH_WORKGROUP_SIZE)
-    variant.workgroup_size = 0; // implicit*.comp size shared arrays with the compiled size
+  if (implicit || self || variant.workgroup_size == VKCLOTH_WORKGROUP_SIZE)
+    variant.workgroup_size =
+        0; // implicit.comp, self_collision.comp size shared arrays with the compiled size
   const std::lock_guard lock(mutex_);
   std::tuple<Shader, Variant, std::vector<std::uint32_t>> key{
       shader, variant, {constants.begin(), constants.end()}};
   if (auto it = pipelines_.find(key); it != pipelines_.end())
     return it->second.get();
   VkPipelineLayout layout = VK_NULL_HANDLE;
-  if (implicit) {
-    auto l = implicit_layouts_locked();
+  if (implicit || self) {
+    auto l =
+        implicit
+            ? single_set_layouts_locked(kImplicitBindings, "implicit", implicit_set_, implicit_layout_)
+            : single_set_layouts_locked(kSelfCollisionBindings, "self-collision", self_set_, self_layout_);
     if (!l)
       return l.error();
     layout = l->layout;

@@ -22,6 +22,8 @@ namespace vkcloth::gpu {
 
 /// The storage bindings of implicit.comp, in descriptor-write order.
 std::span<const std::uint32_t> implicit_bindings();
+/// The storage bindings of self_collision.comp, in descriptor-write order.
+std::span<const std::uint32_t> self_collision_bindings();
 
 /// choose_layout() for `ctx`'s device (layout.cpp).
 DeviceLayout device_layout(const Context::Impl& ctx);
@@ -41,7 +43,16 @@ struct ShaderVariant {
 
 class PipelineRegistry {
 public:
-  enum class Shader { force, integrate, fused, implicit, strain_links, strain_finish, vertices };
+  enum class Shader {
+    force,
+    integrate,
+    fused,
+    implicit,
+    strain_links,
+    strain_finish,
+    vertices,
+    self_collision
+  };
 
   /// Set 0 (storage buffers) and set 1 (texel views) of force/integrate/fused.comp and their
   /// layout (strain_links/strain_finish/vertices.comp use it too, set 0 only).
@@ -49,7 +60,7 @@ public:
     VkDescriptorSetLayout storage = VK_NULL_HANDLE, texel = VK_NULL_HANDLE;
     VkPipelineLayout layout = VK_NULL_HANDLE;
   };
-  /// The one set of implicit.comp and its layout.
+  /// The one set of implicit.comp (or self_collision.comp) and its layout.
   struct ImplicitLayouts {
     VkDescriptorSetLayout set = VK_NULL_HANDLE;
     VkPipelineLayout layout = VK_NULL_HANDLE;
@@ -63,10 +74,11 @@ public:
 
   Result<SolverLayouts> solver_layouts();
   Result<ImplicitLayouts> implicit_layouts();
+  Result<ImplicitLayouts> self_collision_layouts();
   using Variant = ShaderVariant;
   /// The pipeline of `shader` specialised with `constants` (ids 0..size-1, 32 bits each; empty:
   /// none) and, when `variant.workgroup_size` is set, constant kWorkgroupSizeConstant; created on
-  /// first request; its layout is solver_layouts() or implicit_layouts().
+  /// first request; its layout is solver_layouts(), implicit_layouts() or self_collision_layouts().
   Result<VkPipeline> pipeline(Shader shader, std::span<const std::uint32_t> constants, Variant variant = {});
   /// The Context's pipeline cache (VK_NULL_HANDLE when it could not be made: caching is optional).
   VkPipelineCache cache();
@@ -78,7 +90,9 @@ public:
 
 private:
   Result<SolverLayouts> solver_layouts_locked();
-  Result<ImplicitLayouts> implicit_layouts_locked();
+  /// The layouts of a shader with one set of storage buffers (implicit.comp, self_collision.comp).
+  Result<ImplicitLayouts> single_set_layouts_locked(std::span<const std::uint32_t> bindings, const char* name,
+                                                    DescriptorSetLayout& set, PipelineLayout& layout);
   VkPipelineCache cache_locked();
   Result<VkShaderModule> module_locked(Shader shader, BufferAccess access);
 
@@ -86,8 +100,8 @@ private:
   std::mutex mutex_; // several solvers may be created on one Context from different threads
   PipelineCache cache_;
   bool cache_tried_ = false;
-  DescriptorSetLayout solver_storage_, solver_texel_, implicit_set_;
-  PipelineLayout solver_layout_, implicit_layout_;
+  DescriptorSetLayout solver_storage_, solver_texel_, implicit_set_, self_set_;
+  PipelineLayout solver_layout_, implicit_layout_, self_layout_;
   std::map<std::pair<Shader, BufferAccess>, ShaderModule> modules_;
   std::map<std::tuple<Shader, Variant, std::vector<std::uint32_t>>, Pipeline> pipelines_;
 };

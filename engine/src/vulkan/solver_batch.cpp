@@ -224,7 +224,8 @@ std::vector<sh::InstanceParams> SolverBatch::packed_instance_params() const {
                (normals == Normals::fans ? VKCLOTH_FLAG_HAS_FANS : 0u) |
                (float(params.wind.strength) != 0.0f ? VKCLOTH_FLAG_WIND : 0u) |
                (params.contact_inward_only ? 0u : VKCLOTH_FLAG_CONTACT_BOTH) |
-               (options.flip_normals ? VKCLOTH_FLAG_FLIP_NORMALS : 0u);
+               (options.flip_normals ? VKCLOTH_FLAG_FLIP_NORMALS : 0u) |
+               (params.self_collision.enabled ? VKCLOTH_FLAG_SELF_COLLISION : 0u);
     ip.integrator = static_cast<std::uint32_t>(params.integrator);
     ip.collider_first = first_collider;
     ip.collider_count = static_cast<std::uint32_t>(params.colliders.size());
@@ -257,6 +258,10 @@ void SolverBatch::write_params_now() {
   const auto col = packed_colliders();
   if (!col.empty())
     std::memcpy(colliders.mapped, col.data(), col.size() * sizeof(sh::Collider));
+  if (self_collision) {
+    const auto sp = packed_self_params();
+    std::memcpy(self_collision->params().mapped, sp.data(), sp.size() * sizeof(sh::SelfParams));
+  }
   params_dirty = false;
 }
 
@@ -270,6 +275,10 @@ void SolverBatch::record_params_update(VkCommandBuffer c) {
   record_buffer_update(c, instances, ip.data(), ip.size() * sizeof(sh::InstanceParams));
   const auto col = packed_colliders();
   record_buffer_update(c, colliders, col.data(), col.size() * sizeof(sh::Collider));
+  if (self_collision) {
+    const auto sp = packed_self_params();
+    record_buffer_update(c, self_collision->params(), sp.data(), sp.size() * sizeof(sh::SelfParams));
+  }
   params_dirty = false; // before_steps() next makes the transfer writes visible to the dispatches
 }
 
@@ -395,6 +404,7 @@ Result<void> SolverBatch::set_params(std::uint32_t slot, SimParams params) {
     VKCLOTH_TRY(ensure_mesh_buffers());
     VKCLOTH_TRY(ensure_implicit());
     VKCLOTH_TRY(ensure_fused());
+    VKCLOTH_TRY(ensure_self_collision());
     return ensure_tethers();
   }();
   if (!done) // e.g. no room for the tethers: the instance keeps stepping with its old parameters
@@ -443,9 +453,9 @@ Result<void> SolverBatch::ensure_implicit() {
     return {};
   using D = GpuSolverOptions::CgDispatch;
   std::uint32_t max_degree = 0;
-  const auto offsets = batch_topology->edge_offsets();
-  for (std::size_t p = 0; p + 1 < offsets.size(); ++p)
-    max_degree = std::max(max_degree, offsets[p + 1] - offsets[p]);
+  const auto gather = batch_topology->edge_offsets();
+  for (std::size_t p = 0; p + 1 < gather.size(); ++p)
+    max_degree = std::max(max_degree, gather[p + 1] - gather[p]);
   const std::uint32_t budget = ImplicitGpu::iteration_budget(count, max_degree);
   if (options.cg_dispatch == D::one_workgroup && budget == 0)
     return make_error(
@@ -465,6 +475,36 @@ Result<void> SolverBatch::ensure_implicit() {
     return r.error();
   implicit = std::move(*r);
   return write_sets();
+}
+
+// Made when an instance first turns self-collision on: its buffers (the rest positions uploaded,
+// the counts zeroed) and descriptor sets; nothing recorded so far uses them.
+Result<void> SolverBatch::ensure_self_collision() {
+  if (self_collision || self_iterations() == 0)
+    return {};
+  auto r = SelfCollisionGpu::create(ctx, count, size(), ctx->properties.limits.maxComputeWorkGroupCount[0],
+                                    !knobs.force_staging);
+  if (!r)
+    return r.error();
+  self_collision = std::move(*r);
+  std::vector<sh::vec4> rest(count);
+  for (std::uint32_t p = 0; p < count; ++p) {
+    const glm::dvec3 x = batch_topology->system().particles[p].position; // as CpuSolver<float>: cast once
+    rest[p] = {float(x.x), float(x.y), float(x.z), 1.0f};
+  }
+  const Upload up[] = {{&self_collision->rest_positions(), rest.data(), rest.size() * sizeof(sh::vec4)},
+                       {&self_collision->counts(), nullptr, 0}};
+  VKCLOTH_TRY(upload(up));
+  const auto sp = packed_self_params();
+  std::memcpy(self_collision->params().mapped, sp.data(), sp.size() * sizeof(sh::SelfParams));
+  return write_sets();
+}
+
+std::vector<sh::SelfParams> SolverBatch::packed_self_params() const {
+  std::vector<const SimParams*> params;
+  for (const Slot& s : slots)
+    params.push_back(&s.params);
+  return SelfCollisionGpu::packed(params);
 }
 
 void SolverBatch::record(VkCommandBuffer c, std::uint32_t steps) {
@@ -521,6 +561,25 @@ void SolverBatch::record_substep(VkCommandBuffer c, bool first, bool last) {
   record_update(c, first, last);
   if (any_stretch())
     record_stretch(c, parity);
+  if (const std::uint32_t iterations = self_iterations()) {
+    dispatches_ += self_collision->record_substep(c, parity, pc, iterations);
+    if (any_colliders())
+      record_finish_pass(c, parity, 2); // a move may have pushed a particle into a collider
+  }
+}
+
+void SolverBatch::record_finish_pass(VkCommandBuffer c, std::uint32_t read, std::uint32_t stage) {
+  const auto& v = vk();
+  // Set 1 of the positions being written: the pass reads positions[write] through its texel view.
+  const VkDescriptorSet bound_sets[2] = {sets[read][0], texel_sets[read ^ 1u]};
+  v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 2, bound_sets, 0, nullptr);
+  v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, strain_finish_pipeline);
+  sh::PushConstants spc = pc;
+  spc.stage = stage;
+  v.vkCmdPushConstants(c, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(spc), &spc);
+  barriers::dispatch_to_dispatch(v, c); // the previous pass -> this one
+  v.vkCmdDispatch(c, groups_x, groups_y, size());
+  ++dispatches_;
 }
 
 // The tethers per particle, Provot's sweeps (one dispatch per colour: its links share no
@@ -537,20 +596,12 @@ void SolverBatch::record_stretch(VkCommandBuffer c, std::uint32_t read) {
       sweeps = std::max(sweeps, sl.iterations);
     tethered = tethered || sl.tethers();
   }
-  // Set 1 of the positions being written: the passes read positions[write] through its texel view.
+  if (tethered)
+    record_finish_pass(c, read, 0); // binds the sets the sweeps use too
+  // Set 1 of the positions being written: the sweeps read positions[write] through its texel view.
   const VkDescriptorSet bound_sets[2] = {sets[read][0], texel_sets[read ^ 1u]};
   v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 2, bound_sets, 0, nullptr);
   sh::PushConstants spc = pc;
-  auto per_particle = [&](std::uint32_t stage) {
-    spc.stage = stage; // 0: tethers, 1: projection
-    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, strain_finish_pipeline);
-    v.vkCmdPushConstants(c, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(spc), &spc);
-    barriers::dispatch_to_dispatch(v, c); // the update (or the last colour) -> this pass
-    v.vkCmdDispatch(c, groups_x, groups_y, size());
-    ++dispatches_;
-  };
-  if (tethered)
-    per_particle(0);
   if (sweeps)
     v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, strain_links_pipeline);
   for (std::uint32_t sweep = 0; sweep < sweeps; ++sweep)
@@ -566,7 +617,7 @@ void SolverBatch::record_stretch(VkCommandBuffer c, std::uint32_t read) {
       ++dispatches_;
     }
   if (any_colliders())
-    per_particle(1);
+    record_finish_pass(c, read, 1);
 }
 
 void SolverBatch::record_update(VkCommandBuffer c, bool first, bool last) {
@@ -935,6 +986,7 @@ SolverBatch::create(const std::shared_ptr<Context::Impl>& ctx, CommandContext& c
   s.write_params_now();
   VKCLOTH_TRY(s.upload_initial_state(topology, states));
   VKCLOTH_TRY(s.ensure_tethers());
+  VKCLOTH_TRY(s.ensure_self_collision());
   return impl;
 }
 

@@ -22,6 +22,7 @@
 #include <glm/vec3.hpp>
 
 #include "implicit_gpu.hpp"
+#include "self_collision_gpu.hpp"
 #include "resources.hpp"
 #include "vkcloth/gpu/gpu_solver.hpp"
 #include "vkcloth/gpu/testing.hpp"
@@ -206,8 +207,9 @@ private:
   std::uint64_t recorded = 0;            // recorded steps since the flag epoch: flag step numbers
   std::uint32_t parity = 0;              // positions[parity] is current; flipped by every recorded substep
   std::unique_ptr<ImplicitGpu> implicit; // created when the integrator is implicit_euler (batch of one)
-  std::vector<glm::vec2> uvs_;           // per particle of one instance (as uploaded)
-  std::uint64_t dispatches_ = 0;         // recorded so far (ClothWorld::dispatches_recorded)
+  std::unique_ptr<SelfCollisionGpu> self_collision; // created when an instance first turns it on
+  std::vector<glm::vec2> uvs_;                      // per particle of one instance (as uploaded)
+  std::uint64_t dispatches_ = 0;                    // recorded so far (ClothWorld::dispatches_recorded)
 
   const SimParams& family() const { return slots.front().params; } // integrator family, substeps
   bool any_stretch() const {
@@ -215,6 +217,14 @@ private:
       if (s.params.stretch_limit.enabled())
         return true;
     return false;
+  }
+  /// The most self-collision passes an instance asks for (0: none has it on).
+  std::uint32_t self_iterations() const {
+    std::uint32_t most = 0;
+    for (const Slot& s : slots)
+      if (s.params.self_collision.enabled)
+        most = std::max(most, s.params.self_collision.iterations);
+    return most;
   }
   bool any_colliders() const {
     for (const Slot& s : slots)
@@ -254,10 +264,14 @@ private:
   Result<void> ensure_implicit();
   Result<void> ensure_fused();
   Result<void> ensure_tethers();
+  Result<void> ensure_self_collision();
   /// The interleaved vertex pass at the end of a recording (vertices.comp).
   void record_vertices(VkCommandBuffer cmd);
   /// Stretch control after a substep's update (strain_links.comp sweeps, strain_finish.comp).
   void record_stretch(VkCommandBuffer cmd, std::uint32_t read);
+  /// One per-particle pass of strain_finish.comp on the positions being written: `stage` 0 the
+  /// tethers, 1 the projection after stretch control, 2 the projection after self-collision.
+  void record_finish_pass(VkCommandBuffer cmd, std::uint32_t read, std::uint32_t stage);
   Result<void> ensure_collider_capacity();
   Result<void> ensure_mesh_buffers();
   std::vector<shared::Collider> packed_colliders() const;
@@ -265,6 +279,7 @@ private:
   /// (Collider::posed_at, as CpuSolver does) and the new poses are recorded into the collider buffer.
   void record_collider_motion(VkCommandBuffer cmd, double h);
   std::vector<shared::InstanceParams> packed_instance_params() const;
+  std::vector<shared::SelfParams> packed_self_params() const;
   void write_params_now();
   void record_params_update(VkCommandBuffer cmd);
   /// vkCmdUpdateBuffer of `bytes` from the start of `dst`, in pieces of at most 64 KiB (its limit).

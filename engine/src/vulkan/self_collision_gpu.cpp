@@ -1,0 +1,190 @@
+// SPDX-License-Identifier: MIT
+#include "self_collision_gpu.hpp"
+
+#include <algorithm>
+#include <tuple>
+
+#include "../core/kernel.hpp"
+#include "barriers.hpp"
+#include "pipelines.hpp"
+
+namespace vkcloth::gpu {
+
+namespace sh = shared;
+
+Result<std::unique_ptr<SelfCollisionGpu>> SelfCollisionGpu::create(const std::shared_ptr<Context::Impl>& ctx,
+                                                                   std::uint32_t count, std::uint32_t instances,
+                                                                   std::uint32_t groups_max_x, bool allow_map) {
+  std::unique_ptr<SelfCollisionGpu> s(new SelfCollisionGpu());
+  s->ctx_ = ctx;
+  s->count_ = count;
+  s->instances_ = instances;
+  s->table_ = kernel::self_table_size(count);
+  s->groups_max_x_ = std::max<std::uint32_t>(groups_max_x, 1);
+  VKCLOTH_TRY(s->create_buffers(allow_map));
+  VKCLOTH_TRY(s->create_sets());
+  return s;
+}
+
+Result<void> SelfCollisionGpu::create_buffers(bool allow_map) {
+  Context::Impl& ctx = *ctx_;
+  const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  const VkDeviceSize per_particle = VkDeviceSize(instances_) * count_;
+  const VkDeviceSize buckets = VkDeviceSize(instances_) * table_;
+  const std::tuple<Buffer*, VkDeviceSize, const char*> device_buffers[] = {
+      {&rest_, VkDeviceSize(count_) * 16, "self-collision: rest positions"},
+      {&counts_, buckets * 4, "self-collision: bucket counts"},
+      {&starts_, buckets * 4, "self-collision: bucket starts"},
+      {&blocks_, buckets / VKCLOTH_SELF_SCAN_BLOCK * 4, "self-collision: scan blocks"},
+      {&bucket_, per_particle * 4, "self-collision: particle buckets"},
+      {&sorted_, per_particle * 4, "self-collision: sorted particles"},
+      {&delta_, per_particle * 16, "self-collision: moves"}};
+  for (auto [b, bytes, what] : device_buffers) {
+    auto r = create_buffer(ctx, std::max<VkDeviceSize>(bytes, 16), usage, MemoryUse::device, allow_map, what);
+    if (!r)
+      return r.error();
+    *b = std::move(*r);
+  }
+  auto p = create_buffer(ctx, VkDeviceSize(instances_) * sizeof(sh::SelfParams), usage, MemoryUse::host_upload,
+                         true, "self-collision: parameters");
+  if (!p)
+    return p.error();
+  params_ = std::move(*p);
+  return {};
+}
+
+// The Context's layout and pipeline; this batch's pool and two sets (position parity).
+Result<void> SelfCollisionGpu::create_sets() {
+  Context::Impl& ctx = *ctx_;
+  const auto& v = ctx.vk;
+  auto layouts = ctx.pipelines->self_collision_layouts();
+  if (!layouts)
+    return layouts.error();
+  layout_ = layouts->layout;
+  const auto bindings = self_collision_bindings();
+  const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                  2 * static_cast<std::uint32_t>(bindings.size())};
+  VkDescriptorPoolCreateInfo dp{};
+  dp.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
+  dp.maxSets = 2;
+  dp.poolSizeCount = 1;
+  dp.pPoolSizes = &size;
+  VKCLOTH_VK_TRY(v.vkCreateDescriptorPool(ctx.device, &dp, v.allocator, pool_.init(ctx)),
+                 "vkCreateDescriptorPool (self-collision)");
+  const VkDescriptorSetLayout set_layouts[2] = {layouts->set, layouts->set};
+  VkDescriptorSetAllocateInfo ai{};
+  ai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
+  ai.descriptorPool = pool_;
+  ai.descriptorSetCount = 2;
+  ai.pSetLayouts = set_layouts;
+  VKCLOTH_VK_TRY(v.vkAllocateDescriptorSets(ctx.device, &ai, sets_), "vkAllocateDescriptorSets (self-collision)");
+  auto pp = ctx.pipelines->pipeline(PipelineRegistry::Shader::self_collision, {});
+  if (!pp)
+    return pp.error();
+  pass_ = *pp;
+  return {};
+}
+
+Result<void> SelfCollisionGpu::write_sets(const SelfCollisionInputs& in) {
+  const auto bindings = self_collision_bindings();
+  std::vector<VkDescriptorBufferInfo> infos(2 * bindings.size());
+  std::vector<VkWriteDescriptorSet> writes(2 * bindings.size());
+  std::size_t k = 0;
+  for (std::uint32_t read = 0; read < 2; ++read)
+    for (std::uint32_t binding : bindings) {
+      VkBuffer b = VK_NULL_HANDLE;
+      switch (binding) {
+      case VKCLOTH_BINDING_POS_OUT:
+        b = in.pos[read ^ 1u]; // the positions this substep writes
+        break;
+      case VKCLOTH_BINDING_VEL:
+        b = in.vel;
+        break;
+      case VKCLOTH_BINDING_PARTICLE:
+        b = in.particle;
+        break;
+      case VKCLOTH_BINDING_FLAGS:
+        b = in.flags;
+        break;
+      case VKCLOTH_BINDING_INSTANCES:
+        b = in.instances;
+        break;
+      case VKCLOTH_BINDING_SELF_PARAMS:
+        b = params_.buffer;
+        break;
+      case VKCLOTH_BINDING_SELF_REST:
+        b = rest_.buffer;
+        break;
+      case VKCLOTH_BINDING_SELF_COUNTS:
+        b = counts_.buffer;
+        break;
+      case VKCLOTH_BINDING_SELF_STARTS:
+        b = starts_.buffer;
+        break;
+      case VKCLOTH_BINDING_SELF_BLOCKS:
+        b = blocks_.buffer;
+        break;
+      case VKCLOTH_BINDING_SELF_BUCKET:
+        b = bucket_.buffer;
+        break;
+      case VKCLOTH_BINDING_SELF_SORTED:
+        b = sorted_.buffer;
+        break;
+      case VKCLOTH_BINDING_SELF_DELTA:
+        b = delta_.buffer;
+        break;
+      default:
+        break;
+      }
+      infos[k] = {b, 0, VK_WHOLE_SIZE};
+      writes[k] =
+          VkWriteDescriptorSet{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, nullptr, sets_[read], binding, 0, 1,
+                               VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,      nullptr, &infos[k],   nullptr};
+      ++k;
+    }
+  ctx_->vk.vkUpdateDescriptorSets(ctx_->device, static_cast<std::uint32_t>(k), writes.data(), 0, nullptr);
+  return {};
+}
+
+std::vector<sh::SelfParams> SelfCollisionGpu::packed(std::span<const SimParams* const> params) {
+  std::vector<sh::SelfParams> out;
+  for (const SimParams* p : params) {
+    const SelfCollision& sc = p->self_collision;
+    // As CpuSolver<float>::self_collide: each double cast to float once.
+    out.push_back({sc.enabled ? sc.iterations : 0u, float(sc.thickness), float(1.0 / sc.thickness),
+                   float(sc.friction)});
+  }
+  return out;
+}
+
+std::uint32_t SelfCollisionGpu::record_substep(VkCommandBuffer c, std::uint32_t read, sh::PushConstants pc,
+                                               std::uint32_t iterations) {
+  const auto& v = ctx_->vk;
+  v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &sets_[read], 0, nullptr);
+  v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, pass_);
+  pc.pad0 = table_;
+  std::uint32_t dispatches = 0;
+  // `items` invocations (64 per workgroup, rows of at most groups_max_x_ workgroups), every instance.
+  auto pass = [&](std::uint32_t stage, std::uint64_t items) {
+    barriers::dispatch_to_dispatch(v, c); // the previous pass (or the substep's update) -> this one
+    pc.stage = stage;
+    v.vkCmdPushConstants(c, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
+    const std::uint64_t groups = std::max<std::uint64_t>((items + VKCLOTH_WORKGROUP_SIZE - 1) / VKCLOTH_WORKGROUP_SIZE, 1);
+    const std::uint64_t gx = std::min<std::uint64_t>(groups, groups_max_x_);
+    v.vkCmdDispatch(c, std::uint32_t(gx), std::uint32_t((groups + gx - 1) / gx), instances_);
+    ++dispatches;
+  };
+  pass(VKCLOTH_SELF_COUNT, count_);
+  pass(VKCLOTH_SELF_SCAN_BLOCKS, std::uint64_t(table_ / VKCLOTH_SELF_SCAN_BLOCK) * VKCLOTH_WORKGROUP_SIZE);
+  pass(VKCLOTH_SELF_SCAN_TOP, 1);
+  pass(VKCLOTH_SELF_SCATTER, count_);
+  pass(VKCLOTH_SELF_SORT, table_);
+  for (std::uint32_t it = 0; it < iterations; ++it) {
+    pc.pad1 = it;
+    pass(VKCLOTH_SELF_COLLIDE, count_);
+    pass(VKCLOTH_SELF_APPLY, count_);
+  }
+  return dispatches;
+}
+
+} // namespace vkcloth::gpu

@@ -1,0 +1,54 @@
+// SPDX-License-Identifier: MIT
+// Declarations shared by self_collision.comp and the C++ side (engine/src/vulkan/
+// self_collision_gpu.cpp). Self-collision's passes use their own descriptor set layout: the main
+// layout's bindings they need (same numbers, same buffers, vkcloth_shared.h) plus the spatial
+// hash's buffers below. Push constants: the main PushConstants, `stage` selecting the pass and
+// `pad0` the hash table's size, `pad1` the Jacobi iteration (COLLIDE, APPLY).
+#ifndef VKCLOTH_SELF_COLLISION_SHARED_H
+#define VKCLOTH_SELF_COLLISION_SHARED_H
+
+#include "implicit_shared.h"
+
+#ifdef __cplusplus
+namespace vkcloth::gpu::shared {
+#endif
+
+#define VKCLOTH_BINDING_SELF_PARAMS 37 // (after implicit Euler's) SelfParams per instance
+#define VKCLOTH_BINDING_SELF_REST 38   // rest positions (vec4 per particle of the topology)
+#define VKCLOTH_BINDING_SELF_COUNTS 39 // particles per bucket (uint, table size per instance; zero between substeps)
+#define VKCLOTH_BINDING_SELF_STARTS 40 // each bucket's first entry within its scan block (uint, per bucket)
+#define VKCLOTH_BINDING_SELF_BLOCKS 41 // each scan block's first entry (uint, table size / SCAN_BLOCK per instance)
+#define VKCLOTH_BINDING_SELF_BUCKET 42 // each particle's bucket (uint, per particle)
+#define VKCLOTH_BINDING_SELF_SORTED 43 // the particles by bucket, then by index (uint, per particle)
+#define VKCLOTH_BINDING_SELF_DELTA 44  // this Jacobi pass's moves (vec4, per particle)
+
+// Buckets per workgroup of the SCAN_BLOCKS pass: 64 invocations x 8 (the table size is a
+// multiple: kernel.hpp self_table_size).
+#define VKCLOTH_SELF_SCAN_BLOCK 512u
+#define VKCLOTH_SELF_SCAN_PER_INVOCATION 8u
+
+// self_collision.comp passes (PushConstants::stage), in recording order; one barrier between each.
+#define VKCLOTH_SELF_COUNT 0u       // per particle: its bucket; counts[bucket] += 1 (integer atomics)
+#define VKCLOTH_SELF_SCAN_BLOCKS 1u // per scan block: exclusive prefix sums of its counts, its total
+#define VKCLOTH_SELF_SCAN_TOP 2u    // one workgroup per instance: exclusive prefix sums of the block totals
+#define VKCLOTH_SELF_SCATTER 3u     // per particle: a slot in its bucket (counts[bucket] -= 1: zero again)
+#define VKCLOTH_SELF_SORT 4u        // per bucket: its particles in increasing index (the CPU's order)
+#define VKCLOTH_SELF_COLLIDE 5u     // per particle: cloth_kernel.h self_collide -> DELTA
+#define VKCLOTH_SELF_APPLY 6u       // per particle: x += delta, v += delta / h
+
+/// Self-collision parameters of one instance (std430: 16 bytes), converted from the double
+/// SimParams::self_collision as CpuSolver<float>::self_collide converts them.
+struct SelfParams {
+  uint iterations; // 0: self-collision off for this instance
+  float thickness;
+  float inv_cell; // float(1.0 / thickness): the hash's cell size is the thickness
+  float friction;
+};
+
+#ifdef __cplusplus
+static_assert(VKCLOTH_BINDING_SELF_PARAMS == VKCLOTH_BINDING_IMPL_ARGS + 1);
+static_assert(sizeof(SelfParams) == 16);
+} // namespace vkcloth::gpu::shared
+#endif
+
+#endif // VKCLOTH_SELF_COLLISION_SHARED_H

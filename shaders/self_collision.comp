@@ -1,0 +1,161 @@
+// SPDX-License-Identifier: MIT
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// Self-collision (CpuSolver::self_collide; docs/model.md "Self-collision"), one pass per
+// pc.stage (self_collision_shared.h), after the substep's update and stretch control, on the
+// positions being written (POS_OUT). The spatial hash is a counting sort of the particles by
+// bucket: COUNT (integer atomics), the prefix sums in two levels (SCAN_BLOCKS, SCAN_TOP),
+// SCATTER (slots in any order), then SORT (each bucket's particles in increasing index): integer
+// work only, so the table is the same on every run and the same as the CPU's. COLLIDE and APPLY are
+// then cloth_kernel.h self_collide and apply_correction per particle, each invocation writing only
+// its own particle.
+#include "vkcloth_shared.h"
+#include "self_collision_shared.h"
+
+// cloth_kernel.h self_collide's accessors (defined below, after common.glsl's globals).
+#define SELF_DATA_PARAM uint self_data
+#define SELF_DATA self_data
+void self_range(uint unused, uint b, out uint first, out uint stop);
+uint self_sorted(uint unused, uint i);
+void self_particle(uint unused, uint q, out vec3 x, out vec3 v, out float w, out vec3 rest);
+#include "common.glsl"
+
+layout(std430, set = 0, binding = VKCLOTH_BINDING_POS_OUT) buffer PosOut { vec4 pos_out[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_VEL) buffer VelBuf { vec4 vel[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_PARAMS) readonly buffer SelfParamBuf { SelfParams self_params[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_REST) readonly buffer RestBuf { vec4 rest_pos[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_COUNTS) buffer CountBuf { uint counts[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_STARTS) buffer StartBuf { uint starts[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_BLOCKS) buffer BlockBuf { uint blocks[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_BUCKET) buffer BucketBuf { uint bucket_of[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_SORTED) buffer SortedBuf { uint sorted[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_DELTA) buffer DeltaBuf { vec4 delta[]; };
+
+shared uint partial[VKCLOTH_WORKGROUP_SIZE];
+
+// This instance's table: pc.pad0 buckets from inst * pc.pad0, their scan blocks after inst * blocks.
+uint table_base() { return inst * pc.pad0; }
+uint block_base() { return inst * (pc.pad0 / VKCLOTH_SELF_SCAN_BLOCK); }
+
+// Bucket b's first entry in `sorted` (within the instance): its block's start plus its own.
+uint bucket_start(uint b) {
+  if (b >= pc.pad0)
+    return pc.count; // past the last bucket: every particle
+  return blocks[block_base() + b / VKCLOTH_SELF_SCAN_BLOCK] + starts[table_base() + b];
+}
+
+void self_range(uint unused, uint b, out uint first, out uint stop) {
+  first = bucket_start(b);
+  stop = bucket_start(b + 1u);
+}
+uint self_sorted(uint unused, uint i) { return sorted[base + i]; }
+void self_particle(uint unused, uint q, out vec3 x, out vec3 v, out float w, out vec3 rest) {
+  x = pos_out[base + q].xyz;
+  v = vel[base + q].xyz;
+  w = inverse_mass(particle[q].mass, particle[q].pinned != 0u);
+  rest = rest_pos[q].xyz;
+}
+
+// Workgroup exclusive prefix sum of one value per invocation (integers: the same sums in any
+// order); the workgroup's total is left in scan_total. Called in uniform control flow.
+shared uint scan_total;
+uint workgroup_exclusive_scan(uint value) {
+  const uint i = gl_LocalInvocationID.x;
+  partial[i] = value;
+  barrier();
+  if (i == 0u) {
+    uint run = 0u;
+    for (uint k = 0u; k < VKCLOTH_WORKGROUP_SIZE; ++k) {
+      const uint c = partial[k];
+      partial[k] = run;
+      run += c;
+    }
+    scan_total = run;
+  }
+  barrier();
+  return partial[i];
+}
+
+void main() {
+  begin_instance();
+  const SelfParams sp = self_params[inst];
+  if (sp.iterations == 0u || frozen())
+    return;
+  const uint stage = pc.stage;
+  const uint mask = pc.pad0 - 1u;
+  if (stage == VKCLOTH_SELF_SCAN_BLOCKS) {
+    // Workgroup = one block of VKCLOTH_SELF_SCAN_BLOCK buckets; 8 consecutive buckets per invocation.
+    const uint block = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+    const uint first = block * VKCLOTH_SELF_SCAN_BLOCK + gl_LocalInvocationID.x * VKCLOTH_SELF_SCAN_PER_INVOCATION;
+    uint sum = 0u;
+    for (uint k = 0u; k < VKCLOTH_SELF_SCAN_PER_INVOCATION; ++k)
+      sum += counts[table_base() + first + k];
+    uint run = workgroup_exclusive_scan(sum);
+    for (uint k = 0u; k < VKCLOTH_SELF_SCAN_PER_INVOCATION; ++k) {
+      starts[table_base() + first + k] = run;
+      run += counts[table_base() + first + k];
+    }
+    if (gl_LocalInvocationID.x == 0u)
+      blocks[block_base() + block] = scan_total;
+    return;
+  }
+  if (stage == VKCLOTH_SELF_SCAN_TOP) {
+    // One workgroup per instance: the block totals, in place, become the blocks' starts.
+    const uint nblocks = pc.pad0 / VKCLOTH_SELF_SCAN_BLOCK;
+    const uint per = (nblocks + VKCLOTH_WORKGROUP_SIZE - 1u) / VKCLOTH_WORKGROUP_SIZE;
+    const uint first = gl_LocalInvocationID.x * per;
+    const uint stop = min(first + per, nblocks);
+    uint sum = 0u;
+    for (uint k = first; k < stop; ++k)
+      sum += blocks[block_base() + k];
+    uint run = workgroup_exclusive_scan(sum);
+    for (uint k = first; k < stop; ++k) {
+      const uint c = blocks[block_base() + k];
+      blocks[block_base() + k] = run;
+      run += c;
+    }
+    return;
+  }
+  if (stage == VKCLOTH_SELF_SORT) {
+    const uint b = particle_index(); // the bucket
+    if (b >= pc.pad0)
+      return;
+    const uint first = bucket_start(b), stop = bucket_start(b + 1u);
+    for (uint i = first + 1u; i < stop; ++i) { // insertion sort: buckets hold a few particles
+      const uint key = sorted[base + i];
+      uint j = i;
+      while (j > first && sorted[base + j - 1u] > key) {
+        sorted[base + j] = sorted[base + j - 1u];
+        j -= 1u;
+      }
+      sorted[base + j] = key;
+    }
+    return;
+  }
+  const uint p = particle_index();
+  if (p >= pc.count)
+    return;
+  if (stage == VKCLOTH_SELF_COUNT) {
+    const uint b = self_bucket_of(pos_out[base + p].xyz, sp.inv_cell, mask);
+    bucket_of[base + p] = b;
+    atomicAdd(counts[table_base() + b], 1u);
+  } else if (stage == VKCLOTH_SELF_SCATTER) {
+    const uint b = bucket_of[base + p];
+    const uint left = atomicAdd(counts[table_base() + b], 0xffffffffu); // minus one
+    sorted[base + bucket_start(b) + left - 1u] = p;
+  } else if (pc.pad1 < sp.iterations && particle[p].pinned == 0u) {
+    if (stage == VKCLOTH_SELF_COLLIDE) {
+      const vec3 x = pos_out[base + p].xyz;
+      const vec3 v = vel[base + p].xyz;
+      const float w = inverse_mass(particle[p].mass, false);
+      delta[base + p] = vec4(self_collide(0u, p, x, v, w, rest_pos[p].xyz, sp.thickness, sp.inv_cell, mask,
+                                          sp.friction, ip.dt), 0.0);
+    } else { // VKCLOTH_SELF_APPLY
+      vec3 x = pos_out[base + p].xyz;
+      vec3 v = vel[base + p].xyz;
+      apply_correction(x, v, delta[base + p].xyz, ip.dt);
+      pos_out[base + p] = vec4(x, 1.0);
+      vel[base + p] = vec4(v, 0.0);
+    }
+  }
+}
