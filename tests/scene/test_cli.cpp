@@ -101,6 +101,40 @@ TEST_CASE("cli: bad colliders (issue 15) exit 2 and stderr names the key, the fi
   CHECK(set.err.find("colliders[0].friction") != std::string::npos);
 }
 
+TEST_CASE("cli: bad self_collision (issue 16) exits 2 and stderr names the key and the value") {
+  for (const char* command : {"run", "info"}) {
+    CAPTURE(command);
+    const Outcome o = run_cli(std::string("bad_self_collision_") + command,
+                              std::string(command) + " " +
+                                  write_scene("self_collision.json",
+                                              R"({"system": "cloth", "self_collision": {"thickness": -1}})"));
+    CHECK(o.code == 2);
+    CHECK_MESSAGE(o.err.find("self_collision.thickness must be finite and > 0 (metres), got -1") !=
+                      std::string::npos,
+                  o.err);
+    CHECK(o.out.empty());
+  }
+  // Through --set: more than 10 x the sample's 1/9 m spacing, and a word where a boolean goes.
+  const Outcome thick = run_cli("bad_self_collision_set",
+                                "run " + sample("cloth_hanging.json") + " --set self_collision.thickness=2");
+  CHECK(thick.code == 2);
+  CHECK_MESSAGE(thick.err.find("self_collision.thickness 2 m is more than 10 x") != std::string::npos,
+                thick.err);
+  const Outcome word = run_cli("bad_self_collision_word",
+                               "info " + sample("cloth_hanging.json") + " --set self_collision.enabled=yes");
+  CHECK(word.code == 2);
+  CHECK_MESSAGE(word.err.find("self_collision.enabled must be true or false, got \"yes\"") !=
+                    std::string::npos,
+                word.err);
+  // A thickness below half the spacing loads, with the warning on stderr.
+  const Outcome thin = run_cli("self_collision_thin",
+                               "info " + sample("cloth_hanging.json") + " --set self_collision.enabled=true");
+  CHECK(thin.code == 0);
+  CHECK_MESSAGE(thin.err.find("vkcloth: warning: self_collision.thickness 0.01 m is below half") !=
+                    std::string::npos,
+                thin.err);
+}
+
 TEST_CASE("cli: the single spring settles at the static sag L0 + mg/K below the anchor") {
   const fs::path pos = tmp_dir() / "spring_positions.csv";
   const Outcome o =

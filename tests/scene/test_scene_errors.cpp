@@ -361,3 +361,72 @@ TEST_CASE("colliders: a mesh collider's thickness, scale and file") {
   expect_error_in(dir, colliders(R"({"type": "mesh", "path": "flat.obj", "thickness": 0.01})"),
                   {"colliders[0].path: ", "flat.obj", "zero area"});
 }
+
+// ---- Issue 16: self-collision ----
+
+TEST_CASE("self_collision: bad input names the key and the value (issue 16 item 6)") {
+  const std::string base = R"({"system": "cloth", "self_collision": )";
+  const auto expect = [&](const std::string& body, ErrorCode code, std::initializer_list<std::string> needles,
+                          std::vector<std::string> overrides = {}) {
+    CAPTURE(body);
+    CHECK(expect_error(base + body + "}", needles, std::move(overrides)).code == code);
+  };
+  // Ranges (SimParams::validate): invalid_argument.
+  expect(R"({"thickness": 0})", ErrorCode::invalid_argument, {"self_collision.thickness", "> 0", "got 0"});
+  expect(R"({"thickness": -0.01})", ErrorCode::invalid_argument, {"self_collision.thickness", "got -0.01"});
+  expect(R"({"iterations": 0})", ErrorCode::invalid_argument,
+         {"self_collision.iterations", "1..16", "got 0"});
+  expect(R"({"iterations": 17})", ErrorCode::invalid_argument,
+         {"self_collision.iterations", "1..16", "got 17"});
+  expect(R"({"friction": -0.1})", ErrorCode::invalid_argument,
+         {"self_collision.friction", ">= 0", "got -0.1"});
+  // Off, the values are still checked (a later --set self_collision.enabled=true must not meet them).
+  expect(R"({"enabled": false, "thickness": -1})", ErrorCode::invalid_argument,
+         {"self_collision.thickness", "got -1"});
+  // Shapes: parse.
+  expect(R"({"thickness": 1e999})", ErrorCode::parse, {"self_collision.thickness", "1e999"});
+  expect(R"({"thickness": "nan"})", ErrorCode::parse, {"self_collision.thickness", "a number", "\"nan\""});
+  expect(R"({"thickness": "0.01"})", ErrorCode::parse, {"self_collision.thickness", "a number", "\"0.01\""});
+  expect(R"({"friction": null})", ErrorCode::parse, {"self_collision.friction", "a number", "null"});
+  expect(R"({"iterations": 2.5})", ErrorCode::parse, {"self_collision.iterations", "integer", "2.5"});
+  expect(R"({"iterations": -1})", ErrorCode::parse, {"self_collision.iterations", "integer", "-1"});
+  expect(R"({"iterations": "2"})", ErrorCode::parse, {"self_collision.iterations", "integer", "\"2\""});
+  expect(R"({"enabled": 1})", ErrorCode::parse, {"self_collision.enabled", "true or false", "got 1"});
+  expect(R"({"enabled": "yes"})", ErrorCode::parse, {"self_collision.enabled", "true or false", "\"yes\""});
+  expect(R"({"radius": 0.01})", ErrorCode::parse,
+         {"unknown key self_collision.radius", "enabled, thickness, friction, iterations"});
+  expect(R"(true)", ErrorCode::parse, {"self_collision", "an object", "got true"});
+  // The thickness against the cloth (check_self_collision): the default 10 x 10 grid over 1 m has
+  // structural springs of 1/9 m, so more than 1.111 m is refused.
+  expect(R"({"thickness": 2})", ErrorCode::invalid_argument,
+         {"self_collision.thickness 2 m", "more than 10 x the mean rest length", "(0.1111 m)"});
+  // ... on a chain (its springs have no kind: all of them count; the default spring is 0.4 m) ...
+  CHECK(expect_error(R"({"system": "chain", "self_collision": {"thickness": 5}})",
+                     {"self_collision.thickness 5 m", "10 x the mean rest length", "(0.4 m)"})
+            .code == ErrorCode::invalid_argument);
+  // ... and on a mesh cloth (a 3 x 1 strip of unit quads).
+  const auto dir = mesh_dir("self_collision", "strip.obj",
+                            "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 3 0 0\nv 0 0 1\nv 1 0 1\nv 2 0 1\nv 3 0 1\n"
+                            "f 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\n");
+  expect_error_in(
+      dir, R"({"system": "cloth", "cloth": {"mesh": "strip.obj"}, "self_collision": {"thickness": 11}})",
+      {"self_collision.thickness 11 m", "10 x the mean rest length", "(1 m)"});
+  // Off, a thickness far above the spacing is not compared with it.
+  CHECK(parse_scene(base + R"({"enabled": false, "thickness": 2}})", "ok.json").ok());
+
+  // --set reaches every key, and turns self-collision on in a scene without it.
+  expect_error(R"({"system": "cloth"})", {"self_collision.thickness", "got -1"},
+               {"self_collision.thickness=-1"});
+  expect_error(R"({"system": "cloth"})", {"self_collision.thickness", "\"nan\""},
+               {"self_collision.thickness=nan"});
+  expect_error(R"({"system": "cloth"})", {"self_collision.thickness", "1e999"},
+               {"self_collision.thickness=1e999"});
+  expect_error(R"({"system": "cloth"})", {"self_collision.iterations", "got 17"},
+               {"self_collision.enabled=true", "self_collision.iterations=17"});
+  expect_error(R"({"system": "cloth"})", {"self_collision.enabled", "\"maybe\""},
+               {"self_collision.enabled=maybe"});
+  expect_error(R"({"system": "cloth"})", {"unknown key self_collision.thicknes"},
+               {"self_collision.thicknes=0.1"});
+  expect_error(R"({"system": "cloth", "self_collision": {"enabled": false, "thickness": 2}})",
+               {"self_collision.thickness 2 m", "10 x"}, {"self_collision.enabled=true"});
+}

@@ -399,3 +399,92 @@ TEST_CASE("colliders: overrides reach the new keys and the new types") {
   CHECK(c[3].type == Collider::Type::box);
   CHECK(same(c[3].rotation, Collider::rotation_from_degrees({0, 0, 45})));
 }
+
+// ---- Issue 16: self-collision ----
+
+TEST_CASE("self_collision: absent is off with the defaults; present is read into SimParams") {
+  const SelfCollision def;
+  for (const char* text : {R"({"system": "cloth"})", R"({"system": "chain"})"}) {
+    CAPTURE(text);
+    const Scene off = load_ok(text);
+    CHECK_FALSE(off.params.self_collision.enabled);
+    CHECK(off.params.self_collision.thickness == def.thickness);
+    CHECK(off.params.self_collision.friction == def.friction);
+    CHECK(off.params.self_collision.iterations == def.iterations);
+    CHECK(off.warnings.empty());
+  }
+  CHECK_FALSE(def.enabled);
+  CHECK(def.thickness == 0.01);
+  CHECK(def.friction == 0.2);
+  CHECK(def.iterations == 2);
+
+  const Scene on = load_ok(
+      R"({"system": "cloth", "self_collision": {"enabled": true, "thickness": 0.08, "friction": 0.35, "iterations": 5}})");
+  CHECK(on.params.self_collision.enabled);
+  CHECK(on.params.self_collision.thickness == 0.08);
+  CHECK(on.params.self_collision.friction == 0.35);
+  CHECK(on.params.self_collision.iterations == 5);
+  CHECK(on.warnings.empty()); // 0.08 m is above half the 1/9 m spacing
+
+  // Present without "enabled": on, the other keys at their defaults.
+  const Scene bare = load_ok(R"({"system": "cloth", "self_collision": {"thickness": 0.1}})");
+  CHECK(bare.params.self_collision.enabled);
+  CHECK(bare.params.self_collision.thickness == 0.1);
+  CHECK(bare.params.self_collision.friction == def.friction);
+  CHECK(bare.params.self_collision.iterations == def.iterations);
+  CHECK(load_ok(R"({"system": "cloth", "self_collision": {}})").params.self_collision.enabled);
+
+  // "enabled": false keeps the values and turns it off.
+  const Scene disabled = load_ok(
+      R"({"system": "cloth", "self_collision": {"enabled": false, "thickness": 0.001, "iterations": 16}})");
+  CHECK_FALSE(disabled.params.self_collision.enabled);
+  CHECK(disabled.params.self_collision.thickness == 0.001);
+  CHECK(disabled.params.self_collision.iterations == 16);
+  CHECK(disabled.warnings.empty()); // off: not compared with the cloth
+
+  // Limits of the ranges are accepted (friction 0, iterations 1 and 16, a thickness of 10 x the spacing).
+  const Scene edge = load_ok(R"({"system": "cloth", "self_collision": {"friction": 0, "iterations": 1}})");
+  CHECK(edge.params.self_collision.friction == 0.0);
+  CHECK(edge.params.self_collision.iterations == 1);
+  CHECK(
+      load_ok(R"({"system": "chain", "self_collision": {"thickness": 4}})").params.self_collision.thickness ==
+      4.0);
+}
+
+TEST_CASE("self_collision: overrides reach every key and turn it on") {
+  const Scene s =
+      load_ok(R"({"system": "cloth"})", {"self_collision.enabled=true", "self_collision.thickness=0.06",
+                                         "self_collision.friction=0", "self_collision.iterations=3"});
+  CHECK(s.params.self_collision.enabled);
+  CHECK(s.params.self_collision.thickness == 0.06);
+  CHECK(s.params.self_collision.friction == 0.0);
+  CHECK(s.params.self_collision.iterations == 3);
+  const Scene off = load_ok(R"({"system": "cloth", "self_collision": {"thickness": 0.06}})",
+                            {"self_collision.enabled=false"});
+  CHECK_FALSE(off.params.self_collision.enabled);
+  CHECK(off.params.self_collision.thickness == 0.06);
+}
+
+TEST_CASE("self_collision: a thickness below half the smallest rest length is a warning in scene.warnings") {
+  // The default 10 x 10 grid over 1 m: structural springs of 1/9 m; half of that is 0.0556 m.
+  const Scene thin = load_ok(R"({"system": "cloth", "self_collision": {"thickness": 0.01}})");
+  REQUIRE(thin.warnings.size() == 1);
+  CHECK(thin.warnings[0].find(
+            "self_collision.thickness 0.01 m is below half the smallest rest length (0.1111 m)") == 0);
+  CHECK(thin.warnings[0].find("a triangle can pass between two particles") != std::string::npos);
+  // The default thickness (0.01 m) warns as well once turned on.
+  CHECK(load_ok(R"({"system": "cloth"})", {"self_collision.enabled=true"}).warnings.size() == 1);
+  CHECK(load_ok(R"({"system": "cloth", "self_collision": {"thickness": 0.06}})").warnings.empty());
+
+  // A mesh cloth: a 3 x 1 strip of unit quads (structural springs of 1 m).
+  const std::filesystem::path d = std::filesystem::path(VKCLOTH_TEST_TMP) / "self_collision_mesh";
+  std::filesystem::create_directories(d);
+  std::ofstream(d / "strip.obj") << "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 3 0 0\nv 0 0 1\nv 1 0 1\nv 2 0 1\nv 3 0 1\n"
+                                    "f 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\n";
+  const std::string mesh = R"({"system": "cloth", "cloth": {"mesh": "strip.obj"}, "self_collision": )";
+  const Scene mesh_thin = load_in_tmp("self_collision_mesh", mesh + R"({"thickness": 0.2}})");
+  REQUIRE(mesh_thin.warnings.size() == 1);
+  CHECK(mesh_thin.warnings[0].find(
+            "self_collision.thickness 0.2 m is below half the smallest rest length (1 m)") == 0);
+  CHECK(load_in_tmp("self_collision_mesh", mesh + R"({"thickness": 0.6}})").warnings.empty());
+}

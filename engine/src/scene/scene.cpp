@@ -118,6 +118,35 @@ Result<void> read_stretch_limit(const json& doc, SimParams& params) {
                      sl.tether_distance);
 }
 
+// Absent: off (the report's model). Present: on unless "enabled" is false; every other key has the
+// SelfCollision default. The ranges are validate()'s; the thickness against the cloth's spacing is
+// check_self_collision()'s, once the system is built.
+Result<void> read_self_collision(const json& doc, SimParams& params) {
+  SCENE_TRY_ASSIGN(obj, sd::read_object(doc, "", "self_collision"));
+  if (!obj)
+    return {};
+  const char* path = "self_collision";
+  VKCLOTH_TRY(sd::check_keys(*obj, path, {"enabled", "thickness", "friction", "iterations"}));
+  SelfCollision& sc = params.self_collision;
+  sc.enabled = true;
+  VKCLOTH_TRY(sd::read(*obj, path, "enabled", sc.enabled));
+  VKCLOTH_TRY(sd::read(*obj, path, "thickness", sc.thickness));
+  VKCLOTH_TRY(sd::read(*obj, path, "friction", sc.friction));
+  if (obj->contains("iterations")) {
+    SCENE_TRY_ASSIGN(it, sd::as_integer((*obj)["iterations"], "self_collision.iterations", 1000000));
+    sc.iterations = static_cast<std::uint32_t>(it); // the range (1..16) is validate()'s
+  }
+  return {};
+}
+
+/// self_collision.thickness against the built system's spring lengths: an error, or warnings added
+/// to the scene's.
+Result<void> check_scene_self_collision(Scene& scene) {
+  SCENE_TRY_ASSIGN(warnings, check_self_collision(scene.params.self_collision, scene.system));
+  scene.warnings.insert(scene.warnings.end(), warnings.begin(), warnings.end());
+  return {};
+}
+
 /// A file a scene names ("cloth.mesh", "colliders[k].path"): relative to the scene file's directory,
 /// or absolute.
 std::filesystem::path scene_relative(const std::string& file, const std::filesystem::path& scene_dir) {
@@ -465,10 +494,10 @@ Result<ParticleSystem> read_cloth(const json& doc, const std::optional<Material>
 Result<Scene> build_scene(const json& doc, std::string_view source_name) {
   if (!doc.is_object())
     return sd::shape_error(fmt::format("the scene must be a JSON object, got {}", doc.type_name()));
-  VKCLOTH_TRY(
-      sd::check_keys(doc, "",
-                     {"name", "system", "integrator", "physics", "chain", "cloth", "wind", "colliders",
-                      "contact_epsilon", "contact_inward_only", "divergence_limit", "stretch_limit"}));
+  VKCLOTH_TRY(sd::check_keys(doc, "",
+                             {"name", "system", "integrator", "physics", "chain", "cloth", "wind",
+                              "colliders", "contact_epsilon", "contact_inward_only", "divergence_limit",
+                              "stretch_limit", "self_collision"}));
   Scene scene;
   if (!doc.contains("system"))
     return sd::shape_error("missing required key system (\"chain\" or \"cloth\")");
@@ -502,6 +531,7 @@ Result<Scene> build_scene(const json& doc, std::string_view source_name) {
   const std::filesystem::path scene_dir = std::filesystem::path(source_name).parent_path();
   VKCLOTH_TRY(read_colliders(doc, scene_dir, scene));
   VKCLOTH_TRY(read_stretch_limit(doc, scene.params));
+  VKCLOTH_TRY(read_self_collision(doc, scene.params));
   VKCLOTH_TRY(sd::read(doc, "", "contact_epsilon", scene.params.contact_epsilon));
   VKCLOTH_TRY(sd::read(doc, "", "divergence_limit", scene.params.divergence_limit));
   VKCLOTH_TRY(sd::read(doc, "", "contact_inward_only", scene.params.contact_inward_only));
@@ -510,12 +540,13 @@ Result<Scene> build_scene(const json& doc, std::string_view source_name) {
   if (const json* cloth = kind == "cloth" && doc.contains("cloth") ? &doc["cloth"] : nullptr;
       cloth && cloth->is_object() && cloth->contains("mesh")) {
     VKCLOTH_TRY(read_mesh_cloth(*cloth, scene_dir, material, scene));
-    return scene;
+  } else {
+    auto system = kind == "chain" ? read_chain(doc) : read_cloth(doc, material);
+    if (!system)
+      return system.error();
+    scene.system = std::move(*system);
   }
-  auto system = kind == "chain" ? read_chain(doc) : read_cloth(doc, material);
-  if (!system)
-    return system.error();
-  scene.system = std::move(*system);
+  VKCLOTH_TRY(check_scene_self_collision(scene));
   return scene;
 }
 
