@@ -315,7 +315,7 @@ Result<std::vector<std::string>> check_self_collision(const SelfCollision& self,
   const double mean = sum / double(n);
   if (self.thickness > 10.0 * mean)
     return bad(fmt::format("self_collision.thickness {} m is more than 10 x the mean rest length of the "
-                           "cloth's {} springs ({:.4g} m): every particle would touch most of the cloth; "
+                           "system's {} ({:.4g} m): every particle would touch most of the cloth; "
                            "use a thickness near the particle spacing",
                            self.thickness, structural ? "structural springs" : "springs", mean));
   if (self.thickness < 0.5 * smallest)
