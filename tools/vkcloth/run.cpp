@@ -102,6 +102,7 @@ struct RunOptions {
   std::optional<std::uint64_t> export_every; ///< K for both; unset: 1
   std::uint64_t strain_every = 1;            ///< K for "over the run" of the structural strain
   std::uint64_t contact_every = 1;           ///< K for the contact quality (scenes with colliders)
+  bool check_intersections = false;          ///< count the intersecting triangle pairs at the end
   std::string json;                          ///< the summary as JSON; empty: none
 };
 
@@ -380,6 +381,19 @@ int run_command(const RunOptions& opt) {
         contact.deepest.depth, file_vertex(scene->system, contact.deepest.particle), contact.deepest.collider,
         contact.step, scene->params.contact_epsilon,
         contact_every > 1 ? fmt::format(", sampled every {} steps", contact_every) : "", contact.calm_speed);
+  // Self-intersections at the final state (the solver's positions, in particle order).
+  std::optional<IntersectionStats> intersections;
+  if (opt.check_intersections) {
+    auto r = intersecting_triangle_pairs(scene->system, std::span<const glm::dvec3>(pos));
+    if (!r)
+      return report(r.error());
+    intersections = *r;
+    if (r->triangles == 0)
+      fmt::print("intersections: no triangles (a chain), 0 pairs\n");
+    else
+      fmt::print("intersections: {} pairs of triangles intersect (of {} triangles)\n", r->pairs,
+                 r->triangles);
+  }
   if (json) {
     nlohmann::json doc;
     doc["schema"] = "vkcloth-run/1";
@@ -428,6 +442,8 @@ int run_command(const RunOptions& opt) {
                              {"last_second_from_step", calm_from},
                              {"every", contact_every}}
             : nlohmann::json(nullptr);
+    if (intersections)
+      doc["intersections"] = {{"pairs", intersections->pairs}, {"triangles", intersections->triangles}};
     fmt::print(json.get(), "{}\n", doc.dump(2));
     if (std::fflush(json.get()) != 0 || std::ferror(json.get()))
       return report(make_error(ErrorCode::io, "writing the JSON file failed (disk full?)"));
@@ -470,6 +486,10 @@ void add_run_command(CLI::App& app, int* exit) {
                   "Cloths: take the largest structural strain over the run from step 0, every K-th and the "
                   "last step (default 1: every step; on Vulkan each one reads the positions back)")
       ->check(CLI::PositiveNumber);
+  cmd->add_flag(
+      "--check-intersections", opt->check_intersections,
+      "After the run, count the pairs of the cloth's triangles that intersect each other and share "
+      "no vertex (self-intersections at the final state; grids and meshes; JSON \"intersections\")");
   cmd->add_option("--json", opt->json,
                   "Also write the summary as JSON to FILE (keys: docs/scene-format.md; not written on "
                   "divergence)");
