@@ -4,10 +4,10 @@
 // Self-collision (CpuSolver::self_collide; docs/model.md "Self-collision"), one pass per
 // pc.stage (self_collision_shared.h), after the substep's update and stretch control, on the
 // positions being written (POS_OUT). The spatial hash is a counting sort of the particles by
-// bucket: COUNT (integer atomics), the prefix sums in two levels (SCAN_BLOCKS, SCAN_TOP),
+// bucket (of its cell key): COUNT (integer atomics), the prefix sums in two levels (SCAN_BLOCKS, SCAN_TOP),
 // SCATTER (slots in any order), then SORT (each bucket's particles in increasing index): integer
 // work only, so the table is the same on every run and the same as the CPU's. COLLIDE and APPLY are
-// then cloth_kernel.h self_collide and apply_correction per particle, each invocation writing only
+// then cloth_kernel.h self_collide and self_apply per particle, each invocation writing only
 // its own particle.
 #include "vkcloth_shared.h"
 #include "self_collision_shared.h"
@@ -16,7 +16,7 @@
 #define SELF_DATA_PARAM uint self_data
 #define SELF_DATA self_data
 void self_range(uint unused, uint b, out uint first, out uint stop);
-uint self_sorted(uint unused, uint i);
+void self_entry(uint unused, uint i, out uint q, out uint key);
 void self_particle(uint unused, uint q, out vec3 x, out vec3 v, out float w, out vec3 rest);
 #include "common.glsl"
 
@@ -27,7 +27,7 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_REST) readonly buffer Res
 layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_COUNTS) buffer CountBuf { uint counts[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_STARTS) buffer StartBuf { uint starts[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_BLOCKS) buffer BlockBuf { uint blocks[]; };
-layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_BUCKET) buffer BucketBuf { uint bucket_of[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_KEYS) buffer KeyBuf { uint key_of[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_SORTED) buffer SortedBuf { uint sorted[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_DELTA) buffer DeltaBuf { vec4 delta[]; };
 
@@ -48,7 +48,10 @@ void self_range(uint unused, uint b, out uint first, out uint stop) {
   first = bucket_start(b);
   stop = bucket_start(b + 1u);
 }
-uint self_sorted(uint unused, uint i) { return sorted[base + i]; }
+void self_entry(uint unused, uint i, out uint q, out uint key) {
+  q = sorted[base + i];
+  key = key_of[base + q];
+}
 void self_particle(uint unused, uint q, out vec3 x, out vec3 v, out float w, out vec3 rest) {
   x = pos_out[base + q].xyz;
   v = vel[base + q].xyz;
@@ -136,11 +139,11 @@ void main() {
   if (p >= pc.count)
     return;
   if (stage == VKCLOTH_SELF_COUNT) {
-    const uint b = self_bucket_of(pos_out[base + p].xyz, sp.inv_cell, mask);
-    bucket_of[base + p] = b;
-    atomicAdd(counts[table_base() + b], 1u);
+    const uint key = self_key(pos_out[base + p].xyz, sp.inv_cell);
+    key_of[base + p] = key;
+    atomicAdd(counts[table_base() + self_bucket(key, mask)], 1u);
   } else if (stage == VKCLOTH_SELF_SCATTER) {
-    const uint b = bucket_of[base + p];
+    const uint b = self_bucket(key_of[base + p], mask);
     const uint left = atomicAdd(counts[table_base() + b], 0xffffffffu); // minus one
     sorted[base + bucket_start(b) + left - 1u] = p;
   } else if (pc.pad1 < sp.iterations && particle[p].pinned == 0u) {
@@ -148,12 +151,15 @@ void main() {
       const vec3 x = pos_out[base + p].xyz;
       const vec3 v = vel[base + p].xyz;
       const float w = inverse_mass(particle[p].mass, false);
-      delta[base + p] = vec4(self_collide(0u, p, x, v, w, rest_pos[p].xyz, sp.thickness, sp.inv_cell, mask,
-                                          sp.friction, ip.dt), 0.0);
+      vec3 dx;
+      vec3 dv;
+      self_collide(0u, p, x, v, w, rest_pos[p].xyz, sp.thickness, sp.inv_cell, mask, sp.friction, dx, dv);
+      delta[2u * (base + p)] = vec4(dx, 0.0);
+      delta[2u * (base + p) + 1u] = vec4(dv, 0.0);
     } else { // VKCLOTH_SELF_APPLY
       vec3 x = pos_out[base + p].xyz;
       vec3 v = vel[base + p].xyz;
-      apply_correction(x, v, delta[base + p].xyz, ip.dt);
+      self_apply(x, v, delta[2u * (base + p)].xyz, delta[2u * (base + p) + 1u].xyz);
       pos_out[base + p] = vec4(x, 1.0);
       vel[base + p] = vec4(v, 0.0);
     }

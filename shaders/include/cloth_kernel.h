@@ -19,7 +19,7 @@
 // all_finite(vec3) (no component is NaN or inf); for mesh colliders MESH_DATA_PARAM / MESH_DATA
 // (the mesh buffers: a dummy uint in GLSL, whose buffers are global), mesh_node and mesh_triangle;
 // floor; for self_collide (only where SELF_DATA_PARAM is defined) SELF_DATA_PARAM / SELF_DATA,
-// self_range, self_sorted and self_particle;
+// self_range, self_entry and self_particle;
 // VKCLOTH_COLLIDER_PRESENT(type): false only when no collider of that type can reach the caller
 // (C++: always true; GLSL: a specialisation constant, so that the absent shapes' code is compiled
 // out, since llvmpipe runs every branch of a non-uniform `if`). It changes no result.
@@ -466,13 +466,22 @@ KFN int self_cell(real x, real inv_cell) {
   return int(c);
 }
 
-// The hash-table bucket of cell (i, j, k) (Teschner et al. 2003's primes), wrapped to the table:
-// mask = its size - 1, a power of two.
-KFN uint self_bucket(int i, int j, int k, uint mask) {
-  return ((uint(i) * 73856093u) ^ (uint(j) * 19349663u) ^ (uint(k) * 83492791u)) & mask;
+// A cell's key: its coordinates modulo 1024, 10 bits each (the grid repeats every 1024 cells: two
+// cells of one key are 1024 cells apart, so only one of the 27 around a particle has a given key).
+KFN uint self_key_of(int i, int j, int k) {
+  return (uint(i) & 1023u) | ((uint(j) & 1023u) << 10u) | ((uint(k) & 1023u) << 20u);
 }
-KFN uint self_bucket_of(vec3 x, real inv_cell, uint mask) {
-  return self_bucket(self_cell(x.x, inv_cell), self_cell(x.y, inv_cell), self_cell(x.z, inv_cell), mask);
+KFN uint self_key(vec3 x, real inv_cell) {
+  return self_key_of(self_cell(x.x, inv_cell), self_cell(x.y, inv_cell), self_cell(x.z, inv_cell));
+}
+// The key of the cell (di, dj, dk) away from `key`'s.
+KFN uint self_key_step(uint key, int di, int dj, int dk) {
+  return self_key_of(int(key & 1023u) + di, int((key >> 10u) & 1023u) + dj, int(key >> 20u) + dk);
+}
+// The hash-table bucket of a key (Teschner et al. 2003's primes on its three coordinates), wrapped
+// to the table: mask = its size - 1, a power of two.
+KFN uint self_bucket(uint key, uint mask) {
+  return ((key & 1023u) * 73856093u ^ ((key >> 10u) & 1023u) * 19349663u ^ (key >> 20u) * 83492791u) & mask;
 }
 
 // 1 / m, or 0 for a pinned particle (it takes no share of a correction).
@@ -492,61 +501,63 @@ KFN bool self_pair(vec3 x, vec3 xq, vec3 rx, vec3 rxq, real thickness2) {
   return d2 < thickness2 && d2 > real(0) && !(r2 < thickness2);
 }
 
-// Adds p's part of one pair's correction to dx: along n = (x - xq) / |x - xq| the pair moves apart
-// to the thickness, p by its inverse-mass share w / (w + wq); across n the slip of the relative
-// velocity over the substep, h |v_t|, is cancelled up to mu times the depth (Coulomb: all of it
-// within mu depth, static; mu depth of it beyond, kinetic; Macklin et al. 2014, eq. 24).
-KFN void self_contact(INOUT(vec3) dx, vec3 x, vec3 v, real w, vec3 xq, vec3 vq, real wq, real thickness,
-                      real mu, real h) {
+// Adds p's part of one pair's response to dx (a move) and dv (a velocity change), p's share of
+// each being its inverse-mass share w / (w + wq) (Bridson, Fedkiw and Anderson 2002, section 7:
+// a position correction plus a velocity filter). Along n = (x - xq) / |x - xq| the pair moves
+// apart to the thickness (the move changes no velocity: no bounce), and the normal relative
+// velocity, where it approaches, is removed (inelastic); across n Coulomb friction takes up to mu
+// times that removed speed off the relative tangential velocity (all of it within: static). A layer
+// resting on another is held by friction mu g per unit mass, since gravity's approach per substep
+// is g h.
+KFN void self_contact(INOUT(vec3) dx, INOUT(vec3) dv, vec3 x, vec3 v, real w, vec3 xq, vec3 vq, real wq,
+                      real thickness, real mu) {
   precise vec3 u = x - xq;
   precise real d = sqrt(dot3(u, u));
   precise vec3 n = u / d;
   precise real share = w / (w + wq);
   precise real depth = thickness - d;
   precise vec3 rv = v - vq;
-  precise vec3 vt = rv - n * dot3(rv, n);
-  precise real slip = h * sqrt(dot3(vt, vt));
-  precise real cap = mu * depth;
+  precise real vn = dot3(rv, n);
+  precise real approach = max(-vn, real(0));
+  precise vec3 vt = rv - n * vn;
+  precise real slip = sqrt(dot3(vt, vt));
+  precise real cap = mu * approach;
   precise real kept = slip > cap ? cap / slip : real(1); // the part of the slip friction removes
-  precise vec3 t = dx + n * (depth * share);
-  t = t - vt * (h * kept * share);
-  dx = t;
+  precise vec3 mx = dx + n * (depth * share);
+  precise vec3 mv = dv + n * (approach * share);
+  mv = mv - vt * (kept * share);
+  dx = mx;
+  dv = mv;
 }
 
 #ifdef SELF_DATA_PARAM // the includer provides the table (C++: kernel.hpp; GLSL: self_collision.comp)
-// Particle p's move (Jacobi: the mean of its pairs' corrections, so that a particle pressed from
-// many sides does not overshoot): every particle q in the 27 cells around p's, bucket by bucket in
-// a fixed order (a bucket two cells share is visited once), each bucket's particles in increasing
-// index. Provided by the including file: self_range(SELF_DATA, bucket, first, stop) (the bucket's
-// entries of the sorted table), self_sorted(SELF_DATA, i) (its particle), self_particle(SELF_DATA,
-// q, x, v, w, rest). Both backends build the same table, so they sum the same pairs in the same order.
-KFN precise vec3 self_collide(SELF_DATA_PARAM, uint p, vec3 x, vec3 v, real w, vec3 rx, real thickness,
-                              real inv_cell, uint mask, real mu, real h) {
+// Particle p's response (Jacobi: the mean of its pairs' responses, so that a particle pressed from
+// many sides does not overshoot): every particle q of the 27 cells around p's, cell by cell in a
+// fixed order, each cell's particles in increasing index (a bucket holds the particles of every
+// cell hashed to it, in increasing index: those of other cells are skipped by their key).
+// Provided by the including file: self_range(SELF_DATA, bucket, first, stop) (the bucket's entries
+// of the sorted table), self_entry(SELF_DATA, i, q, key) (an entry's particle and the key of the
+// cell it was sorted in), self_particle(SELF_DATA, q, x, v, w, rest). Both backends build the
+// same table, so they sum the same pairs in the same order.
+KFN void self_collide(SELF_DATA_PARAM, uint p, vec3 x, vec3 v, real w, vec3 rx, real thickness, real inv_cell,
+                      uint mask, real mu, OUT(vec3) dx, OUT(vec3) dv) {
   precise real t2 = thickness * thickness;
-  const int ci = self_cell(x.x, inv_cell);
-  const int cj = self_cell(x.y, inv_cell);
-  const int ck = self_cell(x.z, inv_cell);
-  uint seen[27];
-  uint nseen = 0u;
-  precise vec3 sum = vec3(real(0));
+  const uint own = self_key(x, inv_cell);
+  precise vec3 sum_x = vec3(real(0));
+  precise vec3 sum_v = vec3(real(0));
   uint pairs = 0u;
   for (int dk = -1; dk <= 1; ++dk)
     for (int dj = -1; dj <= 1; ++dj)
       for (int di = -1; di <= 1; ++di) {
-        const uint b = self_bucket(ci + di, cj + dj, ck + dk, mask);
-        bool dup = false;
-        for (uint s = 0u; s < nseen; ++s)
-          dup = dup || seen[s] == b;
-        if (dup)
-          continue;
-        seen[nseen] = b;
-        nseen += 1u;
+        const uint key = self_key_step(own, di, dj, dk);
         uint first;
         uint stop;
-        self_range(SELF_DATA, b, first, stop);
+        self_range(SELF_DATA, self_bucket(key, mask), first, stop);
         for (uint i = first; i < stop; ++i) {
-          const uint q = self_sorted(SELF_DATA, i);
-          if (q == p)
+          uint q;
+          uint qkey;
+          self_entry(SELF_DATA, i, q, qkey);
+          if (qkey != key || q == p)
             continue;
           vec3 xq;
           vec3 vq;
@@ -554,15 +565,26 @@ KFN precise vec3 self_collide(SELF_DATA_PARAM, uint p, vec3 x, vec3 v, real w, v
           real wq;
           self_particle(SELF_DATA, q, xq, vq, wq, rq);
           if (self_pair(x, xq, rx, rq, t2)) {
-            self_contact(sum, x, v, w, xq, vq, wq, thickness, mu, h);
+            self_contact(sum_x, sum_v, x, v, w, xq, vq, wq, thickness, mu);
             pairs += 1u;
           }
         }
       }
-  precise vec3 mean = pairs > 0u ? sum / real(pairs) : vec3(real(0));
-  return mean;
+  precise real k = pairs > 0u ? real(1) / real(pairs) : real(0);
+  precise vec3 mx = sum_x * k;
+  precise vec3 mv = sum_v * k;
+  dx = mx;
+  dv = mv;
 }
 #endif
+
+// Applies a self-collision pass's response to a particle.
+KFN void self_apply(INOUT(vec3) x, INOUT(vec3) v, vec3 dx, vec3 dv) {
+  precise vec3 nx = x + dx;
+  precise vec3 nv = v + dv;
+  x = nx;
+  v = nv;
+}
 
 // ---- Integrators (docs/model.md "Integrators") ------------------------------------------------
 

@@ -15,12 +15,14 @@ namespace vkcloth::gpu::shared {
 
 #define VKCLOTH_BINDING_SELF_PARAMS 37 // (after implicit Euler's) SelfParams per instance
 #define VKCLOTH_BINDING_SELF_REST 38   // rest positions (vec4 per particle of the topology)
-#define VKCLOTH_BINDING_SELF_COUNTS 39 // particles per bucket (uint, table size per instance; zero between substeps)
+#define VKCLOTH_BINDING_SELF_COUNTS                                                                          \
+  39 // particles per bucket (uint, table size per instance; zero between substeps)
 #define VKCLOTH_BINDING_SELF_STARTS 40 // each bucket's first entry within its scan block (uint, per bucket)
-#define VKCLOTH_BINDING_SELF_BLOCKS 41 // each scan block's first entry (uint, table size / SCAN_BLOCK per instance)
-#define VKCLOTH_BINDING_SELF_BUCKET 42 // each particle's bucket (uint, per particle)
+#define VKCLOTH_BINDING_SELF_BLOCKS                                                                          \
+  41 // each scan block's first entry (uint, table size / SCAN_BLOCK per instance)
+#define VKCLOTH_BINDING_SELF_KEYS 42   // each particle's cell key when sorted (uint, per particle)
 #define VKCLOTH_BINDING_SELF_SORTED 43 // the particles by bucket, then by index (uint, per particle)
-#define VKCLOTH_BINDING_SELF_DELTA 44  // this Jacobi pass's moves (vec4, per particle)
+#define VKCLOTH_BINDING_SELF_DELTA 44  // this Jacobi pass's move and velocity change (2 vec4 per particle)
 
 // Buckets per workgroup of the SCAN_BLOCKS pass: 64 invocations x 8 (the table size is a
 // multiple: kernel.hpp self_table_size).
@@ -34,7 +36,7 @@ namespace vkcloth::gpu::shared {
 #define VKCLOTH_SELF_SCATTER 3u     // per particle: a slot in its bucket (counts[bucket] -= 1: zero again)
 #define VKCLOTH_SELF_SORT 4u        // per bucket: its particles in increasing index (the CPU's order)
 #define VKCLOTH_SELF_COLLIDE 5u     // per particle: cloth_kernel.h self_collide -> DELTA
-#define VKCLOTH_SELF_APPLY 6u       // per particle: x += delta, v += delta / h
+#define VKCLOTH_SELF_APPLY 6u       // per particle: x += dx, v += dv (cloth_kernel.h self_apply)
 
 /// Self-collision parameters of one instance (std430: 16 bytes), converted from the double
 /// SimParams::self_collision as CpuSolver<float>::self_collide converts them.

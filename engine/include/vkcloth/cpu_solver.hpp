@@ -17,7 +17,7 @@
 //   6. stretch   stretch_limit on: Provot sweeps over the strain links colour by colour, then the
 //                tethers, then the projection again; the moves update the velocities (v += dx / h)
 //   6b. self     self_collision on: the spatial hash, then Jacobi passes pushing apart particles
-//                closer than the thickness (v += dx / h), then the projection again
+//                closer than the thickness and removing their approach, then the projection again
 //   7. check     NaN/inf or |p| > divergence_limit -> Error{diverged} naming the step and time
 #pragma once
 
@@ -139,7 +139,7 @@ private:
   // Stretch control after a substep (docs/model.md "Stretch control").
   void limit_stretch(Real h);
   // Self-collision after that (self_collision.cpp; docs/model.md "Self-collision").
-  void self_collide(Real h);
+  void self_collide();
 
   /// A gather-list entry in the solver's precision (ClothTopology::edges() converted once).
   struct Edge {

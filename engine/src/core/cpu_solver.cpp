@@ -340,7 +340,7 @@ template <typename Real> void CpuSolver<Real>::substep(const Real h) {
   if (params_.stretch_limit.enabled())
     limit_stretch(h);
   if (params_.self_collision.enabled)
-    self_collide(h);
+    self_collide();
 }
 
 // The tethers first (anchors are pinned: every particle's tethers are independent of the

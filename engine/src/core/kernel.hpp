@@ -73,10 +73,12 @@ template <typename V> void mesh_triangle(const MeshData& m, uint i, V& a, V& b, 
 
 /// Self-collision's spatial hash as cloth_kernel.h self_collide walks it, in the solver's precision:
 /// the table (`start`: each bucket's first entry, size + 1 of them; `sorted`: the particles, by bucket
-/// and then index) and the particles' state, read in place (CpuSolver::self_collide).
+/// and then index; `key`: each particle's cell key when sorted) and the particles' state, read in
+/// place (CpuSolver::self_collide).
 template <typename Real> struct SelfDataT {
   const std::uint32_t* start = nullptr;
   const std::uint32_t* sorted = nullptr;
+  const std::uint32_t* key = nullptr;
   const glm::vec<3, Real>* pos = nullptr;
   const glm::vec<3, Real>* vel = nullptr;
   const Real* inv_mass = nullptr;
@@ -86,8 +88,9 @@ template <typename Real> void self_range(const SelfDataT<Real>& d, uint b, uint&
   first = d.start[b];
   stop = d.start[b + 1];
 }
-template <typename Real> uint self_sorted(const SelfDataT<Real>& d, uint i) {
-  return d.sorted[i];
+template <typename Real> void self_entry(const SelfDataT<Real>& d, uint i, uint& q, uint& key) {
+  q = d.sorted[i];
+  key = d.key[q];
 }
 template <typename Real, typename V>
 void self_particle(const SelfDataT<Real>& d, uint q, V& x, V& v, Real& w, V& rest) {
@@ -114,14 +117,14 @@ using SelfData = SelfDataT<double>;
 using namespace f32;
 using namespace f64;
 
-/// Buckets of self-collision's hash table for `count` particles: a power of two, at least the count
+/// Buckets of self-collision's hash table for `count` particles: a power of two, at least twice the count
 /// and a whole number of the GPU scan's blocks (VKCLOTH_SELF_SCAN_BLOCK), the same on both
 /// backends (the table decides which cells share a bucket, so the order pairs are summed in).
 inline std::uint32_t self_table_size(std::uint32_t count) {
-  std::uint32_t t = 512;
-  while (t < count)
+  std::uint64_t t = 512;
+  while (t < 2ull * count) // at most half full: few buckets shared by two cells
     t *= 2;
-  return t;
+  return static_cast<std::uint32_t>(t);
 }
 
 /// The kernel's SpringBlock of precision Real.

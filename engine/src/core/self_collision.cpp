@@ -12,8 +12,7 @@
 
 namespace vkcloth {
 
-
-template <typename Real> void CpuSolver<Real>::self_collide(const Real h) {
+template <typename Real> void CpuSolver<Real>::self_collide() {
   const SelfCollision& sc = params_.self_collision;
   const std::size_t n = pos_.size();
   if (!self_) {
@@ -31,31 +30,33 @@ template <typename Real> void CpuSolver<Real>::self_collide(const Real h) {
 
   // The table: count per bucket, exclusive prefix sums, then the particles in index order.
   g.start.assign(std::size_t(table) + 1, 0);
-  g.bucket.resize(n);
+  g.key.resize(n);
   g.sorted.resize(n);
-  g.delta.resize(n);
+  g.dx.resize(n);
+  g.dv.resize(n);
   for (std::size_t p = 0; p < n; ++p) {
-    const std::uint32_t b = kernel::self_bucket_of(pos_[p], inv_cell, mask);
-    g.bucket[p] = b;
-    ++g.start[std::size_t(b) + 1];
+    g.key[p] = kernel::self_key(pos_[p], inv_cell); // self_bucket takes no real: either precision
+    ++g.start[std::size_t(kernel::f32::self_bucket(g.key[p], mask)) + 1];
   }
   for (std::size_t b = 0; b < table; ++b)
     g.start[b + 1] += g.start[b];
   g.fill.assign(g.start.begin(), g.start.end() - 1);
   for (std::size_t p = 0; p < n; ++p)
-    g.sorted[g.fill[g.bucket[p]]++] = static_cast<std::uint32_t>(p);
+    g.sorted[g.fill[kernel::f32::self_bucket(g.key[p], mask)]++] = static_cast<std::uint32_t>(p);
 
   for (std::uint32_t it = 0; it < sc.iterations; ++it) {
-    const kernel::SelfDataT<Real> data{g.start.data(), g.sorted.data(), pos_.data(),
+    const kernel::SelfDataT<Real> data{g.start.data(), g.sorted.data(),   g.key.data(), pos_.data(),
                                        vel_.data(),    g.inv_mass.data(), g.rest.data()};
     pool_->for_each(n, [&](std::size_t p) {
-      g.delta[p] = pinned_[p] ? Vec3(0)
-                              : kernel::self_collide(data, static_cast<std::uint32_t>(p), pos_[p], vel_[p],
-                                                     g.inv_mass[p], g.rest[p], thickness, inv_cell, mask, mu, h);
+      if (pinned_[p])
+        g.dx[p] = g.dv[p] = Vec3(0);
+      else
+        kernel::self_collide(data, static_cast<std::uint32_t>(p), pos_[p], vel_[p], g.inv_mass[p], g.rest[p],
+                             thickness, inv_cell, mask, mu, g.dx[p], g.dv[p]);
     });
     pool_->for_each(n, [&](std::size_t p) {
       if (!pinned_[p])
-        kernel::apply_correction(pos_[p], vel_[p], g.delta[p], h);
+        kernel::self_apply(pos_[p], vel_[p], g.dx[p], g.dv[p]);
     });
   }
   if (!params_.colliders.empty()) // a move may have pushed a particle into a collider
@@ -67,7 +68,7 @@ template <typename Real> void CpuSolver<Real>::self_collide(const Real h) {
   swept_finite_ = false; // checked with the rest of the state (check_finite)
 }
 
-template void CpuSolver<float>::self_collide(float);
-template void CpuSolver<double>::self_collide(double);
+template void CpuSolver<float>::self_collide();
+template void CpuSolver<double>::self_collide();
 
 } // namespace vkcloth

@@ -16,11 +16,12 @@ template <typename Real> struct SelfCollisionGrid {
   using Vec3 = glm::vec<3, Real>;
   std::vector<Vec3> rest;
   std::vector<Real> inv_mass;
-  std::vector<std::uint32_t> start;  // table size + 1: bucket b's particles are sorted[start[b] .. start[b + 1])
-  std::vector<std::uint32_t> fill;   // the counting sort's next slot per bucket
-  std::vector<std::uint32_t> bucket; // each particle's bucket
+  std::vector<std::uint32_t>
+      start; // table size + 1: bucket b's particles are sorted[start[b] .. start[b + 1])
+  std::vector<std::uint32_t> fill; // the counting sort's next slot per bucket
+  std::vector<std::uint32_t> key;  // each particle's cell key (its bucket: kernel::self_bucket)
   std::vector<std::uint32_t> sorted;
-  std::vector<Vec3> delta; // this pass's moves
+  std::vector<Vec3> dx, dv; // this pass's moves and velocity changes
 };
 } // namespace detail
 

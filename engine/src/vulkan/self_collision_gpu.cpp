@@ -12,9 +12,9 @@ namespace vkcloth::gpu {
 
 namespace sh = shared;
 
-Result<std::unique_ptr<SelfCollisionGpu>> SelfCollisionGpu::create(const std::shared_ptr<Context::Impl>& ctx,
-                                                                   std::uint32_t count, std::uint32_t instances,
-                                                                   std::uint32_t groups_max_x, bool allow_map) {
+Result<std::unique_ptr<SelfCollisionGpu>>
+SelfCollisionGpu::create(const std::shared_ptr<Context::Impl>& ctx, std::uint32_t count,
+                         std::uint32_t instances, std::uint32_t groups_max_x, bool allow_map) {
   std::unique_ptr<SelfCollisionGpu> s(new SelfCollisionGpu());
   s->ctx_ = ctx;
   s->count_ = count;
@@ -36,17 +36,17 @@ Result<void> SelfCollisionGpu::create_buffers(bool allow_map) {
       {&counts_, buckets * 4, "self-collision: bucket counts"},
       {&starts_, buckets * 4, "self-collision: bucket starts"},
       {&blocks_, buckets / VKCLOTH_SELF_SCAN_BLOCK * 4, "self-collision: scan blocks"},
-      {&bucket_, per_particle * 4, "self-collision: particle buckets"},
+      {&keys_, per_particle * 4, "self-collision: cell keys"},
       {&sorted_, per_particle * 4, "self-collision: sorted particles"},
-      {&delta_, per_particle * 16, "self-collision: moves"}};
+      {&delta_, per_particle * 32, "self-collision: moves and velocity changes"}};
   for (auto [b, bytes, what] : device_buffers) {
     auto r = create_buffer(ctx, std::max<VkDeviceSize>(bytes, 16), usage, MemoryUse::device, allow_map, what);
     if (!r)
       return r.error();
     *b = std::move(*r);
   }
-  auto p = create_buffer(ctx, VkDeviceSize(instances_) * sizeof(sh::SelfParams), usage, MemoryUse::host_upload,
-                         true, "self-collision: parameters");
+  auto p = create_buffer(ctx, VkDeviceSize(instances_) * sizeof(sh::SelfParams), usage,
+                         MemoryUse::host_upload, true, "self-collision: parameters");
   if (!p)
     return p.error();
   params_ = std::move(*p);
@@ -77,7 +77,8 @@ Result<void> SelfCollisionGpu::create_sets() {
   ai.descriptorPool = pool_;
   ai.descriptorSetCount = 2;
   ai.pSetLayouts = set_layouts;
-  VKCLOTH_VK_TRY(v.vkAllocateDescriptorSets(ctx.device, &ai, sets_), "vkAllocateDescriptorSets (self-collision)");
+  VKCLOTH_VK_TRY(v.vkAllocateDescriptorSets(ctx.device, &ai, sets_),
+                 "vkAllocateDescriptorSets (self-collision)");
   auto pp = ctx.pipelines->pipeline(PipelineRegistry::Shader::self_collision, {});
   if (!pp)
     return pp.error();
@@ -124,8 +125,8 @@ Result<void> SelfCollisionGpu::write_sets(const SelfCollisionInputs& in) {
       case VKCLOTH_BINDING_SELF_BLOCKS:
         b = blocks_.buffer;
         break;
-      case VKCLOTH_BINDING_SELF_BUCKET:
-        b = bucket_.buffer;
+      case VKCLOTH_BINDING_SELF_KEYS:
+        b = keys_.buffer;
         break;
       case VKCLOTH_BINDING_SELF_SORTED:
         b = sorted_.buffer;
@@ -169,7 +170,8 @@ std::uint32_t SelfCollisionGpu::record_substep(VkCommandBuffer c, std::uint32_t 
     barriers::dispatch_to_dispatch(v, c); // the previous pass (or the substep's update) -> this one
     pc.stage = stage;
     v.vkCmdPushConstants(c, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
-    const std::uint64_t groups = std::max<std::uint64_t>((items + VKCLOTH_WORKGROUP_SIZE - 1) / VKCLOTH_WORKGROUP_SIZE, 1);
+    const std::uint64_t groups =
+        std::max<std::uint64_t>((items + VKCLOTH_WORKGROUP_SIZE - 1) / VKCLOTH_WORKGROUP_SIZE, 1);
     const std::uint64_t gx = std::min<std::uint64_t>(groups, groups_max_x_);
     v.vkCmdDispatch(c, std::uint32_t(gx), std::uint32_t((groups + gx - 1) / gx), instances_);
     ++dispatches;

@@ -55,7 +55,7 @@ private:
   SelfCollisionGpu() = default;
   std::shared_ptr<Context::Impl> ctx_;
   std::uint32_t count_ = 0, instances_ = 0, table_ = 0, groups_max_x_ = 1;
-  Buffer params_, rest_, counts_, starts_, blocks_, bucket_, sorted_, delta_;
+  Buffer params_, rest_, counts_, starts_, blocks_, keys_, sorted_, delta_;
   DescriptorPool pool_;
   VkDescriptorSet sets_[2] = {};
   // The Context's (PipelineRegistry), shared by every batch.
