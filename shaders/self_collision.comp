@@ -4,7 +4,8 @@
 // Self-collision (CpuSolver::self_collide; docs/model.md "Self-collision"), one pass per
 // pc.stage (self_collision_shared.h), after the substep's update and stretch control, on the
 // positions being written (POS_OUT). The spatial hash is a counting sort of the particles by
-// bucket (of its cell key): COUNT (integer atomics), the prefix sums in two levels (SCAN_BLOCKS, SCAN_TOP),
+// bucket (of its cell key): COUNT (integer atomics), the prefix sums in two levels (SCAN_BLOCKS,
+// SCAN_TOP, SCAN_ADD),
 // SCATTER (slots in any order), then SORT (each bucket's particles in increasing index): integer
 // work only, so the table is the same on every run and the same as the CPU's. COLLIDE and APPLY are
 // then cloth_kernel.h self_collide and self_apply per particle, each invocation writing only
@@ -23,40 +24,40 @@ void self_particle(uint unused, uint q, out vec3 x, out vec3 v, out float w, out
 layout(std430, set = 0, binding = VKCLOTH_BINDING_POS_OUT) buffer PosOut { vec4 pos_out[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_VEL) buffer VelBuf { vec4 vel[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_PARAMS) readonly buffer SelfParamBuf { SelfParams self_params[]; };
-layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_REST) readonly buffer RestBuf { vec4 rest_pos[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_REST) readonly buffer RestBuf { vec4 rest_pos[]; }; // xyz, w: 1/m (0: pinned)
 layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_COUNTS) buffer CountBuf { uint counts[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_STARTS) buffer StartBuf { uint starts[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_BLOCKS) buffer BlockBuf { uint blocks[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_KEYS) buffer KeyBuf { uint key_of[]; };
-layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_SORTED) buffer SortedBuf { uint sorted[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_SORTED) buffer SortedBuf { uvec2 sorted[]; }; // particle, key
 layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_DELTA) buffer DeltaBuf { vec4 delta[]; };
 
 shared uint partial[VKCLOTH_WORKGROUP_SIZE];
 
 // This instance's table: pc.pad0 buckets from inst * pc.pad0, their scan blocks after inst * blocks.
 uint table_base() { return inst * pc.pad0; }
+uint start_base() { return inst * (pc.pad0 + 1u); }
 uint block_base() { return inst * (pc.pad0 / VKCLOTH_SELF_SCAN_BLOCK); }
 
-// Bucket b's first entry in `sorted` (within the instance): its block's start plus its own.
-uint bucket_start(uint b) {
-  if (b >= pc.pad0)
-    return pc.count; // past the last bucket: every particle
-  return blocks[block_base() + b / VKCLOTH_SELF_SCAN_BLOCK] + starts[table_base() + b];
-}
+// Bucket b's first entry in `sorted` (within the instance), once SCAN_ADD has run; starts has
+// one more entry per instance than the table has buckets, the particle count.
+uint bucket_start(uint b) { return starts[inst * (pc.pad0 + 1u) + b]; }
 
 void self_range(uint unused, uint b, out uint first, out uint stop) {
   first = bucket_start(b);
   stop = bucket_start(b + 1u);
 }
 void self_entry(uint unused, uint i, out uint q, out uint key) {
-  q = sorted[base + i];
-  key = key_of[base + q];
+  const uvec2 e = sorted[base + i];
+  q = e.x;
+  key = e.y;
 }
 void self_particle(uint unused, uint q, out vec3 x, out vec3 v, out float w, out vec3 rest) {
   x = pos_out[base + q].xyz;
   v = vel[base + q].xyz;
-  w = inverse_mass(particle[q].mass, particle[q].pinned != 0u);
-  rest = rest_pos[q].xyz;
+  const vec4 r = rest_pos[q];
+  w = r.w; // the host's kernel inverse_mass, as the CPU's
+  rest = r.xyz;
 }
 
 // Workgroup exclusive prefix sum of one value per invocation (integers: the same sums in any
@@ -95,7 +96,7 @@ void main() {
       sum += counts[table_base() + first + k];
     uint run = workgroup_exclusive_scan(sum);
     for (uint k = 0u; k < VKCLOTH_SELF_SCAN_PER_INVOCATION; ++k) {
-      starts[table_base() + first + k] = run;
+      starts[start_base() + first + k] = run;
       run += counts[table_base() + first + k];
     }
     if (gl_LocalInvocationID.x == 0u)
@@ -119,19 +120,27 @@ void main() {
     }
     return;
   }
+  if (stage == VKCLOTH_SELF_SCAN_ADD) {
+    const uint b = particle_index(); // the bucket: its block's start added to its own
+    if (b < pc.pad0)
+      starts[start_base() + b] += blocks[block_base() + b / VKCLOTH_SELF_SCAN_BLOCK];
+    else if (b == pc.pad0)
+      starts[start_base() + b] = pc.count; // past the last bucket: every particle
+    return;
+  }
   if (stage == VKCLOTH_SELF_SORT) {
     const uint b = particle_index(); // the bucket
     if (b >= pc.pad0)
       return;
     const uint first = bucket_start(b), stop = bucket_start(b + 1u);
-    for (uint i = first + 1u; i < stop; ++i) { // insertion sort: buckets hold a few particles
-      const uint key = sorted[base + i];
+    for (uint i = first + 1u; i < stop; ++i) { // insertion sort by particle: buckets hold a few
+      const uvec2 e = sorted[base + i];
       uint j = i;
-      while (j > first && sorted[base + j - 1u] > key) {
+      while (j > first && sorted[base + j - 1u].x > e.x) {
         sorted[base + j] = sorted[base + j - 1u];
         j -= 1u;
       }
-      sorted[base + j] = key;
+      sorted[base + j] = e;
     }
     return;
   }
@@ -143,17 +152,18 @@ void main() {
     key_of[base + p] = key;
     atomicAdd(counts[table_base() + self_bucket(key, mask)], 1u);
   } else if (stage == VKCLOTH_SELF_SCATTER) {
-    const uint b = self_bucket(key_of[base + p], mask);
+    const uint key = key_of[base + p];
+    const uint b = self_bucket(key, mask);
     const uint left = atomicAdd(counts[table_base() + b], 0xffffffffu); // minus one
-    sorted[base + bucket_start(b) + left - 1u] = p;
+    sorted[base + bucket_start(b) + left - 1u] = uvec2(p, key);
   } else if (pc.pad1 < sp.iterations && particle[p].pinned == 0u) {
     if (stage == VKCLOTH_SELF_COLLIDE) {
       const vec3 x = pos_out[base + p].xyz;
       const vec3 v = vel[base + p].xyz;
-      const float w = inverse_mass(particle[p].mass, false);
+      const vec4 r = rest_pos[p];
       vec3 dx;
       vec3 dv;
-      self_collide(0u, p, x, v, w, rest_pos[p].xyz, sp.thickness, sp.inv_cell, mask, sp.friction, dx, dv);
+      self_collide(0u, p, x, v, r.w, r.xyz, sp.thickness, sp.inv_cell, mask, sp.friction, dx, dv);
       delta[2u * (base + p)] = vec4(dx, 0.0);
       delta[2u * (base + p) + 1u] = vec4(dv, 0.0);
     } else { // VKCLOTH_SELF_APPLY

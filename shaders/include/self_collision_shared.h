@@ -14,14 +14,14 @@ namespace vkcloth::gpu::shared {
 #endif
 
 #define VKCLOTH_BINDING_SELF_PARAMS 37 // (after implicit Euler's) SelfParams per instance
-#define VKCLOTH_BINDING_SELF_REST 38   // rest positions (vec4 per particle of the topology)
+#define VKCLOTH_BINDING_SELF_REST 38   // rest positions, w: inverse mass (vec4 per particle of the topology)
 #define VKCLOTH_BINDING_SELF_COUNTS                                                                          \
   39 // particles per bucket (uint, table size per instance; zero between substeps)
-#define VKCLOTH_BINDING_SELF_STARTS 40 // each bucket's first entry within its scan block (uint, per bucket)
+#define VKCLOTH_BINDING_SELF_STARTS 40 // each bucket's first entry (uint, table size + 1 per instance)
 #define VKCLOTH_BINDING_SELF_BLOCKS                                                                          \
   41 // each scan block's first entry (uint, table size / SCAN_BLOCK per instance)
 #define VKCLOTH_BINDING_SELF_KEYS 42   // each particle's cell key when sorted (uint, per particle)
-#define VKCLOTH_BINDING_SELF_SORTED 43 // the particles by bucket, then by index (uint, per particle)
+#define VKCLOTH_BINDING_SELF_SORTED 43 // the particles by bucket, then by index, with their keys (uvec2)
 #define VKCLOTH_BINDING_SELF_DELTA 44  // this Jacobi pass's move and velocity change (2 vec4 per particle)
 
 // Buckets per workgroup of the SCAN_BLOCKS pass: 64 invocations x 8 (the table size is a
@@ -33,10 +33,11 @@ namespace vkcloth::gpu::shared {
 #define VKCLOTH_SELF_COUNT 0u       // per particle: its bucket; counts[bucket] += 1 (integer atomics)
 #define VKCLOTH_SELF_SCAN_BLOCKS 1u // per scan block: exclusive prefix sums of its counts, its total
 #define VKCLOTH_SELF_SCAN_TOP 2u    // one workgroup per instance: exclusive prefix sums of the block totals
-#define VKCLOTH_SELF_SCATTER 3u     // per particle: a slot in its bucket (counts[bucket] -= 1: zero again)
-#define VKCLOTH_SELF_SORT 4u        // per bucket: its particles in increasing index (the CPU's order)
-#define VKCLOTH_SELF_COLLIDE 5u     // per particle: cloth_kernel.h self_collide -> DELTA
-#define VKCLOTH_SELF_APPLY 6u       // per particle: x += dx, v += dv (cloth_kernel.h self_apply)
+#define VKCLOTH_SELF_SCAN_ADD 3u    // per bucket: its block's start added (starts: absolute), the end
+#define VKCLOTH_SELF_SCATTER 4u     // per particle: a slot in its bucket (counts[bucket] -= 1: zero again)
+#define VKCLOTH_SELF_SORT 5u        // per bucket: its particles in increasing index (the CPU's order)
+#define VKCLOTH_SELF_COLLIDE 6u     // per particle: cloth_kernel.h self_collide -> DELTA
+#define VKCLOTH_SELF_APPLY 7u       // per particle: x += dx, v += dv (cloth_kernel.h self_apply)
 
 /// Self-collision parameters of one instance (std430: 16 bytes), converted from the double
 /// SimParams::self_collision as CpuSolver<float>::self_collide converts them.

@@ -416,7 +416,7 @@ TEST_CASE("self_collision: absent is off with the defaults; present is read into
   CHECK_FALSE(def.enabled);
   CHECK(def.thickness == 0.01);
   CHECK(def.friction == 0.2);
-  CHECK(def.iterations == 2);
+  CHECK(def.iterations == 1);
 
   const Scene on = load_ok(
       R"({"system": "cloth", "self_collision": {"enabled": true, "thickness": 0.08, "friction": 0.35, "iterations": 5}})");

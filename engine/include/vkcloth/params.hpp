@@ -138,7 +138,7 @@ struct SelfCollision {
   bool enabled = false;
   double thickness = 0.01;      ///< m, > 0: the distance kept between particles not that close at rest
   double friction = 0.2;        ///< >= 0: Coulomb coefficient between touching layers
-  std::uint32_t iterations = 2; ///< 1..16 Jacobi passes per substep
+  std::uint32_t iterations = 1; ///< 1..16 Jacobi passes per substep
 };
 
 struct SimParams {

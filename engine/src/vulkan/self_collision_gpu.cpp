@@ -34,10 +34,10 @@ Result<void> SelfCollisionGpu::create_buffers(bool allow_map) {
   const std::tuple<Buffer*, VkDeviceSize, const char*> device_buffers[] = {
       {&rest_, VkDeviceSize(count_) * 16, "self-collision: rest positions"},
       {&counts_, buckets * 4, "self-collision: bucket counts"},
-      {&starts_, buckets * 4, "self-collision: bucket starts"},
+      {&starts_, (buckets + instances_) * 4, "self-collision: bucket starts"},
       {&blocks_, buckets / VKCLOTH_SELF_SCAN_BLOCK * 4, "self-collision: scan blocks"},
       {&keys_, per_particle * 4, "self-collision: cell keys"},
-      {&sorted_, per_particle * 4, "self-collision: sorted particles"},
+      {&sorted_, per_particle * 8, "self-collision: sorted particles"},
       {&delta_, per_particle * 32, "self-collision: moves and velocity changes"}};
   for (auto [b, bytes, what] : device_buffers) {
     auto r = create_buffer(ctx, std::max<VkDeviceSize>(bytes, 16), usage, MemoryUse::device, allow_map, what);
@@ -179,6 +179,7 @@ std::uint32_t SelfCollisionGpu::record_substep(VkCommandBuffer c, std::uint32_t 
   pass(VKCLOTH_SELF_COUNT, count_);
   pass(VKCLOTH_SELF_SCAN_BLOCKS, std::uint64_t(table_ / VKCLOTH_SELF_SCAN_BLOCK) * VKCLOTH_WORKGROUP_SIZE);
   pass(VKCLOTH_SELF_SCAN_TOP, 1);
+  pass(VKCLOTH_SELF_SCAN_ADD, std::uint64_t(table_) + 1);
   pass(VKCLOTH_SELF_SCATTER, count_);
   pass(VKCLOTH_SELF_SORT, table_);
   for (std::uint32_t it = 0; it < iterations; ++it) {

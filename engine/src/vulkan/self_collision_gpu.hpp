@@ -2,7 +2,7 @@
 // Self-collision on Vulkan (internal to SolverBatch): CpuSolver::self_collide as compute passes of
 // self_collision.comp, recorded after a substep's update and stretch control:
 //
-//   COUNT -> SCAN_BLOCKS -> SCAN_TOP -> SCATTER -> SORT -> iterations x [ COLLIDE -> APPLY ]
+//   COUNT -> SCAN_BLOCKS -> SCAN_TOP -> SCAN_ADD -> SCATTER -> SORT -> iterations x [ COLLIDE -> APPLY ]
 //
 // one barrier between consecutive passes (barriers::dispatch_to_dispatch). The spatial hash (one
 // table per instance, kernel.hpp self_table_size buckets) is rebuilt every substep; the counts
@@ -30,7 +30,8 @@ struct SelfCollisionInputs {
 class SelfCollisionGpu {
 public:
   /// For `instances` instances of `count` particles; `groups_max_x`: the device's
-  /// maxComputeWorkGroupCount[0]. The caller uploads rest_positions() and zeroes counts().
+  /// maxComputeWorkGroupCount[0]. The caller uploads rest_positions() (xyz, w: kernel inverse_mass)
+  /// and zeroes counts().
   static Result<std::unique_ptr<SelfCollisionGpu>> create(const std::shared_ptr<Context::Impl>& ctx,
                                                           std::uint32_t count, std::uint32_t instances,
                                                           std::uint32_t groups_max_x, bool allow_map);

@@ -488,9 +488,10 @@ Result<void> SolverBatch::ensure_self_collision() {
     return r.error();
   self_collision = std::move(*r);
   std::vector<sh::vec4> rest(count);
-  for (std::uint32_t p = 0; p < count; ++p) {
-    const glm::dvec3 x = batch_topology->system().particles[p].position; // as CpuSolver<float>: cast once
-    rest[p] = {float(x.x), float(x.y), float(x.z), 1.0f};
+  for (std::uint32_t p = 0; p < count; ++p) { // as CpuSolver<float>::self_collide makes them
+    const Particle& q = batch_topology->system().particles[p];
+    rest[p] = {float(q.position.x), float(q.position.y), float(q.position.z),
+               kernel::inverse_mass(float(q.mass), q.pinned)};
   }
   const Upload up[] = {{&self_collision->rest_positions(), rest.data(), rest.size() * sizeof(sh::vec4)},
                        {&self_collision->counts(), nullptr, 0}};
