@@ -32,8 +32,8 @@ Result<void> sample_figure(Gallery& G, Drawing& d, nlohmann::json& M, const std:
                                                 (enabled ? "true" : "false")};
     auto scene = load_scene_file(G.samples / "scenes" / (name + ".json"), overrides);
     if (!scene)
-      return Error{scene.error().code,
-                   scene.error().message + " (the self-collision figures: --samples DIR)", 0};
+      return Error{scene.error().code, scene.error().message + " (the self-collision figures: --samples DIR)",
+                   0};
     const std::uint64_t steps =
         G.self_collision_steps ? std::min(G.self_collision_steps, scene->steps) : scene->steps;
     const double dt = scene->params.dt, time = double(steps) * dt;
