@@ -3,6 +3,8 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <string>
 
 #include <nlohmann/json.hpp>
 
@@ -175,6 +177,25 @@ void check_contact_physics(const nlohmann::json& m) {
   CHECK(num(c["cloth_on_torus_knot"]["triangles"]) == 1920);
 }
 
+/// The self-collision figures' numbers (issue 16), run for `steps` steps (--self-collision-steps):
+/// with self-collision no two triangles of either sample intersect; without, no fewer.
+void check_self_collision(const nlohmann::json& m, std::uint64_t steps) {
+  for (const char* name : {"cloth_drop_self_collision", "cloth_slide_self_collision"}) {
+    CAPTURE(name);
+    const auto& off = m["self_collision"][name]["off"];
+    const auto& on = m["self_collision"][name]["on"];
+    for (const auto* r : {&off, &on}) {
+      CHECK_FALSE((*r)["diverged"].get<bool>());
+      CHECK((*r)["steps"].get<std::uint64_t>() == steps);
+      CHECK((*r)["triangles"].get<std::size_t>() > 0);
+    }
+    CHECK_FALSE(off["self_collision"].get<bool>());
+    CHECK(on["self_collision"].get<bool>());
+    CHECK(on["intersecting_pairs"].get<std::size_t>() == 0);
+    CHECK(off["intersecting_pairs"].get<std::size_t>() >= on["intersecting_pairs"].get<std::size_t>());
+  }
+}
+
 /// The render golden-image metric (tests/render/render_test_util.hpp): a pixel differs when a
 /// channel differs by more than 8; the images match when under 0.5% of the pixels differ.
 double differing_fraction(const fs::path& a, const fs::path& b) {
@@ -208,27 +229,36 @@ void check_gallery(const fs::path& dir) {
 
 } // namespace
 
-// The suite runs the gallery with --quick: smaller cloth pictures, the same simulations and numbers.
+// The suite runs the gallery with --quick: smaller cloth pictures, the same simulations and numbers;
+// the self-collision samples only for their first self_collision_steps steps (the full runs take a
+// minute).
+constexpr std::uint64_t self_collision_steps = 100;
+const std::string self_collision_option = " --self-collision-steps " + std::to_string(self_collision_steps);
+
 TEST_CASE("vkcloth figures (cpu): the gallery and the physics behind it") {
   const fs::path out = tmp_dir() / "figures_cpu";
   fs::remove_all(out);
-  const Outcome o = run_cli("figures_cpu", "figures --quick --out " + quote(out.string()), validate);
+  const Outcome o = run_cli(
+      "figures_cpu", "figures --quick" + self_collision_option + " --out " + quote(out.string()), validate);
   REQUIRE_MESSAGE(o.code == 0, o.err);
   CHECK(o.err.find("validation") == std::string::npos);
   CHECK(o.err.find("figures: cloth Figure 7") != std::string::npos); // progress per figure
   CHECK(o.err.find("figures: contact tablecloth") != std::string::npos);
+  CHECK(o.err.find("figures: self_collision cloth dropped") != std::string::npos);
   check_gallery(out);
   const auto m = nlohmann::json::parse(slurp(out / "figures.json"));
   check_spring_physics(m);
   check_cloth_physics(m);
   check_contact_physics(m);
+  check_self_collision(m, self_collision_steps);
   check_stability_map(m);
   if (have_vulkan_device())
     for (const char* f :
          {"cloth_k_struct.png", "cloth_k_shear.png", "cloth_k_bend.png", "cloth_wind.png",
           "cloth_contact.png", "cloth_collisions.png", "cloth_no_structural.png", "cloth_gpu.png",
           "cloth_meshes.png", "cloth_strain_limit.png", "cloth_resolution.png", "cloth_presets.png",
-          "contact_tablecloth.png", "contact_sphere.png", "contact_spinning.png", "contact_shapes.png"})
+          "contact_tablecloth.png", "contact_sphere.png", "contact_spinning.png", "contact_shapes.png",
+          "self_collision_drop.png", "self_collision_slide.png"})
       CHECK_MESSAGE(fs::exists(out / f), f);
 }
 
@@ -237,8 +267,9 @@ TEST_CASE("vkcloth figures --backend vulkan: the same physics on the GPU, zero v
     return;
   const fs::path out = tmp_dir() / "figures_vulkan";
   fs::remove_all(out);
-  const Outcome o =
-      run_cli("figures_vulkan", "figures --quick --backend vulkan --out " + quote(out.string()), validate);
+  const Outcome o = run_cli(
+      "figures_vulkan",
+      "figures --quick --backend vulkan" + self_collision_option + " --out " + quote(out.string()), validate);
   REQUIRE_MESSAGE(o.code == 0, o.err);
   CHECK(o.err.find("validation") == std::string::npos);
   check_gallery(out);
@@ -246,10 +277,12 @@ TEST_CASE("vkcloth figures --backend vulkan: the same physics on the GPU, zero v
   check_spring_physics(m);
   check_cloth_physics(m);
   check_contact_physics(m);
+  check_self_collision(m, self_collision_steps); // always the CPU solver
   // The same pictures as the CPU backend, within the golden-image threshold.
   const fs::path cpu = tmp_dir() / "figures_vulkan_cpu_reference";
   fs::remove_all(cpu);
-  const Outcome oc = run_cli("figures_vulkan_cpu_reference", "figures --quick --out " + quote(cpu.string()));
+  const Outcome oc = run_cli("figures_vulkan_cpu_reference",
+                             "figures --quick" + self_collision_option + " --out " + quote(cpu.string()));
   REQUIRE_MESSAGE(oc.code == 0, oc.err);
   for (const char* f :
        {"cloth_k_struct.png", "cloth_k_shear.png", "cloth_k_bend.png", "cloth_wind.png", "cloth_contact.png",

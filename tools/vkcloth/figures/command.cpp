@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Registers `vkcloth figures`.
 #include <chrono>
+#include <cstdint>
 #include <filesystem>
 
 #include <fmt/format.h>
@@ -16,6 +17,7 @@ struct FiguresOptions {
   std::string backend = "cpu";
   bool quick = false;
   std::string samples = VKCLOTH_SAMPLES_DIR;
+  std::uint64_t self_collision_steps = 0;
 };
 
 int figures_command(const FiguresOptions& opt) {
@@ -28,6 +30,7 @@ int figures_command(const FiguresOptions& opt) {
     return report(make_error(
         ErrorCode::io, fmt::format("cannot create the output directory {}: {}", opt.out, ec.message())));
   figures::Gallery gallery{opt.out, opt.backend, {}, nlohmann::json::object(), opt.quick, opt.samples};
+  gallery.self_collision_steps = opt.self_collision_steps;
   const auto t0 = std::chrono::steady_clock::now();
   fmt::print(stderr, "figures: springs...\n");
   if (auto r = figures::spring_figures(gallery); !r)
@@ -37,6 +40,8 @@ int figures_command(const FiguresOptions& opt) {
   if (auto r = figures::cloth_figures(gallery); !r)
     return report(r.error());
   if (auto r = figures::contact_figures(gallery); !r)
+    return report(r.error());
+  if (auto r = figures::self_collision_figures(gallery); !r)
     return report(r.error());
   if (auto r = figures::stability_figures(gallery); !r)
     return report(r.error());
@@ -67,6 +72,9 @@ void add_figures_command(CLI::App& app, int* exit) {
                   "(default: the source "
                   "tree's)")
       ->capture_default_str();
+  cmd->add_option("--self-collision-steps", opt->self_collision_steps,
+                  "Run the self-collision samples for at most N steps (default 0: the scenes' own steps; "
+                  "for quick checks, the full runs take about a minute)");
   cmd->callback([opt, exit] { *exit = figures_command(*opt); });
 }
 

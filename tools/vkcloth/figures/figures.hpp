@@ -3,6 +3,7 @@
 // index.html gallery and a figures.json of the numbers behind them (checked by the tests).
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -30,6 +31,9 @@ struct Gallery {
   bool quick = false; ///< --quick: smaller cloth pictures (same physics, same numbers)
   std::filesystem::path samples =
       VKCLOTH_SAMPLES_DIR; ///< --samples: scenes/ and meshes/ of the mesh and contact figures
+  /// --self-collision-steps: run the self-collision samples for at most this many steps (0: the
+  /// scene's own steps; the tests use fewer, the full runs take a minute on the CPU solver)
+  std::uint64_t self_collision_steps = 0;
 
   Result<void> write_text(const std::string& file, const std::string& text) const;
   Result<void> write_index() const; ///< index.html and figures.json
@@ -61,6 +65,11 @@ Result<void> cloth_figures(Gallery& gallery);
 /// end on G.backend with the contact measured after every step: image grids (contact.cpp) and
 /// metrics["contact"].
 Result<void> contact_figures(Gallery& gallery);
+/// Self-collision (issue 16): samples/scenes/{cloth_drop_self_collision, cloth_slide_self_collision}.json,
+/// each run for its own steps on the CPU solver without (--set self_collision.enabled=false) and with
+/// self-collision: two-panel image grids (self_collision.cpp) and metrics["self_collision"], with the
+/// intersecting triangle pairs of each final state.
+Result<void> self_collision_figures(Gallery& gallery);
 /// The (K_struct, dt) stability map of semi-implicit Euler, RK4 and implicit Euler (stability.cpp).
 Result<void> stability_figures(Gallery& gallery);
 
