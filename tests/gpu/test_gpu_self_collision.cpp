@@ -44,9 +44,9 @@ TEST_CASE("GPU matches CPU on the self-collision samples: 100 steps within 1e-5 
     REQUIRE(bare.ok());
     REQUIRE(bare->run(100).ok());
     const auto moved = gpu::test::diff(bare->positions(), cpu->positions());
-    MESSAGE(std::string(name) << ": max |p_cpu - p_gpu| after 100 steps = " << d.max_abs << " m (bitwise: "
-                              << d.bitwise << "); self-collision moved the cloth by up to " << moved.max_abs
-                              << " m");
+    MESSAGE(std::string(name) << ": max |p_cpu - p_gpu| after 100 steps = " << d.max_abs
+                              << " m (bitwise: " << d.bitwise << "); self-collision moved the cloth by up to "
+                              << moved.max_abs << " m");
     CHECK(d.max_abs <= 1e-5);
     CHECK(moved.max_abs > 1e-3);
   }
@@ -63,8 +63,8 @@ TEST_CASE("GPU self-collision: no intersecting triangle pairs after the drop set
   REQUIRE(gp.ok());
   auto hits = intersecting_triangle_pairs(scene->system, *gp);
   REQUIRE(hits.ok());
-  MESSAGE("cloth_drop_self_collision on the GPU after 3 s: " << hits->pairs << " intersecting triangle pairs of "
-                                                             << hits->triangles);
+  MESSAGE("cloth_drop_self_collision on the GPU after 3 s: "
+          << hits->pairs << " intersecting triangle pairs of " << hits->triangles);
   CHECK(hits->pairs == 0);
 }
 
@@ -98,7 +98,8 @@ TEST_CASE("ClothWorld: self-collision per instance in one batch, each as its own
     auto gp = world->positions(ids[k]);
     REQUIRE(gp.ok());
     const auto d = gpu::test::diff(cpu->positions(), *gp);
-    MESSAGE("instance " << k << ": max |p_cpu - p_gpu| = " << d.max_abs << " m (bitwise: " << d.bitwise << ")");
+    MESSAGE("instance " << k << ": max |p_cpu - p_gpu| = " << d.max_abs << " m (bitwise: " << d.bitwise
+                        << ")");
     CHECK(d.max_abs <= 1e-5);
   }
 }
