@@ -76,29 +76,12 @@ Result<void> ImplicitGpu::create_buffers(std::uint64_t entries, bool allow_map) 
 // The Context's layouts and pipelines; this batch's pool and two sets (position parity).
 Result<void> ImplicitGpu::create_pipelines() {
   Context::Impl& ctx = *ctx_;
-  const auto& v = ctx.vk;
   auto layouts = ctx.pipelines->implicit_layouts();
   if (!layouts)
     return layouts.error();
   set_layout_ = layouts->set;
   layout_ = layouts->layout;
-  const auto bindings = implicit_bindings();
-  const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-                                  2 * static_cast<std::uint32_t>(bindings.size())};
-  VkDescriptorPoolCreateInfo dp{};
-  dp.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
-  dp.maxSets = 2;
-  dp.poolSizeCount = 1;
-  dp.pPoolSizes = &size;
-  VKCLOTH_VK_TRY(v.vkCreateDescriptorPool(ctx.device, &dp, v.allocator, pool_.init(ctx)),
-                 "vkCreateDescriptorPool (implicit)");
-  const VkDescriptorSetLayout layouts2[2] = {set_layout_, set_layout_};
-  VkDescriptorSetAllocateInfo ai{};
-  ai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
-  ai.descriptorPool = pool_;
-  ai.descriptorSetCount = 2;
-  ai.pSetLayouts = layouts2;
-  VKCLOTH_VK_TRY(v.vkAllocateDescriptorSets(ctx.device, &ai, sets_), "vkAllocateDescriptorSets (implicit)");
+  VKCLOTH_TRY(create_parity_sets(ctx, set_layout_, static_cast<std::uint32_t>(implicit_bindings().size()), pool_, sets_, "implicit"));
   auto pp = ctx.pipelines->pipeline(PipelineRegistry::Shader::implicit, {});
   if (!pp)
     return pp.error();

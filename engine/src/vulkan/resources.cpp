@@ -219,6 +219,27 @@ Result<PipelineLayout> create_pipeline_layout(Context::Impl& ctx, std::span<cons
   return l;
 }
 
+Result<void> create_parity_sets(Context::Impl& ctx, VkDescriptorSetLayout layout, std::uint32_t storage_buffers,
+                                DescriptorPool& pool, VkDescriptorSet (&sets)[2], const char* name) {
+  const auto& v = ctx.vk;
+  const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2 * storage_buffers};
+  VkDescriptorPoolCreateInfo dp{};
+  dp.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
+  dp.maxSets = 2;
+  dp.poolSizeCount = 1;
+  dp.pPoolSizes = &size;
+  VKCLOTH_VK_TRY(v.vkCreateDescriptorPool(ctx.device, &dp, v.allocator, pool.init(ctx)),
+                 fmt::format("vkCreateDescriptorPool ({})", name));
+  const VkDescriptorSetLayout layouts[2] = {layout, layout};
+  VkDescriptorSetAllocateInfo ai{};
+  ai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
+  ai.descriptorPool = pool;
+  ai.descriptorSetCount = 2;
+  ai.pSetLayouts = layouts;
+  VKCLOTH_VK_TRY(v.vkAllocateDescriptorSets(ctx.device, &ai, sets), fmt::format("vkAllocateDescriptorSets ({})", name));
+  return {};
+}
+
 Result<BufferView> create_buffer_view(Context::Impl& ctx, VkBuffer buffer, VkFormat format,
                                       const char* name) {
   VkBufferViewCreateInfo bvi{};

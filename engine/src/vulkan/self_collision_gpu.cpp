@@ -56,29 +56,11 @@ Result<void> SelfCollisionGpu::create_buffers(bool allow_map) {
 // The Context's layout and pipeline; this batch's pool and two sets (position parity).
 Result<void> SelfCollisionGpu::create_sets() {
   Context::Impl& ctx = *ctx_;
-  const auto& v = ctx.vk;
   auto layouts = ctx.pipelines->self_collision_layouts();
   if (!layouts)
     return layouts.error();
   layout_ = layouts->layout;
-  const auto bindings = self_collision_bindings();
-  const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-                                  2 * static_cast<std::uint32_t>(bindings.size())};
-  VkDescriptorPoolCreateInfo dp{};
-  dp.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
-  dp.maxSets = 2;
-  dp.poolSizeCount = 1;
-  dp.pPoolSizes = &size;
-  VKCLOTH_VK_TRY(v.vkCreateDescriptorPool(ctx.device, &dp, v.allocator, pool_.init(ctx)),
-                 "vkCreateDescriptorPool (self-collision)");
-  const VkDescriptorSetLayout set_layouts[2] = {layouts->set, layouts->set};
-  VkDescriptorSetAllocateInfo ai{};
-  ai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
-  ai.descriptorPool = pool_;
-  ai.descriptorSetCount = 2;
-  ai.pSetLayouts = set_layouts;
-  VKCLOTH_VK_TRY(v.vkAllocateDescriptorSets(ctx.device, &ai, sets_),
-                 "vkAllocateDescriptorSets (self-collision)");
+  VKCLOTH_TRY(create_parity_sets(ctx, layouts->set, static_cast<std::uint32_t>(self_collision_bindings().size()), pool_, sets_, "self-collision"));
   auto pp = ctx.pipelines->pipeline(PipelineRegistry::Shader::self_collision, {});
   if (!pp)
     return pp.error();
