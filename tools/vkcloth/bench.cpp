@@ -549,9 +549,11 @@ std::vector<glm::dvec3> to_double(std::span<const glm::vec3> positions) {
 /// its colliders, so that a machine whose speed drifts (other jobs on its cores) slows both alike.
 /// `run(k, steps)` advances solver k; `gpu_ms(k)` is its last GPU time (-1: none); `count()` the
 /// particles in contact on solver 1 now. Returns the two rows (bare, then with colliders) with
-/// their medians.
+/// their medians, their scenes named `scenes` (row 0, row 1).
 template <typename Run, typename GpuMs, typename Count>
-Result<std::array<Row, 2>> alternate_contact(const BenchOptions& o, Run run, GpuMs gpu_ms, Count count) {
+Result<std::array<Row, 2>> alternate_contact(const BenchOptions& o, Run run, GpuMs gpu_ms, Count count,
+                                             std::array<const char*, 2> scenes = {"contact_free",
+                                                                                  "contact"}) {
   for (int k = 0; k < 2; ++k)
     VKCLOTH_TRY(run(k, o.warmup));
   std::array<Row, 2> rows;
@@ -572,28 +574,31 @@ Result<std::array<Row, 2>> alternate_contact(const BenchOptions& o, Run run, Gpu
   for (int k = 0; k < 2; ++k) {
     rows[k].wall_ms = median(wall[k]);
     rows[k].gpu_ms = median(gpu[k]);
-    rows[k].scene = k ? "contact" : "contact_free";
+    rows[k].scene = scenes[k];
   }
   rows[1].in_contact_start = *start;
   rows[1].in_contact_end = *end;
   return rows;
 }
 
-Result<std::array<Row, 2>> bench_cpu_contact(const ContactScene& sc, const BenchOptions& o) {
+/// Times `system` with `bare` (row 0) and `full` (row 1) on the CPU, in alternation
+/// (alternate_contact); `count(positions)` counts on the `full` solver.
+template <typename Count>
+Result<std::array<Row, 2>> bench_cpu_pair(const ParticleSystem& system, const SimParams& bare,
+                                          const SimParams& full, const BenchOptions& o,
+                                          std::array<const char*, 2> scenes, Count count) {
   CpuSolverOptions co;
   co.threads = o.threads;
-  SimParams bare = sc.params;
-  bare.colliders.clear();
-  auto s0 = CpuSolver<float>::create(sc.system, bare, co);
+  auto s0 = CpuSolver<float>::create(system, bare, co);
   if (!s0)
     return s0.error();
-  auto s1 = CpuSolver<float>::create(sc.system, sc.params, co);
+  auto s1 = CpuSolver<float>::create(system, full, co);
   if (!s1)
     return s1.error();
   std::array<CpuSolver<float>*, 2> s = {&*s0, &*s1};
   auto rows = alternate_contact(
       o, [&](int k, std::uint64_t steps) { return s[k]->run(steps); }, [](int) { return -1.0; },
-      [&] { return particles_in_contact(sc, to_double(s1->positions())); });
+      [&] { return count(s1->positions()); }, scenes);
   if (!rows)
     return rows.error();
   for (Row& r : *rows) {
@@ -604,18 +609,20 @@ Result<std::array<Row, 2>> bench_cpu_contact(const ContactScene& sc, const Bench
   return rows;
 }
 
-Result<std::array<Row, 2>> bench_vulkan_contact(gpu::Context& ctx, const ContactScene& sc, bool fused,
-                                                gpu::BufferAccess access, const BenchOptions& o) {
+/// The same on Vulkan (one solver per parameter set, `fused` or two-pass, buffer access `access`).
+template <typename Count>
+Result<std::array<Row, 2>> bench_vulkan_pair(gpu::Context& ctx, const ParticleSystem& system,
+                                             const SimParams& bare, const SimParams& full, bool fused,
+                                             gpu::BufferAccess access, const BenchOptions& o,
+                                             std::array<const char*, 2> scenes, Count count) {
   gpu::GpuSolverOptions go;
   go.fused = fused;
   go.buffer_access = access;
   go.workgroup_size = o.workgroup;
-  SimParams bare = sc.params;
-  bare.colliders.clear();
-  auto s0 = gpu::GpuSolver::create(ctx, sc.system, bare, go);
+  auto s0 = gpu::GpuSolver::create(ctx, system, bare, go);
   if (!s0)
     return s0.error();
-  auto s1 = gpu::GpuSolver::create(ctx, sc.system, sc.params, go);
+  auto s1 = gpu::GpuSolver::create(ctx, system, full, go);
   if (!s1)
     return s1.error();
   std::array<gpu::GpuSolver*, 2> s = {&*s0, &*s1};
@@ -626,11 +633,12 @@ Result<std::array<Row, 2>> bench_vulkan_contact(gpu::Context& ctx, const Contact
         auto x = s1->positions();
         if (!x)
           return x.error();
-        return particles_in_contact(sc, to_double(*x));
-      });
+        return count(std::span<const glm::vec3>(*x));
+      },
+      scenes);
   if (!rows)
     return rows.error();
-  const Integrator integrator = sc.params.integrator;
+  const Integrator integrator = full.integrator;
   for (Row& r : *rows) {
     r.backend = "vulkan";
     r.variant = integrator == Integrator::implicit_euler ? "implicit"
@@ -639,6 +647,22 @@ Result<std::array<Row, 2>> bench_vulkan_contact(gpu::Context& ctx, const Contact
     std::tie(r.layout, r.workgroup) = layout_of(ctx, go, integrator == Integrator::implicit_euler);
   }
   return rows;
+}
+
+Result<std::array<Row, 2>> bench_cpu_contact(const ContactScene& sc, const BenchOptions& o) {
+  SimParams bare = sc.params;
+  bare.colliders.clear();
+  return bench_cpu_pair(sc.system, bare, sc.params, o, {"contact_free", "contact"},
+                        [&](std::span<const glm::vec3> x) { return particles_in_contact(sc, to_double(x)); });
+}
+
+Result<std::array<Row, 2>> bench_vulkan_contact(gpu::Context& ctx, const ContactScene& sc, bool fused,
+                                                gpu::BufferAccess access, const BenchOptions& o) {
+  SimParams bare = sc.params;
+  bare.colliders.clear();
+  return bench_vulkan_pair(
+      ctx, sc.system, bare, sc.params, fused, access, o, {"contact_free", "contact"},
+      [&](std::span<const glm::vec3> x) { return particles_in_contact(sc, to_double(x)); });
 }
 
 Result<std::vector<std::uint32_t>> parse_sizes(const std::string& text) {
