@@ -13,6 +13,7 @@
 #include <sstream>
 #include <thread>
 #include <tuple>
+#include <unordered_map>
 #include <utility>
 
 #include <fmt/format.h>
@@ -55,6 +56,7 @@ struct BenchOptions {
   double wind = 2.0; // m/s^2 on a particle facing the wind (the wind force scales with the mass)
   std::string cg_dispatch = "auto"; // implicit on Vulkan: auto | one_workgroup | per_iteration | both
   std::string contact;              // also time the contact scenes (issue 15): table | mesh | both
+  bool self_collision = false;      // also time each size folded, self-collision on vs off (issue 16)
 };
 
 /// The benchmark scene at n x n: a 1 m x 1 m vertical cloth hanging from its two top corners, in
@@ -336,6 +338,128 @@ Result<std::size_t> particles_in_contact(const ContactScene& sc, std::span<const
   return count;
 }
 
+// ---- Self-collision scene (issue 16) -----------------------------------------------------------
+
+/// The self-collision rows' parameters: thickness = 1.5 x the grid spacing, the thickness that closes
+/// the gaps between particles (a particle of another layer is pushed off anywhere in a grid square,
+/// whose centre is 0.71 spacings from its corners; the 8 neighbours, up to 1.41 spacings away, are
+/// all within it at rest and never collide), friction 0.2 and 2 Jacobi iterations (SelfCollision's
+/// defaults).
+constexpr double self_thickness_over_spacing = 1.5;
+constexpr double self_friction = 0.2;
+constexpr std::uint32_t self_iterations = 2;
+constexpr std::uint32_t self_layers = 4;    // the folded cloth's layers
+constexpr double self_layer_gap = 1.001;    // the layers' starting distance, in thicknesses
+constexpr double self_contact_band = 1.05;  // "in self-contact": within this many thicknesses
+constexpr std::uint32_t self_min_size = 16; // below this the layers are ~1 spacing long
+
+/// The n x n cloth folded on the floor, and what the self-collision rows report about it. `params`
+/// has self-collision on; the baseline row times the same system with it off.
+struct SelfScene {
+  std::uint32_t n = 0;
+  ParticleSystem system;
+  SimParams params;
+  std::vector<glm::dvec3> rest; // the starting positions: the solvers' rest-position filter
+};
+
+/// The bench's horizontal n x n cloth (grid rows' mass scaling and stiffness; no pins, no wind),
+/// folded like an accordion into 4 layers stacked on the floor plane z = 0 (friction 0.6), with
+/// self-collision on (thickness 1.5 x the spacing, friction 0.2, 2 iterations). Each grid line along
+/// y keeps its length: the layers are joined by vertical segments at the two ends of the stack (the
+/// folds; only the springs across the 90-degree kinks start compressed), the bottom layer at eps
+/// above the floor, the layers 1.001 x the thickness apart. The solvers take the starting positions
+/// as the rest positions of their filter (pairs closer than the thickness at rest never collide), so
+/// the layers must start farther apart than the thickness; they fall the 0.1 % onto each other in
+/// the first steps and rest there, every particle of a layer pressed onto the one below by gravity
+/// (in every substep the update moves them into each other and the self-collision passes push them
+/// back apart).
+Result<SelfScene> folded_scene(std::uint32_t n, Integrator integrator, double dt, const BenchOptions& o) {
+  auto cloth = horizontal_cloth(n, integrator, dt, o);
+  if (!cloth)
+    return cloth.error();
+  SimParams p = cloth->params;
+  const double spacing = 1.0 / double(n - 1);
+  p.self_collision.enabled = true;
+  p.self_collision.thickness = self_thickness_over_spacing * spacing;
+  p.self_collision.friction = self_friction;
+  p.self_collision.iterations = self_iterations;
+  p.colliders = {with_contact_friction(Collider::plane({0.0, 0.0, 1.0}, 0.0))};
+  VKCLOTH_TRY(p.validate());
+  auto warnings = check_self_collision(p.self_collision, cloth->system); // none at 1.5 spacings
+  if (!warnings)
+    return warnings.error();
+  const double sep = self_layer_gap * p.self_collision.thickness;
+  const double length = (1.0 - double(self_layers - 1) * sep) / double(self_layers); // of one layer
+  const double y0 = -0.5 * length, y1 = 0.5 * length;
+  for (Particle& q : cloth->system.particles) {
+    const double t = q.position.y + 0.5; // the arc length along y from the cloth's first row
+    auto k = std::uint32_t(std::min(std::floor(t / (length + sep)), double(self_layers - 1)));
+    const double u = t - double(k) * (length + sep); // from the start of layer k
+    const double z = p.contact_epsilon + double(k) * sep;
+    if (u <= length) {
+      q.position.y = k % 2 ? y1 - u : y0 + u;
+      q.position.z = z;
+    } else { // the fold up to layer k + 1
+      q.position.y = k % 2 ? y0 : y1;
+      q.position.z = z + (u - length);
+    }
+  }
+  std::vector<glm::dvec3> rest;
+  for (const Particle& q : cloth->system.particles)
+    rest.push_back(q.position);
+  return SelfScene{n, std::move(cloth->system), std::move(p), std::move(rest)};
+}
+
+/// Particles in self-contact: within 1.05 x the thickness of a particle that was not closer than the
+/// thickness at rest (the solvers' rest-position filter, cloth_kernel.h self_pair), in double from
+/// the float positions and rest positions; a spatial hash of cells 1.05 thickness wide, the 27 cells
+/// around each particle. A band, not the solvers' "closer than the thickness", because a step ends
+/// with its self-collision passes, which leave a resolved pair exactly the thickness apart, and the
+/// resting layers hover 1-5 % of the thickness apart between the substeps that push them together;
+/// the grid's next particles but one, 2 spacings = 1.33 thicknesses apart, stay outside it.
+std::size_t particles_in_self_contact(const SelfScene& sc, std::span<const glm::vec3> positions) {
+  const double thickness = sc.params.self_collision.thickness, rest2 = thickness * thickness;
+  const double t = self_contact_band * thickness, t2 = t * t;
+  using Cell = std::array<std::int64_t, 3>;
+  auto cell = [&](const glm::dvec3& x) {
+    return Cell{std::int64_t(std::floor(x.x / t)), std::int64_t(std::floor(x.y / t)),
+                std::int64_t(std::floor(x.z / t))};
+  };
+  // 21 bits per axis, exact within +-2^20 cells (farther, cells share keys: more candidates only).
+  auto key = [](const Cell& c, int dx, int dy, int dz) {
+    return (std::uint64_t((c[0] + dx) & 0x1fffff) << 42) | (std::uint64_t((c[1] + dy) & 0x1fffff) << 21) |
+           std::uint64_t((c[2] + dz) & 0x1fffff);
+  };
+  std::vector<glm::dvec3> x(positions.begin(), positions.end()), r(x.size());
+  for (std::size_t k = 0; k < x.size(); ++k)
+    r[k] = glm::dvec3(glm::vec3(sc.rest[k])); // the rest positions as the solvers hold them
+  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> cells;
+  for (std::size_t k = 0; k < x.size(); ++k)
+    cells[key(cell(x[k]), 0, 0, 0)].push_back(std::uint32_t(k));
+  std::size_t count = 0;
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    const Cell c = cell(x[k]);
+    bool touching = false;
+    for (int dz = -1; dz <= 1 && !touching; ++dz)
+      for (int dy = -1; dy <= 1 && !touching; ++dy)
+        for (int dx = -1; dx <= 1 && !touching; ++dx) {
+          const auto at = cells.find(key(c, dx, dy, dz));
+          if (at == cells.end())
+            continue;
+          for (std::uint32_t q : at->second) {
+            const glm::dvec3 u = x[k] - x[q], v = r[k] - r[q];
+            const double d2 = glm::dot(u, u);
+            if (q != k && d2 < t2 && d2 > 0.0 && !(glm::dot(v, v) < rest2)) {
+              touching = true;
+              break;
+            }
+          }
+        }
+    count += touching;
+  }
+  return count;
+}
+
 /// Bytes and flops per particle-step counted from the kernels (docs/performance.md, "Counting").
 /// `s` is the mean number of springs per particle (gather-list entries / particles).
 struct Cost {
@@ -402,9 +526,11 @@ struct Row {
   std::string layout;              // Vulkan rows: the buffer access that ran ("texel" | "storage")
   std::uint32_t workgroup = 0;     // Vulkan rows: the workgroup size that ran
   std::string contact;             // contact rows: "table" | "mesh" (scene "contact" or "contact_free")
-  std::size_t in_contact_start = 0, in_contact_end = 0; // scene "contact": particles within 2 eps
+  std::size_t in_contact_start = 0, in_contact_end = 0; // scene "contact": particles within 2 eps;
+                                                        // "self_collision": in self-contact
   std::vector<std::string> colliders;                   // scene "contact": their types
   std::uint32_t collider_triangles = 0;                 // scene "contact": a mesh collider's
+  double self_thickness = 0; // self-collision rows: the thickness (m) of the "on" row's parameters
   Cost cost;
 };
 
@@ -549,9 +675,11 @@ std::vector<glm::dvec3> to_double(std::span<const glm::vec3> positions) {
 /// its colliders, so that a machine whose speed drifts (other jobs on its cores) slows both alike.
 /// `run(k, steps)` advances solver k; `gpu_ms(k)` is its last GPU time (-1: none); `count()` the
 /// particles in contact on solver 1 now. Returns the two rows (bare, then with colliders) with
-/// their medians.
+/// their medians, their scenes named `scenes` (row 0, row 1).
 template <typename Run, typename GpuMs, typename Count>
-Result<std::array<Row, 2>> alternate_contact(const BenchOptions& o, Run run, GpuMs gpu_ms, Count count) {
+Result<std::array<Row, 2>> alternate_contact(const BenchOptions& o, Run run, GpuMs gpu_ms, Count count,
+                                             std::array<const char*, 2> scenes = {"contact_free",
+                                                                                  "contact"}) {
   for (int k = 0; k < 2; ++k)
     VKCLOTH_TRY(run(k, o.warmup));
   std::array<Row, 2> rows;
@@ -572,28 +700,31 @@ Result<std::array<Row, 2>> alternate_contact(const BenchOptions& o, Run run, Gpu
   for (int k = 0; k < 2; ++k) {
     rows[k].wall_ms = median(wall[k]);
     rows[k].gpu_ms = median(gpu[k]);
-    rows[k].scene = k ? "contact" : "contact_free";
+    rows[k].scene = scenes[k];
   }
   rows[1].in_contact_start = *start;
   rows[1].in_contact_end = *end;
   return rows;
 }
 
-Result<std::array<Row, 2>> bench_cpu_contact(const ContactScene& sc, const BenchOptions& o) {
+/// Times `system` with `bare` (row 0) and `full` (row 1) on the CPU, in alternation
+/// (alternate_contact); `count(positions)` counts on the `full` solver.
+template <typename Count>
+Result<std::array<Row, 2>> bench_cpu_pair(const ParticleSystem& system, const SimParams& bare,
+                                          const SimParams& full, const BenchOptions& o,
+                                          std::array<const char*, 2> scenes, Count count) {
   CpuSolverOptions co;
   co.threads = o.threads;
-  SimParams bare = sc.params;
-  bare.colliders.clear();
-  auto s0 = CpuSolver<float>::create(sc.system, bare, co);
+  auto s0 = CpuSolver<float>::create(system, bare, co);
   if (!s0)
     return s0.error();
-  auto s1 = CpuSolver<float>::create(sc.system, sc.params, co);
+  auto s1 = CpuSolver<float>::create(system, full, co);
   if (!s1)
     return s1.error();
   std::array<CpuSolver<float>*, 2> s = {&*s0, &*s1};
   auto rows = alternate_contact(
       o, [&](int k, std::uint64_t steps) { return s[k]->run(steps); }, [](int) { return -1.0; },
-      [&] { return particles_in_contact(sc, to_double(s1->positions())); });
+      [&] { return count(s1->positions()); }, scenes);
   if (!rows)
     return rows.error();
   for (Row& r : *rows) {
@@ -604,18 +735,20 @@ Result<std::array<Row, 2>> bench_cpu_contact(const ContactScene& sc, const Bench
   return rows;
 }
 
-Result<std::array<Row, 2>> bench_vulkan_contact(gpu::Context& ctx, const ContactScene& sc, bool fused,
-                                                gpu::BufferAccess access, const BenchOptions& o) {
+/// The same on Vulkan (one solver per parameter set, `fused` or two-pass, buffer access `access`).
+template <typename Count>
+Result<std::array<Row, 2>> bench_vulkan_pair(gpu::Context& ctx, const ParticleSystem& system,
+                                             const SimParams& bare, const SimParams& full, bool fused,
+                                             gpu::BufferAccess access, const BenchOptions& o,
+                                             std::array<const char*, 2> scenes, Count count) {
   gpu::GpuSolverOptions go;
   go.fused = fused;
   go.buffer_access = access;
   go.workgroup_size = o.workgroup;
-  SimParams bare = sc.params;
-  bare.colliders.clear();
-  auto s0 = gpu::GpuSolver::create(ctx, sc.system, bare, go);
+  auto s0 = gpu::GpuSolver::create(ctx, system, bare, go);
   if (!s0)
     return s0.error();
-  auto s1 = gpu::GpuSolver::create(ctx, sc.system, sc.params, go);
+  auto s1 = gpu::GpuSolver::create(ctx, system, full, go);
   if (!s1)
     return s1.error();
   std::array<gpu::GpuSolver*, 2> s = {&*s0, &*s1};
@@ -626,11 +759,12 @@ Result<std::array<Row, 2>> bench_vulkan_contact(gpu::Context& ctx, const Contact
         auto x = s1->positions();
         if (!x)
           return x.error();
-        return particles_in_contact(sc, to_double(*x));
-      });
+        return count(std::span<const glm::vec3>(*x));
+      },
+      scenes);
   if (!rows)
     return rows.error();
-  const Integrator integrator = sc.params.integrator;
+  const Integrator integrator = full.integrator;
   for (Row& r : *rows) {
     r.backend = "vulkan";
     r.variant = integrator == Integrator::implicit_euler ? "implicit"
@@ -639,6 +773,41 @@ Result<std::array<Row, 2>> bench_vulkan_contact(gpu::Context& ctx, const Contact
     std::tie(r.layout, r.workgroup) = layout_of(ctx, go, integrator == Integrator::implicit_euler);
   }
   return rows;
+}
+
+Result<std::array<Row, 2>> bench_cpu_contact(const ContactScene& sc, const BenchOptions& o) {
+  SimParams bare = sc.params;
+  bare.colliders.clear();
+  return bench_cpu_pair(sc.system, bare, sc.params, o, {"contact_free", "contact"},
+                        [&](std::span<const glm::vec3> x) { return particles_in_contact(sc, to_double(x)); });
+}
+
+Result<std::array<Row, 2>> bench_vulkan_contact(gpu::Context& ctx, const ContactScene& sc, bool fused,
+                                                gpu::BufferAccess access, const BenchOptions& o) {
+  SimParams bare = sc.params;
+  bare.colliders.clear();
+  return bench_vulkan_pair(
+      ctx, sc.system, bare, sc.params, fused, access, o, {"contact_free", "contact"},
+      [&](std::span<const glm::vec3> x) { return particles_in_contact(sc, to_double(x)); });
+}
+
+/// The folded cloth with self-collision off (row 0, scene "self_collision_free") and on (row 1,
+/// "self_collision"), alternated; the particles in self-contact counted on the second.
+Result<std::array<Row, 2>> bench_cpu_self(const SelfScene& sc, const BenchOptions& o) {
+  SimParams off = sc.params;
+  off.self_collision.enabled = false;
+  return bench_cpu_pair(
+      sc.system, off, sc.params, o, {"self_collision_free", "self_collision"},
+      [&](std::span<const glm::vec3> x) -> Result<std::size_t> { return particles_in_self_contact(sc, x); });
+}
+
+Result<std::array<Row, 2>> bench_vulkan_self(gpu::Context& ctx, const SelfScene& sc, bool fused,
+                                             gpu::BufferAccess access, const BenchOptions& o) {
+  SimParams off = sc.params;
+  off.self_collision.enabled = false;
+  return bench_vulkan_pair(
+      ctx, sc.system, off, sc.params, fused, access, o, {"self_collision_free", "self_collision"},
+      [&](std::span<const glm::vec3> x) -> Result<std::size_t> { return particles_in_self_contact(sc, x); });
 }
 
 Result<std::vector<std::uint32_t>> parse_sizes(const std::string& text) {
@@ -678,6 +847,20 @@ const Row* nearest_grid(const std::vector<Row>& rows, const Row& mesh) {
                       std::abs(double(best->particles) - double(mesh.particles))))
       best = &g;
   return best;
+}
+
+bool is_self(const Row& r) {
+  return r.scene == "self_collision" || r.scene == "self_collision_free";
+}
+
+/// The row with self-collision off timed with a self-collision row (same backend, variant, layout,
+/// integrator and size).
+const Row* self_free_of(const std::vector<Row>& rows, const Row& r) {
+  for (const Row& e : rows)
+    if (e.scene == "self_collision_free" && e.size == r.size && e.backend == r.backend &&
+        e.variant == r.variant && e.layout == r.layout && e.integrator == r.integrator)
+      return &e;
+  return nullptr;
 }
 
 /// The bare-cloth row timed with a contact row (its colliders removed; same backend, variant,
@@ -904,6 +1087,56 @@ int bench_command(const BenchOptions& o) {
     }
   }
 
+  if (o.self_collision) { // each size folded on the floor, self-collision on vs off (issue 16)
+    for (std::uint32_t n : *sizes) {
+      if (n < self_min_size) {
+        fmt::print("note: self_collision n = {}: the folded cloth needs n >= {}; left out\n", n,
+                   self_min_size);
+        continue;
+      }
+      auto sc = folded_scene(n, *integrator, dt, o);
+      if (!sc)
+        return report(sc.error());
+      const double s = double(sc->system.adjacency.refs.size()) / double(sc->system.size());
+      auto add = [&](Result<std::array<Row, 2>> pair) -> int {
+        if (!pair && pair.error().code == ErrorCode::unsupported) { // too large for this device
+          fmt::print("note: self_collision n = {} ({}): {}\n", n, to_string(sc->params.integrator),
+                     pair.error().message);
+          return exit_ok;
+        }
+        if (!pair)
+          return report(pair.error());
+        for (Row& r : *pair) {
+          r.integrator = to_string(sc->params.integrator);
+          r.size = n;
+          r.particles = sc->system.size();
+          r.springs = sc->system.springs.size();
+          r.steps = o.steps;
+          r.reps = o.reps;
+          r.self_thickness = sc->params.self_collision.thickness;
+          r.cost = cost_of(r.variant, sc->params.integrator, s, true, 0.0, false, o.steps_per_submit);
+          rows.push_back(r);
+        }
+        return exit_ok;
+      };
+      if (o.backend != "vulkan")
+        if (int e = add(bench_cpu_self(*sc, o)))
+          return e;
+      if (!ctx)
+        continue;
+      const bool rk4 = *integrator == Integrator::rk4;
+      const bool imp = *integrator == Integrator::implicit_euler;
+      if (o.variants.find("fused") != std::string::npos || rk4 || imp)
+        for (gpu::BufferAccess access : layouts)
+          if (int e = add(bench_vulkan_self(*ctx, *sc, true, access, o)))
+            return e;
+      if (o.variants.find("two_pass") != std::string::npos && !rk4 && !imp)
+        for (gpu::BufferAccess access : layouts)
+          if (int e = add(bench_vulkan_self(*ctx, *sc, false, access, o)))
+            return e;
+    }
+  }
+
   // Table for people.
   fmt::print(
       "vkcloth bench: hanging cloth n x n (3 spring kinds, 2 pins, wind), {}, dt {:g} s, {} steps x {} reps "
@@ -932,6 +1165,13 @@ int bench_command(const BenchOptions& o) {
         "n+mesh: 64 x 64 cloth draped on a {}-triangle geodesic sphere (mesh collider); friction "
         "{:g}; no wind; n free: the same cloth without colliders (n column)\n",
         20 * sphere_frequency * sphere_frequency, contact_friction);
+  if (o.self_collision)
+    fmt::print("self-collision rows: n+self: the n x n cloth folded into {} layers on the floor plane "
+               "(friction {:g}), "
+               "self_collision {{thickness: {:g} x the spacing, friction: {:g}, iterations: {}}}; no wind; "
+               "n-self: the "
+               "same cloth with self-collision off (n column)\n",
+               self_layers, contact_friction, self_thickness_over_spacing, self_friction, self_iterations);
   fmt::print("{:<7} {:<9} {:<11} {:>8} {:>8} {:>3} {:>9} {:>9} {:>9} {:>6} {:>7} {:>5} {:>6} {:>8} {:>5}\n",
              "backend", "variant", "layout", "n", "particles", "thr", "ms/step", "gpu ms", "M p-st/s",
              "B/p-st", "GB/s", "%mem", "fl/pst", "GFLOP/s", "%cmp");
@@ -946,11 +1186,13 @@ int bench_command(const BenchOptions& o) {
         "{:<7} {:<9} {:<11} {:>8} {:>8} {:>3} {:>9.4f} {:>9} {:>9.1f} {:>6.0f} {:>7.2f} {:>4.0f}% {:>6.0f} "
         "{:>8.2f} {:>4.1f}%\n",
         r.backend, r.variant, r.layout.empty() ? "-" : fmt::format("{}/{}", r.layout, r.workgroup),
-        r.scene == "grid"           ? fmt::format("{}", r.size)
-        : r.scene == "stretch"      ? fmt::format("{}+{}", r.size, r.order)
-        : r.scene == "contact"      ? fmt::format("{}+{}", r.size, r.contact)
-        : r.scene == "contact_free" ? fmt::format("{} free", r.size)
-                                    : r.order,
+        r.scene == "grid"                  ? fmt::format("{}", r.size)
+        : r.scene == "stretch"             ? fmt::format("{}+{}", r.size, r.order)
+        : r.scene == "contact"             ? fmt::format("{}+{}", r.size, r.contact)
+        : r.scene == "contact_free"        ? fmt::format("{} free", r.size)
+        : r.scene == "self_collision"      ? fmt::format("{}+self", r.size)
+        : r.scene == "self_collision_free" ? fmt::format("{}-self", r.size)
+                                           : r.order,
         r.particles, r.backend == "cpu" ? fmt::format("{}", r.threads) : "-", ms_step,
         gpu_step >= 0 ? fmt::format("{:.4f}", gpu_step) : "-", rate * 1e-6, r.cost.bytes, gbps,
         100.0 * gbps / o.memory_gbps, r.cost.flops, gflops, 100.0 * gflops / o.compute_gflops);
@@ -967,7 +1209,7 @@ int bench_command(const BenchOptions& o) {
         j["cg_dispatch"] = r.cg_dispatch;
       for (const Row& e : rows) // the semi-implicit baseline of the same backend and size
         if (e.backend == r.backend && e.size == r.size && e.integrator == "semi_implicit_euler" &&
-            r.contact.empty() && e.contact.empty())
+            r.contact.empty() && e.contact.empty() && !is_self(r) && !is_self(e))
           j["implicit_over_explicit"] = r.wall_ms / e.wall_ms;
     }
     j["size"] = r.size;
@@ -995,6 +1237,20 @@ int bench_command(const BenchOptions& o) {
           j["contact_phase_fraction"] = (r.wall_ms - f->wall_ms) / f->wall_ms;
       }
     }
+    if (is_self(r)) {
+      j["self_collision_thickness"] = r.self_thickness;
+      j["self_collision_friction"] = self_friction;
+      j["self_collision_iterations"] = self_iterations;
+      if (r.scene == "self_collision") {
+        j["particles_in_self_contact_start"] = r.in_contact_start;
+        j["particles_in_self_contact_end"] = r.in_contact_end;
+        if (const Row* f = self_free_of(rows, r)) {
+          j["self_collision_ratio"] = r.wall_ms / f->wall_ms;
+          j["self_collision_us_per_particle"] =
+              1e3 * (r.wall_ms / double(r.steps) - f->wall_ms / double(f->steps)) / double(r.particles);
+        }
+      }
+    }
     j["instances"] = r.instances;
     j["particles"] = r.particles;
     j["springs"] = r.springs;
@@ -1015,10 +1271,10 @@ int bench_command(const BenchOptions& o) {
     results.push_back(std::move(j));
   }
   for (const Row& r : rows)
-    if (r.integrator == "implicit_euler" && r.contact.empty())
+    if (r.integrator == "implicit_euler" && r.contact.empty() && !is_self(r))
       for (const Row& e : rows)
         if (e.backend == r.backend && e.size == r.size && e.integrator == "semi_implicit_euler" &&
-            e.contact.empty())
+            e.contact.empty() && !is_self(e))
           fmt::print(
               "{}{} n = {}: implicit step {:.4f} ms vs semi-implicit {:.4f} ms: {:.1f}x the explicit cost "
               "({:.1f} CG iterations per step, {} in the last step)\n",
@@ -1046,6 +1302,22 @@ int bench_command(const BenchOptions& o) {
           r.backend, r.variant, r.contact, r.size, r.size, 100.0 * (r.wall_ms - f->wall_ms) / f->wall_ms,
           r.wall_ms / double(r.steps), f->wall_ms / double(f->steps), r.in_contact_start, r.particles,
           r.in_contact_end);
+  bool self_header = false;
+  for (const Row& r : rows)
+    if (const Row* f = r.scene == "self_collision" ? self_free_of(rows, r) : nullptr) {
+      if (!self_header) {
+        fmt::print("self-collision on vs off, alternated (ms per step, wall; us/particle: (on - off) per "
+                   "step / particles; in self-contact: after the warm-up / after the timed steps)\n");
+        fmt::print("{:<7} {:<9} {:<11} {:>5} {:>9} {:>10} {:>10} {:>8} {:>11} {:>17}\n", "backend", "variant",
+                   "layout", "n", "particles", "off ms", "on ms", "on/off", "us/particle", "in self-contact");
+        self_header = true;
+      }
+      const double on = r.wall_ms / double(r.steps), off = f->wall_ms / double(f->steps);
+      fmt::print("{:<7} {:<9} {:<11} {:>5} {:>9} {:>10.4f} {:>10.4f} {:>7.2f}x {:>11.4f} {:>17}\n", r.backend,
+                 r.variant, r.layout.empty() ? "-" : fmt::format("{}/{}", r.layout, r.workgroup), r.size,
+                 r.particles, off, on, r.wall_ms / f->wall_ms, 1e3 * (on - off) / double(r.particles),
+                 fmt::format("{} / {}", r.in_contact_start, r.in_contact_end));
+    }
   if (!o.json.empty()) {
     nlohmann::json doc;
     doc["schema"] = "vkcloth-bench/1";
@@ -1057,6 +1329,7 @@ int bench_command(const BenchOptions& o) {
     doc["cloth_mass"] = o.cloth_mass ? nlohmann::json(*o.cloth_mass) : nlohmann::json(nullptr);
     doc["wind"] = o.wind;
     doc["contact"] = o.contact.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.contact);
+    doc["self_collision"] = o.self_collision;
     doc["steps"] = o.steps;
     doc["warmup"] = o.warmup;
     doc["reps"] = o.reps;
@@ -1144,6 +1417,11 @@ void add_bench_command(CLI::App& app, int* exit) {
          "a 64 x 64 cloth on a ~10 000-triangle mesh sphere, or both; each against the same cloth "
          "without colliders, alternated")
       ->check(CLI::IsMember({"table", "mesh", "both"}));
+  cmd->add_flag(
+      "--self-collision", opt->self_collision,
+      "Also time each size's cloth folded into 4 layers on the floor with self-collision on (issue 16; "
+      "thickness 1.5 x the grid spacing, friction 0.2, 2 iterations) against the same cloth with it off, "
+      "alternated (n >= 16)");
   cmd->add_option(
       "--stiffness", opt->stiffness,
       "Structural, shear and bend stiffness of the grid in N/m, e.g. 10000,2000,2000 (default 40,8,8)");
