@@ -4,12 +4,11 @@
 // Self-collision (CpuSolver::self_collide; docs/model.md "Self-collision"), one pass per
 // pc.stage (self_collision_shared.h), after the substep's update and stretch control, on the
 // positions being written (POS_OUT). The spatial hash is a counting sort of the particles by
-// bucket (of its cell key): COUNT (integer atomics), the prefix sums in two levels (SCAN_BLOCKS,
-// SCAN_TOP, SCAN_ADD),
-// SCATTER (slots in any order), then SORT (each bucket's particles in increasing index): integer
-// work only, so the table is the same on every run and the same as the CPU's. COLLIDE and APPLY are
-// then cloth_kernel.h self_collide and self_apply per particle, each invocation writing only
-// its own particle.
+// bucket (of their cell keys): COUNT (integer atomics), prefix sums in two levels (SCAN_BLOCKS,
+// SCAN_TOP, then SCAN_ADD makes them absolute), SCATTER (slots in any order), then SORT (each
+// bucket's particles in increasing index): integer work only, so the table is the same on every
+// run and the same as the CPU's. COLLIDE and APPLY are then cloth_kernel.h self_collide and
+// self_apply per particle, each invocation writing only its own particle.
 #include "vkcloth_shared.h"
 #include "self_collision_shared.h"
 
@@ -34,14 +33,14 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_DELTA) buffer DeltaBuf { 
 
 shared uint partial[VKCLOTH_WORKGROUP_SIZE];
 
-// This instance's table: pc.pad0 buckets from inst * pc.pad0, their scan blocks after inst * blocks.
+// This instance's table: pc.pad0 buckets (counts), pc.pad0 + 1 starts, and its scan blocks.
 uint table_base() { return inst * pc.pad0; }
 uint start_base() { return inst * (pc.pad0 + 1u); }
 uint block_base() { return inst * (pc.pad0 / VKCLOTH_SELF_SCAN_BLOCK); }
 
 // Bucket b's first entry in `sorted` (within the instance), once SCAN_ADD has run; starts has
 // one more entry per instance than the table has buckets, the particle count.
-uint bucket_start(uint b) { return starts[inst * (pc.pad0 + 1u) + b]; }
+uint bucket_start(uint b) { return starts[start_base() + b]; }
 
 void self_range(uint unused, uint b, out uint first, out uint stop) {
   first = bucket_start(b);

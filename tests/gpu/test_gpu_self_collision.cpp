@@ -103,3 +103,26 @@ TEST_CASE("ClothWorld: self-collision per instance in one batch, each as its own
     CHECK(d.max_abs <= 1e-5);
   }
 }
+
+TEST_CASE("GpuSolver: self-collision turned on between steps, as the CPU solver") {
+  VKCLOTH_GPU_TEST_BEGIN(ctx);
+  auto scene = sample("cloth_slide_self_collision", std::vector<std::string>{"self_collision.enabled=false"});
+  REQUIRE_MESSAGE(scene.ok(), (scene.ok() ? "" : scene.error().message));
+  auto cpu = CpuSolver<float>::create(scene->system, scene->params);
+  REQUIRE(cpu.ok());
+  auto gpu = gpu::GpuSolver::create(ctx, scene->system, scene->params);
+  REQUIRE(gpu.ok());
+  REQUIRE(cpu->run(40).ok());
+  REQUIRE(gpu->simulate(40).ok());
+  SimParams on = scene->params;
+  on.self_collision.enabled = true; // the first instance to ask: its buffers and sets made now
+  REQUIRE(cpu->set_params(on).ok());
+  REQUIRE(gpu->set_params(on).ok());
+  REQUIRE(cpu->run(60).ok());
+  REQUIRE(gpu->simulate(60).ok());
+  auto gp = gpu->positions();
+  REQUIRE(gp.ok());
+  const auto d = gpu::test::diff(cpu->positions(), *gp);
+  MESSAGE("max |p_cpu - p_gpu| = " << d.max_abs << " m (bitwise: " << d.bitwise << ")");
+  CHECK(d.max_abs <= 1e-5);
+}

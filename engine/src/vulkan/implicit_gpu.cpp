@@ -81,7 +81,8 @@ Result<void> ImplicitGpu::create_pipelines() {
     return layouts.error();
   set_layout_ = layouts->set;
   layout_ = layouts->layout;
-  VKCLOTH_TRY(create_parity_sets(ctx, set_layout_, static_cast<std::uint32_t>(implicit_bindings().size()), pool_, sets_, "implicit"));
+  VKCLOTH_TRY(create_parity_sets(ctx, set_layout_, static_cast<std::uint32_t>(implicit_bindings().size()),
+                                 pool_, sets_, "implicit"));
   auto pp = ctx.pipelines->pipeline(PipelineRegistry::Shader::implicit, {});
   if (!pp)
     return pp.error();

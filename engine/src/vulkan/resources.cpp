@@ -219,8 +219,9 @@ Result<PipelineLayout> create_pipeline_layout(Context::Impl& ctx, std::span<cons
   return l;
 }
 
-Result<void> create_parity_sets(Context::Impl& ctx, VkDescriptorSetLayout layout, std::uint32_t storage_buffers,
-                                DescriptorPool& pool, VkDescriptorSet (&sets)[2], const char* name) {
+Result<void> create_parity_sets(Context::Impl& ctx, VkDescriptorSetLayout layout,
+                                std::uint32_t storage_buffers, DescriptorPool& pool,
+                                VkDescriptorSet (&sets)[2], const char* name) {
   const auto& v = ctx.vk;
   const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2 * storage_buffers};
   VkDescriptorPoolCreateInfo dp{};
@@ -236,7 +237,8 @@ Result<void> create_parity_sets(Context::Impl& ctx, VkDescriptorSetLayout layout
   ai.descriptorPool = pool;
   ai.descriptorSetCount = 2;
   ai.pSetLayouts = layouts;
-  VKCLOTH_VK_TRY(v.vkAllocateDescriptorSets(ctx.device, &ai, sets), fmt::format("vkAllocateDescriptorSets ({})", name));
+  VKCLOTH_VK_TRY(v.vkAllocateDescriptorSets(ctx.device, &ai, sets),
+                 fmt::format("vkAllocateDescriptorSets ({})", name));
   return {};
 }
 

@@ -169,8 +169,9 @@ Result<PipelineLayout> create_pipeline_layout(Context::Impl& ctx, std::span<cons
 
 /// A pool of two sets of `layout`, each of `storage_buffers` storage-buffer descriptors, and the two
 /// sets (one per position parity: implicit Euler's and self-collision's passes).
-Result<void> create_parity_sets(Context::Impl& ctx, VkDescriptorSetLayout layout, std::uint32_t storage_buffers,
-                                DescriptorPool& pool, VkDescriptorSet (&sets)[2], const char* name);
+Result<void> create_parity_sets(Context::Impl& ctx, VkDescriptorSetLayout layout,
+                                std::uint32_t storage_buffers, DescriptorPool& pool,
+                                VkDescriptorSet (&sets)[2], const char* name);
 
 /// A whole-buffer texel view of `buffer` in `format`.
 Result<BufferView> create_buffer_view(Context::Impl& ctx, VkBuffer buffer, VkFormat format, const char* name);

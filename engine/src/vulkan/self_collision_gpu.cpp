@@ -60,7 +60,9 @@ Result<void> SelfCollisionGpu::create_sets() {
   if (!layouts)
     return layouts.error();
   layout_ = layouts->layout;
-  VKCLOTH_TRY(create_parity_sets(ctx, layouts->set, static_cast<std::uint32_t>(self_collision_bindings().size()), pool_, sets_, "self-collision"));
+  VKCLOTH_TRY(create_parity_sets(ctx, layouts->set,
+                                 static_cast<std::uint32_t>(self_collision_bindings().size()), pool_, sets_,
+                                 "self-collision"));
   auto pp = ctx.pipelines->pipeline(PipelineRegistry::Shader::self_collision, {});
   if (!pp)
     return pp.error();

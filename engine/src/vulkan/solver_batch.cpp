@@ -478,7 +478,8 @@ Result<void> SolverBatch::ensure_implicit() {
 }
 
 // Made when an instance first turns self-collision on: its buffers (the rest positions uploaded,
-// the counts zeroed) and descriptor sets; nothing recorded so far uses them.
+// the counts zeroed) and descriptor sets, which nothing recorded so far uses. Its parameters are
+// written straight into the mapped buffer here: no recorded work reads it yet.
 Result<void> SolverBatch::ensure_self_collision() {
   if (self_collision || self_iterations() == 0)
     return {};
@@ -498,7 +499,8 @@ Result<void> SolverBatch::ensure_self_collision() {
   VKCLOTH_TRY(upload(up));
   const auto sp = packed_self_params();
   std::memcpy(self_collision->params().mapped, sp.data(), sp.size() * sizeof(sh::SelfParams));
-  return write_sets();
+  // Only its own new sets: the main ones may be in use by recorded work (set_params).
+  return self_collision->write_sets(self_collision_inputs());
 }
 
 std::vector<sh::SelfParams> SolverBatch::packed_self_params() const {

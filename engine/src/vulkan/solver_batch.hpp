@@ -280,6 +280,9 @@ private:
   void record_collider_motion(VkCommandBuffer cmd, double h);
   std::vector<shared::InstanceParams> packed_instance_params() const;
   std::vector<shared::SelfParams> packed_self_params() const;
+  SelfCollisionInputs self_collision_inputs() const {
+    return {{pos[0].buffer, pos[1].buffer}, vel.buffer, particle.buffer, flags.buffer, instances.buffer};
+  }
   void write_params_now();
   void record_params_update(VkCommandBuffer cmd);
   /// vkCmdUpdateBuffer of `bytes` from the start of `dst`, in pieces of at most 64 KiB (its limit).

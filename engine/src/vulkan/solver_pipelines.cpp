@@ -311,8 +311,7 @@ Result<void> SolverBatch::write_sets() {
   vk().vkUpdateDescriptorSets(ctx->device, static_cast<std::uint32_t>(writes.size()), writes.data(), 0,
                               nullptr);
   if (self_collision)
-    VKCLOTH_TRY(self_collision->write_sets(
-        {{pos[0].buffer, pos[1].buffer}, vel.buffer, particle.buffer, flags.buffer, instances.buffer}));
+    VKCLOTH_TRY(self_collision->write_sets(self_collision_inputs()));
   if (implicit)
     return implicit->write_sets({{pos[0].buffer, pos[1].buffer},
                                  vel.buffer,
