@@ -25,7 +25,7 @@ template <typename Real> void CpuSolver<Real>::self_collide() {
   }
   auto& g = *self_;
   const std::uint32_t table = kernel::self_table_size(static_cast<std::uint32_t>(n)), mask = table - 1;
-  // The same conversions as the GPU's host side (SelfCollisionGpu::packed_params).
+  // The same conversions as the GPU's host side (SelfCollisionGpu::packed).
   const Real thickness = Real(sc.thickness), inv_cell = Real(1.0 / sc.thickness), mu = Real(sc.friction);
 
   // The table: count per bucket, exclusive prefix sums, then the particles in index order.
