@@ -483,6 +483,9 @@ Result<void> SolverBatch::ensure_implicit() {
 Result<void> SolverBatch::ensure_self_collision() {
   if (self_collision || self_iterations() == 0)
     return {};
+  // Its largest buffer holds two vec4 per particle of every instance (a move and a velocity change).
+  VKCLOTH_TRY(check_buffer(*ctx, storage_limit(*ctx, knobs), "self-collision moves",
+                           std::uint64_t(size()) * count, 32));
   auto r = SelfCollisionGpu::create(ctx, count, size(), ctx->properties.limits.maxComputeWorkGroupCount[0],
                                     !knobs.force_staging);
   if (!r)
