@@ -1036,6 +1036,50 @@ int bench_command(const BenchOptions& o) {
     }
   }
 
+  // A scene timed on against off in pairs (cpu(): the CPU; vulkan(fused, access): each Vulkan
+  // variant and layout asked for); tag(row) adds the scene's own fields. A device too small for it
+  // is a note naming `what`.
+  auto time_pairs = [&](const std::string& what, const ParticleSystem& system, const SimParams& params,
+                        std::uint32_t size, auto cpu, auto vulkan, auto tag) -> int {
+    const double s = double(system.adjacency.refs.size()) / double(system.size());
+    auto add = [&](Result<std::array<Row, 2>> pair) -> int {
+      if (!pair && pair.error().code == ErrorCode::unsupported) { // too large for this device
+        fmt::print("note: {} ({}): {}\n", what, to_string(params.integrator), pair.error().message);
+        return exit_ok;
+      }
+      if (!pair)
+        return report(pair.error());
+      for (Row& r : *pair) {
+        r.integrator = to_string(params.integrator);
+        r.size = size;
+        r.particles = system.size();
+        r.springs = system.springs.size();
+        r.steps = o.steps;
+        r.reps = o.reps;
+        tag(r);
+        r.cost = cost_of(r.variant, params.integrator, s, true, 0.0, false, o.steps_per_submit);
+        rows.push_back(r);
+      }
+      return exit_ok;
+    };
+    if (o.backend != "vulkan")
+      if (int e = add(cpu()))
+        return e;
+    if (!ctx)
+      return exit_ok;
+    const bool rk4 = *integrator == Integrator::rk4;
+    const bool imp = *integrator == Integrator::implicit_euler;
+    if (o.variants.find("fused") != std::string::npos || rk4 || imp)
+      for (gpu::BufferAccess access : layouts)
+        if (int e = add(vulkan(true, access)))
+          return e;
+    if (o.variants.find("two_pass") != std::string::npos && !rk4 && !imp)
+      for (gpu::BufferAccess access : layouts)
+        if (int e = add(vulkan(false, access)))
+          return e;
+    return exit_ok;
+  };
+
   if (!o.contact.empty()) { // the contact scenes, each timed against the same cloth without colliders
     for (const std::string name : {"table", "mesh"}) {
       if (o.contact != name && o.contact != "both")
@@ -1043,47 +1087,19 @@ int bench_command(const BenchOptions& o) {
       auto sc = name == "table" ? table_scene(*integrator, dt, o) : mesh_scene(*integrator, dt, o);
       if (!sc)
         return report(sc.error());
-      const double s = double(sc->system.adjacency.refs.size()) / double(sc->system.size());
-      auto add = [&](Result<std::array<Row, 2>> pair) -> int {
-        if (!pair && pair.error().code == ErrorCode::unsupported) { // too large for this device
-          fmt::print("note: contact {} ({}): {}\n", name, to_string(sc->params.integrator),
-                     pair.error().message);
-          return exit_ok;
-        }
-        if (!pair)
-          return report(pair.error());
-        for (Row& r : *pair) {
-          r.integrator = to_string(sc->params.integrator);
-          r.size = sc->n;
-          r.particles = sc->system.size();
-          r.springs = sc->system.springs.size();
-          r.steps = o.steps;
-          r.reps = o.reps;
-          r.contact = name;
-          if (r.scene == "contact") {
-            r.colliders = sc->kinds;
-            r.collider_triangles = sc->triangles;
-          }
-          r.cost = cost_of(r.variant, sc->params.integrator, s, true, 0.0, false, o.steps_per_submit);
-          rows.push_back(r);
-        }
-        return exit_ok;
-      };
-      if (o.backend != "vulkan")
-        if (int e = add(bench_cpu_contact(*sc, o)))
-          return e;
-      if (!ctx)
-        continue;
-      const bool rk4 = *integrator == Integrator::rk4;
-      const bool imp = *integrator == Integrator::implicit_euler;
-      if (o.variants.find("fused") != std::string::npos || rk4 || imp)
-        for (gpu::BufferAccess access : layouts)
-          if (int e = add(bench_vulkan_contact(*ctx, *sc, true, access, o)))
-            return e;
-      if (o.variants.find("two_pass") != std::string::npos && !rk4 && !imp)
-        for (gpu::BufferAccess access : layouts)
-          if (int e = add(bench_vulkan_contact(*ctx, *sc, false, access, o)))
-            return e;
+      if (int e = time_pairs(
+              "contact " + name, sc->system, sc->params, sc->n, [&] { return bench_cpu_contact(*sc, o); },
+              [&](bool fused, gpu::BufferAccess access) {
+                return bench_vulkan_contact(*ctx, *sc, fused, access, o);
+              },
+              [&](Row& r) {
+                r.contact = name;
+                if (r.scene == "contact") {
+                  r.colliders = sc->kinds;
+                  r.collider_triangles = sc->triangles;
+                }
+              }))
+        return e;
     }
   }
 
@@ -1097,43 +1113,14 @@ int bench_command(const BenchOptions& o) {
       auto sc = folded_scene(n, *integrator, dt, o);
       if (!sc)
         return report(sc.error());
-      const double s = double(sc->system.adjacency.refs.size()) / double(sc->system.size());
-      auto add = [&](Result<std::array<Row, 2>> pair) -> int {
-        if (!pair && pair.error().code == ErrorCode::unsupported) { // too large for this device
-          fmt::print("note: self_collision n = {} ({}): {}\n", n, to_string(sc->params.integrator),
-                     pair.error().message);
-          return exit_ok;
-        }
-        if (!pair)
-          return report(pair.error());
-        for (Row& r : *pair) {
-          r.integrator = to_string(sc->params.integrator);
-          r.size = n;
-          r.particles = sc->system.size();
-          r.springs = sc->system.springs.size();
-          r.steps = o.steps;
-          r.reps = o.reps;
-          r.self_thickness = sc->params.self_collision.thickness;
-          r.cost = cost_of(r.variant, sc->params.integrator, s, true, 0.0, false, o.steps_per_submit);
-          rows.push_back(r);
-        }
-        return exit_ok;
-      };
-      if (o.backend != "vulkan")
-        if (int e = add(bench_cpu_self(*sc, o)))
-          return e;
-      if (!ctx)
-        continue;
-      const bool rk4 = *integrator == Integrator::rk4;
-      const bool imp = *integrator == Integrator::implicit_euler;
-      if (o.variants.find("fused") != std::string::npos || rk4 || imp)
-        for (gpu::BufferAccess access : layouts)
-          if (int e = add(bench_vulkan_self(*ctx, *sc, true, access, o)))
-            return e;
-      if (o.variants.find("two_pass") != std::string::npos && !rk4 && !imp)
-        for (gpu::BufferAccess access : layouts)
-          if (int e = add(bench_vulkan_self(*ctx, *sc, false, access, o)))
-            return e;
+      if (int e = time_pairs(
+              fmt::format("self_collision n = {}", n), sc->system, sc->params, n,
+              [&] { return bench_cpu_self(*sc, o); },
+              [&](bool fused, gpu::BufferAccess access) {
+                return bench_vulkan_self(*ctx, *sc, fused, access, o);
+              },
+              [&](Row& r) { r.self_thickness = sc->params.self_collision.thickness; }))
+        return e;
     }
   }
 
