@@ -90,105 +90,68 @@ Result<void> ImplicitGpu::create_pipelines() {
   return {};
 }
 
-// Long (~90 lines) but flat: one switch that maps each binding of the implicit layout
+// Long (~60 lines) but flat: one switch that maps each binding of the implicit layout
 // (implicit_shared.h) to its buffer, a table to scan rather than logic to follow.
 Result<void> ImplicitGpu::write_sets(const ImplicitInputs& in) {
-  const auto bindings = implicit_bindings();
-  std::vector<VkDescriptorBufferInfo> infos(2 * bindings.size()); // creation only: not the hot path
-  std::vector<VkWriteDescriptorSet> writes(2 * bindings.size());
-  std::size_t k = 0;
-  for (std::uint32_t read = 0; read < 2; ++read)
-    for (std::uint32_t binding : bindings) {
-      VkBuffer b = VK_NULL_HANDLE;
-      switch (binding) {
-      case VKCLOTH_BINDING_POS_IN:
-        b = in.pos[read];
-        break;
-      case VKCLOTH_BINDING_POS_OUT:
-        b = in.pos[read ^ 1u];
-        break;
-      case VKCLOTH_BINDING_FORCE_OUT:
-        b = in.force;
-        break;
-      case VKCLOTH_BINDING_NORMAL:
-        b = in.normal;
-        break;
-      case VKCLOTH_BINDING_VEL:
-        b = in.vel;
-        break;
-      case VKCLOTH_BINDING_PARTICLE:
-        b = in.particle;
-        break;
-      case VKCLOTH_BINDING_OFFSETS:
-        b = in.offsets;
-        break;
-      case VKCLOTH_BINDING_EDGES:
-        b = in.edges;
-        break;
-      case VKCLOTH_BINDING_COLLIDERS:
-        b = in.colliders;
-        break;
-      case VKCLOTH_BINDING_FLAGS:
-        b = in.flags;
-        break;
-      case VKCLOTH_BINDING_INSTANCES:
-        b = in.instances;
-        break;
-      case VKCLOTH_BINDING_FAN_OFFSETS:
-        b = in.fan_offsets;
-        break;
-      case VKCLOTH_BINDING_FANS:
-        b = in.fans;
-        break;
-      case VKCLOTH_BINDING_MESH_NODES:
-        b = in.mesh_nodes;
-        break;
-      case VKCLOTH_BINDING_MESH_TRIS:
-        b = in.mesh_tris;
-        break;
-      case VKCLOTH_BINDING_IMPL_VF:
-        b = vf_.buffer;
-        break;
-      case VKCLOTH_BINDING_IMPL_KS:
-        b = ks_.buffer;
-        break;
-      case VKCLOTH_BINDING_IMPL_BLOCK_INV:
-        b = block_inv_.buffer;
-        break;
-      case VKCLOTH_BINDING_IMPL_X:
-        b = x_.buffer;
-        break;
-      case VKCLOTH_BINDING_IMPL_R:
-        b = r_.buffer;
-        break;
-      case VKCLOTH_BINDING_IMPL_Z:
-        b = z_.buffer;
-        break;
-      case VKCLOTH_BINDING_IMPL_D:
-        b = d_.buffer;
-        break;
-      case VKCLOTH_BINDING_IMPL_Q:
-        b = q_.buffer;
-        break;
-      case VKCLOTH_BINDING_IMPL_PARTIALS:
-        b = partials_.buffer;
-        break;
-      case VKCLOTH_BINDING_IMPL_STATE:
-        b = state_.buffer;
-        break;
-      case VKCLOTH_BINDING_IMPL_ARGS:
-        b = args_.buffer;
-        break;
-      default:
-        break;
-      }
-      infos[k] = {b, 0, VK_WHOLE_SIZE};
-      writes[k] =
-          VkWriteDescriptorSet{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, nullptr, sets_[read], binding, 0, 1,
-                               VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,      nullptr, &infos[k],   nullptr};
-      ++k;
-    }
-  ctx_->vk.vkUpdateDescriptorSets(ctx_->device, static_cast<std::uint32_t>(k), writes.data(), 0, nullptr);
+  write_parity_sets(*ctx_, sets_, implicit_bindings(),
+                    [&](std::uint32_t read, std::uint32_t binding) -> VkBuffer {
+                      switch (binding) {
+                      case VKCLOTH_BINDING_POS_IN:
+                        return in.pos[read];
+                      case VKCLOTH_BINDING_POS_OUT:
+                        return in.pos[read ^ 1u];
+                      case VKCLOTH_BINDING_FORCE_OUT:
+                        return in.force;
+                      case VKCLOTH_BINDING_NORMAL:
+                        return in.normal;
+                      case VKCLOTH_BINDING_VEL:
+                        return in.vel;
+                      case VKCLOTH_BINDING_PARTICLE:
+                        return in.particle;
+                      case VKCLOTH_BINDING_OFFSETS:
+                        return in.offsets;
+                      case VKCLOTH_BINDING_EDGES:
+                        return in.edges;
+                      case VKCLOTH_BINDING_COLLIDERS:
+                        return in.colliders;
+                      case VKCLOTH_BINDING_FLAGS:
+                        return in.flags;
+                      case VKCLOTH_BINDING_INSTANCES:
+                        return in.instances;
+                      case VKCLOTH_BINDING_FAN_OFFSETS:
+                        return in.fan_offsets;
+                      case VKCLOTH_BINDING_FANS:
+                        return in.fans;
+                      case VKCLOTH_BINDING_MESH_NODES:
+                        return in.mesh_nodes;
+                      case VKCLOTH_BINDING_MESH_TRIS:
+                        return in.mesh_tris;
+                      case VKCLOTH_BINDING_IMPL_VF:
+                        return vf_.buffer;
+                      case VKCLOTH_BINDING_IMPL_KS:
+                        return ks_.buffer;
+                      case VKCLOTH_BINDING_IMPL_BLOCK_INV:
+                        return block_inv_.buffer;
+                      case VKCLOTH_BINDING_IMPL_X:
+                        return x_.buffer;
+                      case VKCLOTH_BINDING_IMPL_R:
+                        return r_.buffer;
+                      case VKCLOTH_BINDING_IMPL_Z:
+                        return z_.buffer;
+                      case VKCLOTH_BINDING_IMPL_D:
+                        return d_.buffer;
+                      case VKCLOTH_BINDING_IMPL_Q:
+                        return q_.buffer;
+                      case VKCLOTH_BINDING_IMPL_PARTIALS:
+                        return partials_.buffer;
+                      case VKCLOTH_BINDING_IMPL_STATE:
+                        return state_.buffer;
+                      case VKCLOTH_BINDING_IMPL_ARGS:
+                        return args_.buffer;
+                      default:
+                        return VK_NULL_HANDLE;
+                      }
+                    });
   return {};
 }
 

@@ -173,6 +173,12 @@ Result<void> create_parity_sets(Context::Impl& ctx, VkDescriptorSetLayout layout
                                 std::uint32_t storage_buffers, DescriptorPool& pool,
                                 VkDescriptorSet (&sets)[2], const char* name);
 
+/// Writes every binding of both parity sets as a whole storage buffer: buffer_of(read, binding)
+/// (`read`: the set's position parity, 0 or 1). Creation and buffer replacement only.
+void write_parity_sets(Context::Impl& ctx, const VkDescriptorSet (&sets)[2],
+                       std::span<const std::uint32_t> bindings,
+                       const std::function<VkBuffer(std::uint32_t read, std::uint32_t binding)>& buffer_of);
+
 /// A whole-buffer texel view of `buffer` in `format`.
 Result<BufferView> create_buffer_view(Context::Impl& ctx, VkBuffer buffer, VkFormat format, const char* name);
 

@@ -71,63 +71,39 @@ Result<void> SelfCollisionGpu::create_sets() {
 }
 
 Result<void> SelfCollisionGpu::write_sets(const SelfCollisionInputs& in) {
-  const auto bindings = self_collision_bindings();
-  std::vector<VkDescriptorBufferInfo> infos(2 * bindings.size());
-  std::vector<VkWriteDescriptorSet> writes(2 * bindings.size());
-  std::size_t k = 0;
-  for (std::uint32_t read = 0; read < 2; ++read)
-    for (std::uint32_t binding : bindings) {
-      VkBuffer b = VK_NULL_HANDLE;
-      switch (binding) {
-      case VKCLOTH_BINDING_POS_OUT:
-        b = in.pos[read ^ 1u]; // the positions this substep writes
-        break;
-      case VKCLOTH_BINDING_VEL:
-        b = in.vel;
-        break;
-      case VKCLOTH_BINDING_PARTICLE:
-        b = in.particle;
-        break;
-      case VKCLOTH_BINDING_FLAGS:
-        b = in.flags;
-        break;
-      case VKCLOTH_BINDING_INSTANCES:
-        b = in.instances;
-        break;
-      case VKCLOTH_BINDING_SELF_PARAMS:
-        b = params_.buffer;
-        break;
-      case VKCLOTH_BINDING_SELF_REST:
-        b = rest_.buffer;
-        break;
-      case VKCLOTH_BINDING_SELF_COUNTS:
-        b = counts_.buffer;
-        break;
-      case VKCLOTH_BINDING_SELF_STARTS:
-        b = starts_.buffer;
-        break;
-      case VKCLOTH_BINDING_SELF_BLOCKS:
-        b = blocks_.buffer;
-        break;
-      case VKCLOTH_BINDING_SELF_KEYS:
-        b = keys_.buffer;
-        break;
-      case VKCLOTH_BINDING_SELF_SORTED:
-        b = sorted_.buffer;
-        break;
-      case VKCLOTH_BINDING_SELF_DELTA:
-        b = delta_.buffer;
-        break;
-      default:
-        break;
-      }
-      infos[k] = {b, 0, VK_WHOLE_SIZE};
-      writes[k] =
-          VkWriteDescriptorSet{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, nullptr, sets_[read], binding, 0, 1,
-                               VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,      nullptr, &infos[k],   nullptr};
-      ++k;
-    }
-  ctx_->vk.vkUpdateDescriptorSets(ctx_->device, static_cast<std::uint32_t>(k), writes.data(), 0, nullptr);
+  write_parity_sets(*ctx_, sets_, self_collision_bindings(),
+                    [&](std::uint32_t read, std::uint32_t binding) -> VkBuffer {
+                      switch (binding) {
+                      case VKCLOTH_BINDING_POS_OUT:
+                        return in.pos[read ^ 1u]; // the positions this substep writes
+                      case VKCLOTH_BINDING_VEL:
+                        return in.vel;
+                      case VKCLOTH_BINDING_PARTICLE:
+                        return in.particle;
+                      case VKCLOTH_BINDING_FLAGS:
+                        return in.flags;
+                      case VKCLOTH_BINDING_INSTANCES:
+                        return in.instances;
+                      case VKCLOTH_BINDING_SELF_PARAMS:
+                        return params_.buffer;
+                      case VKCLOTH_BINDING_SELF_REST:
+                        return rest_.buffer;
+                      case VKCLOTH_BINDING_SELF_COUNTS:
+                        return counts_.buffer;
+                      case VKCLOTH_BINDING_SELF_STARTS:
+                        return starts_.buffer;
+                      case VKCLOTH_BINDING_SELF_BLOCKS:
+                        return blocks_.buffer;
+                      case VKCLOTH_BINDING_SELF_KEYS:
+                        return keys_.buffer;
+                      case VKCLOTH_BINDING_SELF_SORTED:
+                        return sorted_.buffer;
+                      case VKCLOTH_BINDING_SELF_DELTA:
+                        return delta_.buffer;
+                      default:
+                        return VK_NULL_HANDLE;
+                      }
+                    });
   return {};
 }
 
