@@ -42,6 +42,8 @@ template <typename Real> struct ImplicitWorkspace;
 template <typename Real> struct RowArgs;
 template <typename Real> struct ContactShapes;
 template <typename Real> struct SelfCollisionGrid;
+template <typename Real> struct PaddedLists;
+template <typename Real> struct StepArgs;
 } // namespace detail
 
 struct CpuSolverOptions {
@@ -128,7 +130,9 @@ private:
   // (writes force_[p], pos_next_[p], vel_[p]).
   void euler_finish(std::size_t p, Vec3 f, Real h, bool semi);
   void euler_substep(Real h, bool semi);
-  void row_sweep(Real h, bool semi); // euler_substep on a grid stencil (row_kernel.hpp)
+  void row_sweep(Real h, bool semi);  // euler_substep on a grid stencil (row_kernel.hpp)
+  void list_sweep(Real h, bool semi); // euler_substep without a stencil, in SIMD (row_kernel.hpp)
+  void step_args(detail::StepArgs<Real>& a, Real h, bool semi);
   detail::RowArgs<Real> row_args(Real h, bool semi);
   void rk4_substep(Real h);
   // Implicit Euler (implicit_euler.cpp): forces, then the linear system, CG, and the update.
@@ -190,6 +194,7 @@ private:
   std::unique_ptr<detail::ImplicitWorkspace<Real>> implicit_; // created by the first implicit step
   std::unique_ptr<detail::ContactShapes<Real>> contacts_;     // this substep's colliders (prepare_colliders)
   std::unique_ptr<detail::SelfCollisionGrid<Real>> self_;     // created by the first self-collision substep
+  std::unique_ptr<detail::PaddedLists<Real>> lists_;          // created by the first list sweep
   SolveStats solve_;
 };
 

@@ -31,6 +31,13 @@ template <typename Real> struct ContactShapes {
   std::vector<kernel::MeshData> meshes;
   std::vector<FinishShape<Real>> finish;
 };
+/// The padded lists the list kernel reads (row_kernel.hpp ListArgs), built once for vectors of
+/// `width` particles by pad_lists.
+template <typename Real> struct PaddedLists {
+  std::size_t width = 0;
+  std::vector<std::uint32_t> spring_begin, other, fan_begin, fan_a, fan_b;
+  std::vector<Real> rest, stiff;
+};
 } // namespace detail
 
 namespace {
@@ -432,10 +439,42 @@ template <typename Real> void CpuSolver<Real>::euler_substep(const Real h, const
     row_sweep(h, semi);
     return;
   }
+#if VKCLOTH_ROW_SIMD
+  if (simd_ != 0) {
+    list_sweep(h, semi);
+    return;
+  }
+#endif
   // One sweep: p's normal needs only positions (read-only here), and force_at reads p's own.
   pool_->for_each(pos_.size(),
                   [&](std::size_t p) { euler_finish(p, normal_force_at(pos_, vel_, p), h, semi); });
   std::swap(pos_, pos_next_);
+}
+
+// The state and constants both SIMD kernels take.
+template <typename Real>
+void CpuSolver<Real>::step_args(detail::StepArgs<Real>& a, const Real h, const bool semi) {
+  a.vel = &vel_[0].x;
+  a.vel_out = &vel_[0].x;
+  a.mass = mass_.data();
+  a.pinned = pinned_.data();
+  a.force_out = &force_[0].x;
+  a.normal_out = &normal_[0].x;
+  a.pos_next = &pos_next_[0].x;
+  const Vec3 g{params_.gravity}, w{params_.wind.direction};
+  a.gx = g.x;
+  a.gy = g.y;
+  a.gz = g.z;
+  a.damping = Real(params_.damping);
+  a.kw = Real(params_.wind.strength);
+  a.wind = a.kw != Real(0);
+  a.wx = w.x;
+  a.wy = w.y;
+  a.wz = w.z;
+  a.dt = h;
+  a.limit = Real(params_.divergence_limit);
+  a.integrate = params_.colliders.empty(); // the SIMD kernels have no contact code
+  a.semi = semi;
 }
 
 template <typename Real> detail::RowArgs<Real> CpuSolver<Real>::row_args(const Real h, const bool semi) {
@@ -462,32 +501,12 @@ template <typename Real> detail::RowArgs<Real> CpuSolver<Real>::row_args(const R
   ra.sx_next = soa_next_.data() + pad;
   ra.sy_next = ra.sx_next + stride;
   ra.sz_next = ra.sy_next + stride;
-  ra.vel = &vel_[0].x;
-  ra.vel_out = &vel_[0].x;
-  ra.mass = mass_.data();
-  ra.pinned = pinned_.data();
-  ra.force_out = &force_[0].x;
-  ra.normal_out = &normal_[0].x;
-  ra.pos_next = &pos_next_[0].x;
   ra.mask = stencil_->masks.empty() ? nullptr : stencil_->masks.data();
   ra.nx = topology_->grid()->nx;
   ra.off = stencil_offset_.data();
   ra.rest = stencil_rest_.data();
   ra.stiff = stencil_stiff_.data();
-  const Vec3 g{params_.gravity}, w{params_.wind.direction};
-  ra.gx = g.x;
-  ra.gy = g.y;
-  ra.gz = g.z;
-  ra.damping = Real(params_.damping);
-  ra.kw = Real(params_.wind.strength);
-  ra.wind = ra.kw != Real(0);
-  ra.wx = w.x;
-  ra.wy = w.y;
-  ra.wz = w.z;
-  ra.dt = h;
-  ra.limit = Real(params_.divergence_limit);
-  ra.integrate = params_.colliders.empty(); // the SIMD kernels have no contact code
-  ra.semi = semi;
+  step_args(ra, h, semi);
   return ra;
 }
 
@@ -592,6 +611,95 @@ template <typename Real> void CpuSolver<Real>::row_sweep(const Real h, const boo
   std::swap(pos_, pos_next_);
   std::swap(soa_, soa_next_);
   soa_valid_ = true;
+  swept_finite_ = !bad.load(std::memory_order_relaxed);
+}
+
+namespace {
+// The gather and fan lists padded for vectors of `width` particles (row_kernel.hpp ListArgs): the
+// particles that fill whole vectors only; the rest take the per-particle reference.
+template <typename Real, typename Edge>
+std::unique_ptr<detail::PaddedLists<Real>>
+pad_lists(std::size_t width, std::span<const std::uint32_t> edge_offsets, const std::vector<Edge>& edges,
+          std::span<const std::uint32_t> fan_offsets, std::span<const FanTriangle> fans) {
+  auto lists = std::make_unique<detail::PaddedLists<Real>>();
+  detail::PaddedLists<Real>& l = *lists;
+  l.width = width;
+  const std::size_t vectors = (edge_offsets.size() - 1) / width;
+  auto longest = [&](std::span<const std::uint32_t> offsets, std::size_t b) {
+    std::uint32_t most = 0;
+    for (std::size_t p = b * width; p < (b + 1) * width; ++p)
+      most = std::max(most, offsets[p + 1] - offsets[p]);
+    return most;
+  };
+  l.spring_begin.push_back(0);
+  l.fan_begin.push_back(0);
+  for (std::size_t b = 0; b < vectors; ++b) {
+    for (std::uint32_t k = 0, slots = longest(edge_offsets, b); k < slots; ++k)
+      for (std::size_t p = b * width; p < (b + 1) * width; ++p) {
+        const bool has = k < edge_offsets[p + 1] - edge_offsets[p];
+        const Edge e = has ? edges[edge_offsets[p] + k] : Edge{std::uint32_t(p), Real(0), Real(0)};
+        l.other.push_back(e.other);
+        l.rest.push_back(e.rest_length);
+        l.stiff.push_back(e.stiffness);
+      }
+    for (std::uint32_t k = 0, slots = longest(fan_offsets, b); k < slots; ++k)
+      for (std::size_t p = b * width; p < (b + 1) * width; ++p) {
+        const bool has = k < fan_offsets[p + 1] - fan_offsets[p];
+        l.fan_a.push_back(has ? fans[fan_offsets[p] + k].a : std::uint32_t(p));
+        l.fan_b.push_back(has ? fans[fan_offsets[p] + k].b : std::uint32_t(p));
+      }
+    l.spring_begin.push_back(std::uint32_t(l.other.size()));
+    l.fan_begin.push_back(std::uint32_t(l.fan_a.size()));
+  }
+  return lists;
+}
+} // namespace
+
+// Without a stencil (meshes): the list kernel takes whole vectors of particles, the last few the
+// per-particle reference; with colliders the kernel's forces go through euler_finish. One
+// fork-join per substep (sweep + finite check), as in row_sweep.
+template <typename Real> void CpuSolver<Real>::list_sweep(const Real h, const bool semi) {
+  const std::size_t n = pos_.size(), width = (simd_ == 2 ? 64 : 32) / sizeof(Real);
+  if (!lists_ || lists_->width != width)
+    lists_ = pad_lists<Real>(width, edge_offsets_, edges_, topology_->fan_offsets(), topology_->fans());
+  const detail::PaddedLists<Real>& l = *lists_;
+  detail::ListArgs<Real> la{};
+  step_args(la, h, semi);
+  la.pos = &pos_[0].x;
+  la.spring_begin = l.spring_begin.data();
+  la.other = l.other.data();
+  la.rest = l.rest.data();
+  la.stiff = l.stiff.data();
+  la.fan_begin = l.fan_begin.data();
+  la.fan_a = l.fan_a.data();
+  la.fan_b = l.fan_b.data();
+  const std::size_t vectors = n / width;
+  Real* const pn = &pos_next_[0].x;
+  Real* const vn = &vel_[0].x;
+  std::atomic<bool> bad{false};
+  // Work in units of one vector (the last unit: the particles after the last whole vector).
+  pool_->parallel_blocks(
+      vectors + (n % width != 0), std::max<std::size_t>(1, 2048 / width), [&](std::size_t b, std::size_t e) {
+        const std::size_t q0 = b * width, qv = std::min(e, vectors) * width, q1 = std::min(e * width, n);
+        bool simd_bad = false;
+#if VKCLOTH_ROW_SIMD
+        if (qv > q0)
+          (void)(simd_ == 2 ? detail::list_kernel_avx512(la, b, qv / width, simd_bad)
+                            : detail::list_kernel_avx2(la, b, qv / width, simd_bad));
+#endif
+        std::size_t unchecked = qv;
+        if (!la.integrate) { // the forces through the contacts, update, projection
+          for (std::size_t q = q0; q < qv; ++q)
+            euler_finish(q, force_[q], h, semi);
+          unchecked = q0;
+        }
+        for (std::size_t q = std::max(q0, qv); q < q1; ++q)
+          euler_finish(q, normal_force_at(pos_, vel_, q), h, semi);
+        if (simd_bad || bad_components(pn + 3 * unchecked, vn + 3 * unchecked,
+                                       3 * (q1 - std::min(unchecked, q1)), la.limit))
+          bad.store(true, std::memory_order_relaxed);
+      });
+  std::swap(pos_, pos_next_);
   swept_finite_ = !bad.load(std::memory_order_relaxed);
 }
 

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
-// The CPU solver's grid row kernel: its arguments and the per-ISA SIMD entry points.
+// The CPU solver's SIMD kernels (the grid row kernel, the list kernel for meshes, the contacts'
+// finish): their arguments and the per-ISA entry points.
 // The reference is the shared kernel (shaders/include/cloth_kernel.h, per particle in
 // cpu_solver.cpp); row_kernel_avx2.cpp and row_kernel_avx512.cpp hold the same arithmetic with
 // 8 / 16 (float) particles per vector, each file compiled with its own -m flags and only called
@@ -11,15 +12,24 @@
 
 namespace vkcloth::detail {
 
-template <typename Real> struct RowArgs {
-  const Real *px, *py, *pz; // positions, SoA
-  const Real* vel;          // velocities, AoS (x, y, z) per particle; written when integrating
-  Real* vel_out;            // == vel storage (in-place update), may be null when !integrate
+/// What the row and list kernels share: the state of the particles they update, and the body
+/// forces' and the integration's constants.
+template <typename Real> struct StepArgs {
+  const Real* vel; // velocities, AoS (x, y, z) per particle; written when integrating
+  Real* vel_out;   // == vel storage (in-place update), may be null when !integrate
   const Real* mass;
   const std::uint8_t* pinned;
-  Real* force_out;                   // AoS
-  Real* normal_out;                  // AoS
-  Real* pos_next;                    // AoS, written when integrating
+  Real* force_out;  // AoS
+  Real* normal_out; // AoS
+  Real* pos_next;   // AoS, written when integrating
+  Real gx, gy, gz, damping, kw, wx, wy, wz, dt;
+  Real limit; // divergence limit (the SIMD kernels' finite check)
+  bool wind, integrate, semi;
+};
+
+/// A grid's rows: the 12 stencil springs at constant offsets.
+template <typename Real> struct RowArgs : StepArgs<Real> {
+  const Real *px, *py, *pz;          // positions, SoA
   Real *sx_next, *sy_next, *sz_next; // next positions, SoA, written when integrating
   // Per-particle masks (null: every particle in [q0, q1) is interior): bit k (0..11) = stencil
   // spring k is in the particle's gather list, bit 12 + k (0..3) = normal fan term k is present.
@@ -30,9 +40,24 @@ template <typename Real> struct RowArgs {
   const std::int64_t* off; // 12 stencil offsets
   const Real* rest;        // 12
   const Real* stiff;       // 12
-  Real gx, gy, gz, damping, kw, wx, wy, wz, dt;
-  Real limit; // divergence limit (the SIMD kernels' finite check)
-  bool wind, integrate, semi;
+};
+
+/// Any other cloth (a mesh, a grid without a stencil): the gather and fan lists, padded so that a
+/// vector of W particles walks them together. Vector b holds particles [b W, b W + W); its spring
+/// slots are [spring_begin[b], spring_begin[b + 1]), slot k of lane l at spring_begin[b] + k W + l,
+/// in the particle's gather order. A lane with fewer springs than the longest list of its vector
+/// points the rest at itself: a zero-length spring adds nothing (add_spring's `len > 0`). Fan
+/// slots likewise (fan_begin, fan_a, fan_b), the padding with a == the particle itself, skipped by
+/// a select. Positions are read as they are stored (AoS).
+template <typename Real> struct ListArgs : StepArgs<Real> {
+  const Real* pos;
+  const std::uint32_t* spring_begin;
+  const std::uint32_t* other;
+  const Real* rest;
+  const Real* stiff;
+  const std::uint32_t* fan_begin;
+  const std::uint32_t* fan_a;
+  const std::uint32_t* fan_b;
 };
 
 /// A collider as the SIMD finish takes it: kernel::ColliderShape<Real>'s values, copied as they are
@@ -77,5 +102,11 @@ std::int64_t row_kernel_avx512(const RowArgs<float>& a, std::int64_t q0, std::in
 std::int64_t row_kernel_avx512(const RowArgs<double>& a, std::int64_t q0, std::int64_t q1, bool& bad);
 std::int64_t row_kernel_avx2(const RowArgs<float>& a, std::int64_t q0, std::int64_t q1, bool& bad);
 std::int64_t row_kernel_avx2(const RowArgs<double>& a, std::int64_t q0, std::int64_t q1, bool& bad);
+
+// Each runs the vectors [v0, v1) of ListArgs (particles [v0 W, v1 W)), with the same finite check.
+std::int64_t list_kernel_avx512(const ListArgs<float>& a, std::int64_t v0, std::int64_t v1, bool& bad);
+std::int64_t list_kernel_avx512(const ListArgs<double>& a, std::int64_t v0, std::int64_t v1, bool& bad);
+std::int64_t list_kernel_avx2(const ListArgs<float>& a, std::int64_t v0, std::int64_t v1, bool& bad);
+std::int64_t list_kernel_avx2(const ListArgs<double>& a, std::int64_t v0, std::int64_t v1, bool& bad);
 
 } // namespace vkcloth::detail

@@ -96,6 +96,12 @@ std::int64_t row_kernel_avx2(const RowArgs<float>& a, std::int64_t q0, std::int6
 std::int64_t row_kernel_avx2(const RowArgs<double>& a, std::int64_t q0, std::int64_t q1, bool& bad) {
   return simd_dispatch<IsaD>(a, q0, q1, bad);
 }
+std::int64_t list_kernel_avx2(const ListArgs<float>& a, std::int64_t v0, std::int64_t v1, bool& bad) {
+  return list_dispatch<IsaF>(a, v0, v1, bad);
+}
+std::int64_t list_kernel_avx2(const ListArgs<double>& a, std::int64_t v0, std::int64_t v1, bool& bad) {
+  return list_dispatch<IsaD>(a, v0, v1, bad);
+}
 std::int64_t finish_avx2(const FinishArgs<float>& a, std::int64_t q0, std::int64_t q1) {
   return simd_finish<IsaF>(a, q0, q1);
 }

@@ -27,6 +27,137 @@ template <typename T> inline typename T::V bc(typename T::Real x) {
 
 template <bool B> struct Flag { static constexpr bool value = B; };
 
+#define VKCLOTH_AI inline __attribute__((always_inline))
+
+// The end of one vector's step, shared by the row and list kernels: add_body_forces (gravity,
+// damping, wind), the normal and force stores and, when integrating, euler_update with the pins
+// and check_finite's test. `skipped` lanes (a tail vector's, done already) are left out of the
+// check; put3 stores AoS (and knows the tail); put_soa stores the next positions' SoA copy (the
+// row kernel's; the list kernel has none).
+template <typename T, bool wind, bool integrate, bool semi> struct StepTail {
+  using Real = typename T::Real;
+  using V = typename T::V;
+  using M = typename T::M;
+  // Copies of the arguments' pointers: stores through them cannot change these (nor the args).
+  const Real* __restrict mass;
+  const std::uint8_t* __restrict pinned;
+  Real* __restrict vel;
+  Real* __restrict force_out;
+  Real* __restrict normal_out;
+  Real* __restrict pos_next;
+  Real gx_, gy_, gz_, damping_, kw_, wx_, wy_, wz_, dt_, limit_; // broadcast where used (registers are few)
+
+  explicit StepTail(const vkcloth::detail::StepArgs<Real>& args)
+      : mass(args.mass), pinned(args.pinned), vel(args.vel_out), force_out(args.force_out),
+        normal_out(args.normal_out), pos_next(args.pos_next), gx_(args.gx), gy_(args.gy), gz_(args.gz),
+        damping_(args.damping), kw_(args.kw), wx_(args.wx), wy_(args.wy), wz_(args.wz), dt_(args.dt),
+        limit_(args.limit) {}
+
+  template <typename Put3, typename PutSoa>
+  VKCLOTH_AI void operator()(std::int64_t q, V x0, V y0, V z0, V fx, V fy, V fz, V nxv, V nyv, V nzv,
+                             M skipped, M& ok, Put3 put3, PutSoa put_soa) const {
+    const V zero = V{}, gx = bc<T>(gx_), gy = bc<T>(gy_), gz = bc<T>(gz_), damping = bc<T>(damping_),
+            kw = bc<T>(kw_), wx = bc<T>(wx_), wy = bc<T>(wy_), wz = bc<T>(wz_), dt = bc<T>(dt_),
+            lim = bc<T>(limit_), nlim = bc<T>(-limit_);
+    const V m = ld<T>(mass + q);
+    fx = fx + gx * m;
+    fy = fy + gy * m;
+    fz = fz + gz * m;
+    V vx, vy, vz;
+    T::load3(vel + 3 * q, vx, vy, vz);
+    const V dm = damping * m;
+    fx = fx - vx * dm;
+    fy = fy - vy * dm;
+    fz = fz - vz * dm;
+    if constexpr (wind) {
+      const V kn = kw * (nxv * wx + nyv * wy + nzv * wz);
+      fx = fx + nxv * kn;
+      fy = fy + nyv * kn;
+      fz = fz + nzv * kn;
+    }
+    put3(normal_out + 3 * q, nxv, nyv, nzv);
+    put3(force_out + 3 * q, fx, fy, fz);
+    if constexpr (integrate) {
+      const V ax = fx / m, ay = fy / m, az = fz / m;
+      // The current position is x0, y0, z0.
+      V nvx, nvy, nvz, nxx, nxy, nxz;
+      if constexpr (semi) {
+        nvx = vx + ax * dt;
+        nvy = vy + ay * dt;
+        nvz = vz + az * dt;
+        nxx = x0 + nvx * dt;
+        nxy = y0 + nvy * dt;
+        nxz = z0 + nvz * dt;
+      } else {
+        nxx = x0 + vx * dt;
+        nxy = y0 + vy * dt;
+        nxz = z0 + vz * dt;
+        nvx = vx + ax * dt;
+        nvy = vy + ay * dt;
+        nvz = vz + az * dt;
+      }
+      const M pin = T::pinmask(pinned + q);
+      const V ox = pin ? x0 : nxx, oy = pin ? y0 : nxy, oz = pin ? z0 : nxz;
+      put3(pos_next + 3 * q, ox, oy, oz);
+      put_soa(ox, oy, oz);
+      const V ux = pin ? vx : nvx, uy = pin ? vy : nvy, uz = pin ? vz : nvz;
+      put3(vel + 3 * q, ux, uy, uz);
+      // check_finite's test (bad_components), lane by lane: |x| <= limit (false for NaN) is
+      // x <= limit and -limit <= x; c - c == 0 fails for inf and NaN.
+      const M good = (ox <= lim) & (nlim <= ox) & (ox - ox == zero) & (oy <= lim) & (nlim <= oy) &
+                     (oy - oy == zero) & (oz <= lim) & (nlim <= oz) & (oz - oz == zero) & (ux - ux == zero) &
+                     (uy - uy == zero) & (uz - uz == zero);
+      ok = ok & (good | skipped);
+    }
+  }
+};
+
+// unit_or_zero, lane by lane: the fan sum over its length, zero where the length is not > 0.
+template <typename T>
+VKCLOTH_AI void unit_or_zero_v(typename T::V sx, typename T::V sy, typename T::V sz, typename T::V& nx,
+                               typename T::V& ny, typename T::V& nz) {
+  using V = typename T::V;
+  const V zero = V{};
+  const V nlen = T::sqrt(sx * sx + sy * sy + sz * sz);
+  const typename T::M npos = nlen > zero;
+  const V qx = sx / nlen, qy = sy / nlen, qz = sz / nlen;
+  nx = npos ? qx : zero;
+  ny = npos ? qy : zero;
+  nz = npos ? qz : zero;
+}
+
+// add_spring, lane by lane, for the lanes of `present` (u = the neighbour's position - x).
+template <typename T>
+VKCLOTH_AI void add_spring_v(typename T::V& fx, typename T::V& fy, typename T::V& fz, typename T::V ux,
+                             typename T::V uy, typename T::V uz, typename T::V rest, typename T::V k,
+                             typename T::M present) {
+  using V = typename T::V;
+  const V len = T::sqrt(ux * ux + uy * uy + uz * uz);
+  const V c = k * (len - rest) / len;
+  const typename T::M pos = (len > V{}) & present;
+  const V tx = fx + ux * c, ty = fy + uy * c, tz = fz + uz * c;
+  fx = pos ? tx : fx;
+  fy = pos ? ty : fy;
+  fz = pos ? tz : fz;
+}
+
+// Every lane of m is set.
+template <typename T> VKCLOTH_AI bool all_lanes(typename T::M m) {
+  bool r = true;
+  for (int l = 0; l < T::W; ++l)
+    r = r && m[l] != 0;
+  return r;
+}
+
+// Sets `bad` when some lane of `ok` is false.
+template <typename T> VKCLOTH_AI void report_bad(typename T::M ok, bool& bad) {
+  bool all = true;
+  for (int l = 0; l < T::W; ++l)
+    all = all && ok[l] != 0;
+  if (!all)
+    bad = true;
+}
+
 // One vector of W particles per iteration: normal fan, the 12 stencil springs, body forces, the
 // Euler update and the finite check, in the kernel's order. It is long (~180 lines) on purpose:
 // one loop body whose every value stays in a vector register; split into functions, GCC spills
@@ -41,20 +172,12 @@ std::int64_t simd_body(const vkcloth::detail::RowArgs<typename T::Real>& a, std:
   const Real* __restrict px = a.px;
   const Real* __restrict py = a.py;
   const Real* __restrict pz = a.pz;
-  const Real* __restrict mass = a.mass;
-  const std::uint8_t* __restrict pinned = a.pinned;
   const std::uint16_t* __restrict mask = a.mask;
-  Real* __restrict fo = a.force_out;
-  Real* __restrict no = a.normal_out;
-  Real* __restrict vel = a.vel_out;
-  Real* __restrict pos_next = a.pos_next;
   Real* __restrict sxn = a.sx_next;
   Real* __restrict syn = a.sy_next;
   Real* __restrict szn = a.sz_next;
   const V zero = V{};
-  const V gx = bc<T>(a.gx), gy = bc<T>(a.gy), gz = bc<T>(a.gz), damping = bc<T>(a.damping), kw = bc<T>(a.kw),
-          wx = bc<T>(a.wx), wy = bc<T>(a.wy), wz = bc<T>(a.wz), dt = bc<T>(a.dt);
-  const V lim = bc<T>(a.limit), nlim = bc<T>(-a.limit);
+  const StepTail<T, wind, integrate, semi> step_tail(a);
   M lane{}; // lane index, to leave a tail vector's skipped lanes out of the finite check
   for (int l = 0; l < W; ++l)
     lane[l] = l;
@@ -118,79 +241,22 @@ std::int64_t simd_body(const vkcloth::detail::RowArgs<typename T::Real>& a, std:
     VKCLOTH_CROSS_ADD(14, e2x, e2y, e2z, e3x, e3y, e3z)
     VKCLOTH_CROSS_ADD(15, e3x, e3y, e3z, e0x, e0y, e0z)
 #undef VKCLOTH_CROSS_ADD
-    const V nlen = T::sqrt(sx * sx + sy * sy + sz * sz);
-    const M npos = nlen > zero;
-    const V qx = sx / nlen, qy = sy / nlen, qz = sz / nlen;
-    const V nxv = npos ? qx : zero, nyv = npos ? qy : zero, nzv = npos ? qz : zero;
+    V nxv, nyv, nzv;
+    unit_or_zero_v<T>(sx, sy, sz, nxv, nyv, nzv);
     V fx = zero, fy = zero, fz = zero;
+    const M all = lane == lane;
 #pragma GCC unroll 12
     for (int k = 0; k < 12; ++k) {
       const std::int64_t r = q + O[k];
-      const V ux = ld<T>(px + r) - x0, uy = ld<T>(py + r) - y0, uz = ld<T>(pz + r) - z0;
-      const V len = T::sqrt(ux * ux + uy * uy + uz * uz);
-      const V c = K[k] * (len - L[k]) / len;
-      M pos = len > zero;
-      if constexpr (Masked)
-        pos = pos & has(k);
-      const V tx = fx + ux * c, ty = fy + uy * c, tz = fz + uz * c;
-      fx = pos ? tx : fx;
-      fy = pos ? ty : fy;
-      fz = pos ? tz : fz;
+      add_spring_v<T>(fx, fy, fz, ld<T>(px + r) - x0, ld<T>(py + r) - y0, ld<T>(pz + r) - z0, L[k], K[k],
+                      Masked ? has(k) : all);
     }
-    const V m = ld<T>(mass + q);
-    fx = fx + gx * m;
-    fy = fy + gy * m;
-    fz = fz + gz * m;
-    V vx, vy, vz;
-    T::load3(vel + 3 * q, vx, vy, vz);
-    const V dm = damping * m;
-    fx = fx - vx * dm;
-    fy = fy - vy * dm;
-    fz = fz - vz * dm;
-    if constexpr (wind) {
-      const V kn = kw * (nxv * wx + nyv * wy + nzv * wz);
-      fx = fx + nxv * kn;
-      fy = fy + nyv * kn;
-      fz = fz + nzv * kn;
-    }
-    put3(no + 3 * q, nxv, nyv, nzv);
-    put3(fo + 3 * q, fx, fy, fz);
-    if constexpr (integrate) {
-      const V ax = fx / m, ay = fy / m, az = fz / m;
-      // The current position is x0, y0, z0 (the SoA copy holds the AoS positions' values).
-      V nvx, nvy, nvz, nxx, nxy, nxz;
-      if constexpr (semi) {
-        nvx = vx + ax * dt;
-        nvy = vy + ay * dt;
-        nvz = vz + az * dt;
-        nxx = x0 + nvx * dt;
-        nxy = y0 + nvy * dt;
-        nxz = z0 + nvz * dt;
-      } else {
-        nxx = x0 + vx * dt;
-        nxy = y0 + vy * dt;
-        nxz = z0 + vz * dt;
-        nvx = vx + ax * dt;
-        nvy = vy + ay * dt;
-        nvz = vz + az * dt;
-      }
-      const M pin = T::pinmask(pinned + q);
-      const V ox = pin ? x0 : nxx, oy = pin ? y0 : nxy, oz = pin ? z0 : nxz;
-      put3(pos_next + 3 * q, ox, oy, oz);
-      put(sxn + q, ox);
-      put(syn + q, oy);
-      put(szn + q, oz);
-      const V ux = pin ? vx : nvx, uy = pin ? vy : nvy, uz = pin ? vz : nvz;
-      put3(vel + 3 * q, ux, uy, uz);
-      // check_finite's test (bad_components), lane by lane: |x| <= limit (false for NaN) is
-      // x <= limit and -limit <= x; c - c == 0 fails for inf and NaN.
-      M good = (ox <= lim) & (nlim <= ox) & (ox - ox == zero) & (oy <= lim) & (nlim <= oy) &
-               (oy - oy == zero) & (oz <= lim) & (nlim <= oz) & (oz - oz == zero) & (ux - ux == zero) &
-               (uy - uy == zero) & (uz - uz == zero);
-      if constexpr (Tail)
-        good = good | (lane < skip);
-      ok = ok & good;
-    }
+    step_tail(q, x0, y0, z0, fx, fy, fz, nxv, nyv, nzv, Tail ? M(lane < skip) : M{}, ok, put3,
+              [&](V ox, V oy, V oz) {
+                put(sxn + q, ox);
+                put(syn + q, oy);
+                put(szn + q, oz);
+              });
   };
   // Interior vectors (all W masks full) take the unmasked code; with no mask array, all do.
   auto full = [&](std::int64_t q) {
@@ -219,38 +285,119 @@ std::int64_t simd_body(const vkcloth::detail::RowArgs<typename T::Real>& a, std:
       vec(q, int(W - (q1 - done)), Flag<true>{}, Flag<true>{});
     done = q1;
   }
-  if constexpr (integrate) {
-    bool all = true;
-    for (int l = 0; l < W; ++l)
-      all = all && ok[l] != 0;
-    if (!all)
-      bad = true;
-  }
+  if constexpr (integrate)
+    report_bad<T>(ok, bad);
   return done;
+}
+
+// Calls fn(Flag<wind>, Flag<integrate>, Flag<semi>) with the arguments' flags as constants.
+template <typename Args, typename Fn> VKCLOTH_AI std::int64_t with_flags(const Args& a, Fn fn) {
+  using F = Flag<false>;
+  using R = Flag<true>;
+  switch ((a.wind ? 4 : 0) | (a.integrate ? 2 : 0) | (a.semi ? 1 : 0)) {
+  case 0:
+    return fn(F{}, F{}, F{});
+  case 1:
+    return fn(F{}, F{}, R{});
+  case 2:
+    return fn(F{}, R{}, F{});
+  case 3:
+    return fn(F{}, R{}, R{});
+  case 4:
+    return fn(R{}, F{}, F{});
+  case 5:
+    return fn(R{}, F{}, R{});
+  case 6:
+    return fn(R{}, R{}, F{});
+  default:
+    return fn(R{}, R{}, R{});
+  }
 }
 
 template <typename T>
 std::int64_t simd_dispatch(const vkcloth::detail::RowArgs<typename T::Real>& a, std::int64_t q0,
                            std::int64_t q1, bool& bad) {
-  const int v = (a.wind ? 4 : 0) | (a.integrate ? 2 : 0) | (a.semi ? 1 : 0);
-  switch (v) {
-  case 0:
-    return simd_body<T, false, false, false>(a, q0, q1, bad);
-  case 1:
-    return simd_body<T, false, false, true>(a, q0, q1, bad);
-  case 2:
-    return simd_body<T, false, true, false>(a, q0, q1, bad);
-  case 3:
-    return simd_body<T, false, true, true>(a, q0, q1, bad);
-  case 4:
-    return simd_body<T, true, false, false>(a, q0, q1, bad);
-  case 5:
-    return simd_body<T, true, false, true>(a, q0, q1, bad);
-  case 6:
-    return simd_body<T, true, true, false>(a, q0, q1, bad);
-  default:
-    return simd_body<T, true, true, true>(a, q0, q1, bad);
+  return with_flags(a, [&](auto wind, auto integrate, auto semi) {
+    return simd_body<T, decltype(wind)::value, decltype(integrate)::value, decltype(semi)::value>(a, q0, q1,
+                                                                                                  bad);
+  });
+}
+
+// ---- The list kernel: meshes and other cloths without a stencil (ListArgs) ---------------------
+// The same step as simd_body, the springs and fan terms read from the padded lists instead of at
+// constant offsets: per slot, the W lanes' neighbour indices are one vector load and their
+// positions W scalar loads (the lanes' neighbours differ). A vector's lanes walk as many slots as
+// its longest list; the padding adds nothing (row_kernel.hpp ListArgs), so each lane sums its own
+// terms in its list's order, with the kernel's operations: the reference's bits.
+
+template <typename T> VKCLOTH_AI typename T::M load_index(const std::uint32_t* p) {
+  typename T::M m;
+  for (int l = 0; l < T::W; ++l)
+    m[l] = p[l];
+  return m;
+}
+
+template <typename T, bool wind, bool integrate, bool semi>
+std::int64_t list_body(const vkcloth::detail::ListArgs<typename T::Real>& a, std::int64_t v0, std::int64_t v1,
+                       bool& bad) {
+  using Real = typename T::Real;
+  using V = typename T::V;
+  using M = typename T::M;
+  constexpr int W = T::W;
+  const Real* __restrict pos = a.pos;
+  const StepTail<T, wind, integrate, semi> step_tail(a);
+  M lane{};
+  for (int l = 0; l < W; ++l)
+    lane[l] = l;
+  const M all = lane == lane;
+  M ok = all;
+  const V zero = V{};
+  for (std::int64_t b = v0; b < v1; ++b) {
+    const std::int64_t q = b * W;
+    V x0, y0, z0;
+    T::load3(pos + 3 * q, x0, y0, z0);
+    const M self = lane + static_cast<__typeof__(lane[0] + 0)>(q);
+    V sx = zero, sy = zero, sz = zero;
+    for (std::uint32_t s = a.fan_begin[b]; s < a.fan_begin[b + 1]; s += W) {
+      const M ia = load_index<T>(a.fan_a + s), ib = load_index<T>(a.fan_b + s);
+      V ax, ay, az, bx, by, bz;
+      T::gather3(pos, ia, ax, ay, az);
+      T::gather3(pos, ib, bx, by, bz);
+      ax = ax - x0;
+      ay = ay - y0;
+      az = az - z0;
+      bx = bx - x0;
+      by = by - y0;
+      bz = bz - z0;
+      const M h = ia != self; // add_fan_triangle: sum + cross3(ea, eb)
+      sx = h ? sx + (ay * bz - by * az) : sx;
+      sy = h ? sy + (az * bx - bz * ax) : sy;
+      sz = h ? sz + (ax * by - bx * ay) : sz;
+    }
+    V nxv, nyv, nzv;
+    unit_or_zero_v<T>(sx, sy, sz, nxv, nyv, nzv);
+    V fx = zero, fy = zero, fz = zero;
+    for (std::uint32_t s = a.spring_begin[b]; s < a.spring_begin[b + 1]; s += W) {
+      V xq, yq, zq;
+      T::gather3(pos, load_index<T>(a.other + s), xq, yq, zq);
+      add_spring_v<T>(fx, fy, fz, xq - x0, yq - y0, zq - z0, ld<T>(a.rest + s), ld<T>(a.stiff + s), all);
+    }
+    step_tail(
+        q, x0, y0, z0, fx, fy, fz, nxv, nyv, nzv, M{}, ok,
+        [](Real* p, V x, V y, V z) { T::store3(p, x, y, z); }, [](V, V, V) {});
   }
+  if constexpr (integrate)
+    report_bad<T>(ok, bad);
+  return v1;
+}
+
+template <typename T>
+std::int64_t list_dispatch(const vkcloth::detail::ListArgs<typename T::Real>& a, std::int64_t v0,
+                           std::int64_t v1, bool& bad) {
+  return with_flags(a, [&](auto wind, auto integrate, auto semi) {
+    return list_body<T, decltype(wind)::value, decltype(integrate)::value, decltype(semi)::value>(a, v0, v1,
+                                                                                                  bad);
+  });
 }
 
 // ---- Contacts: the finish of a grid substep with colliders (FinishArgs) -----------------------
@@ -263,8 +410,6 @@ std::int64_t simd_dispatch(const vkcloth::detail::RowArgs<typename T::Real>& a, 
 // tests/test_cloth.cpp "the SIMD row kernels ... give the shared reference's bits" covers it.
 
 template <typename T> struct V3 { typename T::V x, y, z; };
-
-#define VKCLOTH_AI inline __attribute__((always_inline))
 
 template <typename T> VKCLOTH_AI V3<T> bc3(const typename T::Real* p) {
   return {bc<T>(p[0]), bc<T>(p[1]), bc<T>(p[2])};
@@ -507,6 +652,15 @@ template <typename Real, typename V, typename M, int W> struct IsaGeneric {
       p[3 * l] = x[l];
       p[3 * l + 1] = y[l];
       p[3 * l + 2] = z[l];
+    }
+  }
+  // The positions of the W particles `index` names, from AoS storage.
+  static void gather3(const Real* pos, M index, V& x, V& y, V& z) {
+    for (int l = 0; l < W; ++l) {
+      const Real* p = pos + 3 * std::size_t(index[l]);
+      x[l] = p[0];
+      y[l] = p[1];
+      z[l] = p[2];
     }
   }
   static M pinmask(const std::uint8_t* p) {
