@@ -20,7 +20,7 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_POS_IN) readonly buffer PosIn 
 // loads: what a GPU with a real memory path wants.
 // The topology's lists the same way: offsets_at(p) = offsets[p], edge_at(e) = edges[e],
 // fan_offsets_at(p) = fan_offsets[p], fan_at(t) = fans[t] (the mesh path: CSR gather, fan normal).
-// EDGES is viewed as R32UI, 3 texels per 12-byte Edge (no RGB32 texel format is mandatory).
+// EDGES is viewed as RGBA32UI, one texel per 16-byte Edge.
 #ifdef VKCLOTH_TEXEL_VIEWS
 layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_POS_IN) uniform samplerBuffer pos_in_texel;
 layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_PARTICLE) uniform usamplerBuffer particle_texel;
@@ -33,9 +33,8 @@ float mass_at(uint p) { return uintBitsToFloat(texelFetch(particle_texel, int(p)
 bool pinned_at(uint p) { return texelFetch(particle_texel, int(p)).y != 0u; }
 uint offsets_at(uint p) { return texelFetch(offsets_texel, int(p)).x; }
 Edge edge_at(uint e) {
-  const int t = VKCLOTH_EDGE_TEXELS * int(e);
-  return Edge(texelFetch(edges_texel, t).x, uintBitsToFloat(texelFetch(edges_texel, t + 1).x),
-              uintBitsToFloat(texelFetch(edges_texel, t + 2).x));
+  const uvec4 t = texelFetch(edges_texel, int(e));
+  return Edge(t.x, uintBitsToFloat(t.y), uintBitsToFloat(t.z), 0u);
 }
 uint fan_offsets_at(uint p) { return texelFetch(fan_offsets_texel, int(p)).x; }
 FanEntry fan_at(uint t) {
@@ -148,7 +147,9 @@ vec3 grid_normal(uint p) {
 }
 
 // The topology's fan around p (ClothTopology::fans, a mesh surface), in order: term for term
-// CpuSolver::normal_at, so the same bits. Edge vectors `precise` as in grid_normal.
+// CpuSolver::normal_at, so the same bits. Edge vectors `precise` as in grid_normal. (Reusing the
+// last term's eb where the ring order makes it a's edge was measured slower on lavapipe: the
+// branch costs more than the fetch it saves.)
 vec3 fan_normal(uint p) {
   const vec3 x = pos_at(p);
   vec3 sum = vec3(0.0);

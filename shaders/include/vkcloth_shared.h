@@ -70,7 +70,7 @@ struct vec4 {
 #define VKCLOTH_TEXEL_BINDING_FLAGS 3
 #define VKCLOTH_TEXEL_BINDING_INSTANCES 4    // InstanceParams as RGBA32UI, 5 texels per instance
 #define VKCLOTH_TEXEL_BINDING_OFFSETS 5      // OFFSETS as R32UI
-#define VKCLOTH_TEXEL_BINDING_EDGES 6        // EDGES as R32UI, VKCLOTH_EDGE_TEXELS texels per Edge
+#define VKCLOTH_TEXEL_BINDING_EDGES 6        // EDGES as RGBA32UI, one texel per Edge
 #define VKCLOTH_TEXEL_BINDING_FAN_OFFSETS 7  // FAN_OFFSETS as R32UI
 #define VKCLOTH_TEXEL_BINDING_FANS 8         // FANS as RG32UI, one texel per FanEntry
 #define VKCLOTH_TEXEL_BINDING_STRAIN_LINKS 9 // STRAIN_LINKS as R32UI, 3 texels per StrainLink
@@ -79,7 +79,6 @@ struct vec4 {
 #define VKCLOTH_TEXEL_BINDING_MESH_NODES 12  // MESH_NODES as RGBA32UI, 2 texels per MeshNode
 #define VKCLOTH_TEXEL_BINDING_MESH_TRIS 13   // MESH_TRIS as RGBA32UI, 3 texels per MeshTriangle
 #define VKCLOTH_TEXEL_BINDING_COUNT 14
-#define VKCLOTH_EDGE_TEXELS 3     // 32-bit words per Edge (static_assert below)
 #define VKCLOTH_COLLIDER_TEXELS 9 // 16-byte texels per Collider (static_assert below)
 
 // InstanceParams::flags bits.
@@ -159,11 +158,12 @@ struct ParticleInfo {
   uint pinned; // 1 when pinned
 };
 
-/// One gather-list entry (std430: 12 bytes, stride 12).
+/// One gather-list entry (std430: 16 bytes: one RGBA32UI texel, fetched at once on the texel path).
 struct Edge {
   uint other;
   float rest_length;
   float stiffness;
+  uint unused; // zero
 };
 
 /// One triangle of a particle's normal fan (ClothTopology's FanTriangle; std430: 8 bytes):
@@ -234,8 +234,7 @@ static_assert(offsetof(InstanceParams, dt) == 48);
 static_assert(offsetof(InstanceParams, limit) == 64);
 static_assert(sizeof(ParticleInfo) == 8);
 static_assert(sizeof(Vertex) == 32);
-static_assert(sizeof(Edge) == 12);
-static_assert(sizeof(Edge) == VKCLOTH_EDGE_TEXELS * 4);
+static_assert(sizeof(Edge) == 16);
 static_assert(sizeof(FanEntry) == 8);
 static_assert(sizeof(StrainLink) == 12);
 static_assert(sizeof(TetherSlot) == 8);

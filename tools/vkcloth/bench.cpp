@@ -486,8 +486,10 @@ Cost cost_of(const std::string& variant, Integrator integrator, double s, bool g
   const bool rk4 = integrator == Integrator::rk4;
   // Euler update: a = f/m 3, two axpys 12. RK4: 4 stages (eval + k sums 6 + next stage 12), final 12.
   c.flops = rk4 ? 4.0 * (eval + 18.0) + 12.0 : eval + 15.0;
-  // offsets + 12-byte edges; a mesh's fan lists: offsets + 8-byte terms
-  const double csr = grid ? 0.0 : 4.0 + 12.0 * s + (fans > 0.0 ? 4.0 + 8.0 * fans : 0.0);
+  // offsets + edges (12 bytes on the CPU, whose list kernel pads them per vector, ~15 % on a
+  // mesh, not counted; 16 on the GPU: one RGBA32UI texel); a mesh's fan lists: offsets + 8-byte terms
+  const double edge_bytes = variant == "cpu" ? 12.0 : 16.0;
+  const double csr = grid ? 0.0 : 4.0 + edge_bytes * s + (fans > 0.0 ? 4.0 + 8.0 * fans : 0.0);
   if (variant == "cpu") {
     // float vec3 (12 B): read pos, vel; write pos_next, vel, force, normal (and, on grids, the
     // next step's SoA position copy); mass 4 + pinned 1.

@@ -714,12 +714,12 @@ Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ClothTopology&
                     "use fewer particles or fewer instances of one topology",
                     ctx.name, batch * n, batch, n, batch * n, lim.maxTexelBufferElements));
   // So are the topology's lists (force_body.glsl offsets_at, edge_at, fan_offsets_at, fan_at):
-  // n + 1 offsets, VKCLOTH_EDGE_TEXELS texels per spring entry, one per fan triangle.
+  // n + 1 offsets, one texel per spring entry and per fan triangle.
   const struct {
     const char* what;
     std::uint64_t texels;
   } lists[] = {{"spring adjacency offsets", n + 1},
-               {"spring adjacency", edges_n * VKCLOTH_EDGE_TEXELS},
+               {"spring adjacency", edges_n},
                {"strain links", links_n * 3}, // three R32UI texels each
                {"normal fan offsets", fan_lists ? n + 1 : 0},
                {"normal fans", fans_n}};
@@ -860,7 +860,7 @@ Result<void> SolverBatch::upload_initial_state(const ClothTopology& topology,
   std::vector<sh::Edge> edge_data(edges_count);
   for (std::size_t e = 0; e < edges_count; ++e) {
     const GatherEdge& g = topology.edges()[e];
-    edge_data[e] = {g.other, float(g.rest_length), float(g.stiffness)};
+    edge_data[e] = {g.other, float(g.rest_length), float(g.stiffness), 0u};
   }
   // The fans as uploaded (FanTriangle and FanEntry are both two uint32 indices; copied field by
   // field all the same), or nothing: a zeroed element (Normals::grid and none never read them).

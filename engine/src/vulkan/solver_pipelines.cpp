@@ -108,8 +108,8 @@ Result<void> SolverBatch::create_descriptor_sets() {
 }
 
 // Set k: its positions view (k = 0, 1: positions[k]; 2: stage positions) and the same shared
-// views. Uniform texel buffer support is mandatory for these formats. Edges and strain links are
-// viewed as R32UI, 3 texels each (no RGB32 format is mandatory for texel buffers).
+// views. Uniform texel buffer support is mandatory for these formats. Strain links are viewed as
+// R32UI, 3 texels each (no RGB32 format is mandatory for texel buffers); an Edge is one RGBA32UI.
 Result<void> SolverBatch::create_texel_views() {
   const struct {
     const Buffer* buffer;
@@ -124,7 +124,7 @@ Result<void> SolverBatch::create_texel_views() {
                  {&flags, VK_FORMAT_R32_UINT, &flags_view, "flags"},
                  {&instances, VK_FORMAT_R32G32B32A32_UINT, &instances_view, "instance parameters"},
                  {&offsets, VK_FORMAT_R32_UINT, &offsets_view, "adjacency offsets"},
-                 {&edges, VK_FORMAT_R32_UINT, &edges_view, "adjacency"},
+                 {&edges, VK_FORMAT_R32G32B32A32_UINT, &edges_view, "adjacency"},
                  {&fan_offsets, VK_FORMAT_R32_UINT, &fan_offsets_view, "normal fan offsets"},
                  {&fans, VK_FORMAT_R32G32_UINT, &fans_view, "normal fans"},
                  {&strain_links, VK_FORMAT_R32_UINT, &strain_links_view, "strain links"}};
