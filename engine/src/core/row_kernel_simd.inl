@@ -151,17 +151,14 @@ template <typename T> VKCLOTH_AI bool all_lanes(typename T::M m) {
 
 // Sets `bad` when some lane of `ok` is false.
 template <typename T> VKCLOTH_AI void report_bad(typename T::M ok, bool& bad) {
-  bool all = true;
-  for (int l = 0; l < T::W; ++l)
-    all = all && ok[l] != 0;
-  if (!all)
+  if (!all_lanes<T>(ok))
     bad = true;
 }
 
 // One vector of W particles per iteration: normal fan, the 12 stencil springs, body forces, the
-// Euler update and the finite check, in the kernel's order. It is long (~180 lines) on purpose:
-// one loop body whose every value stays in a vector register; split into functions, GCC spills
-// the 16-lane temporaries between them (the SoA loads and the 12 spring terms share them).
+// Euler update and the finite check, in the kernel's order. One loop body whose values stay in
+// vector registers: the pieces it shares with the list kernel (StepTail, add_spring_v,
+// unit_or_zero_v) are always inlined, since across real calls GCC spills the 16-lane temporaries.
 template <typename T, bool wind, bool integrate, bool semi>
 std::int64_t simd_body(const vkcloth::detail::RowArgs<typename T::Real>& a, std::int64_t q0, std::int64_t q1,
                        bool& bad) {
