@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
 // SolverBatch (solver_batch.hpp): descriptor set layouts, sets and texel views, the compute
 // pipelines (force, integrate, the fused variants) and their specialisation constants (the grid
-// stencil, the fused variant, the fan-normal switch). The stepping, buffers and readbacks are in
-// solver_batch.cpp.
+// stencil, the fused variant, the fan-normal switch). The buffers and readbacks are in
+// solver_batch.cpp, the recording of the steps in solver_batch_record.cpp.
 #include "resources.hpp"
 
 #include <algorithm>
