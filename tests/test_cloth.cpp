@@ -50,6 +50,19 @@ glm::dvec3 stored(Backend b, glm::dvec3 p) {
   return is_float(b) ? glm::dvec3(glm::vec3(p)) : p;
 }
 
+/// Moves every particle by up to `amplitude` along each axis and gives each free one a velocity of
+/// up to 10 x `amplitude` per axis, from a seeded generator (the same jitter on every run), so that
+/// no lane of a SIMD kernel sees a symmetric configuration.
+void jitter_state(ParticleSystem& s, double amplitude, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> jitter(-amplitude, amplitude);
+  for (Particle& q : s.particles) {
+    q.position += glm::dvec3{jitter(rng), jitter(rng), jitter(rng)};
+    if (!q.pinned)
+      q.velocity = glm::dvec3{jitter(rng), jitter(rng), jitter(rng)} * 10.0;
+  }
+}
+
 } // namespace
 
 TEST_CASE("a free cloth without gravity, damping or colliders keeps its total momentum") {
@@ -407,13 +420,7 @@ TEST_CASE("the CPU row sweep: masked border rows and the per-particle border giv
   d.origin = {-0.5, 0.0, 0.5};
   ParticleSystem masked = cloth(d);
   masked.particles[std::size_t(1 * d.nx + 20)].pinned = true; // a pinned border particle
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<double> jitter(-0.004, 0.004);
-  for (Particle& q : masked.particles) {
-    q.position += glm::dvec3{jitter(rng), jitter(rng), jitter(rng)};
-    if (!q.pinned)
-      q.velocity = glm::dvec3{jitter(rng), jitter(rng), jitter(rng)} * 10.0;
-  }
+  jitter_state(masked, 0.004, 11);
   ParticleSystem border = masked;
   border.springs.push_back(Spring{0, d.nx + 3, 0.1, 0.0, SpringKind::plain});
   border.finalize();
@@ -554,13 +561,7 @@ TEST_CASE_TEMPLATE("the SIMD row kernels (AVX2, AVX-512) give the shared referen
   d.origin = {-0.5, 0.0, 0.5};
   ParticleSystem sys = cloth(d);
   sys.particles[std::size_t(10 * d.nx + 17)].pinned = true;
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> jitter(-0.004, 0.004);
-  for (Particle& q : sys.particles) {
-    q.position += glm::dvec3{jitter(rng), jitter(rng), jitter(rng)};
-    if (!q.pinned)
-      q.velocity = glm::dvec3{jitter(rng), jitter(rng), jitter(rng)} * 10.0;
-  }
+  jitter_state(sys, 0.004, 7);
   SimParams p;
   p.wind = {0.07, {0.2, 1, 0.1}};
   // Colliders 2 and 3 (the SIMD finish, row_kernel_simd.inl simd_finish): every shape it takes,
@@ -620,13 +621,7 @@ TEST_CASE_TEMPLATE(
     auto made = make_mesh_cloth(*mesh, desc);
     REQUIRE(made.ok());
     ParticleSystem sys = made->system;
-    std::mt19937 rng(11);
-    std::uniform_real_distribution<double> jitter(-0.003, 0.003);
-    for (Particle& q : sys.particles) {
-      q.position += glm::dvec3{jitter(rng), jitter(rng), jitter(rng)};
-      if (!q.pinned)
-        q.velocity = glm::dvec3{jitter(rng), jitter(rng), jitter(rng)} * 10.0;
-    }
+    jitter_state(sys, 0.003, 11);
     glm::dvec3 low(1e9);
     for (const Particle& q : sys.particles)
       low = glm::min(low, q.position);
