@@ -5,8 +5,10 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <limits>
 #include <string>
+#include <tuple>
 #include <utility>
 
 #include "vkcloth/gpu/world.hpp"
@@ -279,4 +281,141 @@ TEST_CASE("the grid's triangle strip with restart holds the triangle list's tria
     CHECK(from_strip == from_list);
   }
   CHECK(gpu::grid_triangle_strip_indices(1, 5).empty());
+}
+
+namespace {
+
+/// A surface from triangles (or polygons with `face_offsets`), springs along the given pairs.
+ParticleSystem surface_system(std::size_t n, std::vector<std::uint32_t> triangles,
+                              std::vector<std::pair<std::uint32_t, std::uint32_t>> springs,
+                              std::vector<std::uint32_t> face_offsets = {},
+                              std::vector<std::uint32_t> faces = {}) {
+  ParticleSystem s;
+  for (std::size_t p = 0; p < n; ++p) {
+    Particle q;
+    const double angle = 0.7 * double(p);
+    q.position = {std::cos(angle) * (1.0 + 0.1 * double(p)), std::sin(angle), 0.01 * double(p)};
+    q.mass = 0.1;
+    s.particles.push_back(q);
+  }
+  for (auto [a, b] : springs)
+    s.springs.push_back(Spring{a, b, 0.5 + 0.01 * double(a + b), 10.0 + double(a), SpringKind::structural});
+  s.surface = Surface{};
+  s.surface->triangles = std::move(triangles);
+  s.surface->face_offsets = std::move(face_offsets);
+  s.surface->faces = std::move(faces);
+  s.surface->uvs.assign(n, glm::vec2(0.0f));
+  s.finalize();
+  return s;
+}
+
+/// Particle p's fan triangles as its ring bits spell them (cloth_kernel.h add_ring_term's walk).
+std::vector<std::pair<std::uint32_t, std::uint32_t>> ring_triangles(const ClothTopology& t, std::uint32_t p) {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> out;
+  std::uint32_t prev = ~0u, first = ~0u;
+  for (std::uint32_t e = t.edge_offsets()[p]; e < t.edge_offsets()[p + 1]; ++e) {
+    const GatherEdge& g = t.edges()[e];
+    if (g.ring & ring_start)
+      first = g.other;
+    if (g.ring & ring_prev)
+      out.emplace_back(prev, g.other);
+    if (g.ring & ring_close)
+      out.emplace_back(g.other, first);
+    prev = g.other;
+  }
+  return out;
+}
+
+/// Every particle: the ring bits spell exactly its fan's triangles (those with p twice left out:
+/// they add zero); the ring entries come first; the gather list holds the adjacency's springs
+/// (other end and constants) plus a zero-stiffness entry per fan neighbour no spring reaches.
+void check_rings(const ParticleSystem& s, std::size_t zero_entries_expected) {
+  const auto t = prepare(s);
+  REQUIRE(t->ring_normals());
+  std::size_t zero_entries = 0;
+  for (std::uint32_t p = 0; p < s.size(); ++p) {
+    CAPTURE(p);
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> fan;
+    for (std::uint32_t k = t->fan_offsets()[p]; k < t->fan_offsets()[p + 1]; ++k)
+      if (t->fans()[k].a != p && t->fans()[k].b != p)
+        fan.emplace_back(t->fans()[k].a, t->fans()[k].b);
+    auto spelled = ring_triangles(*t, p);
+    std::sort(fan.begin(), fan.end());
+    std::sort(spelled.begin(), spelled.end());
+    CHECK(spelled == fan);
+
+    bool ring_part = true;
+    std::vector<std::tuple<std::uint32_t, double, double>> got, want;
+    for (std::uint32_t e = t->edge_offsets()[p]; e < t->edge_offsets()[p + 1]; ++e) {
+      const GatherEdge& g = t->edges()[e];
+      CHECK((g.ring == 0 || ring_part)); // no ring entry after a plain one
+      ring_part = ring_part && g.ring != 0;
+      if (g.stiffness == 0.0 && g.rest_length == 0.0)
+        ++zero_entries;
+      else
+        got.emplace_back(g.other, g.rest_length, g.stiffness);
+    }
+    for (std::uint32_t e = s.adjacency.offsets[p]; e < s.adjacency.offsets[p + 1]; ++e) {
+      const Spring& sp = s.springs[s.adjacency.refs[e].spring];
+      want.emplace_back(s.adjacency.refs[e].other, sp.rest_length, sp.stiffness);
+    }
+    std::sort(got.begin(), got.end());
+    std::sort(want.begin(), want.end());
+    CHECK(got == want);
+  }
+  CHECK(zero_entries == zero_entries_expected);
+}
+
+} // namespace
+
+TEST_CASE("a surface's gather lists carry its normal fans: ring bits spell every fan triangle") {
+  SUBCASE("a hexagon around a centre: one closed ring inside, open chains on the rim") {
+    // Centre 0, rim 1..6 counter-clockwise; springs along every triangle edge.
+    std::vector<std::uint32_t> tris;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> springs;
+    for (std::uint32_t k = 1; k <= 6; ++k) {
+      const std::uint32_t next = k % 6 + 1;
+      tris.insert(tris.end(), {0, k, next});
+      springs.emplace_back(0, k);
+      springs.emplace_back(k, next);
+    }
+    const ParticleSystem s = surface_system(7, tris, springs);
+    check_rings(s, 0);
+    const auto t = prepare(s);
+    // The centre: its 6 neighbours in ring order, one chain that closes.
+    REQUIRE(t->edge_offsets()[1] - t->edge_offsets()[0] == 6);
+    CHECK(t->edges()[0].ring == ring_start);
+    for (int k = 1; k < 5; ++k)
+      CHECK(t->edges()[std::size_t(k)].ring == ring_prev);
+    CHECK(t->edges()[5].ring == (ring_prev | ring_close));
+    // A rim particle: an open chain of 3 (its two triangles).
+    const std::uint32_t rim = t->edge_offsets()[1];
+    CHECK(t->edges()[rim].ring == ring_start);
+    CHECK(t->edges()[rim + 1].ring == ring_prev);
+    CHECK(t->edges()[rim + 2].ring == ring_prev);
+  }
+  SUBCASE("a bowtie: two chains at the shared corner") {
+    check_rings(surface_system(5, {0, 1, 2, 0, 3, 4}, {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {3, 4}, {4, 0}}), 0);
+  }
+  SUBCASE("fan neighbours no spring reaches get zero-stiffness entries") {
+    // Triangle (0, 1, 2) with a single spring 0-1: particle 0 lacks 2, 1 lacks 2, 2 lacks 0 and 1.
+    check_rings(surface_system(3, {0, 1, 2}, {{0, 1}}), 4);
+  }
+  SUBCASE("a neighbour twice in one fan (two triangles on one edge pair) and a degenerate triangle") {
+    // (0, 1, 2) and (0, 2, 1): particle 0's chain 1 -> 2 -> 1 closes; (0, 0, 3) adds nothing.
+    check_rings(surface_system(4, {0, 1, 2, 0, 2, 1, 0, 0, 3}, {{0, 1}, {1, 2}, {2, 0}, {0, 3}}), 0);
+  }
+  SUBCASE("quads: each corner's edge neighbours") {
+    // A 3 x 2 strip of two quads, 0 1 2 / 3 4 5, counter-clockwise.
+    check_rings(surface_system(6, {0, 1, 4, 0, 4, 3, 1, 2, 5, 1, 5, 4},
+                               {{0, 1}, {1, 2}, {3, 4}, {4, 5}, {0, 3}, {1, 4}, {2, 5}, {0, 4}, {1, 5}},
+                               {0, 4, 8}, {0, 1, 4, 3, 1, 2, 5, 4}),
+                0);
+  }
+  SUBCASE("a grid keeps its adjacency order and its fan lists") {
+    const auto t = prepare(cloth(4, 6)); // no stencil under 5 x 5 either
+    CHECK_FALSE(t->ring_normals());
+    for (const GatherEdge& g : t->edges())
+      CHECK(g.ring == 0);
+  }
 }

@@ -52,6 +52,19 @@ KFN void add_fan_triangle(INOUT(vec3) sum, vec3 ea, vec3 eb) {
   sum = t;
 }
 
+// A gather-list entry's part in its particle's fan (Edge::ring, VKCLOTH_RING_*), u its edge: the
+// list walks the fan's triangles as chains of neighbours, so the normal reuses the springs' edges.
+// `prev` and `first` carry the previous entry's edge and the chain's first between calls.
+KFN void add_ring_term(INOUT(vec3) sum, INOUT(vec3) prev, INOUT(vec3) first, vec3 u, uint ring) {
+  if ((ring & VKCLOTH_RING_START) != 0u)
+    first = u;
+  if ((ring & VKCLOTH_RING_PREV) != 0u)
+    add_fan_triangle(sum, prev, u);
+  if ((ring & VKCLOTH_RING_CLOSE) != 0u)
+    add_fan_triangle(sum, u, first);
+  prev = u;
+}
+
 // The unit normal of a fan sum; zero for a degenerate fan (and for particles without a surface).
 KFN precise vec3 unit_or_zero(vec3 sum) {
   precise real len = sqrt(dot3(sum, sum));
@@ -61,15 +74,19 @@ KFN precise vec3 unit_or_zero(vec3 sum) {
 
 // ---- Forces (docs/model.md "Springs", "Forces", "Wind") -------------------------
 
-// Eq. 2, one spring of particle x towards its neighbour xq: f += K (|u| - L0) u / |u|, u = xq - x.
-// A zero-length spring has no direction and adds nothing.
-KFN void add_spring(INOUT(vec3) f, vec3 x, vec3 xq, real rest, real k) {
-  precise vec3 u = xq - x;
+// Eq. 2, one spring of a particle towards its neighbour, u = x_q - x the edge between them:
+// f += K (|u| - L0) u / |u|. A zero-length spring has no direction and adds nothing.
+KFN void add_spring_edge(INOUT(vec3) f, vec3 u, real rest, real k) {
   precise real len = sqrt(dot3(u, u));
   if (len > real(0)) {
     precise vec3 t = f + u * (k * (len - rest) / len);
     f = t;
   }
+}
+
+KFN void add_spring(INOUT(vec3) f, vec3 x, vec3 xq, real rest, real k) {
+  precise vec3 u = xq - x;
+  add_spring_edge(f, u, rest, k);
 }
 
 // The springs' sum plus gravity m g, fluid damping -mu m v and (when `wind`) wind Kw <n, u> n.

@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: MIT
 // The force evaluation of one particle, shared by force.comp (two-pass layout), fused.comp (one
-// pass per Euler step) and implicit.comp: vertex normal from the grid fan or the topology's fan
-// lists, spring gather in the topology's order, gravity, damping, wind, then contact filtering;
-// each formula from cloth_kernel.h, which the CPU reference compiles too. Reads POS_IN (all
-// particles), OFFSETS, EDGES, FAN_OFFSETS, FANS, PARTICLE (with VKCLOTH_TEXEL_VIEWS
-// through set 1's texel views, see below).
+// pass per Euler step) and implicit.comp: vertex normal from the grid fan or from the gather
+// lists' ring terms, spring gather in the topology's order, gravity, damping, wind, then contact
+// filtering; each formula from cloth_kernel.h, which the CPU reference compiles too. Reads POS_IN
+// (all particles), OFFSETS, EDGES, PARTICLE (with VKCLOTH_TEXEL_VIEWS through set 1's texel views,
+// see below).
 #ifndef VKCLOTH_FORCE_BODY_GLSL
 #define VKCLOTH_FORCE_BODY_GLSL
 
@@ -18,41 +18,29 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_POS_IN) readonly buffer PosIn 
 // branch per component, a texel fetch into one vectorised gather of the 8 lanes' texels. A 32-bit
 // texel fetch is a copy: same bits. Without it (the *_storage builds, implicit.comp), plain std430
 // loads: what a GPU with a real memory path wants.
-// The topology's lists the same way: offsets_at(p) = offsets[p], edge_at(e) = edges[e],
-// fan_offsets_at(p) = fan_offsets[p], fan_at(t) = fans[t] (the mesh path: CSR gather, fan normal).
-// EDGES is viewed as RGBA32UI, one texel per 16-byte Edge.
+// The topology's lists the same way: offsets_at(p) = offsets[p], edge_at(e) = edges[e] (the mesh
+// path: CSR gather and ring normal). EDGES is viewed as RGBA32UI, one texel per 16-byte Edge.
 #ifdef VKCLOTH_TEXEL_VIEWS
 layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_POS_IN) uniform samplerBuffer pos_in_texel;
 layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_PARTICLE) uniform usamplerBuffer particle_texel;
 layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_OFFSETS) uniform usamplerBuffer offsets_texel;
 layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_EDGES) uniform usamplerBuffer edges_texel;
-layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_FAN_OFFSETS) uniform usamplerBuffer fan_offsets_texel;
-layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_FANS) uniform usamplerBuffer fans_texel;
 vec3 pos_at(uint q) { return texelFetch(pos_in_texel, int(base + q)).xyz; }
 float mass_at(uint p) { return uintBitsToFloat(texelFetch(particle_texel, int(p)).x); }
 bool pinned_at(uint p) { return texelFetch(particle_texel, int(p)).y != 0u; }
 uint offsets_at(uint p) { return texelFetch(offsets_texel, int(p)).x; }
 Edge edge_at(uint e) {
   const uvec4 t = texelFetch(edges_texel, int(e));
-  return Edge(t.x, uintBitsToFloat(t.y), uintBitsToFloat(t.z), 0u);
-}
-uint fan_offsets_at(uint p) { return texelFetch(fan_offsets_texel, int(p)).x; }
-FanEntry fan_at(uint t) {
-  const uvec2 f = texelFetch(fans_texel, int(t)).xy;
-  return FanEntry(f.x, f.y);
+  return Edge(t.x, uintBitsToFloat(t.y), uintBitsToFloat(t.z), t.w);
 }
 #else
 layout(std430, set = 0, binding = VKCLOTH_BINDING_OFFSETS) readonly buffer OffsetBuf { uint offsets[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_EDGES) readonly buffer EdgeBuf { Edge edges[]; };
-layout(std430, set = 0, binding = VKCLOTH_BINDING_FAN_OFFSETS) readonly buffer FanOffsetBuf { uint fan_offsets[]; };
-layout(std430, set = 0, binding = VKCLOTH_BINDING_FANS) readonly buffer FanBuf { FanEntry fans[]; };
 vec3 pos_at(uint q) { return pos_in[base + q].xyz; }
 float mass_at(uint p) { return particle[p].mass; }
 bool pinned_at(uint p) { return particle[p].pinned != 0u; }
 uint offsets_at(uint p) { return offsets[p]; }
 Edge edge_at(uint e) { return edges[e]; }
-uint fan_offsets_at(uint p) { return fan_offsets[p]; }
-FanEntry fan_at(uint t) { return fans[t]; }
 #endif
 
 // Grid stencil (specialisation constants, set by the host when every interior particle's gather
@@ -103,10 +91,11 @@ layout(constant_id = 38) const float SC_K11 = 0.0;
 // the CSR loop, which llvmpipe runs for every 8-lane group holding a border particle (and whose
 // per-lane loads it pays, masked, for every group).
 layout(constant_id = 39) const bool SC_BORDER = false;
-// False: no instance of the batch takes the fan-list normal (VKCLOTH_FLAG_HAS_FANS), the fan loop
-// compiled out (llvmpipe would run its body once per group even when no invocation enters it).
-// The host sets it with the fused.comp and force.comp pipelines; implicit.comp keeps the default.
-layout(constant_id = 42) const bool SC_FANS = true;
+// False: no instance of the batch takes its normal from the gather lists
+// (VKCLOTH_FLAG_RING_NORMALS), the ring terms compiled out (llvmpipe would run them once per group
+// even when no invocation needs them). The host sets it with the fused.comp and force.comp
+// pipelines; implicit.comp keeps the default.
+layout(constant_id = 42) const bool SC_RING = true;
 
 // Bit `bit` when stencil neighbour `off` of grid particle (i, j) lies inside the grid
 // (off = dj nx + di with |di|, |dj| <= 2; compile-time constants after specialisation).
@@ -146,23 +135,6 @@ vec3 grid_normal(uint p) {
   return unit_or_zero(sum);
 }
 
-// The topology's fan around p (ClothTopology::fans, a mesh surface), in order: term for term
-// CpuSolver::normal_at, so the same bits. Edge vectors `precise` as in grid_normal. (Reusing the
-// last term's eb where the ring order makes it a's edge was measured slower on lavapipe: the
-// branch costs more than the fetch it saves.)
-vec3 fan_normal(uint p) {
-  const vec3 x = pos_at(p);
-  vec3 sum = vec3(0.0);
-  const uint end = fan_offsets_at(p + 1u);
-  for (uint t = fan_offsets_at(p); t < end; ++t) {
-    const FanEntry f = fan_at(t);
-    precise vec3 ea = pos_at(f.a) - x;
-    precise vec3 eb = pos_at(f.b) - x;
-    add_fan_triangle(sum, ea, eb);
-  }
-  return unit_or_zero(sum);
-}
-
 #ifdef VKCLOTH_FRICTION_AFTER_SOLVE
 // implicit.comp: the force the contact filter removed from this particle (F - filtered F).
 vec3 contact_removed_force = vec3(0.0);
@@ -173,7 +145,6 @@ vec3 contact_removed_force = vec3(0.0);
 void particle_force(uint p, inout vec3 v_io, out vec3 f_out, out vec3 nrm_out) {
   vec3 nrm = vec3(0.0);
   if ((ip.flags & VKCLOTH_FLAG_HAS_GRID) != 0u) nrm = grid_normal(p);
-  else if (SC_FANS && (ip.flags & VKCLOTH_FLAG_HAS_FANS) != 0u) nrm = fan_normal(p);
 
   const vec3 x = pos_at(p);
   vec3 f = vec3(0.0);
@@ -202,11 +173,18 @@ void particle_force(uint p, inout vec3 v_io, out vec3 f_out, out vec3 nrm_out) {
     if ((has & 1024u) != 0u) spring_term(f, x, uint(q + SC_OFF10), SC_L10, SC_K10);
     if ((has & 2048u) != 0u) spring_term(f, x, uint(q + SC_OFF11), SC_L11, SC_K11);
   } else {
+    // The springs' edges also make the normal (ClothTopology::ring_normals; CpuSolver::
+    // normal_force_at, term for term).
+    const bool ring = SC_RING && (ip.flags & VKCLOTH_FLAG_RING_NORMALS) != 0u;
+    vec3 fan = vec3(0.0), prev = vec3(0.0), first = vec3(0.0);
     const uint end = offsets_at(p + 1u);
     for (uint e = offsets_at(p); e < end; ++e) {
       const Edge s = edge_at(e);
-      spring_term(f, x, s.other, s.rest_length, s.stiffness);
+      precise vec3 u = pos_at(s.other) - x;
+      add_spring_edge(f, u, s.rest_length, s.stiffness);
+      if (ring) add_ring_term(fan, prev, first, u, s.ring);
     }
+    if (ring) nrm = unit_or_zero(fan);
   }
   const float m = mass_at(p);
   vec3 v = v_io;

@@ -13,16 +13,16 @@
 namespace vkcloth::gpu::shared {
 #endif
 
-#define VKCLOTH_BINDING_SELF_PARAMS 37 // (after implicit Euler's) SelfParams per instance
-#define VKCLOTH_BINDING_SELF_REST 38   // rest positions, w: inverse mass (vec4 per particle of the topology)
+#define VKCLOTH_BINDING_SELF_PARAMS 35 // (after implicit Euler's) SelfParams per instance
+#define VKCLOTH_BINDING_SELF_REST 36   // rest positions, w: inverse mass (vec4 per particle of the topology)
 #define VKCLOTH_BINDING_SELF_COUNTS                                                                          \
-  39 // particles per bucket (uint, table size per instance; zero between substeps)
-#define VKCLOTH_BINDING_SELF_STARTS 40 // each bucket's first entry (uint, table size + 1 per instance)
+  37 // particles per bucket (uint, table size per instance; zero between substeps)
+#define VKCLOTH_BINDING_SELF_STARTS 38 // each bucket's first entry (uint, table size + 1 per instance)
 #define VKCLOTH_BINDING_SELF_BLOCKS                                                                          \
-  41 // each scan block's first entry (uint, table size / SCAN_BLOCK per instance)
-#define VKCLOTH_BINDING_SELF_KEYS 42   // each particle's cell key when sorted (uint, per particle)
-#define VKCLOTH_BINDING_SELF_SORTED 43 // the particles by bucket, then by index, with their keys (uvec2)
-#define VKCLOTH_BINDING_SELF_DELTA 44  // this Jacobi pass's move and velocity change (2 vec4 per particle)
+  39 // each scan block's first entry (uint, table size / SCAN_BLOCK per instance)
+#define VKCLOTH_BINDING_SELF_KEYS 40   // each particle's cell key when sorted (uint, per particle)
+#define VKCLOTH_BINDING_SELF_SORTED 41 // the particles by bucket, then by index, with their keys (uvec2)
+#define VKCLOTH_BINDING_SELF_DELTA 42  // this Jacobi pass's move and velocity change (2 vec4 per particle)
 
 // Buckets per workgroup of the SCAN_BLOCKS pass: 64 invocations x 8 (the table size is a
 // multiple: kernel.hpp self_table_size).

@@ -27,41 +27,39 @@ struct vec4 {
 // Descriptor bindings (set 0). One layout serves both pipelines; each shader declares the
 // bindings it uses. Four descriptor sets differ only in which buffers sit behind the
 // *_IN / *_BASE / *_OUT / FORCE_OUT bindings (position parity x state-or-RK4-stage input).
-#define VKCLOTH_BINDING_POS_IN 0       // positions the force pass reads (state or RK4 stage)
-#define VKCLOTH_BINDING_VEL_IN 1       // velocities the force pass reads (state or RK4 stage)
-#define VKCLOTH_BINDING_FORCE_OUT 2    // force after contacts (state force, or RK4 stage scratch)
-#define VKCLOTH_BINDING_VEL_FILT 3     // velocity after contact filtering (force -> integrate)
-#define VKCLOTH_BINDING_NORMAL 4       // unit vertex normals (cloth), written every force pass
-#define VKCLOTH_BINDING_POS_BASE 5     // positions at the start of the step (= positions[read])
-#define VKCLOTH_BINDING_POS_OUT 6      // positions at the end of the step (= positions[write])
-#define VKCLOTH_BINDING_VEL 7          // state velocities (read and written by integrate)
-#define VKCLOTH_BINDING_STAGE_POS 8    // RK4 stage positions y_k
-#define VKCLOTH_BINDING_STAGE_VEL 9    // RK4 stage velocities
-#define VKCLOTH_BINDING_ACC_POS 10     // RK4 running sum k1 + 2 k2 + 2 k3 + k4 (positions)
-#define VKCLOTH_BINDING_ACC_VEL 11     // RK4 running sum (velocities)
-#define VKCLOTH_BINDING_PARTICLE 12    // ParticleInfo per particle
-#define VKCLOTH_BINDING_OFFSETS 13     // CSR offsets, count + 1 entries (SpringAdjacency::offsets)
-#define VKCLOTH_BINDING_EDGES 14       // CSR entries in gather order (Edge)
-#define VKCLOTH_BINDING_COLLIDERS 15   // Collider array (collider_count entries, at least one slot)
-#define VKCLOTH_BINDING_FLAGS 16       // Flags per instance (divergence detection)
-#define VKCLOTH_BINDING_INSTANCES 17   // InstanceParams per instance
-#define VKCLOTH_BINDING_FAN_OFFSETS 18 // normal fans' CSR offsets, count + 1 (ClothTopology::fan_offsets)
-#define VKCLOTH_BINDING_FANS 19        // FanEntry per fan triangle (ClothTopology::fans)
+#define VKCLOTH_BINDING_POS_IN 0     // positions the force pass reads (state or RK4 stage)
+#define VKCLOTH_BINDING_VEL_IN 1     // velocities the force pass reads (state or RK4 stage)
+#define VKCLOTH_BINDING_FORCE_OUT 2  // force after contacts (state force, or RK4 stage scratch)
+#define VKCLOTH_BINDING_VEL_FILT 3   // velocity after contact filtering (force -> integrate)
+#define VKCLOTH_BINDING_NORMAL 4     // unit vertex normals (cloth), written every force pass
+#define VKCLOTH_BINDING_POS_BASE 5   // positions at the start of the step (= positions[read])
+#define VKCLOTH_BINDING_POS_OUT 6    // positions at the end of the step (= positions[write])
+#define VKCLOTH_BINDING_VEL 7        // state velocities (read and written by integrate)
+#define VKCLOTH_BINDING_STAGE_POS 8  // RK4 stage positions y_k
+#define VKCLOTH_BINDING_STAGE_VEL 9  // RK4 stage velocities
+#define VKCLOTH_BINDING_ACC_POS 10   // RK4 running sum k1 + 2 k2 + 2 k3 + k4 (positions)
+#define VKCLOTH_BINDING_ACC_VEL 11   // RK4 running sum (velocities)
+#define VKCLOTH_BINDING_PARTICLE 12  // ParticleInfo per particle
+#define VKCLOTH_BINDING_OFFSETS 13   // CSR offsets, count + 1 entries (SpringAdjacency::offsets)
+#define VKCLOTH_BINDING_EDGES 14     // CSR entries in gather order (Edge)
+#define VKCLOTH_BINDING_COLLIDERS 15 // Collider array (collider_count entries, at least one slot)
+#define VKCLOTH_BINDING_FLAGS 16     // Flags per instance (divergence detection)
+#define VKCLOTH_BINDING_INSTANCES 17 // InstanceParams per instance
 #define VKCLOTH_BINDING_STRAIN_LINKS                                                                         \
-  20 // StrainLink per strain link, in colour order (ClothTopology::strain_links)
+  18 // StrainLink per strain link, in colour order (ClothTopology::strain_links)
 #define VKCLOTH_BINDING_TETHERS                                                                              \
-  21 // TetherSlot, VKCLOTH_TETHERS_PER_PARTICLE per particle, euclidean then geodesic
-#define VKCLOTH_BINDING_UV 22 // texture coordinates (vec4: u, v, 0, 0), read by vertices.comp
+  19 // TetherSlot, VKCLOTH_TETHERS_PER_PARTICLE per particle, euclidean then geodesic
+#define VKCLOTH_BINDING_UV 20 // texture coordinates (vec4: u, v, 0, 0), read by vertices.comp
 #define VKCLOTH_BINDING_VERTICES                                                                             \
-  23 // interleaved Vertex per particle (GpuSolverOptions::interleaved_vertices)
-#define VKCLOTH_BINDING_MESH_NODES 24 // MeshNode: every mesh collider's hierarchy (Collider::mesh_root)
-#define VKCLOTH_BINDING_MESH_TRIS 25  // MeshTriangle: their triangles in leaf order (Collider::mesh_tri0)
-#define VKCLOTH_BINDING_COUNT 26
+  21 // interleaved Vertex per particle (GpuSolverOptions::interleaved_vertices)
+#define VKCLOTH_BINDING_MESH_NODES 22 // MeshNode: every mesh collider's hierarchy (Collider::mesh_root)
+#define VKCLOTH_BINDING_MESH_TRIS 23  // MeshTriangle: their triangles in leaf order (Collider::mesh_tri0)
+#define VKCLOTH_BINDING_COUNT 24
 
 // Set 1 (force.comp, fused.comp, strain_*.comp): POS_IN again, as an RGBA32F uniform texel buffer view,
 // PARTICLE as an RG32UI one (x: the mass's bits, y: pinned), and (fused.comp) VEL as RGBA32F and
 // FLAGS as R32UI; INSTANCES as RGBA32UI (common.glsl begin_instance); the topology's lists
-// (force_body.glsl offsets_at, edge_at, fan_offsets_at, fan_at) as R32UI / RG32UI views; the
+// (force_body.glsl offsets_at, edge_at) as R32UI / RGBA32UI views; the
 // colliders and the mesh colliders' nodes and triangles as RGBA32UI (common.glsl collider_shape,
 // mesh_node, mesh_triangle).
 #define VKCLOTH_TEXEL_BINDING_POS_IN 0
@@ -71,24 +69,29 @@ struct vec4 {
 #define VKCLOTH_TEXEL_BINDING_INSTANCES 4    // InstanceParams as RGBA32UI, 5 texels per instance
 #define VKCLOTH_TEXEL_BINDING_OFFSETS 5      // OFFSETS as R32UI
 #define VKCLOTH_TEXEL_BINDING_EDGES 6        // EDGES as RGBA32UI, one texel per Edge
-#define VKCLOTH_TEXEL_BINDING_FAN_OFFSETS 7  // FAN_OFFSETS as R32UI
-#define VKCLOTH_TEXEL_BINDING_FANS 8         // FANS as RG32UI, one texel per FanEntry
-#define VKCLOTH_TEXEL_BINDING_STRAIN_LINKS 9 // STRAIN_LINKS as R32UI, 3 texels per StrainLink
-#define VKCLOTH_TEXEL_BINDING_TETHERS 10     // TETHERS as RG32UI, one texel per TetherSlot
-#define VKCLOTH_TEXEL_BINDING_COLLIDERS 11   // COLLIDERS as RGBA32UI, VKCLOTH_COLLIDER_TEXELS per Collider
-#define VKCLOTH_TEXEL_BINDING_MESH_NODES 12  // MESH_NODES as RGBA32UI, 2 texels per MeshNode
-#define VKCLOTH_TEXEL_BINDING_MESH_TRIS 13   // MESH_TRIS as RGBA32UI, 3 texels per MeshTriangle
-#define VKCLOTH_TEXEL_BINDING_COUNT 14
+#define VKCLOTH_TEXEL_BINDING_STRAIN_LINKS 7 // STRAIN_LINKS as R32UI, 3 texels per StrainLink
+#define VKCLOTH_TEXEL_BINDING_TETHERS 8      // TETHERS as RG32UI, one texel per TetherSlot
+#define VKCLOTH_TEXEL_BINDING_COLLIDERS 9    // COLLIDERS as RGBA32UI, VKCLOTH_COLLIDER_TEXELS per Collider
+#define VKCLOTH_TEXEL_BINDING_MESH_NODES 10  // MESH_NODES as RGBA32UI, 2 texels per MeshNode
+#define VKCLOTH_TEXEL_BINDING_MESH_TRIS 11   // MESH_TRIS as RGBA32UI, 3 texels per MeshTriangle
+#define VKCLOTH_TEXEL_BINDING_COUNT 12
 #define VKCLOTH_COLLIDER_TEXELS 9 // 16-byte texels per Collider (static_assert below)
 
 // InstanceParams::flags bits.
 #define VKCLOTH_FLAG_HAS_GRID 1u      // the topology is a grid: rebuild normals from the grid fan
 #define VKCLOTH_FLAG_WIND 2u          // wind strength != 0
 #define VKCLOTH_FLAG_CONTACT_BOTH 4u  // contacts remove the whole normal part (Figure 12 variant)
-#define VKCLOTH_FLAG_HAS_FANS 8u      // a surface that is not a grid: normals from FAN_OFFSETS / FANS
+#define VKCLOTH_FLAG_RING_NORMALS 8u  // a surface that is not a grid: normals from the EDGES' ring bits
 #define VKCLOTH_FLAG_FLIP_NORMALS 16u // store -n in the normals buffer (GpuSolverOptions::flip_normals)
 #define VKCLOTH_FLAG_SELF_COLLISION                                                                          \
   32u // self-collision on (self_collision.comp; strain_finish.comp's stage 2)
+
+// Edge::ring bits (ClothTopology's ring-ordered gather lists, cloth_kernel.h add_ring_term): the
+// fan triangle (a, b) of a particle adds cross(x_a - x, x_b - x) to its normal; a chain of fan
+// triangles (r0, r1), (r1, r2), ... is carried by consecutive entries r0, r1, r2, ...
+#define VKCLOTH_RING_START 1u // the first entry of a chain: remember its edge
+#define VKCLOTH_RING_PREV 2u  // add the triangle (previous entry, this entry)
+#define VKCLOTH_RING_CLOSE 4u // then add the triangle (this entry, the chain's first entry)
 
 // InstanceParams::stretch bits (SimParams::stretch_limit).
 #define VKCLOTH_STRETCH_PROVOT 1u       // Provot sweeps over the strain links (strain_links.comp)
@@ -163,14 +166,7 @@ struct Edge {
   uint other;
   float rest_length;
   float stiffness;
-  uint unused; // zero
-};
-
-/// One triangle of a particle's normal fan (ClothTopology's FanTriangle; std430: 8 bytes):
-/// n_p += cross(x_a - x_p, x_b - x_p).
-struct FanEntry {
-  uint a;
-  uint b;
+  uint ring; // VKCLOTH_RING_* bits: this entry's part in the vertex normal (GatherEdge::ring)
 };
 
 /// A strain link (ClothTopology's StrainLink; std430: 12 bytes).
@@ -235,7 +231,6 @@ static_assert(offsetof(InstanceParams, limit) == 64);
 static_assert(sizeof(ParticleInfo) == 8);
 static_assert(sizeof(Vertex) == 32);
 static_assert(sizeof(Edge) == 16);
-static_assert(sizeof(FanEntry) == 8);
 static_assert(sizeof(StrainLink) == 12);
 static_assert(sizeof(TetherSlot) == 8);
 static_assert(offsetof(InstanceParams, max_strain) == 68);

@@ -114,9 +114,8 @@ private:
   CpuSolver();
   // Per-particle kernels (each formula from shaders/include/cloth_kernel.h): each reads shared
   // inputs and writes only particle p's outputs.
-  Vec3 normal_at(std::span<const Vec3> pos, std::size_t p) const;
-  Vec3 force_at(std::span<const Vec3> pos, std::span<const Vec3> vel, std::size_t p) const;
-  /// normal_at + force_at for particle p: writes normal_[p], returns the force.
+  /// Particle p's normal and force: writes normal_[p] (from the grid fan, or from the gather
+  /// list's ring terms with ClothTopology::ring_normals), returns the force.
   Vec3 normal_force_at(std::span<const Vec3> pos, std::span<const Vec3> vel, std::size_t p);
   // Contacts (cloth_kernel.h contact_response / project_out) with every collider at this substep's
   // pose; h_over_m: substep / mass (friction's impulse); side: where the particle came from.
@@ -150,6 +149,7 @@ private:
     std::uint32_t other;
     Real rest_length;
     Real stiffness;
+    std::uint32_t ring; // VKCLOTH_RING_*
   };
 
   std::shared_ptr<const ClothTopology> topology_;

@@ -26,12 +26,22 @@
 
 namespace vkcloth {
 
+/// GatherEdge::ring bits (the shaders' VKCLOTH_RING_*; cloth_kernel.h add_ring_term): the fan
+/// triangle (a, b) of particle p adds cross(x_a - x_p, x_b - x_p) to p's normal; a chain of fan
+/// triangles (r0, r1), (r1, r2), ... is carried by consecutive entries towards r0, r1, r2, ...
+inline constexpr std::uint32_t ring_start = 1; ///< the first entry of a chain: remember its edge
+inline constexpr std::uint32_t ring_prev = 2;  ///< add the triangle (previous entry, this entry)
+inline constexpr std::uint32_t ring_close = 4; ///< then the triangle (this entry, the chain's first)
+
 /// One gather-list entry: the spring's other end and its constants (double, as in the system;
 /// each solver converts to its own precision).
 struct GatherEdge {
   std::uint32_t other = 0;
   double rest_length = 0.0;
   double stiffness = 0.0;
+  /// ring_start | ring_prev | ring_close: this entry's part in the particle's normal fan, in
+  /// ring-ordered lists (ClothTopology::ring_normals); zero otherwise.
+  std::uint32_t ring = 0;
 };
 
 /// One triangle of particle p's normal fan: n_p += cross(x_a - x_p, x_b - x_p), an area-weighted
@@ -93,10 +103,17 @@ public:
   std::size_t size() const { return system_.size(); }
 
   /// CSR over particles, size() + 1 entries: particle p's gather list is
-  /// edges()[edge_offsets()[p] .. edge_offsets()[p+1]), in SpringAdjacency order, which is THE
-  /// force summation order of every solver.
-  std::span<const std::uint32_t> edge_offsets() const { return system_.adjacency.offsets; }
+  /// edges()[edge_offsets()[p] .. edge_offsets()[p+1]), THE force summation order of every
+  /// solver: SpringAdjacency's order, except with ring_normals().
+  std::span<const std::uint32_t> edge_offsets() const { return edge_offsets_; }
   std::span<const GatherEdge> edges() const { return edges_; }
+  /// True when the gather lists also carry the normal fans (every cloth with a surface that is not
+  /// a grid; a grid keeps SpringAdjacency's order, its stencil's): each list starts with its fan's neighbours
+  /// in ring order, flagged (GatherEdge::ring), then the other springs in SpringAdjacency order, so a solver
+  /// builds the normal from the springs' edges (cloth_kernel.h add_ring_term) instead of fetching the fan's
+  /// neighbours again. A fan neighbour that no spring reaches (a degenerate mesh) gets an entry of
+  /// stiffness zero.
+  bool ring_normals() const { return ring_normals_; }
 
   const std::optional<Grid>& grid() const { return system_.grid; }
   /// Null when the grid stencil does not apply (no grid, a grid under 5 x 5, irregular interior).
@@ -105,7 +122,8 @@ public:
   /// 3 indices per counter-clockwise triangle; for a grid exactly gpu::grid_triangle_indices(nx,
   /// ny); empty for chains.
   std::span<const std::uint32_t> triangles() const { return triangles_; }
-  /// CSR over particles, size() + 1 entries (all zero without a surface: no normals).
+  /// CSR over particles, size() + 1 entries (all zero without a surface: no normals). The
+  /// solvers read them for grids; other surfaces carry them in their gather lists (ring_normals).
   std::span<const std::uint32_t> fan_offsets() const { return fan_offsets_; }
   std::span<const FanTriangle> fans() const { return fans_; }
   /// Texture coordinates per particle; a grid's (i, j) maps to (i / (nx-1), j / (ny-1)); zero for
@@ -132,7 +150,9 @@ private:
   ClothTopology() = default;
 
   ParticleSystem system_;
+  std::vector<std::uint32_t> edge_offsets_;
   std::vector<GatherEdge> edges_;
+  bool ring_normals_ = false;
   std::optional<GridStencil> stencil_;
   std::vector<std::uint32_t> triangles_;
   std::vector<std::uint32_t> fan_offsets_;

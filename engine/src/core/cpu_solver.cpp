@@ -35,7 +35,7 @@ template <typename Real> struct ContactShapes {
 /// `width` particles by pad_lists.
 template <typename Real> struct PaddedLists {
   std::size_t width = 0;
-  std::vector<std::uint32_t> spring_begin, other, fan_begin, fan_a, fan_b;
+  std::vector<std::uint32_t> spring_begin, other, ring, ring_end;
   std::vector<Real> rest, stiff;
 };
 } // namespace detail
@@ -113,7 +113,7 @@ Result<CpuSolver<Real>> CpuSolver<Real>::create(std::shared_ptr<const ClothTopol
   s.edge_offsets_ = s.topology_->edge_offsets();
   s.edges_.reserve(s.topology_->edges().size());
   for (const GatherEdge& e : s.topology_->edges())
-    s.edges_.push_back(Edge{e.other, Real(e.rest_length), Real(e.stiffness)});
+    s.edges_.push_back(Edge{e.other, Real(e.rest_length), Real(e.stiffness), e.ring});
   s.mass_.resize(n);
   s.pinned_.resize(n);
   s.pos_.resize(n);
@@ -171,34 +171,22 @@ Result<void> CpuSolver<Real>::set_particle(std::uint32_t index, Vec3 position, V
 }
 
 template <typename Real>
-typename CpuSolver<Real>::Vec3 CpuSolver<Real>::normal_at(std::span<const Vec3> pos, std::size_t p) const {
-  // The topology's fan around p, in order: an area-weighted vertex normal (zero without a surface).
-  const std::span<const std::uint32_t> fan_offsets = topology_->fan_offsets();
-  const std::span<const FanTriangle> fans = topology_->fans();
-  const Vec3 x = pos[p];
-  Vec3 sum(0);
-  for (std::uint32_t t = fan_offsets[p]; t < fan_offsets[p + 1]; ++t)
-    kernel::add_fan_triangle(sum, pos[fans[t].a] - x, pos[fans[t].b] - x);
-  return kernel::unit_or_zero(sum);
-}
-
-template <typename Real>
 typename CpuSolver<Real>::Vec3 CpuSolver<Real>::normal_force_at(std::span<const Vec3> pos,
                                                                 std::span<const Vec3> vel, std::size_t p) {
-  normal_[p] = normal_at(pos, p);
-  return force_at(pos, vel, p);
-}
-
-template <typename Real>
-typename CpuSolver<Real>::Vec3 CpuSolver<Real>::force_at(std::span<const Vec3> pos, std::span<const Vec3> vel,
-                                                         std::size_t p) const {
   const Vec3 x = pos[p];
   Vec3 f(0);
+  Vec3 fan(0); // an area-weighted vertex normal (zero without a surface)
   bool interior = false;
   if (stencil_) {
     const std::size_t nx = topology_->grid()->nx, ny = topology_->grid()->ny;
     const std::size_t i = p % nx, j = p / nx;
     interior = i >= 2 && i + 2 < nx && j >= 2 && j + 2 < ny;
+  }
+  if (!topology_->ring_normals()) { // the topology's fan around p, in order
+    const std::span<const std::uint32_t> fan_offsets = topology_->fan_offsets();
+    const std::span<const FanTriangle> fans = topology_->fans();
+    for (std::uint32_t t = fan_offsets[p]; t < fan_offsets[p + 1]; ++t)
+      kernel::add_fan_triangle(fan, pos[fans[t].a] - x, pos[fans[t].b] - x);
   }
   if (interior) {
     // Same terms, same order as the CSR loop below (the topology's stencil detection checked it).
@@ -206,9 +194,15 @@ typename CpuSolver<Real>::Vec3 CpuSolver<Real>::force_at(std::span<const Vec3> p
       kernel::add_spring(f, x, pos[std::size_t(std::int64_t(p) + stencil_offset_[k])], stencil_rest_[k],
                          stencil_stiff_[k]);
   } else {
-    for (std::uint32_t e = edge_offsets_[p]; e < edge_offsets_[p + 1]; ++e)
-      kernel::add_spring(f, x, pos[edges_[e].other], edges_[e].rest_length, edges_[e].stiffness);
+    Vec3 prev(0), first(0);
+    for (std::uint32_t e = edge_offsets_[p]; e < edge_offsets_[p + 1]; ++e) {
+      const Edge& s = edges_[e];
+      const Vec3 u = pos[s.other] - x;
+      kernel::add_spring_edge(f, u, s.rest_length, s.stiffness);
+      kernel::add_ring_term(fan, prev, first, u, s.ring);
+    }
   }
+  normal_[p] = kernel::unit_or_zero(fan);
   const Real kw = Real(params_.wind.strength);
   return kernel::add_body_forces(f, mass_[p], vel[p], Vec3{params_.gravity}, Real(params_.damping),
                                  kw != Real(0), normal_[p], Vec3{params_.wind.direction}, kw);
@@ -440,8 +434,8 @@ template <typename Real> void CpuSolver<Real>::euler_substep(const Real h, const
     return;
   }
 #if VKCLOTH_ROW_SIMD
-  if (simd_ != 0) {
-    list_sweep(h, semi);
+  if (simd_ != 0 && (topology_->ring_normals() || !topology_->has_surface())) {
+    list_sweep(h, semi); // meshes and chains (a grid without a stencil takes the reference)
     return;
   }
 #endif
@@ -615,41 +609,35 @@ template <typename Real> void CpuSolver<Real>::row_sweep(const Real h, const boo
 }
 
 namespace {
-// The gather and fan lists padded for vectors of `width` particles (row_kernel.hpp ListArgs): the
+// The gather lists padded for vectors of `width` particles (row_kernel.hpp ListArgs): the
 // particles that fill whole vectors only; the rest take the per-particle reference.
 template <typename Real, typename Edge>
 std::unique_ptr<detail::PaddedLists<Real>>
-pad_lists(std::size_t width, std::span<const std::uint32_t> edge_offsets, const std::vector<Edge>& edges,
-          std::span<const std::uint32_t> fan_offsets, std::span<const FanTriangle> fans) {
+pad_lists(std::size_t width, std::span<const std::uint32_t> edge_offsets, const std::vector<Edge>& edges) {
   auto lists = std::make_unique<detail::PaddedLists<Real>>();
   detail::PaddedLists<Real>& l = *lists;
   l.width = width;
   const std::size_t vectors = (edge_offsets.size() - 1) / width;
-  auto longest = [&](std::span<const std::uint32_t> offsets, std::size_t b) {
-    std::uint32_t most = 0;
-    for (std::size_t p = b * width; p < (b + 1) * width; ++p)
-      most = std::max(most, offsets[p + 1] - offsets[p]);
-    return most;
-  };
   l.spring_begin.push_back(0);
-  l.fan_begin.push_back(0);
   for (std::size_t b = 0; b < vectors; ++b) {
-    for (std::uint32_t k = 0, slots = longest(edge_offsets, b); k < slots; ++k)
+    std::uint32_t slots = 0, ring_slots = 0;
+    for (std::size_t p = b * width; p < (b + 1) * width; ++p) {
+      slots = std::max(slots, edge_offsets[p + 1] - edge_offsets[p]);
+      for (std::uint32_t e = edge_offsets[p]; e < edge_offsets[p + 1]; ++e)
+        if (edges[e].ring != 0)
+          ring_slots = std::max(ring_slots, e - edge_offsets[p] + 1);
+    }
+    for (std::uint32_t k = 0; k < slots; ++k)
       for (std::size_t p = b * width; p < (b + 1) * width; ++p) {
         const bool has = k < edge_offsets[p + 1] - edge_offsets[p];
-        const Edge e = has ? edges[edge_offsets[p] + k] : Edge{std::uint32_t(p), Real(0), Real(0)};
+        const Edge e = has ? edges[edge_offsets[p] + k] : Edge{std::uint32_t(p), Real(0), Real(0), 0};
         l.other.push_back(e.other);
         l.rest.push_back(e.rest_length);
         l.stiff.push_back(e.stiffness);
+        l.ring.push_back(e.ring);
       }
-    for (std::uint32_t k = 0, slots = longest(fan_offsets, b); k < slots; ++k)
-      for (std::size_t p = b * width; p < (b + 1) * width; ++p) {
-        const bool has = k < fan_offsets[p + 1] - fan_offsets[p];
-        l.fan_a.push_back(has ? fans[fan_offsets[p] + k].a : std::uint32_t(p));
-        l.fan_b.push_back(has ? fans[fan_offsets[p] + k].b : std::uint32_t(p));
-      }
+    l.ring_end.push_back(l.spring_begin.back() + ring_slots * std::uint32_t(width));
     l.spring_begin.push_back(std::uint32_t(l.other.size()));
-    l.fan_begin.push_back(std::uint32_t(l.fan_a.size()));
   }
   return lists;
 }
@@ -661,7 +649,7 @@ pad_lists(std::size_t width, std::span<const std::uint32_t> edge_offsets, const 
 template <typename Real> void CpuSolver<Real>::list_sweep(const Real h, const bool semi) {
   const std::size_t n = pos_.size(), width = (simd_ == 2 ? 64 : 32) / sizeof(Real);
   if (!lists_ || lists_->width != width)
-    lists_ = pad_lists<Real>(width, edge_offsets_, edges_, topology_->fan_offsets(), topology_->fans());
+    lists_ = pad_lists<Real>(width, edge_offsets_, edges_);
   const detail::PaddedLists<Real>& l = *lists_;
   detail::ListArgs<Real> la{};
   step_args(la, h, semi);
@@ -670,9 +658,8 @@ template <typename Real> void CpuSolver<Real>::list_sweep(const Real h, const bo
   la.other = l.other.data();
   la.rest = l.rest.data();
   la.stiff = l.stiff.data();
-  la.fan_begin = l.fan_begin.data();
-  la.fan_a = l.fan_a.data();
-  la.fan_b = l.fan_b.data();
+  la.ring = l.ring.data();
+  la.ring_end = l.ring_end.data();
   const std::size_t vectors = n / width;
   Real* const pn = &pos_next_[0].x;
   Real* const vn = &vel_[0].x;

@@ -10,6 +10,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "vkcloth_shared.h" // VKCLOTH_RING_*
+
 namespace vkcloth::detail {
 
 /// What the row and list kernels share: the state of the particles they update, and the body
@@ -42,22 +44,21 @@ template <typename Real> struct RowArgs : StepArgs<Real> {
   const Real* stiff;       // 12
 };
 
-/// Any other cloth (a mesh, a grid without a stencil): the gather and fan lists, padded so that a
-/// vector of W particles walks them together. Vector b holds particles [b W, b W + W); its spring
-/// slots are [spring_begin[b], spring_begin[b + 1]), slot k of lane l at spring_begin[b] + k W + l,
-/// in the particle's gather order. A lane with fewer springs than the longest list of its vector
-/// points the rest at itself: a zero-length spring adds nothing (add_spring's `len > 0`). Fan
-/// slots likewise (fan_begin, fan_a, fan_b), the padding with a == the particle itself, skipped by
-/// a select. Positions are read as they are stored (AoS).
+/// Any other cloth (a mesh, a grid without a stencil): the gather lists, padded so that a vector of
+/// W particles walks them together. Vector b holds particles [b W, b W + W); its spring slots are
+/// [spring_begin[b], spring_begin[b + 1]), slot k of lane l at spring_begin[b] + k W + l, in the
+/// particle's gather order. A lane with fewer springs than the longest list of its vector points
+/// the rest at itself: a zero-length spring adds nothing (add_spring's `len > 0`), and its ring
+/// bits are zero. The lists carry the normal fans (ClothTopology::ring_normals, `ring` per slot):
+/// no lane has ring bits at or after slot ring_end[b]. Positions are read as they are stored (AoS).
 template <typename Real> struct ListArgs : StepArgs<Real> {
   const Real* pos;
   const std::uint32_t* spring_begin;
   const std::uint32_t* other;
   const Real* rest;
   const Real* stiff;
-  const std::uint32_t* fan_begin;
-  const std::uint32_t* fan_a;
-  const std::uint32_t* fan_b;
+  const std::uint32_t* ring;
+  const std::uint32_t* ring_end;
 };
 
 /// A collider as the SIMD finish takes it: kernel::ColliderShape<Real>'s values, copied as they are

@@ -6,13 +6,13 @@
 // translation units never share (ODR-merge) a function compiled for the other's ISA.
 //
 // An optimised copy of the shared kernel (shaders/include/cloth_kernel.h: add_fan_triangle,
-// unit_or_zero, add_spring, add_body_forces, euler_update, diverged), the one place a formula is
-// written twice: GCC vector types cannot pass through the kernel's scalar-typed functions. Bits:
-// every lane performs the kernel's operations on its particle, one for one and in the same order;
-// IEEE +, -, *, / and sqrt are correctly rounded in SIMD as in scalar code, -ffp-contract=off
-// forbids FMA, `if (len > 0)` is the same select. tests/test_cloth.cpp "the SIMD row kernels ...
-// give the shared reference's bits" fails when they differ: change both together.
-// Do not include anything else here (no std headers with inline functions: see above).
+// add_ring_term, unit_or_zero, add_spring, add_body_forces, euler_update, diverged), the one place a formula
+// is written twice: GCC vector types cannot pass through the kernel's scalar-typed functions. Bits: every
+// lane performs the kernel's operations on its particle, one for one and in the same order; IEEE +, -, *, /
+// and sqrt are correctly rounded in SIMD as in scalar code, -ffp-contract=off forbids FMA, `if (len > 0)` is
+// the same select. tests/test_cloth.cpp "the SIMD row kernels ... give the shared reference's bits" fails
+// when they differ: change both together. Do not include anything else here (no std headers with inline
+// functions: see above).
 
 namespace {
 
@@ -320,91 +320,7 @@ std::int64_t simd_dispatch(const vkcloth::detail::RowArgs<typename T::Real>& a, 
   });
 }
 
-// ---- The list kernel: meshes and other cloths without a stencil (ListArgs) ---------------------
-// The same step as simd_body, the springs and fan terms read from the padded lists instead of at
-// constant offsets: per slot, the W lanes' neighbour indices are one vector load and their
-// positions W scalar loads (the lanes' neighbours differ). A vector's lanes walk as many slots as
-// its longest list; the padding adds nothing (row_kernel.hpp ListArgs), so each lane sums its own
-// terms in its list's order, with the kernel's operations: the reference's bits.
-
-template <typename T> VKCLOTH_AI typename T::M load_index(const std::uint32_t* p) {
-  typename T::M m;
-  for (int l = 0; l < T::W; ++l)
-    m[l] = p[l];
-  return m;
-}
-
-template <typename T, bool wind, bool integrate, bool semi>
-std::int64_t list_body(const vkcloth::detail::ListArgs<typename T::Real>& a, std::int64_t v0, std::int64_t v1,
-                       bool& bad) {
-  using Real = typename T::Real;
-  using V = typename T::V;
-  using M = typename T::M;
-  constexpr int W = T::W;
-  const Real* __restrict pos = a.pos;
-  const StepTail<T, wind, integrate, semi> step_tail(a);
-  M lane{};
-  for (int l = 0; l < W; ++l)
-    lane[l] = l;
-  const M all = lane == lane;
-  M ok = all;
-  const V zero = V{};
-  for (std::int64_t b = v0; b < v1; ++b) {
-    const std::int64_t q = b * W;
-    V x0, y0, z0;
-    T::load3(pos + 3 * q, x0, y0, z0);
-    const M self = lane + static_cast<__typeof__(lane[0] + 0)>(q);
-    V sx = zero, sy = zero, sz = zero;
-    for (std::uint32_t s = a.fan_begin[b]; s < a.fan_begin[b + 1]; s += W) {
-      const M ia = load_index<T>(a.fan_a + s), ib = load_index<T>(a.fan_b + s);
-      V ax, ay, az, bx, by, bz;
-      T::gather3(pos, ia, ax, ay, az);
-      T::gather3(pos, ib, bx, by, bz);
-      ax = ax - x0;
-      ay = ay - y0;
-      az = az - z0;
-      bx = bx - x0;
-      by = by - y0;
-      bz = bz - z0;
-      const M h = ia != self; // add_fan_triangle: sum + cross3(ea, eb)
-      sx = h ? sx + (ay * bz - by * az) : sx;
-      sy = h ? sy + (az * bx - bz * ax) : sy;
-      sz = h ? sz + (ax * by - bx * ay) : sz;
-    }
-    V nxv, nyv, nzv;
-    unit_or_zero_v<T>(sx, sy, sz, nxv, nyv, nzv);
-    V fx = zero, fy = zero, fz = zero;
-    for (std::uint32_t s = a.spring_begin[b]; s < a.spring_begin[b + 1]; s += W) {
-      V xq, yq, zq;
-      T::gather3(pos, load_index<T>(a.other + s), xq, yq, zq);
-      add_spring_v<T>(fx, fy, fz, xq - x0, yq - y0, zq - z0, ld<T>(a.rest + s), ld<T>(a.stiff + s), all);
-    }
-    step_tail(
-        q, x0, y0, z0, fx, fy, fz, nxv, nyv, nzv, M{}, ok,
-        [](Real* p, V x, V y, V z) { T::store3(p, x, y, z); }, [](V, V, V) {});
-  }
-  if constexpr (integrate)
-    report_bad<T>(ok, bad);
-  return v1;
-}
-
-template <typename T>
-std::int64_t list_dispatch(const vkcloth::detail::ListArgs<typename T::Real>& a, std::int64_t v0,
-                           std::int64_t v1, bool& bad) {
-  return with_flags(a, [&](auto wind, auto integrate, auto semi) {
-    return list_body<T, decltype(wind)::value, decltype(integrate)::value, decltype(semi)::value>(a, v0, v1,
-                                                                                                  bad);
-  });
-}
-
-// ---- Contacts: the finish of a grid substep with colliders (FinishArgs) -----------------------
-// The second optimised copy of the shared kernel: cloth_kernel.h collider_contact (plane, sphere,
-// capsule, box), remove_inward, contact_filter, coulomb_friction, contact_response, surface_velocity,
-// project_out and euler_update, as CpuSolver::euler_finish calls them, W particles per vector. The
-// collider's type is the same for every lane (a switch per collider); each `if` on a per-particle
-// value becomes a select between values computed for every lane, each expression written in the
-// kernel's order (glm's min, max and abs: (y < x) ? y : x, (x < y) ? y : x, x >= 0 ? x : -x).
-// tests/test_cloth.cpp "the SIMD row kernels ... give the shared reference's bits" covers it.
+// ---- Three-lane-vector helpers (the list kernel, the contact finish) -------------------------
 
 template <typename T> struct V3 { typename T::V x, y, z; };
 
@@ -435,6 +351,96 @@ template <typename T> VKCLOTH_AI typename T::V dot(V3<T> a, V3<T> b) {
 template <typename T> VKCLOTH_AI V3<T> cross(V3<T> x, V3<T> y) {
   return {x.y * y.z - y.y * x.z, x.z * y.x - y.z * x.x, x.x * y.y - y.x * x.y};
 }
+// ---- The list kernel: meshes and other cloths without a stencil (ListArgs) ---------------------
+// The same step as simd_body, the springs read from the padded lists instead of at constant
+// offsets: per slot, the W lanes' neighbour indices are one vector load and their positions W
+// scalar loads (the lanes' neighbours differ). A vector's lanes walk as many slots as its longest
+// list; the padding adds nothing (row_kernel.hpp ListArgs), so each lane sums its own terms in its
+// list's order, with the kernel's operations: the reference's bits. The normal comes from the same
+// edges (cloth_kernel.h add_ring_term), in the slots before ring_end.
+
+template <typename T> VKCLOTH_AI typename T::M load_index(const std::uint32_t* p) {
+  typename T::M m;
+  for (int l = 0; l < T::W; ++l)
+    m[l] = p[l];
+  return m;
+}
+
+// add_ring_term, lane by lane: `ring` holds each lane's VKCLOTH_RING_* bits.
+template <typename T>
+VKCLOTH_AI void add_ring_term_v(V3<T>& sum, V3<T>& prev, V3<T>& first, V3<T> u, typename T::M ring) {
+  using M = typename T::M;
+  const M start = (ring & (M{} + VKCLOTH_RING_START)) != 0;
+  const M with_prev = (ring & (M{} + VKCLOTH_RING_PREV)) != 0;
+  const M close = (ring & (M{} + VKCLOTH_RING_CLOSE)) != 0;
+  first = sel<T>(start, u, first);
+  sum = sel<T>(with_prev, sum + cross<T>(prev, u), sum);
+  sum = sel<T>(close, sum + cross<T>(u, first), sum);
+  prev = u;
+}
+
+template <typename T, bool wind, bool integrate, bool semi>
+std::int64_t list_body(const vkcloth::detail::ListArgs<typename T::Real>& a, std::int64_t v0, std::int64_t v1,
+                       bool& bad) {
+  using Real = typename T::Real;
+  using V = typename T::V;
+  using M = typename T::M;
+  constexpr int W = T::W;
+  const Real* __restrict pos = a.pos;
+  const StepTail<T, wind, integrate, semi> step_tail(a);
+  M lane{};
+  for (int l = 0; l < W; ++l)
+    lane[l] = l;
+  const M all = lane == lane;
+  M ok = all;
+  const V zero = V{};
+  for (std::int64_t b = v0; b < v1; ++b) {
+    const std::int64_t q = b * W;
+    V xs, ys, zs;
+    T::load3(pos + 3 * q, xs, ys, zs);
+    const V3<T> x0{xs, ys, zs};
+    V3<T> f{zero, zero, zero}, fan{zero, zero, zero}, prev{zero, zero, zero}, first{zero, zero, zero};
+    auto spring = [&](std::uint32_t s) {
+      V xq, yq, zq;
+      T::gather3(pos, load_index<T>(a.other + s), xq, yq, zq);
+      const V3<T> u{xq - x0.x, yq - x0.y, zq - x0.z};
+      add_spring_v<T>(f.x, f.y, f.z, u.x, u.y, u.z, ld<T>(a.rest + s), ld<T>(a.stiff + s), all);
+      return u;
+    };
+    std::uint32_t s = a.spring_begin[b];
+    for (; s < a.ring_end[b]; s += W)
+      add_ring_term_v<T>(fan, prev, first, spring(s), load_index<T>(a.ring + s));
+    for (; s < a.spring_begin[b + 1]; s += W)
+      spring(s);
+    V nxv, nyv, nzv;
+    unit_or_zero_v<T>(fan.x, fan.y, fan.z, nxv, nyv, nzv);
+    step_tail(
+        q, x0.x, x0.y, x0.z, f.x, f.y, f.z, nxv, nyv, nzv, M{}, ok,
+        [](Real* p, V x, V y, V z) { T::store3(p, x, y, z); }, [](V, V, V) {});
+  }
+  if constexpr (integrate)
+    report_bad<T>(ok, bad);
+  return v1;
+}
+
+template <typename T>
+std::int64_t list_dispatch(const vkcloth::detail::ListArgs<typename T::Real>& a, std::int64_t v0,
+                           std::int64_t v1, bool& bad) {
+  return with_flags(a, [&](auto wind, auto integrate, auto semi) {
+    return list_body<T, decltype(wind)::value, decltype(integrate)::value, decltype(semi)::value>(a, v0, v1,
+                                                                                                  bad);
+  });
+}
+
+// ---- Contacts: the finish of a grid substep with colliders (FinishArgs) -----------------------
+// The second optimised copy of the shared kernel: cloth_kernel.h collider_contact (plane, sphere,
+// capsule, box), remove_inward, contact_filter, coulomb_friction, contact_response, surface_velocity,
+// project_out and euler_update, as CpuSolver::euler_finish calls them, W particles per vector. The
+// collider's type is the same for every lane (a switch per collider); each `if` on a per-particle
+// value becomes a select between values computed for every lane, each expression written in the
+// kernel's order (glm's min, max and abs: (y < x) ? y : x, (x < y) ? y : x, x >= 0 ? x : -x).
+// tests/test_cloth.cpp "the SIMD row kernels ... give the shared reference's bits" covers it.
+
 // glm's scalar max(x, y) = (x < y) ? y : x, lane by lane.
 template <typename T> VKCLOTH_AI typename T::V vmax(typename T::V x, typename T::V y) {
   return x < y ? y : x;

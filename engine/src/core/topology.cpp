@@ -2,11 +2,13 @@
 #include "vkcloth/topology.hpp"
 
 #include "vkcloth/builders.hpp"
+#include "vkcloth_shared.h" // VKCLOTH_RING_*
 
 #include "stretch_topology.hpp"
 
 #include <algorithm>
 #include <limits>
+#include <unordered_map>
 #include <utility>
 
 namespace vkcloth {
@@ -124,6 +126,98 @@ void fill_fans(std::span<const std::uint32_t> face_offsets, std::span<const std:
   }
 }
 
+/// Particle p's fan as chains of neighbours: each triangle (a, b) links a to b; a chain starts
+/// where no unused triangle ends (else anywhere: a closed ring), follows the first unused triangle
+/// leaving its last neighbour, and closes when it comes back to its start. The terms come out in
+/// chain order; those of a degenerate triangle (p a corner
+/// twice) are left out, as they add zero.
+struct RingNode {
+  std::uint32_t other;
+  std::uint32_t ring; // ring_start | ring_prev | ring_close
+};
+static_assert(ring_start == VKCLOTH_RING_START && ring_prev == VKCLOTH_RING_PREV &&
+                  ring_close == VKCLOTH_RING_CLOSE,
+              "the shaders read GatherEdge::ring's bits");
+std::vector<RingNode> fan_chains(std::uint32_t p, std::span<const FanTriangle> fan) {
+  std::vector<FanTriangle> left;
+  for (const FanTriangle& t : fan)
+    if (t.a != p && t.b != p)
+      left.push_back(t);
+  // Unused triangles leaving each neighbour (in fan order) and how many unused ones end there.
+  std::unordered_map<std::uint32_t, std::vector<std::size_t>> leaving;
+  std::unordered_map<std::uint32_t, std::size_t> ending;
+  for (std::size_t k = left.size(); k-- > 0;) {
+    leaving[left[k].a].push_back(k); // reversed: back() is the first in fan order
+    ++ending[left[k].b];
+  }
+  std::vector<bool> used(left.size(), false);
+  auto take = [&](std::size_t k) {
+    used[k] = true;
+    --ending[left[k].b];
+    std::vector<std::size_t>& out_of = leaving[left[k].a];
+    out_of.erase(std::find(out_of.begin(), out_of.end(), k));
+  };
+  std::vector<RingNode> out;
+  std::size_t open_scan = 0, any_scan = 0;
+  for (std::size_t done = 0; done < left.size(); ++done) {
+    while (open_scan < left.size() && (used[open_scan] || ending[left[open_scan].a] != 0))
+      ++open_scan; // a start no unused triangle ends at stays one: the scan never goes back
+    while (used[any_scan])
+      ++any_scan;
+    const std::size_t start = open_scan < left.size() ? open_scan : any_scan;
+    take(start);
+    const std::size_t first = out.size();
+    out.push_back({left[start].a, ring_start});
+    out.push_back({left[start].b, ring_prev});
+    for (;;) {
+      const std::vector<std::size_t>& next = leaving[out.back().other];
+      if (next.empty())
+        break;
+      const std::size_t k = next.back();
+      take(k);
+      ++done;
+      out.push_back({left[k].b, ring_prev});
+    }
+    if (out.back().other == out[first].other) { // back at the start: the last triangle closes
+      out.pop_back();
+      out.back().ring |= ring_close;
+    }
+  }
+  return out;
+}
+
+/// Puts each particle's fan into its gather list (ClothTopology::ring_normals): the chains' nodes
+/// first, each taking the particle's first unused entry towards that neighbour (or a new entry of
+/// stiffness zero), then the other entries in their order.
+void ring_order(std::span<const std::uint32_t> fan_offsets, std::span<const FanTriangle> fans,
+                std::vector<std::uint32_t>& offsets, std::vector<GatherEdge>& edges) {
+  std::vector<std::uint32_t> out_offsets{0};
+  std::vector<GatherEdge> out;
+  out.reserve(edges.size());
+  for (std::size_t p = 0; p + 1 < offsets.size(); ++p) {
+    const std::span<const GatherEdge> list(edges.data() + offsets[p], offsets[p + 1] - offsets[p]);
+    std::vector<bool> taken(list.size(), false);
+    for (const RingNode& node :
+         fan_chains(std::uint32_t(p), fans.subspan(fan_offsets[p], fan_offsets[p + 1] - fan_offsets[p]))) {
+      GatherEdge e{node.other, 0.0, 0.0, node.ring};
+      for (std::size_t k = 0; k < list.size(); ++k)
+        if (!taken[k] && list[k].other == node.other) {
+          taken[k] = true;
+          e = list[k];
+          e.ring = node.ring;
+          break;
+        }
+      out.push_back(e);
+    }
+    for (std::size_t k = 0; k < list.size(); ++k)
+      if (!taken[k])
+        out.push_back(list[k]);
+    out_offsets.push_back(std::uint32_t(out.size()));
+  }
+  offsets = std::move(out_offsets);
+  edges = std::move(out);
+}
+
 /// The grid stencil of `t`'s gather lists, if it applies: the one detection rule every solver
 /// uses. The size limits (nx, ny >= 5; the first interior particle's list has 12 entries) are the
 /// ones the CPU and GPU solvers applied before this routine replaced theirs.
@@ -176,6 +270,7 @@ Result<std::shared_ptr<const ClothTopology>> ClothTopology::create(const Particl
   const ParticleSystem& s = t->system_;
   const std::size_t n = s.size();
 
+  t->edge_offsets_ = s.adjacency.offsets;
   t->edges_.reserve(s.adjacency.refs.size());
   for (const SpringRef& r : s.adjacency.refs) {
     const Spring& sp = s.springs[r.spring];
@@ -220,6 +315,10 @@ Result<std::shared_ptr<const ClothTopology>> ClothTopology::create(const Particl
     } else {
       fill_fans(s.surface->face_offsets, s.surface->faces, n, t->fan_offsets_, t->fans_);
     }
+  }
+  if (s.surface && !t->fans_.empty()) {
+    ring_order(t->fan_offsets_, t->fans_, t->edge_offsets_, t->edges_);
+    t->ring_normals_ = true;
   }
   detail::colour_strain_links(s, t->strain_links_, t->strain_colour_offsets_);
   return std::shared_ptr<const ClothTopology>(std::move(t));

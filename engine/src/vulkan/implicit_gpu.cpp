@@ -118,10 +118,6 @@ Result<void> ImplicitGpu::write_sets(const ImplicitInputs& in) {
                         return in.flags;
                       case VKCLOTH_BINDING_INSTANCES:
                         return in.instances;
-                      case VKCLOTH_BINDING_FAN_OFFSETS:
-                        return in.fan_offsets;
-                      case VKCLOTH_BINDING_FANS:
-                        return in.fans;
                       case VKCLOTH_BINDING_MESH_NODES:
                         return in.mesh_nodes;
                       case VKCLOTH_BINDING_MESH_TRIS:

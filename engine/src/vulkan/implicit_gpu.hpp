@@ -30,8 +30,8 @@ namespace vkcloth::gpu {
 /// The solver's buffers the implicit passes share (same bindings as the main layout). The
 /// implicit passes run batches of one instance (the CG reductions are per instance).
 struct ImplicitInputs {
-  VkBuffer pos[2], vel, force, normal, particle, offsets, edges, colliders, flags, instances, fan_offsets,
-      fans, mesh_nodes, mesh_tris;
+  VkBuffer pos[2], vel, force, normal, particle, offsets, edges, colliders, flags, instances, mesh_nodes,
+      mesh_tris;
 };
 
 class ImplicitGpu {

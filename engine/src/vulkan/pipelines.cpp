@@ -69,16 +69,18 @@ bool single_build(PipelineRegistry::Shader s) {
 }
 
 /// The storage bindings of implicit.comp (implicit_shared.h).
-constexpr std::uint32_t kImplicitBindings[] = {
-    VKCLOTH_BINDING_POS_IN,         VKCLOTH_BINDING_FORCE_OUT,  VKCLOTH_BINDING_NORMAL,
-    VKCLOTH_BINDING_POS_OUT,        VKCLOTH_BINDING_VEL,        VKCLOTH_BINDING_PARTICLE,
-    VKCLOTH_BINDING_OFFSETS,        VKCLOTH_BINDING_EDGES,      VKCLOTH_BINDING_COLLIDERS,
-    VKCLOTH_BINDING_FLAGS,          VKCLOTH_BINDING_INSTANCES,  VKCLOTH_BINDING_FAN_OFFSETS,
-    VKCLOTH_BINDING_FANS,           VKCLOTH_BINDING_IMPL_VF,    VKCLOTH_BINDING_IMPL_KS,
-    VKCLOTH_BINDING_IMPL_BLOCK_INV, VKCLOTH_BINDING_IMPL_X,     VKCLOTH_BINDING_IMPL_R,
-    VKCLOTH_BINDING_IMPL_Z,         VKCLOTH_BINDING_IMPL_D,     VKCLOTH_BINDING_IMPL_Q,
-    VKCLOTH_BINDING_IMPL_PARTIALS,  VKCLOTH_BINDING_IMPL_STATE, VKCLOTH_BINDING_IMPL_ARGS,
-    VKCLOTH_BINDING_MESH_NODES,     VKCLOTH_BINDING_MESH_TRIS};
+constexpr std::uint32_t kImplicitBindings[] = {VKCLOTH_BINDING_POS_IN,     VKCLOTH_BINDING_FORCE_OUT,
+                                               VKCLOTH_BINDING_NORMAL,     VKCLOTH_BINDING_POS_OUT,
+                                               VKCLOTH_BINDING_VEL,        VKCLOTH_BINDING_PARTICLE,
+                                               VKCLOTH_BINDING_OFFSETS,    VKCLOTH_BINDING_EDGES,
+                                               VKCLOTH_BINDING_COLLIDERS,  VKCLOTH_BINDING_FLAGS,
+                                               VKCLOTH_BINDING_INSTANCES,  VKCLOTH_BINDING_IMPL_VF,
+                                               VKCLOTH_BINDING_IMPL_KS,    VKCLOTH_BINDING_IMPL_BLOCK_INV,
+                                               VKCLOTH_BINDING_IMPL_X,     VKCLOTH_BINDING_IMPL_R,
+                                               VKCLOTH_BINDING_IMPL_Z,     VKCLOTH_BINDING_IMPL_D,
+                                               VKCLOTH_BINDING_IMPL_Q,     VKCLOTH_BINDING_IMPL_PARTIALS,
+                                               VKCLOTH_BINDING_IMPL_STATE, VKCLOTH_BINDING_IMPL_ARGS,
+                                               VKCLOTH_BINDING_MESH_NODES, VKCLOTH_BINDING_MESH_TRIS};
 
 /// The storage bindings of self_collision.comp (self_collision_shared.h).
 constexpr std::uint32_t kSelfCollisionBindings[] = {
@@ -127,13 +129,11 @@ Result<PipelineRegistry::SolverLayouts> PipelineRegistry::solver_layouts_locked(
     auto sl = create_compute_set_layout(ctx_, storage, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, "solver");
     if (!sl)
       return sl.error();
-    const std::uint32_t texel[] = {VKCLOTH_TEXEL_BINDING_POS_IN,     VKCLOTH_TEXEL_BINDING_PARTICLE,
-                                   VKCLOTH_TEXEL_BINDING_VEL,        VKCLOTH_TEXEL_BINDING_FLAGS,
-                                   VKCLOTH_TEXEL_BINDING_INSTANCES,  VKCLOTH_TEXEL_BINDING_OFFSETS,
-                                   VKCLOTH_TEXEL_BINDING_EDGES,      VKCLOTH_TEXEL_BINDING_FAN_OFFSETS,
-                                   VKCLOTH_TEXEL_BINDING_FANS,       VKCLOTH_TEXEL_BINDING_STRAIN_LINKS,
-                                   VKCLOTH_TEXEL_BINDING_TETHERS,    VKCLOTH_TEXEL_BINDING_COLLIDERS,
-                                   VKCLOTH_TEXEL_BINDING_MESH_NODES, VKCLOTH_TEXEL_BINDING_MESH_TRIS};
+    const std::uint32_t texel[] = {
+        VKCLOTH_TEXEL_BINDING_POS_IN,    VKCLOTH_TEXEL_BINDING_PARTICLE,     VKCLOTH_TEXEL_BINDING_VEL,
+        VKCLOTH_TEXEL_BINDING_FLAGS,     VKCLOTH_TEXEL_BINDING_INSTANCES,    VKCLOTH_TEXEL_BINDING_OFFSETS,
+        VKCLOTH_TEXEL_BINDING_EDGES,     VKCLOTH_TEXEL_BINDING_STRAIN_LINKS, VKCLOTH_TEXEL_BINDING_TETHERS,
+        VKCLOTH_TEXEL_BINDING_COLLIDERS, VKCLOTH_TEXEL_BINDING_MESH_NODES,   VKCLOTH_TEXEL_BINDING_MESH_TRIS};
     static_assert(std::size(texel) == VKCLOTH_TEXEL_BINDING_COUNT);
     auto tl =
         create_compute_set_layout(ctx_, texel, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, "solver texel views");

@@ -210,7 +210,7 @@ std::vector<sh::InstanceParams> SolverBatch::packed_instance_params() const {
         float(params.substeps == 1 ? params.dt : params.dt / double(params.substeps)); // as the CPU
     sh::InstanceParams ip{};
     ip.flags = (normals == Normals::grid ? VKCLOTH_FLAG_HAS_GRID : 0u) |
-               (normals == Normals::fans ? VKCLOTH_FLAG_HAS_FANS : 0u) |
+               (normals == Normals::ring ? VKCLOTH_FLAG_RING_NORMALS : 0u) |
                (float(params.wind.strength) != 0.0f ? VKCLOTH_FLAG_WIND : 0u) |
                (params.contact_inward_only ? 0u : VKCLOTH_FLAG_CONTACT_BOTH) |
                (options.flip_normals ? VKCLOTH_FLAG_FLIP_NORMALS : 0u) |
@@ -492,12 +492,10 @@ Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ClothTopology&
                                   const testing::SolverKnobs& knobs, const DeviceLayout& layout) {
   const std::uint32_t workgroup = layout.workgroup_size;
   const bool texel = layout.access == BufferAccess::texel_views; // the storage builds make no texel views
-  const bool fan_lists = SolverBatch::normals_of(topology, knobs) == SolverBatch::Normals::fans;
   const std::uint64_t n = topology.size();
   const VkPhysicalDeviceLimits& lim = ctx.properties.limits;
   const StorageLimit limit = storage_limit(ctx, knobs);
   const std::uint64_t edges_n = topology.edges().size();
-  const std::uint64_t fans_n = fan_lists ? topology.fans().size() : 0;
   const std::uint64_t links_n = topology.strain_links().size();
   const struct {
     const char* what;
@@ -505,7 +503,6 @@ Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ClothTopology&
     std::uint64_t per;
   } needs[] = {{"per-particle (vec4)", batch * n, 16},
                {"spring adjacency", edges_n, sizeof(sh::Edge)},
-               {"normal fans", fans_n, sizeof(sh::FanEntry)},
                {"particle constants", n, sizeof(sh::ParticleInfo)},
                {"strain links", links_n, sizeof(sh::StrainLink)},
                {"interleaved vertices", options.interleaved_vertices ? batch * n : 0, sizeof(sh::Vertex)}};
@@ -520,16 +517,14 @@ Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ClothTopology&
                     "{} texels per texel buffer view but the device allows {} (maxTexelBufferElements); "
                     "use fewer particles or fewer instances of one topology",
                     ctx.name, batch * n, batch, n, batch * n, lim.maxTexelBufferElements));
-  // So are the topology's lists (force_body.glsl offsets_at, edge_at, fan_offsets_at, fan_at):
-  // n + 1 offsets, one texel per spring entry and per fan triangle.
+  // So are the topology's lists (force_body.glsl offsets_at, edge_at): n + 1 offsets, one texel
+  // per spring entry.
   const struct {
     const char* what;
     std::uint64_t texels;
   } lists[] = {{"spring adjacency offsets", n + 1},
                {"spring adjacency", edges_n},
-               {"strain links", links_n * 3}, // three R32UI texels each
-               {"normal fan offsets", fan_lists ? n + 1 : 0},
-               {"normal fans", fans_n}};
+               {"strain links", links_n * 3}}; // three R32UI texels each
   for (const auto& list : lists)
     if (texel)
       VKCLOTH_TRY(check_texels(ctx, list.what, list.texels, "use fewer springs or particles"));
@@ -588,10 +583,6 @@ Result<void> SolverBatch::create_buffers() {
       {&particle, std::max<VkDeviceSize>(n * sizeof(sh::ParticleInfo), 16), "particle constants"},
       {&offsets, std::max<VkDeviceSize>((n + 1) * sizeof(std::uint32_t), 16), "adjacency offsets"},
       {&edges, std::max<VkDeviceSize>(edges_count * sizeof(sh::Edge), 16), "adjacency"},
-      // Without fan normals: one zeroed element each (a valid binding the shaders never index).
-      {&fan_offsets, std::max<VkDeviceSize>(fans_count ? (n + 1) * sizeof(std::uint32_t) : 0, 16),
-       "normal fan offsets"},
-      {&fans, std::max<VkDeviceSize>(fans_count * sizeof(sh::FanEntry), 16), "normal fans"},
       {&strain_links, std::max<VkDeviceSize>(strain_link_count() * sizeof(sh::StrainLink), 16),
        "strain links"},
       {&tethers, 16, "tethers (none yet)"},
@@ -667,40 +658,32 @@ Result<void> SolverBatch::upload_initial_state(const ClothTopology& topology,
   std::vector<sh::Edge> edge_data(edges_count);
   for (std::size_t e = 0; e < edges_count; ++e) {
     const GatherEdge& g = topology.edges()[e];
-    edge_data[e] = {g.other, float(g.rest_length), float(g.stiffness), 0u};
+    edge_data[e] = {g.other, float(g.rest_length), float(g.stiffness), g.ring};
   }
-  // The fans as uploaded (FanTriangle and FanEntry are both two uint32 indices; copied field by
-  // field all the same), or nothing: a zeroed element (Normals::grid and none never read them).
-  std::vector<sh::FanEntry> fan_data(fans_count);
-  for (std::size_t t = 0; t < fans_count; ++t)
-    fan_data[t] = {topology.fans()[t].a, topology.fans()[t].b};
   std::vector<sh::StrainLink> link_data;
   for (const StrainLink& l : topology.strain_links())
     link_data.push_back({l.a, l.b, float(l.rest_length)});
   const std::span<const std::uint32_t> triangles = topology.triangles();
-  const Upload uploads[] = {
-      {&strain_links, link_data.empty() ? nullptr : link_data.data(),
-       link_data.size() * sizeof(sh::StrainLink)},
-      {&tethers, nullptr, 0},
-      {&pos[0], x0.data(), vec4_bytes},
-      {&pos[1], x0.data(), vec4_bytes},
-      {&vel, v0.data(), vec4_bytes},
-      {&uv, uv0.data(), vec4_bytes},
-      {&particle, info.data(), n * sizeof(sh::ParticleInfo)},
-      {&offsets, topology.edge_offsets().data(), (n + 1) * sizeof(std::uint32_t)},
-      {&edges, edge_data.data(), edges_count * sizeof(sh::Edge)},
-      {&fan_offsets, fans_count ? topology.fan_offsets().data() : nullptr, (n + 1) * sizeof(std::uint32_t)},
-      {&fans, fans_count ? fan_data.data() : nullptr, fans_count * sizeof(sh::FanEntry)},
-      {&indices, triangles.data(), triangles.size() * sizeof(std::uint32_t)},
-      {&force, nullptr, 0},
-      {&force_stage, nullptr, 0},
-      {&vel_filt, nullptr, 0},
-      {&normal, nullptr, 0},
-      {&vertices, nullptr, 0},
-      {&stage_pos, nullptr, 0},
-      {&stage_vel, nullptr, 0},
-      {&acc_pos, nullptr, 0},
-      {&acc_vel, nullptr, 0}};
+  const Upload uploads[] = {{&strain_links, link_data.empty() ? nullptr : link_data.data(),
+                             link_data.size() * sizeof(sh::StrainLink)},
+                            {&tethers, nullptr, 0},
+                            {&pos[0], x0.data(), vec4_bytes},
+                            {&pos[1], x0.data(), vec4_bytes},
+                            {&vel, v0.data(), vec4_bytes},
+                            {&uv, uv0.data(), vec4_bytes},
+                            {&particle, info.data(), n * sizeof(sh::ParticleInfo)},
+                            {&offsets, topology.edge_offsets().data(), (n + 1) * sizeof(std::uint32_t)},
+                            {&edges, edge_data.data(), edges_count * sizeof(sh::Edge)},
+                            {&indices, triangles.data(), triangles.size() * sizeof(std::uint32_t)},
+                            {&force, nullptr, 0},
+                            {&force_stage, nullptr, 0},
+                            {&vel_filt, nullptr, 0},
+                            {&normal, nullptr, 0},
+                            {&vertices, nullptr, 0},
+                            {&stage_pos, nullptr, 0},
+                            {&stage_vel, nullptr, 0},
+                            {&acc_pos, nullptr, 0},
+                            {&acc_vel, nullptr, 0}};
   return upload(uploads);
 }
 
@@ -742,11 +725,10 @@ Result<void> SolverBatch::upload(std::span<const Upload> uploads) {
   });
 }
 
-SolverBatch::Normals SolverBatch::normals_of(const ClothTopology& topology,
-                                             const testing::SolverKnobs& knobs) {
-  if (topology.grid() && !knobs.fan_normals)
+SolverBatch::Normals SolverBatch::normals_of(const ClothTopology& topology) {
+  if (topology.grid())
     return Normals::grid; // every grid, even one without triangles (a strip: zero normals)
-  return topology.fans().empty() ? Normals::none : Normals::fans;
+  return topology.ring_normals() ? Normals::ring : Normals::none;
 }
 
 Result<std::unique_ptr<SolverBatch>>
@@ -775,8 +757,7 @@ SolverBatch::create(const std::shared_ptr<Context::Impl>& ctx, CommandContext& c
   s.knobs = knobs;
   s.count = s.pc.count = static_cast<std::uint32_t>(topology.size());
   s.edges_count = topology.edges().size();
-  s.normals = normals_of(topology, knobs);
-  s.fans_count = s.normals == Normals::fans ? topology.fans().size() : 0;
+  s.normals = normals_of(topology);
   s.index_count = static_cast<std::uint32_t>(topology.triangles().size());
   s.batch_topology = &topology;
   s.strain_colours.assign(topology.strain_colour_offsets().begin(), topology.strain_colour_offsets().end());

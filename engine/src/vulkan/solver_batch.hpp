@@ -115,11 +115,11 @@ public:
   enum class Normals : std::uint32_t {
     none, ///< a chain: zero normals, no wind
     grid, ///< the unrolled grid fan (force_body.glsl grid_normal, VKCLOTH_FLAG_HAS_GRID)
-    fans  ///< the topology's fan lists (fan_normal, VKCLOTH_FLAG_HAS_FANS): meshes
+    ring  ///< the gather lists' ring terms (ClothTopology::ring_normals, VKCLOTH_FLAG_RING_NORMALS): meshes
   };
-  /// The normal path of `topology`'s batches: a grid's own fast path unless `knobs.fan_normals`;
-  /// the fan lists for any other topology with fans.
-  static Normals normals_of(const ClothTopology& topology, const testing::SolverKnobs& knobs);
+  /// The normal path of `topology`'s batches: a grid's own fast path; the ring terms for any other
+  /// topology with a surface.
+  static Normals normals_of(const ClothTopology& topology);
 
   /// Grid stencil (force_body.glsl's specialisation constants 0..39): constant_id order.
   struct Stencil {
@@ -149,9 +149,8 @@ private:
   // is one member here plus its creation.
   Buffer pos[2], vel, force, force_stage, vel_filt, normal, uv, stage_pos, stage_vel, acc_pos, acc_vel;
   Buffer vertices; // GpuSolverOptions::interleaved_vertices (else one zeroed element)
-  // The shared topology: particle constants, gather lists, normal fans (filled only for
-  // Normals::fans, else one zeroed element), triangles (`indices`, for drawing).
-  Buffer particle, offsets, edges, fan_offsets, fans, indices;
+  // The shared topology: particle constants, gather lists, triangles (`indices`, for drawing).
+  Buffer particle, offsets, edges, indices;
   // Stretch control: the strain links in colour order, and the tethers (one zeroed element until
   // an instance asks for tethers: ensure_tethers()).
   Buffer strain_links, tethers;
@@ -190,10 +189,10 @@ private:
   // Set 1 of force.comp / fused.comp: POS_IN as an RGBA32F uniform texel buffer (force_body.glsl
   // pos_at), the particle constants as an RG32UI one, velocities, flags, instance parameters.
   // pos_views [0], [1]: positions[0], positions[1]; [2]: RK4 stage positions. The topology's
-  // spring and fan lists too (force_body.glsl offsets_at, edge_at, fan_offsets_at, fan_at).
+  // spring lists too (force_body.glsl offsets_at, edge_at).
   BufferView pos_views[3];
   BufferView particle_view, vel_view, flags_view, instances_view;
-  BufferView offsets_view, edges_view, fan_offsets_view, fans_view, strain_links_view, tethers_view;
+  BufferView offsets_view, edges_view, strain_links_view, tethers_view;
   // The collider buffer and the mesh buffers (replaced when they grow: create_buffer_views again).
   BufferView colliders_view, mesh_nodes_view, mesh_tris_view;
   VkDescriptorSet texel_sets[3] = {};
@@ -201,7 +200,6 @@ private:
   std::uint32_t groups_x = 1, groups_y = 1;
   Stencil stencil;
   std::uint64_t edges_count = 0;
-  std::uint64_t fans_count = 0; // entries of `fans` (0 unless Normals::fans)
 
   shared::PushConstants pc{};            // per dispatch (count, grid, stage, step)
   std::uint64_t recorded = 0;            // recorded steps since the flag epoch: flag step numbers

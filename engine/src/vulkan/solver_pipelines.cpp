@@ -26,15 +26,15 @@ namespace {
 /// The specialisation constants of force.comp and fused.comp, as 32-bit words by constant_id:
 /// 0..39 the grid stencil (force_body.glsl), 40 SC_WRITE_AUX (fused.comp only; force.comp has no
 /// constant 40, and an entry for an id a shader lacks is ignored), 41 SC_COLLIDER_TYPES (common.glsl:
-/// a mask of collider types), 42 SC_FANS (force_body.glsl); 40 and 42 are VkBool32s.
+/// a mask of collider types), 42 SC_RING (force_body.glsl); 40 and 42 are VkBool32s.
 std::array<std::uint32_t, 43> solver_constants(const SolverBatch::Stencil& st, bool write_aux,
-                                               std::uint32_t collider_types, bool fans) {
+                                               std::uint32_t collider_types, bool ring) {
   static_assert(sizeof(SolverBatch::Stencil) == 40 * 4);
   std::array<std::uint32_t, 43> words{};
   std::memcpy(words.data(), &st, sizeof(st));
   words[40] = write_aux ? 1u : 0u;
   words[41] = collider_types;
-  words[42] = fans ? 1u : 0u;
+  words[42] = ring ? 1u : 0u;
   return words;
 }
 
@@ -116,7 +116,7 @@ Result<void> SolverBatch::create_texel_views() {
     VkFormat format;
     BufferView* view;
     const char* what;
-  } views[12] = {{&pos[0], VK_FORMAT_R32G32B32A32_SFLOAT, &pos_views[0], "positions[0]"},
+  } views[10] = {{&pos[0], VK_FORMAT_R32G32B32A32_SFLOAT, &pos_views[0], "positions[0]"},
                  {&pos[1], VK_FORMAT_R32G32B32A32_SFLOAT, &pos_views[1], "positions[1]"},
                  {&stage_pos, VK_FORMAT_R32G32B32A32_SFLOAT, &pos_views[2], "stage positions"},
                  {&particle, VK_FORMAT_R32G32_UINT, &particle_view, "particle constants"},
@@ -125,10 +125,7 @@ Result<void> SolverBatch::create_texel_views() {
                  {&instances, VK_FORMAT_R32G32B32A32_UINT, &instances_view, "instance parameters"},
                  {&offsets, VK_FORMAT_R32_UINT, &offsets_view, "adjacency offsets"},
                  {&edges, VK_FORMAT_R32G32B32A32_UINT, &edges_view, "adjacency"},
-                 {&fan_offsets, VK_FORMAT_R32_UINT, &fan_offsets_view, "normal fan offsets"},
-                 {&fans, VK_FORMAT_R32G32_UINT, &fans_view, "normal fans"},
                  {&strain_links, VK_FORMAT_R32_UINT, &strain_links_view, "strain links"}};
-  static_assert(sizeof(sh::FanEntry) == 8, "one RG32UI texel per FanEntry");
   static_assert(sizeof(sh::StrainLink) == 12, "three R32UI texels per StrainLink");
   for (const auto& view : views) {
     auto r = create_buffer_view(*ctx, view.buffer->buffer, view.format, view.what);
@@ -169,8 +166,6 @@ Result<void> SolverBatch::create_buffer_views() {
       {&instances_view, VKCLOTH_TEXEL_BINDING_INSTANCES},
       {&offsets_view, VKCLOTH_TEXEL_BINDING_OFFSETS},
       {&edges_view, VKCLOTH_TEXEL_BINDING_EDGES},
-      {&fan_offsets_view, VKCLOTH_TEXEL_BINDING_FAN_OFFSETS},
-      {&fans_view, VKCLOTH_TEXEL_BINDING_FANS},
       {&strain_links_view, VKCLOTH_TEXEL_BINDING_STRAIN_LINKS},
       {&tethers_view, VKCLOTH_TEXEL_BINDING_TETHERS},
       {&colliders_view, VKCLOTH_TEXEL_BINDING_COLLIDERS},
@@ -203,7 +198,7 @@ Result<void> SolverBatch::create_buffer_views() {
 Result<void> SolverBatch::create_pipelines() {
   using Shader = PipelineRegistry::Shader;
   const auto constants =
-      solver_constants(stencil, true, VKCLOTH_COLLIDER_ALL_TYPES, normals == Normals::fans);
+      solver_constants(stencil, true, VKCLOTH_COLLIDER_ALL_TYPES, normals == Normals::ring);
   const PipelineRegistry::Variant variant{access, workgroup};
   auto fp = ctx->pipelines->pipeline(Shader::force, constants, variant);
   if (!fp)
@@ -237,7 +232,7 @@ Result<void> SolverBatch::ensure_fused() {
   if (!options.fused || (fused_pipes[0][types] && fused_pipes[1][types]))
     return {};
   for (std::uint32_t aux = 0; aux < 2; ++aux) {
-    const auto constants = solver_constants(stencil, aux != 0, types, normals == Normals::fans);
+    const auto constants = solver_constants(stencil, aux != 0, types, normals == Normals::ring);
     auto p = ctx->pipelines->pipeline(PipelineRegistry::Shader::fused, constants, {access, workgroup});
     if (!p)
       return p.error();
@@ -289,8 +284,6 @@ Result<void> SolverBatch::write_sets() {
       by_binding[VKCLOTH_BINDING_COLLIDERS] = &colliders;
       by_binding[VKCLOTH_BINDING_FLAGS] = &flags;
       by_binding[VKCLOTH_BINDING_INSTANCES] = &instances;
-      by_binding[VKCLOTH_BINDING_FAN_OFFSETS] = &fan_offsets;
-      by_binding[VKCLOTH_BINDING_FANS] = &fans;
       by_binding[VKCLOTH_BINDING_STRAIN_LINKS] = &strain_links;
       by_binding[VKCLOTH_BINDING_TETHERS] = &tethers;
       by_binding[VKCLOTH_BINDING_UV] = &uv;
@@ -323,8 +316,6 @@ Result<void> SolverBatch::write_sets() {
                                  colliders.buffer,
                                  flags.buffer,
                                  instances.buffer,
-                                 fan_offsets.buffer,
-                                 fans.buffer,
                                  mesh_nodes.buffer,
                                  mesh_tris.buffer});
   return {};

@@ -33,10 +33,6 @@ struct SolverKnobs {
   /// lists; same terms in the same order, so the same bits. `true` keeps the CSR gather for every
   /// particle (comparison).
   bool csr_only = false;
-  /// Cloth grids: rebuild the vertex normals from the topology's fan lists (the path of mesh
-  /// surfaces, force_body.glsl fan_normal) instead of the unrolled grid fan (grid_normal). The
-  /// grid's fans are the same triangles in the same order, so the same bits (comparison).
-  bool fan_normals = false;
 };
 
 /// GpuSolver::create with knobs.
