@@ -439,7 +439,7 @@ template <typename Real> void CpuSolver<Real>::euler_substep(const Real h, const
     return;
   }
 #endif
-  // One sweep: p's normal needs only positions (read-only here), and force_at reads p's own.
+  // One sweep: p's normal and force read positions only (read-only here) and p's own velocity.
   pool_->for_each(pos_.size(),
                   [&](std::size_t p) { euler_finish(p, normal_force_at(pos_, vel_, p), h, semi); });
   std::swap(pos_, pos_next_);

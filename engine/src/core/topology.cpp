@@ -21,7 +21,7 @@ bool same_constants(const GatherEdge& e, const GridStencil& st, int k) {
 }
 
 /// The fan of grid particle (i, j): neighbours right, up, left, down; each present adjacent pair
-/// (k, k+1 mod 4) is one triangle, in that order (CpuSolver::normal_at, force_body.glsl
+/// (k, k+1 mod 4) is one triangle, in that order (CpuSolver::normal_force_at, force_body.glsl
 /// grid_normal, term for term).
 struct GridFan {
   bool has[4];
