@@ -129,8 +129,7 @@ void fill_fans(std::span<const std::uint32_t> face_offsets, std::span<const std:
 /// Particle p's fan as chains of neighbours: each triangle (a, b) links a to b; a chain starts
 /// where no unused triangle ends (else anywhere: a closed ring), follows the first unused triangle
 /// leaving its last neighbour, and closes when it comes back to its start. The terms come out in
-/// chain order; those of a degenerate triangle (p a corner
-/// twice) are left out, as they add zero.
+/// chain order; those of a degenerate triangle (p a corner twice) are left out, as they add zero.
 struct RingNode {
   std::uint32_t other;
   std::uint32_t ring; // ring_start | ring_prev | ring_close
