@@ -36,6 +36,7 @@ template <typename Real> struct ContactShapes {
 template <typename Real> struct PaddedLists {
   std::size_t width = 0;
   std::vector<std::uint32_t> spring_begin, other, ring, ring_end;
+  std::vector<std::uint8_t> reads_last; ///< per vector: some slot names the last particle
   std::vector<Real> rest, stiff;
 };
 } // namespace detail
@@ -617,7 +618,7 @@ pad_lists(std::size_t width, std::span<const std::uint32_t> edge_offsets, const 
   auto lists = std::make_unique<detail::PaddedLists<Real>>();
   detail::PaddedLists<Real>& l = *lists;
   l.width = width;
-  const std::size_t vectors = (edge_offsets.size() - 1) / width;
+  const std::size_t n = edge_offsets.size() - 1, vectors = n / width;
   l.spring_begin.push_back(0);
   for (std::size_t b = 0; b < vectors; ++b) {
     std::uint32_t slots = 0, ring_slots = 0;
@@ -637,6 +638,8 @@ pad_lists(std::size_t width, std::span<const std::uint32_t> edge_offsets, const 
         l.ring.push_back(e.ring);
       }
     l.ring_end.push_back(l.spring_begin.back() + ring_slots * std::uint32_t(width));
+    l.reads_last.push_back(std::find(l.other.begin() + l.spring_begin.back(), l.other.end(), n - 1) !=
+                           l.other.end());
     l.spring_begin.push_back(std::uint32_t(l.other.size()));
   }
   return lists;
@@ -660,6 +663,7 @@ template <typename Real> void CpuSolver<Real>::list_sweep(const Real h, const bo
   la.stiff = l.stiff.data();
   la.ring = l.ring.data();
   la.ring_end = l.ring_end.data();
+  la.reads_last = l.reads_last.data();
   const std::size_t vectors = n / width;
   Real* const pn = &pos_next_[0].x;
   Real* const vn = &vel_[0].x;

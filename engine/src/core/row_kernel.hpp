@@ -50,7 +50,8 @@ template <typename Real> struct RowArgs : StepArgs<Real> {
 /// particle's gather order. A lane with fewer springs than the longest list of its vector points
 /// the rest at itself: a zero-length spring adds nothing (add_spring's `len > 0`), and its ring
 /// bits are zero. The lists carry the normal fans (ClothTopology::ring_normals, `ring` per slot):
-/// no lane has ring bits at or after slot ring_end[b]. Positions are read as they are stored (AoS).
+/// no lane has ring bits at or after slot ring_end[b]. Positions are read as they are stored (AoS);
+/// reads_last[b] is set when some slot of vector b names the last particle.
 template <typename Real> struct ListArgs : StepArgs<Real> {
   const Real* pos;
   const std::uint32_t* spring_begin;
@@ -59,6 +60,7 @@ template <typename Real> struct ListArgs : StepArgs<Real> {
   const Real* stiff;
   const std::uint32_t* ring;
   const std::uint32_t* ring_end;
+  const std::uint8_t* reads_last;
 };
 
 /// A collider as the SIMD finish takes it: kernel::ColliderShape<Real>'s values, copied as they are

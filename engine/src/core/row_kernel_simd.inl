@@ -357,7 +357,8 @@ template <typename T> VKCLOTH_AI V3<T> cross(V3<T> x, V3<T> y) {
 // scalar loads (the lanes' neighbours differ). A vector's lanes walk as many slots as its longest
 // list; the padding adds nothing (row_kernel.hpp ListArgs), so each lane sums its own terms in its
 // list's order, with the kernel's operations: the reference's bits. The normal comes from the same
-// edges (cloth_kernel.h add_ring_term), in the slots before ring_end.
+// edges (cloth_kernel.h add_ring_term), in the slots before ring_end. A vector whose lists name the
+// last particle gathers with gather3_last (T::gather3 may read one float past the particle it loads).
 
 template <typename T> VKCLOTH_AI typename T::M load_index(const std::uint32_t* p) {
   typename T::M m;
@@ -400,9 +401,13 @@ std::int64_t list_body(const vkcloth::detail::ListArgs<typename T::Real>& a, std
     T::load3(pos + 3 * q, xs, ys, zs);
     const V3<T> x0{xs, ys, zs};
     V3<T> f{zero, zero, zero}, fan{zero, zero, zero}, prev{zero, zero, zero}, first{zero, zero, zero};
+    const bool reads_last = a.reads_last[b];
     auto spring = [&](std::uint32_t s) {
       V xq, yq, zq;
-      T::gather3(pos, load_index<T>(a.other + s), xq, yq, zq);
+      if (reads_last)
+        T::gather3_last(pos, a.other + s, xq, yq, zq);
+      else
+        T::gather3(pos, a.other + s, xq, yq, zq);
       const V3<T> u{xq - x0.x, yq - x0.y, zq - x0.z};
       add_spring_v<T>(f.x, f.y, f.z, u.x, u.y, u.z, ld<T>(a.rest + s), ld<T>(a.stiff + s), all);
       return u;
@@ -657,14 +662,18 @@ template <typename Real, typename V, typename M, int W> struct IsaGeneric {
       p[3 * l + 2] = z[l];
     }
   }
-  // The positions of the W particles `index` names, from AoS storage.
-  static void gather3(const Real* pos, M index, V& x, V& y, V& z) {
+  // The positions of the W particles index[0..W) names, from AoS storage.
+  static void gather3(const Real* pos, const std::uint32_t* index, V& x, V& y, V& z) {
     for (int l = 0; l < W; ++l) {
       const Real* p = pos + 3 * std::size_t(index[l]);
       x[l] = p[0];
       y[l] = p[1];
       z[l] = p[2];
     }
+  }
+  // The same where index may name the last particle (the ISA files' gather3 reads past it).
+  static void gather3_last(const Real* pos, const std::uint32_t* index, V& x, V& y, V& z) {
+    IsaGeneric::gather3(pos, index, x, y, z);
   }
   static M pinmask(const std::uint8_t* p) {
     M m;
