@@ -533,6 +533,10 @@ struct Row {
   std::vector<std::string> colliders;                   // scene "contact": their types
   std::uint32_t collider_triangles = 0;                 // scene "contact": a mesh collider's
   double self_thickness = 0; // self-collision rows: the thickness (m) of the "on" row's parameters
+  // Mesh rows: the grid the row is quoted against, timed in alternation with it (each repetition
+  // runs `steps` of the grid, then of the mesh): its side and median wall time (-1: not paired).
+  std::uint32_t partner_size = 0;
+  double partner_ms = -1;
   Cost cost;
 };
 
@@ -553,20 +557,53 @@ double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
-Result<Row> bench_cpu(const BenchScene& sc, std::uint32_t n, const BenchOptions& o) {
+/// A grid a mesh row is timed against in alternation (Row::partner_ms), so that a machine whose
+/// speed drifts (other jobs on its cores) slows both alike.
+struct Partner {
+  const BenchScene& scene;
+  std::uint32_t size;
+};
+
+/// `reps` repetitions of `steps` steps of `run(steps)`, each after one of `partner_run(steps)`
+/// when given: the medians of the wall times (the partner's -1 without one).
+template <typename Run, typename PartnerRun>
+Result<std::pair<double, double>> timed_reps(const BenchOptions& o, Run run, PartnerRun* partner_run) {
+  std::vector<double> wall, partner_wall;
+  for (unsigned r = 0; r < o.reps; ++r) {
+    if (partner_run) {
+      const auto t0 = Clock::now();
+      VKCLOTH_TRY((*partner_run)(o.steps));
+      partner_wall.push_back(ms_since(t0));
+    }
+    const auto t0 = Clock::now();
+    VKCLOTH_TRY(run(o.steps));
+    wall.push_back(ms_since(t0));
+  }
+  return std::pair{median(wall), partner_run ? median(partner_wall) : -1.0};
+}
+
+Result<Row> bench_cpu(const BenchScene& sc, std::uint32_t n, const BenchOptions& o,
+                      std::optional<Partner> partner = std::nullopt) {
   CpuSolverOptions co;
   co.threads = o.threads;
   auto s = CpuSolver<float>::create(sc.system, sc.params, co);
   if (!s)
     return s.error();
+  std::optional<CpuSolver<float>> grid;
+  if (partner) {
+    auto g = CpuSolver<float>::create(partner->scene.system, partner->scene.params, co);
+    if (!g)
+      return g.error();
+    grid.emplace(std::move(*g));
+    VKCLOTH_TRY(grid->run(o.warmup));
+  }
   VKCLOTH_TRY(s->run(o.warmup));
   const SolveStats before = s->last_solve();
-  std::vector<double> wall;
-  for (unsigned r = 0; r < o.reps; ++r) {
-    const auto t0 = Clock::now();
-    VKCLOTH_TRY(s->run(o.steps));
-    wall.push_back(ms_since(t0));
-  }
+  auto grid_run = [&](std::uint64_t steps) { return grid->run(steps); };
+  auto times = timed_reps(
+      o, [&](std::uint64_t steps) { return s->run(steps); }, grid ? &grid_run : nullptr);
+  if (!times)
+    return times.error();
   Row row;
   row.backend = "cpu";
   row.variant = "cpu";
@@ -575,7 +612,9 @@ Result<Row> bench_cpu(const BenchScene& sc, std::uint32_t n, const BenchOptions&
   row.cg_per_step = cg_per_step(before, s->last_solve());
   row.threads = s->threads();
   row.size = n;
-  row.wall_ms = median(wall);
+  row.wall_ms = times->first;
+  row.partner_ms = times->second;
+  row.partner_size = partner ? partner->size : 0;
   return row;
 }
 
@@ -589,10 +628,10 @@ std::pair<std::string, std::uint32_t> layout_of(gpu::Context& ctx, const gpu::Gp
   return {gpu::to_string(a), go.workgroup_size ? go.workgroup_size : d.workgroup_size};
 }
 
-Result<Row>
-bench_vulkan(gpu::Context& ctx, const BenchScene& sc, std::uint32_t n, bool fused, gpu::BufferAccess access,
-             const BenchOptions& o,
-             gpu::GpuSolverOptions::CgDispatch cg = gpu::GpuSolverOptions::CgDispatch::automatic) {
+Result<Row> bench_vulkan(gpu::Context& ctx, const BenchScene& sc, std::uint32_t n, bool fused,
+                         gpu::BufferAccess access, const BenchOptions& o,
+                         gpu::GpuSolverOptions::CgDispatch cg = gpu::GpuSolverOptions::CgDispatch::automatic,
+                         std::optional<Partner> partner = std::nullopt) {
   gpu::GpuSolverOptions go;
   go.fused = fused;
   go.buffer_access = access;
@@ -601,15 +640,28 @@ bench_vulkan(gpu::Context& ctx, const BenchScene& sc, std::uint32_t n, bool fuse
   auto s = gpu::GpuSolver::create(ctx, sc.system, sc.params, go);
   if (!s)
     return s.error();
+  std::optional<gpu::GpuSolver> grid;
+  if (partner) {
+    auto g = gpu::GpuSolver::create(ctx, partner->scene.system, partner->scene.params, go);
+    if (!g)
+      return g.error();
+    grid.emplace(std::move(*g));
+    VKCLOTH_TRY(grid->simulate(o.warmup, o.steps_per_submit));
+  }
   VKCLOTH_TRY(s->simulate(o.warmup, o.steps_per_submit));
   const SolveStats before = s->last_solve();
-  std::vector<double> wall, gpu_ms;
-  for (unsigned r = 0; r < o.reps; ++r) {
-    const auto t0 = Clock::now();
-    VKCLOTH_TRY(s->simulate(o.steps, o.steps_per_submit));
-    wall.push_back(ms_since(t0));
-    gpu_ms.push_back(s->last_gpu_ms());
-  }
+  std::vector<double> gpu_ms;
+  auto grid_run = [&](std::uint64_t steps) { return grid->simulate(steps, o.steps_per_submit); };
+  auto times = timed_reps(
+      o,
+      [&](std::uint64_t steps) -> Result<void> {
+        VKCLOTH_TRY(s->simulate(steps, o.steps_per_submit));
+        gpu_ms.push_back(s->last_gpu_ms());
+        return {};
+      },
+      grid ? &grid_run : nullptr);
+  if (!times)
+    return times.error();
   Row row;
   row.backend = "vulkan";
   row.variant = sc.params.integrator == Integrator::implicit_euler ? "implicit"
@@ -621,7 +673,9 @@ bench_vulkan(gpu::Context& ctx, const BenchScene& sc, std::uint32_t n, bool fuse
   if (sc.params.integrator == Integrator::implicit_euler)
     row.cg_dispatch = s->implicit_one_workgroup() ? "one_workgroup" : "per_iteration";
   row.size = n;
-  row.wall_ms = median(wall);
+  row.wall_ms = times->first;
+  row.partner_ms = times->second;
+  row.partner_size = partner ? partner->size : 0;
   row.gpu_ms = median(gpu_ms);
   std::tie(row.layout, row.workgroup) =
       layout_of(ctx, go, sc.params.integrator == Integrator::implicit_euler);
@@ -838,15 +892,21 @@ double per_particle_step(const Row& r) {
   return r.wall_ms / (double(r.particles) * double(r.steps));
 }
 
+/// A mesh row's cost per particle-step over that of the grid timed in alternation with it.
+double mesh_over_grid(const Row& r) {
+  const double grid_particles = double(r.partner_size) * double(r.partner_size);
+  return per_particle_step(r) / (r.partner_ms / (grid_particles * double(r.steps)));
+}
+
 /// The grid row of the same backend, variant and integrator whose particle count is closest to a
-/// mesh row's (or a stretch row's: its own grid): that row's cost is quoted against it.
-const Row* nearest_grid(const std::vector<Row>& rows, const Row& mesh) {
+/// stretch row's (its own grid): that row's cost is quoted against it.
+const Row* nearest_grid(const std::vector<Row>& rows, const Row& r) {
   const Row* best = nullptr;
   for (const Row& g : rows)
-    if (g.scene == "grid" && g.backend == mesh.backend && g.variant == mesh.variant &&
-        g.layout == mesh.layout && g.integrator == mesh.integrator && g.instances == 1 &&
-        (!best || std::abs(double(g.particles) - double(mesh.particles)) <
-                      std::abs(double(best->particles) - double(mesh.particles))))
+    if (g.scene == "grid" && g.backend == r.backend && g.variant == r.variant && g.layout == r.layout &&
+        g.integrator == r.integrator && g.instances == 1 &&
+        (!best || std::abs(double(g.particles) - double(r.particles)) <
+                      std::abs(double(best->particles) - double(r.particles))))
       best = &g;
   return best;
 }
@@ -932,7 +992,7 @@ int bench_command(const BenchOptions& o) {
   const bool implicit = *integrator == Integrator::implicit_euler;
   // Times one scene on the chosen backends (CPU; Vulkan fused / two-pass; ClothWorld batches).
   auto time_scene = [&](const BenchScene& sc, std::uint32_t n, const std::string& scene,
-                        const std::string& order) -> int {
+                        const std::string& order, std::optional<Partner> partner = std::nullopt) -> int {
     const double s = double(sc.system.adjacency.refs.size()) / double(sc.system.size());
     double fans = 0.0;
     if (sc.system.surface) {
@@ -963,7 +1023,7 @@ int bench_command(const BenchOptions& o) {
       return exit_ok;
     };
     if (o.backend != "vulkan")
-      if (int e = add(bench_cpu(sc, n, o)))
+      if (int e = add(bench_cpu(sc, n, o, partner)))
         return e;
     if (!ctx)
       return exit_ok;
@@ -986,12 +1046,12 @@ int bench_command(const BenchOptions& o) {
                 return e;
           continue;
         }
-        if (int e = add(bench_vulkan(*ctx, sc, n, true, access, o)))
+        if (int e = add(bench_vulkan(*ctx, sc, n, true, access, o, D::automatic, partner)))
           return e;
       }
     if (two_pass && !rk4 && !imp)
       for (gpu::BufferAccess access : layouts)
-        if (int e = add(bench_vulkan(*ctx, sc, n, false, access, o)))
+        if (int e = add(bench_vulkan(*ctx, sc, n, false, access, o, D::automatic, partner)))
           return e;
     if (o.instances > 1 && scene == "grid") { // many cloths: one batch vs one dispatch chain per cloth
       for (gpu::BufferAccess access : layouts) {
@@ -1029,11 +1089,24 @@ int bench_command(const BenchOptions& o) {
     auto mesh = read_mesh(o.mesh);
     if (!mesh)
       return report(mesh.error());
+    // Each order timed in alternation with the grid of --sizes nearest its particle count.
+    std::optional<BenchScene> grid;
+    std::uint32_t side = 0;
     for (const char* order : {"meshopt", "file", "shuffled"}) {
       auto sc = mesh_bench_scene(*mesh, order, *integrator, dt);
       if (!sc)
         return report(sc.error());
-      if (int e = time_scene(*sc, 0, "mesh", order))
+      if (!grid) {
+        const double root = std::sqrt(double(sc->system.size()));
+        side = *std::min_element(sizes->begin(), sizes->end(), [&](std::uint32_t a, std::uint32_t b) {
+          return std::abs(double(a) - root) < std::abs(double(b) - root);
+        });
+        auto g = bench_scene(side, *integrator, dt, o);
+        if (!g)
+          return report(g.error());
+        grid.emplace(std::move(*g));
+      }
+      if (int e = time_scene(*sc, 0, "mesh", order, Partner{*grid, side}))
         return e;
     }
   }
@@ -1205,8 +1278,9 @@ int bench_command(const BenchOptions& o) {
     j["scene"] = r.scene;
     if (r.scene == "mesh") {
       j["order"] = r.order;
-      if (const Row* g = nearest_grid(rows, r))
-        j["mesh_over_grid"] = per_particle_step(r) / per_particle_step(*g);
+      j["mesh_over_grid"] = mesh_over_grid(r);
+      j["grid_size_alternated"] = r.partner_size;
+      j["grid_ms_per_step_alternated"] = r.partner_ms / double(r.steps);
     }
     if (r.scene == "stretch") {
       j["stretch_method"] = r.order;
@@ -1271,11 +1345,12 @@ int bench_command(const BenchOptions& o) {
               r.wall_ms / double(r.steps), e.wall_ms / double(e.steps), r.wall_ms / e.wall_ms, r.cg_per_step,
               r.cg_iterations);
   for (const Row& r : rows)
-    if (const Row* g = r.scene == "mesh" ? nearest_grid(rows, r) : nullptr)
+    if (r.scene == "mesh")
       fmt::print(
-          "{} {} mesh ({} order, {} particles): {:.2f}x the cost per particle-step of the {} x {} grid\n",
-          r.backend, r.variant, r.order, r.particles, per_particle_step(r) / per_particle_step(*g), g->size,
-          g->size);
+          "{} {} mesh ({} order, {} particles): {:.2f}x the cost per particle-step of the {} x {} grid "
+          "timed in alternation with it ({:.4f} vs {:.4f} ms per step)\n",
+          r.backend, r.variant, r.order, r.particles, mesh_over_grid(r), r.partner_size, r.partner_size,
+          r.wall_ms / double(r.steps), r.partner_ms / double(r.steps));
   for (const Row& r : rows)
     if (const Row* g = r.scene == "stretch" ? nearest_grid(rows, r) : nullptr)
       fmt::print(
