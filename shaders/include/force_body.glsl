@@ -174,17 +174,28 @@ void particle_force(uint p, inout vec3 v_io, out vec3 f_out, out vec3 nrm_out) {
     if ((has & 2048u) != 0u) spring_term(f, x, uint(q + SC_OFF11), SC_L11, SC_K11);
   } else {
     // The springs' edges also make the normal (ClothTopology::ring_normals; CpuSolver::
-    // normal_force_at, term for term).
+    // normal_force_at, term for term). The fan's entries come first, each with ring bits: a first
+    // loop takes them with their ring terms, a second the plain springs (one loop with the ring
+    // terms in every pass cost llvmpipe, which runs both sides of a branch, a third more).
     const bool ring = SC_RING && (ip.flags & VKCLOTH_FLAG_RING_NORMALS) != 0u;
-    vec3 fan = vec3(0.0), prev = vec3(0.0), first = vec3(0.0);
     const uint end = offsets_at(p + 1u);
-    for (uint e = offsets_at(p); e < end; ++e) {
+    uint e = offsets_at(p);
+    if (ring) {
+      vec3 fan = vec3(0.0), prev = vec3(0.0), first = vec3(0.0);
+      for (; e < end; ++e) {
+        const Edge s = edge_at(e);
+        if (s.ring == 0u) break;
+        precise vec3 u = pos_at(s.other) - x;
+        add_spring_edge(f, u, s.rest_length, s.stiffness);
+        add_ring_term(fan, prev, first, u, s.ring);
+      }
+      nrm = unit_or_zero(fan);
+    }
+    for (; e < end; ++e) {
       const Edge s = edge_at(e);
       precise vec3 u = pos_at(s.other) - x;
       add_spring_edge(f, u, s.rest_length, s.stiffness);
-      if (ring) add_ring_term(fan, prev, first, u, s.ring);
     }
-    if (ring) nrm = unit_or_zero(fan);
   }
   const float m = mass_at(p);
   vec3 v = v_io;
