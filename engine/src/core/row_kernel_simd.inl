@@ -353,12 +353,12 @@ template <typename T> VKCLOTH_AI V3<T> cross(V3<T> x, V3<T> y) {
 }
 // ---- The list kernel: meshes and other cloths without a stencil (ListArgs) ---------------------
 // The same step as simd_body, the springs read from the padded lists instead of at constant
-// offsets: per slot, the W lanes' neighbour indices are one vector load and their positions W
-// scalar loads (the lanes' neighbours differ). A vector's lanes walk as many slots as its longest
-// list; the padding adds nothing (row_kernel.hpp ListArgs), so each lane sums its own terms in its
-// list's order, with the kernel's operations: the reference's bits. The normal comes from the same
-// edges (cloth_kernel.h add_ring_term), in the slots before ring_end. A vector whose lists name the
-// last particle gathers with gather3_last (T::gather3 may read one float past the particle it loads).
+// offsets: per slot, the W lanes' neighbours' positions come from T::gather3 (the float ISAs: one
+// 16-byte load per lane and a transpose; the lanes' neighbours differ). A vector's lanes walk as many slots
+// as its longest list; the padding adds nothing (row_kernel.hpp ListArgs), so each lane sums its own terms in
+// its list's order, with the kernel's operations: the reference's bits. The normal comes from the same edges
+// (cloth_kernel.h add_ring_term), in the slots before ring_end. A vector whose lists name the last particle
+// gathers with gather3_last (T::gather3 may read one float past the particle it loads).
 
 template <typename T> VKCLOTH_AI typename T::M load_index(const std::uint32_t* p) {
   typename T::M m;
