@@ -11,13 +11,13 @@
 #include <vector>
 
 #include <fmt/format.h>
-#include <glm/ext/matrix_transform.hpp>
 #include <glm/geometric.hpp>
 #include <glm/mat3x3.hpp>
 #include <glm/mat4x4.hpp>
 #include <glm/vec4.hpp>
 
 #include "../vulkan/barriers.hpp"
+#include "collider_shapes.hpp"
 #include "../vulkan/pipelines.hpp"
 #include "vkcloth/collider_mesh.hpp"
 #include "vkcloth/gpu/world.hpp"
@@ -31,6 +31,10 @@
 
 namespace vkcloth::render {
 
+using detail::ColliderDraw;
+using detail::MeshRange;
+using detail::MeshVertex;
+using detail::Pose;
 using gpu::Buffer;
 using gpu::MemoryUse;
 
@@ -45,197 +49,6 @@ struct DrawConstants {
   glm::vec4 shape;     // mesh.vert: xyz vertex scale, w capsule half length
 };
 static_assert(sizeof(DrawConstants) == 128, "push constants must fit the guaranteed 128 bytes");
-
-/// Mesh vertex: position (w: checker u, or a capsule vertex's end) and normal (w: checker v), as
-/// mesh.vert reads them.
-struct MeshVertex {
-  glm::vec4 pos;
-  glm::vec4 normal;
-};
-
-struct MeshRange {
-  std::uint32_t first = 0, count = 0;
-  float mode = 0.0f, cell = 1.0f;
-  glm::vec3 color{1.0f};
-};
-
-constexpr float pi = 3.14159265358979f;
-
-/// A sphere of radius `r` around `c`, `slices` around z and `stacks` from pole to pole.
-void add_sphere(std::vector<MeshVertex>& v, std::vector<std::uint32_t>& idx, glm::vec3 c, float r,
-                std::uint32_t slices, std::uint32_t stacks) {
-  const auto base = static_cast<std::uint32_t>(v.size());
-  for (std::uint32_t j = 0; j <= stacks; ++j) {
-    const float th = pi * float(j) / float(stacks);
-    for (std::uint32_t i = 0; i <= slices; ++i) {
-      const float ph = 2.0f * pi * float(i) / float(slices);
-      const glm::vec3 n(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th));
-      v.push_back({glm::vec4(c + r * n, 0.0f), glm::vec4(n, 0.0f)});
-    }
-  }
-  for (std::uint32_t j = 0; j < stacks; ++j)
-    for (std::uint32_t i = 0; i < slices; ++i) {
-      const std::uint32_t a = base + j * (slices + 1) + i, b = a + slices + 1;
-      idx.insert(idx.end(), {a, b, a + 1, a + 1, b, b + 1});
-    }
-}
-
-/// A unit-radius capsule along z of length 0: a unit sphere cut at its equator, whose upper
-/// half's vertices carry w = +1 and lower half's w = -1, the equator in both. mesh.vert moves each
-/// half by +-pc.shape.w along z, which opens the strip between the two equators into the
-/// cylinder (its normals, the equator's, are already horizontal).
-void add_unit_capsule(std::vector<MeshVertex>& v, std::vector<std::uint32_t>& idx, std::uint32_t slices,
-                      std::uint32_t half_stacks) {
-  const auto base = static_cast<std::uint32_t>(v.size());
-  const std::uint32_t rings = 2 * (half_stacks + 1); // each half: pole .. equator
-  for (std::uint32_t ring = 0; ring < rings; ++ring) {
-    const bool upper = ring <= half_stacks;
-    const std::uint32_t j = upper ? ring : ring - 1; // the equator (j = half_stacks) twice
-    const float th = pi * float(j) / float(2 * half_stacks);
-    for (std::uint32_t i = 0; i <= slices; ++i) {
-      const float ph = 2.0f * pi * float(i) / float(slices);
-      const glm::vec3 n(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th));
-      v.push_back({glm::vec4(n, upper ? 1.0f : -1.0f), glm::vec4(n, 0.0f)});
-    }
-  }
-  for (std::uint32_t ring = 0; ring + 1 < rings; ++ring)
-    for (std::uint32_t i = 0; i < slices; ++i) {
-      const std::uint32_t a = base + ring * (slices + 1) + i, b = a + slices + 1;
-      idx.insert(idx.end(), {a, b, a + 1, a + 1, b, b + 1});
-    }
-}
-
-/// The box [-1, 1]^3: 6 faces of 4 vertices with the face's normal (flat shading: each face lit
-/// on its own, so the edges show), 12 triangles.
-void add_unit_box(std::vector<MeshVertex>& v, std::vector<std::uint32_t>& idx) {
-  for (int axis = 0; axis < 3; ++axis)
-    for (float side : {-1.0f, 1.0f}) {
-      glm::vec3 n(0.0f), t(0.0f), s(0.0f);
-      n[axis] = side;
-      t[(axis + 1) % 3] = 1.0f;
-      s[(axis + 2) % 3] = 1.0f;
-      const auto base = static_cast<std::uint32_t>(v.size());
-      for (int q = 0; q < 4; ++q) {
-        const float u = (q == 1 || q == 2) ? 1.0f : -1.0f, w = q >= 2 ? 1.0f : -1.0f;
-        v.push_back({glm::vec4(n + u * t + w * s, 0.0f), glm::vec4(n, 0.0f)});
-      }
-      idx.insert(idx.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
-    }
-}
-
-/// A mesh collider's triangles in its own frame, three vertices each with the face normal.
-void add_collider_mesh(std::vector<MeshVertex>& v, std::vector<std::uint32_t>& idx,
-                       const ColliderMesh& mesh) {
-  for (const ColliderMesh::Triangle& t : mesh.triangles()) {
-    const glm::vec3 c = glm::cross(t.b - t.a, t.c - t.a);
-    const float len = glm::length(c);
-    const glm::vec3 n = len > 0.0f ? c / len : glm::vec3(0.0f, 0.0f, 1.0f);
-    const auto base = static_cast<std::uint32_t>(v.size());
-    for (const glm::vec3& p : {t.a, t.b, t.c})
-      v.push_back({glm::vec4(p, 0.0f), glm::vec4(n, 0.0f)});
-    idx.insert(idx.end(), {base, base + 1, base + 2});
-  }
-}
-
-/// Unit tangents t, s with (t, s, n) right-handed, as the floor square is laid out.
-glm::mat3 plane_frame(glm::vec3 n) {
-  const glm::vec3 t =
-      glm::normalize(glm::cross(n, std::abs(n.z) < 0.9f ? glm::vec3(0, 0, 1) : glm::vec3(1, 0, 0)));
-  return glm::mat3(t, glm::cross(n, t), n);
-}
-
-/// Where the floor square of a plane (unit normal n, offset) is centred: the point of the plane
-/// nearest to `around`, a hair below the surface (cloth resting at offset + eps never z-fights
-/// with it).
-glm::vec3 plane_centre(glm::vec3 n, float offset, glm::vec3 around) {
-  return around - (glm::dot(n, around) - offset + 1e-3f) * n;
-}
-
-/// A plane collider drawn as a square of half side `half` around `centre` (plane_centre);
-/// checker coordinates in the w components (mesh.vert).
-void add_plane(std::vector<MeshVertex>& v, std::vector<std::uint32_t>& idx, glm::vec3 n, glm::vec3 centre,
-               float half) {
-  const glm::mat3 f = plane_frame(n);
-  const auto base = static_cast<std::uint32_t>(v.size());
-  for (int q = 0; q < 4; ++q) {
-    const float u = (q == 1 || q == 2) ? half : -half, w = q >= 2 ? half : -half;
-    v.push_back({glm::vec4(centre + u * f[0] + w * f[1], u + half), glm::vec4(n, w + half)});
-  }
-  idx.insert(idx.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
-}
-
-/// A collider's draw: its mesh in the shared buffers and what create() built it from.
-struct ColliderDraw {
-  Collider::Type type = Collider::Type::plane;
-  MeshRange range;
-  const ColliderMesh* mesh = nullptr; ///< mesh: the ColliderMesh whose triangles `range` holds
-  glm::vec3 plane_normal{0.0f};       ///< plane: the square's normal, as built (world) ...
-  glm::vec3 plane_centre{0.0f};       ///< ... and its centre
-  glm::vec3 around{0.0f};             ///< plane: the point the square is centred under
-};
-
-/// A draw's rigid pose (its frame -> world) and mesh.vert's shape (vertex scale, capsule half length).
-struct Pose {
-  glm::dmat4 model{1.0};
-  glm::vec4 shape{1.0f, 1.0f, 1.0f, 0.0f};
-};
-
-/// The collider shapes a cloth rests on are drawn slightly inside the true surface. Particles rest
-/// at the surface + eps, but the flat cloth triangles between them cut chords through a curved
-/// surface (a sag of h^2 / 8r for a spacing h over radius r): a sphere or capsule drawn at full
-/// size would poke through a coarse cloth draped on it, so both are drawn 5% thinner. A box's
-/// faces are flat (no chords): drawn 1 mm inside, like the floor, so cloth lying on a face never
-/// z-fights with it.
-constexpr double round_shrink = 0.95;
-constexpr double box_inset = 1e-3;
-
-/// Where `k` is now, for the draw `d` built from the create()-time collider of the same type.
-Pose pose_of(const ColliderDraw& d, const Collider& k) {
-  Pose p;
-  switch (k.type) {
-  case Collider::Type::plane: {
-    // Built in the world; a plane moved along (or turned from) its create()-time normal is the same
-    // square carried onto the new plane: the old centre to the new, the old frame onto the new.
-    const glm::vec3 n = glm::normalize(glm::vec3(k.normal));
-    const glm::vec3 c = plane_centre(n, float(k.offset), d.around);
-    if (n == d.plane_normal && c == d.plane_centre)
-      return p; // where it was built: the identity
-    const glm::dmat3 turn =
-        glm::dmat3(plane_frame(n)) * glm::transpose(glm::dmat3(plane_frame(d.plane_normal)));
-    p.model = glm::translate(glm::dmat4(1.0), glm::dvec3(c)) * glm::dmat4(turn) *
-              glm::translate(glm::dmat4(1.0), -glm::dvec3(d.plane_centre));
-    return p;
-  }
-  case Collider::Type::sphere:
-    p.model = glm::translate(glm::dmat4(1.0), k.center);
-    p.shape = glm::vec4(glm::vec3(float(k.radius * round_shrink)), 0.0f);
-    return p;
-  case Collider::Type::capsule: {
-    // The unit capsule lies along z: turn z onto b - a (any turn about the axis will do) and put
-    // its middle at (a + b) / 2. a == b: a sphere (half length 0).
-    const glm::dvec3 axis = k.b - k.a;
-    const double length = glm::length(axis);
-    const glm::dvec3 z = length > 0.0 ? axis / length : glm::dvec3(0.0, 0.0, 1.0);
-    const glm::dvec3 x =
-        glm::normalize(glm::cross(std::abs(z.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0), z));
-    p.model = glm::dmat4(glm::dvec4(x, 0.0), glm::dvec4(glm::cross(z, x), 0.0), glm::dvec4(z, 0.0),
-                         glm::dvec4((k.a + k.b) * 0.5, 1.0));
-    p.shape = glm::vec4(glm::vec3(float(k.radius * round_shrink)), float(0.5 * length));
-    return p;
-  }
-  case Collider::Type::box: {
-    const glm::dvec3 h = glm::max(k.half_extents - box_inset, 0.9 * k.half_extents);
-    p.model = glm::translate(glm::dmat4(1.0), k.center) * glm::dmat4(k.rotation);
-    p.shape = glm::vec4(glm::vec3(h), 0.0f);
-    return p;
-  }
-  case Collider::Type::mesh:
-    // Drawn as it is: the cloth rests `thickness` away from its triangles.
-    p.model = glm::translate(glm::dmat4(1.0), k.center) * glm::dmat4(k.rotation);
-    return p;
-  }
-  return p;
-}
 
 } // namespace
 
@@ -328,7 +141,7 @@ Result<void> ClothRenderer::Impl::build_geometry(const ClothTopology& topology, 
     case Collider::Type::plane: {
       d.plane_normal = glm::normalize(glm::vec3(k.normal));
       d.around = b.center();
-      d.plane_centre = plane_centre(d.plane_normal, float(k.offset), d.around);
+      d.plane_centre = detail::plane_centre(d.plane_normal, float(k.offset), d.around);
       d.range = shape([&] { add_plane(verts, midx, d.plane_normal, d.plane_centre, half); });
       d.range.mode = 1.0f;
       d.range.cell = half / 5.0f;
@@ -717,7 +530,7 @@ void ClothRenderer::Impl::record_colliders(VkCommandBuffer cmd, const Camera& ca
     const ColliderDraw& d = draws[i];
     if (now[i].type != d.type || (d.type == Collider::Type::mesh && now[i].mesh.get() != d.mesh))
       continue; // not the collider this draw was built for
-    const Pose p = pose_of(d, now[i]);
+    const Pose p = detail::pose_of(d, now[i]);
     // The draw's frame is the collider's: clip from it, the eye and the light in it (the inverse
     // of a rigid pose: R^T (x - t)).
     const glm::dmat3 r(p.model);
