@@ -82,12 +82,34 @@ void write_trace_rows(std::FILE* f, std::uint64_t step, double time, const std::
                file_vertex(system, k), p[k].x, p[k].y, p[k].z, v[k].x, v[k].y, v[k].z);
 }
 
-/// The contact quality over a run (`vkcloth run` on a scene with colliders).
+/// The contact quality over a run (`vkcloth run` on a scene with colliders): the deepest penetration
+/// after any sampled step, and the largest speed over the run's last second (the jitter of a cloth
+/// that should be at rest).
 constexpr std::uint64_t no_step = ~std::uint64_t{0};
 struct ContactTrack {
   PenetrationStats deepest;     ///< the deepest sampled penetration ...
   std::uint64_t step = no_step; ///< ... and its step
   double calm_speed = 0.0;      ///< the largest free-particle speed over the last second
+  std::uint64_t calm_from = 0;  ///< the first step of the last second
+
+  ContactTrack(std::uint64_t total_steps, double dt) {
+    const auto last_second_steps = static_cast<std::uint64_t>(std::ceil(1.0 / dt - 1e-9));
+    calm_from = total_steps > last_second_steps ? total_steps - last_second_steps : 0;
+  }
+  /// The state after step `step`, with the colliders where they are then.
+  Result<void> add(const ParticleSystem& system, std::span<const Collider> colliders,
+                   const std::vector<glm::dvec3>& pos, const std::vector<glm::dvec3>& vel, std::uint64_t at) {
+    auto depth = penetration(system, colliders, pos);
+    if (!depth)
+      return depth.error();
+    if (depth->depth > deepest.depth || step == no_step) {
+      deepest = *depth;
+      step = at;
+    }
+    if (at > calm_from)
+      calm_speed = std::max(calm_speed, max_free_speed(system, vel));
+    return {};
+  }
 };
 
 struct RunOptions {
@@ -195,6 +217,138 @@ private:
   std::uint64_t frames_ = 0;
 };
 
+/// The output files, opened before the run: a typo in a path should not cost a whole run.
+struct Outputs {
+  File trace, positions, json;
+};
+
+Result<Outputs> open_outputs(const RunOptions& opt) {
+  Outputs out;
+  const std::pair<const std::string*, File*> wanted[] = {
+      {&opt.trace, &out.trace}, {&opt.positions, &out.positions}, {&opt.json, &out.json}};
+  const char* what[] = {"trace", "positions", "JSON"};
+  for (std::size_t k = 0; k < std::size(wanted); ++k) {
+    if (wanted[k].first->empty())
+      continue;
+    auto f = open_output(*wanted[k].first, what[k]);
+    if (!f)
+      return f.error();
+    *wanted[k].second = std::move(*f);
+  }
+  if (out.trace)
+    fmt::print(out.trace.get(), "step,time,particle,x,y,z,vx,vy,vz\n");
+  return out;
+}
+
+/// What the run measured, for the summary lines and --json.
+struct RunSummary {
+  double wall = 0.0;                     ///< seconds of wall time in the step loop
+  double max_displacement = 0.0;         ///< m, the largest move of a particle from its start
+  SolveStats cg;                         ///< implicit_euler's last solve
+  std::optional<StrainStats> end_strain; ///< cloths: the strain of the final state
+  StrainTrack strain;                    ///< ... and the largest over the run
+  std::uint64_t strain_every = 1;
+  std::optional<ContactTrack> contact; ///< scenes with colliders
+  std::uint64_t contact_every = 1;
+  std::optional<IntersectionStats> intersections; ///< --check-intersections
+};
+
+void print_summary(const Scene& scene, const RunOptions& opt, const SimBackend& backend,
+                   const RunSummary& r) {
+  const ParticleSystem& system = scene.system;
+  fmt::print(
+      "{}: {} particles, {} springs, {} steps of {:g} s ({}, {} {}): simulated {:.6g} s in {:.3f} s wall, "
+      "max displacement {:.6g} m\n",
+      scene.name, system.size(), system.springs.size(), backend.step_index(), scene.params.dt,
+      to_string(scene.params.integrator), opt.backend, opt.precision, backend.time(), r.wall,
+      r.max_displacement);
+  if (scene.params.integrator == Integrator::implicit_euler)
+    fmt::print(
+        "implicit_euler: last solve {} CG iterations, relative residual {:.3g} (tolerance {:g}, cap {}); "
+        "{:.1f} CG iterations per solve over the run ({} solves)\n",
+        r.cg.iterations, r.cg.residual, scene.params.cg_tolerance, scene.params.cg_max_iterations,
+        r.cg.mean_iterations(), r.cg.solves);
+  if (r.end_strain) {
+    const Spring& sp = system.springs[r.end_strain->spring];
+    fmt::print(
+        "largest structural strain: {:.6g} at the end (spring {}: particles {}-{}), {:.6g} over the run "
+        "(step {}{})\n",
+        r.end_strain->max, r.end_strain->spring, file_vertex(system, sp.a), file_vertex(system, sp.b),
+        r.strain.run.max, r.strain.run_step,
+        r.strain_every > 1 ? fmt::format(", sampled every {} steps", r.strain_every) : "");
+  }
+  if (r.contact)
+    fmt::print(
+        "contact: deepest penetration {:.3g} m (particle {}, collider {}, step {}; contact_epsilon {:g}{}), "
+        "largest speed over the last second {:.3g} m/s\n",
+        r.contact->deepest.depth, file_vertex(system, r.contact->deepest.particle),
+        r.contact->deepest.collider, r.contact->step, scene.params.contact_epsilon,
+        r.contact_every > 1 ? fmt::format(", sampled every {} steps", r.contact_every) : "",
+        r.contact->calm_speed);
+  if (r.intersections) {
+    if (r.intersections->triangles == 0)
+      fmt::print("intersections: no triangles (a chain), 0 pairs\n");
+    else
+      fmt::print("intersections: {} pairs of triangles intersect (of {} triangles)\n", r.intersections->pairs,
+                 r.intersections->triangles);
+  }
+}
+
+/// The summary as JSON (schema "vkcloth-run/1", keys in docs/scene-format.md).
+nlohmann::json summary_json(const Scene& scene, const RunOptions& opt, const SimBackend& backend,
+                            const RunSummary& r) {
+  const ParticleSystem& system = scene.system;
+  nlohmann::json doc;
+  doc["schema"] = "vkcloth-run/1";
+  doc["scene"] = scene.name;
+  doc["particles"] = system.size();
+  doc["springs"] = system.springs.size();
+  doc["steps"] = backend.step_index();
+  doc["dt"] = scene.params.dt;
+  doc["integrator"] = to_string(scene.params.integrator);
+  doc["backend"] = opt.backend;
+  doc["precision"] = opt.precision;
+  doc["simulated_time"] = backend.time();
+  doc["wall_s"] = r.wall;
+  doc["max_displacement"] = r.max_displacement;
+  doc["implicit_euler"] = scene.params.integrator == Integrator::implicit_euler
+                              ? nlohmann::json{{"cg_iterations", r.cg.iterations},
+                                               {"cg_residual", r.cg.residual},
+                                               {"cg_iterations_mean", r.cg.mean_iterations()},
+                                               {"cg_solves", r.cg.solves}}
+                              : nlohmann::json(nullptr);
+  if (r.end_strain) {
+    const auto ends = [&](std::uint32_t k) {
+      const Spring& sp = system.springs[k];
+      return nlohmann::json::array({file_vertex(system, sp.a), file_vertex(system, sp.b)});
+    };
+    doc["max_structural_strain"] = {{"end", r.end_strain->max},
+                                    {"end_spring", r.end_strain->spring},
+                                    {"end_particles", ends(r.end_strain->spring)},
+                                    {"run", r.strain.run.max},
+                                    {"run_step", r.strain.run_step},
+                                    {"run_spring", r.strain.run.spring},
+                                    {"run_particles", ends(r.strain.run.spring)},
+                                    {"every", r.strain_every},
+                                    {"structural_springs", r.end_strain->count}};
+  } else {
+    doc["max_structural_strain"] = nullptr;
+  }
+  doc["contact"] =
+      r.contact ? nlohmann::json{{"max_penetration", r.contact->deepest.depth},
+                                 {"penetration_particle", file_vertex(system, r.contact->deepest.particle)},
+                                 {"penetration_collider", r.contact->deepest.collider},
+                                 {"penetration_step", r.contact->step},
+                                 {"contact_epsilon", scene.params.contact_epsilon},
+                                 {"max_speed_last_second", r.contact->calm_speed},
+                                 {"last_second_from_step", r.contact->calm_from},
+                                 {"every", r.contact_every}}
+                : nlohmann::json(nullptr);
+  if (r.intersections)
+    doc["intersections"] = {{"pairs", r.intersections->pairs}, {"triangles", r.intersections->triangles}};
+  return doc;
+}
+
 int run_command(const RunOptions& opt) {
   const auto precision = parse_precision(opt.precision);
   if (!precision)
@@ -210,29 +364,10 @@ int run_command(const RunOptions& opt) {
   if (!backend_r)
     return report(backend_r.error());
   SimBackend& backend = **backend_r;
-
-  // Open the outputs first: a typo in a path should not cost a whole run.
-  File trace, positions, json;
-  if (!opt.trace.empty()) {
-    auto f = open_output(opt.trace, "trace");
-    if (!f)
-      return report(f.error());
-    trace = std::move(*f);
-    fmt::print(trace.get(), "step,time,particle,x,y,z,vx,vy,vz\n");
-  }
-  if (!opt.positions.empty()) {
-    auto f = open_output(opt.positions, "positions");
-    if (!f)
-      return report(f.error());
-    positions = std::move(*f);
-  }
-
-  if (!opt.json.empty()) {
-    auto f = open_output(opt.json, "JSON");
-    if (!f)
-      return report(f.error());
-    json = std::move(*f);
-  }
+  auto outputs = open_outputs(opt);
+  if (!outputs)
+    return report(outputs.error());
+  File& trace = outputs->trace;
 
   std::vector<glm::dvec3> pos, vel;
   const auto read = [&] { return backend.read_state(pos, vel); };
@@ -248,29 +383,13 @@ int run_command(const RunOptions& opt) {
   auto strain0 = strain_of_pos();
   if (!strain0)
     return report(strain0.error());
+  RunSummary sum;
   const bool track_strain = strain0->count > 0; // chains (and K_struct = 0) have no structural spring
-  const std::uint64_t strain_every = std::max<std::uint64_t>(opt.strain_every, 1);
-  StrainTrack strain{*strain0, 0};
-  // Contact quality (scenes with colliders): the deepest penetration after any sampled step, and
-  // the largest speed over the run's last second (the jitter of a cloth that should be at rest).
-  const bool track_contact = !scene->params.colliders.empty();
-  const std::uint64_t contact_every = std::max<std::uint64_t>(opt.contact_every, 1);
-  const auto last_second_steps = static_cast<std::uint64_t>(std::ceil(1.0 / scene->params.dt - 1e-9));
-  const std::uint64_t calm_from = total > last_second_steps ? total - last_second_steps : 0;
-  ContactTrack contact;
-  const auto sample_contact = [&]() -> Result<void> {
-    const auto colliders = backend.colliders();
-    auto depth = penetration(scene->system, colliders, pos);
-    if (!depth)
-      return depth.error();
-    if (depth->depth > contact.deepest.depth || contact.step == no_step) {
-      contact.deepest = *depth;
-      contact.step = backend.step_index();
-    }
-    if (backend.step_index() > calm_from)
-      contact.calm_speed = std::max(contact.calm_speed, max_free_speed(scene->system, vel));
-    return {};
-  };
+  sum.strain_every = std::max<std::uint64_t>(opt.strain_every, 1);
+  sum.strain = StrainTrack{*strain0, 0};
+  if (!scene->params.colliders.empty())
+    sum.contact.emplace(total, scene->params.dt);
+  sum.contact_every = std::max<std::uint64_t>(opt.contact_every, 1);
   const std::vector<std::uint32_t> order = file_order(scene->system);
   if (trace)
     write_trace_rows(trace.get(), 0, backend.time(), pos, vel, scene->system, order);
@@ -284,16 +403,16 @@ int run_command(const RunOptions& opt) {
     Progress progress(total);
     std::uint64_t done = 0;
     while (done < total) {
-      // Step to the next trace row, exported frame or progress redraw, whichever comes first.
+      // Step to the next trace row, exported frame, sample or progress redraw, whichever comes first.
       std::uint64_t next = progress.next_tick(done);
       if (trace)
         next = std::min(next, next_multiple(done, every));
       if (frames.enabled())
         next = std::min(next, next_multiple(done, frames.every()));
       if (track_strain)
-        next = std::min(next, next_multiple(done, strain_every));
-      if (track_contact)
-        next = std::min(next, next_multiple(done, contact_every));
+        next = std::min(next, next_multiple(done, sum.strain_every));
+      if (sum.contact)
+        next = std::min(next, next_multiple(done, sum.contact_every));
       next = std::min(next, total);
       if (auto r = backend.step(next - done); !r) {
         if (trace)
@@ -305,20 +424,20 @@ int run_command(const RunOptions& opt) {
       done = next;
       const bool trace_due = trace && done % every == 0;
       const bool frame_due = frames.enabled() && done % frames.every() == 0;
-      const bool contact_due = track_contact && (done % contact_every == 0 || done == total);
+      const bool contact_due = sum.contact && (done % sum.contact_every == 0 || done == total);
       if (trace_due || frame_due || contact_due) {
         if (auto r = read(); !r)
           return report(r.error());
       }
       if (contact_due)
-        if (auto r = sample_contact(); !r)
+        if (auto r = sum.contact->add(scene->system, backend.colliders(), pos, vel, backend.step_index()); !r)
           return report(r.error());
-      if (track_strain && (done % strain_every == 0 || done == total)) {
+      if (track_strain && (done % sum.strain_every == 0 || done == total)) {
         // From `pos` when it was just read; else the backend reads the positions only.
         auto s = trace_due || frame_due ? strain_of_pos() : backend.strain(scene->system);
         if (!s)
           return report(s.error());
-        strain.add(*s, backend.step_index());
+        sum.strain.add(*s, backend.step_index());
       }
       if (trace_due)
         write_trace_rows(trace.get(), backend.step_index(), backend.time(), pos, vel, scene->system, order);
@@ -328,123 +447,41 @@ int run_command(const RunOptions& opt) {
       progress.update(done);
     }
   }
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  sum.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   if (auto r = read(); !r)
     return report(r.error());
-  if (positions) {
+  if (File& positions = outputs->positions) {
     fmt::print(positions.get(), "particle,x,y,z\n"); // in the file's vertex order, as --trace
     for (const std::uint32_t k : order)
       fmt::print(positions.get(), "{},{:.9g},{:.9g},{:.9g}\n", file_vertex(scene->system, k), pos[k].x,
                  pos[k].y, pos[k].z);
   }
-  for (File* f : {&trace, &positions})
+  for (File* f : {&outputs->trace, &outputs->positions})
     if (*f && (std::fflush(f->get()) != 0 || std::ferror(f->get())))
       return report(make_error(ErrorCode::io, "writing an output file failed (disk full?)"));
   if (auto r = frames.finish(); !r)
     return report(r.error());
 
-  double max_disp = 0.0;
   for (std::size_t k = 0; k < pos.size(); ++k)
-    max_disp = std::max(max_disp, glm::length(pos[k] - initial[k]));
-  fmt::print(
-      "{}: {} particles, {} springs, {} steps of {:g} s ({}, {} {}): simulated {:.6g} s in {:.3f} s wall, "
-      "max displacement {:.6g} m\n",
-      scene->name, scene->system.size(), scene->system.springs.size(), backend.step_index(), scene->params.dt,
-      to_string(scene->params.integrator), opt.backend, opt.precision, backend.time(), wall, max_disp);
-  const SolveStats cg = backend.last_solve();
-  if (scene->params.integrator == Integrator::implicit_euler)
-    fmt::print(
-        "implicit_euler: last solve {} CG iterations, relative residual {:.3g} (tolerance {:g}, cap {}); "
-        "{:.1f} CG iterations per solve over the run ({} solves)\n",
-        cg.iterations, cg.residual, scene->params.cg_tolerance, scene->params.cg_max_iterations,
-        cg.mean_iterations(), cg.solves);
-  std::optional<StrainStats> end_strain;
+    sum.max_displacement = std::max(sum.max_displacement, glm::length(pos[k] - initial[k]));
+  sum.cg = backend.last_solve();
   if (track_strain) {
     auto s = strain_of_pos();
     if (!s)
       return report(s.error());
-    end_strain = *s;
-    strain.add(*s, backend.step_index()); // already there unless the run had no steps
-    const Spring& sp = scene->system.springs[end_strain->spring];
-    fmt::print(
-        "largest structural strain: {:.6g} at the end (spring {}: particles {}-{}), {:.6g} over the run "
-        "(step {}{})\n",
-        end_strain->max, end_strain->spring, file_vertex(scene->system, sp.a),
-        file_vertex(scene->system, sp.b), strain.run.max, strain.run_step,
-        strain_every > 1 ? fmt::format(", sampled every {} steps", strain_every) : "");
+    sum.end_strain = *s;
+    sum.strain.add(*s, backend.step_index()); // already there unless the run had no steps
   }
-  if (track_contact)
-    fmt::print(
-        "contact: deepest penetration {:.3g} m (particle {}, collider {}, step {}; contact_epsilon {:g}{}), "
-        "largest speed over the last second {:.3g} m/s\n",
-        contact.deepest.depth, file_vertex(scene->system, contact.deepest.particle), contact.deepest.collider,
-        contact.step, scene->params.contact_epsilon,
-        contact_every > 1 ? fmt::format(", sampled every {} steps", contact_every) : "", contact.calm_speed);
-  // Self-intersections at the final state (the solver's positions, in particle order).
-  std::optional<IntersectionStats> intersections;
-  if (opt.check_intersections) {
+  if (opt.check_intersections) { // self-intersections at the final state (the solver's positions)
     auto r = intersecting_triangle_pairs(scene->system, std::span<const glm::dvec3>(pos));
     if (!r)
       return report(r.error());
-    intersections = *r;
-    if (r->triangles == 0)
-      fmt::print("intersections: no triangles (a chain), 0 pairs\n");
-    else
-      fmt::print("intersections: {} pairs of triangles intersect (of {} triangles)\n", r->pairs,
-                 r->triangles);
+    sum.intersections = *r;
   }
-  if (json) {
-    nlohmann::json doc;
-    doc["schema"] = "vkcloth-run/1";
-    doc["scene"] = scene->name;
-    doc["particles"] = scene->system.size();
-    doc["springs"] = scene->system.springs.size();
-    doc["steps"] = backend.step_index();
-    doc["dt"] = scene->params.dt;
-    doc["integrator"] = to_string(scene->params.integrator);
-    doc["backend"] = opt.backend;
-    doc["precision"] = opt.precision;
-    doc["simulated_time"] = backend.time();
-    doc["wall_s"] = wall;
-    doc["max_displacement"] = max_disp;
-    doc["implicit_euler"] = scene->params.integrator == Integrator::implicit_euler
-                                ? nlohmann::json{{"cg_iterations", cg.iterations},
-                                                 {"cg_residual", cg.residual},
-                                                 {"cg_iterations_mean", cg.mean_iterations()},
-                                                 {"cg_solves", cg.solves}}
-                                : nlohmann::json(nullptr);
-    if (end_strain) {
-      const auto ends = [&](std::uint32_t k) {
-        const Spring& sp = scene->system.springs[k];
-        return nlohmann::json::array({file_vertex(scene->system, sp.a), file_vertex(scene->system, sp.b)});
-      };
-      doc["max_structural_strain"] = {{"end", end_strain->max},
-                                      {"end_spring", end_strain->spring},
-                                      {"end_particles", ends(end_strain->spring)},
-                                      {"run", strain.run.max},
-                                      {"run_step", strain.run_step},
-                                      {"run_spring", strain.run.spring},
-                                      {"run_particles", ends(strain.run.spring)},
-                                      {"every", strain_every},
-                                      {"structural_springs", end_strain->count}};
-    } else {
-      doc["max_structural_strain"] = nullptr;
-    }
-    doc["contact"] =
-        track_contact
-            ? nlohmann::json{{"max_penetration", contact.deepest.depth},
-                             {"penetration_particle", file_vertex(scene->system, contact.deepest.particle)},
-                             {"penetration_collider", contact.deepest.collider},
-                             {"penetration_step", contact.step},
-                             {"contact_epsilon", scene->params.contact_epsilon},
-                             {"max_speed_last_second", contact.calm_speed},
-                             {"last_second_from_step", calm_from},
-                             {"every", contact_every}}
-            : nlohmann::json(nullptr);
-    if (intersections)
-      doc["intersections"] = {{"pairs", intersections->pairs}, {"triangles", intersections->triangles}};
-    fmt::print(json.get(), "{}\n", doc.dump(2));
+  print_summary(*scene, opt, backend, sum);
+  if (File& json = outputs->json) {
+    fmt::print(json.get(), "{}\n", summary_json(*scene, opt, backend, sum).dump(2));
     if (std::fflush(json.get()) != 0 || std::ferror(json.get()))
       return report(make_error(ErrorCode::io, "writing the JSON file failed (disk full?)"));
   }
