@@ -92,8 +92,8 @@ Result<std::size_t> particles_in_contact(const ContactScene& sc, std::span<const
 /// The self-collision rows' parameters: thickness = 1.5 x the grid spacing, the thickness that closes
 /// the gaps between particles (a particle of another layer is pushed off anywhere in a grid square,
 /// whose centre is 0.71 spacings from its corners; the 8 neighbours, up to 1.41 spacings away, are
-/// all within it at rest and never collide), friction 0.2 and 2 Jacobi iterations (SelfCollision's
-/// defaults).
+/// all within it at rest and never collide), friction 0.2 and SelfCollision's default number of
+/// Jacobi iterations (1).
 constexpr double self_thickness_over_spacing = 1.5;
 constexpr double self_friction = 0.2;
 constexpr std::uint32_t self_iterations = SelfCollision{}.iterations; // the default (1)
