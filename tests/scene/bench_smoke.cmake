@@ -2,6 +2,10 @@
 # `vkcloth bench --json` smoke test: runs at tiny sizes and checks that the JSON parses and carries
 # the documented keys (docs/performance.md). No timing is asserted.
 
+# The JSON's folder: made here, so that this test does not depend on another having run first.
+get_filename_component(out_dir "${OUT}" DIRECTORY)
+file(MAKE_DIRECTORY "${out_dir}")
+
 # Runs `vkcloth bench ARGN`: fails naming `what` unless it exits 0; its standard output in `out`.
 function(run_bench what)
   execute_process(COMMAND "${VKCLOTH}" bench ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
