@@ -101,7 +101,10 @@ glm::vec2 default_grid_uv(std::uint32_t i, std::uint32_t j, std::uint32_t nx, st
   return {nx > 1 ? float(i) / float(nx - 1) : 0.0f, ny > 1 ? float(j) / float(ny - 1) : 0.0f};
 }
 
-Result<ParticleSystem> make_cloth(const ClothDesc& d) {
+namespace {
+
+/// The description's sizes, extent, origin and material (or per-particle mass and stiffness).
+Result<void> check_cloth_desc(const ClothDesc& d) {
   if (d.nx < 1 || d.ny < 1 || d.nx > max_cloth_side || d.ny > max_cloth_side)
     return bad(fmt::format("cloth.resolution [{}, {}] is out of range: each side must be in 1..{}", d.nx,
                            d.ny, max_cloth_side));
@@ -113,40 +116,40 @@ Result<ParticleSystem> make_cloth(const ClothDesc& d) {
     return bad(fmt::format("cloth.size must be finite and > 0, got [{}, {}]", d.size.x, d.size.y));
   if (!finite(d.origin))
     return bad("cloth.origin must be finite");
-  if (d.material) {
-    VKCLOTH_TRY(check_material(*d.material));
-    if (d.nx < 2 || d.ny < 2)
-      return bad(
-          fmt::format("cloth.material needs a grid of at least 2 x 2 points, got [{}, {}]", d.nx, d.ny));
-  } else {
-    VKCLOTH_TRY(check_cloth_material(d.particle_mass, d.stiffness));
-  }
+  if (!d.material)
+    return check_cloth_material(d.particle_mass, d.stiffness);
+  VKCLOTH_TRY(check_material(*d.material));
+  if (d.nx < 2 || d.ny < 2)
+    return bad(fmt::format("cloth.material needs a grid of at least 2 x 2 points, got [{}, {}]", d.nx, d.ny));
+  return {};
+}
 
+/// The springs' stiffness along i (spacing dx) and along j (dy): the description's for both
+/// without a material, else the material's at these spacings.
+struct GridStiffness {
+  ClothStiffness i, j;
+};
+Result<GridStiffness> grid_stiffness(const ClothDesc& d, double dx, double dy) {
+  if (!d.material)
+    return GridStiffness{d.stiffness, d.stiffness};
+  const Material& m = *d.material;
+  auto k = [&](SpringKind kind, double along, double across) {
+    return spring_stiffness(m, kind, along, across);
+  };
+  auto si = k(SpringKind::structural, dx, dy), sj = k(SpringKind::structural, dy, dx);
+  auto sh = k(SpringKind::shear, dx, dy);
+  auto bi = k(SpringKind::bend, dx, dy), bj = k(SpringKind::bend, dy, dx);
+  for (const Result<double>* r : {&si, &sj, &sh, &bi, &bj})
+    if (!*r)
+      return r->error();
+  return GridStiffness{{*si, *sh, *bi}, {*sj, *sh, *bj}};
+}
+
+/// The grid's texture coordinates: the description's, or its uv_transform of the default ones;
+/// empty for the default ones themselves (default_grid_uv).
+Result<std::vector<glm::vec2>> grid_uvs(const ClothDesc& d) {
   const std::uint32_t nx = d.nx, ny = d.ny;
-  const double dx = nx > 1 ? d.size.x / (nx - 1) : 0.0;
-  const double dy = ny > 1 ? d.size.y / (ny - 1) : 0.0;
-  // Per-direction stiffness: along i (spacing dx) and along j (dy); the same without a material.
-  ClothStiffness ki = d.stiffness, kj = d.stiffness;
-  if (d.material) {
-    const Material& m = *d.material;
-    auto k = [&](SpringKind kind, double along, double across) {
-      return spring_stiffness(m, kind, along, across);
-    };
-    auto si = k(SpringKind::structural, dx, dy), sj = k(SpringKind::structural, dy, dx);
-    auto sh = k(SpringKind::shear, dx, dy);
-    auto bi = k(SpringKind::bend, dx, dy), bj = k(SpringKind::bend, dy, dx);
-    for (const Result<double>* r : {&si, &sj, &sh, &bi, &bj})
-      if (!*r)
-        return r->error();
-    ki = {*si, *sh, *bi};
-    kj = {*sj, *sh, *bj};
-  }
-  const glm::dvec3 eu{1, 0, 0};
-  const glm::dvec3 ev =
-      d.orientation == ClothOrientation::vertical ? glm::dvec3{0, 0, 1} : glm::dvec3{0, 1, 0};
-
-  ParticleSystem sys;
-  sys.grid = Grid{nx, ny, {}};
+  const std::size_t count = std::size_t(nx) * ny;
   if (!d.uvs.empty()) {
     if (d.uvs.size() != count)
       return bad(fmt::format("cloth uvs: {} texture coordinates for a {} x {} grid of {} particles",
@@ -155,25 +158,26 @@ Result<ParticleSystem> make_cloth(const ClothDesc& d) {
       if (!std::isfinite(d.uvs[k].x) || !std::isfinite(d.uvs[k].y))
         return bad(fmt::format("cloth uvs: texture coordinate {} is not finite ({}, {})", k, d.uvs[k].x,
                                d.uvs[k].y));
-    sys.grid->uvs = d.uvs;
-  } else if (d.uv_transform != UvTransform{}) {
-    const UvTransform& m = d.uv_transform;
-    for (const glm::vec2 a : {m.offset, m.u_axis, m.v_axis})
-      if (!std::isfinite(a.x) || !std::isfinite(a.y))
-        return bad("cloth uv_transform must be finite");
-    sys.grid->uvs.resize(count);
-    for (std::uint32_t j = 0; j < ny; ++j)
-      for (std::uint32_t i = 0; i < nx; ++i) {
-        const glm::vec2 st = default_grid_uv(i, j, nx, ny);
-        sys.grid->uvs[std::size_t(j) * nx + i] = m.offset + st.x * m.u_axis + st.y * m.v_axis;
-      }
+    return d.uvs;
   }
-  sys.particles.resize(count);
+  if (d.uv_transform == UvTransform{})
+    return std::vector<glm::vec2>{};
+  const UvTransform& m = d.uv_transform;
+  for (const glm::vec2 a : {m.offset, m.u_axis, m.v_axis})
+    if (!std::isfinite(a.x) || !std::isfinite(a.y))
+      return bad("cloth uv_transform must be finite");
+  std::vector<glm::vec2> uvs(count);
   for (std::uint32_t j = 0; j < ny; ++j)
-    for (std::uint32_t i = 0; i < nx; ++i)
-      sys.particles[j * nx + i] =
-          Particle{d.origin + (i * dx) * eu + (j * dy) * ev, {}, d.particle_mass, false};
+    for (std::uint32_t i = 0; i < nx; ++i) {
+      const glm::vec2 st = default_grid_uv(i, j, nx, ny);
+      uvs[std::size_t(j) * nx + i] = m.offset + st.x * m.u_axis + st.y * m.v_axis;
+    }
+  return uvs;
+}
 
+/// Pins the description's grid points (by default the two top corners).
+Result<void> pin_grid(const ClothDesc& d, ParticleSystem& sys) {
+  const std::uint32_t nx = d.nx, ny = d.ny;
   std::vector<std::array<std::uint32_t, 2>> pins = d.pins;
   if (pins.empty() && d.pin_default_corners)
     pins = {{0, ny - 1}, {nx - 1, ny - 1}};
@@ -183,55 +187,91 @@ Result<ParticleSystem> make_cloth(const ClothDesc& d) {
       return bad(fmt::format("cloth.pins[{}] = [{}, {}] is outside the {} x {} grid", k, i, j, nx, ny));
     sys.particles[j * nx + i].pinned = true;
   }
+  return {};
+}
 
-  // Springs are emitted kind by kind (structural, shear, bend); this order is the gather order.
+/// The report's springs, kind by kind (structural, shear, bend; this order is the gather order).
+/// A kind is left out when its stiffness is zero (a material's are all > 0 but structural). A
+/// material's springs along the border stand for half a cell (as the border's masses do): half the
+/// stiffness, so that the lattice's energy under a uniform strain is the membrane's.
+void add_grid_springs(ParticleSystem& sys, std::uint32_t nx, std::uint32_t ny, double dx, double dy,
+                      const GridStiffness& k, bool material) {
   auto add = [&](std::uint32_t i0, std::uint32_t j0, std::uint32_t i1, std::uint32_t j1, double rest,
-                 double k, SpringKind kind) {
-    sys.springs.push_back(Spring{j0 * nx + i0, j1 * nx + i1, rest, k, kind});
+                 double stiffness, SpringKind kind) {
+    sys.springs.push_back(Spring{j0 * nx + i0, j1 * nx + i1, rest, stiffness, kind});
   };
-  // A material's springs along the border stand for half a cell (as the border's masses do):
-  // half the stiffness, so that the lattice's energy under a uniform strain is the membrane's.
-  const double half = d.material ? 0.5 : 1.0;
+  const double half = material ? 0.5 : 1.0;
   auto row_edge = [&](std::uint32_t j) { return j == 0 || j == ny - 1 ? half : 1.0; };
   auto col_edge = [&](std::uint32_t i) { return i == 0 || i == nx - 1 ? half : 1.0; };
-  // A kind is left out when its stiffness is zero (a material's are all > 0 but structural).
-  if (ki.structural > 0.0 || kj.structural > 0.0) {
+  if (k.i.structural > 0.0 || k.j.structural > 0.0) {
     for (std::uint32_t j = 0; j < ny; ++j)
       for (std::uint32_t i = 0; i + 1 < nx; ++i)
-        add(i, j, i + 1, j, dx, row_edge(j) * ki.structural, SpringKind::structural);
+        add(i, j, i + 1, j, dx, row_edge(j) * k.i.structural, SpringKind::structural);
     for (std::uint32_t j = 0; j + 1 < ny; ++j)
       for (std::uint32_t i = 0; i < nx; ++i)
-        add(i, j, i, j + 1, dy, col_edge(i) * kj.structural, SpringKind::structural);
+        add(i, j, i, j + 1, dy, col_edge(i) * k.j.structural, SpringKind::structural);
   }
-  if (ki.shear > 0.0) {
+  if (k.i.shear > 0.0) {
     const double diag = std::sqrt(dx * dx + dy * dy);
     for (std::uint32_t j = 0; j + 1 < ny; ++j)
       for (std::uint32_t i = 0; i + 1 < nx; ++i) {
-        add(i, j, i + 1, j + 1, diag, ki.shear, SpringKind::shear);
-        add(i + 1, j, i, j + 1, diag, ki.shear, SpringKind::shear);
+        add(i, j, i + 1, j + 1, diag, k.i.shear, SpringKind::shear);
+        add(i + 1, j, i, j + 1, diag, k.i.shear, SpringKind::shear);
       }
   }
-  if (ki.bend > 0.0 || kj.bend > 0.0) {
+  if (k.i.bend > 0.0 || k.j.bend > 0.0) {
     for (std::uint32_t j = 0; j < ny; ++j)
       for (std::uint32_t i = 0; i + 2 < nx; ++i)
-        add(i, j, i + 2, j, 2 * dx, row_edge(j) * ki.bend, SpringKind::bend);
+        add(i, j, i + 2, j, 2 * dx, row_edge(j) * k.i.bend, SpringKind::bend);
     for (std::uint32_t j = 0; j + 2 < ny; ++j)
       for (std::uint32_t i = 0; i < nx; ++i)
-        add(i, j, i, j + 2, 2 * dy, col_edge(i) * kj.bend, SpringKind::bend);
+        add(i, j, i, j + 2, 2 * dy, col_edge(i) * k.j.bend, SpringKind::bend);
   }
-  if (d.material) { // lumped masses over the grid's cells (a, a+1, a+1+nx, a+nx)
-    std::vector<glm::dvec3> x(count);
-    for (std::size_t p = 0; p < count; ++p)
-      x[p] = sys.particles[p].position;
-    std::vector<std::uint32_t> offsets{0}, corners;
-    for (std::uint32_t j = 0; j + 1 < ny; ++j)
-      for (std::uint32_t i = 0; i + 1 < nx; ++i) {
-        const std::uint32_t a = j * nx + i;
-        corners.insert(corners.end(), {a, a + 1, a + 1 + nx, a + nx});
-        offsets.push_back(static_cast<std::uint32_t>(corners.size()));
-      }
-    lump_masses(offsets, corners, x, d.material->density, sys.particles);
-  }
+}
+
+/// A material's masses: lumped over the grid's cells (a, a+1, a+1+nx, a+nx) at `density`.
+void lump_grid_masses(ParticleSystem& sys, std::uint32_t nx, std::uint32_t ny, double density) {
+  std::vector<glm::dvec3> x(sys.particles.size());
+  for (std::size_t p = 0; p < x.size(); ++p)
+    x[p] = sys.particles[p].position;
+  std::vector<std::uint32_t> offsets{0}, corners;
+  for (std::uint32_t j = 0; j + 1 < ny; ++j)
+    for (std::uint32_t i = 0; i + 1 < nx; ++i) {
+      const std::uint32_t a = j * nx + i;
+      corners.insert(corners.end(), {a, a + 1, a + 1 + nx, a + nx});
+      offsets.push_back(static_cast<std::uint32_t>(corners.size()));
+    }
+  lump_masses(offsets, corners, x, density, sys.particles);
+}
+
+} // namespace
+
+Result<ParticleSystem> make_cloth(const ClothDesc& d) {
+  VKCLOTH_TRY(check_cloth_desc(d));
+  const std::uint32_t nx = d.nx, ny = d.ny;
+  const double dx = nx > 1 ? d.size.x / (nx - 1) : 0.0;
+  const double dy = ny > 1 ? d.size.y / (ny - 1) : 0.0;
+  auto stiffness = grid_stiffness(d, dx, dy);
+  if (!stiffness)
+    return stiffness.error();
+  auto uvs = grid_uvs(d);
+  if (!uvs)
+    return uvs.error();
+
+  ParticleSystem sys;
+  sys.grid = Grid{nx, ny, std::move(*uvs)};
+  const glm::dvec3 eu{1, 0, 0};
+  const glm::dvec3 ev =
+      d.orientation == ClothOrientation::vertical ? glm::dvec3{0, 0, 1} : glm::dvec3{0, 1, 0};
+  sys.particles.resize(std::size_t(nx) * ny);
+  for (std::uint32_t j = 0; j < ny; ++j)
+    for (std::uint32_t i = 0; i < nx; ++i)
+      sys.particles[j * nx + i] =
+          Particle{d.origin + (i * dx) * eu + (j * dy) * ev, {}, d.particle_mass, false};
+  VKCLOTH_TRY(pin_grid(d, sys));
+  add_grid_springs(sys, nx, ny, dx, dy, *stiffness, d.material.has_value());
+  if (d.material)
+    lump_grid_masses(sys, nx, ny, d.material->density);
   sys.finalize();
   return sys;
 }
