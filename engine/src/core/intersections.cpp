@@ -208,15 +208,15 @@ bool share_vertex(const std::uint32_t* a, const std::uint32_t* b) {
   return false;
 }
 
-Result<IntersectionStats> pairs_impl(std::span<const std::uint32_t> indices, std::span<const glm::dvec3> x) {
+/// The triangle list must index `x`, in triples, and every position must be finite.
+Result<void> check_triangles(std::span<const std::uint32_t> indices, std::span<const glm::dvec3> x) {
   constexpr const char* fn = "intersecting_triangle_pairs";
   if (indices.size() % 3 != 0)
     return make_error(ErrorCode::invalid_argument,
                       fmt::format("{}: {} triangle indices, not a multiple of 3", fn, indices.size()));
-  const std::size_t n = indices.size() / 3;
-  if (n > std::numeric_limits<std::uint32_t>::max())
+  if (indices.size() / 3 > std::numeric_limits<std::uint32_t>::max())
     return make_error(ErrorCode::invalid_argument,
-                      fmt::format("{}: {} triangles, more than 2^32 - 1", fn, n));
+                      fmt::format("{}: {} triangles, more than 2^32 - 1", fn, indices.size() / 3));
   for (std::size_t k = 0; k < indices.size(); ++k)
     if (indices[k] >= x.size())
       return make_error(ErrorCode::invalid_argument,
@@ -227,54 +227,73 @@ Result<IntersectionStats> pairs_impl(std::span<const std::uint32_t> indices, std
       return make_error(
           ErrorCode::invalid_argument,
           fmt::format("{}: position {} is not finite: ({}, {}, {})", fn, k, x[k].x, x[k].y, x[k].z));
+  return {};
+}
 
-  IntersectionStats stats;
-  stats.triangles = n;
-  // Per triangle: area normal (zero: degenerate, skipped), longest edge, box.
-  const auto corners = [&](std::size_t t) {
-    return Tri{x[indices[3 * t]], x[indices[3 * t + 1]], x[indices[3 * t + 2]]};
-  };
-  std::vector<glm::dvec3> normals(n);
-  std::vector<double> longest(n);
-  std::vector<Box> boxes(n);
-  std::vector<std::uint32_t> live; // the triangles that are not degenerate
-  live.reserve(n);
-  double edge_sum = 0.0;
+/// Per triangle: area normal (zero: degenerate, skipped), longest edge and box; the triangles
+/// that are not degenerate, their common box and their mean edge length.
+struct TriangleSet {
+  std::vector<glm::dvec3> normals;
+  std::vector<double> longest;
+  std::vector<Box> boxes;
+  std::vector<std::uint32_t> live;
   Box all;
-  all.lo = glm::dvec3(std::numeric_limits<double>::infinity());
-  all.hi = -all.lo;
+  double mean_edge = 0.0;
+  std::size_t degenerate = 0;
+};
+
+template <typename Corners> TriangleSet triangle_set(std::size_t n, const Corners& corners) {
+  TriangleSet s;
+  s.normals.resize(n);
+  s.longest.resize(n);
+  s.boxes.resize(n);
+  s.live.reserve(n);
+  double edge_sum = 0.0;
+  s.all.lo = glm::dvec3(std::numeric_limits<double>::infinity());
+  s.all.hi = -s.all.lo;
   for (std::size_t t = 0; t < n; ++t) {
     const Tri tri = corners(t);
-    longest[t] = longest_edge(tri);
-    normals[t] = area_normal(tri, longest[t]);
-    if (normals[t] == glm::dvec3(0.0)) {
-      ++stats.degenerate;
+    s.longest[t] = longest_edge(tri);
+    s.normals[t] = area_normal(tri, s.longest[t]);
+    if (s.normals[t] == glm::dvec3(0.0)) {
+      ++s.degenerate;
       continue;
     }
-    live.push_back(static_cast<std::uint32_t>(t));
-    boxes[t] = Box(tri);
-    all.lo = glm::min(all.lo, boxes[t].lo);
-    all.hi = glm::max(all.hi, boxes[t].hi);
+    s.live.push_back(static_cast<std::uint32_t>(t));
+    s.boxes[t] = Box(tri);
+    s.all.lo = glm::min(s.all.lo, s.boxes[t].lo);
+    s.all.hi = glm::max(s.all.hi, s.boxes[t].hi);
     edge_sum += glm::length(tri[1] - tri[0]) + glm::length(tri[2] - tri[1]) + glm::length(tri[0] - tri[2]);
   }
-  if (live.size() < 2)
-    return stats;
+  if (!s.live.empty())
+    s.mean_edge = edge_sum / (3.0 * static_cast<double>(s.live.size()));
+  return s;
+}
 
-  // The grid: cells of about the mean edge, coarser where the extent or the cell count needs it.
-  const glm::dvec3 extent = all.hi - all.lo;
-  double cell = std::max(edge_sum / (3.0 * static_cast<double>(live.size())),
-                         std::max({extent.x, extent.y, extent.z}) / static_cast<double>(max_cell - 1));
-  const std::uint64_t budget = 16 * static_cast<std::uint64_t>(live.size()) + 4096;
-  std::vector<CellRange> ranges(n);
+/// The broad phase: each live triangle's range of grid cells, and one entry per (cell, triangle)
+/// sorted by cell then triangle. Cells of about the mean edge, coarser where the extent or the
+/// entry budget needs it (long triangles: fewer, larger cells).
+struct CellEntries {
+  std::vector<CellRange> ranges; // by triangle
+  std::vector<Entry> sorted;
+};
+
+CellEntries cell_entries(const TriangleSet& s) {
+  const glm::dvec3 extent = s.all.hi - s.all.lo;
+  double cell =
+      std::max(s.mean_edge, std::max({extent.x, extent.y, extent.z}) / static_cast<double>(max_cell - 1));
+  const std::uint64_t budget = 16 * static_cast<std::uint64_t>(s.live.size()) + 4096;
+  CellEntries c;
+  c.ranges.resize(s.boxes.size());
   std::uint64_t entries = 0;
   for (;;) {
     entries = 0;
-    for (const std::uint32_t t : live) {
-      CellRange& r = ranges[t];
+    for (const std::uint32_t t : s.live) {
+      CellRange& r = c.ranges[t];
       std::uint64_t cells = 1;
       for (int k = 0; k < 3; ++k) {
-        r.lo[k] = cell_of(boxes[t].lo[k] - all.lo[k], cell);
-        r.hi[k] = std::max(r.lo[k], cell_of(boxes[t].hi[k] - all.lo[k], cell));
+        r.lo[k] = cell_of(s.boxes[t].lo[k] - s.all.lo[k], cell);
+        r.hi[k] = std::max(r.lo[k], cell_of(s.boxes[t].hi[k] - s.all.lo[k], cell));
         cells *= static_cast<std::uint64_t>(r.hi[k] - r.lo[k] + 1);
       }
       entries += cells;
@@ -283,18 +302,34 @@ Result<IntersectionStats> pairs_impl(std::span<const std::uint32_t> indices, std
     }
     if (entries <= budget)
       break;
-    cell *= 2.0; // long triangles: fewer, larger cells
+    cell *= 2.0;
   }
-  std::vector<Entry> cells;
-  cells.reserve(entries);
-  for (const std::uint32_t t : live) {
-    const CellRange& r = ranges[t];
+  c.sorted.reserve(entries);
+  for (const std::uint32_t t : s.live) {
+    const CellRange& r = c.ranges[t];
     for (std::int32_t i = r.lo[0]; i <= r.hi[0]; ++i)
       for (std::int32_t j = r.lo[1]; j <= r.hi[1]; ++j)
         for (std::int32_t k = r.lo[2]; k <= r.hi[2]; ++k)
-          cells.push_back({cell_key(i, j, k), t});
+          c.sorted.push_back({cell_key(i, j, k), t});
   }
-  std::sort(cells.begin(), cells.end());
+  std::sort(c.sorted.begin(), c.sorted.end());
+  return c;
+}
+
+Result<IntersectionStats> pairs_impl(std::span<const std::uint32_t> indices, std::span<const glm::dvec3> x) {
+  VKCLOTH_TRY(check_triangles(indices, x));
+  const std::size_t n = indices.size() / 3;
+  const auto corners = [&](std::size_t t) {
+    return Tri{x[indices[3 * t]], x[indices[3 * t + 1]], x[indices[3 * t + 2]]};
+  };
+  const TriangleSet set = triangle_set(n, corners);
+  IntersectionStats stats;
+  stats.triangles = n;
+  stats.degenerate = set.degenerate;
+  if (set.live.size() < 2)
+    return stats;
+  const CellEntries grid = cell_entries(set);
+  const std::vector<Entry>& cells = grid.sorted;
 
   // Each pair once: in the first cell both triangles' cell ranges share.
   bool found = false;
@@ -307,14 +342,15 @@ Result<IntersectionStats> pairs_impl(std::span<const std::uint32_t> indices, std
       const std::uint32_t a = cells[u].tri; // a < b: sorted by triangle within a cell
       for (std::size_t v = u + 1; v < end; ++v) {
         const std::uint32_t b = cells[v].tri;
-        if (!boxes[a].overlaps(boxes[b]) ||
+        if (!set.boxes[a].overlaps(set.boxes[b]) ||
             share_vertex(&indices[3 * std::size_t(a)], &indices[3 * std::size_t(b)]))
           continue;
-        const CellRange &ra = ranges[a], &rb = ranges[b];
+        const CellRange &ra = grid.ranges[a], &rb = grid.ranges[b];
         if (cell_key(std::max(ra.lo[0], rb.lo[0]), std::max(ra.lo[1], rb.lo[1]),
                      std::max(ra.lo[2], rb.lo[2])) != key)
           continue;
-        if (!intersect(corners(a), normals[a], longest[a], corners(b), normals[b], longest[b]))
+        if (!intersect(corners(a), set.normals[a], set.longest[a], corners(b), set.normals[b],
+                       set.longest[b]))
           continue;
         ++stats.pairs;
         if (!found || a < stats.first_a || (a == stats.first_a && b < stats.first_b)) {
