@@ -5,7 +5,6 @@
 #include <array>
 #include <cmath>
 #include <cstring>
-#include <optional>
 #include <span>
 #include <utility>
 #include <vector>
@@ -122,74 +121,15 @@ Result<void> ClothRenderer::Impl::build_geometry(const ClothTopology& topology, 
   // in the world around the scene's centre.
   const Bounds b = scene_bounds(system, params);
   const float half = o.floor_half_size > 0.0f ? o.floor_half_size : std::max(1.0f, 1.6f * b.radius());
-  std::vector<MeshVertex> verts;
-  std::vector<std::uint32_t> midx;
-  std::optional<MeshRange> sphere, capsule, box;
-  std::vector<std::pair<const ColliderMesh*, MeshRange>> meshes;
-  // `add` appends one shape's triangles and returns their range.
-  const auto shape = [&](auto&& add) {
-    MeshRange r;
-    r.first = static_cast<std::uint32_t>(midx.size());
-    add();
-    r.count = static_cast<std::uint32_t>(midx.size()) - r.first;
-    return r;
-  };
+  detail::ShapeBuffer shapes;
   for (const Collider& k : params.colliders) {
-    ColliderDraw d;
-    d.type = k.type;
-    switch (k.type) {
-    case Collider::Type::plane: {
-      d.plane_normal = glm::normalize(glm::vec3(k.normal));
-      d.around = b.center();
-      d.plane_centre = detail::plane_centre(d.plane_normal, float(k.offset), d.around);
-      d.range = shape([&] { add_plane(verts, midx, d.plane_normal, d.plane_centre, half); });
-      d.range.mode = 1.0f;
-      d.range.cell = half / 5.0f;
-      d.range.color = palette.floor;
-      break;
-    }
-    case Collider::Type::sphere:
-      if (!sphere)
-        sphere = shape([&] { add_sphere(verts, midx, glm::vec3(0.0f), 1.0f, 48, 24); });
-      d.range = *sphere;
-      d.range.color = palette.sphere;
-      break;
-    case Collider::Type::capsule:
-      if (!capsule)
-        capsule = shape([&] { add_unit_capsule(verts, midx, 48, 12); });
-      d.range = *capsule;
-      d.range.color = palette.capsule;
-      break;
-    case Collider::Type::box:
-      if (!box)
-        box = shape([&] { add_unit_box(verts, midx); });
-      d.range = *box;
-      d.range.color = palette.box;
-      break;
-    case Collider::Type::mesh: {
-      if (!k.mesh)
-        return make_error(ErrorCode::invalid_argument,
-                          fmt::format("collider {} is a mesh without its ColliderMesh", colliders.size()));
-      d.mesh = k.mesh.get();
-      auto known =
-          std::find_if(meshes.begin(), meshes.end(), [&](const auto& m) { return m.first == d.mesh; });
-      if (known == meshes.end())
-        known = meshes.emplace(meshes.end(), d.mesh, shape([&] { add_collider_mesh(verts, midx, *k.mesh); }));
-      d.range = known->second;
-      d.range.color = palette.mesh;
-      break;
-    }
-    default:
-      return make_error(ErrorCode::invalid_argument, fmt::format("collider {} has an unknown type ({})",
-                                                                 colliders.size(), std::uint32_t(k.type)));
-    }
-    draws.push_back(d);
+    auto d = shapes.add(k, colliders.size(), palette, b.center(), half);
+    if (!d)
+      return d.error();
+    draws.push_back(*d);
     colliders.push_back(k);
   }
-  unit_sphere.first = static_cast<std::uint32_t>(midx.size());
-  add_sphere(verts, midx, glm::vec3(0.0f), 1.0f, 16, 8);
-  unit_sphere.count = static_cast<std::uint32_t>(midx.size()) - unit_sphere.first;
-  unit_sphere.color = palette.chain;
+  unit_sphere = shapes.add_mass_sphere(palette.chain);
   if (o.mass_radius > 0.0f) {
     mass_radius = o.mass_radius;
   } else if (!surface) {
@@ -198,13 +138,13 @@ Result<void> ClothRenderer::Impl::build_geometry(const ClothTopology& topology, 
       shortest = std::min(shortest, s.rest_length);
     mass_radius = std::isfinite(shortest) && shortest > 0 ? float(shortest) * 0.12f : 0.03f;
   }
-  auto mv = host_buffer(verts.data(), verts.size() * sizeof(MeshVertex), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
-                        "mesh vertices");
+  auto mv = host_buffer(shapes.vertices.data(), shapes.vertices.size() * sizeof(MeshVertex),
+                        VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, "mesh vertices");
   if (!mv)
     return mv.error();
   mesh_vertices = std::move(*mv);
-  auto mi = host_buffer(midx.data(), midx.size() * sizeof(std::uint32_t), VK_BUFFER_USAGE_INDEX_BUFFER_BIT,
-                        "mesh indices");
+  auto mi = host_buffer(shapes.indices.data(), shapes.indices.size() * sizeof(std::uint32_t),
+                        VK_BUFFER_USAGE_INDEX_BUFFER_BIT, "mesh indices");
   if (!mi)
     return mi.error();
   mesh_index = std::move(*mi);

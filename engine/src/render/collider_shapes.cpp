@@ -1,7 +1,10 @@
 // SPDX-License-Identifier: MIT
 #include "collider_shapes.hpp"
 
+#include <algorithm>
 #include <cmath>
+
+#include <fmt/format.h>
 
 #include <glm/ext/matrix_transform.hpp>
 #include <glm/geometric.hpp>
@@ -159,6 +162,63 @@ Pose pose_of(const ColliderDraw& d, const Collider& k) {
     return p;
   }
   return p;
+}
+
+Result<ColliderDraw> ShapeBuffer::add(const Collider& k, std::size_t index, const Palette& palette,
+                                      glm::vec3 around, float floor_half) {
+  ColliderDraw d;
+  d.type = k.type;
+  switch (k.type) {
+  case Collider::Type::plane:
+    d.plane_normal = glm::normalize(glm::vec3(k.normal));
+    d.around = around;
+    d.plane_centre = plane_centre(d.plane_normal, float(k.offset), d.around);
+    d.range = shape([&] { add_plane(vertices, indices, d.plane_normal, d.plane_centre, floor_half); });
+    d.range.mode = 1.0f;
+    d.range.cell = floor_half / 5.0f;
+    d.range.color = palette.floor;
+    return d;
+  case Collider::Type::sphere:
+    if (!sphere_)
+      sphere_ = shape([&] { add_sphere(vertices, indices, glm::vec3(0.0f), 1.0f, 48, 24); });
+    d.range = *sphere_;
+    d.range.color = palette.sphere;
+    return d;
+  case Collider::Type::capsule:
+    if (!capsule_)
+      capsule_ = shape([&] { add_unit_capsule(vertices, indices, 48, 12); });
+    d.range = *capsule_;
+    d.range.color = palette.capsule;
+    return d;
+  case Collider::Type::box:
+    if (!box_)
+      box_ = shape([&] { add_unit_box(vertices, indices); });
+    d.range = *box_;
+    d.range.color = palette.box;
+    return d;
+  case Collider::Type::mesh: {
+    if (!k.mesh)
+      return make_error(ErrorCode::invalid_argument,
+                        fmt::format("collider {} is a mesh without its ColliderMesh", index));
+    d.mesh = k.mesh.get();
+    auto known =
+        std::find_if(meshes_.begin(), meshes_.end(), [&](const auto& m) { return m.first == d.mesh; });
+    if (known == meshes_.end())
+      known = meshes_.emplace(meshes_.end(), d.mesh,
+                              shape([&] { add_collider_mesh(vertices, indices, *k.mesh); }));
+    d.range = known->second;
+    d.range.color = palette.mesh;
+    return d;
+  }
+  }
+  return make_error(ErrorCode::invalid_argument,
+                    fmt::format("collider {} has an unknown type ({})", index, std::uint32_t(k.type)));
+}
+
+MeshRange ShapeBuffer::add_mass_sphere(glm::vec3 color) {
+  MeshRange r = shape([&] { add_sphere(vertices, indices, glm::vec3(0.0f), 1.0f, 16, 8); });
+  r.color = color;
+  return r;
 }
 
 } // namespace vkcloth::render::detail

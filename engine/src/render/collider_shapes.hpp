@@ -5,6 +5,8 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
+#include <utility>
 #include <vector>
 
 #include <glm/mat4x4.hpp>
@@ -13,6 +15,8 @@
 
 #include "vkcloth/collider_mesh.hpp"
 #include "vkcloth/params.hpp"
+#include "vkcloth/render/cloth_renderer.hpp"
+#include "vkcloth/result.hpp"
 
 namespace vkcloth::render::detail {
 
@@ -77,5 +81,34 @@ void add_plane(std::vector<MeshVertex>& v, std::vector<std::uint32_t>& idx, glm:
 
 /// Where `k` is now, for the draw `d` built from the create()-time collider of the same type.
 Pose pose_of(const ColliderDraw& d, const Collider& k);
+
+/// The colliders' meshes in one vertex and index list (ClothRenderer's mesh buffers): each shape
+/// once in its own frame (a unit sphere, capsule and box, each ColliderMesh; pose_of places them),
+/// and each plane's floor square in the world.
+class ShapeBuffer {
+public:
+  /// Collider `index`'s draw, its shape added when it is the first of its kind (or mesh). The floor
+  /// square of a plane: half side `floor_half`, centred under `around`.
+  Result<ColliderDraw> add(const Collider& k, std::size_t index, const Palette& palette, glm::vec3 around,
+                           float floor_half);
+  /// A unit sphere for the masses of a chain (instanced at the particles).
+  MeshRange add_mass_sphere(glm::vec3 color);
+
+  std::vector<MeshVertex> vertices;
+  std::vector<std::uint32_t> indices;
+
+private:
+  /// Appends one shape's triangles (`append(vertices, indices)`) and returns their range.
+  template <typename Append> MeshRange shape(Append&& append) {
+    MeshRange r;
+    r.first = static_cast<std::uint32_t>(indices.size());
+    append();
+    r.count = static_cast<std::uint32_t>(indices.size()) - r.first;
+    return r;
+  }
+
+  std::optional<MeshRange> sphere_, capsule_, box_;
+  std::vector<std::pair<const ColliderMesh*, MeshRange>> meshes_;
+};
 
 } // namespace vkcloth::render::detail
