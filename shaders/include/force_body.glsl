@@ -91,11 +91,14 @@ layout(constant_id = 38) const float SC_K11 = 0.0;
 // the CSR loop, which llvmpipe runs for every 8-lane group holding a border particle (and whose
 // per-lane loads it pays, masked, for every group).
 layout(constant_id = 39) const bool SC_BORDER = false;
-// False: no instance of the batch takes its normal from the gather lists
-// (VKCLOTH_FLAG_RING_NORMALS), the ring terms compiled out (llvmpipe would run them once per group
-// even when no invocation needs them). The host sets it with the fused.comp and force.comp
-// pipelines; implicit.comp keeps the default.
-layout(constant_id = 42) const bool SC_RING = true;
+// The normal paths an instance of the batch may take: VKCLOTH_FLAG_HAS_GRID (the grid fan) and
+// VKCLOTH_FLAG_RING_NORMALS (the gather lists' ring terms); the other one is compiled out
+// (llvmpipe runs a branch's body once per group even when no invocation takes it: the grid fan's
+// four fetches on a mesh, the ring terms on a grid). The host sets it with the fused.comp and
+// force.comp pipelines (SolverBatch::Normals); implicit.comp keeps the default, both.
+layout(constant_id = 42) const uint SC_NORMAL_FLAGS = VKCLOTH_FLAG_HAS_GRID | VKCLOTH_FLAG_RING_NORMALS;
+const bool SC_GRID_FAN = (SC_NORMAL_FLAGS & VKCLOTH_FLAG_HAS_GRID) != 0u;
+const bool SC_RING = (SC_NORMAL_FLAGS & VKCLOTH_FLAG_RING_NORMALS) != 0u;
 
 // Bit `bit` when stencil neighbour `off` of grid particle (i, j) lies inside the grid
 // (off = dj nx + di with |di|, |dj| <= 2; compile-time constants after specialisation).
@@ -144,7 +147,7 @@ vec3 contact_removed_force = vec3(0.0);
 // and its unit normal (nrm).
 void particle_force(uint p, inout vec3 v_io, out vec3 f_out, out vec3 nrm_out) {
   vec3 nrm = vec3(0.0);
-  if ((ip.flags & VKCLOTH_FLAG_HAS_GRID) != 0u) nrm = grid_normal(p);
+  if (SC_GRID_FAN && (ip.flags & VKCLOTH_FLAG_HAS_GRID) != 0u) nrm = grid_normal(p);
 
   const vec3 x = pos_at(p);
   vec3 f = vec3(0.0);

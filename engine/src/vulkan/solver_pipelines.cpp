@@ -24,17 +24,20 @@ namespace sh = shared;
 namespace {
 
 /// The specialisation constants of force.comp and fused.comp, as 32-bit words by constant_id:
-/// 0..39 the grid stencil (force_body.glsl), 40 SC_WRITE_AUX (fused.comp only; force.comp has no
-/// constant 40, and an entry for an id a shader lacks is ignored), 41 SC_COLLIDER_TYPES (common.glsl:
-/// a mask of collider types), 42 SC_RING (force_body.glsl); 40 and 42 are VkBool32s.
+/// 0..39 the grid stencil (force_body.glsl), 40 SC_WRITE_AUX (fused.comp only, a VkBool32; force.comp
+/// has no constant 40, and an entry for an id a shader lacks is ignored), 41 SC_COLLIDER_TYPES
+/// (common.glsl: a mask of collider types), 42 SC_NORMAL_FLAGS (force_body.glsl: the batch's normal
+/// path as its instance flag).
 std::array<std::uint32_t, 43> solver_constants(const SolverBatch::Stencil& st, bool write_aux,
-                                               std::uint32_t collider_types, bool ring) {
+                                               std::uint32_t collider_types, SolverBatch::Normals normals) {
   static_assert(sizeof(SolverBatch::Stencil) == 40 * 4);
   std::array<std::uint32_t, 43> words{};
   std::memcpy(words.data(), &st, sizeof(st));
   words[40] = write_aux ? 1u : 0u;
   words[41] = collider_types;
-  words[42] = ring ? 1u : 0u;
+  words[42] = normals == SolverBatch::Normals::grid   ? VKCLOTH_FLAG_HAS_GRID
+              : normals == SolverBatch::Normals::ring ? VKCLOTH_FLAG_RING_NORMALS
+                                                      : 0u;
   return words;
 }
 
@@ -197,8 +200,7 @@ Result<void> SolverBatch::create_buffer_views() {
 // the batch's build (texel views or storage buffers) and workgroup size (resolve_layout).
 Result<void> SolverBatch::create_pipelines() {
   using Shader = PipelineRegistry::Shader;
-  const auto constants =
-      solver_constants(stencil, true, VKCLOTH_COLLIDER_ALL_TYPES, normals == Normals::ring);
+  const auto constants = solver_constants(stencil, true, VKCLOTH_COLLIDER_ALL_TYPES, normals);
   const PipelineRegistry::Variant variant{access, workgroup};
   auto fp = ctx->pipelines->pipeline(Shader::force, constants, variant);
   if (!fp)
@@ -232,7 +234,7 @@ Result<void> SolverBatch::ensure_fused() {
   if (!options.fused || (fused_pipes[0][types] && fused_pipes[1][types]))
     return {};
   for (std::uint32_t aux = 0; aux < 2; ++aux) {
-    const auto constants = solver_constants(stencil, aux != 0, types, normals == Normals::ring);
+    const auto constants = solver_constants(stencil, aux != 0, types, normals);
     auto p = ctx->pipelines->pipeline(PipelineRegistry::Shader::fused, constants, {access, workgroup});
     if (!p)
       return p.error();
