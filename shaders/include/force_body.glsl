@@ -18,17 +18,22 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_POS_IN) readonly buffer PosIn 
 // branch per component, a texel fetch into one vectorised gather of the 8 lanes' texels. A 32-bit
 // texel fetch is a copy: same bits. Without it (the *_storage builds, implicit.comp), plain std430
 // loads: what a GPU with a real memory path wants.
-// The topology's lists the same way: offsets_at(p) = offsets[p], edge_at(e) = edges[e] (the mesh
-// path: CSR gather and ring normal). EDGES is viewed as RGBA32UI, one texel per 16-byte Edge.
+// The topology's lists the same way: edge_at(e) = edges[e] (the mesh path: CSR gather and ring
+// normal; EDGES viewed as RGBA32UI, one texel per 16-byte Edge), and list_range(p) = particle p's
+// entries [x, z) of which [x, y) are its fan's. The texel builds read the three from one RANGES
+// texel (SolverBatch: begin, fan end, end), so the fan loop needs no exit on the first entry without
+// ring bits (llvmpipe pays such a data-dependent exit in every pass); the storage builds take
+// begin and end from OFFSETS and y = end, and the fan loop stops at that entry (FAN_EXIT).
 #ifdef VKCLOTH_TEXEL_VIEWS
 layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_POS_IN) uniform samplerBuffer pos_in_texel;
 layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_PARTICLE) uniform usamplerBuffer particle_texel;
-layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_OFFSETS) uniform usamplerBuffer offsets_texel;
+layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_RANGES) uniform usamplerBuffer ranges_texel;
 layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_EDGES) uniform usamplerBuffer edges_texel;
 vec3 pos_at(uint q) { return texelFetch(pos_in_texel, int(base + q)).xyz; }
 float mass_at(uint p) { return uintBitsToFloat(texelFetch(particle_texel, int(p)).x); }
 bool pinned_at(uint p) { return texelFetch(particle_texel, int(p)).y != 0u; }
-uint offsets_at(uint p) { return texelFetch(offsets_texel, int(p)).x; }
+uvec3 list_range(uint p) { return texelFetch(ranges_texel, int(p)).xyz; }
+const bool FAN_EXIT = false;
 Edge edge_at(uint e) {
   const uvec4 t = texelFetch(edges_texel, int(e));
   return Edge(t.x, uintBitsToFloat(t.y), uintBitsToFloat(t.z), t.w);
@@ -39,7 +44,8 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_EDGES) readonly buffer EdgeBuf
 vec3 pos_at(uint q) { return pos_in[base + q].xyz; }
 float mass_at(uint p) { return particle[p].mass; }
 bool pinned_at(uint p) { return particle[p].pinned != 0u; }
-uint offsets_at(uint p) { return offsets[p]; }
+uvec3 list_range(uint p) { return uvec3(offsets[p], offsets[p + 1u], offsets[p + 1u]); }
+const bool FAN_EXIT = true;
 Edge edge_at(uint e) { return edges[e]; }
 #endif
 
@@ -181,13 +187,14 @@ void particle_force(uint p, inout vec3 v_io, out vec3 f_out, out vec3 nrm_out) {
     // loop takes them with their ring terms, a second the plain springs (one loop with the ring
     // terms in every pass cost llvmpipe, which runs both sides of a branch, a third more).
     const bool ring = SC_RING && (ip.flags & VKCLOTH_FLAG_RING_NORMALS) != 0u;
-    const uint end = offsets_at(p + 1u);
-    uint e = offsets_at(p);
+    const uvec3 range = list_range(p);
+    const uint end = range.z;
+    uint e = range.x;
     if (ring) {
       vec3 fan = vec3(0.0), prev = vec3(0.0), first = vec3(0.0);
-      for (; e < end; ++e) {
+      for (; e < range.y; ++e) {
         const Edge s = edge_at(e);
-        if (s.ring == 0u) break;
+        if (FAN_EXIT && s.ring == 0u) break;
         precise vec3 u = pos_at(s.other) - x;
         add_spring_edge(f, u, s.rest_length, s.stiffness);
         add_ring_term(fan, prev, first, u, s.ring);

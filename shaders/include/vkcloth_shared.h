@@ -59,7 +59,7 @@ struct vec4 {
 // Set 1 (force.comp, fused.comp, strain_*.comp): POS_IN again, as an RGBA32F uniform texel buffer view,
 // PARTICLE as an RG32UI one (x: the mass's bits, y: pinned), and (fused.comp) VEL as RGBA32F and
 // FLAGS as R32UI; INSTANCES as RGBA32UI (common.glsl begin_instance); the topology's lists
-// (force_body.glsl offsets_at, edge_at) as R32UI / RGBA32UI views; the
+// (force_body.glsl list_range, edge_at) as RGBA32UI views; the
 // colliders and the mesh colliders' nodes and triangles as RGBA32UI (common.glsl collider_shape,
 // mesh_node, mesh_triangle).
 #define VKCLOTH_TEXEL_BINDING_POS_IN 0
@@ -67,7 +67,7 @@ struct vec4 {
 #define VKCLOTH_TEXEL_BINDING_VEL 2
 #define VKCLOTH_TEXEL_BINDING_FLAGS 3
 #define VKCLOTH_TEXEL_BINDING_INSTANCES 4    // InstanceParams as RGBA32UI, 5 texels per instance
-#define VKCLOTH_TEXEL_BINDING_OFFSETS 5      // OFFSETS as R32UI
+#define VKCLOTH_TEXEL_BINDING_RANGES 5       // per particle its list's begin, fan end, end (RGBA32UI)
 #define VKCLOTH_TEXEL_BINDING_EDGES 6        // EDGES as RGBA32UI, one texel per Edge
 #define VKCLOTH_TEXEL_BINDING_STRAIN_LINKS 7 // STRAIN_LINKS as R32UI, 3 texels per StrainLink
 #define VKCLOTH_TEXEL_BINDING_TETHERS 8      // TETHERS as RG32UI, one texel per TetherSlot

@@ -517,12 +517,12 @@ Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ClothTopology&
                     "{} texels per texel buffer view but the device allows {} (maxTexelBufferElements); "
                     "use fewer particles or fewer instances of one topology",
                     ctx.name, batch * n, batch, n, batch * n, lim.maxTexelBufferElements));
-  // So are the topology's lists (force_body.glsl offsets_at, edge_at): n + 1 offsets, one texel
-  // per spring entry.
+  // So are the topology's lists (force_body.glsl list_range, edge_at): one range per particle, one
+  // texel per spring entry.
   const struct {
     const char* what;
     std::uint64_t texels;
-  } lists[] = {{"spring adjacency offsets", n + 1},
+  } lists[] = {{"spring adjacency ranges", n},
                {"spring adjacency", edges_n},
                {"strain links", links_n * 3}}; // three R32UI texels each
   for (const auto& list : lists)
@@ -582,6 +582,7 @@ Result<void> SolverBatch::create_buffers() {
       {&acc_vel, vec4_bytes, "rk4 sums (velocities)"},
       {&particle, std::max<VkDeviceSize>(n * sizeof(sh::ParticleInfo), 16), "particle constants"},
       {&offsets, std::max<VkDeviceSize>((n + 1) * sizeof(std::uint32_t), 16), "adjacency offsets"},
+      {&ranges, std::max<VkDeviceSize>(n * 4 * sizeof(std::uint32_t), 16), "adjacency ranges"},
       {&edges, std::max<VkDeviceSize>(edges_count * sizeof(sh::Edge), 16), "adjacency"},
       {&strain_links, std::max<VkDeviceSize>(strain_link_count() * sizeof(sh::StrainLink), 16),
        "strain links"},
@@ -660,6 +661,18 @@ Result<void> SolverBatch::upload_initial_state(const ClothTopology& topology,
     const GatherEdge& g = topology.edges()[e];
     edge_data[e] = {g.other, float(g.rest_length), float(g.stiffness), g.ring};
   }
+  // Each particle's list as (begin, end of its fan entries, end, 0): the texel builds' loops then
+  // know where the fan ends (force_body.glsl list_range).
+  const std::span<const std::uint32_t> off = topology.edge_offsets();
+  std::vector<std::uint32_t> range_data(4 * n, 0);
+  for (std::size_t p = 0; p < n; ++p) {
+    std::uint32_t fan_end = off[p];
+    while (fan_end < off[p + 1] && topology.edges()[fan_end].ring != 0)
+      ++fan_end;
+    range_data[4 * p] = off[p];
+    range_data[4 * p + 1] = fan_end;
+    range_data[4 * p + 2] = off[p + 1];
+  }
   std::vector<sh::StrainLink> link_data;
   for (const StrainLink& l : topology.strain_links())
     link_data.push_back({l.a, l.b, float(l.rest_length)});
@@ -673,6 +686,7 @@ Result<void> SolverBatch::upload_initial_state(const ClothTopology& topology,
                             {&uv, uv0.data(), vec4_bytes},
                             {&particle, info.data(), n * sizeof(sh::ParticleInfo)},
                             {&offsets, topology.edge_offsets().data(), (n + 1) * sizeof(std::uint32_t)},
+                            {&ranges, range_data.data(), range_data.size() * sizeof(std::uint32_t)},
                             {&edges, edge_data.data(), edges_count * sizeof(sh::Edge)},
                             {&indices, triangles.data(), triangles.size() * sizeof(std::uint32_t)},
                             {&force, nullptr, 0},

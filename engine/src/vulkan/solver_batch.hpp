@@ -150,7 +150,7 @@ private:
   Buffer pos[2], vel, force, force_stage, vel_filt, normal, uv, stage_pos, stage_vel, acc_pos, acc_vel;
   Buffer vertices; // GpuSolverOptions::interleaved_vertices (else one zeroed element)
   // The shared topology: particle constants, gather lists, triangles (`indices`, for drawing).
-  Buffer particle, offsets, edges, indices;
+  Buffer particle, offsets, ranges, edges, indices;
   // Stretch control: the strain links in colour order, and the tethers (one zeroed element until
   // an instance asks for tethers: ensure_tethers()).
   Buffer strain_links, tethers;
@@ -189,10 +189,10 @@ private:
   // Set 1 of force.comp / fused.comp: POS_IN as an RGBA32F uniform texel buffer (force_body.glsl
   // pos_at), the particle constants as an RG32UI one, velocities, flags, instance parameters.
   // pos_views [0], [1]: positions[0], positions[1]; [2]: RK4 stage positions. The topology's
-  // spring lists too (force_body.glsl offsets_at, edge_at).
+  // spring lists too (force_body.glsl list_range, edge_at: RANGES, which only these views read, and EDGES).
   BufferView pos_views[3];
   BufferView particle_view, vel_view, flags_view, instances_view;
-  BufferView offsets_view, edges_view, strain_links_view, tethers_view;
+  BufferView ranges_view, edges_view, strain_links_view, tethers_view;
   // The collider buffer and the mesh buffers (replaced when they grow: create_buffer_views again).
   BufferView colliders_view, mesh_nodes_view, mesh_tris_view;
   VkDescriptorSet texel_sets[3] = {};

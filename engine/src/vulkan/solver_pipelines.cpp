@@ -126,7 +126,7 @@ Result<void> SolverBatch::create_texel_views() {
                  {&vel, VK_FORMAT_R32G32B32A32_SFLOAT, &vel_view, "velocities"},
                  {&flags, VK_FORMAT_R32_UINT, &flags_view, "flags"},
                  {&instances, VK_FORMAT_R32G32B32A32_UINT, &instances_view, "instance parameters"},
-                 {&offsets, VK_FORMAT_R32_UINT, &offsets_view, "adjacency offsets"},
+                 {&ranges, VK_FORMAT_R32G32B32A32_UINT, &ranges_view, "adjacency ranges"},
                  {&edges, VK_FORMAT_R32G32B32A32_UINT, &edges_view, "adjacency"},
                  {&strain_links, VK_FORMAT_R32_UINT, &strain_links_view, "strain links"}};
   static_assert(sizeof(sh::StrainLink) == 12, "three R32UI texels per StrainLink");
@@ -167,7 +167,7 @@ Result<void> SolverBatch::create_buffer_views() {
       {&vel_view, VKCLOTH_TEXEL_BINDING_VEL},
       {&flags_view, VKCLOTH_TEXEL_BINDING_FLAGS},
       {&instances_view, VKCLOTH_TEXEL_BINDING_INSTANCES},
-      {&offsets_view, VKCLOTH_TEXEL_BINDING_OFFSETS},
+      {&ranges_view, VKCLOTH_TEXEL_BINDING_RANGES},
       {&edges_view, VKCLOTH_TEXEL_BINDING_EDGES},
       {&strain_links_view, VKCLOTH_TEXEL_BINDING_STRAIN_LINKS},
       {&tethers_view, VKCLOTH_TEXEL_BINDING_TETHERS},
