@@ -4,7 +4,7 @@
 // lists' ring terms, spring gather in the topology's order, gravity, damping, wind, then contact
 // filtering; each formula from cloth_kernel.h, which the CPU reference compiles too. Reads POS_IN
 // (all particles), OFFSETS, EDGES, PARTICLE (with VKCLOTH_TEXEL_VIEWS through set 1's texel views,
-// see below).
+// and RANGES there instead of OFFSETS; see below).
 #ifndef VKCLOTH_FORCE_BODY_GLSL
 #define VKCLOTH_FORCE_BODY_GLSL
 

@@ -327,8 +327,10 @@ private:
   std::unordered_set<std::uint64_t> seen_;
 };
 
-/// The particles of a run of this many in the spatial order are read by one GPU workgroup
-/// (VKCLOTH_WORKGROUP_SIZE) and by whole CPU vectors (8 or 16 lanes).
+/// Runs of this many particles of the spatial order are grouped by valence: the compiled GPU
+/// workgroup size (VKCLOTH_WORKGROUP_SIZE; a device that picks another size still gets lanes of
+/// one length, only runs that straddle its workgroups) and a multiple of every CPU vector width
+/// (8 or 16 lanes).
 constexpr std::size_t valence_run = 64;
 
 /// Within each run of valence_run vertices of `order`, the vertices sorted by their number of mesh
@@ -337,17 +339,20 @@ constexpr std::size_t valence_run = 64;
 /// grow with its edges: grouping equal counts shortens that walk, while each run keeps its
 /// vertices, so the memory a workgroup reads stays the same.
 void group_by_valence(std::vector<std::uint32_t>& order, const Faces& faces, std::size_t n_file) {
-  std::unordered_set<std::uint64_t> edges;
-  std::vector<std::uint32_t> valence(n_file, 0);
+  // Every face edge, then each once: sorted rather than hashed (a mesh may have millions).
+  std::vector<std::uint64_t> edges;
+  edges.reserve(faces.corners.size());
   for (std::size_t f = 0; f < faces.size(); ++f) {
     const std::span<const std::uint32_t> c = faces[f];
-    for (std::size_t i = 0; i < c.size(); ++i) {
-      const std::uint32_t a = c[i], b = c[(i + 1) % c.size()];
-      if (edges.insert(edge_key(a, b)).second) {
-        ++valence[a];
-        ++valence[b];
-      }
-    }
+    for (std::size_t i = 0; i < c.size(); ++i)
+      edges.push_back(edge_key(c[i], c[(i + 1) % c.size()]));
+  }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  std::vector<std::uint32_t> valence(n_file, 0);
+  for (const std::uint64_t e : edges) {
+    ++valence[std::uint32_t(e >> 32)];
+    ++valence[std::uint32_t(e)];
   }
   for (std::size_t begin = 0; begin < order.size(); begin += valence_run)
     std::stable_sort(order.begin() + std::ptrdiff_t(begin),

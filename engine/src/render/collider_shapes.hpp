@@ -98,7 +98,8 @@ public:
   std::vector<std::uint32_t> indices;
 
 private:
-  /// Appends one shape's triangles (`append(vertices, indices)`) and returns their range.
+  /// Appends one shape's triangles (`append()` adds them to vertices and indices) and returns their
+  /// range.
   template <typename Append> MeshRange shape(Append&& append) {
     MeshRange r;
     r.first = static_cast<std::uint32_t>(indices.size());

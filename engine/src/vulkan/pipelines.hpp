@@ -2,8 +2,8 @@
 // The compute pipelines of one Context, made once and shared by every batch (GpuSolver,
 // ClothWorld) on it: shader modules, descriptor set layouts, pipeline layouts, a VkPipelineCache,
 // and the pipelines keyed by (shader, specialisation constants), e.g. force.comp per grid stencil
-// x SC_RING, fused.comp per stencil x SC_WRITE_AUX x SC_COLLIDER_TYPES x SC_RING. Lookups happen when a
-// batch is created or its parameters change, never per dispatch: batches keep the raw handles,
+// x SC_NORMAL_FLAGS, fused.comp per stencil x SC_WRITE_AUX x SC_COLLIDER_TYPES x SC_NORMAL_FLAGS. Lookups
+// happen when a batch is created or its parameters change, never per dispatch: batches keep the raw handles,
 // which live as long as the Context's internals (each batch holds them). Internal to
 // engine/src/vulkan.
 #pragma once

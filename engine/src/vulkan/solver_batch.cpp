@@ -26,6 +26,24 @@ namespace sh = shared;
 
 namespace {
 
+// Each particle's gather list as (begin, end of its fan entries, end, 0): what the texel builds read
+// instead of the offsets, so that their fan loop knows where the fan ends (force_body.glsl
+// list_range). The fan's entries are a prefix of the list, each with ring bits.
+std::vector<std::uint32_t> list_ranges(const ClothTopology& topology) {
+  const std::span<const std::uint32_t> off = topology.edge_offsets();
+  const std::size_t n = off.size() - 1;
+  std::vector<std::uint32_t> ranges(4 * n, 0);
+  for (std::size_t p = 0; p < n; ++p) {
+    std::uint32_t fan_end = off[p];
+    while (fan_end < off[p + 1] && topology.edges()[fan_end].ring != 0)
+      ++fan_end;
+    ranges[4 * p] = off[p];
+    ranges[4 * p + 1] = fan_end;
+    ranges[4 * p + 2] = off[p + 1];
+  }
+  return ranges;
+}
+
 std::string vec_str(glm::vec3 v) {
   return fmt::format("({:.4g}, {:.4g}, {:.4g})", double(v.x), double(v.y), double(v.z));
 }
@@ -209,9 +227,7 @@ std::vector<sh::InstanceParams> SolverBatch::packed_instance_params() const {
     const float dt =
         float(params.substeps == 1 ? params.dt : params.dt / double(params.substeps)); // as the CPU
     sh::InstanceParams ip{};
-    ip.flags = (normals == Normals::grid ? VKCLOTH_FLAG_HAS_GRID : 0u) |
-               (normals == Normals::ring ? VKCLOTH_FLAG_RING_NORMALS : 0u) |
-               (float(params.wind.strength) != 0.0f ? VKCLOTH_FLAG_WIND : 0u) |
+    ip.flags = normal_flag(normals) | (float(params.wind.strength) != 0.0f ? VKCLOTH_FLAG_WIND : 0u) |
                (params.contact_inward_only ? 0u : VKCLOTH_FLAG_CONTACT_BOTH) |
                (options.flip_normals ? VKCLOTH_FLAG_FLIP_NORMALS : 0u) |
                (params.self_collision.enabled ? VKCLOTH_FLAG_SELF_COLLISION : 0u);
@@ -582,7 +598,9 @@ Result<void> SolverBatch::create_buffers() {
       {&acc_vel, vec4_bytes, "rk4 sums (velocities)"},
       {&particle, std::max<VkDeviceSize>(n * sizeof(sh::ParticleInfo), 16), "particle constants"},
       {&offsets, std::max<VkDeviceSize>((n + 1) * sizeof(std::uint32_t), 16), "adjacency offsets"},
-      {&ranges, std::max<VkDeviceSize>(n * 4 * sizeof(std::uint32_t), 16), "adjacency ranges"},
+      {&ranges,
+       access == BufferAccess::texel_views ? std::max<VkDeviceSize>(n * 4 * sizeof(std::uint32_t), 16) : 16,
+       "adjacency ranges"}, // read by the texel builds only
       {&edges, std::max<VkDeviceSize>(edges_count * sizeof(sh::Edge), 16), "adjacency"},
       {&strain_links, std::max<VkDeviceSize>(strain_link_count() * sizeof(sh::StrainLink), 16),
        "strain links"},
@@ -661,43 +679,34 @@ Result<void> SolverBatch::upload_initial_state(const ClothTopology& topology,
     const GatherEdge& g = topology.edges()[e];
     edge_data[e] = {g.other, float(g.rest_length), float(g.stiffness), g.ring};
   }
-  // Each particle's list as (begin, end of its fan entries, end, 0): the texel builds' loops then
-  // know where the fan ends (force_body.glsl list_range).
-  const std::span<const std::uint32_t> off = topology.edge_offsets();
-  std::vector<std::uint32_t> range_data(4 * n, 0);
-  for (std::size_t p = 0; p < n; ++p) {
-    std::uint32_t fan_end = off[p];
-    while (fan_end < off[p + 1] && topology.edges()[fan_end].ring != 0)
-      ++fan_end;
-    range_data[4 * p] = off[p];
-    range_data[4 * p + 1] = fan_end;
-    range_data[4 * p + 2] = off[p + 1];
-  }
+  const std::vector<std::uint32_t> range_data =
+      access == BufferAccess::texel_views ? list_ranges(topology) : std::vector<std::uint32_t>{};
   std::vector<sh::StrainLink> link_data;
   for (const StrainLink& l : topology.strain_links())
     link_data.push_back({l.a, l.b, float(l.rest_length)});
   const std::span<const std::uint32_t> triangles = topology.triangles();
-  const Upload uploads[] = {{&strain_links, link_data.empty() ? nullptr : link_data.data(),
-                             link_data.size() * sizeof(sh::StrainLink)},
-                            {&tethers, nullptr, 0},
-                            {&pos[0], x0.data(), vec4_bytes},
-                            {&pos[1], x0.data(), vec4_bytes},
-                            {&vel, v0.data(), vec4_bytes},
-                            {&uv, uv0.data(), vec4_bytes},
-                            {&particle, info.data(), n * sizeof(sh::ParticleInfo)},
-                            {&offsets, topology.edge_offsets().data(), (n + 1) * sizeof(std::uint32_t)},
-                            {&ranges, range_data.data(), range_data.size() * sizeof(std::uint32_t)},
-                            {&edges, edge_data.data(), edges_count * sizeof(sh::Edge)},
-                            {&indices, triangles.data(), triangles.size() * sizeof(std::uint32_t)},
-                            {&force, nullptr, 0},
-                            {&force_stage, nullptr, 0},
-                            {&vel_filt, nullptr, 0},
-                            {&normal, nullptr, 0},
-                            {&vertices, nullptr, 0},
-                            {&stage_pos, nullptr, 0},
-                            {&stage_vel, nullptr, 0},
-                            {&acc_pos, nullptr, 0},
-                            {&acc_vel, nullptr, 0}};
+  const Upload uploads[] = {
+      {&strain_links, link_data.empty() ? nullptr : link_data.data(),
+       link_data.size() * sizeof(sh::StrainLink)},
+      {&tethers, nullptr, 0},
+      {&pos[0], x0.data(), vec4_bytes},
+      {&pos[1], x0.data(), vec4_bytes},
+      {&vel, v0.data(), vec4_bytes},
+      {&uv, uv0.data(), vec4_bytes},
+      {&particle, info.data(), n * sizeof(sh::ParticleInfo)},
+      {&offsets, topology.edge_offsets().data(), (n + 1) * sizeof(std::uint32_t)},
+      {&ranges, range_data.empty() ? nullptr : range_data.data(), range_data.size() * sizeof(std::uint32_t)},
+      {&edges, edge_data.data(), edges_count * sizeof(sh::Edge)},
+      {&indices, triangles.data(), triangles.size() * sizeof(std::uint32_t)},
+      {&force, nullptr, 0},
+      {&force_stage, nullptr, 0},
+      {&vel_filt, nullptr, 0},
+      {&normal, nullptr, 0},
+      {&vertices, nullptr, 0},
+      {&stage_pos, nullptr, 0},
+      {&stage_vel, nullptr, 0},
+      {&acc_pos, nullptr, 0},
+      {&acc_vel, nullptr, 0}};
   return upload(uploads);
 }
 

@@ -117,6 +117,11 @@ public:
     grid, ///< the unrolled grid fan (force_body.glsl grid_normal, VKCLOTH_FLAG_HAS_GRID)
     ring  ///< the gather lists' ring terms (ClothTopology::ring_normals, VKCLOTH_FLAG_RING_NORMALS): meshes
   };
+  /// The instance flag of a normal path (VKCLOTH_FLAG_HAS_GRID, VKCLOTH_FLAG_RING_NORMALS or 0): what
+  /// InstanceParams::flags carries and what SC_NORMAL_FLAGS keeps compiled in (force_body.glsl).
+  static std::uint32_t normal_flag(Normals n) {
+    return n == Normals::grid ? VKCLOTH_FLAG_HAS_GRID : n == Normals::ring ? VKCLOTH_FLAG_RING_NORMALS : 0u;
+  }
   /// The normal path of `topology`'s batches: a grid's own fast path; the ring terms for any other
   /// topology with a surface.
   static Normals normals_of(const ClothTopology& topology);

@@ -35,9 +35,7 @@ std::array<std::uint32_t, 43> solver_constants(const SolverBatch::Stencil& st, b
   std::memcpy(words.data(), &st, sizeof(st));
   words[40] = write_aux ? 1u : 0u;
   words[41] = collider_types;
-  words[42] = normals == SolverBatch::Normals::grid   ? VKCLOTH_FLAG_HAS_GRID
-              : normals == SolverBatch::Normals::ring ? VKCLOTH_FLAG_RING_NORMALS
-                                                      : 0u;
+  words[42] = SolverBatch::normal_flag(normals);
   return words;
 }
 

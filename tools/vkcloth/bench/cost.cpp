@@ -31,8 +31,10 @@ Cost cost_of(const std::string& variant, Integrator integrator, double s, bool g
   const bool rk4 = integrator == Integrator::rk4;
   // Euler update: a = f/m 3, two axpys 12. RK4: 4 stages (eval + k sums 6 + next stage 12), final 12.
   c.flops = rk4 ? 4.0 * (eval + 18.0) + 12.0 : eval + 15.0;
-  // offsets + edges (12 bytes on the CPU, whose list kernel pads them per vector, ~15 % on a
-  // mesh, not counted; 16 on the GPU: one RGBA32UI texel); a mesh's fan lists: offsets + 8-byte terms
+  // offsets + edges (12 bytes on the CPU, whose list kernel pads them per vector, ~6 % on a
+  // valence-grouped mesh, not counted; 16 on the GPU: one RGBA32UI texel, and the texel builds read
+  // a 16-byte range texel instead of the 4-byte offset: not counted); a mesh's fan lists: offsets +
+  // 8-byte terms
   const double edge_bytes = variant == "cpu" ? 12.0 : 16.0;
   const double csr = grid ? 0.0 : 4.0 + edge_bytes * s + (fans > 0.0 ? 4.0 + 8.0 * fans : 0.0);
   if (variant == "cpu") {
