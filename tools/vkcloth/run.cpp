@@ -349,6 +349,62 @@ nlohmann::json summary_json(const Scene& scene, const RunOptions& opt, const Sim
   return doc;
 }
 
+/// The run: the backend stepped to the next trace row, exported frame, strain or contact sample, or
+/// progress redraw, whichever comes first, its state read back (into pos, vel) only when one of
+/// them needs it. On a blow-up the trace rows and the frames before it are kept, and the blow-up is
+/// the error.
+Result<void> step_loop(const Scene& scene, SimBackend& backend, FrameExport& frames, std::FILE* trace,
+                       std::uint64_t trace_every, const std::vector<std::uint32_t>& order, bool track_strain,
+                       std::vector<glm::dvec3>& pos, std::vector<glm::dvec3>& vel, RunSummary& sum) {
+  const std::uint64_t total = scene.steps;
+  const std::uint64_t every = std::max<std::uint64_t>(trace_every, 1);
+  const auto next_multiple = [](std::uint64_t done, std::uint64_t k) { return (done / k + 1) * k; };
+  Progress progress(total);
+  std::uint64_t done = 0;
+  while (done < total) {
+    std::uint64_t next = progress.next_tick(done);
+    if (trace)
+      next = std::min(next, next_multiple(done, every));
+    if (frames.enabled())
+      next = std::min(next, next_multiple(done, frames.every()));
+    if (track_strain)
+      next = std::min(next, next_multiple(done, sum.strain_every));
+    if (sum.contact)
+      next = std::min(next, next_multiple(done, sum.contact_every));
+    next = std::min(next, total);
+    if (auto r = backend.step(next - done); !r) {
+      if (trace)
+        std::fflush(trace);             // the rows before the blow-up stay
+      if (auto w = frames.finish(); !w) // and so do the frames
+        report(w.error());
+      return r.error();
+    }
+    done = next;
+    const bool trace_due = trace && done % every == 0;
+    const bool frame_due = frames.enabled() && done % frames.every() == 0;
+    const bool contact_due = sum.contact && (done % sum.contact_every == 0 || done == total);
+    if (trace_due || frame_due || contact_due)
+      VKCLOTH_TRY(backend.read_state(pos, vel));
+    if (contact_due)
+      VKCLOTH_TRY(sum.contact->add(scene.system, backend.colliders(), pos, vel, backend.step_index()));
+    if (track_strain && (done % sum.strain_every == 0 || done == total)) {
+      // From `pos` when it was just read (exact copies of the solver's positions); else the
+      // backend reads the positions only.
+      auto s = trace_due || frame_due ? structural_strain(scene.system, std::span<const glm::dvec3>(pos))
+                                      : backend.strain(scene.system);
+      if (!s)
+        return s.error();
+      sum.strain.add(*s, backend.step_index());
+    }
+    if (trace_due)
+      write_trace_rows(trace, backend.step_index(), backend.time(), pos, vel, scene.system, order);
+    if (frame_due)
+      VKCLOTH_TRY(frames.add(backend.time(), pos));
+    progress.update(done);
+  }
+  return {};
+}
+
 int run_command(const RunOptions& opt) {
   const auto precision = parse_precision(opt.precision);
   if (!precision)
@@ -371,8 +427,6 @@ int run_command(const RunOptions& opt) {
 
   std::vector<glm::dvec3> pos, vel;
   const auto read = [&] { return backend.read_state(pos, vel); };
-  const std::uint64_t total = scene->steps;
-  const std::uint64_t every = std::max<std::uint64_t>(opt.trace_every, 1);
   if (auto r = read(); !r)
     return report(r.error());
   const std::vector<glm::dvec3> initial = pos; // in the solver's precision, for the displacement
@@ -388,7 +442,7 @@ int run_command(const RunOptions& opt) {
   sum.strain_every = std::max<std::uint64_t>(opt.strain_every, 1);
   sum.strain = StrainTrack{*strain0, 0};
   if (!scene->params.colliders.empty())
-    sum.contact.emplace(total, scene->params.dt);
+    sum.contact.emplace(scene->steps, scene->params.dt);
   sum.contact_every = std::max<std::uint64_t>(opt.contact_every, 1);
   const std::vector<std::uint32_t> order = file_order(scene->system);
   if (trace)
@@ -396,57 +450,11 @@ int run_command(const RunOptions& opt) {
   if (frames.enabled())
     if (auto r = frames.add(backend.time(), pos); !r)
       return report(r.error());
-  const auto next_multiple = [](std::uint64_t done, std::uint64_t k) { return (done / k + 1) * k; };
-
   const auto t0 = std::chrono::steady_clock::now();
-  {
-    Progress progress(total);
-    std::uint64_t done = 0;
-    while (done < total) {
-      // Step to the next trace row, exported frame, sample or progress redraw, whichever comes first.
-      std::uint64_t next = progress.next_tick(done);
-      if (trace)
-        next = std::min(next, next_multiple(done, every));
-      if (frames.enabled())
-        next = std::min(next, next_multiple(done, frames.every()));
-      if (track_strain)
-        next = std::min(next, next_multiple(done, sum.strain_every));
-      if (sum.contact)
-        next = std::min(next, next_multiple(done, sum.contact_every));
-      next = std::min(next, total);
-      if (auto r = backend.step(next - done); !r) {
-        if (trace)
-          std::fflush(trace.get());       // the rows before the blow-up stay
-        if (auto w = frames.finish(); !w) // and so do the frames
-          report(w.error());
-        return report(r.error());
-      }
-      done = next;
-      const bool trace_due = trace && done % every == 0;
-      const bool frame_due = frames.enabled() && done % frames.every() == 0;
-      const bool contact_due = sum.contact && (done % sum.contact_every == 0 || done == total);
-      if (trace_due || frame_due || contact_due) {
-        if (auto r = read(); !r)
-          return report(r.error());
-      }
-      if (contact_due)
-        if (auto r = sum.contact->add(scene->system, backend.colliders(), pos, vel, backend.step_index()); !r)
-          return report(r.error());
-      if (track_strain && (done % sum.strain_every == 0 || done == total)) {
-        // From `pos` when it was just read; else the backend reads the positions only.
-        auto s = trace_due || frame_due ? strain_of_pos() : backend.strain(scene->system);
-        if (!s)
-          return report(s.error());
-        sum.strain.add(*s, backend.step_index());
-      }
-      if (trace_due)
-        write_trace_rows(trace.get(), backend.step_index(), backend.time(), pos, vel, scene->system, order);
-      if (frame_due)
-        if (auto r = frames.add(backend.time(), pos); !r)
-          return report(r.error());
-      progress.update(done);
-    }
-  }
+  if (auto r = step_loop(*scene, backend, frames, trace.get(), opt.trace_every, order, track_strain, pos, vel,
+                         sum);
+      !r)
+    return report(r.error());
   sum.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   if (auto r = read(); !r)
