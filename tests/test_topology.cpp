@@ -350,6 +350,7 @@ void check_rings(const ParticleSystem& s, std::size_t zero_entries_expected) {
       const GatherEdge& g = t->edges()[e];
       CHECK((g.ring == 0 || ring_part)); // no ring entry after a plain one
       ring_part = ring_part && g.ring != 0;
+      CHECK((e < t->fan_ends()[p]) == ring_part); // fan_ends: the end of that prefix
       if (g.stiffness == 0.0 && g.rest_length == 0.0)
         ++zero_entries;
       else

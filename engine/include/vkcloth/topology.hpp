@@ -114,6 +114,9 @@ public:
   /// neighbours again. A fan neighbour that no spring reaches (a degenerate mesh) gets an entry of
   /// stiffness zero.
   bool ring_normals() const { return ring_normals_; }
+  /// size() entries: where particle p's fan entries end in edges(), the first entry of its list
+  /// without ring bits (its list's begin without ring_normals()). The solvers' fan loops stop there.
+  std::span<const std::uint32_t> fan_ends() const { return fan_ends_; }
 
   const std::optional<Grid>& grid() const { return system_.grid; }
   /// Null when the grid stencil does not apply (no grid, a grid under 5 x 5, irregular interior).
@@ -152,6 +155,7 @@ private:
   ParticleSystem system_;
   std::vector<std::uint32_t> edge_offsets_;
   std::vector<GatherEdge> edges_;
+  std::vector<std::uint32_t> fan_ends_;
   bool ring_normals_ = false;
   std::optional<GridStencil> stencil_;
   std::vector<std::uint32_t> triangles_;

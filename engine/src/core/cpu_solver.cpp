@@ -614,7 +614,8 @@ namespace {
 // particles that fill whole vectors only; the rest take the per-particle reference.
 template <typename Real, typename Edge>
 std::unique_ptr<detail::PaddedLists<Real>>
-pad_lists(std::size_t width, std::span<const std::uint32_t> edge_offsets, const std::vector<Edge>& edges) {
+pad_lists(std::size_t width, std::span<const std::uint32_t> edge_offsets,
+          std::span<const std::uint32_t> fan_ends, const std::vector<Edge>& edges) {
   auto lists = std::make_unique<detail::PaddedLists<Real>>();
   detail::PaddedLists<Real>& l = *lists;
   l.width = width;
@@ -624,9 +625,7 @@ pad_lists(std::size_t width, std::span<const std::uint32_t> edge_offsets, const 
     std::uint32_t slots = 0, ring_slots = 0;
     for (std::size_t p = b * width; p < (b + 1) * width; ++p) {
       slots = std::max(slots, edge_offsets[p + 1] - edge_offsets[p]);
-      for (std::uint32_t e = edge_offsets[p]; e < edge_offsets[p + 1]; ++e)
-        if (edges[e].ring != 0)
-          ring_slots = std::max(ring_slots, e - edge_offsets[p] + 1);
+      ring_slots = std::max(ring_slots, fan_ends[p] - edge_offsets[p]);
     }
     for (std::uint32_t k = 0; k < slots; ++k)
       for (std::size_t p = b * width; p < (b + 1) * width; ++p) {
@@ -652,7 +651,7 @@ pad_lists(std::size_t width, std::span<const std::uint32_t> edge_offsets, const 
 template <typename Real> void CpuSolver<Real>::list_sweep(const Real h, const bool semi) {
   const std::size_t n = pos_.size(), width = (simd_ == 2 ? 64 : 32) / sizeof(Real);
   if (!lists_ || lists_->width != width)
-    lists_ = pad_lists<Real>(width, edge_offsets_, edges_);
+    lists_ = pad_lists<Real>(width, edge_offsets_, topology_->fan_ends(), edges_);
   const detail::PaddedLists<Real>& l = *lists_;
   detail::ListArgs<Real> la{};
   step_args(la, h, semi);

@@ -319,6 +319,13 @@ Result<std::shared_ptr<const ClothTopology>> ClothTopology::create(const Particl
     ring_order(t->fan_offsets_, t->fans_, t->edge_offsets_, t->edges_);
     t->ring_normals_ = true;
   }
+  t->fan_ends_.resize(n);
+  for (std::size_t p = 0; p < n; ++p) { // the fan's entries are a prefix of the list (ring_order)
+    std::uint32_t e = t->edge_offsets_[p];
+    while (e < t->edge_offsets_[p + 1] && t->edges_[e].ring != 0)
+      ++e;
+    t->fan_ends_[p] = e;
+  }
   detail::colour_strain_links(s, t->strain_links_, t->strain_colour_offsets_);
   return std::shared_ptr<const ClothTopology>(std::move(t));
 }

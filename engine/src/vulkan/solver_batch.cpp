@@ -28,17 +28,14 @@ namespace {
 
 // Each particle's gather list as (begin, end of its fan entries, end, 0): what the texel builds read
 // instead of the offsets, so that their fan loop knows where the fan ends (force_body.glsl
-// list_range). The fan's entries are a prefix of the list, each with ring bits.
+// list_range).
 std::vector<std::uint32_t> list_ranges(const ClothTopology& topology) {
   const std::span<const std::uint32_t> off = topology.edge_offsets();
-  const std::size_t n = off.size() - 1;
+  const std::size_t n = topology.size();
   std::vector<std::uint32_t> ranges(4 * n, 0);
   for (std::size_t p = 0; p < n; ++p) {
-    std::uint32_t fan_end = off[p];
-    while (fan_end < off[p + 1] && topology.edges()[fan_end].ring != 0)
-      ++fan_end;
     ranges[4 * p] = off[p];
-    ranges[4 * p + 1] = fan_end;
+    ranges[4 * p + 1] = topology.fan_ends()[p];
     ranges[4 * p + 2] = off[p + 1];
   }
   return ranges;
