@@ -144,12 +144,18 @@ TEST_CASE("stretch control on every backend: GPU = CPU float within 1e-5 m after
       {"tethers (geodesic), rk4", M::tethers, StretchLimit::TetherDistance::geodesic, Integrator::rk4, false},
       {"both, implicit Euler, sphere", M::both, StretchLimit::TetherDistance::geodesic,
        Integrator::implicit_euler, true},
+      {"projection, semi-implicit", M::projection, StretchLimit::TetherDistance::euclidean,
+       Integrator::semi_implicit_euler, false},
+      {"projection, explicit, sphere", M::projection, StretchLimit::TetherDistance::geodesic,
+       Integrator::explicit_euler, true},
+      {"projection, implicit Euler, sphere", M::projection, StretchLimit::TetherDistance::euclidean,
+       Integrator::implicit_euler, true},
   };
   const ParticleSystem s = hanging(16);
   for (const Case& c : cases) {
     const std::string case_name = c.name;
     CAPTURE(case_name);
-    SimParams p = limited(c.method, 3, 0.005);
+    SimParams p = limited(c.method, c.method == M::projection ? 10 : 3, 0.005);
     p.integrator = c.integrator;
     p.stretch_limit.tether_distance = c.distance;
     if (c.sphere)
@@ -160,8 +166,12 @@ TEST_CASE("stretch control on every backend: GPU = CPU float within 1e-5 m after
       auto sim = make_sim(b, s, p);
       REQUIRE(sim->run(100).ok());
       results.push_back(sim->positions());
-      // Provot's sweeps act: the soft cloth (strain 19 without them, test below) stays near 0.1.
-      if (c.method != M::tethers)
+      // Provot's sweeps act: the soft cloth (strain 19 without them, test below) stays near 0.1;
+      // the projection holds it within its tolerance, but for the colliders' projection after it
+      // (the sphere pushes particles in contact out: 0.1024 at the end of the explicit case).
+      if (c.method == M::projection)
+        CHECK(max_structural_strain(s, results.back()) < (c.sphere ? 0.11 : 0.1 + 2e-4));
+      else if (c.method != M::tethers)
         CHECK(max_structural_strain(s, results.back()) < 0.25);
     }
     if (results.size() < 2)
@@ -170,7 +180,11 @@ TEST_CASE("stretch control on every backend: GPU = CPU float within 1e-5 m after
     for (std::size_t q = 0; q < s.size(); ++q)
       diff = std::max(diff, glm::length(results[0][q] - results[1][q]));
     MESSAGE(case_name << ": CPU float vs Vulkan " << diff << " m");
-    CHECK(diff < 1e-5);
+    // The GPU's implicit Euler sums its CG's dot products in another order (equal to rounding,
+    // 8e-7 m above); the projection decides which links it solves for by thresholds, so those
+    // roundings can change a decision, which then moves the cloth by up to ~1e-3 of its size.
+    const bool amplified = c.method == M::projection && c.integrator == Integrator::implicit_euler;
+    CHECK(diff < (amplified ? 2e-3 : 1e-5));
   }
 }
 
@@ -207,6 +221,29 @@ TEST_CASE("the report's super-elastic cloth (K_struct = 5) keeps its structural 
   }
 }
 
+TEST_CASE("the fast projection holds the report's super-elastic cloth within max_strain + 1e-3 at every "
+          "resolution (issue 17 point 4b)") {
+  // The same cloth as above (K_struct = 5, 5 kg, two corners pinned), max_strain 0.1, at 16, 32 and
+  // 64: the largest structural strain at every step of the first second stays below 0.1 + 1e-3,
+  // where the sweeps leave 0.104 / 0.115 / 0.145 (above). Each Newton iteration solves for every
+  // link over (or near) the bound at once, so the correction reaches the whole cloth in one step.
+  const double dt = 0.002;
+  for (std::uint32_t n : {16u, 32u, 64u}) {
+    CAPTURE(n);
+    const ParticleSystem s = hanging(n);
+    auto sim = CpuSolver<float>::create(s, limited(StretchLimit::Method::projection, 10, dt));
+    REQUIRE(sim.ok());
+    double worst = 0.0;
+    for (int k = 0; k < int(std::lround(1.0 / dt)); ++k) {
+      REQUIRE(sim->step().ok());
+      worst = std::max(worst, max_structural_strain(s, widen(sim->positions())));
+    }
+    MESSAGE(n << " x " << n << ": largest structural strain over the first second " << worst);
+    CHECK(worst < 0.1 + 1e-3);
+    CHECK(worst > 0.0999); // the bound is reached: the springs alone stretch far past it
+  }
+}
+
 TEST_CASE("the report's scenes with stretch control stay stable at their dt") {
   // The report's 10 x 10 scenes at dt = 0.02 with the default 4 sweeps: no blow-up on any
   // backend, and the structural strain at the end well under what the springs alone leave.
@@ -219,18 +256,20 @@ TEST_CASE("the report's scenes with stretch control stay stable at their dt") {
     auto plain = make_sim(Backend::cpu_float, scene->system, scene->params);
     REQUIRE(plain->run(scene->steps).ok());
     const double without = max_structural_strain(scene->system, plain->positions());
-    SimParams p = scene->params;
-    p.stretch_limit.method = StretchLimit::Method::both;
-    for (Backend b : float_backends()) {
-      ValidationScope validation;
-      auto sim = make_sim(b, scene->system, p);
-      const auto r = sim->run(scene->steps);
-      CHECK_MESSAGE(r.ok(), (r.ok() ? "" : r.error().message));
-      const double with = max_structural_strain(scene->system, sim->positions());
-      MESSAGE(name << " (" << to_string(b) << "): structural strain " << without << " without, " << with
-                   << " with stretch control");
-      CHECK(with < 0.25);
-      CHECK(with <= std::max(0.101, 0.5 * without));
+    for (StretchLimit::Method method : {StretchLimit::Method::both, StretchLimit::Method::projection}) {
+      SimParams p = scene->params;
+      p.stretch_limit.method = method;
+      for (Backend b : float_backends()) {
+        ValidationScope validation;
+        auto sim = make_sim(b, scene->system, p);
+        const auto r = sim->run(scene->steps);
+        CHECK_MESSAGE(r.ok(), (r.ok() ? "" : r.error().message));
+        const double with = max_structural_strain(scene->system, sim->positions());
+        const std::string what = scene_name + " (" + to_string(b) + ", " + to_string(method) + ")";
+        MESSAGE(what << ": structural strain " << without << " without, " << with << " with stretch control");
+        CHECK(with < 0.25);
+        CHECK(with <= std::max(0.101, 0.5 * without));
+      }
     }
   }
 }

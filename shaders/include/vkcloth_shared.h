@@ -97,8 +97,17 @@ struct vec4 {
 #define VKCLOTH_STRETCH_PROVOT 1u       // Provot sweeps over the strain links (strain_links.comp)
 #define VKCLOTH_STRETCH_TETHERS 2u      // tethers (strain_finish.comp)
 #define VKCLOTH_STRETCH_GEODESIC 4u     // tethers with geodesic rest lengths (the second half of TETHERS)
+#define VKCLOTH_STRETCH_PROJECTION 8u   // the fast projection (strain_project.comp)
 #define VKCLOTH_TETHERS_PER_PARTICLE 4u // vkcloth::tethers_per_particle
 #define VKCLOTH_NO_TETHER 0xffffffffu   // an unused tether slot (vkcloth::no_tether)
+// The fast projection (cloth_kernel.h projection_*, docs/model.md "Stretch control"): links whose
+// C = |u|^2 / B^2 - 1 is above -BAND take part in a Newton iteration's solve (those within the band
+// keep their length, so the solve cannot stretch them past the bound); the projection stops once
+// every link's strain is within TOLERANCE of max_strain; each solve is Jacobi-preconditioned CG
+// to |r|^2 <= CG_TOL2 |r0|^2, at most cg_cap(links) iterations (projection_cg_cap).
+#define VKCLOTH_PROJECTION_BAND 0.01
+#define VKCLOTH_PROJECTION_TOLERANCE 1.0e-4
+#define VKCLOTH_PROJECTION_CG_TOL2 1.0e-8
 
 // InstanceParams::integrator (the vkcloth::Integrator values; engine/src/core/kernel.hpp asserts it).
 #define VKCLOTH_INTEGRATOR_EXPLICIT_EULER 0u

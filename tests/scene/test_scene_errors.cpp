@@ -163,7 +163,7 @@ TEST_CASE("stretch_limit: bad input names the key and the value (issue 17 point 
                {"stretch_limit.iterations", "1..100", "got 0"});
   expect_error(base + R"({"method": "both", "iterations": 101}})", {"stretch_limit.iterations", "got 101"});
   expect_error(base + R"({"method": "both", "iterations": 2.5}})", {"stretch_limit.iterations"});
-  expect_error(base + R"({"method": "hard"}})", {"stretch_limit.method", "\"hard\"", "provot"});
+  expect_error(base + R"({"method": "hard"}})", {"stretch_limit.method", "\"hard\"", "provot", "projection"});
   expect_error(base + R"({"max_strain": 0.1}})", {"stretch_limit.method is required"});
   expect_error(base + R"({"method": "both", "tether_distance": "manhattan"}})",
                {"stretch_limit.tether_distance", "\"manhattan\""});
@@ -176,6 +176,11 @@ TEST_CASE("stretch_limit: bad input names the key and the value (issue 17 point 
   REQUIRE(on.ok());
   CHECK(on->params.stretch_limit.method == StretchLimit::Method::provot);
   CHECK(on->params.stretch_limit.iterations == 4);
+  auto projection = parse_scene(R"({"system": "cloth"})", "ok.json",
+                                std::vector<std::string>{"stretch_limit.method=projection"});
+  REQUIRE(projection.ok());
+  CHECK(projection->params.stretch_limit.projection());
+  CHECK(projection->params.stretch_limit.tethers()); // the tethers first
   auto off = parse_scene(R"({"system": "cloth"})", "ok.json");
   REQUIRE(off.ok());
   CHECK(!off->params.stretch_limit.enabled()); // off by default: the report's model

@@ -42,6 +42,7 @@ template <typename Real> struct ImplicitWorkspace;
 template <typename Real> struct RowArgs;
 template <typename Real> struct ContactShapes;
 template <typename Real> struct SelfCollisionGrid;
+template <typename Real> struct StrainProjection;
 template <typename Real> struct PaddedLists;
 template <typename Real> struct StepArgs;
 } // namespace detail
@@ -143,6 +144,7 @@ private:
   void limit_stretch(Real h);
   // Self-collision after that (self_collision.cpp; docs/model.md "Self-collision").
   void self_collide();
+  void project_strain(Real h);
 
   /// A gather-list entry in the solver's precision (ClothTopology::edges() converted once).
   struct Edge {
@@ -191,10 +193,11 @@ private:
   std::uint64_t step_ = 0;
   double time_ = 0.0;
   std::unique_ptr<detail::ThreadPool> pool_;
-  std::unique_ptr<detail::ImplicitWorkspace<Real>> implicit_; // created by the first implicit step
-  std::unique_ptr<detail::ContactShapes<Real>> contacts_;     // this substep's colliders (prepare_colliders)
-  std::unique_ptr<detail::SelfCollisionGrid<Real>> self_;     // created by the first self-collision substep
-  std::unique_ptr<detail::PaddedLists<Real>> lists_;          // created by the first list sweep
+  std::unique_ptr<detail::ImplicitWorkspace<Real>> implicit_;  // created by the first implicit step
+  std::unique_ptr<detail::ContactShapes<Real>> contacts_;      // this substep's colliders (prepare_colliders)
+  std::unique_ptr<detail::SelfCollisionGrid<Real>> self_;      // created by the first self-collision substep
+  std::unique_ptr<detail::StrainProjection<Real>> projection_; // created by the first fast-projection substep
+  std::unique_ptr<detail::PaddedLists<Real>> lists_;           // created by the first list sweep
   SolveStats solve_;
 };
 

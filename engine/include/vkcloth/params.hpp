@@ -105,19 +105,25 @@ struct Wind {
 /// than (1 + max_strain) L0 back to that length, `iterations` sweeps over the springs in colour
 /// order (Gauss-Seidel, each colour a set of springs that share no particle); tethers (long-range
 /// attachments, Kim, Chentanez and Mueller 2012) keep each particle within (1 + max_strain) of its
-/// rest distance to the pinned particles it hangs from (up to 4, nearest first). The position
+/// rest distance to the pinned particles it hangs from (up to 4, nearest first); the fast
+/// projection (Goldenthal et al. 2007, after the tethers) solves for every structural spring over
+/// the limit at once, Newton iterations of a CG, until each is within 1e-4 of it. The position
 /// changes update the velocities (v += dx / dt); the colliders' projection follows.
 struct StretchLimit {
-  enum class Method : std::uint32_t { off = 0, tethers = 1, provot = 2, both = 3 };
+  enum class Method : std::uint32_t { off = 0, tethers = 1, provot = 2, both = 3, projection = 4 };
   /// How a tether's rest length is measured in the rest state: straight, or along the cloth.
   enum class TetherDistance : std::uint32_t { euclidean = 0, geodesic = 1 };
   Method method = Method::off;
-  double max_strain = 0.1;      ///< > 0: the largest allowed (|u| - L0) / L0
-  std::uint32_t iterations = 4; ///< 1..100 Provot sweeps per substep
+  double max_strain = 0.1; ///< > 0: the largest allowed (|u| - L0) / L0
+  /// 1..100 per substep: Provot sweeps, or (projection) the most Newton iterations.
+  std::uint32_t iterations = 4;
   TetherDistance tether_distance = TetherDistance::euclidean;
 
   bool provot() const { return method == Method::provot || method == Method::both; }
-  bool tethers() const { return method == Method::tethers || method == Method::both; }
+  bool tethers() const {
+    return method == Method::tethers || method == Method::both || method == Method::projection;
+  }
+  bool projection() const { return method == Method::projection; }
   bool enabled() const { return method != Method::off; }
 };
 

@@ -142,6 +142,11 @@ public:
   /// backend. Within a colour, links keep their spring order.
   std::span<const StrainLink> strain_links() const { return strain_links_; }
   std::span<const std::uint32_t> strain_colour_offsets() const { return strain_colour_offsets_; }
+  /// Each particle's strain links (the fast projection's gather, StretchLimit::Method::projection):
+  /// particle p's are strain_incidence()[strain_incidence_offsets()[p] .. [p + 1]), each entry
+  /// 2 l + e for link l = strain_links()[l], e = 1 when p is its end b (0: end a), in link order.
+  std::span<const std::uint32_t> strain_incidence_offsets() const { return strain_incidence_offsets_; }
+  std::span<const std::uint32_t> strain_incidence() const { return strain_incidence_; }
   /// tethers_per_particle slots per particle (particle p's at [p * tethers_per_particle, ...)): the
   /// pinned particles nearest to p along the springs (structural, shear and chain springs at their
   /// rest lengths), nearest first, with rest distances measured straight (euclidean) or along
@@ -164,6 +169,7 @@ private:
   std::vector<glm::vec2> uvs_;
   std::vector<StrainLink> strain_links_;
   std::vector<std::uint32_t> strain_colour_offsets_;
+  std::vector<std::uint32_t> strain_incidence_offsets_, strain_incidence_;
   // Tethers, computed on first use (tethers()): [0] euclidean, [1] geodesic.
   mutable std::once_flag tethers_once_[2];
   mutable std::vector<Tether> tethers_[2];

@@ -15,6 +15,7 @@
 #include "kernel.hpp"
 #include "row_kernel.hpp"
 #include "self_collision.hpp"
+#include "strain_projection.hpp"
 #include "thread_pool.hpp"
 
 // Every per-particle formula comes from shaders/include/cloth_kernel.h (kernel.hpp), the source
@@ -348,8 +349,10 @@ template <typename Real> void CpuSolver<Real>::substep(const Real h) {
 // The tethers first (anchors are pinned: every particle's tethers are independent of the
 // others'), then Provot's sweeps (one colour at a time: its links share no particle, so they are
 // projected in parallel with the same result as in order), so that the structural springs get
-// the last word; then the colliders' projection, since a correction may have pulled a particle
-// into one. Each formula: cloth_kernel.h; the GPU: strain_finish.comp and strain_links.comp.
+// the last word; or, for method projection, the fast projection after the tethers
+// (strain_projection.cpp);
+// then the colliders' projection, since a correction may have pulled a particle into one. Each
+// formula: cloth_kernel.h; the GPU: strain_finish.comp, strain_links.comp, strain_project.comp.
 template <typename Real> void CpuSolver<Real>::limit_stretch(const Real h) {
   const StretchLimit& sl = params_.stretch_limit;
   const Real max_strain = Real(sl.max_strain);
@@ -402,6 +405,10 @@ template <typename Real> void CpuSolver<Real>::limit_stretch(const Real h) {
         moved(l.a);
         moved(l.b);
       });
+  if (sl.projection()) {
+    project_strain(h);
+    soa_valid_ = false; // the next row sweep transposes the moved positions
+  }
   if (!params_.colliders.empty())
     pool_->for_each(pos_.size(), [&](std::size_t p) {
       if (!pinned_[p]) {

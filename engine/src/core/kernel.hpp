@@ -127,6 +127,17 @@ inline std::uint32_t self_table_size(std::uint32_t count) {
   return static_cast<std::uint32_t>(t);
 }
 
+/// The most CG iterations of one fast-projection solve over `links` links, the same on both
+/// backends: CG needs about as many as the links' graph is wide (its condition number grows with
+/// the square of the width), ~sqrt(links) on a cloth; 10 sqrt(links) leaves room for its worst
+/// steps in float (the report's soft cloth at 64 x 64 took up to ~5 sqrt(links)).
+inline std::uint32_t projection_cg_cap(std::size_t links) {
+  std::uint32_t root = 0;
+  while (std::uint64_t(root) * root < links)
+    ++root;
+  return 50 + 10 * root;
+}
+
 /// The kernel's SpringBlock of precision Real.
 template <typename Real>
 using SpringBlock = std::conditional_t<std::is_same_v<Real, float>, f32::SpringBlock, f64::SpringBlock>;

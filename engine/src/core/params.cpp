@@ -220,13 +220,15 @@ const char* to_string(StretchLimit::Method method) {
     return "provot";
   case StretchLimit::Method::both:
     return "both";
+  case StretchLimit::Method::projection:
+    return "projection";
   }
   return "?";
 }
 
 std::optional<StretchLimit::Method> parse_stretch_method(std::string_view name) {
   using M = StretchLimit::Method;
-  for (M m : {M::off, M::tethers, M::provot, M::both})
+  for (M m : {M::off, M::tethers, M::provot, M::both, M::projection})
     if (name == to_string(m))
       return m;
   return std::nullopt;
@@ -274,7 +276,7 @@ Result<void> SimParams::validate() {
     return bad(fmt::format("contact_epsilon must be finite and >= 0, got {}", contact_epsilon));
   if (!std::isfinite(divergence_limit) || divergence_limit <= 0.0)
     return bad(fmt::format("divergence_limit must be finite and > 0, got {}", divergence_limit));
-  if (std::uint32_t(stretch_limit.method) > std::uint32_t(StretchLimit::Method::both))
+  if (std::uint32_t(stretch_limit.method) > std::uint32_t(StretchLimit::Method::projection))
     return bad(fmt::format("stretch_limit.method: unknown method {}", std::uint32_t(stretch_limit.method)));
   if (!std::isfinite(stretch_limit.max_strain) || stretch_limit.max_strain <= 0.0)
     return bad(

@@ -63,6 +63,23 @@ void colour_strain_links(const ParticleSystem& system, std::vector<StrainLink>& 
       links[next[colour[s]]++] = StrainLink{springs[s].a, springs[s].b, springs[s].rest_length};
 }
 
+void link_incidence(std::size_t particles, const std::vector<StrainLink>& links,
+                    std::vector<std::uint32_t>& offsets, std::vector<std::uint32_t>& entries) {
+  offsets.assign(particles + 1, 0);
+  for (const StrainLink& l : links) {
+    ++offsets[l.a + 1];
+    ++offsets[l.b + 1];
+  }
+  for (std::size_t p = 0; p < particles; ++p)
+    offsets[p + 1] += offsets[p];
+  entries.resize(offsets.back());
+  std::vector<std::uint32_t> next(offsets.begin(), offsets.end() - 1);
+  for (std::uint32_t l = 0; l < links.size(); ++l) {
+    entries[next[links[l].a]++] = 2 * l;
+    entries[next[links[l].b]++] = 2 * l + 1;
+  }
+}
+
 std::vector<Tether> find_tethers(const ParticleSystem& system, bool geodesic) {
   // Dijkstra from every pinned particle at once, each particle keeping the first
   // tethers_per_particle distinct anchors that reach it: a (particle, anchor) pair is settled at

@@ -16,6 +16,11 @@ namespace vkcloth::detail {
 void colour_strain_links(const ParticleSystem& system, std::vector<StrainLink>& links,
                          std::vector<std::uint32_t>& offsets);
 
+/// Each of `particles` particles' links, in link order: offsets (particles + 1 entries) and
+/// entries 2 l + (1 when the particle is link l's end b).
+void link_incidence(std::size_t particles, const std::vector<StrainLink>& links,
+                    std::vector<std::uint32_t>& offsets, std::vector<std::uint32_t>& entries);
+
 /// tethers_per_particle slots per particle: the nearest pinned particles along the springs
 /// (structural, shear, chain) with euclidean or geodesic rest distances.
 std::vector<Tether> find_tethers(const ParticleSystem& system, bool geodesic);

@@ -327,6 +327,7 @@ Result<std::shared_ptr<const ClothTopology>> ClothTopology::create(const Particl
     t->fan_ends_[p] = e;
   }
   detail::colour_strain_links(s, t->strain_links_, t->strain_colour_offsets_);
+  detail::link_incidence(n, t->strain_links_, t->strain_incidence_offsets_, t->strain_incidence_);
   return std::shared_ptr<const ClothTopology>(std::move(t));
 }
 

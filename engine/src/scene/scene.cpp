@@ -105,7 +105,7 @@ Result<void> read_stretch_limit(const json& doc, SimParams& params) {
   const char* path = "stretch_limit";
   VKCLOTH_TRY(sd::check_keys(*obj, path, {"method", "max_strain", "iterations", "tether_distance"}));
   StretchLimit& sl = params.stretch_limit;
-  const char* methods = "\"tethers\", \"provot\", \"both\" or \"off\"";
+  const char* methods = "\"tethers\", \"provot\", \"both\", \"projection\" or \"off\"";
   if (!obj->contains("method"))
     return sd::shape_error(fmt::format("stretch_limit.method is required: {}", methods));
   VKCLOTH_TRY(read_choice(*obj, path, "method", parse_stretch_method, methods, sl.method));

@@ -7,6 +7,7 @@
 
 #include "implicit_shared.h"
 #include "self_collision_shared.h"
+#include "strain_projection_shared.h"
 #include "vkcloth/shaders/force_storage_comp_spv.hpp"
 #include "vkcloth/shaders/force_texel_comp_spv.hpp"
 #include "vkcloth/shaders/fused_storage_comp_spv.hpp"
@@ -19,6 +20,7 @@
 #include "vkcloth/shaders/strain_finish_texel_comp_spv.hpp"
 #include "vkcloth/shaders/strain_links_storage_comp_spv.hpp"
 #include "vkcloth/shaders/strain_links_texel_comp_spv.hpp"
+#include "vkcloth/shaders/strain_project_comp_spv.hpp"
 #include "vkcloth/shaders/vertices_comp_spv.hpp"
 #include "vkcloth_shared.h"
 
@@ -58,6 +60,8 @@ ShaderCode code_of(PipelineRegistry::Shader s, BufferAccess access) {
     return {spirv::vertices_comp_spv, "vertices.comp"};
   case S::self_collision:
     return {spirv::self_collision_comp_spv, "self_collision.comp"};
+  case S::strain_project:
+    return {spirv::strain_project_comp_spv, "strain_project.comp"};
   }
   return {{}, "?"};
 }
@@ -65,7 +69,7 @@ ShaderCode code_of(PipelineRegistry::Shader s, BufferAccess access) {
 /// Shaders compiled in one build only.
 bool single_build(PipelineRegistry::Shader s) {
   using S = PipelineRegistry::Shader;
-  return s == S::implicit || s == S::vertices || s == S::self_collision;
+  return s == S::implicit || s == S::vertices || s == S::self_collision || s == S::strain_project;
 }
 
 /// The storage bindings of implicit.comp (implicit_shared.h).
@@ -90,6 +94,13 @@ constexpr std::uint32_t kSelfCollisionBindings[] = {
     VKCLOTH_BINDING_SELF_BLOCKS, VKCLOTH_BINDING_SELF_KEYS,   VKCLOTH_BINDING_SELF_SORTED,
     VKCLOTH_BINDING_SELF_DELTA};
 
+/// The storage bindings of strain_project.comp (strain_projection_shared.h).
+constexpr std::uint32_t kStrainProjectBindings[] = {
+    VKCLOTH_BINDING_POS_OUT,        VKCLOTH_BINDING_VEL,        VKCLOTH_BINDING_PARTICLE,
+    VKCLOTH_BINDING_FLAGS,          VKCLOTH_BINDING_INSTANCES,  VKCLOTH_BINDING_STRAIN_LINKS,
+    VKCLOTH_BINDING_PROJ_INCIDENCE, VKCLOTH_BINDING_PROJ_LINKS, VKCLOTH_BINDING_PROJ_GATHER,
+    VKCLOTH_BINDING_PROJ_STATE};
+
 } // namespace
 
 std::span<const std::uint32_t> implicit_bindings() {
@@ -98,6 +109,10 @@ std::span<const std::uint32_t> implicit_bindings() {
 
 std::span<const std::uint32_t> self_collision_bindings() {
   return kSelfCollisionBindings;
+}
+
+std::span<const std::uint32_t> strain_project_bindings() {
+  return kStrainProjectBindings;
 }
 
 VkPipelineCache PipelineRegistry::cache() {
@@ -161,6 +176,12 @@ Result<PipelineRegistry::ImplicitLayouts> PipelineRegistry::self_collision_layou
   return single_set_layouts_locked(kSelfCollisionBindings, "self-collision", self_set_, self_layout_);
 }
 
+Result<PipelineRegistry::ImplicitLayouts> PipelineRegistry::strain_project_layouts() {
+  const std::lock_guard lock(mutex_);
+  return single_set_layouts_locked(kStrainProjectBindings, "strain projection", project_set_,
+                                   project_layout_);
+}
+
 Result<PipelineRegistry::ImplicitLayouts>
 PipelineRegistry::single_set_layouts_locked(std::span<const std::uint32_t> bindings, const char* name,
                                             DescriptorSetLayout& set, PipelineLayout& layout) {
@@ -191,25 +212,26 @@ Result<VkShaderModule> PipelineRegistry::module_locked(Shader shader, BufferAcce
 
 Result<VkPipeline> PipelineRegistry::pipeline(Shader shader, std::span<const std::uint32_t> constants,
                                               Variant variant) {
-  const bool implicit = shader == Shader::implicit, self = shader == Shader::self_collision;
+  const bool implicit = shader == Shader::implicit, self = shader == Shader::self_collision,
+             project = shader == Shader::strain_project;
   if (single_build(shader))
     variant.access = BufferAccess::texel_views; // one module, whatever was asked
   if (variant.access == BufferAccess::automatic)
     variant.access = device_layout(ctx_).access;
-  if (implicit || self || variant.workgroup_size == VKCLOTH_WORKGROUP_SIZE)
-    variant.workgroup_size =
-        0; // implicit.comp, self_collision.comp size shared arrays with the compiled size
+  if (implicit || self || project || variant.workgroup_size == VKCLOTH_WORKGROUP_SIZE)
+    variant.workgroup_size = 0; // implicit, self_collision, strain_project.comp size shared arrays with it
   const std::lock_guard lock(mutex_);
   std::tuple<Shader, Variant, std::vector<std::uint32_t>> key{
       shader, variant, {constants.begin(), constants.end()}};
   if (auto it = pipelines_.find(key); it != pipelines_.end())
     return it->second.get();
   VkPipelineLayout layout = VK_NULL_HANDLE;
-  if (implicit || self) {
+  if (implicit || self || project) {
     auto l =
-        implicit
-            ? single_set_layouts_locked(kImplicitBindings, "implicit", implicit_set_, implicit_layout_)
-            : single_set_layouts_locked(kSelfCollisionBindings, "self-collision", self_set_, self_layout_);
+        implicit ? single_set_layouts_locked(kImplicitBindings, "implicit", implicit_set_, implicit_layout_)
+        : self ? single_set_layouts_locked(kSelfCollisionBindings, "self-collision", self_set_, self_layout_)
+               : single_set_layouts_locked(kStrainProjectBindings, "strain projection", project_set_,
+                                           project_layout_);
     if (!l)
       return l.error();
     layout = l->layout;
@@ -250,6 +272,20 @@ Result<VkPipeline> PipelineRegistry::pipeline(Shader shader, std::span<const std
       ctx_.vk.vkCreateComputePipelines(ctx_.device, cache_locked(), 1, &ci, ctx_.vk.allocator, p.init(ctx_)),
       fmt::format("vkCreateComputePipelines ({})", name));
   return pipelines_.emplace(std::move(key), std::move(p)).first->second.get();
+}
+
+Result<OneSetPass> create_one_set_pass(Context::Impl& ctx, PipelineRegistry::Shader shader,
+                                       DescriptorPool& pool, VkDescriptorSet (&sets)[2], const char* name) {
+  const bool self = shader == PipelineRegistry::Shader::self_collision;
+  auto layouts = self ? ctx.pipelines->self_collision_layouts() : ctx.pipelines->strain_project_layouts();
+  if (!layouts)
+    return layouts.error();
+  const std::size_t bindings = self ? self_collision_bindings().size() : strain_project_bindings().size();
+  VKCLOTH_TRY(create_parity_sets(ctx, layouts->set, static_cast<std::uint32_t>(bindings), pool, sets, name));
+  auto pipeline = ctx.pipelines->pipeline(shader, {});
+  if (!pipeline)
+    return pipeline.error();
+  return OneSetPass{layouts->layout, *pipeline};
 }
 
 } // namespace vkcloth::gpu

@@ -24,6 +24,8 @@ namespace vkcloth::gpu {
 std::span<const std::uint32_t> implicit_bindings();
 /// The storage bindings of self_collision.comp, in descriptor-write order.
 std::span<const std::uint32_t> self_collision_bindings();
+/// The storage bindings of strain_project.comp, in descriptor-write order.
+std::span<const std::uint32_t> strain_project_bindings();
 
 /// choose_layout() for `ctx`'s device (layout.cpp).
 DeviceLayout device_layout(const Context::Impl& ctx);
@@ -51,7 +53,8 @@ public:
     strain_links,
     strain_finish,
     vertices,
-    self_collision
+    self_collision,
+    strain_project
   };
 
   /// Set 0 (storage buffers) and set 1 (texel views) of force/integrate/fused.comp and their
@@ -60,7 +63,7 @@ public:
     VkDescriptorSetLayout storage = VK_NULL_HANDLE, texel = VK_NULL_HANDLE;
     VkPipelineLayout layout = VK_NULL_HANDLE;
   };
-  /// The one set of implicit.comp (or self_collision.comp) and its layout.
+  /// The one set of implicit.comp (or self_collision.comp, strain_project.comp) and its layout.
   struct ImplicitLayouts {
     VkDescriptorSetLayout set = VK_NULL_HANDLE;
     VkPipelineLayout layout = VK_NULL_HANDLE;
@@ -75,10 +78,12 @@ public:
   Result<SolverLayouts> solver_layouts();
   Result<ImplicitLayouts> implicit_layouts();
   Result<ImplicitLayouts> self_collision_layouts();
+  Result<ImplicitLayouts> strain_project_layouts();
   using Variant = ShaderVariant;
   /// The pipeline of `shader` specialised with `constants` (ids 0..size-1, 32 bits each; empty:
   /// none) and, when `variant.workgroup_size` is set, constant kWorkgroupSizeConstant; created on
-  /// first request; its layout is solver_layouts(), implicit_layouts() or self_collision_layouts().
+  /// first request; its layout is solver_layouts(), implicit_layouts(), self_collision_layouts() or
+  /// strain_project_layouts().
   Result<VkPipeline> pipeline(Shader shader, std::span<const std::uint32_t> constants, Variant variant = {});
   /// The Context's pipeline cache (VK_NULL_HANDLE when it could not be made: caching is optional).
   VkPipelineCache cache();
@@ -100,10 +105,21 @@ private:
   std::mutex mutex_; // several solvers may be created on one Context from different threads
   PipelineCache cache_;
   bool cache_tried_ = false;
-  DescriptorSetLayout solver_storage_, solver_texel_, implicit_set_, self_set_;
-  PipelineLayout solver_layout_, implicit_layout_, self_layout_;
+  DescriptorSetLayout solver_storage_, solver_texel_, implicit_set_, self_set_, project_set_;
+  PipelineLayout solver_layout_, implicit_layout_, self_layout_, project_layout_;
   std::map<std::pair<Shader, BufferAccess>, ShaderModule> modules_;
   std::map<std::tuple<Shader, Variant, std::vector<std::uint32_t>>, Pipeline> pipelines_;
 };
+
+/// A pass with one set of storage buffers and its own layout (self_collision.comp,
+/// strain_project.comp): the Context's pipeline layout and pipeline.
+struct OneSetPass {
+  VkPipelineLayout layout = VK_NULL_HANDLE;
+  VkPipeline pipeline = VK_NULL_HANDLE;
+};
+/// `shader`'s (self_collision or strain_project) layout and pipeline from `ctx`'s registry, and
+/// `pool` with the two parity sets of its layout (create_parity_sets), named `name`.
+Result<OneSetPass> create_one_set_pass(Context::Impl& ctx, PipelineRegistry::Shader shader,
+                                       DescriptorPool& pool, VkDescriptorSet (&sets)[2], const char* name);
 
 } // namespace vkcloth::gpu

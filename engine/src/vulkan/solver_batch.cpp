@@ -244,6 +244,7 @@ std::vector<sh::InstanceParams> SolverBatch::packed_instance_params() const {
     const StretchLimit& sl = params.stretch_limit;
     ip.max_strain = float(sl.max_strain);
     ip.stretch = (sl.provot() ? VKCLOTH_STRETCH_PROVOT : 0u) | (sl.tethers() ? VKCLOTH_STRETCH_TETHERS : 0u) |
+                 (sl.projection() ? VKCLOTH_STRETCH_PROJECTION : 0u) |
                  (sl.tethers() && sl.tether_distance == StretchLimit::TetherDistance::geodesic
                       ? VKCLOTH_STRETCH_GEODESIC
                       : 0u);
@@ -382,6 +383,7 @@ Result<void> SolverBatch::set_params(std::uint32_t slot, SimParams params) {
     VKCLOTH_TRY(ensure_implicit());
     VKCLOTH_TRY(ensure_fused());
     VKCLOTH_TRY(ensure_self_collision());
+    VKCLOTH_TRY(ensure_projection());
     return ensure_tethers();
   }();
   if (!done) // e.g. no room for the tethers: the instance keeps stepping with its old parameters
@@ -481,6 +483,24 @@ Result<void> SolverBatch::ensure_self_collision() {
   std::memcpy(self_collision->params().mapped, sp.data(), sp.size() * sizeof(sh::SelfParams));
   // Only its own new sets: the main ones may be in use by recorded work (set_params).
   return self_collision->write_sets(self_collision_inputs());
+}
+
+// Made when an instance first asks for the fast projection: its buffers (each particle's links
+// uploaded) and its own descriptor sets, which nothing recorded so far uses.
+Result<void> SolverBatch::ensure_projection() {
+  if (projection || projection_iterations() == 0)
+    return {};
+  // Its largest buffer holds two vec4 per strain link of every instance.
+  VKCLOTH_TRY(check_buffer(*ctx, storage_limit(*ctx, knobs), "strain projection links",
+                           std::uint64_t(size()) * strain_link_count(), 32));
+  auto r = StrainProjectionGpu::create(ctx, *batch_topology, size(), !knobs.force_staging);
+  if (!r)
+    return r.error();
+  projection = std::move(*r);
+  const std::vector<std::uint32_t> incidence = StrainProjectionGpu::incidence_data(*batch_topology);
+  const Upload up[] = {{&projection->incidence(), incidence.data(), incidence.size() * 4}};
+  VKCLOTH_TRY(upload(up));
+  return projection->write_sets(projection_inputs());
 }
 
 std::vector<sh::SelfParams> SolverBatch::packed_self_params() const {
@@ -801,6 +821,7 @@ SolverBatch::create(const std::shared_ptr<Context::Impl>& ctx, CommandContext& c
   VKCLOTH_TRY(s.upload_initial_state(topology, states));
   VKCLOTH_TRY(s.ensure_tethers());
   VKCLOTH_TRY(s.ensure_self_collision());
+  VKCLOTH_TRY(s.ensure_projection());
   return impl;
 }
 

@@ -23,6 +23,7 @@
 
 #include "implicit_gpu.hpp"
 #include "self_collision_gpu.hpp"
+#include "strain_projection_gpu.hpp"
 #include "resources.hpp"
 #include "vkcloth/gpu/gpu_solver.hpp"
 #include "vkcloth/gpu/testing.hpp"
@@ -211,6 +212,7 @@ private:
   std::uint32_t parity = 0;              // positions[parity] is current; flipped by every recorded substep
   std::unique_ptr<ImplicitGpu> implicit; // created when the integrator is implicit_euler (batch of one)
   std::unique_ptr<SelfCollisionGpu> self_collision; // created when an instance first turns it on
+  std::unique_ptr<StrainProjectionGpu> projection;  // created when an instance first asks for it
   std::vector<glm::vec2> uvs_;                      // per particle of one instance (as uploaded)
   std::uint64_t dispatches_ = 0;                    // recorded so far (ClothWorld::dispatches_recorded)
 
@@ -220,6 +222,14 @@ private:
       if (s.params.stretch_limit.enabled())
         return true;
     return false;
+  }
+  /// The most Newton iterations of the fast projection an instance asks for (0: none uses it).
+  std::uint32_t projection_iterations() const {
+    std::uint32_t most = 0;
+    for (const Slot& s : slots)
+      if (s.params.stretch_limit.projection())
+        most = std::max(most, s.params.stretch_limit.iterations);
+    return most;
   }
   /// The most self-collision passes an instance asks for (0: none has it on).
   std::uint32_t self_iterations() const {
@@ -268,6 +278,7 @@ private:
   Result<void> ensure_fused();
   Result<void> ensure_tethers();
   Result<void> ensure_self_collision();
+  Result<void> ensure_projection();
   /// The interleaved vertex pass at the end of a recording (vertices.comp).
   void record_vertices(VkCommandBuffer cmd);
   /// Stretch control after a substep's update (strain_links.comp sweeps, strain_finish.comp).
@@ -285,6 +296,14 @@ private:
   std::vector<shared::SelfParams> packed_self_params() const;
   SelfCollisionInputs self_collision_inputs() const {
     return {{pos[0].buffer, pos[1].buffer}, vel.buffer, particle.buffer, flags.buffer, instances.buffer};
+  }
+  StrainProjectionInputs projection_inputs() const {
+    return {{pos[0].buffer, pos[1].buffer},
+            vel.buffer,
+            particle.buffer,
+            flags.buffer,
+            instances.buffer,
+            strain_links.buffer};
   }
   void write_params_now();
   void record_params_update(VkCommandBuffer cmd);

@@ -128,7 +128,8 @@ void SolverBatch::record_finish_pass(VkCommandBuffer c, std::uint32_t read, std:
 }
 
 // The tethers per particle, Provot's sweeps (one dispatch per colour: its links share no
-// particle), then the projection per particle; each pass after a barrier. Instances with fewer
+// particle) or the fast projection (strain_project.comp), then the colliders' projection per
+// particle; each pass after a barrier. Instances with fewer
 // sweeps, without tethers, colliders or stretch control skip what they do not need
 // (strain_finish.comp, strain_links.comp).
 void SolverBatch::record_stretch(VkCommandBuffer c, std::uint32_t read) {
@@ -161,6 +162,8 @@ void SolverBatch::record_stretch(VkCommandBuffer c, std::uint32_t read) {
       v.vkCmdDispatch(c, gx, gy, size());
       ++dispatches_;
     }
+  if (const std::uint32_t newton = projection_iterations())
+    dispatches_ += projection->record_substep(c, read, pc, newton);
   if (any_colliders())
     record_finish_pass(c, read, 1);
 }

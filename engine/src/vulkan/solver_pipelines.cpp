@@ -305,6 +305,8 @@ Result<void> SolverBatch::write_sets() {
                               nullptr);
   if (self_collision)
     VKCLOTH_TRY(self_collision->write_sets(self_collision_inputs()));
+  if (projection)
+    VKCLOTH_TRY(projection->write_sets(projection_inputs()));
   if (implicit)
     return implicit->write_sets({{pos[0].buffer, pos[1].buffer},
                                  vel.buffer,

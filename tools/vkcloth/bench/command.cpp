@@ -424,9 +424,9 @@ void add_bench_command(CLI::App& app, int* exit) {
       ->check(CLI::ExistingFile);
   cmd->add_option(
          "--stretch", opt->stretch,
-         "Also time each grid with stretch control (tethers, provot or both; max_strain 0.1, 4 sweeps) "
-         "against the plain step")
-      ->check(CLI::IsMember({"tethers", "provot", "both"}));
+         "Also time each grid with stretch control (tethers, provot, both or projection; max_strain 0.1, 4 "
+         "sweeps or Newton iterations) against the plain step")
+      ->check(CLI::IsMember({"tethers", "provot", "both", "projection"}));
   cmd->add_option(
          "--contact", opt->contact,
          "Also time the contact scenes (issue 15): a 256 x 256 cloth on a table (box on a floor plane), "

@@ -1,0 +1,131 @@
+// SPDX-License-Identifier: MIT
+#include "strain_projection_gpu.hpp"
+
+#include <algorithm>
+#include <tuple>
+
+#include <fmt/format.h>
+
+#include "../core/kernel.hpp"
+#include "barriers.hpp"
+#include "pipelines.hpp"
+
+namespace vkcloth::gpu {
+
+namespace sh = shared;
+
+Result<std::unique_ptr<StrainProjectionGpu>> StrainProjectionGpu::create(const std::shared_ptr<Context::Impl>& ctx,
+                                                                         const ClothTopology& topology,
+                                                                         std::uint32_t instances, bool allow_map) {
+  std::unique_ptr<StrainProjectionGpu> s(new StrainProjectionGpu());
+  s->ctx_ = ctx;
+  s->count_ = static_cast<std::uint32_t>(topology.size());
+  s->links_ = static_cast<std::uint32_t>(topology.strain_links().size());
+  s->instances_ = instances;
+  s->cg_cap_ = kernel::projection_cg_cap(s->links_);
+  // The most loop iterations one phase costs an invocation (strain_project.comp): a pass over the
+  // links plus a reduction tree, or a pass over the particles walking their links.
+  const auto offsets = topology.strain_incidence_offsets();
+  std::uint32_t degree = 0;
+  for (std::size_t p = 0; p + 1 < offsets.size(); ++p)
+    degree = std::max(degree, offsets[p + 1] - offsets[p]);
+  const std::uint32_t W = VKCLOTH_WORKGROUP_SIZE;
+  const std::uint64_t link_phase = (s->links_ + W - 1) / W + 8, particle_phase = std::uint64_t((s->count_ + W - 1) / W) * (1 + degree);
+  const std::uint64_t phase = std::max(link_phase, particle_phase) + 1; // + the phase loop's own
+  if (phase > VKCLOTH_PROJ_LOOP_BUDGET)
+    return make_error(ErrorCode::unsupported,
+                      fmt::format("stretch_limit.method projection: {} strain links over {} particles are too many "
+                                  "for the one workgroup that projects a cloth on Vulkan; use method both",
+                                  s->links_, s->count_));
+  s->phases_per_dispatch_ = static_cast<std::uint32_t>(VKCLOTH_PROJ_LOOP_BUDGET / phase);
+  VKCLOTH_TRY(s->create_buffers(offsets.size() + topology.strain_incidence().size(), allow_map));
+  VKCLOTH_TRY(s->create_sets());
+  return s;
+}
+
+std::vector<std::uint32_t> StrainProjectionGpu::incidence_data(const ClothTopology& topology) {
+  std::vector<std::uint32_t> out(topology.strain_incidence_offsets().begin(),
+                                 topology.strain_incidence_offsets().end());
+  out.insert(out.end(), topology.strain_incidence().begin(), topology.strain_incidence().end());
+  return out;
+}
+
+Result<void> StrainProjectionGpu::create_buffers(std::uint64_t incidence_words, bool allow_map) {
+  const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  const std::tuple<Buffer*, VkDeviceSize, const char*> buffers[] = {
+      {&incidence_, incidence_words * 4, "strain projection: each particle's links"},
+      {&link_state_, VkDeviceSize(instances_) * links_ * 32, "strain projection: link state"},
+      {&gathered_, VkDeviceSize(instances_) * count_ * 16, "strain projection: gathers"},
+      {&state_, VkDeviceSize(instances_) * sizeof(sh::ProjState), "strain projection: state"}};
+  for (auto [b, bytes, what] : buffers) {
+    auto r = create_buffer(*ctx_, std::max<VkDeviceSize>(bytes, 16), usage, MemoryUse::device, allow_map, what);
+    if (!r)
+      return r.error();
+    *b = std::move(*r);
+  }
+  return {};
+}
+
+// The Context's layout and pipeline; this batch's pool and two sets (position parity).
+Result<void> StrainProjectionGpu::create_sets() {
+  auto pass = create_one_set_pass(*ctx_, PipelineRegistry::Shader::strain_project, pool_, sets_, "strain projection");
+  if (!pass)
+    return pass.error();
+  layout_ = pass->layout;
+  pass_ = pass->pipeline;
+  return {};
+}
+
+Result<void> StrainProjectionGpu::write_sets(const StrainProjectionInputs& in) {
+  write_parity_sets(*ctx_, sets_, strain_project_bindings(),
+                    [&](std::uint32_t read, std::uint32_t binding) -> VkBuffer {
+                      switch (binding) {
+                      case VKCLOTH_BINDING_POS_OUT:
+                        return in.pos[read ^ 1u]; // the positions this substep writes
+                      case VKCLOTH_BINDING_VEL:
+                        return in.vel;
+                      case VKCLOTH_BINDING_PARTICLE:
+                        return in.particle;
+                      case VKCLOTH_BINDING_FLAGS:
+                        return in.flags;
+                      case VKCLOTH_BINDING_INSTANCES:
+                        return in.instances;
+                      case VKCLOTH_BINDING_STRAIN_LINKS:
+                        return in.strain_links;
+                      case VKCLOTH_BINDING_PROJ_INCIDENCE:
+                        return incidence_.buffer;
+                      case VKCLOTH_BINDING_PROJ_LINKS:
+                        return link_state_.buffer;
+                      case VKCLOTH_BINDING_PROJ_GATHER:
+                        return gathered_.buffer;
+                      case VKCLOTH_BINDING_PROJ_STATE:
+                        return state_.buffer;
+                      default:
+                        return VK_NULL_HANDLE;
+                      }
+                    });
+  return {};
+}
+
+std::uint32_t StrainProjectionGpu::record_substep(VkCommandBuffer c, std::uint32_t read, sh::PushConstants pc,
+                                                  std::uint32_t newton) {
+  const auto& v = ctx_->vk;
+  v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &sets_[read], 0, nullptr);
+  v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, pass_);
+  pc.pad0 = links_;
+  pc.pad1 = cg_cap_;
+  pc.nx = phases_per_dispatch_;
+  // The worst case: every Newton iteration runs LINKS, cg_cap x (GATHER, MATVEC, UPDATE,
+  // DIRECTION) and APPLY.
+  const std::uint64_t phases = std::uint64_t(newton) * (2 + 4ull * cg_cap_);
+  const auto dispatches = static_cast<std::uint32_t>((phases + phases_per_dispatch_ - 1) / phases_per_dispatch_);
+  for (std::uint32_t k = 0; k < dispatches; ++k) {
+    pc.stage = k;
+    v.vkCmdPushConstants(c, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
+    barriers::dispatch_to_dispatch(v, c); // the tethers (or the last dispatch) -> this one
+    v.vkCmdDispatch(c, 1, 1, instances_);
+  }
+  return dispatches;
+}
+
+} // namespace vkcloth::gpu

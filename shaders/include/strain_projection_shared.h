@@ -1,0 +1,51 @@
+// SPDX-License-Identifier: MIT
+// Declarations shared by strain_project.comp and the C++ side (engine/src/vulkan/
+// strain_projection_gpu.cpp). The fast projection's pass uses its own descriptor set layout: the
+// main layout's bindings it needs (same numbers, same buffers, vkcloth_shared.h) plus its own
+// below. Push constants: the main PushConstants; `stage` the dispatch within the substep (0 starts
+// the projection over), `pad0` the strain links, `pad1` the most CG iterations of one solve
+// (kernel.hpp projection_cg_cap), `nx` the phases one dispatch may run (its loop budget).
+#ifndef VKCLOTH_STRAIN_PROJECTION_SHARED_H
+#define VKCLOTH_STRAIN_PROJECTION_SHARED_H
+
+#include "self_collision_shared.h"
+
+#ifdef __cplusplus
+namespace vkcloth::gpu::shared {
+#endif
+
+#define VKCLOTH_BINDING_PROJ_INCIDENCE 43 // uint: the topology's strain_incidence_offsets, then its strain_incidence
+#define VKCLOTH_BINDING_PROJ_LINKS 44     // 2 vec4 per link per instance: (g, 1 / A_ll), (lambda, r, d, q)
+#define VKCLOTH_BINDING_PROJ_GATHER 45    // vec4 per particle per instance: grad C^T of d or lambda
+#define VKCLOTH_BINDING_PROJ_STATE 46     // ProjState per instance
+
+// The phases of one Newton iteration (ProjState::phase), as CpuSolver::project_strain runs them.
+#define VKCLOTH_PROJ_LINKS 0u     // per link: C, g, in the solve, r = d = rhs; sums r.z, r.r; max C
+#define VKCLOTH_PROJ_GATHER 1u    // per particle: grad C^T d
+#define VKCLOTH_PROJ_MATVEC 2u    // per link: q = A d; sum d.q -> alpha
+#define VKCLOTH_PROJ_UPDATE 3u    // per link: lambda += alpha d, r -= alpha q; sums -> beta
+#define VKCLOTH_PROJ_DIRECTION 4u // per link: d = z + beta d
+#define VKCLOTH_PROJ_APPLY 5u     // per particle: x -= W grad C^T lambda (v follows)
+#define VKCLOTH_PROJ_DONE 6u      // this substep's projection is over
+
+// llvmpipe stops every loop of an invocation after 65 535 iterations in all (silently); one
+// dispatch runs as many phases as keep each invocation under this many (pc.nx).
+#define VKCLOTH_PROJ_LOOP_BUDGET 30000u
+
+/// Where one instance's projection stands between dispatches (std430: 48 bytes).
+struct ProjState {
+  uint phase;  // VKCLOTH_PROJ_*
+  uint newton; // Newton iterations done
+  uint cg;     // CG iterations of this solve done
+  uint pad;
+  float rz, rr, stop, alpha; // r.z, r.r, the solve's |r|^2 target, the step
+  float beta, pad1, pad2, pad3;
+};
+
+#ifdef __cplusplus
+static_assert(VKCLOTH_BINDING_PROJ_INCIDENCE == VKCLOTH_BINDING_SELF_DELTA + 1);
+static_assert(sizeof(ProjState) == 48);
+} // namespace vkcloth::gpu::shared
+#endif
+
+#endif // VKCLOTH_STRAIN_PROJECTION_SHARED_H
