@@ -55,18 +55,12 @@ Result<void> SelfCollisionGpu::create_buffers(bool allow_map) {
 
 // The Context's layout and pipeline; this batch's pool and two sets (position parity).
 Result<void> SelfCollisionGpu::create_sets() {
-  Context::Impl& ctx = *ctx_;
-  auto layouts = ctx.pipelines->self_collision_layouts();
-  if (!layouts)
-    return layouts.error();
-  layout_ = layouts->layout;
-  VKCLOTH_TRY(create_parity_sets(ctx, layouts->set,
-                                 static_cast<std::uint32_t>(self_collision_bindings().size()), pool_, sets_,
-                                 "self-collision"));
-  auto pp = ctx.pipelines->pipeline(PipelineRegistry::Shader::self_collision, {});
-  if (!pp)
-    return pp.error();
-  pass_ = *pp;
+  auto pass =
+      create_one_set_pass(*ctx_, PipelineRegistry::Shader::self_collision, pool_, sets_, "self-collision");
+  if (!pass)
+    return pass.error();
+  layout_ = pass->layout;
+  pass_ = pass->pipeline;
   return {};
 }
 
