@@ -9,7 +9,8 @@
 // fixed-shape trees in shared memory (deterministic; not the CPU's sequential sums, hence equal to
 // the CPU to rounding). llvmpipe caps an invocation's loop iterations, so one dispatch runs at most
 // pc.nx phases and leaves the rest to the next dispatch, its state in ProjState; the host records
-// enough dispatches for the worst case, and those after the end return at once.
+// enough indirect dispatches for the worst case, and the last instance to finish sets their group
+// count to zero (ProjArgsHead), so that the dispatches left are empty.
 #include "vkcloth_shared.h"
 #include "strain_projection_shared.h"
 #include "common.glsl"
@@ -21,6 +22,10 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_PROJ_INCIDENCE) readonly buffe
 layout(std430, set = 0, binding = VKCLOTH_BINDING_PROJ_LINKS) coherent buffer LinkState { vec4 link_state[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_PROJ_GATHER) coherent buffer GatherBuf { vec4 gathered[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_PROJ_STATE) buffer StateBuf { ProjState state[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_PROJ_ARGS) buffer ArgBuf {
+  ProjArgsHead args;
+  uint counted[]; // per instance: 1 once it added itself to args.finished this substep
+};
 
 shared vec4 red[VKCLOTH_WORKGROUP_SIZE];
 
@@ -66,10 +71,23 @@ vec3 gather_at(uint p, uint which) {
   return u;
 }
 
+// Once per substep, an instance that is done (or has no projection to run) counts itself; the
+// last one empties the substep's remaining dispatches.
+void count_finished() {
+  if (counted[inst] != 0u)
+    return;
+  counted[inst] = 1u;
+  if (atomicAdd(args.finished, 1u) + 1u == gl_NumWorkGroups.z)
+    args.x = 0u;
+}
+
 void main() {
   begin_instance();
-  if ((ip.stretch & VKCLOTH_STRETCH_PROJECTION) == 0u || frozen())
+  if ((ip.stretch & VKCLOTH_STRETCH_PROJECTION) == 0u || frozen()) {
+    if (gl_LocalInvocationID.x == 0u)
+      count_finished();
     return;
+  }
   const uint l = gl_LocalInvocationID.x, W = VKCLOTH_WORKGROUP_SIZE;
   const uint m = pc.pad0, n = pc.count;
   ProjState st = state[inst];
@@ -171,6 +189,9 @@ void main() {
     }
     end_phase();
   }
-  if (l == 0u)
+  if (l == 0u) {
     state[inst] = st;
+    if (st.phase == VKCLOTH_PROJ_DONE)
+      count_finished();
+  }
 }

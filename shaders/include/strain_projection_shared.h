@@ -14,10 +14,12 @@
 namespace vkcloth::gpu::shared {
 #endif
 
-#define VKCLOTH_BINDING_PROJ_INCIDENCE 43 // uint: the topology's strain_incidence_offsets, then its strain_incidence
-#define VKCLOTH_BINDING_PROJ_LINKS 44     // 2 vec4 per link per instance: (g, 1 / A_ll), (lambda, r, d, q)
-#define VKCLOTH_BINDING_PROJ_GATHER 45    // vec4 per particle per instance: grad C^T of d or lambda
-#define VKCLOTH_BINDING_PROJ_STATE 46     // ProjState per instance
+#define VKCLOTH_BINDING_PROJ_INCIDENCE                                                                       \
+  43 // uint: the topology's strain_incidence_offsets, then its strain_incidence
+#define VKCLOTH_BINDING_PROJ_LINKS 44  // 2 vec4 per link per instance: (g, 1 / A_ll), (lambda, r, d, q)
+#define VKCLOTH_BINDING_PROJ_GATHER 45 // vec4 per particle per instance: grad C^T of d or lambda
+#define VKCLOTH_BINDING_PROJ_STATE 46  // ProjState per instance
+#define VKCLOTH_BINDING_PROJ_ARGS 47   // ProjArgs: the dispatches' indirect arguments, reset every substep
 
 // The phases of one Newton iteration (ProjState::phase), as CpuSolver::project_strain runs them.
 #define VKCLOTH_PROJ_LINKS 0u     // per link: C, g, in the solve, r = d = rhs; sums r.z, r.r; max C
@@ -42,9 +44,18 @@ struct ProjState {
   float beta, pad1, pad2, pad3;
 };
 
+/// The indirect arguments of the substep's dispatches (x, y, z: 1, 1, instances, written by the host
+/// before the first) and which instances are done: the last to finish sets x = 0, so that the
+/// dispatches left are empty (std430: 16 bytes, then one uint per instance).
+struct ProjArgsHead {
+  uint x, y, z;
+  uint finished; // instances done (or without the projection) this substep
+};
+
 #ifdef __cplusplus
 static_assert(VKCLOTH_BINDING_PROJ_INCIDENCE == VKCLOTH_BINDING_SELF_DELTA + 1);
 static_assert(sizeof(ProjState) == 48);
+static_assert(sizeof(ProjArgsHead) == 16);
 } // namespace vkcloth::gpu::shared
 #endif
 

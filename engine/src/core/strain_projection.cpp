@@ -80,9 +80,8 @@ template <typename Real> void CpuSolver<Real>::project_strain(const Real h) {
       w.c[i] = c;
     });
     const Real worst = m ? *std::max_element(w.c.begin(), w.c.end()) : Real(-1);
-    auto [rz, rr] = workgroup_sums<Real>(m, [&](std::size_t i) {
-      return std::pair<Real, Real>(w.r[i] * w.z[i], w.r[i] * w.r[i]);
-    });
+    auto [rz, rr] = workgroup_sums<Real>(
+        m, [&](std::size_t i) { return std::pair<Real, Real>(w.r[i] * w.z[i], w.r[i] * w.r[i]); });
     if (!(worst > c_tolerance))
       break; // every link within the tolerance (or no link at all)
     const Real stop = Real(VKCLOTH_PROJECTION_CG_TOL2) * rr;
@@ -102,9 +101,8 @@ template <typename Real> void CpuSolver<Real>::project_strain(const Real h) {
       pool_->for_each(m, [&](std::size_t i) { // UPDATE
         w.z[i] = kernel::projection_cg_update(w.lambda[i], w.r[i], w.d[i], w.q[i], alpha, w.inv_diag[i]);
       });
-      const auto [rz_next, rr_next] = workgroup_sums<Real>(m, [&](std::size_t i) {
-        return std::pair<Real, Real>(w.r[i] * w.z[i], w.r[i] * w.r[i]);
-      });
+      const auto [rz_next, rr_next] = workgroup_sums<Real>(
+          m, [&](std::size_t i) { return std::pair<Real, Real>(w.r[i] * w.z[i], w.r[i] * w.r[i]); });
       const Real beta = rz_next / rz;
       rr = rr_next;
       rz = rz_next;

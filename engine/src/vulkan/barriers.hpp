@@ -131,6 +131,15 @@ inline void implicit_pass(const VolkDeviceTable& vk, VkCommandBuffer cmd) {
          VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
 }
 
+/// After the host resets the strain projection's indirect arguments (vkCmdUpdateBuffer, after
+/// before_host_edit): the transfer writes are visible to the indirect dispatches' argument reads
+/// and to the shader, which reads and rewrites them.
+inline void host_edit_to_indirect(const VolkDeviceTable& vk, VkCommandBuffer cmd) {
+  memory(vk, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+         VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+         VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+}
+
 } // namespace vkcloth::gpu::barriers
 
 namespace vkcloth::gpu::barriers {

@@ -14,9 +14,9 @@ namespace vkcloth::gpu {
 
 namespace sh = shared;
 
-Result<std::unique_ptr<StrainProjectionGpu>> StrainProjectionGpu::create(const std::shared_ptr<Context::Impl>& ctx,
-                                                                         const ClothTopology& topology,
-                                                                         std::uint32_t instances, bool allow_map) {
+Result<std::unique_ptr<StrainProjectionGpu>>
+StrainProjectionGpu::create(const std::shared_ptr<Context::Impl>& ctx, const ClothTopology& topology,
+                            std::uint32_t instances, bool allow_map) {
   std::unique_ptr<StrainProjectionGpu> s(new StrainProjectionGpu());
   s->ctx_ = ctx;
   s->count_ = static_cast<std::uint32_t>(topology.size());
@@ -30,14 +30,22 @@ Result<std::unique_ptr<StrainProjectionGpu>> StrainProjectionGpu::create(const s
   for (std::size_t p = 0; p + 1 < offsets.size(); ++p)
     degree = std::max(degree, offsets[p + 1] - offsets[p]);
   const std::uint32_t W = VKCLOTH_WORKGROUP_SIZE;
-  const std::uint64_t link_phase = (s->links_ + W - 1) / W + 8, particle_phase = std::uint64_t((s->count_ + W - 1) / W) * (1 + degree);
+  const std::uint64_t link_phase = (s->links_ + W - 1) / W + 8,
+                      particle_phase = std::uint64_t((s->count_ + W - 1) / W) * (1 + degree);
   const std::uint64_t phase = std::max(link_phase, particle_phase) + 1; // + the phase loop's own
   if (phase > VKCLOTH_PROJ_LOOP_BUDGET)
-    return make_error(ErrorCode::unsupported,
-                      fmt::format("stretch_limit.method projection: {} strain links over {} particles are too many "
-                                  "for the one workgroup that projects a cloth on Vulkan; use method both",
-                                  s->links_, s->count_));
+    return make_error(
+        ErrorCode::unsupported,
+        fmt::format("stretch_limit.method projection: {} strain links over {} particles are too many "
+                    "for the one workgroup that projects a cloth on Vulkan; use method both",
+                    s->links_, s->count_));
   s->phases_per_dispatch_ = static_cast<std::uint32_t>(VKCLOTH_PROJ_LOOP_BUDGET / phase);
+  if ((4 + std::uint64_t(instances)) * 4 > 65536) // the arguments' reset is one vkCmdUpdateBuffer
+    return make_error(
+        ErrorCode::unsupported,
+        fmt::format("stretch_limit.method projection: {} instances of one topology in one batch are "
+                    "more than the 16 380 it takes; use method both",
+                    instances));
   VKCLOTH_TRY(s->create_buffers(offsets.size() + topology.strain_incidence().size(), allow_map));
   VKCLOTH_TRY(s->create_sets());
   return s;
@@ -58,17 +66,27 @@ Result<void> StrainProjectionGpu::create_buffers(std::uint64_t incidence_words, 
       {&gathered_, VkDeviceSize(instances_) * count_ * 16, "strain projection: gathers"},
       {&state_, VkDeviceSize(instances_) * sizeof(sh::ProjState), "strain projection: state"}};
   for (auto [b, bytes, what] : buffers) {
-    auto r = create_buffer(*ctx_, std::max<VkDeviceSize>(bytes, 16), usage, MemoryUse::device, allow_map, what);
+    auto r =
+        create_buffer(*ctx_, std::max<VkDeviceSize>(bytes, 16), usage, MemoryUse::device, allow_map, what);
     if (!r)
       return r.error();
     *b = std::move(*r);
   }
+  args_reset_.assign(4 + std::size_t(instances_), 0u);
+  args_reset_[0] = args_reset_[1] = 1u;
+  args_reset_[2] = instances_;
+  auto a = create_buffer(*ctx_, args_reset_.size() * 4, usage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT,
+                         MemoryUse::device, allow_map, "strain projection: indirect arguments");
+  if (!a)
+    return a.error();
+  args_ = std::move(*a);
   return {};
 }
 
 // The Context's layout and pipeline; this batch's pool and two sets (position parity).
 Result<void> StrainProjectionGpu::create_sets() {
-  auto pass = create_one_set_pass(*ctx_, PipelineRegistry::Shader::strain_project, pool_, sets_, "strain projection");
+  auto pass =
+      create_one_set_pass(*ctx_, PipelineRegistry::Shader::strain_project, pool_, sets_, "strain projection");
   if (!pass)
     return pass.error();
   layout_ = pass->layout;
@@ -100,6 +118,8 @@ Result<void> StrainProjectionGpu::write_sets(const StrainProjectionInputs& in) {
                         return gathered_.buffer;
                       case VKCLOTH_BINDING_PROJ_STATE:
                         return state_.buffer;
+                      case VKCLOTH_BINDING_PROJ_ARGS:
+                        return args_.buffer;
                       default:
                         return VK_NULL_HANDLE;
                       }
@@ -118,12 +138,16 @@ std::uint32_t StrainProjectionGpu::record_substep(VkCommandBuffer c, std::uint32
   // The worst case: every Newton iteration runs LINKS, cg_cap x (GATHER, MATVEC, UPDATE,
   // DIRECTION) and APPLY.
   const std::uint64_t phases = std::uint64_t(newton) * (2 + 4ull * cg_cap_);
-  const auto dispatches = static_cast<std::uint32_t>((phases + phases_per_dispatch_ - 1) / phases_per_dispatch_);
+  const auto dispatches =
+      static_cast<std::uint32_t>((phases + phases_per_dispatch_ - 1) / phases_per_dispatch_);
+  barriers::before_host_edit(v, c); // the last substep's dispatches read and wrote the arguments
+  v.vkCmdUpdateBuffer(c, args_.buffer, 0, args_reset_.size() * 4, args_reset_.data());
+  barriers::host_edit_to_indirect(v, c);
   for (std::uint32_t k = 0; k < dispatches; ++k) {
     pc.stage = k;
     v.vkCmdPushConstants(c, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
-    barriers::dispatch_to_dispatch(v, c); // the tethers (or the last dispatch) -> this one
-    v.vkCmdDispatch(c, 1, 1, instances_);
+    barriers::implicit_pass(v, c); // the tethers (or the last dispatch) -> this one, its arguments too
+    v.vkCmdDispatchIndirect(c, args_.buffer, 0);
   }
   return dispatches;
 }

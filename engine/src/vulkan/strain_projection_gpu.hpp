@@ -3,13 +3,15 @@
 // as strain_project.comp, recorded after the tethers of a substep's stretch control. One workgroup
 // per instance runs the whole projection (Newton iterations of a CG over the links); llvmpipe's cap
 // on an invocation's loop iterations splits it into dispatches of at most `phases per dispatch`
-// phases each, one barrier between them (barriers::dispatch_to_dispatch), enough of them for the
-// worst case (every Newton iteration, every CG iteration); those after the end return at once.
+// phases each, one barrier between them (barriers::implicit_pass), enough of them for the worst case
+// (every Newton iteration, every CG iteration): indirect dispatches, whose group count the last
+// instance to finish sets to zero (ProjArgsHead, reset by the host before the substep's first).
 #pragma once
 
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <vector>
 
 #include "resources.hpp"
 #include "strain_projection_shared.h"
@@ -46,7 +48,8 @@ private:
   StrainProjectionGpu() = default;
   std::shared_ptr<Context::Impl> ctx_;
   std::uint32_t count_ = 0, links_ = 0, instances_ = 0, cg_cap_ = 0, phases_per_dispatch_ = 1;
-  Buffer incidence_, link_state_, gathered_, state_;
+  Buffer incidence_, link_state_, gathered_, state_, args_;
+  std::vector<std::uint32_t> args_reset_; // ProjArgsHead (1, 1, instances, 0), then no instance counted
   DescriptorPool pool_;
   VkDescriptorSet sets_[2] = {};
   VkPipelineLayout layout_ = VK_NULL_HANDLE; // the Context's (PipelineRegistry)
