@@ -6,8 +6,8 @@
 // instance runs the whole projection: Newton iterations, each a Jacobi-preconditioned CG over the
 // links in the solve, in the phases of strain_projection_shared.h, with workgroup barriers between
 // them (every phase reads what other invocations wrote in the last one), and its dot products as
-// fixed-shape trees in shared memory (deterministic; not the CPU's sequential sums, hence equal to
-// the CPU to rounding). llvmpipe caps an invocation's loop iterations, so one dispatch runs at most
+// fixed-shape trees in shared memory, which the CPU sums in the same order (workgroup_sums): the
+// same bits on lavapipe. llvmpipe caps an invocation's loop iterations, so one dispatch runs at most
 // pc.nx phases and leaves the rest to the next dispatch, its state in ProjState; the host records
 // enough indirect dispatches for the worst case, and the last instance to finish sets their group
 // count to zero (ProjArgsHead), so that the dispatches left are empty.

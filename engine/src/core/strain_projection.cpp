@@ -42,20 +42,19 @@ template <typename Real> void CpuSolver<Real>::project_strain(const Real h) {
   const std::span<const std::uint32_t> offsets = topology_->strain_incidence_offsets();
   const std::span<const std::uint32_t> incidence = topology_->strain_incidence();
   const std::size_t n = pos_.size(), m = links.size();
-  const Real max_strain = Real(sl.max_strain);
+  const Real max_strain = Real(sl.max_strain); // set_params may change it: the bounds are not kept
   if (!projection_) {
     projection_ = std::make_unique<detail::StrainProjection<Real>>();
     auto& w = *projection_;
-    for (std::size_t p = 0; p < n; ++p)
-      w.inv_mass.push_back(kernel::inverse_mass(mass_[p], pinned_[p] != 0));
-    for (const StrainLink& l : links)
-      w.bound.push_back(kernel::stretch_bound(Real(l.rest_length), max_strain));
     w.g.resize(m);
     for (auto* v : {&w.c, &w.inv_diag, &w.lambda, &w.r, &w.d, &w.q, &w.z})
       v->assign(m, Real(0));
     w.u.resize(n);
+    w.inv_mass.resize(n);
   }
   auto& w = *projection_;
+  for (std::size_t p = 0; p < n; ++p) // as the GPU computes them (cloth_kernel.h inverse_mass)
+    w.inv_mass[p] = kernel::inverse_mass(mass_[p], pinned_[p] != 0);
   const Real c_tolerance = kernel::projection_c_tolerance(max_strain);
   const std::uint32_t cg_cap = kernel::projection_cg_cap(m);
   // GATHER: each particle's grad C^T s over its links, s = d (the CG) or lambda (APPLY).
@@ -71,7 +70,8 @@ template <typename Real> void CpuSolver<Real>::project_strain(const Real h) {
     // LINKS: each link's constraint, whether it is in the solve, and the CG's start (lambda = 0).
     pool_->for_each(m, [&](std::size_t i) {
       const StrainLink& l = links[i];
-      const Real c = kernel::projection_constraint(pos_[l.a], pos_[l.b], w.bound[i], w.g[i]);
+      const Real bound = kernel::stretch_bound(Real(l.rest_length), max_strain);
+      const Real c = kernel::projection_constraint(pos_[l.a], pos_[l.b], bound, w.g[i]);
       const bool kept = newton > 0 && w.lambda[i] > Real(0);
       w.inv_diag[i] = kernel::projection_inv_diag(c, kept, w.g[i], w.inv_mass[l.a], w.inv_mass[l.b]);
       w.r[i] = kernel::projection_rhs(c, w.inv_diag[i]);
