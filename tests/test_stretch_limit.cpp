@@ -111,20 +111,63 @@ TEST_CASE("tethers: the pinned particles nearest along the cloth, euclidean and 
 
 TEST_CASE("stretch control leaves the velocity of the move: x1 - x0 = dt v1 (semi-implicit Euler)") {
   const ParticleSystem s = hanging(12);
-  const SimParams p = limited(StretchLimit::Method::both, 4, 0.01);
+  for (StretchLimit::Method method : {StretchLimit::Method::both, StretchLimit::Method::projection}) {
+    CAPTURE(to_string(method));
+    const SimParams p = limited(method, 4, 0.01);
+    auto solver = CpuSolver<double>::create(s, p);
+    REQUIRE(solver.ok());
+    REQUIRE(solver->run(50).ok());
+    const std::vector<glm::dvec3> x0 = widen(solver->positions());
+    REQUIRE(solver->step().ok());
+    double worst = 0.0, moved = 0.0;
+    for (std::size_t q = 0; q < s.size(); ++q) {
+      const glm::dvec3 dx = glm::dvec3(solver->positions()[q]) - x0[q];
+      worst = std::max(worst, glm::length(dx - p.dt * glm::dvec3(solver->velocities()[q])));
+      moved = std::max(moved, glm::length(dx));
+    }
+    CHECK(moved > 1e-4); // the cloth is moving, and being corrected
+    CHECK(worst < 1e-12);
+  }
+}
+
+TEST_CASE("the fast projection conserves momentum and the centre of mass of a free cloth, and ends "
+          "within max_strain + 1e-4") {
+  // Nothing pinned, no tethers to anchor: each link's move is W grad C^T lambda, whose gradients
+  // sum to zero, so sum m dx = 0 (momentum: v += dx / h) and the centre of mass stays put. A cloth
+  // stretched 30 % along x, falling at 1 m/s: one step brings every link back to the bound.
+  ClothDesc d;
+  d.nx = 12;
+  d.ny = 9;
+  d.particle_mass = 0.01;
+  d.pin_default_corners = false;
+  auto made = make_cloth(d);
+  REQUIRE(made.ok());
+  ParticleSystem s = std::move(*made);
+  for (Particle& q : s.particles) {
+    q.position.x *= 1.3;
+    q.velocity = {0.0, 0.0, -1.0};
+  }
+  SimParams p = limited(StretchLimit::Method::projection, 20, 1e-3);
+  p.gravity = {0.0, 0.0, 0.0};
+  p.damping = 0.0;
   auto solver = CpuSolver<double>::create(s, p);
   REQUIRE(solver.ok());
-  REQUIRE(solver->run(50).ok());
-  const std::vector<glm::dvec3> x0 = widen(solver->positions());
+  auto centre_and_momentum = [&](std::span<const glm::dvec3> x, std::span<const glm::dvec3> v) {
+    glm::dvec3 c(0.0), m(0.0);
+    for (std::size_t q = 0; q < s.size(); ++q) {
+      c += s.particles[q].mass * x[q];
+      m += s.particles[q].mass * v[q];
+    }
+    return std::pair{c / (0.01 * double(s.size())), m};
+  };
+  const auto [c0, m0] = centre_and_momentum(widen(solver->positions()), widen(solver->velocities()));
   REQUIRE(solver->step().ok());
-  double worst = 0.0, moved = 0.0;
-  for (std::size_t q = 0; q < s.size(); ++q) {
-    const glm::dvec3 dx = glm::dvec3(solver->positions()[q]) - x0[q];
-    worst = std::max(worst, glm::length(dx - p.dt * glm::dvec3(solver->velocities()[q])));
-    moved = std::max(moved, glm::length(dx));
-  }
-  CHECK(moved > 1e-4); // the cloth is moving, and being corrected
-  CHECK(worst < 1e-12);
+  const auto [c1, m1] = centre_and_momentum(widen(solver->positions()), widen(solver->velocities()));
+  CHECK(max_structural_strain(s, widen(solver->positions())) < 0.1 + 1e-4);
+  CHECK(max_structural_strain(s, widen(solver->positions())) >
+        0.1 - 1e-3); // stretched to the bound, not past it
+  CHECK(glm::length(m1 - m0) < 1e-12);
+  CHECK(glm::length(c1 - (c0 + p.dt * m0 / (0.01 * double(s.size())))) < 1e-12);
 }
 
 TEST_CASE("stretch control on every backend: GPU = CPU float within 1e-5 m after 100 steps") {
