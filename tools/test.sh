@@ -15,10 +15,12 @@ extra=()
 # code that smaller tests run too (implicit Euler, self-collision, the figures): the release run
 # keeps them, the sanitizer run skips them (~10 min of a 2-core CI machine): among them every
 # sample through the CLI (the in-process "every sample scene loads and runs" test runs the same
-# solvers under the sanitizers) and the batch of three 64 x 64 self-colliding cloths.
+# solvers under the sanitizers), the batch of three 64 x 64 self-colliding cloths and the fast
+# projection's second of 16 / 32 / 64 cloths (its smaller tests run the same code).
 heavy='implicit Euler matches the CPU implicit solver on the sample scenes|the stiff cloth is stable at dt = 0.02'
 heavy+='|compare passes on every sample scene|no intersecting triangle pairs after the drop settles'
 heavy+='|the stiff 64x64 cloth hangs stably|no triangle passes through another after the drop settles'
 heavy+='|vkcloth figures --backend vulkan|^cli:run-every-sample$|self-collision per instance in one batch'
+heavy+='|the fast projection holds the report.s super-elastic cloth'
 [[ $preset == asan ]] && extra=(-E "^package:|$heavy")
 ctest --preset "$preset" -j "$(nproc)" "${extra[@]}"
