@@ -274,6 +274,25 @@ Result<VkPipeline> PipelineRegistry::pipeline(Shader shader, std::span<const std
   return pipelines_.emplace(std::move(key), std::move(p)).first->second.get();
 }
 
+VkBuffer OneSetInputs::main_binding(std::uint32_t read, std::uint32_t binding) const {
+  switch (binding) {
+  case VKCLOTH_BINDING_POS_OUT:
+    return pos[read ^ 1u]; // the positions this substep writes
+  case VKCLOTH_BINDING_VEL:
+    return vel;
+  case VKCLOTH_BINDING_PARTICLE:
+    return particle;
+  case VKCLOTH_BINDING_FLAGS:
+    return flags;
+  case VKCLOTH_BINDING_INSTANCES:
+    return instances;
+  case VKCLOTH_BINDING_STRAIN_LINKS:
+    return strain_links;
+  default:
+    return VK_NULL_HANDLE;
+  }
+}
+
 Result<OneSetPass> create_one_set_pass(Context::Impl& ctx, PipelineRegistry::Shader shader,
                                        DescriptorPool& pool, VkDescriptorSet (&sets)[2], const char* name) {
   const bool self = shader == PipelineRegistry::Shader::self_collision;

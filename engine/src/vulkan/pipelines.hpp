@@ -111,6 +111,15 @@ private:
   std::map<std::tuple<Shader, Variant, std::vector<std::uint32_t>>, Pipeline> pipelines_;
 };
 
+/// The solver's buffers a one-set pass (self_collision.comp, strain_project.comp) shares with the
+/// main layout, at the same binding numbers.
+struct OneSetInputs {
+  VkBuffer pos[2], vel, particle, flags, instances, strain_links;
+  /// The buffer of main-layout `binding` in the set of position parity `read` (POS_OUT: the
+  /// positions that substep writes); VK_NULL_HANDLE for a binding of the pass's own.
+  VkBuffer main_binding(std::uint32_t read, std::uint32_t binding) const;
+};
+
 /// A pass with one set of storage buffers and its own layout (self_collision.comp,
 /// strain_project.comp): the Context's pipeline layout and pipeline.
 struct OneSetPass {

@@ -64,20 +64,10 @@ Result<void> SelfCollisionGpu::create_sets() {
   return {};
 }
 
-Result<void> SelfCollisionGpu::write_sets(const SelfCollisionInputs& in) {
+Result<void> SelfCollisionGpu::write_sets(const OneSetInputs& in) {
   write_parity_sets(*ctx_, sets_, self_collision_bindings(),
                     [&](std::uint32_t read, std::uint32_t binding) -> VkBuffer {
                       switch (binding) {
-                      case VKCLOTH_BINDING_POS_OUT:
-                        return in.pos[read ^ 1u]; // the positions this substep writes
-                      case VKCLOTH_BINDING_VEL:
-                        return in.vel;
-                      case VKCLOTH_BINDING_PARTICLE:
-                        return in.particle;
-                      case VKCLOTH_BINDING_FLAGS:
-                        return in.flags;
-                      case VKCLOTH_BINDING_INSTANCES:
-                        return in.instances;
                       case VKCLOTH_BINDING_SELF_PARAMS:
                         return params_.buffer;
                       case VKCLOTH_BINDING_SELF_REST:
@@ -95,7 +85,7 @@ Result<void> SelfCollisionGpu::write_sets(const SelfCollisionInputs& in) {
                       case VKCLOTH_BINDING_SELF_DELTA:
                         return delta_.buffer;
                       default:
-                        return VK_NULL_HANDLE;
+                        return in.main_binding(read, binding);
                       }
                     });
   return {};

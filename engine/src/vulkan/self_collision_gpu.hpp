@@ -16,16 +16,12 @@
 
 #include <glm/vec3.hpp>
 
+#include "pipelines.hpp"
 #include "resources.hpp"
 #include "self_collision_shared.h"
 #include "vkcloth/params.hpp"
 
 namespace vkcloth::gpu {
-
-/// The solver's buffers the self-collision passes share (same bindings as the main layout).
-struct SelfCollisionInputs {
-  VkBuffer pos[2], vel, particle, flags, instances;
-};
 
 class SelfCollisionGpu {
 public:
@@ -39,7 +35,7 @@ public:
   SelfCollisionGpu& operator=(const SelfCollisionGpu&) = delete;
 
   /// (Re)writes the two descriptor sets (position parity); call again when an input buffer changes.
-  Result<void> write_sets(const SelfCollisionInputs& in);
+  Result<void> write_sets(const OneSetInputs& in);
   Buffer& rest_positions() { return rest_; }
   Buffer& counts() { return counts_; }
   /// The per-instance parameters (host-visible; written by the caller at creation, then by

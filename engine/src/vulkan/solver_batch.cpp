@@ -482,7 +482,7 @@ Result<void> SolverBatch::ensure_self_collision() {
   const auto sp = packed_self_params();
   std::memcpy(self_collision->params().mapped, sp.data(), sp.size() * sizeof(sh::SelfParams));
   // Only its own new sets: the main ones may be in use by recorded work (set_params).
-  return self_collision->write_sets(self_collision_inputs());
+  return self_collision->write_sets(one_set_inputs());
 }
 
 // Made when an instance first asks for the fast projection: its buffers (each particle's links
@@ -500,7 +500,7 @@ Result<void> SolverBatch::ensure_projection() {
   const std::vector<std::uint32_t> incidence = StrainProjectionGpu::incidence_data(*batch_topology);
   const Upload up[] = {{&projection->incidence(), incidence.data(), incidence.size() * 4}};
   VKCLOTH_TRY(upload(up));
-  return projection->write_sets(projection_inputs());
+  return projection->write_sets(one_set_inputs());
 }
 
 std::vector<sh::SelfParams> SolverBatch::packed_self_params() const {

@@ -294,10 +294,8 @@ private:
   void record_collider_motion(VkCommandBuffer cmd, double h);
   std::vector<shared::InstanceParams> packed_instance_params() const;
   std::vector<shared::SelfParams> packed_self_params() const;
-  SelfCollisionInputs self_collision_inputs() const {
-    return {{pos[0].buffer, pos[1].buffer}, vel.buffer, particle.buffer, flags.buffer, instances.buffer};
-  }
-  StrainProjectionInputs projection_inputs() const {
+  /// What self-collision's and the projection's passes share with the main layout.
+  OneSetInputs one_set_inputs() const {
     return {{pos[0].buffer, pos[1].buffer},
             vel.buffer,
             particle.buffer,

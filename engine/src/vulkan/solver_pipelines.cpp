@@ -304,9 +304,9 @@ Result<void> SolverBatch::write_sets() {
   vk().vkUpdateDescriptorSets(ctx->device, static_cast<std::uint32_t>(writes.size()), writes.data(), 0,
                               nullptr);
   if (self_collision)
-    VKCLOTH_TRY(self_collision->write_sets(self_collision_inputs()));
+    VKCLOTH_TRY(self_collision->write_sets(one_set_inputs()));
   if (projection)
-    VKCLOTH_TRY(projection->write_sets(projection_inputs()));
+    VKCLOTH_TRY(projection->write_sets(one_set_inputs()));
   if (implicit)
     return implicit->write_sets({{pos[0].buffer, pos[1].buffer},
                                  vel.buffer,

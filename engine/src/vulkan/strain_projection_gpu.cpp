@@ -94,22 +94,10 @@ Result<void> StrainProjectionGpu::create_sets() {
   return {};
 }
 
-Result<void> StrainProjectionGpu::write_sets(const StrainProjectionInputs& in) {
+Result<void> StrainProjectionGpu::write_sets(const OneSetInputs& in) {
   write_parity_sets(*ctx_, sets_, strain_project_bindings(),
                     [&](std::uint32_t read, std::uint32_t binding) -> VkBuffer {
                       switch (binding) {
-                      case VKCLOTH_BINDING_POS_OUT:
-                        return in.pos[read ^ 1u]; // the positions this substep writes
-                      case VKCLOTH_BINDING_VEL:
-                        return in.vel;
-                      case VKCLOTH_BINDING_PARTICLE:
-                        return in.particle;
-                      case VKCLOTH_BINDING_FLAGS:
-                        return in.flags;
-                      case VKCLOTH_BINDING_INSTANCES:
-                        return in.instances;
-                      case VKCLOTH_BINDING_STRAIN_LINKS:
-                        return in.strain_links;
                       case VKCLOTH_BINDING_PROJ_INCIDENCE:
                         return incidence_.buffer;
                       case VKCLOTH_BINDING_PROJ_LINKS:
@@ -121,7 +109,7 @@ Result<void> StrainProjectionGpu::write_sets(const StrainProjectionInputs& in) {
                       case VKCLOTH_BINDING_PROJ_ARGS:
                         return args_.buffer;
                       default:
-                        return VK_NULL_HANDLE;
+                        return in.main_binding(read, binding);
                       }
                     });
   return {};

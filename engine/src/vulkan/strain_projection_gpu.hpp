@@ -13,16 +13,12 @@
 #include <span>
 #include <vector>
 
+#include "pipelines.hpp"
 #include "resources.hpp"
 #include "strain_projection_shared.h"
 #include "vkcloth/topology.hpp"
 
 namespace vkcloth::gpu {
-
-/// The solver's buffers the projection shares (same bindings as the main layout).
-struct StrainProjectionInputs {
-  VkBuffer pos[2], vel, particle, flags, instances, strain_links;
-};
 
 class StrainProjectionGpu {
 public:
@@ -35,7 +31,7 @@ public:
   StrainProjectionGpu& operator=(const StrainProjectionGpu&) = delete;
 
   /// (Re)writes the two descriptor sets (position parity); call again when an input buffer changes.
-  Result<void> write_sets(const StrainProjectionInputs& in);
+  Result<void> write_sets(const OneSetInputs& in);
   Buffer& incidence() { return incidence_; }
   /// The topology's strain_incidence_offsets, then its strain_incidence (the shader's layout).
   static std::vector<std::uint32_t> incidence_data(const ClothTopology& topology);
