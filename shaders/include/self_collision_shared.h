@@ -24,6 +24,16 @@ namespace vkcloth::gpu::shared {
 #define VKCLOTH_BINDING_SELF_SORTED 41 // the particles by bucket, then by index, with their keys (uvec2)
 #define VKCLOTH_BINDING_SELF_DELTA 42  // this Jacobi pass's move and velocity change (2 vec4 per particle)
 
+// Set 1 of the self_collision_texel build: what COLLIDE's walk reads, through uniform texel buffer
+// views (llvmpipe turns a storage-buffer load into a per-lane loop, a texel fetch into one
+// gather); the self_collision_storage build reads the same from set 0 and has no set 1.
+#define VKCLOTH_SELF_TEXEL_POS 0    // the positions being written (POS_OUT), RGBA32F
+#define VKCLOTH_SELF_TEXEL_VEL 1    // velocities, RGBA32F
+#define VKCLOTH_SELF_TEXEL_REST 2   // SELF_REST, RGBA32F
+#define VKCLOTH_SELF_TEXEL_STARTS 3 // SELF_STARTS, R32UI
+#define VKCLOTH_SELF_TEXEL_SORTED 4 // SELF_SORTED, RG32UI
+#define VKCLOTH_SELF_TEXEL_COUNT 5
+
 // Buckets per workgroup of the SCAN_BLOCKS pass: 64 invocations x 8 (the table size is a
 // multiple: kernel.hpp self_table_size).
 #define VKCLOTH_SELF_SCAN_BLOCK 512u

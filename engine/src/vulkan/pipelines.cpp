@@ -13,7 +13,8 @@
 #include "vkcloth/shaders/fused_storage_comp_spv.hpp"
 #include "vkcloth/shaders/fused_texel_comp_spv.hpp"
 #include "vkcloth/shaders/implicit_comp_spv.hpp"
-#include "vkcloth/shaders/self_collision_comp_spv.hpp"
+#include "vkcloth/shaders/self_collision_storage_comp_spv.hpp"
+#include "vkcloth/shaders/self_collision_texel_comp_spv.hpp"
 #include "vkcloth/shaders/integrate_storage_comp_spv.hpp"
 #include "vkcloth/shaders/integrate_texel_comp_spv.hpp"
 #include "vkcloth/shaders/strain_finish_storage_comp_spv.hpp"
@@ -59,7 +60,9 @@ ShaderCode code_of(PipelineRegistry::Shader s, BufferAccess access) {
   case S::vertices:
     return {spirv::vertices_comp_spv, "vertices.comp"};
   case S::self_collision:
-    return {spirv::self_collision_comp_spv, "self_collision.comp"};
+    return texel
+               ? ShaderCode{spirv::self_collision_texel_comp_spv, "self_collision.comp (texel views)"}
+               : ShaderCode{spirv::self_collision_storage_comp_spv, "self_collision.comp (storage buffers)"};
   case S::strain_project:
     return {spirv::strain_project_comp_spv, "strain_project.comp"};
   }
@@ -69,7 +72,7 @@ ShaderCode code_of(PipelineRegistry::Shader s, BufferAccess access) {
 /// Shaders compiled in one build only.
 bool single_build(PipelineRegistry::Shader s) {
   using S = PipelineRegistry::Shader;
-  return s == S::implicit || s == S::vertices || s == S::self_collision || s == S::strain_project;
+  return s == S::implicit || s == S::vertices || s == S::strain_project;
 }
 
 /// The storage bindings of implicit.comp (implicit_shared.h).
@@ -93,6 +96,12 @@ constexpr std::uint32_t kSelfCollisionBindings[] = {
     VKCLOTH_BINDING_SELF_REST,   VKCLOTH_BINDING_SELF_COUNTS, VKCLOTH_BINDING_SELF_STARTS,
     VKCLOTH_BINDING_SELF_BLOCKS, VKCLOTH_BINDING_SELF_KEYS,   VKCLOTH_BINDING_SELF_SORTED,
     VKCLOTH_BINDING_SELF_DELTA};
+
+/// Set 1 of self_collision.comp's texel build: uniform texel buffer views (self_collision_shared.h).
+constexpr std::uint32_t kSelfCollisionTexelBindings[] = {VKCLOTH_SELF_TEXEL_POS, VKCLOTH_SELF_TEXEL_VEL,
+                                                         VKCLOTH_SELF_TEXEL_REST, VKCLOTH_SELF_TEXEL_STARTS,
+                                                         VKCLOTH_SELF_TEXEL_SORTED};
+static_assert(std::size(kSelfCollisionTexelBindings) == VKCLOTH_SELF_TEXEL_COUNT);
 
 /// The storage bindings of strain_project.comp (strain_projection_shared.h).
 constexpr std::uint32_t kStrainProjectBindings[] = {
@@ -173,7 +182,31 @@ Result<PipelineRegistry::ImplicitLayouts> PipelineRegistry::implicit_layouts() {
 
 Result<PipelineRegistry::ImplicitLayouts> PipelineRegistry::self_collision_layouts() {
   const std::lock_guard lock(mutex_);
-  return single_set_layouts_locked(kSelfCollisionBindings, "self-collision", self_set_, self_layout_);
+  return self_collision_layouts_locked();
+}
+
+// Set 0: the storage buffers; set 1: the texel build's views (the storage build uses set 0 only).
+Result<PipelineRegistry::ImplicitLayouts> PipelineRegistry::self_collision_layouts_locked() {
+  if (!self_layout_) {
+    auto sl = create_compute_set_layout(ctx_, kSelfCollisionBindings, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                        "self-collision");
+    if (!sl)
+      return sl.error();
+    auto tl =
+        create_compute_set_layout(ctx_, kSelfCollisionTexelBindings, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER,
+                                  "self-collision texel views");
+    if (!tl)
+      return tl.error();
+    const VkDescriptorSetLayout sets[2] = {*sl, *tl};
+    auto pl = create_pipeline_layout(ctx_, sets, VK_SHADER_STAGE_COMPUTE_BIT, sizeof(shared::PushConstants),
+                                     "self-collision");
+    if (!pl)
+      return pl.error();
+    self_set_ = std::move(*sl);
+    self_texel_set_ = std::move(*tl);
+    self_layout_ = std::move(*pl);
+  }
+  return ImplicitLayouts{self_set_, self_layout_, self_texel_set_};
 }
 
 Result<PipelineRegistry::ImplicitLayouts> PipelineRegistry::strain_project_layouts() {
@@ -227,11 +260,11 @@ Result<VkPipeline> PipelineRegistry::pipeline(Shader shader, std::span<const std
     return it->second.get();
   VkPipelineLayout layout = VK_NULL_HANDLE;
   if (implicit || self || project) {
-    auto l =
-        implicit ? single_set_layouts_locked(kImplicitBindings, "implicit", implicit_set_, implicit_layout_)
-        : self ? single_set_layouts_locked(kSelfCollisionBindings, "self-collision", self_set_, self_layout_)
-               : single_set_layouts_locked(kStrainProjectBindings, "strain projection", project_set_,
-                                           project_layout_);
+    auto l = implicit
+                 ? single_set_layouts_locked(kImplicitBindings, "implicit", implicit_set_, implicit_layout_)
+             : self ? self_collision_layouts_locked()
+                    : single_set_layouts_locked(kStrainProjectBindings, "strain projection", project_set_,
+                                                project_layout_);
     if (!l)
       return l.error();
     layout = l->layout;
@@ -294,17 +327,18 @@ VkBuffer OneSetInputs::main_binding(std::uint32_t read, std::uint32_t binding) c
 }
 
 Result<OneSetPass> create_one_set_pass(Context::Impl& ctx, PipelineRegistry::Shader shader,
-                                       DescriptorPool& pool, VkDescriptorSet (&sets)[2], const char* name) {
+                                       DescriptorPool& pool, VkDescriptorSet (&sets)[2], const char* name,
+                                       BufferAccess access) {
   const bool self = shader == PipelineRegistry::Shader::self_collision;
   auto layouts = self ? ctx.pipelines->self_collision_layouts() : ctx.pipelines->strain_project_layouts();
   if (!layouts)
     return layouts.error();
   const std::size_t bindings = self ? self_collision_bindings().size() : strain_project_bindings().size();
   VKCLOTH_TRY(create_parity_sets(ctx, layouts->set, static_cast<std::uint32_t>(bindings), pool, sets, name));
-  auto pipeline = ctx.pipelines->pipeline(shader, {});
+  auto pipeline = ctx.pipelines->pipeline(shader, {}, {access, 0});
   if (!pipeline)
     return pipeline.error();
-  return OneSetPass{layouts->layout, *pipeline};
+  return OneSetPass{layouts->layout, *pipeline, layouts->texel};
 }
 
 } // namespace vkcloth::gpu

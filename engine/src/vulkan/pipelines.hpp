@@ -35,7 +35,8 @@ DeviceLayout device_layout(const Context::Impl& ctx);
 inline constexpr std::uint32_t kWorkgroupSizeConstant = 43;
 
 /// Which build of a shader and its workgroup size (DeviceLayout). force, integrate, fused and
-/// strain_* have a *_texel and a *_storage build; the others one build, `access` ignored.
+/// strain_*, self_collision have a *_texel and a *_storage build; the others one build, `access`
+/// ignored.
 /// `workgroup_size` 0: the compiled VKCLOTH_WORKGROUP_SIZE (implicit*.comp: always).
 struct ShaderVariant {
   BufferAccess access = BufferAccess::texel_views;
@@ -63,10 +64,12 @@ public:
     VkDescriptorSetLayout storage = VK_NULL_HANDLE, texel = VK_NULL_HANDLE;
     VkPipelineLayout layout = VK_NULL_HANDLE;
   };
-  /// The one set of implicit.comp (or self_collision.comp, strain_project.comp) and its layout.
+  /// The one set of implicit.comp (or self_collision.comp, strain_project.comp) and its layout;
+  /// self_collision.comp's texel build also reads set 1, `texel` (the others: none).
   struct ImplicitLayouts {
     VkDescriptorSetLayout set = VK_NULL_HANDLE;
     VkPipelineLayout layout = VK_NULL_HANDLE;
+    VkDescriptorSetLayout texel = VK_NULL_HANDLE;
   };
 
   /// Makes nothing yet (the Context's allocation callbacks may still be unset): every object is
@@ -98,6 +101,7 @@ private:
   /// The layouts of a shader with one set of storage buffers (implicit.comp, self_collision.comp).
   Result<ImplicitLayouts> single_set_layouts_locked(std::span<const std::uint32_t> bindings, const char* name,
                                                     DescriptorSetLayout& set, PipelineLayout& layout);
+  Result<ImplicitLayouts> self_collision_layouts_locked();
   VkPipelineCache cache_locked();
   Result<VkShaderModule> module_locked(Shader shader, BufferAccess access);
 
@@ -105,7 +109,7 @@ private:
   std::mutex mutex_; // several solvers may be created on one Context from different threads
   PipelineCache cache_;
   bool cache_tried_ = false;
-  DescriptorSetLayout solver_storage_, solver_texel_, implicit_set_, self_set_, project_set_;
+  DescriptorSetLayout solver_storage_, solver_texel_, implicit_set_, self_set_, self_texel_set_, project_set_;
   PipelineLayout solver_layout_, implicit_layout_, self_layout_, project_layout_;
   std::map<std::pair<Shader, BufferAccess>, ShaderModule> modules_;
   std::map<std::tuple<Shader, Variant, std::vector<std::uint32_t>>, Pipeline> pipelines_;
@@ -121,14 +125,18 @@ struct OneSetInputs {
 };
 
 /// A pass with one set of storage buffers and its own layout (self_collision.comp,
-/// strain_project.comp): the Context's pipeline layout and pipeline.
+/// strain_project.comp): the Context's pipeline layout and pipeline, and the layout of the texel
+/// build's set 1 (self_collision.comp; VK_NULL_HANDLE for the others).
 struct OneSetPass {
   VkPipelineLayout layout = VK_NULL_HANDLE;
   VkPipeline pipeline = VK_NULL_HANDLE;
+  VkDescriptorSetLayout texel_set = VK_NULL_HANDLE;
 };
-/// `shader`'s (self_collision or strain_project) layout and pipeline from `ctx`'s registry, and
-/// `pool` with the two parity sets of its layout (create_parity_sets), named `name`.
+/// `shader`'s (self_collision or strain_project) layout and pipeline (its `access` build) from
+/// `ctx`'s registry, and `pool` with the two parity sets of its layout (create_parity_sets),
+/// named `name`.
 Result<OneSetPass> create_one_set_pass(Context::Impl& ctx, PipelineRegistry::Shader shader,
-                                       DescriptorPool& pool, VkDescriptorSet (&sets)[2], const char* name);
+                                       DescriptorPool& pool, VkDescriptorSet (&sets)[2], const char* name,
+                                       BufferAccess access = BufferAccess::texel_views);
 
 } // namespace vkcloth::gpu

@@ -219,11 +219,11 @@ Result<PipelineLayout> create_pipeline_layout(Context::Impl& ctx, std::span<cons
   return l;
 }
 
-Result<void> create_parity_sets(Context::Impl& ctx, VkDescriptorSetLayout layout,
-                                std::uint32_t storage_buffers, DescriptorPool& pool,
-                                VkDescriptorSet (&sets)[2], const char* name) {
+Result<void> create_parity_sets(Context::Impl& ctx, VkDescriptorSetLayout layout, std::uint32_t descriptors,
+                                DescriptorPool& pool, VkDescriptorSet (&sets)[2], const char* name,
+                                VkDescriptorType type) {
   const auto& v = ctx.vk;
-  const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2 * storage_buffers};
+  const VkDescriptorPoolSize size{type, 2 * descriptors};
   VkDescriptorPoolCreateInfo dp{};
   dp.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
   dp.maxSets = 2;

@@ -167,11 +167,11 @@ Result<PipelineLayout> create_pipeline_layout(Context::Impl& ctx, std::span<cons
                                               VkShaderStageFlags stages, std::uint32_t push_bytes,
                                               const char* name);
 
-/// A pool of two sets of `layout`, each of `storage_buffers` storage-buffer descriptors, and the two
-/// sets (one per position parity: implicit Euler's and self-collision's passes).
-Result<void> create_parity_sets(Context::Impl& ctx, VkDescriptorSetLayout layout,
-                                std::uint32_t storage_buffers, DescriptorPool& pool,
-                                VkDescriptorSet (&sets)[2], const char* name);
+/// A pool of two sets of `layout`, each of `descriptors` descriptors of `type`, and the two sets
+/// (one per position parity: implicit Euler's, self-collision's and the projection's passes).
+Result<void> create_parity_sets(Context::Impl& ctx, VkDescriptorSetLayout layout, std::uint32_t descriptors,
+                                DescriptorPool& pool, VkDescriptorSet (&sets)[2], const char* name,
+                                VkDescriptorType type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
 
 /// Writes every binding of both parity sets as a whole storage buffer: buffer_of(read, binding)
 /// (`read`: the set's position parity, 0 or 1). Creation and buffer replacement only.

@@ -2,6 +2,8 @@
 #include "self_collision_gpu.hpp"
 
 #include <algorithm>
+#include <array>
+#include <utility>
 #include <tuple>
 
 #include "../core/kernel.hpp"
@@ -12,15 +14,22 @@ namespace vkcloth::gpu {
 
 namespace sh = shared;
 
-Result<std::unique_ptr<SelfCollisionGpu>>
-SelfCollisionGpu::create(const std::shared_ptr<Context::Impl>& ctx, std::uint32_t count,
-                         std::uint32_t instances, std::uint32_t groups_max_x, bool allow_map) {
+Result<std::unique_ptr<SelfCollisionGpu>> SelfCollisionGpu::create(const std::shared_ptr<Context::Impl>& ctx,
+                                                                   std::uint32_t count,
+                                                                   std::uint32_t instances,
+                                                                   std::uint32_t groups_max_x, bool allow_map,
+                                                                   BufferAccess access) {
   std::unique_ptr<SelfCollisionGpu> s(new SelfCollisionGpu());
   s->ctx_ = ctx;
   s->count_ = count;
   s->instances_ = instances;
   s->table_ = kernel::self_table_size(count);
   s->groups_max_x_ = std::max<std::uint32_t>(groups_max_x, 1);
+  // The largest view is the bucket starts' (table + 1 per instance); a batch past the limit runs
+  // the storage build, which reads the same values (a speed choice: the same bits either way).
+  const std::uint64_t texels = std::uint64_t(instances) * (std::uint64_t(s->table_) + 1);
+  if (access == BufferAccess::texel_views && texels <= ctx->properties.limits.maxTexelBufferElements)
+    s->access_ = BufferAccess::texel_views;
   VKCLOTH_TRY(s->create_buffers(allow_map));
   VKCLOTH_TRY(s->create_sets());
   return s;
@@ -28,7 +37,9 @@ SelfCollisionGpu::create(const std::shared_ptr<Context::Impl>& ctx, std::uint32_
 
 Result<void> SelfCollisionGpu::create_buffers(bool allow_map) {
   Context::Impl& ctx = *ctx_;
-  const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  // UNIFORM_TEXEL_BUFFER: the texel build views rest positions, starts and the sorted table.
+  const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                                   VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
   const VkDeviceSize per_particle = VkDeviceSize(instances_) * count_;
   const VkDeviceSize buckets = VkDeviceSize(instances_) * table_;
   const std::tuple<Buffer*, VkDeviceSize, const char*> device_buffers[] = {
@@ -53,14 +64,65 @@ Result<void> SelfCollisionGpu::create_buffers(bool allow_map) {
   return {};
 }
 
-// The Context's layout and pipeline; this batch's pool and two sets (position parity).
+// The Context's layout and pipeline; this batch's pool and two sets (position parity), and for
+// the texel build a pool and two sets of views.
 Result<void> SelfCollisionGpu::create_sets() {
-  auto pass =
-      create_one_set_pass(*ctx_, PipelineRegistry::Shader::self_collision, pool_, sets_, "self-collision");
+  auto pass = create_one_set_pass(*ctx_, PipelineRegistry::Shader::self_collision, pool_, sets_,
+                                  "self-collision", access_);
   if (!pass)
     return pass.error();
   layout_ = pass->layout;
   pass_ = pass->pipeline;
+  if (access_ == BufferAccess::texel_views)
+    VKCLOTH_TRY(create_parity_sets(*ctx_, pass->texel_set, VKCLOTH_SELF_TEXEL_COUNT, texel_pool_, texel_sets_,
+                                   "self-collision texel views", VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER));
+  return {};
+}
+
+// Set 1 of parity `read`: positions[read ^ 1] (the positions that substep writes) and the views
+// every parity shares. Made once: the buffers they view live as long as the batch (the ones a
+// batch replaces, colliders and tethers, are not read here).
+Result<void> SelfCollisionGpu::write_texel_sets(const OneSetInputs& in) {
+  if (sorted_view_ != VK_NULL_HANDLE)
+    return {};
+  const struct {
+    VkBuffer buffer;
+    VkFormat format;
+    BufferView* view;
+    const char* what;
+  } views[] = {{in.pos[0], VK_FORMAT_R32G32B32A32_SFLOAT, &pos_views_[0], "self-collision: positions[0]"},
+               {in.pos[1], VK_FORMAT_R32G32B32A32_SFLOAT, &pos_views_[1], "self-collision: positions[1]"},
+               {in.vel, VK_FORMAT_R32G32B32A32_SFLOAT, &vel_view_, "self-collision: velocities"},
+               {rest_.buffer, VK_FORMAT_R32G32B32A32_SFLOAT, &rest_view_, "self-collision: rest positions"},
+               {starts_.buffer, VK_FORMAT_R32_UINT, &starts_view_, "self-collision: bucket starts"},
+               {sorted_.buffer, VK_FORMAT_R32G32_UINT, &sorted_view_, "self-collision: sorted particles"}};
+  for (const auto& view : views) {
+    auto r = create_buffer_view(*ctx_, view.buffer, view.format, view.what);
+    if (!r)
+      return r.error();
+    *view.view = std::move(*r);
+  }
+  std::array<VkWriteDescriptorSet, 2 * VKCLOTH_SELF_TEXEL_COUNT> writes{};
+  std::size_t w = 0;
+  for (std::uint32_t read = 0; read < 2; ++read) {
+    const std::pair<const BufferView*, std::uint32_t> bound[VKCLOTH_SELF_TEXEL_COUNT] = {
+        {&pos_views_[read ^ 1u], VKCLOTH_SELF_TEXEL_POS},
+        {&vel_view_, VKCLOTH_SELF_TEXEL_VEL},
+        {&rest_view_, VKCLOTH_SELF_TEXEL_REST},
+        {&starts_view_, VKCLOTH_SELF_TEXEL_STARTS},
+        {&sorted_view_, VKCLOTH_SELF_TEXEL_SORTED}};
+    for (auto [view, binding] : bound) {
+      writes[w] = VkWriteDescriptorSet{};
+      writes[w].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+      writes[w].dstSet = texel_sets_[read];
+      writes[w].dstBinding = binding;
+      writes[w].descriptorCount = 1;
+      writes[w].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+      writes[w].pTexelBufferView = view->ptr();
+      ++w;
+    }
+  }
+  ctx_->vk.vkUpdateDescriptorSets(ctx_->device, static_cast<std::uint32_t>(w), writes.data(), 0, nullptr);
   return {};
 }
 
@@ -88,7 +150,7 @@ Result<void> SelfCollisionGpu::write_sets(const OneSetInputs& in) {
                         return in.main_binding(read, binding);
                       }
                     });
-  return {};
+  return access_ == BufferAccess::texel_views ? write_texel_sets(in) : Result<void>{};
 }
 
 std::vector<sh::SelfParams> SelfCollisionGpu::packed(std::span<const SimParams* const> params) {
@@ -105,7 +167,9 @@ std::vector<sh::SelfParams> SelfCollisionGpu::packed(std::span<const SimParams* 
 std::uint32_t SelfCollisionGpu::record_substep(VkCommandBuffer c, std::uint32_t read, sh::PushConstants pc,
                                                std::uint32_t iterations) {
   const auto& v = ctx_->vk;
-  v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &sets_[read], 0, nullptr);
+  const VkDescriptorSet bound[2] = {sets_[read], texel_sets_[read]};
+  v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0,
+                            access_ == BufferAccess::texel_views ? 2 : 1, bound, 0, nullptr);
   v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, pass_);
   pc.pad0 = table_;
   std::uint32_t dispatches = 0;

@@ -6,7 +6,9 @@
 //
 // one barrier between consecutive passes (barriers::dispatch_to_dispatch). The spatial hash (one
 // table per instance, kernel.hpp self_table_size buckets) is rebuilt every substep; the counts
-// go back to zero as SCATTER hands out the slots, so no clearing pass is needed.
+// go back to zero as SCATTER hands out the slots, so no clearing pass is needed. In a batch whose
+// shaders read through texel views (DeviceLayout), COLLIDE reads through its own set 1 of views
+// (self_collision_texel), unless one would exceed maxTexelBufferElements (then the storage build).
 #pragma once
 
 #include <cstdint>
@@ -26,15 +28,17 @@ namespace vkcloth::gpu {
 class SelfCollisionGpu {
 public:
   /// For `instances` instances of `count` particles; `groups_max_x`: the device's
-  /// maxComputeWorkGroupCount[0]. The caller uploads rest_positions() (xyz, w: kernel inverse_mass)
-  /// and zeroes counts().
+  /// maxComputeWorkGroupCount[0]; `access`: the batch's build (texel views or storage buffers).
+  /// The caller uploads rest_positions() (xyz, w: kernel inverse_mass) and zeroes counts().
   static Result<std::unique_ptr<SelfCollisionGpu>> create(const std::shared_ptr<Context::Impl>& ctx,
                                                           std::uint32_t count, std::uint32_t instances,
-                                                          std::uint32_t groups_max_x, bool allow_map);
+                                                          std::uint32_t groups_max_x, bool allow_map,
+                                                          BufferAccess access);
   SelfCollisionGpu(const SelfCollisionGpu&) = delete;
   SelfCollisionGpu& operator=(const SelfCollisionGpu&) = delete;
 
-  /// (Re)writes the two descriptor sets (position parity); call again when an input buffer changes.
+  /// (Re)writes the two descriptor sets (position parity), and the views of the texel build;
+  /// call again when an input buffer changes.
   Result<void> write_sets(const OneSetInputs& in);
   Buffer& rest_positions() { return rest_; }
   Buffer& counts() { return counts_; }
@@ -52,15 +56,20 @@ private:
   SelfCollisionGpu() = default;
   std::shared_ptr<Context::Impl> ctx_;
   std::uint32_t count_ = 0, instances_ = 0, table_ = 0, groups_max_x_ = 1;
+  BufferAccess access_ = BufferAccess::storage_buffers; // the build that runs (never automatic)
   Buffer params_, rest_, counts_, starts_, blocks_, keys_, sorted_, delta_;
-  DescriptorPool pool_;
-  VkDescriptorSet sets_[2] = {};
+  DescriptorPool pool_, texel_pool_;
+  VkDescriptorSet sets_[2] = {}, texel_sets_[2] = {}; // [read]: set 0 and the texel build's set 1
+  // The texel build's views: positions[0], positions[1] (the parity's POS_OUT), then velocities,
+  // rest positions, bucket starts and the sorted table (VKCLOTH_SELF_TEXEL_* order from VEL on).
+  BufferView pos_views_[2], vel_view_, rest_view_, starts_view_, sorted_view_;
   // The Context's (PipelineRegistry), shared by every batch.
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
   VkPipeline pass_ = VK_NULL_HANDLE;
 
   Result<void> create_buffers(bool allow_map);
   Result<void> create_sets();
+  Result<void> write_texel_sets(const OneSetInputs& in);
 };
 
 } // namespace vkcloth::gpu

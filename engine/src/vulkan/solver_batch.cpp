@@ -466,7 +466,7 @@ Result<void> SolverBatch::ensure_self_collision() {
   VKCLOTH_TRY(check_buffer(*ctx, storage_limit(*ctx, knobs), "self-collision moves",
                            std::uint64_t(size()) * count, 32));
   auto r = SelfCollisionGpu::create(ctx, count, size(), ctx->properties.limits.maxComputeWorkGroupCount[0],
-                                    !knobs.force_staging);
+                                    !knobs.force_staging, access);
   if (!r)
     return r.error();
   self_collision = std::move(*r);
