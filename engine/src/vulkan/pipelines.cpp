@@ -327,18 +327,14 @@ VkBuffer OneSetInputs::main_binding(std::uint32_t read, std::uint32_t binding) c
 }
 
 Result<OneSetPass> create_one_set_pass(Context::Impl& ctx, PipelineRegistry::Shader shader,
-                                       DescriptorPool& pool, VkDescriptorSet (&sets)[2], const char* name,
-                                       BufferAccess access) {
+                                       DescriptorPool& pool, VkDescriptorSet (&sets)[2], const char* name) {
   const bool self = shader == PipelineRegistry::Shader::self_collision;
   auto layouts = self ? ctx.pipelines->self_collision_layouts() : ctx.pipelines->strain_project_layouts();
   if (!layouts)
     return layouts.error();
   const std::size_t bindings = self ? self_collision_bindings().size() : strain_project_bindings().size();
   VKCLOTH_TRY(create_parity_sets(ctx, layouts->set, static_cast<std::uint32_t>(bindings), pool, sets, name));
-  auto pipeline = ctx.pipelines->pipeline(shader, {}, {access, 0});
-  if (!pipeline)
-    return pipeline.error();
-  return OneSetPass{layouts->layout, *pipeline, layouts->texel};
+  return OneSetPass{layouts->layout, layouts->texel};
 }
 
 } // namespace vkcloth::gpu

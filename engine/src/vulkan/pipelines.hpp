@@ -125,18 +125,15 @@ struct OneSetInputs {
 };
 
 /// A pass with one set of storage buffers and its own layout (self_collision.comp,
-/// strain_project.comp): the Context's pipeline layout and pipeline, and the layout of the texel
-/// build's set 1 (self_collision.comp; VK_NULL_HANDLE for the others).
+/// strain_project.comp): the Context's pipeline layout, and the layout of the texel build's set 1
+/// (self_collision.comp; VK_NULL_HANDLE for the others). Its pipelines: PipelineRegistry::pipeline.
 struct OneSetPass {
   VkPipelineLayout layout = VK_NULL_HANDLE;
-  VkPipeline pipeline = VK_NULL_HANDLE;
   VkDescriptorSetLayout texel_set = VK_NULL_HANDLE;
 };
-/// `shader`'s (self_collision or strain_project) layout and pipeline (its `access` build) from
-/// `ctx`'s registry, and `pool` with the two parity sets of its layout (create_parity_sets),
-/// named `name`.
+/// `shader`'s (self_collision or strain_project) layouts from `ctx`'s registry, and `pool` with
+/// the two parity sets of its layout (create_parity_sets), named `name`.
 Result<OneSetPass> create_one_set_pass(Context::Impl& ctx, PipelineRegistry::Shader shader,
-                                       DescriptorPool& pool, VkDescriptorSet (&sets)[2], const char* name,
-                                       BufferAccess access = BufferAccess::texel_views);
+                                       DescriptorPool& pool, VkDescriptorSet (&sets)[2], const char* name);
 
 } // namespace vkcloth::gpu

@@ -64,15 +64,21 @@ Result<void> SelfCollisionGpu::create_buffers(bool allow_map) {
   return {};
 }
 
-// The Context's layout and pipeline; this batch's pool and two sets (position parity), and for
-// the texel build a pool and two sets of views.
+// The Context's layout and pipelines (one per pass, SC_SELF_STAGE); this batch's pool and two
+// sets (position parity), and for the texel build a pool and two sets of views.
 Result<void> SelfCollisionGpu::create_sets() {
-  auto pass = create_one_set_pass(*ctx_, PipelineRegistry::Shader::self_collision, pool_, sets_,
-                                  "self-collision", access_);
+  auto pass = create_one_set_pass(*ctx_, PipelineRegistry::Shader::self_collision, pool_, sets_, "self-collision");
   if (!pass)
     return pass.error();
   layout_ = pass->layout;
-  pass_ = pass->pipeline;
+  for (std::uint32_t stage = 0; stage < kPasses; ++stage) {
+    std::array<std::uint32_t, 41> constants{};
+    constants[40] = stage; // SC_SELF_STAGE
+    auto p = ctx_->pipelines->pipeline(PipelineRegistry::Shader::self_collision, constants, {access_, 0});
+    if (!p)
+      return p.error();
+    passes_[stage] = *p;
+  }
   if (access_ == BufferAccess::texel_views)
     VKCLOTH_TRY(create_parity_sets(*ctx_, pass->texel_set, VKCLOTH_SELF_TEXEL_COUNT, texel_pool_, texel_sets_,
                                    "self-collision texel views", VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER));
@@ -170,12 +176,12 @@ std::uint32_t SelfCollisionGpu::record_substep(VkCommandBuffer c, std::uint32_t 
   const VkDescriptorSet bound[2] = {sets_[read], texel_sets_[read]};
   v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0,
                             access_ == BufferAccess::texel_views ? 2 : 1, bound, 0, nullptr);
-  v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, pass_);
   pc.pad0 = table_;
   std::uint32_t dispatches = 0;
   // `items` invocations (64 per workgroup, rows of at most groups_max_x_ workgroups), every instance.
   auto pass = [&](std::uint32_t stage, std::uint64_t items) {
     barriers::dispatch_to_dispatch(v, c); // the previous pass (or the substep's update) -> this one
+    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, passes_[stage]);
     pc.stage = stage;
     v.vkCmdPushConstants(c, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
     const std::uint64_t groups =

@@ -65,7 +65,8 @@ private:
   BufferView pos_views_[2], vel_view_, rest_view_, starts_view_, sorted_view_;
   // The Context's (PipelineRegistry), shared by every batch.
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
-  VkPipeline pass_ = VK_NULL_HANDLE;
+  static constexpr std::uint32_t kPasses = VKCLOTH_SELF_APPLY + 1;
+  VkPipeline passes_[kPasses] = {}; // [stage]: self_collision.comp specialised with SC_SELF_STAGE
 
   Result<void> create_buffers(bool allow_map);
   Result<void> create_sets();

@@ -212,10 +212,6 @@ Result<void> SolverBatch::create_pipelines() {
   if (!lp)
     return lp.error();
   strain_links_pipeline = *lp;
-  auto sp = ctx->pipelines->pipeline(Shader::strain_finish, {}, variant);
-  if (!sp)
-    return sp.error();
-  strain_finish_pipeline = *sp;
   if (options.interleaved_vertices) {
     auto vp = ctx->pipelines->pipeline(Shader::vertices, {}, variant);
     if (!vp)
@@ -237,6 +233,25 @@ Result<void> SolverBatch::ensure_fused() {
     if (!p)
       return p.error();
     fused_pipes[aux][types] = *p;
+  }
+  return {};
+}
+
+// The strain_finish.comp variants the current parameters need: the tethers' stage (no collider
+// code), and the colliders' stages for the collider types in the batch; each made once per Context.
+Result<void> SolverBatch::ensure_finish_passes() {
+  const std::uint32_t types = collider_types();
+  for (std::uint32_t stage = 0; stage < 3; ++stage) {
+    const std::uint32_t t = stage == 0 ? 0u : types;
+    if (finish_pipes[stage][t])
+      continue;
+    std::array<std::uint32_t, 43> constants{};
+    constants[40] = stage; // SC_FINISH_STAGE
+    constants[41] = t;     // SC_COLLIDER_TYPES
+    auto p = ctx->pipelines->pipeline(PipelineRegistry::Shader::strain_finish, constants, {access, workgroup});
+    if (!p)
+      return p.error();
+    finish_pipes[stage][t] = *p;
   }
   return {};
 }

@@ -90,7 +90,10 @@ Result<void> StrainProjectionGpu::create_sets() {
   if (!pass)
     return pass.error();
   layout_ = pass->layout;
-  pass_ = pass->pipeline;
+  auto pipeline = ctx_->pipelines->pipeline(PipelineRegistry::Shader::strain_project, {});
+  if (!pipeline)
+    return pipeline.error();
+  pass_ = *pipeline;
   return {};
 }
 
