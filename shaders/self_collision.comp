@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: MIT
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// Self-collision (CpuSolver::self_collide; docs/model.md "Self-collision"), one pass per
-// stage (self_collision_shared.h; SC_SELF_STAGE below), after the substep's update and stretch control, on the
-// positions being written (POS_OUT). The spatial hash is a counting sort of the particles by
+// Self-collision (CpuSolver::self_collide; docs/model.md "Self-collision"), one pass per stage
+// (self_collision_shared.h), after the substep's update and stretch control, on the positions
+// being written (POS_OUT). The spatial hash is a counting sort of the particles by
 // bucket (of their cell keys): COUNT (integer atomics), prefix sums in two levels (SCAN_BLOCKS,
 // SCAN_TOP, then SCAN_ADD makes them absolute), SCATTER (slots in any order), then SORT (each
 // bucket's particles in increasing index): integer work only, so the table is the same on every
@@ -101,18 +101,14 @@ uint workgroup_exclusive_scan(uint value) {
   return partial[i];
 }
 
-// The pass this pipeline runs (SelfCollisionGpu makes one per pass): llvmpipe runs the code of
-// every branch, even one no invocation takes, so one pipeline for all passes made COUNT, SCAN and
-// APPLY pay for COLLIDE's walk. VKCLOTH_SELF_ANY_STAGE: pc.stage.
-#define VKCLOTH_SELF_ANY_STAGE 0xffffffffu
-layout(constant_id = 40) const uint SC_SELF_STAGE = VKCLOTH_SELF_ANY_STAGE;
-
+// One pipeline per pass (SC_STAGE; SelfCollisionGpu), so that on llvmpipe COUNT, the scans, SORT
+// and APPLY do not pay for COLLIDE's walk.
 void main() {
   begin_instance();
   const SelfParams sp = self_params[inst];
   if (sp.iterations == 0u || frozen())
     return;
-  const uint stage = SC_SELF_STAGE != VKCLOTH_SELF_ANY_STAGE ? SC_SELF_STAGE : pc.stage;
+  const uint stage = pass_stage();
   const uint mask = pc.pad0 - 1u;
   if (stage == VKCLOTH_SELF_SCAN_BLOCKS) {
     // Workgroup = one block of VKCLOTH_SELF_SCAN_BLOCK buckets; 8 consecutive buckets per invocation.

@@ -20,20 +20,15 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_TETHERS) readonly buffer Tethe
 uvec2 tether_at(uint s) { return uvec2(tethers[s].anchor, floatBitsToUint(tethers[s].rest_length)); }
 #endif
 
-// The stage this pipeline runs (SolverBatch::ensure_finish_passes makes one per stage): llvmpipe
-// runs the code of both sides of a branch, even one no invocation takes, so the tether pass
-// would pay for the colliders' projection (the mesh walk) in every invocation. The other
-// constants (SC_COLLIDER_TYPES: the batch's collider types for stages 1 and 2, none for the
-// tethers) compile out what the stage does not need. VKCLOTH_FINISH_ANY_STAGE: pc.stage.
-#define VKCLOTH_FINISH_ANY_STAGE 3u
-layout(constant_id = 40) const uint SC_FINISH_STAGE = VKCLOTH_FINISH_ANY_STAGE;
-
+// One pipeline per stage (SC_STAGE; SolverBatch::ensure_finish_passes), so that the tether pass
+// does not pay for the colliders' projection (the mesh walk) on llvmpipe; SC_COLLIDER_TYPES
+// compiles out the shapes the batch lacks (all of them for the tethers).
 void main() {
   begin_instance();
   const uint p = particle_index();
   if (p >= pc.count)
     return;
-  const uint stage = SC_FINISH_STAGE != VKCLOTH_FINISH_ANY_STAGE ? SC_FINISH_STAGE : pc.stage;
+  const uint stage = pass_stage();
   const bool tether_pass = stage == 0u;
   // Stage 1 projects after stretch control, stage 2 after self-collision: each only where it ran.
   const bool ran = stage == 1u ? ip.stretch != 0u : (ip.flags & VKCLOTH_FLAG_SELF_COLLISION) != 0u;

@@ -40,6 +40,13 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_MESH_TRIS) readonly buffer Mes
 layout(std430, set = 0, binding = VKCLOTH_BINDING_FLAGS) buffer FlagBuf { Flags flags[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_INSTANCES) readonly buffer InstanceBuf { InstanceParams instances[]; };
 
+// The pass this pipeline runs, fixed when it is made (pipelines.hpp ShaderVariant::stage): llvmpipe
+// runs the code of every branch, even one that no invocation takes, so a shader whose passes branch
+// on the stage (strain_finish, self_collision, implicit .comp) gets one pipeline per stage, the
+// others' code compiled out. VKCLOTH_ANY_STAGE (the default): pc.stage decides.
+layout(constant_id = VKCLOTH_STAGE_CONSTANT) const uint SC_STAGE = VKCLOTH_ANY_STAGE;
+uint pass_stage() { return SC_STAGE != VKCLOTH_ANY_STAGE ? SC_STAGE : pc.stage; }
+
 // This invocation's instance of the batch, the index of its particle 0 in the state buffers and
 // its parameters; set by begin_instance(), the first call of every main().
 uint inst;

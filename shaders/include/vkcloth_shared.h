@@ -18,6 +18,11 @@ struct vec4 {
 // Invocations per workgroup (1-D). Dispatches round up and every shader guards `p < count`.
 #define VKCLOTH_WORKGROUP_SIZE 64
 
+// The specialisation constant that fixes the pass a pipeline runs (common.glsl SC_STAGE; the host:
+// pipelines.hpp ShaderVariant::stage); VKCLOTH_ANY_STAGE: the push constants' `stage` decides.
+#define VKCLOTH_STAGE_CONSTANT 44
+#define VKCLOTH_ANY_STAGE 0xffffffffu
+
 // Batches: one dispatch serves every instance (cloth) of a batch that shares one topology;
 // instance = gl_WorkGroupID.z. Per-particle state buffers hold the instances one after the other
 // (instance i's particle p at i * count + p); topology buffers (PARTICLE, OFFSETS, EDGES) are

@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <span>
 #include <vector>
 #include <tuple>
 
@@ -73,7 +74,8 @@ Result<void> ImplicitGpu::create_buffers(std::uint64_t entries, bool allow_map) 
   return {};
 }
 
-// The Context's layouts and pipelines; this batch's pool and two sets (position parity).
+// The Context's layouts and pipelines (one per pass this batch records: implicit.comp
+// specialised with its mode, ShaderVariant::stage); this batch's pool and two sets (position parity).
 Result<void> ImplicitGpu::create_pipelines() {
   Context::Impl& ctx = *ctx_;
   auto layouts = ctx.pipelines->implicit_layouts();
@@ -83,10 +85,18 @@ Result<void> ImplicitGpu::create_pipelines() {
   layout_ = layouts->layout;
   VKCLOTH_TRY(create_parity_sets(ctx, set_layout_, static_cast<std::uint32_t>(implicit_bindings().size()),
                                  pool_, sets_, "implicit"));
-  auto pp = ctx.pipelines->pipeline(PipelineRegistry::Shader::implicit, {});
-  if (!pp)
-    return pp.error();
-  pass_ = *pp;
+  const std::uint32_t one_workgroup[] = {VKCLOTH_IMPL_FORCE, VKCLOTH_IMPL_SYSTEM, VKCLOTH_IMPL_SOLVE,
+                                         VKCLOTH_IMPL_FINISH};
+  const std::uint32_t per_iteration[] = {VKCLOTH_IMPL_FORCE,  VKCLOTH_IMPL_SYSTEM,    VKCLOTH_IMPL_MATVEC,
+                                         VKCLOTH_IMPL_UPDATE, VKCLOTH_IMPL_DIRECTION, VKCLOTH_IMPL_FINISH};
+  for (std::uint32_t mode : budget_ > 0 ? std::span<const std::uint32_t>(one_workgroup)
+                                        : std::span<const std::uint32_t>(per_iteration)) {
+    auto pp =
+        ctx.pipelines->pipeline(PipelineRegistry::Shader::implicit, {}, {BufferAccess::texel_views, 0, mode});
+    if (!pp)
+      return pp.error();
+    passes_[mode] = *pp;
+  }
   return {};
 }
 
@@ -158,7 +168,6 @@ std::uint32_t ImplicitGpu::record_substep(VkCommandBuffer c, std::uint32_t read,
   pc.c_next = tol * tol; // as CpuSolver<float>: Real(tol) * Real(tol)
   pc.pad0 = params.cg_max_iterations;
   v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &sets_[read], 0, nullptr);
-  v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, pass_);
   bool need_barrier = !first;
   std::uint32_t dispatches = 0;
   enum class Groups { all, one, indirect }; // every particle's group; one workgroup; CgArgs
@@ -166,6 +175,7 @@ std::uint32_t ImplicitGpu::record_substep(VkCommandBuffer c, std::uint32_t read,
     if (need_barrier)
       barriers::implicit_pass(v, c); // previous pass -> this one (RAW, WAR, indirect args)
     need_barrier = true;
+    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, passes_[stage]);
     pc.stage = stage;
     ++dispatches;
     v.vkCmdPushConstants(c, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);

@@ -23,6 +23,7 @@
 
 #include "resources.hpp"
 #include "vkcloth/params.hpp"
+#include "implicit_shared.h"
 #include "vkcloth_shared.h"
 
 namespace vkcloth::gpu {
@@ -70,7 +71,7 @@ private:
   // The Context's (PipelineRegistry), shared by every implicit batch.
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
-  VkPipeline pass_ = VK_NULL_HANDLE;
+  VkPipeline passes_[VKCLOTH_IMPL_SOLVE + 1] = {}; // [mode]: implicit.comp specialised with it (SC_STAGE)
 
   Result<void> create_buffers(std::uint64_t entries, bool allow_map);
   Result<void> create_pipelines();

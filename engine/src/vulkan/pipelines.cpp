@@ -277,7 +277,8 @@ Result<VkPipeline> PipelineRegistry::pipeline(Shader shader, std::span<const std
   auto m = module_locked(shader, variant.access);
   if (!m)
     return m.error();
-  // Constants 0..size-1, then the workgroup size (kWorkgroupSizeConstant) when it is not the compiled one.
+  // Constants 0..size-1, then the workgroup size (kWorkgroupSizeConstant) when it is not the
+  // compiled one, then the stage.
   std::vector<std::uint32_t> words(constants.begin(), constants.end());
   std::vector<VkSpecializationMapEntry> entries(constants.size());
   for (std::uint32_t k = 0; k < entries.size(); ++k)
@@ -286,6 +287,11 @@ Result<VkPipeline> PipelineRegistry::pipeline(Shader shader, std::span<const std
     static_assert(kWorkgroupSizeConstant >= 43, "after the solver's constants 0..42");
     entries.push_back({kWorkgroupSizeConstant, static_cast<std::uint32_t>(words.size() * 4), 4});
     words.push_back(variant.workgroup_size);
+  }
+  if (variant.stage != VKCLOTH_ANY_STAGE) {
+    static_assert(VKCLOTH_STAGE_CONSTANT > kWorkgroupSizeConstant);
+    entries.push_back({VKCLOTH_STAGE_CONSTANT, static_cast<std::uint32_t>(words.size() * 4), 4});
+    words.push_back(variant.stage);
   }
   const VkSpecializationInfo spec{static_cast<std::uint32_t>(entries.size()), entries.data(),
                                   words.size() * sizeof(std::uint32_t), words.data()};

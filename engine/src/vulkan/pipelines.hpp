@@ -9,6 +9,7 @@
 #pragma once
 
 #include "resources.hpp"
+#include "vkcloth_shared.h"
 #include "vkcloth/gpu/layout.hpp"
 
 #include <map>
@@ -34,13 +35,15 @@ DeviceLayout device_layout(const Context::Impl& ctx);
 /// solver's constants 0..42 (solver_pipelines.cpp).
 inline constexpr std::uint32_t kWorkgroupSizeConstant = 43;
 
-/// Which build of a shader and its workgroup size (DeviceLayout). force, integrate, fused and
-/// strain_*, self_collision have a *_texel and a *_storage build; the others one build, `access`
-/// ignored.
-/// `workgroup_size` 0: the compiled VKCLOTH_WORKGROUP_SIZE (implicit*.comp: always).
+/// Which build of a shader, its workgroup size (DeviceLayout) and the pass it runs. force,
+/// integrate, fused and strain_*, self_collision have a *_texel and a *_storage build; the others
+/// one build, `access` ignored. `workgroup_size` 0: the compiled VKCLOTH_WORKGROUP_SIZE
+/// (implicit*.comp: always). `stage` (constant VKCLOTH_STAGE_CONSTANT, common.glsl SC_STAGE): the
+/// one pass of a multi-pass shader this pipeline runs, or VKCLOTH_ANY_STAGE (the push constant's).
 struct ShaderVariant {
   BufferAccess access = BufferAccess::texel_views;
   std::uint32_t workgroup_size = 0;
+  std::uint32_t stage = VKCLOTH_ANY_STAGE;
   auto operator<=>(const ShaderVariant&) const = default;
 };
 
@@ -84,7 +87,8 @@ public:
   Result<ImplicitLayouts> strain_project_layouts();
   using Variant = ShaderVariant;
   /// The pipeline of `shader` specialised with `constants` (ids 0..size-1, 32 bits each; empty:
-  /// none) and, when `variant.workgroup_size` is set, constant kWorkgroupSizeConstant; created on
+  /// none), when `variant.workgroup_size` is set constant kWorkgroupSizeConstant, and when
+  /// `variant.stage` is set constant VKCLOTH_STAGE_CONSTANT; created on
   /// first request; its layout is solver_layouts(), implicit_layouts(), self_collision_layouts() or
   /// strain_project_layouts().
   Result<VkPipeline> pipeline(Shader shader, std::span<const std::uint32_t> constants, Variant variant = {});

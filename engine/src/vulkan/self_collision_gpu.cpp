@@ -64,17 +64,16 @@ Result<void> SelfCollisionGpu::create_buffers(bool allow_map) {
   return {};
 }
 
-// The Context's layout and pipelines (one per pass, SC_SELF_STAGE); this batch's pool and two
+// The Context's layout and pipelines (one per pass: ShaderVariant::stage); this batch's pool and two
 // sets (position parity), and for the texel build a pool and two sets of views.
 Result<void> SelfCollisionGpu::create_sets() {
-  auto pass = create_one_set_pass(*ctx_, PipelineRegistry::Shader::self_collision, pool_, sets_, "self-collision");
+  auto pass =
+      create_one_set_pass(*ctx_, PipelineRegistry::Shader::self_collision, pool_, sets_, "self-collision");
   if (!pass)
     return pass.error();
   layout_ = pass->layout;
   for (std::uint32_t stage = 0; stage < kPasses; ++stage) {
-    std::array<std::uint32_t, 41> constants{};
-    constants[40] = stage; // SC_SELF_STAGE
-    auto p = ctx_->pipelines->pipeline(PipelineRegistry::Shader::self_collision, constants, {access_, 0});
+    auto p = ctx_->pipelines->pipeline(PipelineRegistry::Shader::self_collision, {}, {access_, 0, stage});
     if (!p)
       return p.error();
     passes_[stage] = *p;

@@ -66,7 +66,7 @@ private:
   // The Context's (PipelineRegistry), shared by every batch.
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
   static constexpr std::uint32_t kPasses = VKCLOTH_SELF_APPLY + 1;
-  VkPipeline passes_[kPasses] = {}; // [stage]: self_collision.comp specialised with SC_SELF_STAGE
+  VkPipeline passes_[kPasses] = {}; // [stage]: self_collision.comp specialised with its stage (SC_STAGE)
 
   Result<void> create_buffers(bool allow_map);
   Result<void> create_sets();

@@ -184,7 +184,7 @@ private:
   VkPipeline force_pipeline = VK_NULL_HANDLE, integrate_pipeline = VK_NULL_HANDLE;
   VkPipeline strain_links_pipeline = VK_NULL_HANDLE;
   VkPipeline vertices_pipeline = VK_NULL_HANDLE;
-  // strain_finish.comp per stage (SC_FINISH_STAGE: 0 tethers, 1 after stretch control, 2 after
+  // strain_finish.comp per stage (SC_STAGE: 0 tethers, 1 after stretch control, 2 after
   // self-collision) and collider types (as fused_pipes; the tethers' always 0): [stage][types],
   // looked up when first needed (ensure_finish_passes).
   VkPipeline finish_pipes[3][VKCLOTH_COLLIDER_ALL_TYPES + 1] = {};

@@ -118,7 +118,8 @@ void SolverBatch::record_finish_pass(VkCommandBuffer c, std::uint32_t read, std:
   // Set 1 of the positions being written: the pass reads positions[write] through its texel view.
   const VkDescriptorSet bound_sets[2] = {sets[read][0], texel_sets[read ^ 1u]};
   v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 2, bound_sets, 0, nullptr);
-  v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, finish_pipes[stage][stage == 0 ? 0u : collider_types()]);
+  v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE,
+                      finish_pipes[stage][stage == 0 ? 0u : collider_types()]);
   sh::PushConstants spc = pc;
   spc.stage = stage;
   v.vkCmdPushConstants(c, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(spc), &spc);

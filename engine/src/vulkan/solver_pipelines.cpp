@@ -245,10 +245,10 @@ Result<void> SolverBatch::ensure_finish_passes() {
     const std::uint32_t t = stage == 0 ? 0u : types;
     if (finish_pipes[stage][t])
       continue;
-    std::array<std::uint32_t, 43> constants{};
-    constants[40] = stage; // SC_FINISH_STAGE
-    constants[41] = t;     // SC_COLLIDER_TYPES
-    auto p = ctx->pipelines->pipeline(PipelineRegistry::Shader::strain_finish, constants, {access, workgroup});
+    std::array<std::uint32_t, 42> constants{}; // strain_finish.comp has only 41 of the ids 0..41
+    constants[41] = t;                         // SC_COLLIDER_TYPES
+    auto p = ctx->pipelines->pipeline(PipelineRegistry::Shader::strain_finish, constants,
+                                      {access, workgroup, stage});
     if (!p)
       return p.error();
     finish_pipes[stage][t] = *p;
