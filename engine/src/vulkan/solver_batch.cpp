@@ -382,7 +382,7 @@ Result<void> SolverBatch::set_params(std::uint32_t slot, SimParams params) {
     VKCLOTH_TRY(ensure_mesh_buffers());
     VKCLOTH_TRY(ensure_implicit());
     VKCLOTH_TRY(ensure_fused());
-    VKCLOTH_TRY(ensure_finish_passes());
+    VKCLOTH_TRY(ensure_collider_pipelines());
     VKCLOTH_TRY(ensure_self_collision());
     VKCLOTH_TRY(ensure_projection());
     return ensure_tethers();
@@ -818,7 +818,7 @@ SolverBatch::create(const std::shared_ptr<Context::Impl>& ctx, CommandContext& c
   VKCLOTH_TRY(s.write_sets());
   VKCLOTH_TRY(s.ensure_implicit());
   VKCLOTH_TRY(s.ensure_fused());
-  VKCLOTH_TRY(s.ensure_finish_passes());
+  VKCLOTH_TRY(s.ensure_collider_pipelines());
   s.write_params_now();
   VKCLOTH_TRY(s.upload_initial_state(topology, states));
   VKCLOTH_TRY(s.ensure_tethers());

@@ -181,12 +181,15 @@ private:
   // Layouts and pipelines: the Context's (PipelineRegistry, pipelines.hpp), shared by every batch.
   VkDescriptorSetLayout set_layout = VK_NULL_HANDLE, texel_layout = VK_NULL_HANDLE;
   VkPipelineLayout layout = VK_NULL_HANDLE;
-  VkPipeline force_pipeline = VK_NULL_HANDLE, integrate_pipeline = VK_NULL_HANDLE;
+  // force.comp and integrate.comp (the two-pass layout, RK4) per collider types (as fused_pipes),
+  // looked up when first needed (ensure_collider_pipelines).
+  VkPipeline force_pipes[VKCLOTH_COLLIDER_ALL_TYPES + 1] = {};
+  VkPipeline integrate_pipes[VKCLOTH_COLLIDER_ALL_TYPES + 1] = {};
   VkPipeline strain_links_pipeline = VK_NULL_HANDLE;
   VkPipeline vertices_pipeline = VK_NULL_HANDLE;
   // strain_finish.comp per stage (SC_STAGE: 0 tethers, 1 after stretch control, 2 after
   // self-collision) and collider types (as fused_pipes; the tethers' always 0): [stage][types],
-  // looked up when first needed (ensure_finish_passes).
+  // looked up when first needed (ensure_collider_pipelines).
   VkPipeline finish_pipes[3][VKCLOTH_COLLIDER_ALL_TYPES + 1] = {};
   // fused.comp variants, looked up when first needed (ensure_fused): [write_aux][collider types].
   // write_aux = 0 (SC_WRITE_AUX false: no force and normal stores) for every fused substep of a
@@ -280,7 +283,7 @@ private:
   Result<void> write_sets();
   Result<void> ensure_implicit();
   Result<void> ensure_fused();
-  Result<void> ensure_finish_passes();
+  Result<void> ensure_collider_pipelines();
   Result<void> ensure_tethers();
   Result<void> ensure_self_collision();
   Result<void> ensure_projection();

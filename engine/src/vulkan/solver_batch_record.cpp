@@ -204,10 +204,10 @@ void SolverBatch::record_update(VkCommandBuffer c, bool first, bool last) {
     v.vkCmdPushConstants(c, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
     if (!first || k > 0)
       barriers::dispatch_to_dispatch(v, c); // integrate (previous stage/step) -> force
-    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, force_pipeline);
+    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, force_pipes[collider_types()]);
     v.vkCmdDispatch(c, groups_x, groups_y, instances_z);
     barriers::dispatch_to_dispatch(v, c); // force -> integrate
-    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, integrate_pipeline);
+    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, integrate_pipes[collider_types()]);
     v.vkCmdDispatch(c, groups_x, groups_y, instances_z);
     dispatches_ += 2;
   }

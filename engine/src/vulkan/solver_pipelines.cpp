@@ -193,21 +193,12 @@ Result<void> SolverBatch::create_buffer_views() {
   return {};
 }
 
-// force.comp (specialised with the grid stencil and the fan switch; contact loops kept, the
-// default), integrate.comp, the stretch passes and vertices.comp, from the Context's registry, in
-// the batch's build (texel views or storage buffers) and workgroup size (resolve_layout).
+// Provot's sweeps and vertices.comp, from the Context's registry, in the batch's build (texel
+// views or storage buffers) and workgroup size (resolve_layout); the passes specialised with the
+// batch's collider types come from ensure_fused and ensure_collider_pipelines.
 Result<void> SolverBatch::create_pipelines() {
   using Shader = PipelineRegistry::Shader;
-  const auto constants = solver_constants(stencil, true, VKCLOTH_COLLIDER_ALL_TYPES, normals);
   const PipelineRegistry::Variant variant{access, workgroup};
-  auto fp = ctx->pipelines->pipeline(Shader::force, constants, variant);
-  if (!fp)
-    return fp.error();
-  force_pipeline = *fp;
-  auto ip = ctx->pipelines->pipeline(Shader::integrate, {}, variant);
-  if (!ip)
-    return ip.error();
-  integrate_pipeline = *ip;
   auto lp = ctx->pipelines->pipeline(Shader::strain_links, {}, variant);
   if (!lp)
     return lp.error();
@@ -237,10 +228,27 @@ Result<void> SolverBatch::ensure_fused() {
   return {};
 }
 
-// The strain_finish.comp variants the current parameters need: the tethers' stage (no collider
-// code), and the colliders' stages for the collider types in the batch; each made once per Context.
-Result<void> SolverBatch::ensure_finish_passes() {
+// The variants the current parameters need of the passes specialised with the batch's collider
+// types (SC_COLLIDER_TYPES, as ensure_fused): force.comp (with the grid stencil and the fan
+// switch) and integrate.comp where the batch runs the two-pass layout, and strain_finish.comp per
+// stage (the tethers' with no collider code); each made once per Context.
+Result<void> SolverBatch::ensure_collider_pipelines() {
+  using Shader = PipelineRegistry::Shader;
   const std::uint32_t types = collider_types();
+  const Integrator integrator = family().integrator;
+  const bool two_pass =
+      integrator != Integrator::implicit_euler && (!options.fused || integrator == Integrator::rk4);
+  if (two_pass && !force_pipes[types]) {
+    const auto constants = solver_constants(stencil, true, types, normals);
+    auto fp = ctx->pipelines->pipeline(Shader::force, constants, {access, workgroup});
+    if (!fp)
+      return fp.error();
+    auto ip = ctx->pipelines->pipeline(Shader::integrate, constants, {access, workgroup});
+    if (!ip)
+      return ip.error();
+    force_pipes[types] = *fp;
+    integrate_pipes[types] = *ip;
+  }
   for (std::uint32_t stage = 0; stage < 3; ++stage) {
     const std::uint32_t t = stage == 0 ? 0u : types;
     if (finish_pipes[stage][t])
