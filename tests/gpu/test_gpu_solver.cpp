@@ -357,14 +357,16 @@ TEST_CASE("GPU blow-up detection names the exact step") {
   }
 }
 
-// The two-pass layout's force and integrate passes (and RK4's) are specialised with the collider
-// types of the batch, as the fused pass (SolverBatch::ensure_collider_pipelines): colliders that
-// set_params adds between steps must reach them. The falling cloth without its colliders for 30
-// steps, then with its plane and sphere (two new types) for 60.
-TEST_CASE("GPU two-pass and RK4 passes follow colliders added by set_params, as the CPU") {
+// The two-pass layout's force and integrate passes (and RK4's, and implicit Euler's FORCE and
+// FINISH) are specialised with the collider types of the batch, as the fused pass
+// (SolverBatch::ensure_collider_pipelines): colliders that set_params adds between steps must
+// reach them. The falling cloth without its colliders for 30 steps, then with its plane and
+// sphere (two new types) for 60.
+TEST_CASE("GPU two-pass, RK4 and implicit passes follow colliders added by set_params, as the CPU") {
   VKCLOTH_GPU_TEST_BEGIN(ctx);
   const TestScene with = falling_cloth();
-  for (Integrator integrator : {Integrator::semi_implicit_euler, Integrator::rk4}) {
+  for (Integrator integrator :
+       {Integrator::semi_implicit_euler, Integrator::rk4, Integrator::implicit_euler}) {
     CAPTURE(to_string(integrator));
     SimParams bare = with.params;
     bare.integrator = integrator;
@@ -386,7 +388,8 @@ TEST_CASE("GPU two-pass and RK4 passes follow colliders added by set_params, as 
     auto gp = gpu->positions();
     REQUIRE(gp.ok());
     const Diff d = diff(*gp, cpu->positions());
-    MESSAGE(std::string(to_string(integrator)) << " two-pass, colliders from step 30: max |p_gpu - p_cpu| = " << d.max_abs);
+    MESSAGE(std::string(to_string(integrator))
+            << " two-pass, colliders from step 30: max |p_gpu - p_cpu| = " << d.max_abs);
     CHECK(d.max_abs <= tolerance);
     // The colliders acted: the cloth ends higher than it would without them.
     auto free_fall = CpuSolver<float>::create(with.system, bare);

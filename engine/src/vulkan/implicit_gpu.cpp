@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <span>
+#include <utility>
 #include <vector>
 #include <tuple>
 
@@ -85,10 +86,10 @@ Result<void> ImplicitGpu::create_pipelines() {
   layout_ = layouts->layout;
   VKCLOTH_TRY(create_parity_sets(ctx, set_layout_, static_cast<std::uint32_t>(implicit_bindings().size()),
                                  pool_, sets_, "implicit"));
-  const std::uint32_t one_workgroup[] = {VKCLOTH_IMPL_FORCE, VKCLOTH_IMPL_SYSTEM, VKCLOTH_IMPL_SOLVE,
-                                         VKCLOTH_IMPL_FINISH};
-  const std::uint32_t per_iteration[] = {VKCLOTH_IMPL_FORCE,  VKCLOTH_IMPL_SYSTEM,    VKCLOTH_IMPL_MATVEC,
-                                         VKCLOTH_IMPL_UPDATE, VKCLOTH_IMPL_DIRECTION, VKCLOTH_IMPL_FINISH};
+  // FORCE and FINISH come per collider types (ensure_collider_passes).
+  const std::uint32_t one_workgroup[] = {VKCLOTH_IMPL_SYSTEM, VKCLOTH_IMPL_SOLVE};
+  const std::uint32_t per_iteration[] = {VKCLOTH_IMPL_SYSTEM, VKCLOTH_IMPL_MATVEC, VKCLOTH_IMPL_UPDATE,
+                                         VKCLOTH_IMPL_DIRECTION};
   for (std::uint32_t mode : budget_ > 0 ? std::span<const std::uint32_t>(one_workgroup)
                                         : std::span<const std::uint32_t>(per_iteration)) {
     auto pp =
@@ -96,6 +97,21 @@ Result<void> ImplicitGpu::create_pipelines() {
     if (!pp)
       return pp.error();
     passes_[mode] = *pp;
+  }
+  return {};
+}
+
+Result<void> ImplicitGpu::ensure_collider_passes(std::uint32_t types,
+                                                 std::span<const std::uint32_t> constants) {
+  if (force_passes_[types])
+    return {};
+  for (auto [mode, pass] : {std::pair{VKCLOTH_IMPL_FORCE, &force_passes_[types]},
+                            std::pair{VKCLOTH_IMPL_FINISH, &finish_passes_[types]}}) {
+    auto pp = ctx_->pipelines->pipeline(PipelineRegistry::Shader::implicit, constants,
+                                        {BufferAccess::texel_views, 0, mode});
+    if (!pp)
+      return pp.error();
+    *pass = *pp;
   }
   return {};
 }
@@ -168,6 +184,9 @@ std::uint32_t ImplicitGpu::record_substep(VkCommandBuffer c, std::uint32_t read,
   pc.c_next = tol * tol; // as CpuSolver<float>: Real(tol) * Real(tol)
   pc.pad0 = params.cg_max_iterations;
   v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &sets_[read], 0, nullptr);
+  std::uint32_t types = 0; // as SolverBatch::collider_types, for this batch's one instance
+  for (const Collider& col : params.colliders)
+    types |= 1u << std::uint32_t(col.type);
   bool need_barrier = !first;
   std::uint32_t dispatches = 0;
   enum class Groups { all, one, indirect }; // every particle's group; one workgroup; CgArgs
@@ -175,7 +194,10 @@ std::uint32_t ImplicitGpu::record_substep(VkCommandBuffer c, std::uint32_t read,
     if (need_barrier)
       barriers::implicit_pass(v, c); // previous pass -> this one (RAW, WAR, indirect args)
     need_barrier = true;
-    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, passes_[stage]);
+    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE,
+                        stage == VKCLOTH_IMPL_FORCE    ? force_passes_[types]
+                        : stage == VKCLOTH_IMPL_FINISH ? finish_passes_[types]
+                                                       : passes_[stage]);
     pc.stage = stage;
     ++dispatches;
     v.vkCmdPushConstants(c, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);

@@ -20,6 +20,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 
 #include "resources.hpp"
 #include "vkcloth/params.hpp"
@@ -51,6 +52,10 @@ public:
 
   /// (Re)writes the two descriptor sets (position parity); call again when an input buffer changes.
   Result<void> write_sets(const ImplicitInputs& in);
+  /// The FORCE and FINISH passes (the ones that meet colliders) for collider types `types`,
+  /// specialised with `constants` (force_body.glsl's, SC_COLLIDER_TYPES = types); made once per
+  /// types (SolverBatch::ensure_collider_pipelines), before a substep with them is recorded.
+  Result<void> ensure_collider_passes(std::uint32_t types, std::span<const std::uint32_t> constants);
   /// Records one substep reading positions[read], writing positions[read ^ 1]. `pc` is the main
   /// push-constant block (the substep's dt is in the InstanceParams); `first`: no barrier needed before the
   /// first pass. Returns the number of dispatches recorded.
@@ -71,7 +76,10 @@ private:
   // The Context's (PipelineRegistry), shared by every implicit batch.
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
-  VkPipeline passes_[VKCLOTH_IMPL_SOLVE + 1] = {}; // [mode]: implicit.comp specialised with it (SC_STAGE)
+  // [mode]: implicit.comp specialised with it (SC_STAGE); FORCE and FINISH per collider types.
+  VkPipeline passes_[VKCLOTH_IMPL_SOLVE + 1] = {};
+  VkPipeline force_passes_[VKCLOTH_COLLIDER_ALL_TYPES + 1] = {},
+                                                        finish_passes_[VKCLOTH_COLLIDER_ALL_TYPES + 1] = {};
 
   Result<void> create_buffers(std::uint64_t entries, bool allow_map);
   Result<void> create_pipelines();

@@ -238,6 +238,11 @@ Result<void> SolverBatch::ensure_collider_pipelines() {
   const Integrator integrator = family().integrator;
   const bool two_pass =
       integrator != Integrator::implicit_euler && (!options.fused || integrator == Integrator::rk4);
+  if (implicit) { // its FORCE and FINISH passes: CSR gather (no stencil), every normal path as the flags say
+    auto words = solver_constants(Stencil{}, true, types, Normals::grid); // Stencil{}: the defaults
+    words[42] = VKCLOTH_FLAG_HAS_GRID | VKCLOTH_FLAG_RING_NORMALS; // SC_NORMAL_FLAGS: both, the default
+    VKCLOTH_TRY(implicit->ensure_collider_passes(types, words));
+  }
   if (two_pass && !force_pipes[types]) {
     const auto constants = solver_constants(stencil, true, types, normals);
     auto fp = ctx->pipelines->pipeline(Shader::force, constants, {access, workgroup});
