@@ -389,7 +389,7 @@ TEST_CASE("GPU two-pass, RK4 and implicit passes follow colliders added by set_p
     REQUIRE(gp.ok());
     const Diff d = diff(*gp, cpu->positions());
     MESSAGE(std::string(to_string(integrator))
-            << " two-pass, colliders from step 30: max |p_gpu - p_cpu| = " << d.max_abs);
+            << " (fused = false), colliders from step 30: max |p_gpu - p_cpu| = " << d.max_abs);
     CHECK(d.max_abs <= tolerance);
     // The colliders acted: the cloth ends higher than it would without them.
     auto free_fall = CpuSolver<float>::create(with.system, bare);
