@@ -78,8 +78,8 @@ private:
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
   // [mode]: implicit.comp specialised with it (SC_STAGE); FORCE and FINISH per collider types.
   VkPipeline passes_[VKCLOTH_IMPL_SOLVE + 1] = {};
-  VkPipeline force_passes_[VKCLOTH_COLLIDER_ALL_TYPES + 1] = {},
-                                                        finish_passes_[VKCLOTH_COLLIDER_ALL_TYPES + 1] = {};
+  VkPipeline force_passes_[VKCLOTH_COLLIDER_ALL_TYPES + 1] = {};
+  VkPipeline finish_passes_[VKCLOTH_COLLIDER_ALL_TYPES + 1] = {};
 
   Result<void> create_buffers(std::uint64_t entries, bool allow_map);
   Result<void> create_pipelines();

@@ -254,14 +254,20 @@ Result<void> SolverBatch::ensure_collider_pipelines() {
     force_pipes[types] = *fp;
     integrate_pipes[types] = *ip;
   }
+  // strain_finish.comp's stages where record_stretch and record_substep use them: the tethers, the
+  // colliders after stretch control, the colliders after self-collision.
+  bool tethered = false;
+  for (const Slot& s : slots)
+    tethered = tethered || s.params.stretch_limit.tethers();
+  const bool needed[3] = {tethered, any_stretch() && any_colliders(),
+                          self_iterations() > 0 && any_colliders()};
   for (std::uint32_t stage = 0; stage < 3; ++stage) {
     const std::uint32_t t = stage == 0 ? 0u : types;
-    if (finish_pipes[stage][t])
+    if (!needed[stage] || finish_pipes[stage][t])
       continue;
-    std::array<std::uint32_t, 42> constants{}; // strain_finish.comp has only 41 of the ids 0..41
+    std::array<std::uint32_t, 42> constants{}; // ids 0..41, of which strain_finish.comp has only 41
     constants[41] = t;                         // SC_COLLIDER_TYPES
-    auto p = ctx->pipelines->pipeline(PipelineRegistry::Shader::strain_finish, constants,
-                                      {access, workgroup, stage});
+    auto p = ctx->pipelines->pipeline(Shader::strain_finish, constants, {access, workgroup, stage});
     if (!p)
       return p.error();
     finish_pipes[stage][t] = *p;
