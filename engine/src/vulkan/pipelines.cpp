@@ -2,6 +2,8 @@
 #include "pipelines.hpp"
 
 #include <array>
+#include <string>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -110,6 +112,36 @@ constexpr std::uint32_t kStrainProjectBindings[] = {
     VKCLOTH_BINDING_PROJ_INCIDENCE, VKCLOTH_BINDING_PROJ_LINKS, VKCLOTH_BINDING_PROJ_GATHER,
     VKCLOTH_BINDING_PROJ_STATE,     VKCLOTH_BINDING_PROJ_ARGS};
 
+/// Set 0 of `storage` storage buffers and, unless `texel` is empty, set 1 of `texel` uniform texel
+/// buffer views (into *texel_set), and their pipeline layout with the push constants; named `name`.
+Result<void> create_layouts(Context::Impl& ctx, std::span<const std::uint32_t> storage,
+                            std::span<const std::uint32_t> texel, const std::string& name,
+                            DescriptorSetLayout& storage_set, DescriptorSetLayout* texel_set,
+                            PipelineLayout& layout) {
+  auto sl = create_compute_set_layout(ctx, storage, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, name.c_str());
+  if (!sl)
+    return sl.error();
+  std::vector<VkDescriptorSetLayout> sets{*sl};
+  DescriptorSetLayout tl;
+  if (!texel.empty()) {
+    auto t = create_compute_set_layout(ctx, texel, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER,
+                                       (name + " texel views").c_str());
+    if (!t)
+      return t.error();
+    tl = std::move(*t);
+    sets.push_back(tl);
+  }
+  auto pl = create_pipeline_layout(ctx, sets, VK_SHADER_STAGE_COMPUTE_BIT, sizeof(shared::PushConstants),
+                                   name.c_str());
+  if (!pl)
+    return pl.error();
+  storage_set = std::move(*sl);
+  if (texel_set)
+    *texel_set = std::move(tl);
+  layout = std::move(*pl);
+  return {};
+}
+
 } // namespace
 
 std::span<const std::uint32_t> implicit_bindings() {
@@ -150,27 +182,14 @@ Result<PipelineRegistry::SolverLayouts> PipelineRegistry::solver_layouts_locked(
     std::array<std::uint32_t, VKCLOTH_BINDING_COUNT> storage{};
     for (std::uint32_t i = 0; i < storage.size(); ++i)
       storage[i] = i;
-    auto sl = create_compute_set_layout(ctx_, storage, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, "solver");
-    if (!sl)
-      return sl.error();
     const std::uint32_t texel[] = {
         VKCLOTH_TEXEL_BINDING_POS_IN,    VKCLOTH_TEXEL_BINDING_PARTICLE,     VKCLOTH_TEXEL_BINDING_VEL,
         VKCLOTH_TEXEL_BINDING_FLAGS,     VKCLOTH_TEXEL_BINDING_INSTANCES,    VKCLOTH_TEXEL_BINDING_RANGES,
         VKCLOTH_TEXEL_BINDING_EDGES,     VKCLOTH_TEXEL_BINDING_STRAIN_LINKS, VKCLOTH_TEXEL_BINDING_TETHERS,
         VKCLOTH_TEXEL_BINDING_COLLIDERS, VKCLOTH_TEXEL_BINDING_MESH_NODES,   VKCLOTH_TEXEL_BINDING_MESH_TRIS};
     static_assert(std::size(texel) == VKCLOTH_TEXEL_BINDING_COUNT);
-    auto tl =
-        create_compute_set_layout(ctx_, texel, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, "solver texel views");
-    if (!tl)
-      return tl.error();
-    const VkDescriptorSetLayout sets[2] = {*sl, *tl};
-    auto pl = create_pipeline_layout(ctx_, sets, VK_SHADER_STAGE_COMPUTE_BIT, sizeof(shared::PushConstants),
-                                     "solver");
-    if (!pl)
-      return pl.error();
-    solver_storage_ = std::move(*sl);
-    solver_texel_ = std::move(*tl);
-    solver_layout_ = std::move(*pl);
+    VKCLOTH_TRY(
+        create_layouts(ctx_, storage, texel, "solver", solver_storage_, &solver_texel_, solver_layout_));
   }
   return SolverLayouts{solver_storage_, solver_texel_, solver_layout_};
 }
@@ -187,25 +206,9 @@ Result<PipelineRegistry::ImplicitLayouts> PipelineRegistry::self_collision_layou
 
 // Set 0: the storage buffers; set 1: the texel build's views (the storage build uses set 0 only).
 Result<PipelineRegistry::ImplicitLayouts> PipelineRegistry::self_collision_layouts_locked() {
-  if (!self_layout_) {
-    auto sl = create_compute_set_layout(ctx_, kSelfCollisionBindings, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-                                        "self-collision");
-    if (!sl)
-      return sl.error();
-    auto tl =
-        create_compute_set_layout(ctx_, kSelfCollisionTexelBindings, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER,
-                                  "self-collision texel views");
-    if (!tl)
-      return tl.error();
-    const VkDescriptorSetLayout sets[2] = {*sl, *tl};
-    auto pl = create_pipeline_layout(ctx_, sets, VK_SHADER_STAGE_COMPUTE_BIT, sizeof(shared::PushConstants),
-                                     "self-collision");
-    if (!pl)
-      return pl.error();
-    self_set_ = std::move(*sl);
-    self_texel_set_ = std::move(*tl);
-    self_layout_ = std::move(*pl);
-  }
+  if (!self_layout_)
+    VKCLOTH_TRY(create_layouts(ctx_, kSelfCollisionBindings, kSelfCollisionTexelBindings, "self-collision",
+                               self_set_, &self_texel_set_, self_layout_));
   return ImplicitLayouts{self_set_, self_layout_, self_texel_set_};
 }
 
@@ -218,18 +221,8 @@ Result<PipelineRegistry::ImplicitLayouts> PipelineRegistry::strain_project_layou
 Result<PipelineRegistry::ImplicitLayouts>
 PipelineRegistry::single_set_layouts_locked(std::span<const std::uint32_t> bindings, const char* name,
                                             DescriptorSetLayout& set, PipelineLayout& layout) {
-  if (!layout) {
-    auto sl = create_compute_set_layout(ctx_, bindings, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, name);
-    if (!sl)
-      return sl.error();
-    const VkDescriptorSetLayout sets[1] = {*sl};
-    auto pl =
-        create_pipeline_layout(ctx_, sets, VK_SHADER_STAGE_COMPUTE_BIT, sizeof(shared::PushConstants), name);
-    if (!pl)
-      return pl.error();
-    set = std::move(*sl);
-    layout = std::move(*pl);
-  }
+  if (!layout)
+    VKCLOTH_TRY(create_layouts(ctx_, bindings, {}, name, set, nullptr, layout));
   return ImplicitLayouts{set, layout};
 }
 
