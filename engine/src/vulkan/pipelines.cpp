@@ -194,36 +194,36 @@ Result<PipelineRegistry::SolverLayouts> PipelineRegistry::solver_layouts_locked(
   return SolverLayouts{solver_storage_, solver_texel_, solver_layout_};
 }
 
-Result<PipelineRegistry::ImplicitLayouts> PipelineRegistry::implicit_layouts() {
+Result<PipelineRegistry::PassLayouts> PipelineRegistry::implicit_layouts() {
   const std::lock_guard lock(mutex_);
   return single_set_layouts_locked(kImplicitBindings, "implicit", implicit_set_, implicit_layout_);
 }
 
-Result<PipelineRegistry::ImplicitLayouts> PipelineRegistry::self_collision_layouts() {
+Result<PipelineRegistry::PassLayouts> PipelineRegistry::self_collision_layouts() {
   const std::lock_guard lock(mutex_);
   return self_collision_layouts_locked();
 }
 
 // Set 0: the storage buffers; set 1: the texel build's views (the storage build uses set 0 only).
-Result<PipelineRegistry::ImplicitLayouts> PipelineRegistry::self_collision_layouts_locked() {
+Result<PipelineRegistry::PassLayouts> PipelineRegistry::self_collision_layouts_locked() {
   if (!self_layout_)
     VKCLOTH_TRY(create_layouts(ctx_, kSelfCollisionBindings, kSelfCollisionTexelBindings, "self-collision",
                                self_set_, &self_texel_set_, self_layout_));
-  return ImplicitLayouts{self_set_, self_layout_, self_texel_set_};
+  return PassLayouts{self_set_, self_layout_, self_texel_set_};
 }
 
-Result<PipelineRegistry::ImplicitLayouts> PipelineRegistry::strain_project_layouts() {
+Result<PipelineRegistry::PassLayouts> PipelineRegistry::strain_project_layouts() {
   const std::lock_guard lock(mutex_);
   return single_set_layouts_locked(kStrainProjectBindings, "strain projection", project_set_,
                                    project_layout_);
 }
 
-Result<PipelineRegistry::ImplicitLayouts>
+Result<PipelineRegistry::PassLayouts>
 PipelineRegistry::single_set_layouts_locked(std::span<const std::uint32_t> bindings, const char* name,
                                             DescriptorSetLayout& set, PipelineLayout& layout) {
   if (!layout)
     VKCLOTH_TRY(create_layouts(ctx_, bindings, {}, name, set, nullptr, layout));
-  return ImplicitLayouts{set, layout};
+  return PassLayouts{set, layout};
 }
 
 Result<VkShaderModule> PipelineRegistry::module_locked(Shader shader, BufferAccess access) {

@@ -67,9 +67,10 @@ public:
     VkDescriptorSetLayout storage = VK_NULL_HANDLE, texel = VK_NULL_HANDLE;
     VkPipelineLayout layout = VK_NULL_HANDLE;
   };
-  /// The one set of implicit.comp (or self_collision.comp, strain_project.comp) and its layout;
-  /// self_collision.comp's texel build also reads set 1, `texel` (the others: none).
-  struct ImplicitLayouts {
+  /// The layouts of a pass with its own storage set (implicit.comp, self_collision.comp,
+  /// strain_project.comp): that set and the pipeline layout; self_collision.comp's texel build also
+  /// reads set 1, `texel` (the others: none).
+  struct PassLayouts {
     VkDescriptorSetLayout set = VK_NULL_HANDLE;
     VkPipelineLayout layout = VK_NULL_HANDLE;
     VkDescriptorSetLayout texel = VK_NULL_HANDLE;
@@ -82,9 +83,9 @@ public:
   PipelineRegistry& operator=(const PipelineRegistry&) = delete;
 
   Result<SolverLayouts> solver_layouts();
-  Result<ImplicitLayouts> implicit_layouts();
-  Result<ImplicitLayouts> self_collision_layouts();
-  Result<ImplicitLayouts> strain_project_layouts();
+  Result<PassLayouts> implicit_layouts();
+  Result<PassLayouts> self_collision_layouts();
+  Result<PassLayouts> strain_project_layouts();
   using Variant = ShaderVariant;
   /// The pipeline of `shader` specialised with `constants` (ids 0..size-1, 32 bits each; empty:
   /// none), when `variant.workgroup_size` is set constant kWorkgroupSizeConstant, and when
@@ -103,9 +104,9 @@ public:
 private:
   Result<SolverLayouts> solver_layouts_locked();
   /// The layouts of a shader with one set of storage buffers (implicit.comp, self_collision.comp).
-  Result<ImplicitLayouts> single_set_layouts_locked(std::span<const std::uint32_t> bindings, const char* name,
-                                                    DescriptorSetLayout& set, PipelineLayout& layout);
-  Result<ImplicitLayouts> self_collision_layouts_locked();
+  Result<PassLayouts> single_set_layouts_locked(std::span<const std::uint32_t> bindings, const char* name,
+                                                DescriptorSetLayout& set, PipelineLayout& layout);
+  Result<PassLayouts> self_collision_layouts_locked();
   VkPipelineCache cache_locked();
   Result<VkShaderModule> module_locked(Shader shader, BufferAccess access);
 
