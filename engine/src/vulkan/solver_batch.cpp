@@ -395,10 +395,7 @@ Result<void> SolverBatch::set_params(std::uint32_t slot, SimParams params) {
 // The tethers of both rest-length kinds (VKCLOTH_BINDING_TETHERS: euclidean, then geodesic),
 // uploaded when an instance first asks for tethers; the buffer replaces the zeroed element.
 Result<void> SolverBatch::ensure_tethers() {
-  bool wanted = false;
-  for (const Slot& s : slots)
-    wanted = wanted || s.params.stretch_limit.tethers();
-  if (!wanted || tethers_uploaded)
+  if (!any_tethers() || tethers_uploaded)
     return {};
   // Two kinds x tethers_per_particle slots per particle, one RG32UI texel each: within the limits?
   const std::uint64_t slots_n = 2ull * count * tethers_per_particle;

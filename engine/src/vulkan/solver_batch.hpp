@@ -230,6 +230,12 @@ private:
         return true;
     return false;
   }
+  bool any_tethers() const {
+    for (const Slot& s : slots)
+      if (s.params.stretch_limit.tethers())
+        return true;
+    return false;
+  }
   /// The most Newton iterations of the fast projection an instance asks for (0: none uses it).
   std::uint32_t projection_iterations() const {
     std::uint32_t most = 0;

@@ -136,14 +136,12 @@ void SolverBatch::record_finish_pass(VkCommandBuffer c, std::uint32_t read, std:
 void SolverBatch::record_stretch(VkCommandBuffer c, std::uint32_t read) {
   const auto& v = vk();
   std::uint32_t sweeps = 0;
-  bool tethered = false;
   for (const Slot& s : slots) {
     const StretchLimit& sl = s.params.stretch_limit;
     if (sl.provot())
       sweeps = std::max(sweeps, sl.iterations);
-    tethered = tethered || sl.tethers();
   }
-  if (tethered)
+  if (any_tethers())
     record_finish_pass(c, read, 0); // binds the sets the sweeps use too
   // Set 1 of the positions being written: the sweeps read positions[write] through its texel view.
   const VkDescriptorSet bound_sets[2] = {sets[read][0], texel_sets[read ^ 1u]};

@@ -256,10 +256,7 @@ Result<void> SolverBatch::ensure_collider_pipelines() {
   }
   // strain_finish.comp's stages where record_stretch and record_substep use them: the tethers, the
   // colliders after stretch control, the colliders after self-collision.
-  bool tethered = false;
-  for (const Slot& s : slots)
-    tethered = tethered || s.params.stretch_limit.tethers();
-  const bool needed[3] = {tethered, any_stretch() && any_colliders(),
+  const bool needed[3] = {any_tethers(), any_stretch() && any_colliders(),
                           self_iterations() > 0 && any_colliders()};
   for (std::uint32_t stage = 0; stage < 3; ++stage) {
     const std::uint32_t t = stage == 0 ? 0u : types;
