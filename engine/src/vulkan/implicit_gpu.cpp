@@ -178,15 +178,12 @@ Result<void> ImplicitGpu::write_sets(const ImplicitInputs& in) {
 }
 
 std::uint32_t ImplicitGpu::record_substep(VkCommandBuffer c, std::uint32_t read, sh::PushConstants pc,
-                                          const SimParams& params, bool first) {
+                                          const SimParams& params, std::uint32_t types, bool first) {
   const auto& v = ctx_->vk;
   const float tol = float(params.cg_tolerance);
   pc.c_next = tol * tol; // as CpuSolver<float>: Real(tol) * Real(tol)
   pc.pad0 = params.cg_max_iterations;
   v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &sets_[read], 0, nullptr);
-  std::uint32_t types = 0; // as SolverBatch::collider_types, for this batch's one instance
-  for (const Collider& col : params.colliders)
-    types |= 1u << std::uint32_t(col.type);
   bool need_barrier = !first;
   std::uint32_t dispatches = 0;
   enum class Groups { all, one, indirect }; // every particle's group; one workgroup; CgArgs

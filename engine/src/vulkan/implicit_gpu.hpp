@@ -57,10 +57,11 @@ public:
   /// types (SolverBatch::ensure_collider_pipelines), before a substep with them is recorded.
   Result<void> ensure_collider_passes(std::uint32_t types, std::span<const std::uint32_t> constants);
   /// Records one substep reading positions[read], writing positions[read ^ 1]. `pc` is the main
-  /// push-constant block (the substep's dt is in the InstanceParams); `first`: no barrier needed before the
-  /// first pass. Returns the number of dispatches recorded.
+  /// push-constant block (the substep's dt is in the InstanceParams); `types`: the batch's collider
+  /// types (ensure_collider_passes made their FORCE and FINISH passes); `first`: no barrier needed
+  /// before the first pass. Returns the number of dispatches recorded.
   std::uint32_t record_substep(VkCommandBuffer cmd, std::uint32_t read, shared::PushConstants pc,
-                               const SimParams& params, bool first);
+                               const SimParams& params, std::uint32_t types, bool first);
   bool one_workgroup() const { return budget_ > 0; }
   /// The last completed solve (host-visible state; valid once the recorded work finished).
   SolveStats stats() const;

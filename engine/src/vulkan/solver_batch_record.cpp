@@ -171,7 +171,7 @@ void SolverBatch::record_update(VkCommandBuffer c, bool first, bool last) {
   const auto& v = vk();
   const std::uint32_t read = parity;
   if (family().integrator == Integrator::implicit_euler) {
-    dispatches_ += implicit->record_substep(c, read, pc, family(), first);
+    dispatches_ += implicit->record_substep(c, read, pc, family(), collider_types(), first);
     return;
   }
   const std::uint32_t instances_z = size(); // one dispatch serves every instance (gl_WorkGroupID.z)
