@@ -273,6 +273,27 @@ Result<BufferView> create_buffer_view(Context::Impl& ctx, VkBuffer buffer, VkFor
   return v;
 }
 
+Result<void> create_texel_views(Context::Impl& ctx, std::span<const TexelViewSpec> specs) {
+  for (const TexelViewSpec& s : specs) {
+    auto r = create_buffer_view(ctx, s.buffer, s.format, s.what);
+    if (!r)
+      return r.error();
+    *s.view = std::move(*r);
+  }
+  return {};
+}
+
+VkWriteDescriptorSet texel_write(VkDescriptorSet set, std::uint32_t binding, const BufferView& view) {
+  VkWriteDescriptorSet w{};
+  w.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+  w.dstSet = set;
+  w.dstBinding = binding;
+  w.descriptorCount = 1;
+  w.descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+  w.pTexelBufferView = view.ptr();
+  return w;
+}
+
 Result<CommandContext> CommandContext::create(Context::Impl& ctx, const char* owner) {
   const auto& v = ctx.vk;
   CommandContext c;

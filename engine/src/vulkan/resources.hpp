@@ -182,6 +182,20 @@ void write_parity_sets(Context::Impl& ctx, const VkDescriptorSet (&sets)[2],
 /// A whole-buffer texel view of `buffer` in `format`.
 Result<BufferView> create_buffer_view(Context::Impl& ctx, VkBuffer buffer, VkFormat format, const char* name);
 
+/// A texel buffer view to make (create_texel_views): the whole of `buffer` as `format`, into
+/// *view, named `what` in errors.
+struct TexelViewSpec {
+  VkBuffer buffer;
+  VkFormat format;
+  BufferView* view;
+  const char* what;
+};
+/// Makes every view of `specs` (create_buffer_view), each replacing what its BufferView held.
+Result<void> create_texel_views(Context::Impl& ctx, std::span<const TexelViewSpec> specs);
+
+/// The descriptor write of `view` as the uniform texel buffer at `binding` of `set`.
+VkWriteDescriptorSet texel_write(VkDescriptorSet set, std::uint32_t binding, const BufferView& view);
+
 /// The convenience path of solvers, worlds, the renderer and the offscreen target: one resettable
 /// command buffer of the Context's queue family and a fence. submit_and_wait() resets the buffer,
 /// records `record(cmd)` (one-time submit), submits it on the Context's queue and waits.

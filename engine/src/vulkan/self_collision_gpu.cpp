@@ -90,23 +90,14 @@ Result<void> SelfCollisionGpu::create_sets() {
 Result<void> SelfCollisionGpu::write_texel_sets(const OneSetInputs& in) {
   if (sorted_view_ != VK_NULL_HANDLE)
     return {};
-  const struct {
-    VkBuffer buffer;
-    VkFormat format;
-    BufferView* view;
-    const char* what;
-  } views[] = {{in.pos[0], VK_FORMAT_R32G32B32A32_SFLOAT, &pos_views_[0], "self-collision: positions[0]"},
-               {in.pos[1], VK_FORMAT_R32G32B32A32_SFLOAT, &pos_views_[1], "self-collision: positions[1]"},
-               {in.vel, VK_FORMAT_R32G32B32A32_SFLOAT, &vel_view_, "self-collision: velocities"},
-               {rest_.buffer, VK_FORMAT_R32G32B32A32_SFLOAT, &rest_view_, "self-collision: rest positions"},
-               {starts_.buffer, VK_FORMAT_R32_UINT, &starts_view_, "self-collision: bucket starts"},
-               {sorted_.buffer, VK_FORMAT_R32G32_UINT, &sorted_view_, "self-collision: sorted particles"}};
-  for (const auto& view : views) {
-    auto r = create_buffer_view(*ctx_, view.buffer, view.format, view.what);
-    if (!r)
-      return r.error();
-    *view.view = std::move(*r);
-  }
+  const TexelViewSpec views[] = {
+      {in.pos[0], VK_FORMAT_R32G32B32A32_SFLOAT, &pos_views_[0], "self-collision: positions[0]"},
+      {in.pos[1], VK_FORMAT_R32G32B32A32_SFLOAT, &pos_views_[1], "self-collision: positions[1]"},
+      {in.vel, VK_FORMAT_R32G32B32A32_SFLOAT, &vel_view_, "self-collision: velocities"},
+      {rest_.buffer, VK_FORMAT_R32G32B32A32_SFLOAT, &rest_view_, "self-collision: rest positions"},
+      {starts_.buffer, VK_FORMAT_R32_UINT, &starts_view_, "self-collision: bucket starts"},
+      {sorted_.buffer, VK_FORMAT_R32G32_UINT, &sorted_view_, "self-collision: sorted particles"}};
+  VKCLOTH_TRY(create_texel_views(*ctx_, views));
   std::array<VkWriteDescriptorSet, 2 * VKCLOTH_SELF_TEXEL_COUNT> writes{};
   std::size_t w = 0;
   for (std::uint32_t read = 0; read < 2; ++read) {
@@ -116,16 +107,8 @@ Result<void> SelfCollisionGpu::write_texel_sets(const OneSetInputs& in) {
         {&rest_view_, VKCLOTH_SELF_TEXEL_REST},
         {&starts_view_, VKCLOTH_SELF_TEXEL_STARTS},
         {&sorted_view_, VKCLOTH_SELF_TEXEL_SORTED}};
-    for (auto [view, binding] : bound) {
-      writes[w] = VkWriteDescriptorSet{};
-      writes[w].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-      writes[w].dstSet = texel_sets_[read];
-      writes[w].dstBinding = binding;
-      writes[w].descriptorCount = 1;
-      writes[w].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
-      writes[w].pTexelBufferView = view->ptr();
-      ++w;
-    }
+    for (auto [view, binding] : bound)
+      writes[w++] = texel_write(texel_sets_[read], binding, *view);
   }
   ctx_->vk.vkUpdateDescriptorSets(ctx_->device, static_cast<std::uint32_t>(w), writes.data(), 0, nullptr);
   return {};

@@ -112,28 +112,19 @@ Result<void> SolverBatch::create_descriptor_sets() {
 // views. Uniform texel buffer support is mandatory for these formats. Strain links are viewed as
 // R32UI, 3 texels each (no RGB32 format is mandatory for texel buffers); an Edge is one RGBA32UI.
 Result<void> SolverBatch::create_texel_views() {
-  const struct {
-    const Buffer* buffer;
-    VkFormat format;
-    BufferView* view;
-    const char* what;
-  } views[10] = {{&pos[0], VK_FORMAT_R32G32B32A32_SFLOAT, &pos_views[0], "positions[0]"},
-                 {&pos[1], VK_FORMAT_R32G32B32A32_SFLOAT, &pos_views[1], "positions[1]"},
-                 {&stage_pos, VK_FORMAT_R32G32B32A32_SFLOAT, &pos_views[2], "stage positions"},
-                 {&particle, VK_FORMAT_R32G32_UINT, &particle_view, "particle constants"},
-                 {&vel, VK_FORMAT_R32G32B32A32_SFLOAT, &vel_view, "velocities"},
-                 {&flags, VK_FORMAT_R32_UINT, &flags_view, "flags"},
-                 {&instances, VK_FORMAT_R32G32B32A32_UINT, &instances_view, "instance parameters"},
-                 {&ranges, VK_FORMAT_R32G32B32A32_UINT, &ranges_view, "adjacency ranges"},
-                 {&edges, VK_FORMAT_R32G32B32A32_UINT, &edges_view, "adjacency"},
-                 {&strain_links, VK_FORMAT_R32_UINT, &strain_links_view, "strain links"}};
+  const TexelViewSpec views[] = {
+      {pos[0].buffer, VK_FORMAT_R32G32B32A32_SFLOAT, &pos_views[0], "positions[0]"},
+      {pos[1].buffer, VK_FORMAT_R32G32B32A32_SFLOAT, &pos_views[1], "positions[1]"},
+      {stage_pos.buffer, VK_FORMAT_R32G32B32A32_SFLOAT, &pos_views[2], "stage positions"},
+      {particle.buffer, VK_FORMAT_R32G32_UINT, &particle_view, "particle constants"},
+      {vel.buffer, VK_FORMAT_R32G32B32A32_SFLOAT, &vel_view, "velocities"},
+      {flags.buffer, VK_FORMAT_R32_UINT, &flags_view, "flags"},
+      {instances.buffer, VK_FORMAT_R32G32B32A32_UINT, &instances_view, "instance parameters"},
+      {ranges.buffer, VK_FORMAT_R32G32B32A32_UINT, &ranges_view, "adjacency ranges"},
+      {edges.buffer, VK_FORMAT_R32G32B32A32_UINT, &edges_view, "adjacency"},
+      {strain_links.buffer, VK_FORMAT_R32_UINT, &strain_links_view, "strain links"}};
   static_assert(sizeof(sh::StrainLink) == 12, "three R32UI texels per StrainLink");
-  for (const auto& view : views) {
-    auto r = create_buffer_view(*ctx, view.buffer->buffer, view.format, view.what);
-    if (!r)
-      return r.error();
-    *view.view = std::move(*r);
-  }
+  VKCLOTH_TRY(vkcloth::gpu::create_texel_views(*ctx, views));
   return create_buffer_views();
 }
 
@@ -145,21 +136,12 @@ Result<void> SolverBatch::create_buffer_views() {
   static_assert(sizeof(sh::MeshNode) == 2 * 16 && sizeof(sh::MeshTriangle) == 3 * 16);
   if (access != BufferAccess::texel_views || !texel_sets[0])
     return {}; // no views (init_pipelines), or not yet (create_buffers: create_texel_views makes them)
-  const struct {
-    const Buffer* buffer;
-    VkFormat format;
-    BufferView* view;
-    const char* what;
-  } views[4] = {{&tethers, VK_FORMAT_R32G32_UINT, &tethers_view, "tethers"},
-                {&colliders, VK_FORMAT_R32G32B32A32_UINT, &colliders_view, "colliders"},
-                {&mesh_nodes, VK_FORMAT_R32G32B32A32_UINT, &mesh_nodes_view, "mesh collider nodes"},
-                {&mesh_tris, VK_FORMAT_R32G32B32A32_UINT, &mesh_tris_view, "mesh collider triangles"}};
-  for (const auto& view : views) {
-    auto r = create_buffer_view(*ctx, view.buffer->buffer, view.format, view.what);
-    if (!r)
-      return r.error();
-    *view.view = std::move(*r);
-  }
+  const TexelViewSpec views[] = {
+      {tethers.buffer, VK_FORMAT_R32G32_UINT, &tethers_view, "tethers"},
+      {colliders.buffer, VK_FORMAT_R32G32B32A32_UINT, &colliders_view, "colliders"},
+      {mesh_nodes.buffer, VK_FORMAT_R32G32B32A32_UINT, &mesh_nodes_view, "mesh collider nodes"},
+      {mesh_tris.buffer, VK_FORMAT_R32G32B32A32_UINT, &mesh_tris_view, "mesh collider triangles"}};
+  VKCLOTH_TRY(vkcloth::gpu::create_texel_views(*ctx, views));
   const std::pair<const BufferView*, std::uint32_t> shared_views[VKCLOTH_TEXEL_BINDING_COUNT - 1] = {
       {&particle_view, VKCLOTH_TEXEL_BINDING_PARTICLE},
       {&vel_view, VKCLOTH_TEXEL_BINDING_VEL},
@@ -174,20 +156,10 @@ Result<void> SolverBatch::create_buffer_views() {
       {&mesh_tris_view, VKCLOTH_TEXEL_BINDING_MESH_TRIS}};
   std::array<VkWriteDescriptorSet, VKCLOTH_TEXEL_BINDING_COUNT * 3> writes{};
   std::size_t w = 0;
-  auto write = [&](VkDescriptorSet set, std::uint32_t binding, const BufferView& view) {
-    writes[w] = VkWriteDescriptorSet{};
-    writes[w].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-    writes[w].dstSet = set;
-    writes[w].dstBinding = binding;
-    writes[w].descriptorCount = 1;
-    writes[w].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
-    writes[w].pTexelBufferView = view.ptr();
-    ++w;
-  };
   for (std::uint32_t k = 0; k < 3; ++k) {
-    write(texel_sets[k], VKCLOTH_TEXEL_BINDING_POS_IN, pos_views[k]);
+    writes[w++] = texel_write(texel_sets[k], VKCLOTH_TEXEL_BINDING_POS_IN, pos_views[k]);
     for (auto [view, binding] : shared_views)
-      write(texel_sets[k], binding, *view);
+      writes[w++] = texel_write(texel_sets[k], binding, *view);
   }
   vk().vkUpdateDescriptorSets(ctx->device, static_cast<std::uint32_t>(w), writes.data(), 0, nullptr);
   return {};
