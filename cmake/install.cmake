@@ -13,20 +13,23 @@
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
-install(TARGETS vkcloth EXPORT vkclothTargets
+# The umbrella vkcloth::vkcloth and its four layers (engine/CMakeLists.txt); the kernel headers and
+# the testing header (engine/testing) stay in the source tree.
+set(vkcloth_libraries vkcloth_core vkcloth_io vkcloth_gpu vkcloth_render)
+install(TARGETS vkcloth ${vkcloth_libraries} EXPORT vkclothTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
   RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
   INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/engine/include/vkcloth DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 # The generated public header (engine/CMakeLists.txt): the GLM version the library was built with.
-get_target_property(vkcloth_binary_dir vkcloth BINARY_DIR)
+get_target_property(vkcloth_binary_dir vkcloth_core BINARY_DIR)
 install(FILES ${vkcloth_binary_dir}/include/vkcloth/glm_version.hpp DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/vkcloth)
 
 # The static library's private libraries, for the config: each as "package|target|library name".
 # The library name is the file name of the library the build used (libtinygltf.so -> tinygltf).
 set(VKCLOTH_PRIVATE_LINK "")
-get_target_property(vkcloth_type vkcloth TYPE)
+get_target_property(vkcloth_type vkcloth_core TYPE)
 if(vkcloth_type STREQUAL "STATIC_LIBRARY")
   foreach(dep IN ITEMS "tinyobjloader|tinyobjloader::tinyobjloader_double" "TinyGLTF|TinyGLTF::TinyGLTF"
                        "meshoptimizer|meshoptimizer::meshoptimizer")

@@ -159,7 +159,7 @@ void mesh_triangle(uint unused, uint i, out vec3 a, out vec3 b, out vec3 c) {
 }
 #endif
 #define VKCLOTH_COLLIDER_PRESENT(type) ((SC_COLLIDER_TYPES & (1u << (type))) != 0u)
-#include "cloth_kernel.h"
+#include "kernel/cloth_kernel.h"
 
 // The instance's collider c as the kernel takes it (the host packed kernel_shape<float>).
 ColliderShape collider_shape(uint c) {

@@ -34,9 +34,7 @@ namespace vkcloth::gpu::shared {
 #define VKCLOTH_SELF_TEXEL_SORTED 4 // SELF_SORTED, RG32UI
 #define VKCLOTH_SELF_TEXEL_COUNT 5
 
-// Buckets per workgroup of the SCAN_BLOCKS pass: 64 invocations x 8 (the table size is a
-// multiple: kernel.hpp self_table_size).
-#define VKCLOTH_SELF_SCAN_BLOCK 512u
+// VKCLOTH_SELF_SCAN_BLOCK (kernel/constants.h): buckets per workgroup of the SCAN_BLOCKS pass.
 #define VKCLOTH_SELF_SCAN_PER_INVOCATION 8u
 
 // self_collision.comp passes (PushConstants::stage), in recording order; one barrier between each.

@@ -5,6 +5,8 @@
 #ifndef VKCLOTH_SHARED_H
 #define VKCLOTH_SHARED_H
 
+#include "kernel/constants.h" // the physics' constants (ring bits, collider types, ...)
+
 #ifdef __cplusplus
 #include <cstddef>
 #include <cstdint>
@@ -14,9 +16,6 @@ struct vec4 {
   float x, y, z, w;
 };
 #endif
-
-// Invocations per workgroup (1-D). Dispatches round up and every shader guards `p < count`.
-#define VKCLOTH_WORKGROUP_SIZE 64
 
 // The specialisation constant that fixes the pass a pipeline runs (common.glsl SC_STAGE; the host:
 // pipelines.hpp ShaderVariant::stage); VKCLOTH_ANY_STAGE: the push constants' `stage` decides.
@@ -90,42 +89,6 @@ struct vec4 {
 #define VKCLOTH_FLAG_FLIP_NORMALS 16u // store -n in the normals buffer (GpuSolverOptions::flip_normals)
 #define VKCLOTH_FLAG_SELF_COLLISION                                                                          \
   32u // self-collision on (self_collision.comp; strain_finish.comp's stage 2)
-
-// Edge::ring bits (ClothTopology's ring-ordered gather lists, cloth_kernel.h add_ring_term): the
-// fan triangle (a, b) of a particle adds cross(x_a - x, x_b - x) to its normal; a chain of fan
-// triangles (r0, r1), (r1, r2), ... is carried by consecutive entries r0, r1, r2, ...
-#define VKCLOTH_RING_START 1u // the first entry of a chain: remember its edge
-#define VKCLOTH_RING_PREV 2u  // add the triangle (previous entry, this entry)
-#define VKCLOTH_RING_CLOSE 4u // then add the triangle (this entry, the chain's first entry)
-
-// InstanceParams::stretch bits (SimParams::stretch_limit).
-#define VKCLOTH_STRETCH_PROVOT 1u       // Provot sweeps over the strain links (strain_links.comp)
-#define VKCLOTH_STRETCH_TETHERS 2u      // tethers (strain_finish.comp)
-#define VKCLOTH_STRETCH_GEODESIC 4u     // tethers with geodesic rest lengths (the second half of TETHERS)
-#define VKCLOTH_STRETCH_PROJECTION 8u   // the fast projection (strain_project.comp)
-#define VKCLOTH_TETHERS_PER_PARTICLE 4u // vkcloth::tethers_per_particle
-#define VKCLOTH_NO_TETHER 0xffffffffu   // an unused tether slot (vkcloth::no_tether)
-// The fast projection (cloth_kernel.h projection_*, docs/model.md "Stretch control"): links whose
-// C = |u|^2 / B^2 - 1 is above -BAND take part in a Newton iteration's solve (those within the band
-// keep their length, so the solve cannot stretch them past the bound); the projection stops once
-// every link's strain is within TOLERANCE of max_strain; each solve is Jacobi-preconditioned CG
-// to |r|^2 <= CG_TOL2 |r0|^2, at most cg_cap(links) iterations (projection_cg_cap).
-#define VKCLOTH_PROJECTION_BAND 0.01
-#define VKCLOTH_PROJECTION_TOLERANCE 1.0e-4
-#define VKCLOTH_PROJECTION_CG_TOL2 1.0e-8
-
-// InstanceParams::integrator (the vkcloth::Integrator values; engine/src/core/kernel.hpp asserts it).
-#define VKCLOTH_INTEGRATOR_EXPLICIT_EULER 0u
-#define VKCLOTH_INTEGRATOR_SEMI_IMPLICIT_EULER 1u
-#define VKCLOTH_INTEGRATOR_RK4 2u
-
-// Collider::type (the vkcloth::Collider::Type values; engine/src/core/kernel.hpp asserts it).
-#define VKCLOTH_COLLIDER_PLANE 0u
-#define VKCLOTH_COLLIDER_SPHERE 1u
-#define VKCLOTH_COLLIDER_CAPSULE 2u
-#define VKCLOTH_COLLIDER_BOX 3u
-#define VKCLOTH_COLLIDER_MESH 4u
-#define VKCLOTH_COLLIDER_ALL_TYPES 0x1fu // bit t for every type t above (SC_COLLIDER_TYPES)
 
 // Flags::first_bad_step before anything diverged.
 #define VKCLOTH_NO_BAD_STEP 0xffffffffu

@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
 
+#include "cpu_solver_impl.hpp"
 #include "implicit_euler.hpp"
 #include "kernel.hpp"
 #include "row_kernel.hpp"
@@ -18,44 +19,15 @@
 #include "strain_projection.hpp"
 #include "thread_pool.hpp"
 
-// Every per-particle formula comes from shaders/include/cloth_kernel.h (kernel.hpp), the source
+// Every per-particle formula comes from engine/kernel/cloth_kernel.h (kernel.hpp), the source
 // the compute shaders include too; this file gathers the inputs, loops and schedules. The engine
 // is built with -ffp-contract=off, so the compiler does not fuse the kernel's expressions.
 
 namespace vkcloth {
 
-namespace detail {
-/// The colliders as the kernel takes them at this substep's pose, and their meshes; the same values
-/// for the SIMD finish of the grid rows (row_kernel.hpp FinishShape), empty when a collider is a mesh.
-template <typename Real> struct ContactShapes {
-  std::vector<kernel::ColliderShape<Real>> shapes;
-  std::vector<kernel::MeshData> meshes;
-  std::vector<FinishShape<Real>> finish;
-};
-/// The padded lists the list kernel reads (row_kernel.hpp ListArgs), built once for vectors of
-/// `width` particles by pad_lists.
-template <typename Real> struct PaddedLists {
-  std::size_t width = 0;
-  std::vector<std::uint32_t> spring_begin, other, ring, ring_end;
-  std::vector<std::uint8_t> reads_last; ///< per vector: some slot names the last particle
-  std::vector<Real> rest, stiff;
-};
-} // namespace detail
+using detail::bad_components;
 
 namespace {
-
-using detail::RowArgs;
-
-/// check_finite's test, branch-free (vectorisable OR-reduction over flat arrays of n3 components):
-/// nonzero when a component is not finite (c - c != 0 for inf and NaN) or a position has |x| > limit
-/// (or is NaN). The row sweep runs it on each block it wrote, check_finite on the whole state.
-template <typename Real> unsigned bad_components(const Real* x, const Real* v, std::size_t n3, Real limit) {
-  unsigned bad = 0;
-  for (std::size_t i = 0; i < n3; ++i)
-    bad |= unsigned(!(std::abs(x[i]) <= limit)) | unsigned(!(x[i] - x[i] == Real(0))) |
-           unsigned(!(v[i] - v[i] == Real(0)));
-  return bad;
-}
 
 /// Row kernel ISA: 2 = AVX-512F, 1 = AVX2, 0 = scalar; the widest the CPU has, capped by the
 /// environment variable VKCLOTH_CPU_SIMD = scalar | avx2 | avx512 (tests compare them bitwise).
@@ -79,13 +51,8 @@ int detect_simd() {
 
 } // namespace
 
-template <typename Real> CpuSolver<Real>::CpuSolver() = default;
-template <typename Real> CpuSolver<Real>::CpuSolver(CpuSolver&&) noexcept = default;
-template <typename Real> CpuSolver<Real>& CpuSolver<Real>::operator=(CpuSolver&&) noexcept = default;
-template <typename Real> CpuSolver<Real>::~CpuSolver() = default;
-template <typename Real> unsigned CpuSolver<Real>::threads() const {
-  return pool_->size();
-}
+template <typename Real> CpuSolver<Real>::Impl::Impl() = default;
+template <typename Real> CpuSolver<Real>::Impl::~Impl() = default;
 
 template <typename Real>
 Result<CpuSolver<Real>> CpuSolver<Real>::create(const ParticleSystem& system, SimParams params,
@@ -109,13 +76,14 @@ Result<CpuSolver<Real>> CpuSolver<Real>::create(std::shared_ptr<const ClothTopol
   const ParticleSystem& system = topology->system();
   const std::size_t n = system.size();
 
-  CpuSolver s;
+  auto impl = std::make_unique<Impl>();
+  Impl& s = *impl;
   s.topology_ = std::move(topology);
   s.params_ = params;
   s.edge_offsets_ = s.topology_->edge_offsets();
   s.edges_.reserve(s.topology_->edges().size());
   for (const GatherEdge& e : s.topology_->edges())
-    s.edges_.push_back(Edge{e.other, Real(e.rest_length), Real(e.stiffness), e.ring});
+    s.edges_.push_back(typename Impl::Edge{e.other, Real(e.rest_length), Real(e.stiffness), e.ring});
   s.mass_.resize(n);
   s.pinned_.resize(n);
   s.pos_.resize(n);
@@ -144,17 +112,17 @@ Result<CpuSolver<Real>> CpuSolver<Real>::create(std::shared_ptr<const ClothTopol
   const auto useful = static_cast<unsigned>(std::max<std::size_t>(1, n / 1024));
   s.pool_ = std::make_unique<detail::ThreadPool>(std::min(wanted, useful));
   s.simd_ = detect_simd();
-  return s;
+  return CpuSolver(std::move(impl));
 }
 
-template <typename Real> Result<void> CpuSolver<Real>::set_params(SimParams params) {
+template <typename Real> Result<void> CpuSolver<Real>::Impl::set_params(SimParams params) {
   VKCLOTH_TRY(params.validate());
   params_ = params;
   return {};
 }
 
 template <typename Real>
-Result<void> CpuSolver<Real>::set_particle(std::uint32_t index, Vec3 position, Vec3 velocity) {
+Result<void> CpuSolver<Real>::Impl::set_particle(std::uint32_t index, Vec3 position, Vec3 velocity) {
   if (index >= pos_.size())
     return make_error(ErrorCode::invalid_argument,
                       fmt::format("set_particle: index {} is out of range (the system has {} particles)",
@@ -173,8 +141,8 @@ Result<void> CpuSolver<Real>::set_particle(std::uint32_t index, Vec3 position, V
 }
 
 template <typename Real>
-typename CpuSolver<Real>::Vec3 CpuSolver<Real>::normal_force_at(std::span<const Vec3> pos,
-                                                                std::span<const Vec3> vel, std::size_t p) {
+typename CpuSolver<Real>::Vec3
+CpuSolver<Real>::Impl::normal_force_at(std::span<const Vec3> pos, std::span<const Vec3> vel, std::size_t p) {
   const Vec3 x = pos[p];
   Vec3 f(0);
   Vec3 fan(0); // an area-weighted vertex normal (zero without a surface)
@@ -212,7 +180,7 @@ typename CpuSolver<Real>::Vec3 CpuSolver<Real>::normal_force_at(std::span<const 
 
 // The colliders at their pose for this substep, as the kernel takes them (kernel_shape: the
 // conversion the GPU solver uses too); a mesh collider's hierarchy is walked in place.
-template <typename Real> void CpuSolver<Real>::prepare_colliders() {
+template <typename Real> void CpuSolver<Real>::Impl::prepare_colliders() {
   if (!contacts_)
     contacts_ = std::make_unique<detail::ContactShapes<Real>>();
   auto& shapes = contacts_->shapes;
@@ -258,14 +226,14 @@ template <typename Real> void CpuSolver<Real>::prepare_colliders() {
 }
 
 // Moving colliders advance by the substep h (in double, as the GPU solver's host side does).
-template <typename Real> void CpuSolver<Real>::advance_colliders(double h) {
+template <typename Real> void CpuSolver<Real>::Impl::advance_colliders(double h) {
   for (Collider& c : params_.colliders)
     if (c.moving())
       c = c.posed_at(h);
 }
 
 template <typename Real>
-void CpuSolver<Real>::contact_at(Vec3 pos, Vec3& vel, Vec3& force, Real h_over_m, bool friction) const {
+void CpuSolver<Real>::Impl::contact_at(Vec3 pos, Vec3& vel, Vec3& force, Real h_over_m, bool friction) const {
   const Real band = Real(2) * Real(params_.contact_epsilon);
   const bool both = !params_.contact_inward_only; // Figure 12's variant: outward parts go too
   const auto& shapes = contacts_->shapes;
@@ -280,13 +248,13 @@ void CpuSolver<Real>::contact_at(Vec3 pos, Vec3& vel, Vec3& force, Real h_over_m
   }
 }
 
-template <typename Real> void CpuSolver<Real>::project_at(Vec3 side, Vec3& pos, Vec3& vel) const {
+template <typename Real> void CpuSolver<Real>::Impl::project_at(Vec3 side, Vec3& pos, Vec3& vel) const {
   const Real eps = Real(params_.contact_epsilon);
   for (std::size_t k = 0; k < contacts_->shapes.size(); ++k)
     kernel::project_out(contacts_->meshes[k], contacts_->shapes[k], eps, side, pos, vel);
 }
 
-template <typename Real> Result<void> CpuSolver<Real>::check_finite() const {
+template <typename Real> Result<void> CpuSolver<Real>::Impl::check_finite() const {
   const Real limit = Real(params_.divergence_limit);
   // bad_components first (no early exit, vectorised); only when something is bad does the loop
   // below look for the first particle (kernel::diverged), for the message.
@@ -306,7 +274,7 @@ template <typename Real> Result<void> CpuSolver<Real>::check_finite() const {
   return {};
 }
 
-template <typename Real> Result<void> CpuSolver<Real>::step() {
+template <typename Real> Result<void> CpuSolver<Real>::Impl::step() {
   // integrator.substeps = k: k substeps of dt / k (bit-identical to k steps with dt / k).
   const std::uint32_t k = params_.substeps;
   const double h = k == 1 ? params_.dt : params_.dt / double(k);
@@ -322,7 +290,7 @@ template <typename Real> Result<void> CpuSolver<Real>::step() {
   return check_finite();
 }
 
-template <typename Real> void CpuSolver<Real>::substep(const Real h) {
+template <typename Real> void CpuSolver<Real>::Impl::substep(const Real h) {
   swept_finite_ = false;
   switch (params_.integrator) {
   case Integrator::explicit_euler:
@@ -353,7 +321,7 @@ template <typename Real> void CpuSolver<Real>::substep(const Real h) {
 // (strain_projection.cpp);
 // then the colliders' projection, since a correction may have pulled a particle into one. Each
 // formula: cloth_kernel.h; the GPU: strain_finish.comp, strain_links.comp, strain_project.comp.
-template <typename Real> void CpuSolver<Real>::limit_stretch(const Real h) {
+template <typename Real> void CpuSolver<Real>::Impl::limit_stretch(const Real h) {
   const StretchLimit& sl = params_.stretch_limit;
   const Real max_strain = Real(sl.max_strain);
   // The row sweep's SoA copy of the positions (when valid) follows every move, so the next sweep
@@ -420,7 +388,7 @@ template <typename Real> void CpuSolver<Real>::limit_stretch(const Real h) {
 }
 
 template <typename Real>
-void CpuSolver<Real>::euler_finish(std::size_t p, Vec3 f, const Real h, const bool semi) {
+void CpuSolver<Real>::Impl::euler_finish(std::size_t p, Vec3 f, const Real h, const bool semi) {
   if (pinned_[p]) {
     force_[p] = f;
     pos_next_[p] = pos_[p];
@@ -436,7 +404,7 @@ void CpuSolver<Real>::euler_finish(std::size_t p, Vec3 f, const Real h, const bo
   vel_[p] = v; // only particle p reads its own velocity: updating in place is safe
 }
 
-template <typename Real> void CpuSolver<Real>::euler_substep(const Real h, const bool semi) {
+template <typename Real> void CpuSolver<Real>::Impl::euler_substep(const Real h, const bool semi) {
   if (stencil_) {
     row_sweep(h, semi);
     return;
@@ -453,255 +421,8 @@ template <typename Real> void CpuSolver<Real>::euler_substep(const Real h, const
   std::swap(pos_, pos_next_);
 }
 
-// The state and constants both SIMD kernels take.
-template <typename Real>
-void CpuSolver<Real>::step_args(detail::StepArgs<Real>& a, const Real h, const bool semi) {
-  a.vel = &vel_[0].x;
-  a.vel_out = &vel_[0].x;
-  a.mass = mass_.data();
-  a.pinned = pinned_.data();
-  a.force_out = &force_[0].x;
-  a.normal_out = &normal_[0].x;
-  a.pos_next = &pos_next_[0].x;
-  const Vec3 g{params_.gravity}, w{params_.wind.direction};
-  a.gx = g.x;
-  a.gy = g.y;
-  a.gz = g.z;
-  a.damping = Real(params_.damping);
-  a.kw = Real(params_.wind.strength);
-  a.wind = a.kw != Real(0);
-  a.wx = w.x;
-  a.wy = w.y;
-  a.wz = w.z;
-  a.dt = h;
-  a.limit = Real(params_.divergence_limit);
-  a.integrate = params_.colliders.empty(); // the SIMD kernels have no contact code
-  a.semi = semi;
-}
-
-template <typename Real> detail::RowArgs<Real> CpuSolver<Real>::row_args(const Real h, const bool semi) {
-  const std::size_t n = pos_.size(), pad = soa_pad_, stride = n + 2 * pad;
-  if (soa_.size() != 3 * stride) {
-    soa_.assign(3 * stride, Real(0));
-    soa_next_.assign(3 * stride, Real(0));
-    soa_valid_ = false;
-  }
-  RowArgs<Real> ra{};
-  ra.px = soa_.data() + pad;
-  ra.py = ra.px + stride;
-  ra.pz = ra.py + stride;
-  if (!soa_valid_) { // first step, or pos_ changed outside the row sweep
-    Real *sx = soa_.data() + pad, *sy = sx + stride, *sz = sy + stride;
-    pool_->parallel_for(n, [&](std::size_t b, std::size_t e) {
-      for (std::size_t p = b; p < e; ++p) {
-        sx[p] = pos_[p].x;
-        sy[p] = pos_[p].y;
-        sz[p] = pos_[p].z;
-      }
-    });
-  }
-  ra.sx_next = soa_next_.data() + pad;
-  ra.sy_next = ra.sx_next + stride;
-  ra.sz_next = ra.sy_next + stride;
-  ra.mask = stencil_->masks.empty() ? nullptr : stencil_->masks.data();
-  ra.nx = topology_->grid()->nx;
-  ra.off = stencil_offset_.data();
-  ra.rest = stencil_rest_.data();
-  ra.stiff = stencil_stiff_.data();
-  step_args(ra, h, semi);
-  return ra;
-}
-
-// Grid stencil: the vectorised row kernel takes every particle (masks for the border), or, when
-// some gather list is irregular (no masks), the interior runs of each row while the border
-// particles take the per-particle reference. It reads positions from the SoA copy and writes the
-// next one; one fork-join per substep (sweep + finite check).
-template <typename Real> void CpuSolver<Real>::row_sweep(const Real h, const bool semi) {
-  const RowArgs<Real> ra = row_args(h, semi);
-  // With colliders, none of them a mesh: the kernel's forces go through the SIMD finish (contacts,
-  // update, projection: row_kernel_simd.inl simd_finish), the remainders through euler_finish.
-  detail::FinishArgs<Real> fa{};
-  const bool simd_finish = !ra.integrate && simd_ != 0 && !contacts_->finish.empty();
-  if (simd_finish) {
-    fa.px = ra.px;
-    fa.py = ra.py;
-    fa.pz = ra.pz;
-    fa.vel = &vel_[0].x;
-    fa.force = &force_[0].x;
-    fa.mass = mass_.data();
-    fa.pinned = pinned_.data();
-    fa.pos_next = &pos_next_[0].x;
-    fa.sx_next = ra.sx_next;
-    fa.sy_next = ra.sy_next;
-    fa.sz_next = ra.sz_next;
-    fa.shapes = contacts_->finish.data();
-    fa.shape_count = static_cast<std::uint32_t>(contacts_->finish.size());
-    fa.band = Real(2) * Real(params_.contact_epsilon); // contact_at's band and project_at's eps
-    fa.eps = Real(params_.contact_epsilon);
-    fa.dt = h;
-    fa.both = !params_.contact_inward_only;
-    fa.semi = semi;
-  }
-  const std::int64_t gnx = ra.nx, gny = topology_->grid()->ny;
-  Real* const pn = &pos_next_[0].x;
-  Real* const vn = &vel_[0].x;
-  // The reference's update of particle q, and its entry in the next SoA copy.
-  auto finish = [&](std::int64_t q, Vec3 f) {
-    euler_finish(std::size_t(q), f, h, semi);
-    const Vec3 x = pos_next_[std::size_t(q)];
-    ra.sx_next[q] = x.x;
-    ra.sy_next[q] = x.y;
-    ra.sz_next[q] = x.z;
-  };
-  // Whole vectors in SIMD, a remainder shorter than one vector (or everything, without SIMD)
-  // through the per-particle reference; then the finite check of what the SIMD kernel did not check.
-  auto run = [&](std::int64_t q0, std::int64_t q1, unsigned& bad_here) {
-    std::int64_t done = q0;
-    bool simd_bad = false;
-#if VKCLOTH_ROW_SIMD
-    if (simd_ == 2)
-      done = detail::row_kernel_avx512(ra, done, q1, simd_bad);
-    else if (simd_ == 1)
-      done = detail::row_kernel_avx2(ra, done, q1, simd_bad);
-#endif
-    std::int64_t unchecked = done;
-    if (!ra.integrate) { // the SIMD kernels' forces go through the contacts here
-      std::int64_t finished = q0;
-#if VKCLOTH_ROW_SIMD
-      if (simd_finish)
-        finished = simd_ == 2 ? detail::finish_avx512(fa, q0, done) : detail::finish_avx2(fa, q0, done);
-#endif
-      for (std::int64_t q = finished; q < done; ++q)
-        finish(q, force_[std::size_t(q)]);
-      unchecked = q0;
-    }
-    for (std::int64_t q = done; q < q1; ++q)
-      finish(q, normal_force_at(pos_, vel_, std::size_t(q)));
-    bad_here |= unsigned(simd_bad) | bad_components(pn + 3 * unchecked, vn + 3 * unchecked,
-                                                    std::size_t(3 * (q1 - unchecked)), ra.limit);
-  };
-  std::atomic<bool> bad{false};
-  // Claimed in blocks of ~2048 particles by whichever thread is free (a thread the OS delays holds
-  // up at most one block); within one, pieces of ~1024: finish() and the check read what the
-  // kernel just wrote.
-  pool_->parallel_blocks(pos_.size(), 2048, [&](std::size_t b, std::size_t e) {
-    constexpr std::size_t block = 1024;
-    unsigned bad_here = 0;
-    for (std::size_t b0 = b; b0 < e;) {
-      const std::size_t b1 = e - b0 < 2 * block ? e : b0 + block;
-      if (ra.mask) {
-        run(std::int64_t(b0), std::int64_t(b1), bad_here);
-      } else {
-        for (std::size_t p = b0; p < b1;) {
-          const std::int64_t j = std::int64_t(p) / gnx, i = std::int64_t(p) % gnx;
-          if (j >= 2 && j + 2 < gny && i >= 2 && i + 2 < gnx) { // an interior run of row j
-            const std::size_t run_end = std::min<std::size_t>(b1, std::size_t(j * gnx + gnx - 2));
-            run(std::int64_t(p), std::int64_t(run_end), bad_here);
-            p = run_end;
-            continue;
-          }
-          finish(std::int64_t(p), normal_force_at(pos_, vel_, p));
-          bad_here |= bad_components(pn + 3 * p, vn + 3 * p, 3, ra.limit);
-          ++p;
-        }
-      }
-      b0 = b1;
-    }
-    if (bad_here)
-      bad.store(true, std::memory_order_relaxed);
-  });
-  std::swap(pos_, pos_next_);
-  std::swap(soa_, soa_next_);
-  soa_valid_ = true;
-  swept_finite_ = !bad.load(std::memory_order_relaxed);
-}
-
-namespace {
-// The gather lists padded for vectors of `width` particles (row_kernel.hpp ListArgs): the
-// particles that fill whole vectors only; the rest take the per-particle reference.
-template <typename Real, typename Edge>
-std::unique_ptr<detail::PaddedLists<Real>>
-pad_lists(std::size_t width, std::span<const std::uint32_t> edge_offsets,
-          std::span<const std::uint32_t> fan_ends, const std::vector<Edge>& edges) {
-  auto lists = std::make_unique<detail::PaddedLists<Real>>();
-  detail::PaddedLists<Real>& l = *lists;
-  l.width = width;
-  const std::size_t n = edge_offsets.size() - 1, vectors = n / width;
-  l.spring_begin.push_back(0);
-  for (std::size_t b = 0; b < vectors; ++b) {
-    std::uint32_t slots = 0, ring_slots = 0;
-    for (std::size_t p = b * width; p < (b + 1) * width; ++p) {
-      slots = std::max(slots, edge_offsets[p + 1] - edge_offsets[p]);
-      ring_slots = std::max(ring_slots, fan_ends[p] - edge_offsets[p]);
-    }
-    for (std::uint32_t k = 0; k < slots; ++k)
-      for (std::size_t p = b * width; p < (b + 1) * width; ++p) {
-        const bool has = k < edge_offsets[p + 1] - edge_offsets[p];
-        const Edge e = has ? edges[edge_offsets[p] + k] : Edge{std::uint32_t(p), Real(0), Real(0), 0};
-        l.other.push_back(e.other);
-        l.rest.push_back(e.rest_length);
-        l.stiff.push_back(e.stiffness);
-        l.ring.push_back(e.ring);
-      }
-    l.ring_end.push_back(l.spring_begin.back() + ring_slots * std::uint32_t(width));
-    l.reads_last.push_back(std::find(l.other.begin() + l.spring_begin.back(), l.other.end(), n - 1) !=
-                           l.other.end());
-    l.spring_begin.push_back(std::uint32_t(l.other.size()));
-  }
-  return lists;
-}
-} // namespace
-
-// Without a stencil (meshes): the list kernel takes whole vectors of particles, the last few the
-// per-particle reference; with colliders the kernel's forces go through euler_finish. One
-// fork-join per substep (sweep + finite check), as in row_sweep.
-template <typename Real> void CpuSolver<Real>::list_sweep(const Real h, const bool semi) {
-  const std::size_t n = pos_.size(), width = (simd_ == 2 ? 64 : 32) / sizeof(Real);
-  if (!lists_ || lists_->width != width)
-    lists_ = pad_lists<Real>(width, edge_offsets_, topology_->fan_ends(), edges_);
-  const detail::PaddedLists<Real>& l = *lists_;
-  detail::ListArgs<Real> la{};
-  step_args(la, h, semi);
-  la.pos = &pos_[0].x;
-  la.spring_begin = l.spring_begin.data();
-  la.other = l.other.data();
-  la.rest = l.rest.data();
-  la.stiff = l.stiff.data();
-  la.ring = l.ring.data();
-  la.ring_end = l.ring_end.data();
-  la.reads_last = l.reads_last.data();
-  const std::size_t vectors = n / width;
-  Real* const pn = &pos_next_[0].x;
-  Real* const vn = &vel_[0].x;
-  std::atomic<bool> bad{false};
-  // Work in units of one vector (the last unit: the particles after the last whole vector).
-  pool_->parallel_blocks(
-      vectors + (n % width != 0), std::max<std::size_t>(1, 2048 / width), [&](std::size_t b, std::size_t e) {
-        const std::size_t q0 = b * width, qv = std::min(e, vectors) * width, q1 = std::min(e * width, n);
-        bool simd_bad = false;
-#if VKCLOTH_ROW_SIMD
-        if (qv > q0)
-          (void)(simd_ == 2 ? detail::list_kernel_avx512(la, b, qv / width, simd_bad)
-                            : detail::list_kernel_avx2(la, b, qv / width, simd_bad));
-#endif
-        std::size_t unchecked = qv;
-        if (!la.integrate) { // the forces through the contacts, update, projection
-          for (std::size_t q = q0; q < qv; ++q)
-            euler_finish(q, force_[q], h, semi);
-          unchecked = q0;
-        }
-        for (std::size_t q = std::max(q0, qv); q < q1; ++q)
-          euler_finish(q, normal_force_at(pos_, vel_, q), h, semi);
-        if (simd_bad || bad_components(pn + 3 * unchecked, vn + 3 * unchecked,
-                                       3 * (q1 - std::min(unchecked, q1)), la.limit))
-          bad.store(true, std::memory_order_relaxed);
-      });
-  std::swap(pos_, pos_next_);
-  swept_finite_ = !bad.load(std::memory_order_relaxed);
-}
-
 // Stage s evaluates (v, F/m) at y_s = y0 + c_s k_{s-1}; contacts filter each stage.
-template <typename Real> void CpuSolver<Real>::rk4_substep(const Real h) {
+template <typename Real> void CpuSolver<Real>::Impl::rk4_substep(const Real h) {
   const std::size_t n = pos_.size();
   if (stage_pos_.size() != n) {
     for (auto& k : k_pos_)
@@ -747,13 +468,7 @@ template <typename Real> void CpuSolver<Real>::rk4_substep(const Real h) {
   });
 }
 
-template <typename Real> Result<void> CpuSolver<Real>::run(std::uint64_t steps) {
-  for (std::uint64_t s = 0; s < steps; ++s)
-    VKCLOTH_TRY(step());
-  return {};
-}
-
-template <typename Real> typename CpuSolver<Real>::Energy CpuSolver<Real>::energy() const {
+template <typename Real> typename CpuSolver<Real>::Energy CpuSolver<Real>::Impl::energy() const {
   Energy e;
   for (std::size_t p = 0; p < pos_.size(); ++p) {
     const glm::dvec3 v{vel_[p]}, x{pos_[p]};
@@ -769,6 +484,65 @@ template <typename Real> typename CpuSolver<Real>::Energy CpuSolver<Real>::energ
   return e;
 }
 
+// The API: each call forwards to the Impl.
+template <typename Real> CpuSolver<Real>::CpuSolver(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+template <typename Real> CpuSolver<Real>::CpuSolver(CpuSolver&&) noexcept = default;
+template <typename Real> CpuSolver<Real>& CpuSolver<Real>::operator=(CpuSolver&&) noexcept = default;
+template <typename Real> CpuSolver<Real>::~CpuSolver() = default;
+template <typename Real> unsigned CpuSolver<Real>::threads() const {
+  return impl_->pool_->size();
+}
+template <typename Real> Result<void> CpuSolver<Real>::step() {
+  return impl_->step();
+}
+template <typename Real> Result<void> CpuSolver<Real>::run(std::uint64_t steps) {
+  for (std::uint64_t s = 0; s < steps; ++s)
+    VKCLOTH_TRY(impl_->step());
+  return {};
+}
+template <typename Real> Result<void> CpuSolver<Real>::set_params(SimParams params) {
+  return impl_->set_params(std::move(params));
+}
+template <typename Real> const SimParams& CpuSolver<Real>::params() const {
+  return impl_->params_;
+}
+template <typename Real> auto CpuSolver<Real>::positions() const -> std::span<const Vec3> {
+  return impl_->pos_;
+}
+template <typename Real> auto CpuSolver<Real>::velocities() const -> std::span<const Vec3> {
+  return impl_->vel_;
+}
+template <typename Real> auto CpuSolver<Real>::forces() const -> std::span<const Vec3> {
+  return impl_->force_;
+}
+template <typename Real> auto CpuSolver<Real>::normals() const -> std::span<const Vec3> {
+  return impl_->normal_;
+}
+template <typename Real> const SolveStats& CpuSolver<Real>::last_solve() const {
+  return impl_->solve_;
+}
+template <typename Real> std::uint64_t CpuSolver<Real>::step_index() const {
+  return impl_->step_;
+}
+template <typename Real> double CpuSolver<Real>::time() const {
+  return impl_->time_;
+}
+template <typename Real> const ParticleSystem& CpuSolver<Real>::system() const {
+  return impl_->system();
+}
+template <typename Real> const std::shared_ptr<const ClothTopology>& CpuSolver<Real>::topology() const {
+  return impl_->topology_;
+}
+template <typename Real>
+Result<void> CpuSolver<Real>::set_particle(std::uint32_t index, Vec3 position, Vec3 velocity) {
+  return impl_->set_particle(index, position, velocity);
+}
+template <typename Real> auto CpuSolver<Real>::energy() const -> Energy {
+  return impl_->energy();
+}
+
+template struct CpuSolver<float>::Impl;
+template struct CpuSolver<double>::Impl;
 template class CpuSolver<float>;
 template class CpuSolver<double>;
 

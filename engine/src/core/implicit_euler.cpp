@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "thread_pool.hpp"
+#include "cpu_solver_impl.hpp"
 #include "vkcloth/cpu_solver.hpp"
 
 namespace vkcloth {
@@ -23,7 +24,7 @@ template <typename Real, typename V> Real dot_all(const std::vector<V>& a, const
 
 // The phases of one implicit substep (the method: implicit_euler.hpp). Each parallel sweep writes
 // only particle p's entries; the dot products are sequential, in particle order.
-template <typename Real> void CpuSolver<Real>::implicit_substep(const Real h) {
+template <typename Real> void CpuSolver<Real>::Impl::implicit_substep(const Real h) {
   const std::size_t n = pos_.size();
   if (!implicit_)
     implicit_ = std::make_unique<detail::ImplicitWorkspace<Real>>();
@@ -52,7 +53,7 @@ template <typename Real> void CpuSolver<Real>::implicit_substep(const Real h) {
 
 // 2. Per-entry K_s, the block-Jacobi preconditioner, b = h (f - h L v) filtered, and the warm
 // start's residual r = b - S A x0 (x0: the previous dv, read-only here); z = P^-1 r, d = z.
-template <typename Real> void CpuSolver<Real>::implicit_system(const Real h) {
+template <typename Real> void CpuSolver<Real>::Impl::implicit_system(const Real h) {
   auto& w = *implicit_;
   const Real mu_h = Real(1) + h * Real(params_.damping); // M - h D = (1 + h mu) M
   const Real h2 = h * h;
@@ -85,7 +86,7 @@ template <typename Real> void CpuSolver<Real>::implicit_system(const Real h) {
 }
 
 // 3. Preconditioned CG on the filtered system; records the iterations and residual in solve_.
-template <typename Real> void CpuSolver<Real>::implicit_cg(const Real h) {
+template <typename Real> void CpuSolver<Real>::Impl::implicit_cg(const Real h) {
   auto& w = *implicit_;
   const Real mu_h = Real(1) + h * Real(params_.damping);
   const Real h2 = h * h;
@@ -146,7 +147,7 @@ template <typename Real> void CpuSolver<Real>::implicit_cg(const Real h) {
 
 // 4. v' = v + dv, the inward part removed in contact; x' = x + h v', projected. Only particle p's
 // own state is read here, so the update is in place.
-template <typename Real> void CpuSolver<Real>::implicit_update(const Real h) {
+template <typename Real> void CpuSolver<Real>::Impl::implicit_update(const Real h) {
   auto& w = *implicit_;
   pool_->for_each(pos_.size(), [&](std::size_t p) {
     if (pinned_[p])
@@ -164,13 +165,13 @@ template <typename Real> void CpuSolver<Real>::implicit_update(const Real h) {
   });
 }
 
-template void CpuSolver<float>::implicit_substep(float);
-template void CpuSolver<double>::implicit_substep(double);
-template void CpuSolver<float>::implicit_system(float);
-template void CpuSolver<double>::implicit_system(double);
-template void CpuSolver<float>::implicit_cg(float);
-template void CpuSolver<double>::implicit_cg(double);
-template void CpuSolver<float>::implicit_update(float);
-template void CpuSolver<double>::implicit_update(double);
+template void CpuSolver<float>::Impl::implicit_substep(float);
+template void CpuSolver<double>::Impl::implicit_substep(double);
+template void CpuSolver<float>::Impl::implicit_system(float);
+template void CpuSolver<double>::Impl::implicit_system(double);
+template void CpuSolver<float>::Impl::implicit_cg(float);
+template void CpuSolver<double>::Impl::implicit_cg(double);
+template void CpuSolver<float>::Impl::implicit_update(float);
+template void CpuSolver<double>::Impl::implicit_update(double);
 
 } // namespace vkcloth

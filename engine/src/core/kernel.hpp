@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// The per-particle physics as C++: shaders/include/cloth_kernel.h, the one source the compute
+// The per-particle physics as C++: engine/kernel/cloth_kernel.h, the one source the compute
 // shaders include too, compiled here with GLM (which follows GLSL's syntax) once for float
 // (kernel::f32, CpuSolver<float>: the GPU's bits) and once for double (kernel::f64). Both sets
 // are visible in vkcloth::kernel; overloading on the vector type picks the precision.
@@ -15,7 +15,7 @@
 
 #include "vkcloth/collider_mesh.hpp"
 #include "vkcloth/params.hpp"
-#include "vkcloth_shared.h"
+#include "kernel/constants.h"
 
 // The shader constants the kernel compares against are the C++ enums' values.
 static_assert(VKCLOTH_COLLIDER_PLANE == std::uint32_t(vkcloth::Collider::Type::plane));
@@ -104,14 +104,14 @@ namespace f32 {
 using real = float;
 using vec3 = glm::vec3;
 using SelfData = SelfDataT<float>;
-#include "cloth_kernel.h"
+#include "kernel/cloth_kernel.h"
 } // namespace f32
 
 namespace f64 {
 using real = double;
 using vec3 = glm::dvec3;
 using SelfData = SelfDataT<double>;
-#include "cloth_kernel.h"
+#include "kernel/cloth_kernel.h"
 } // namespace f64
 
 using namespace f32;

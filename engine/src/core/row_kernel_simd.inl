@@ -5,7 +5,7 @@
 // sqrt, pin mask, AoS load3/store3). Everything here has internal linkage, so the two ISA
 // translation units never share (ODR-merge) a function compiled for the other's ISA.
 //
-// An optimised copy of the shared kernel (shaders/include/cloth_kernel.h: add_fan_triangle,
+// An optimised copy of the shared kernel (engine/kernel/cloth_kernel.h: add_fan_triangle,
 // add_ring_term, unit_or_zero, add_spring, add_body_forces, euler_update, diverged), the one place a formula
 // is written twice: GCC vector types cannot pass through the kernel's scalar-typed functions. Bits: every
 // lane performs the kernel's operations on its particle, one for one and in the same order; IEEE +, -, *, /

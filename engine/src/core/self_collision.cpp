@@ -8,11 +8,12 @@
 #include "kernel.hpp"
 #include "self_collision.hpp"
 #include "thread_pool.hpp"
+#include "cpu_solver_impl.hpp"
 #include "vkcloth/cpu_solver.hpp"
 
 namespace vkcloth {
 
-template <typename Real> void CpuSolver<Real>::self_collide() {
+template <typename Real> void CpuSolver<Real>::Impl::self_collide() {
   const SelfCollision& sc = params_.self_collision;
   const std::size_t n = pos_.size();
   if (!self_) {
@@ -68,7 +69,7 @@ template <typename Real> void CpuSolver<Real>::self_collide() {
   swept_finite_ = false; // checked with the rest of the state (check_finite)
 }
 
-template void CpuSolver<float>::self_collide();
-template void CpuSolver<double>::self_collide();
+template void CpuSolver<float>::Impl::self_collide();
+template void CpuSolver<double>::Impl::self_collide();
 
 } // namespace vkcloth

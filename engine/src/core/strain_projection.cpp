@@ -11,6 +11,7 @@
 #include "kernel.hpp"
 #include "strain_projection.hpp"
 #include "thread_pool.hpp"
+#include "cpu_solver_impl.hpp"
 #include "vkcloth/cpu_solver.hpp"
 
 namespace vkcloth {
@@ -36,7 +37,7 @@ template <typename Real, typename Term> std::pair<Real, Real> workgroup_sums(std
 
 } // namespace
 
-template <typename Real> void CpuSolver<Real>::project_strain(const Real h) {
+template <typename Real> void CpuSolver<Real>::Impl::project_strain(const Real h) {
   const StretchLimit& sl = params_.stretch_limit;
   const std::span<const StrainLink> links = topology_->strain_links();
   const std::span<const std::uint32_t> offsets = topology_->strain_incidence_offsets();
@@ -116,7 +117,7 @@ template <typename Real> void CpuSolver<Real>::project_strain(const Real h) {
   }
 }
 
-template void CpuSolver<float>::project_strain(float);
-template void CpuSolver<double>::project_strain(double);
+template void CpuSolver<float>::Impl::project_strain(float);
+template void CpuSolver<double>::Impl::project_strain(double);
 
 } // namespace vkcloth

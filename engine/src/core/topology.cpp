@@ -2,7 +2,7 @@
 #include "vkcloth/topology.hpp"
 
 #include "vkcloth/builders.hpp"
-#include "vkcloth_shared.h" // VKCLOTH_RING_*
+#include "kernel/constants.h" // VKCLOTH_RING_*
 
 #include "stretch_topology.hpp"
 

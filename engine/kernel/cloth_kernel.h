@@ -1,0 +1,38 @@
+// SPDX-License-Identifier: MIT
+// The per-particle physics of vkcloth, written ONCE for both backends: the compute shaders
+// include this file as GLSL (through common.glsl) and the CPU reference solver compiles it as
+// C++ (through engine/src/core/kernel.hpp, with GLM, for float and for double), as Jolt's
+// HairIntegrate.h is shared by its HLSL and its C++ solver. The equations: docs/model.md.
+//
+// Rules that keep CPU and GPU bit-identical (on lavapipe; a real GPU may round sqrt/division
+// differently):
+// - Every expression is written out in one fixed order, and every result lands in a `precise`
+//   variable, so the shader compiler may neither reassociate nor fuse it into an FMA (the C++
+//   side builds with -ffp-contract=off; `precise` is empty there).
+// - Literals are `real(...)`: a bare 2.0 would be a double in C++.
+// - Pure functions of values: no buffer (a mesh collider's hierarchy is read through the including
+//   file's accessors), no loop over particles or colliders. Each caller
+//   gathers its inputs its own way (texel fetches, std::vector) and loops itself.
+//
+// Provided by the including file: real, vec3, uint, KFN (function prefix: `inline` in C++),
+// OUT(T) / INOUT(T) (out / inout parameters: T& in C++), precise, sqrt, abs, min, max, and
+// all_finite(vec3) (no component is NaN or inf); for mesh colliders MESH_DATA_PARAM / MESH_DATA
+// (the mesh buffers: a dummy uint in GLSL, whose buffers are global), mesh_node and mesh_triangle;
+// floor; for self_collide (only where SELF_DATA_PARAM is defined) SELF_DATA_PARAM / SELF_DATA,
+// self_range, self_entry and self_particle;
+// VKCLOTH_COLLIDER_PRESENT(type): false only when no collider of that type can reach the caller
+// (C++: always true; GLSL: a specialisation constant, so that the absent shapes' code is compiled
+// out, since llvmpipe runs every branch of a non-uniform `if`). It changes no result.
+// Constants: constants.h (included here).
+// No include guard: kernel.hpp includes this file once per precision, in two namespaces.
+
+// One header per concern, in dependency order.
+#include "constants.h"
+#include "vector.h"
+#include "forces.h"
+#include "contacts.h"
+#include "friction.h"
+#include "strain.h"
+#include "self_collision.h"
+#include "integrators.h"
+#include "implicit.h"

@@ -1,0 +1,100 @@
+// SPDX-License-Identifier: MIT
+// vkcloth kernel, the contact response: the inward part removed (Figure 12), Coulomb friction and the
+// projection out of a collider (docs/model.md "Collisions", "Friction").
+// Part of the kernel that cloth_kernel.h gathers (the rules it states hold here: fixed order,
+// `precise` results, real(...) literals). No include guard: the C++ bridge includes it once per precision.
+
+// Removes the part of `w` along n that points into the collider (<w, n> < 0); with `both`
+// (Figure 12's variant) the outward part as well.
+KFN void remove_inward(INOUT(vec3) w, vec3 n, bool both) {
+  precise real wn = dot3(w, n);
+  if (wn < real(0) || (both && wn != real(0))) {
+    precise vec3 t = w - n * wn;
+    w = t;
+  }
+}
+
+// Contact filter of one collider: within the band (distance < 2 eps) velocity and force lose
+// their parts pointing into the collider, so a hand lifting the cloth keeps its outward pull.
+KFN void contact_filter(INOUT(vec3) v, INOUT(vec3) f, vec3 n, real distance, real band, bool both) {
+  if (!(distance < band))
+    return;
+  remove_inward(v, n, both);
+  remove_inward(f, n, both);
+}
+
+// Coulomb friction on the relative velocity w and the force f once their inward normal parts are
+// gone; j: the normal impulse per unit mass of this substep (the inward velocity removed plus
+// h / m times the inward force removed). The tangential velocity the substep would end with,
+// slip = w_t + (h / m) f_t, is cancelled when |slip| <= mu_s j (static: w_t and f_t go) and
+// otherwise shortened by mu_k j (kinetic: w_t and f_t scaled by the same factor).
+KFN void coulomb_friction(INOUT(vec3) w, INOUT(vec3) f, vec3 n, real j, real mu_k, real mu_s, real h_over_m) {
+  precise vec3 wt = w - n * dot3(w, n);
+  precise vec3 ft = f - n * dot3(f, n);
+  precise vec3 slip = wt + ft * h_over_m;
+  precise real slip_len = sqrt(dot3(slip, slip));
+  precise real hold = mu_s * j;
+  precise real k = slip_len > hold ? mu_k * j / slip_len : real(1);
+  precise vec3 nw = w - wt * k;
+  precise vec3 nf = f - ft * k;
+  w = nw;
+  f = nf;
+}
+
+// The contact response of one collider for particle x with velocity v and force f (mass m,
+// substep h: h_over_m = h / m): the report's filter relative to the collider's surface velocity,
+// then friction. A still, frictionless collider is exactly contact_filter (the report's model).
+KFN void contact_response(INOUT(vec3) v, INOUT(vec3) f, ColliderShape s, vec3 x, vec3 n, real distance,
+                          real band, bool both, real h_over_m) {
+  if (!s.moving && s.mu_s == real(0) && s.mu_k == real(0)) {
+    contact_filter(v, f, n, distance, band, both);
+    return;
+  }
+  if (!(distance < band))
+    return;
+  precise vec3 vs = s.moving ? surface_velocity(s, x) : vec3(real(0));
+  precise vec3 w = v - vs;
+  precise real wn = dot3(w, n), fn = dot3(f, n);
+  remove_inward(w, n, both);
+  remove_inward(f, n, both);
+  precise real j = max(-wn, real(0)) + max(-fn, real(0)) * h_over_m;
+  coulomb_friction(w, f, n, j, s.mu_k, s.mu_s, h_over_m);
+  precise vec3 nv = w + vs;
+  v = nv;
+}
+
+// Eq. 5 / eq. 6: a point inside a collider goes back to its surface + eps, and loses its
+// inward velocity (relative to the surface's). p_side: where the particle came from (a mesh's side).
+// A mesh is searched as far as the particle moved, so that one that crossed it within the step
+// is found even when it ended farther than the thickness beyond.
+KFN void project_out(MESH_DATA_PARAM, ColliderShape s, real eps, vec3 p_side, INOUT(vec3) x, INOUT(vec3) v) {
+  real distance;
+  vec3 n;
+  precise vec3 moved = x - p_side;
+  precise real reach = s.type == VKCLOTH_COLLIDER_MESH ? sqrt(dot3(moved, moved)) : real(0);
+  collider_contact(MESH_DATA, s, x, p_side, reach, distance, n);
+  if (!(distance < real(0)))
+    return;
+  if (s.type == VKCLOTH_COLLIDER_PLANE) {
+    precise real back = eps - distance;
+    precise vec3 t = x + n * back;
+    x = t;
+  } else if (s.type == VKCLOTH_COLLIDER_SPHERE) {
+    precise real r = s.b + eps;
+    precise vec3 t = s.a + n * r;
+    x = t;
+  } else {
+    precise real back = eps - distance;
+    precise vec3 t = x + n * back;
+    x = t;
+  }
+  if (!s.moving) {
+    remove_inward(v, n, false);
+    return;
+  }
+  precise vec3 vs = surface_velocity(s, x);
+  precise vec3 w = v - vs;
+  remove_inward(w, n, false);
+  precise vec3 nv = w + vs;
+  v = nv;
+}

@@ -1,0 +1,136 @@
+// SPDX-License-Identifier: MIT
+// vkcloth kernel, self-collision: the hash of cells and the pair repulsion (docs/model.md "Self-collision").
+// Part of the kernel that cloth_kernel.h gathers (the rules it states hold here: fixed order,
+// `precise` results, real(...) literals). No include guard: the C++ bridge includes it once per precision.
+
+// ---- Self-collision (docs/model.md "Self-collision") ------------------------------------------
+
+// One coordinate of the spatial hash's cell of x: floor(x / cell), inv_cell = 1 / cell. Beyond
+// +-1e9 cells (a diverged state, NaN) it is cell 0, so that the conversion to int is defined on both
+// sides; the divergence check reports such a state.
+KFN int self_cell(real x, real inv_cell) {
+  precise real c = floor(x * inv_cell);
+  if (!(c >= real(-1.0e9) && c <= real(1.0e9)))
+    c = real(0);
+  return int(c);
+}
+
+// A cell's key: its coordinates modulo 1024, 10 bits each (the grid repeats every 1024 cells: two
+// cells of one key are 1024 cells apart, so only one of the 27 around a particle has a given key).
+KFN uint self_key_of(int i, int j, int k) {
+  return (uint(i) & 1023u) | ((uint(j) & 1023u) << 10u) | ((uint(k) & 1023u) << 20u);
+}
+KFN uint self_key(vec3 x, real inv_cell) {
+  return self_key_of(self_cell(x.x, inv_cell), self_cell(x.y, inv_cell), self_cell(x.z, inv_cell));
+}
+// The key of the cell (di, dj, dk) away from `key`'s.
+KFN uint self_key_step(uint key, int di, int dj, int dk) {
+  return self_key_of(int(key & 1023u) + di, int((key >> 10u) & 1023u) + dj, int(key >> 20u) + dk);
+}
+// The hash-table bucket of a key (Teschner et al. 2003's primes on its three coordinates), wrapped
+// to the table: mask = its size - 1, a power of two.
+KFN uint self_bucket(uint key, uint mask) {
+  return ((key & 1023u) * 73856093u ^ ((key >> 10u) & 1023u) * 19349663u ^ (key >> 20u) * 83492791u) & mask;
+}
+
+// 1 / m, or 0 for a pinned particle (it takes no share of a correction).
+KFN precise real inverse_mass(real m, bool pinned) {
+  precise real w = pinned ? real(0) : real(1) / m;
+  return w;
+}
+
+// Whether x and xq (rest positions rx, rxq) are a self-collision pair: closer than the thickness
+// now (and not at one point, which has no direction) but not that close at rest (the rest-position
+// filter of NvCloth: neighbours joined by short springs never collide).
+KFN bool self_pair(vec3 x, vec3 xq, vec3 rx, vec3 rxq, real thickness2) {
+  precise vec3 u = x - xq;
+  precise real d2 = dot3(u, u);
+  precise vec3 r = rx - rxq;
+  precise real r2 = dot3(r, r);
+  return d2 < thickness2 && d2 > real(0) && !(r2 < thickness2);
+}
+
+// Adds p's part of one pair's response to dx (a move) and dv (a velocity change), p's share of
+// each being its inverse-mass share w / (w + wq) (Bridson, Fedkiw and Anderson 2002, section 7:
+// a position correction plus a velocity filter). Along n = (x - xq) / |x - xq| the pair moves
+// apart to the thickness (the move changes no velocity: no bounce), and the normal relative
+// velocity, where it approaches, is removed (inelastic); across n Coulomb friction takes up to mu
+// times that removed speed off the relative tangential velocity (all of it within: static). A layer
+// resting on another is held by friction mu g per unit mass, since gravity's approach per substep
+// is g h.
+KFN void self_contact(INOUT(vec3) dx, INOUT(vec3) dv, vec3 x, vec3 v, real w, vec3 xq, vec3 vq, real wq,
+                      real thickness, real mu) {
+  precise vec3 u = x - xq;
+  precise real d = sqrt(dot3(u, u));
+  precise vec3 n = u / d;
+  precise real share = w / (w + wq);
+  precise real depth = thickness - d;
+  precise vec3 rv = v - vq;
+  precise real vn = dot3(rv, n);
+  precise real approach = max(-vn, real(0));
+  precise vec3 vt = rv - n * vn;
+  precise real slip = sqrt(dot3(vt, vt));
+  precise real cap = mu * approach;
+  precise real kept = slip > cap ? cap / slip : real(1); // the part of the slip friction removes
+  precise vec3 mx = dx + n * (depth * share);
+  precise vec3 mv = dv + n * (approach * share);
+  mv = mv - vt * (kept * share);
+  dx = mx;
+  dv = mv;
+}
+
+#ifdef SELF_DATA_PARAM // the includer provides the table (C++: kernel.hpp; GLSL: self_collision.comp)
+// Particle p's response (Jacobi: the mean of its pairs' responses, so that a particle pressed from
+// many sides does not overshoot): every particle q of the 27 cells around p's, cell by cell in a
+// fixed order, each cell's particles in increasing index (a bucket holds the particles of every
+// cell hashed to it, in increasing index: those of other cells are skipped by their key).
+// Provided by the including file: self_range(SELF_DATA, bucket, first, stop) (the bucket's entries
+// of the sorted table), self_entry(SELF_DATA, i, q, key) (an entry's particle and the key of the
+// cell it was sorted in), self_particle(SELF_DATA, q, x, v, w, rest). Both backends build the
+// same table, so they sum the same pairs in the same order.
+KFN void self_collide(SELF_DATA_PARAM, uint p, vec3 x, vec3 v, real w, vec3 rx, real thickness, real inv_cell,
+                      uint mask, real mu, OUT(vec3) dx, OUT(vec3) dv) {
+  precise real t2 = thickness * thickness;
+  const uint own = self_key(x, inv_cell);
+  precise vec3 sum_x = vec3(real(0));
+  precise vec3 sum_v = vec3(real(0));
+  uint pairs = 0u;
+  for (int dk = -1; dk <= 1; ++dk)
+    for (int dj = -1; dj <= 1; ++dj)
+      for (int di = -1; di <= 1; ++di) {
+        const uint key = self_key_step(own, di, dj, dk);
+        uint first;
+        uint stop;
+        self_range(SELF_DATA, self_bucket(key, mask), first, stop);
+        for (uint i = first; i < stop; ++i) {
+          uint q;
+          uint qkey;
+          self_entry(SELF_DATA, i, q, qkey);
+          if (qkey != key || q == p)
+            continue;
+          vec3 xq;
+          vec3 vq;
+          vec3 rq;
+          real wq;
+          self_particle(SELF_DATA, q, xq, vq, wq, rq);
+          if (self_pair(x, xq, rx, rq, t2)) {
+            self_contact(sum_x, sum_v, x, v, w, xq, vq, wq, thickness, mu);
+            pairs += 1u;
+          }
+        }
+      }
+  precise real k = pairs > 0u ? real(1) / real(pairs) : real(0);
+  precise vec3 mx = sum_x * k;
+  precise vec3 mv = sum_v * k;
+  dx = mx;
+  dv = mv;
+}
+#endif
+
+// Applies a self-collision pass's response to a particle.
+KFN void self_apply(INOUT(vec3) x, INOUT(vec3) v, vec3 dx, vec3 dv) {
+  precise vec3 nx = x + dx;
+  precise vec3 nv = v + dv;
+  x = nx;
+  v = nv;
+}

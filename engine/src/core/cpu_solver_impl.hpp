@@ -1,0 +1,156 @@
+// SPDX-License-Identifier: MIT
+// CpuSolver's internals (the public header holds the API only): the state in the solver's
+// precision and the per-particle loops of one substep. Defined in cpu_solver.cpp (Euler, RK4, the
+// row and list sweeps), implicit_euler.cpp, self_collision.cpp and strain_projection.cpp.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "kernel.hpp"
+#include "row_kernel.hpp"
+#include "vkcloth/cpu_solver.hpp"
+
+namespace vkcloth {
+
+namespace detail {
+class ThreadPool;
+template <typename Real> struct ImplicitWorkspace;
+template <typename Real> struct SelfCollisionGrid;
+template <typename Real> struct StrainProjection;
+/// The colliders as the kernel takes them at this substep's pose, and their meshes; the same values
+/// for the SIMD finish of the grid rows (row_kernel.hpp FinishShape), empty when a collider is a mesh.
+template <typename Real> struct ContactShapes {
+  std::vector<kernel::ColliderShape<Real>> shapes;
+  std::vector<kernel::MeshData> meshes;
+  std::vector<FinishShape<Real>> finish;
+};
+/// The padded lists the list kernel reads (row_kernel.hpp ListArgs), built once for vectors of
+/// `width` particles by pad_lists.
+template <typename Real> struct PaddedLists {
+  std::size_t width = 0;
+  std::vector<std::uint32_t> spring_begin, other, ring, ring_end;
+  std::vector<std::uint8_t> reads_last; ///< per vector: some slot names the last particle
+  std::vector<Real> rest, stiff;
+};
+
+/// check_finite's test, branch-free (vectorisable OR-reduction over flat arrays of n3 components):
+/// nonzero when a component is not finite (c - c != 0 for inf and NaN) or a position has |x| > limit
+/// (or is NaN). The row sweep runs it on each block it wrote, check_finite on the whole state.
+template <typename Real>
+inline unsigned bad_components(const Real* x, const Real* v, std::size_t n3, Real limit) {
+  unsigned bad = 0;
+  for (std::size_t i = 0; i < n3; ++i)
+    bad |= unsigned(!(std::abs(x[i]) <= limit)) | unsigned(!(x[i] - x[i] == Real(0))) |
+           unsigned(!(v[i] - v[i] == Real(0)));
+  return bad;
+}
+} // namespace detail
+
+template <typename Real> struct CpuSolver<Real>::Impl {
+  using Vec3 = typename CpuSolver<Real>::Vec3;
+  using Energy = typename CpuSolver<Real>::Energy;
+
+  Impl();
+  ~Impl();
+
+  // The API's work (CpuSolver forwards here).
+  Result<void> step();
+  Result<void> set_params(SimParams params);
+  Result<void> set_particle(std::uint32_t index, Vec3 position, Vec3 velocity);
+  Energy energy() const;
+  double time() const { return time_; }
+  const ParticleSystem& system() const { return topology_->system(); }
+
+  // Per-particle kernels (each formula from engine/kernel/cloth_kernel.h): each reads shared
+  // inputs and writes only particle p's outputs.
+  /// Particle p's normal and force: writes normal_[p] (from the grid fan, or from the gather
+  /// list's ring terms with ClothTopology::ring_normals), returns the force.
+  Vec3 normal_force_at(std::span<const Vec3> pos, std::span<const Vec3> vel, std::size_t p);
+  // Contacts (cloth_kernel.h contact_response / project_out) with every collider at this substep's
+  // pose; h_over_m: substep / mass (friction's impulse); side: where the particle came from.
+  void contact_at(Vec3 pos, Vec3& vel, Vec3& force, Real h_over_m, bool friction = true) const;
+  void project_at(Vec3 side, Vec3& pos, Vec3& vel) const;
+  void prepare_colliders();
+  void advance_colliders(double h);
+  Result<void> check_finite() const;
+  void substep(Real h);
+  // Explicit / semi-implicit Euler: contacts, update and projection of particle p with force f
+  // (writes force_[p], pos_next_[p], vel_[p]).
+  void euler_finish(std::size_t p, Vec3 f, Real h, bool semi);
+  void euler_substep(Real h, bool semi);
+  void row_sweep(Real h, bool semi);  // euler_substep on a grid stencil (row_kernel.hpp)
+  void list_sweep(Real h, bool semi); // euler_substep without a stencil, in SIMD (row_kernel.hpp)
+  void step_args(detail::StepArgs<Real>& a, Real h, bool semi);
+  detail::RowArgs<Real> row_args(Real h, bool semi);
+  void rk4_substep(Real h);
+  // Implicit Euler (implicit_euler.cpp): forces, then the linear system, CG, and the update.
+  void implicit_substep(Real h);
+  void implicit_system(Real h);
+  void implicit_cg(Real h);
+  void implicit_update(Real h);
+  // Stretch control after a substep (docs/model.md "Stretch control").
+  void limit_stretch(Real h);
+  // Self-collision after that (self_collision.cpp; docs/model.md "Self-collision").
+  void self_collide();
+  void project_strain(Real h);
+
+  /// A gather-list entry in the solver's precision (ClothTopology::edges() converted once).
+  struct Edge {
+    std::uint32_t other;
+    Real rest_length;
+    Real stiffness;
+    std::uint32_t ring; // VKCLOTH_RING_*
+  };
+
+  std::shared_ptr<const ClothTopology> topology_;
+  SimParams params_;
+  std::span<const std::uint32_t> edge_offsets_; // the topology's
+  std::vector<Edge> edges_;
+  std::vector<Real> mass_;
+  std::vector<std::uint8_t> pinned_;
+  std::vector<Vec3> pos_, vel_, force_, normal_;
+  std::vector<Vec3> pos_next_;                     // integration writes here while forces still read pos_
+  std::array<std::vector<Vec3>, 4> k_pos_, k_vel_; // RK4 stage derivatives
+  std::vector<Vec3> stage_pos_, stage_vel_;
+  // The topology's grid stencil (null: none): interior particles' springs from these constants
+  // instead of the CSR lists, same terms in the same order, so the same bits.
+  const GridStencil* stencil_ = nullptr;
+  std::array<std::int64_t, 12> stencil_offset_{};
+  std::array<Real, 12> stencil_rest_{}, stencil_stiff_{};
+  // Positions as SoA for the row kernel: x, y, z blocks of n + 2 soa_pad_ each, particle p of a
+  // block at soa_pad_ + p (the pads let masked border lanes read absent neighbours). The row sweep
+  // writes the next step's copy (soa_next_) as it integrates; soa_valid_ is false after anything
+  // else changed pos_ (set_particle, RK4, implicit Euler), and the next row sweep transposes.
+  std::vector<Real> soa_, soa_next_;
+  std::size_t soa_pad_ = 0;
+  bool soa_valid_ = false;
+  bool swept_finite_ = false; // the last substep's row sweep found every position/velocity finite
+  int simd_ = 0;              // row kernel ISA: 0 none, 1 AVX2, 2 AVX-512F (cpu_solver.cpp)
+  // Stretch control in the solver's precision (converted from the topology when first needed).
+  struct Link {
+    std::uint32_t a, b;
+    Real rest_length;
+  };
+  struct TetherSlot {
+    std::uint32_t anchor;
+    Real rest_length;
+  };
+  std::vector<Link> strain_links_;
+  std::vector<TetherSlot> tethers_;
+  StretchLimit::TetherDistance tether_kind_ = StretchLimit::TetherDistance::euclidean;
+  std::uint64_t step_ = 0;
+  double time_ = 0.0;
+  std::unique_ptr<detail::ThreadPool> pool_;
+  std::unique_ptr<detail::ImplicitWorkspace<Real>> implicit_;  // created by the first implicit step
+  std::unique_ptr<detail::ContactShapes<Real>> contacts_;      // this substep's colliders (prepare_colliders)
+  std::unique_ptr<detail::SelfCollisionGrid<Real>> self_;      // created by the first self-collision substep
+  std::unique_ptr<detail::StrainProjection<Real>> projection_; // created by the first fast-projection substep
+  std::unique_ptr<detail::PaddedLists<Real>> lists_;           // created by the first list sweep
+  SolveStats solve_;
+};
+
+} // namespace vkcloth
