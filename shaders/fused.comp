@@ -23,25 +23,14 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_VEL) buffer VelBuf { vec4 vel[
 #include "finish.glsl"
 
 // False for every substep of a recorded batch but the last (GpuSolver fused_pipes[0][*]): the
-// forces and normals of the other substeps are overwritten before anyone can read them, and
-// llvmpipe pays a per-lane scalar loop for each of these stores.
+// forces and normals of the other substeps are overwritten before anyone can read them, so they
+// are not stored (docs/performance.md "lavapipe (llvmpipe) notes").
 layout(constant_id = 40) const bool SC_WRITE_AUX = true;
 
-// The state velocity and the flags word read through texel views of VEL and FLAGS (set 1), like
-// the positions (force_body.glsl pos_at): on llvmpipe an SSBO load is a per-lane loop even at a
-// constant offset. Each invocation reads its own velocity before it stores it, and any flags value
-// this dispatch can see gives the same frozen() answer (older steps' values are visible through
-// the barrier; this step's own writes are >= pc.step). The *_storage build loads them from VEL and
-// FLAGS themselves.
-#ifdef VKCLOTH_TEXEL_VIEWS
-layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_VEL) uniform samplerBuffer vel_texel;
-layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_FLAGS) uniform usamplerBuffer flags_texel;
-vec3 vel_now(uint g) { return texelFetch(vel_texel, int(g)).xyz; }
-bool frozen_now() { return texelFetch(flags_texel, int(inst * 4u + 1u)).x < pc.step; }
-#else
-vec3 vel_now(uint g) { return vel[g].xyz; }
-bool frozen_now() { return frozen(); }
-#endif
+// read_velocity, read_frozen: the state velocity (each invocation reads its own before it stores
+// it) and the flags word.
+#define VKCLOTH_ACCESS_VEL_FLAGS
+#include "buffer_access.glsl"
 
 void main() {
   begin_instance();
@@ -49,12 +38,11 @@ void main() {
   if (p >= pc.count) return;
   const uint g = base + p; // this particle's entry in the state buffers
   // A frozen step (after a divergence) writes back the state it read through the same stores as a
-  // live step (keeps it in the buffer that becomes current): llvmpipe runs every branch, so a
-  // separate copy cost a masked per-lane load and store loop in every step. finish() re-checks the
-  // frozen state, which is the bad step's output: the same particles, no flag changes.
-  // frozen(): Flags[inst].first_bad_step (4 words per Flags) < this step
-  const bool fr = frozen_now();
-  const vec3 v0 = vel_now(g);
+  // live step (keeps it in the buffer that becomes current; not a separate copy: docs/performance.md
+  // "lavapipe (llvmpipe) notes"). finish() re-checks the frozen state, which is the bad step's
+  // output: the same particles, no flag changes.
+  const bool fr = read_frozen();
+  const vec3 v0 = read_velocity(p);
   vec3 vf = v0;
   vec3 f, nrm;
   particle_force(p, vf, f, nrm);
@@ -63,12 +51,14 @@ void main() {
     normal_out[g] = normal_output(nrm);
   }
 
-  const bool pinned = pinned_at(p);
-  const vec3 x0 = pos_at(p);
+  const bool pinned = read_particle(p).pinned != 0u;
+  const vec3 x0 = read_pos_in(p);
   vec3 x = x0;
   vec3 v = vf;
-  if (!pinned && !fr)
-    euler_update(ip.integrator == VKCLOTH_INTEGRATOR_SEMI_IMPLICIT_EULER, x, v, f, mass_at(p), ip.dt);
+  if (!pinned && !fr) {
+    const float m = read_particle(p).mass;
+    euler_update(ip.integrator == VKCLOTH_INTEGRATOR_SEMI_IMPLICIT_EULER, x, v, f, m, ip.dt);
+  }
   if (fr) v = v0;
   finish(p, pinned || fr, x0, x, v);
 }

@@ -213,7 +213,8 @@ void main() {
   begin_instance(); // always instance 0: implicit passes run batches of one
   const uint p = particle_index();
   const bool live = p < pc.count;
-  const uint mode = pass_stage(); // one pipeline per mode (ImplicitGpu): llvmpipe runs every branch
+  // One pipeline per mode (ImplicitGpu; why: docs/performance.md "lavapipe (llvmpipe) notes").
+  const uint mode = pass_stage();
   const float h = ip.dt;
   precise float mu_h = 1.0 + h * ip.gravity_damping.w;
   precise float h2 = h * h;

@@ -43,40 +43,23 @@ uint block_base() { return inst * (pc.pad0 / VKCLOTH_SELF_SCAN_BLOCK); }
 uint bucket_start(uint b) { return starts[start_base() + b]; }
 
 // What COLLIDE reads (its own particle, then every candidate's entry, particle and bucket range):
-// through set 1's views in the texel build, from set 0 in the storage build. Written only by
-// other passes (APPLY, SCAN_*, SCATTER, SORT), with a barrier between each.
-#ifdef VKCLOTH_TEXEL_VIEWS
-layout(set = 1, binding = VKCLOTH_SELF_TEXEL_POS) uniform samplerBuffer pos_texel;
-layout(set = 1, binding = VKCLOTH_SELF_TEXEL_VEL) uniform samplerBuffer vel_texel;
-layout(set = 1, binding = VKCLOTH_SELF_TEXEL_REST) uniform samplerBuffer rest_texel;
-layout(set = 1, binding = VKCLOTH_SELF_TEXEL_STARTS) uniform usamplerBuffer starts_texel;
-layout(set = 1, binding = VKCLOTH_SELF_TEXEL_SORTED) uniform usamplerBuffer sorted_texel;
-vec3 collide_pos(uint q) { return texelFetch(pos_texel, int(base + q)).xyz; }
-vec3 collide_vel(uint q) { return texelFetch(vel_texel, int(base + q)).xyz; }
-vec4 collide_rest(uint q) { return texelFetch(rest_texel, int(q)); }
-uint collide_start(uint b) { return texelFetch(starts_texel, int(start_base() + b)).x; }
-uvec2 collide_entry(uint i) { return texelFetch(sorted_texel, int(base + i)).xy; }
-#else
-vec3 collide_pos(uint q) { return pos_out[base + q].xyz; }
-vec3 collide_vel(uint q) { return vel[base + q].xyz; }
-vec4 collide_rest(uint q) { return rest_pos[q]; }
-uint collide_start(uint b) { return bucket_start(b); }
-uvec2 collide_entry(uint i) { return sorted[base + i]; }
-#endif
+// read_pos_out, read_velocity, read_self_rest, read_bucket_start, read_sorted.
+#define VKCLOTH_ACCESS_SELF_COLLIDE
+#include "buffer_access.glsl"
 
 void self_range(uint unused, uint b, out uint first, out uint stop) {
-  first = collide_start(b);
-  stop = collide_start(b + 1u);
+  first = read_bucket_start(b);
+  stop = read_bucket_start(b + 1u);
 }
 void self_entry(uint unused, uint i, out uint q, out uint key) {
-  const uvec2 e = collide_entry(i);
+  const uvec2 e = read_sorted(i);
   q = e.x;
   key = e.y;
 }
 void self_particle(uint unused, uint q, out vec3 x, out vec3 v, out float w, out vec3 rest) {
-  x = collide_pos(q);
-  v = collide_vel(q);
-  const vec4 r = collide_rest(q);
+  x = read_pos_out(q);
+  v = read_velocity(q);
+  const vec4 r = read_self_rest(q);
   w = r.w; // the host's kernel inverse_mass, as the CPU's
   rest = r.xyz;
 }
@@ -101,8 +84,8 @@ uint workgroup_exclusive_scan(uint value) {
   return partial[i];
 }
 
-// One pipeline per pass (SC_STAGE; SelfCollisionGpu), so that on llvmpipe COUNT, the scans, SORT
-// and APPLY do not pay for COLLIDE's walk.
+// One pipeline per pass (SC_STAGE; SelfCollisionGpu): COUNT, the scans, SORT and APPLY without
+// COLLIDE's walk (docs/performance.md "lavapipe (llvmpipe) notes").
 void main() {
   begin_instance();
   const SelfParams sp = self_params[inst];
@@ -181,9 +164,9 @@ void main() {
     sorted[base + bucket_start(b) + left - 1u] = uvec2(p, key);
   } else if (pc.pad1 < sp.iterations && particle[p].pinned == 0u) {
     if (stage == VKCLOTH_SELF_COLLIDE) {
-      const vec3 x = collide_pos(p);
-      const vec3 v = collide_vel(p);
-      const vec4 r = collide_rest(p);
+      const vec3 x = read_pos_out(p);
+      const vec3 v = read_velocity(p);
+      const vec4 r = read_self_rest(p);
       vec3 dx;
       vec3 dv;
       self_collide(0u, p, x, v, r.w, r.xyz, sp.thickness, sp.inv_cell, mask, sp.friction, dx, dv);

@@ -10,19 +10,18 @@
 #include "vkcloth_shared.h"
 #define VKCLOTH_PC_COPY
 #include "common.glsl"
-#include "strain_texel.glsl"
 
-#ifdef VKCLOTH_TEXEL_VIEWS
-layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_TETHERS) uniform usamplerBuffer tethers_texel;
-uvec2 tether_at(uint s) { return texelFetch(tethers_texel, int(s)).xy; }
-#else
-layout(std430, set = 0, binding = VKCLOTH_BINDING_TETHERS) readonly buffer TetherBuf { TetherSlot tethers[]; };
-uvec2 tether_at(uint s) { return uvec2(tethers[s].anchor, floatBitsToUint(tethers[s].rest_length)); }
-#endif
+// pos_out and vel (declared there), read_pos_out, read_velocity, read_particle, read_frozen,
+// read_tether.
+#define VKCLOTH_ACCESS_POS_OUT
+#define VKCLOTH_ACCESS_PARTICLE
+#define VKCLOTH_ACCESS_VEL_FLAGS
+#define VKCLOTH_ACCESS_TETHERS
+#include "buffer_access.glsl"
 
-// One pipeline per stage (SC_STAGE; SolverBatch::ensure_finish_passes), so that the tether pass
-// does not pay for the colliders' projection (the mesh walk) on llvmpipe; SC_COLLIDER_TYPES
-// compiles out the shapes the batch lacks (all of them for the tethers).
+// One pipeline per stage (SC_STAGE; SolverBatch::ensure_finish_passes): the tether pass has no
+// collider code (docs/performance.md "lavapipe (llvmpipe) notes"); SC_COLLIDER_TYPES compiles out
+// the shapes the batch lacks (all of them for the tethers).
 void main() {
   begin_instance();
   const uint p = particle_index();
@@ -33,20 +32,20 @@ void main() {
   // Stage 1 projects after stretch control, stage 2 after self-collision: each only where it ran.
   const bool ran = stage == 1u ? ip.stretch != 0u : (ip.flags & VKCLOTH_FLAG_SELF_COLLISION) != 0u;
   if ((tether_pass ? (ip.stretch & VKCLOTH_STRETCH_TETHERS) == 0u : ip.collider_count == 0u || !ran) ||
-      pinned_at(p) || frozen_now())
+      read_particle(p).pinned != 0u || read_frozen())
     return;
-  vec3 x = pos_now(p);
-  vec3 v = vel_now(p);
+  vec3 x = read_pos_out(p);
+  vec3 v = read_velocity(p);
   bool moved = false;
   if (tether_pass) {
     // Euclidean rest lengths first, geodesic ones after (pc.count * VKCLOTH_TETHERS_PER_PARTICLE slots each).
     const uint first =
         ((ip.stretch & VKCLOTH_STRETCH_GEODESIC) != 0u ? pc.count + p : p) * VKCLOTH_TETHERS_PER_PARTICLE;
     for (uint k = 0u; k < VKCLOTH_TETHERS_PER_PARTICLE; ++k) {
-      const uvec2 t = tether_at(first + k); // TetherSlot: anchor, rest length
-      if (t.x == VKCLOTH_NO_TETHER) break;
+      const TetherSlot t = read_tether(first + k);
+      if (t.anchor == VKCLOTH_NO_TETHER) break;
       vec3 d;
-      if (tether_move(x, pos_now(t.x), stretch_bound(uintBitsToFloat(t.y), ip.max_strain), d)) {
+      if (tether_move(x, read_pos_out(t.anchor), stretch_bound(t.rest_length, ip.max_strain), d)) {
         apply_correction(x, v, d, ip.dt);
         moved = true;
       }

@@ -10,33 +10,30 @@
 #include "vkcloth_shared.h"
 #define VKCLOTH_PC_COPY
 #include "common.glsl"
-#include "strain_texel.glsl"
 
-#ifdef VKCLOTH_TEXEL_VIEWS
-layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_STRAIN_LINKS) uniform usamplerBuffer links_texel;
-StrainLink link_at(uint l) {
-  const int t = 3 * int(l); // StrainLink as 3 R32UI texels
-  return StrainLink(texelFetch(links_texel, t).x, texelFetch(links_texel, t + 1).x,
-                    uintBitsToFloat(texelFetch(links_texel, t + 2).x));
-}
-#else
-layout(std430, set = 0, binding = VKCLOTH_BINDING_STRAIN_LINKS) readonly buffer LinkBuf { StrainLink links[]; };
-StrainLink link_at(uint l) { return links[l]; }
-#endif
+// pos_out and vel (declared there), read_pos_out, read_velocity, read_particle, read_frozen,
+// read_strain_link.
+#define VKCLOTH_ACCESS_POS_OUT
+#define VKCLOTH_ACCESS_PARTICLE
+#define VKCLOTH_ACCESS_VEL_FLAGS
+#define VKCLOTH_ACCESS_STRAIN_LINKS
+#include "buffer_access.glsl"
 
 void main() {
   begin_instance();
   const uint k = particle_index(); // the link within its colour
-  if (k >= pc.pad1 || (ip.stretch & VKCLOTH_STRETCH_PROVOT) == 0u || pc.stage >= ip.stretch_sweeps || frozen_now())
+  if (k >= pc.pad1 || (ip.stretch & VKCLOTH_STRETCH_PROVOT) == 0u || pc.stage >= ip.stretch_sweeps ||
+      read_frozen())
     return;
-  const StrainLink link = link_at(pc.pad0 + k);
+  const StrainLink link = read_strain_link(pc.pad0 + k);
   const uint a = link.a, b = link.b;
   const float rest = link.rest_length;
-  vec3 xa = pos_now(a), xb = pos_now(b);
+  vec3 xa = read_pos_out(a), xb = read_pos_out(b);
   vec3 da, db;
-  if (!provot_link(xa, xb, pinned_at(a), pinned_at(b), stretch_bound(rest, ip.max_strain), da, db))
+  if (!provot_link(xa, xb, read_particle(a).pinned != 0u, read_particle(b).pinned != 0u,
+                   stretch_bound(rest, ip.max_strain), da, db))
     return; // within the bound: nothing moves
-  vec3 va = vel_now(a), vb = vel_now(b);
+  vec3 va = read_velocity(a), vb = read_velocity(b);
   apply_correction(xa, va, da, ip.dt);
   apply_correction(xb, vb, db, ip.dt);
   pos_out[base + a] = vec4(xa, 1.0);

@@ -3,51 +3,17 @@
 // pass per Euler step) and implicit.comp: vertex normal from the grid fan or from the gather
 // lists' ring terms, spring gather in the topology's order, gravity, damping, wind, then contact
 // filtering; each formula from cloth_kernel.h, which the CPU reference compiles too. Reads POS_IN
-// (all particles), OFFSETS, EDGES, PARTICLE (with VKCLOTH_TEXEL_VIEWS through set 1's texel views,
-// and RANGES there instead of OFFSETS; see below).
+// (all particles), the particle constants and the gather lists through buffer_access.glsl
+// (read_pos_in, read_particle, read_list_range, read_edge).
 #ifndef VKCLOTH_FORCE_BODY_GLSL
 #define VKCLOTH_FORCE_BODY_GLSL
 
 layout(std430, set = 0, binding = VKCLOTH_BINDING_POS_IN) readonly buffer PosIn { vec4 pos_in[]; };
 
-// pos_at(q) = pos_in[base + q].xyz (this instance's particle q; q indexes the shared topology),
-// mass_at(p) = particle[p].mass, pinned_at(p) = particle[p].pinned != 0.
-// With VKCLOTH_TEXEL_VIEWS (the *_texel builds of force.comp and fused.comp, shaders/CMakeLists.txt;
-// chosen per device by DeviceLayout) they read the same buffers through uniform texel buffer views
-// (set 1): llvmpipe (Mesa 22.x) turns an SSBO load into a per-lane loop with a bounds check and a
-// branch per component, a texel fetch into one vectorised gather of the 8 lanes' texels. A 32-bit
-// texel fetch is a copy: same bits. Without it (the *_storage builds, implicit.comp), plain std430
-// loads: what a GPU with a real memory path wants.
-// The topology's lists the same way: edge_at(e) = edges[e] (the mesh path: CSR gather and ring
-// normal; EDGES viewed as RGBA32UI, one texel per 16-byte Edge), and list_range(p) = particle p's
-// entries [x, z) of which [x, y) are its fan's. The texel builds read the three from one RANGES
-// texel (SolverBatch: begin, fan end, end), so the fan loop needs no exit on the first entry without
-// ring bits (llvmpipe pays such a data-dependent exit in every pass); the storage builds take
-// begin and end from OFFSETS and y = end, and the fan loop stops at that entry (FAN_EXIT).
-#ifdef VKCLOTH_TEXEL_VIEWS
-layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_POS_IN) uniform samplerBuffer pos_in_texel;
-layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_PARTICLE) uniform usamplerBuffer particle_texel;
-layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_RANGES) uniform usamplerBuffer ranges_texel;
-layout(set = 1, binding = VKCLOTH_TEXEL_BINDING_EDGES) uniform usamplerBuffer edges_texel;
-vec3 pos_at(uint q) { return texelFetch(pos_in_texel, int(base + q)).xyz; }
-float mass_at(uint p) { return uintBitsToFloat(texelFetch(particle_texel, int(p)).x); }
-bool pinned_at(uint p) { return texelFetch(particle_texel, int(p)).y != 0u; }
-uvec3 list_range(uint p) { return texelFetch(ranges_texel, int(p)).xyz; }
-const bool FAN_EXIT = false;
-Edge edge_at(uint e) {
-  const uvec4 t = texelFetch(edges_texel, int(e));
-  return Edge(t.x, uintBitsToFloat(t.y), uintBitsToFloat(t.z), t.w);
-}
-#else
-layout(std430, set = 0, binding = VKCLOTH_BINDING_OFFSETS) readonly buffer OffsetBuf { uint offsets[]; };
-layout(std430, set = 0, binding = VKCLOTH_BINDING_EDGES) readonly buffer EdgeBuf { Edge edges[]; };
-vec3 pos_at(uint q) { return pos_in[base + q].xyz; }
-float mass_at(uint p) { return particle[p].mass; }
-bool pinned_at(uint p) { return particle[p].pinned != 0u; }
-uvec3 list_range(uint p) { return uvec3(offsets[p], offsets[p + 1u], offsets[p + 1u]); }
-const bool FAN_EXIT = true;
-Edge edge_at(uint e) { return edges[e]; }
-#endif
+#define VKCLOTH_ACCESS_POS_IN
+#define VKCLOTH_ACCESS_PARTICLE
+#define VKCLOTH_ACCESS_LISTS
+#include "buffer_access.glsl"
 
 // Grid stencil (specialisation constants, set by the host when every interior particle's gather
 // list is the same up to translation: GpuSolver detect_stencil, like CpuSolver::detect_stencil).
@@ -94,13 +60,11 @@ layout(constant_id = 37) const float SC_K10 = 0.0;
 layout(constant_id = 38) const float SC_K11 = 0.0;
 // Border particles too: every particle's gather list is the stencil's entries whose neighbour lies
 // inside the grid, in stencil order (GpuSolver detect_stencil checks it). Then no particle takes
-// the CSR loop, which llvmpipe runs for every 8-lane group holding a border particle (and whose
-// per-lane loads it pays, masked, for every group).
+// the CSR loop (why: docs/performance.md "lavapipe (llvmpipe) notes").
 layout(constant_id = 39) const bool SC_BORDER = false;
 // The normal paths an instance of the batch may take: VKCLOTH_FLAG_HAS_GRID (the grid fan) and
-// VKCLOTH_FLAG_RING_NORMALS (the gather lists' ring terms); the other one is compiled out
-// (llvmpipe runs a branch's body once per group even when no invocation takes it: the grid fan's
-// four fetches on a mesh, the ring terms on a grid). The host sets it with the fused.comp and
+// VKCLOTH_FLAG_RING_NORMALS (the gather lists' ring terms); the other one is compiled out (why:
+// docs/performance.md "lavapipe (llvmpipe) notes"). The host sets it with the fused.comp and
 // force.comp pipelines (SolverBatch::Normals); implicit.comp keeps the default, both.
 layout(constant_id = 42) const uint SC_NORMAL_FLAGS = VKCLOTH_FLAG_HAS_GRID | VKCLOTH_FLAG_RING_NORMALS;
 const bool SC_GRID_FAN = (SC_NORMAL_FLAGS & VKCLOTH_FLAG_HAS_GRID) != 0u;
@@ -121,21 +85,23 @@ uint stencil_present(uint i, uint j) {
 }
 
 // One spring term (cloth_kernel.h add_spring) towards this instance's particle q.
-void spring_term(inout vec3 f, vec3 x, uint q, float rest, float k) { add_spring(f, x, pos_at(q), rest, k); }
+void spring_term(inout vec3 f, vec3 x, uint q, float rest, float k) {
+  add_spring(f, x, read_pos_in(q), rest, k);
+}
 
 // The grid fan of particle (i, j): right, up, left, down; one triangle per consecutive present
-// pair, k = 0..3 in that order, as the topology's fan lists give it to the CPU (unrolled: no
-// local arrays, which llvmpipe would keep in memory with per-lane gathers).
+// pair, k = 0..3 in that order, as the topology's fan lists give it to the CPU (unrolled, no local
+// arrays: docs/performance.md "lavapipe (llvmpipe) notes").
 vec3 grid_normal(uint p) {
   const uint nx = SC_STENCIL ? SC_NX : pc.nx; // a constant divisor when specialised
   const uint i = p % nx, j = p / nx;
-  const vec3 x = pos_at(p);
+  const vec3 x = read_pos_in(p);
   const bool h0 = i + 1u < nx, h1 = j + 1u < (SC_STENCIL ? SC_NY : pc.ny), h2 = i > 0u, h3 = j > 0u;
   precise vec3 e0 = vec3(0.0), e1 = vec3(0.0), e2 = vec3(0.0), e3 = vec3(0.0);
-  if (h0) e0 = pos_at(p + 1u) - x;
-  if (h1) e1 = pos_at(p + nx) - x;
-  if (h2) e2 = pos_at(p - 1u) - x;
-  if (h3) e3 = pos_at(p - nx) - x;
+  if (h0) e0 = read_pos_in(p + 1u) - x;
+  if (h1) e1 = read_pos_in(p + nx) - x;
+  if (h2) e2 = read_pos_in(p - 1u) - x;
+  if (h3) e3 = read_pos_in(p - nx) - x;
   vec3 sum = vec3(0.0);
   if (h0 && h1) add_fan_triangle(sum, e0, e1);
   if (h1 && h2) add_fan_triangle(sum, e1, e2);
@@ -155,7 +121,7 @@ void particle_force(uint p, inout vec3 v_io, out vec3 f_out, out vec3 nrm_out) {
   vec3 nrm = vec3(0.0);
   if (SC_GRID_FAN && (ip.flags & VKCLOTH_FLAG_HAS_GRID) != 0u) nrm = grid_normal(p);
 
-  const vec3 x = pos_at(p);
+  const vec3 x = read_pos_in(p);
   vec3 f = vec3(0.0);
   bool interior = false;
   uint has = 0xfffu; // bit k: stencil neighbour k exists (all of them inside)
@@ -184,30 +150,30 @@ void particle_force(uint p, inout vec3 v_io, out vec3 f_out, out vec3 nrm_out) {
   } else {
     // The springs' edges also make the normal (ClothTopology::ring_normals; CpuSolver::
     // normal_force_at, term for term). The fan's entries come first, each with ring bits: a first
-    // loop takes them with their ring terms, a second the plain springs (one loop with the ring
-    // terms in every pass cost llvmpipe, which runs both sides of a branch, a third more).
+    // loop takes them with their ring terms, a second the plain springs (two loops rather than one:
+    // docs/performance.md "lavapipe (llvmpipe) notes"). FAN_EXIT: buffer_access.glsl.
     const bool ring = SC_RING && (ip.flags & VKCLOTH_FLAG_RING_NORMALS) != 0u;
-    const uvec3 range = list_range(p);
+    const uvec3 range = read_list_range(p);
     const uint end = range.z;
     uint e = range.x;
     if (ring) {
       vec3 fan = vec3(0.0), prev = vec3(0.0), first = vec3(0.0);
       for (; e < range.y; ++e) {
-        const Edge s = edge_at(e);
+        const Edge s = read_edge(e);
         if (FAN_EXIT && s.ring == 0u) break;
-        precise vec3 u = pos_at(s.other) - x;
+        precise vec3 u = read_pos_in(s.other) - x;
         add_spring_edge(f, u, s.rest_length, s.stiffness);
         add_ring_term(fan, prev, first, u, s.ring);
       }
       nrm = unit_or_zero(fan);
     }
     for (; e < end; ++e) {
-      const Edge s = edge_at(e);
-      precise vec3 u = pos_at(s.other) - x;
+      const Edge s = read_edge(e);
+      precise vec3 u = read_pos_in(s.other) - x;
       add_spring_edge(f, u, s.rest_length, s.stiffness);
     }
   }
-  const float m = mass_at(p);
+  const float m = read_particle(p).mass;
   vec3 v = v_io;
   f = add_body_forces(f, m, v, ip.gravity_damping.xyz, ip.gravity_damping.w, (ip.flags & VKCLOTH_FLAG_WIND) != 0u,
                       nrm, ip.wind.xyz, ip.wind.w);
@@ -217,7 +183,7 @@ void particle_force(uint p, inout vec3 v_io, out vec3 f_out, out vec3 nrm_out) {
 #ifdef VKCLOTH_FRICTION_AFTER_SOLVE
   const vec3 unfiltered = f;
 #endif
-  if (!pinned_at(p)) {
+  if (read_particle(p).pinned == 0u) {
     const bool both = (ip.flags & VKCLOTH_FLAG_CONTACT_BOTH) != 0u;
     precise float h_over_m = ip.dt / m;
     for (uint c = 0u; c < (SC_COLLIDERS ? ip.collider_count : 0u); ++c) {

@@ -38,8 +38,7 @@ DeviceLayout choose_layout(const VkPhysicalDeviceProperties& properties, std::ui
   DeviceLayout out;
   out.subgroup_size = subgroup_size;
   if (properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU) {
-    // llvmpipe (Mesa 22.x) turns every storage-buffer load into a per-lane loop and vectorises
-    // texel fetches: 2-3x on the mesh and stretch passes (docs/performance.md).
+    // Texel views: docs/performance.md "lavapipe (llvmpipe) notes".
     out.access = BufferAccess::texel_views;
     out.workgroup_size = std::min<std::uint32_t>(VKCLOTH_WORKGROUP_SIZE, max_size);
     out.reason = fmt::format("CPU device: texel views (llvmpipe vectorises texel fetches, not storage-buffer "

@@ -199,10 +199,11 @@ private:
   VkPipeline fused_pipes[2][VKCLOTH_COLLIDER_ALL_TYPES + 1] = {};
   DescriptorPool pool;
   VkDescriptorSet sets[2][2] = {}; // [positions read index][0: state input, 1: RK4 stage input]
-  // Set 1 of force.comp / fused.comp: POS_IN as an RGBA32F uniform texel buffer (force_body.glsl
-  // pos_at), the particle constants as an RG32UI one, velocities, flags, instance parameters.
+  // Set 1 of force.comp / fused.comp: POS_IN as an RGBA32F uniform texel buffer (buffer_access.glsl
+  // read_pos_in), the particle constants as an RG32UI one, velocities, flags, instance parameters.
   // pos_views [0], [1]: positions[0], positions[1]; [2]: RK4 stage positions. The topology's
-  // spring lists too (force_body.glsl list_range, edge_at: RANGES, which only these views read, and EDGES).
+  // spring lists too (buffer_access.glsl read_list_range, read_edge: RANGES, which only these views
+  // read, and EDGES).
   BufferView pos_views[3];
   BufferView particle_view, vel_view, flags_view, instances_view;
   BufferView ranges_view, edges_view, strain_links_view, tethers_view;

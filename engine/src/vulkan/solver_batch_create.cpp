@@ -53,8 +53,8 @@ Result<void> check_texels(const Context::Impl& ctx, const char* what, std::uint6
 namespace {
 
 // Each particle's gather list as (begin, end of its fan entries, end, 0): what the texel builds read
-// instead of the offsets, so that their fan loop knows where the fan ends (force_body.glsl
-// list_range).
+// instead of the offsets, so that their fan loop knows where the fan ends (buffer_access.glsl
+// read_list_range).
 std::vector<std::uint32_t> list_ranges(const ClothTopology& topology) {
   const std::span<const std::uint32_t> off = topology.edge_offsets();
   const std::size_t n = topology.size();
@@ -109,8 +109,8 @@ Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ClothTopology&
                     "{} texels per texel buffer view but the device allows {} (maxTexelBufferElements); "
                     "use fewer particles or fewer instances of one topology",
                     ctx.name, batch * n, batch, n, batch * n, lim.maxTexelBufferElements));
-  // So are the topology's lists (force_body.glsl list_range, edge_at): one range per particle, one
-  // texel per spring entry.
+  // So are the topology's lists (buffer_access.glsl read_list_range, read_edge): one range per
+  // particle, one texel per spring entry.
   const struct {
     const char* what;
     std::uint64_t texels;
@@ -148,7 +148,7 @@ Result<DispatchGrid> check_limits(const Context::Impl& ctx, const ClothTopology&
 Result<void> SolverBatch::create_buffers() {
   const std::size_t n = count;
   // VERTEX_BUFFER: a renderer binds positions, normals and uvs as vertex buffers (render/);
-  // UNIFORM_TEXEL_BUFFER: positions are read through texel views (force_body.glsl pos_at).
+  // UNIFORM_TEXEL_BUFFER: positions are read through texel views (buffer_access.glsl read_pos_in).
   const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
                                    VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT |
                                    VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
