@@ -10,6 +10,7 @@
 // small enough that the dispatches of the per-iteration passes cost more than their work.
 #define VKCLOTH_FRICTION_AFTER_SOLVE // force_body.glsl: friction once, in the FINISH pass
 #include "implicit_shared.h"
+#define VKCLOTH_PUSH_STRUCT ImplicitPush
 #include "common.glsl"
 #include "force_body.glsl"
 
@@ -83,7 +84,7 @@ void finish_reduction(vec4 part, uint pass) {
   for (uint i = l; i < groups; i += VKCLOTH_WORKGROUP_SIZE) acc = acc + partials[i];
   const vec4 sum = workgroup_sum(acc);
   if (l != 0u) return;
-  const float tol2 = pc.c_next;
+  const float tol2 = pc.tolerance2;
   bool done = cg.done != 0u;
   if (pass == VKCLOTH_IMPL_SYSTEM) {
     cg.rz = sum.x;
@@ -105,7 +106,7 @@ void finish_reduction(vec4 part, uint pass) {
     cg.rr = sum.y;
     cg.iterations = cg.iterations + 1u;
     cg.total_iterations = cg.total_iterations + 1u;
-    done = sum.y <= tol2 * cg.ref2 || cg.iterations >= pc.pad0;
+    done = sum.y <= tol2 * cg.ref2 || cg.iterations >= pc.cg_max_iterations;
   }
   cg.done = done ? 1u : 0u;
   cg.arrived = 0u; // for the next reducing pass
@@ -152,8 +153,8 @@ vec4 update_row(uint p, float alpha) {
   return vec4(dot3(r, z), dot3(r, r), 0.0, 0.0);
 }
 
-// VKCLOTH_IMPL_SOLVE: up to pc.nx CG iterations of implicit_euler.hpp in ONE workgroup,
-// continuing from CgState (SYSTEM's reduction starts each solve). The host bounds pc.nx so that
+// VKCLOTH_IMPL_SOLVE: up to pc.solve_budget CG iterations of implicit_euler.hpp in ONE workgroup,
+// continuing from CgState (SYSTEM's reduction starts each solve). The host bounds pc.solve_budget so that
 // no invocation runs more than ~30 000 loop iterations per dispatch: llvmpipe (Mesa 22.3) ends
 // any loop after 65 535 iterations of an invocation, silently.
 // The sums: each invocation adds its particles in order, then the fixed tree. Control flow is
@@ -163,14 +164,14 @@ vec4 update_row(uint p, float alpha) {
 void solve_in_one_workgroup(float mu_h, float h2) {
   const uint l = gl_LocalInvocationID.x;
   const uint n = pc.count;
-  const float tol2 = pc.c_next;
+  const float tol2 = pc.tolerance2;
   if (cg.done != 0u) return; // uniform: converged (or nothing to solve)
   float rz = cg.rz, rr = cg.rr;
   const float ref2 = cg.ref2;
   uint it = cg.iterations;
   const uint it_start = it;
-  bool done = rr <= tol2 * ref2 || it >= pc.pad0;
-  uint budget = pc.nx;
+  bool done = rr <= tol2 * ref2 || it >= pc.cg_max_iterations;
+  uint budget = pc.solve_budget;
   while (!done && budget > 0u) {
     precise float dq_l = 0.0;
     for (uint p = l; p < n; p += VKCLOTH_WORKGROUP_SIZE) {
@@ -195,7 +196,7 @@ void solve_in_one_workgroup(float mu_h, float h2) {
         cd[p] = vec4(d, 0.0);
       }
     }
-    done = !descends || rr <= tol2 * ref2 || it >= pc.pad0;
+    done = !descends || rr <= tol2 * ref2 || it >= pc.cg_max_iterations;
     --budget;
     memoryBarrierBuffer(); // the new d, before the neighbours' matvec reads it
     barrier();             // (and every read of cg above, before invocation 0 rewrites it)

@@ -18,6 +18,7 @@
 void self_range(uint unused, uint b, out uint first, out uint stop);
 void self_entry(uint unused, uint i, out uint q, out uint key);
 void self_particle(uint unused, uint q, out vec3 x, out vec3 v, out float w, out vec3 rest);
+#define VKCLOTH_PUSH_STRUCT SelfPush
 #include "common.glsl"
 
 layout(std430, set = 0, binding = VKCLOTH_BINDING_POS_OUT) buffer PosOut { vec4 pos_out[]; };
@@ -33,10 +34,10 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_DELTA) buffer DeltaBuf { 
 
 shared uint partial[VKCLOTH_WORKGROUP_SIZE];
 
-// This instance's table: pc.pad0 buckets (counts), pc.pad0 + 1 starts, and its scan blocks.
-uint table_base() { return inst * pc.pad0; }
-uint start_base() { return inst * (pc.pad0 + 1u); }
-uint block_base() { return inst * (pc.pad0 / VKCLOTH_SELF_SCAN_BLOCK); }
+// This instance's table: pc.table_size buckets (counts), pc.table_size + 1 starts, and its scan blocks.
+uint table_base() { return inst * pc.table_size; }
+uint start_base() { return inst * (pc.table_size + 1u); }
+uint block_base() { return inst * (pc.table_size / VKCLOTH_SELF_SCAN_BLOCK); }
 
 // Bucket b's first entry in `sorted` (within the instance), once SCAN_ADD has run; starts has
 // one more entry per instance than the table has buckets, the particle count.
@@ -92,7 +93,7 @@ void main() {
   if (sp.iterations == 0u || frozen())
     return;
   const uint stage = pass_stage();
-  const uint mask = pc.pad0 - 1u;
+  const uint mask = pc.table_size - 1u;
   if (stage == VKCLOTH_SELF_SCAN_BLOCKS) {
     // Workgroup = one block of VKCLOTH_SELF_SCAN_BLOCK buckets; 8 consecutive buckets per invocation.
     const uint block = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
@@ -111,7 +112,7 @@ void main() {
   }
   if (stage == VKCLOTH_SELF_SCAN_TOP) {
     // One workgroup per instance: the block totals, in place, become the blocks' starts.
-    const uint nblocks = pc.pad0 / VKCLOTH_SELF_SCAN_BLOCK;
+    const uint nblocks = pc.table_size / VKCLOTH_SELF_SCAN_BLOCK;
     const uint per = (nblocks + VKCLOTH_WORKGROUP_SIZE - 1u) / VKCLOTH_WORKGROUP_SIZE;
     const uint first = gl_LocalInvocationID.x * per;
     const uint stop = min(first + per, nblocks);
@@ -128,15 +129,15 @@ void main() {
   }
   if (stage == VKCLOTH_SELF_SCAN_ADD) {
     const uint b = particle_index(); // the bucket: its block's start added to its own
-    if (b < pc.pad0)
+    if (b < pc.table_size)
       starts[start_base() + b] += blocks[block_base() + b / VKCLOTH_SELF_SCAN_BLOCK];
-    else if (b == pc.pad0)
+    else if (b == pc.table_size)
       starts[start_base() + b] = pc.count; // past the last bucket: every particle
     return;
   }
   if (stage == VKCLOTH_SELF_SORT) {
     const uint b = particle_index(); // the bucket
-    if (b >= pc.pad0)
+    if (b >= pc.table_size)
       return;
     const uint first = bucket_start(b), stop = bucket_start(b + 1u);
     for (uint i = first + 1u; i < stop; ++i) { // insertion sort by particle: buckets hold a few
@@ -162,7 +163,7 @@ void main() {
     const uint b = self_bucket(key, mask);
     const uint left = atomicAdd(counts[table_base() + b], 0xffffffffu); // minus one
     sorted[base + bucket_start(b) + left - 1u] = uvec2(p, key);
-  } else if (pc.pad1 < sp.iterations && particle[p].pinned == 0u) {
+  } else if (pc.iteration < sp.iterations && particle[p].pinned == 0u) {
     if (stage == VKCLOTH_SELF_COLLIDE) {
       const vec3 x = read_pos_out(p);
       const vec3 v = read_velocity(p);

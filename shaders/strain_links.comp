@@ -3,12 +3,13 @@
 #extension GL_GOOGLE_include_directive : require
 // Stretch control, Provot's sweep over one colour of strain links (CpuSolver::limit_stretch; the
 // formulas: cloth_kernel.h provot_link, apply_correction). One invocation per link of the colour
-// (pc.pad0: its first link, pc.pad1: its count; pc.stage: the sweep), of every instance of the
+// (pc.link_first: its first link, pc.link_count: its count; pc.stage: the sweep), of every instance of the
 // batch. The links of a colour share no particle, so each invocation alone reads and writes its
 // two particles' new positions (POS_OUT) and velocities (VEL); the colours follow each other
 // with a barrier between them, as the CPU's loop over colours.
 #include "vkcloth_shared.h"
 #define VKCLOTH_PC_COPY
+#define VKCLOTH_PUSH_STRUCT StrainLinksPush
 #include "common.glsl"
 
 // pos_out and vel (declared there), read_pos_out, read_velocity, read_particle, read_frozen,
@@ -22,10 +23,10 @@
 void main() {
   begin_instance();
   const uint k = particle_index(); // the link within its colour
-  if (k >= pc.pad1 || (ip.stretch & VKCLOTH_STRETCH_PROVOT) == 0u || pc.stage >= ip.stretch_sweeps ||
+  if (k >= pc.link_count || (ip.stretch & VKCLOTH_STRETCH_PROVOT) == 0u || pc.stage >= ip.stretch_sweeps ||
       read_frozen())
     return;
-  const StrainLink link = read_strain_link(pc.pad0 + k);
+  const StrainLink link = read_strain_link(pc.link_first + k);
   const uint a = link.a, b = link.b;
   const float rest = link.rest_length;
   vec3 xa = read_pos_out(a), xb = read_pos_out(b);

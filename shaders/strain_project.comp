@@ -8,11 +8,12 @@
 // them (every phase reads what other invocations wrote in the last one), and its dot products as
 // fixed-shape trees in shared memory, which the CPU sums in the same order (workgroup_sums): the
 // same bits on lavapipe. llvmpipe caps an invocation's loop iterations, so one dispatch runs at most
-// pc.nx phases and leaves the rest to the next dispatch, its state in ProjState; the host records
+// pc.phase_budget phases and leaves the rest to the next dispatch, its state in ProjState; the host records
 // enough indirect dispatches for the worst case, and the last instance to finish sets their group
 // count to zero (ProjArgsHead), so that the dispatches left are empty.
 #include "vkcloth_shared.h"
 #include "strain_projection_shared.h"
+#define VKCLOTH_PUSH_STRUCT ProjectionPush
 #include "common.glsl"
 
 layout(std430, set = 0, binding = VKCLOTH_BINDING_POS_OUT) coherent buffer PosOut { vec4 pos_out[]; };
@@ -56,7 +57,7 @@ void end_phase() {
 }
 
 float inv_mass_of(uint p) { return inverse_mass(particle[p].mass, particle[p].pinned != 0u); }
-uint link_slot(uint i) { return 2u * (inst * pc.pad0 + i); }
+uint link_slot(uint i) { return 2u * (inst * pc.links + i); }
 
 // grad C^T s for particle p: s is the link state's component `which` (2: d, 0: lambda).
 vec3 gather_at(uint p, uint which) {
@@ -89,14 +90,14 @@ void main() {
     return;
   }
   const uint l = gl_LocalInvocationID.x, W = VKCLOTH_WORKGROUP_SIZE;
-  const uint m = pc.pad0, n = pc.count;
+  const uint m = pc.links, n = pc.count;
   ProjState st = state[inst];
   if (pc.stage == 0u) { // the substep's first dispatch: a new projection
     st.phase = VKCLOTH_PROJ_LINKS;
     st.newton = 0u;
   }
   const float c_tolerance = projection_c_tolerance(ip.max_strain);
-  for (uint budget = pc.nx; budget > 0u && st.phase != VKCLOTH_PROJ_DONE; --budget) {
+  for (uint budget = pc.phase_budget; budget > 0u && st.phase != VKCLOTH_PROJ_DONE; --budget) {
     if (st.phase == VKCLOTH_PROJ_LINKS) {
       precise vec3 acc = vec3(0.0, 0.0, -1.0); // r.z, r.r, max C
       for (uint i = l; i < m; i += W) {
@@ -124,7 +125,7 @@ void main() {
         precise float stop = float(VKCLOTH_PROJECTION_CG_TOL2) * sums.y;
         st.stop = stop;
         st.cg = 0u;
-        st.phase = pc.pad1 > 0u && st.rr > st.stop ? VKCLOTH_PROJ_GATHER : VKCLOTH_PROJ_APPLY;
+        st.phase = pc.cg_cap > 0u && st.rr > st.stop ? VKCLOTH_PROJ_GATHER : VKCLOTH_PROJ_APPLY;
       }
     } else if (st.phase == VKCLOTH_PROJ_GATHER) {
       for (uint p = l; p < n; p += W)
@@ -174,7 +175,7 @@ void main() {
         precise float d = z + st.beta * b.z;
         link_state[link_slot(i) + 1u] = vec4(b.x, b.y, d, b.w);
       }
-      st.phase = st.cg < pc.pad1 && st.rr > st.stop ? VKCLOTH_PROJ_GATHER : VKCLOTH_PROJ_APPLY;
+      st.phase = st.cg < pc.cg_cap && st.rr > st.stop ? VKCLOTH_PROJ_GATHER : VKCLOTH_PROJ_APPLY;
     } else { // VKCLOTH_PROJ_APPLY
       for (uint p = l; p < n; p += W) {
         if (particle[p].pinned != 0u)

@@ -14,13 +14,18 @@ layout(local_size_x = VKCLOTH_WORKGROUP_SIZE, local_size_x_id = 43) in;
 layout(local_size_x = VKCLOTH_WORKGROUP_SIZE) in;
 #endif
 
+// The push constants' struct: PushConstants, or the pass's own (vkcloth_shared.h), which the shader
+// names before including this file.
+#ifndef VKCLOTH_PUSH_STRUCT
+#define VKCLOTH_PUSH_STRUCT PushConstants
+#endif
 #ifdef VKCLOTH_PC_COPY
 // The shader copies the push constants into `pc` before any branch (begin_instance: pc = pc_block;
 // why: docs/performance.md "lavapipe (llvmpipe) notes").
-layout(push_constant) uniform PushBlock { PushConstants pc_block; };
-PushConstants pc;
+layout(push_constant) uniform PushBlock { VKCLOTH_PUSH_STRUCT pc_block; };
+VKCLOTH_PUSH_STRUCT pc;
 #else
-layout(push_constant) uniform PushBlock { PushConstants pc; };
+layout(push_constant) uniform PushBlock { VKCLOTH_PUSH_STRUCT pc; };
 #endif
 
 // Bit t set: some instance of the batch may have a collider of type t (VKCLOTH_COLLIDER_*); 0: none

@@ -41,10 +41,19 @@ namespace vkcloth::gpu::shared {
                                   // last workgroup: beta, iterations + 1, done = converged or cap
 #define VKCLOTH_IMPL_DIRECTION 4u // d = z + beta d
 #define VKCLOTH_IMPL_FINISH 5u    // v' = v + x, contacts, x' = x + h v', projection, flags
-#define VKCLOTH_IMPL_SOLVE 6u     // ONE workgroup: up to nx more CG iterations (until done)
-// Repurposed PushConstants fields (unused by the implicit passes otherwise):
-//   c_next = cg_tolerance^2, pad0 = cg_max_iterations;
-//   SOLVE: nx = the dispatch's iteration budget (the CG loop needs no grid size).
+#define VKCLOTH_IMPL_SOLVE 6u     // ONE workgroup: up to solve_budget more CG iterations (until done)
+
+/// implicit.comp's push constants (vkcloth_shared.h PushConstants' five fields, then its own).
+struct ImplicitPush {
+  uint count;
+  uint nx;
+  uint ny;
+  uint stage; // the pass (VKCLOTH_IMPL_*)
+  uint step;
+  uint cg_max_iterations;
+  uint solve_budget; // SOLVE: the CG iterations this dispatch may run
+  float tolerance2;  // cg_tolerance^2
+};
 
 /// CG scalars, written only by the last workgroup of a reducing pass or by SOLVE (one invocation).
 struct CgState {
@@ -71,6 +80,7 @@ struct CgArgs {
 #ifdef __cplusplus
 static_assert(VKCLOTH_BINDING_IMPL_VF == VKCLOTH_BINDING_COUNT); // right after the main layout's bindings
 static_assert(sizeof(CgState) == 48);
+static_assert(sizeof(ImplicitPush) == sizeof(PushConstants));
 static_assert(sizeof(CgArgs) == 16);
 } // namespace vkcloth::gpu::shared
 #endif

@@ -2,8 +2,7 @@
 // Declarations shared by self_collision.comp and the C++ side (engine/src/vulkan/
 // self_collision_gpu.cpp). Self-collision's passes use their own descriptor set layout: the main
 // layout's bindings they need (same numbers, same buffers, vkcloth_shared.h) plus the spatial
-// hash's buffers below. Push constants: the main PushConstants, `stage` selecting the pass and
-// `pad0` the hash table's size, `pad1` the Jacobi iteration (COLLIDE, APPLY).
+// hash's buffers below. Push constants: SelfPush below, `stage` selecting the pass.
 #ifndef VKCLOTH_SELF_COLLISION_SHARED_H
 #define VKCLOTH_SELF_COLLISION_SHARED_H
 
@@ -56,7 +55,20 @@ struct SelfParams {
   float friction;
 };
 
+/// self_collision.comp's push constants (PushConstants' five fields, then its own).
+struct SelfPush {
+  uint count;
+  uint nx;
+  uint ny;
+  uint stage; // the pass (VKCLOTH_SELF_*)
+  uint step;
+  uint table_size; // buckets of each instance's hash table (kernel.hpp self_table_size)
+  uint iteration;  // the Jacobi iteration (COLLIDE, APPLY)
+  uint unused;
+};
+
 #ifdef __cplusplus
+static_assert(sizeof(SelfPush) == sizeof(PushConstants));
 static_assert(VKCLOTH_BINDING_SELF_PARAMS == VKCLOTH_BINDING_IMPL_ARGS + 1);
 static_assert(sizeof(SelfParams) == 16);
 } // namespace vkcloth::gpu::shared

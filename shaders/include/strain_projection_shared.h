@@ -2,9 +2,7 @@
 // Declarations shared by strain_project.comp and the C++ side (engine/src/vulkan/
 // strain_projection_gpu.cpp). The fast projection's pass uses its own descriptor set layout: the
 // main layout's bindings it needs (same numbers, same buffers, vkcloth_shared.h) plus its own
-// below. Push constants: the main PushConstants; `stage` the dispatch within the substep (0 starts
-// the projection over), `pad0` the strain links, `pad1` the most CG iterations of one solve
-// (kernel.hpp projection_cg_cap), `nx` the phases one dispatch may run (its loop budget).
+// below. Push constants: ProjectionPush below.
 #ifndef VKCLOTH_STRAIN_PROJECTION_SHARED_H
 #define VKCLOTH_STRAIN_PROJECTION_SHARED_H
 
@@ -31,7 +29,7 @@ namespace vkcloth::gpu::shared {
 #define VKCLOTH_PROJ_DONE 6u      // this substep's projection is over
 
 // llvmpipe stops every loop of an invocation after 65 535 iterations in all (silently); one
-// dispatch runs as many phases as keep each invocation under this many (pc.nx).
+// dispatch runs as many phases as keep each invocation under this many (pc.phase_budget).
 #define VKCLOTH_PROJ_LOOP_BUDGET 30000u
 
 /// Where one instance's projection stands between dispatches (std430: 48 bytes).
@@ -52,7 +50,20 @@ struct ProjArgsHead {
   uint finished; // instances done (or without the projection) this substep
 };
 
+/// strain_project.comp's push constants (PushConstants' five fields, then its own).
+struct ProjectionPush {
+  uint count;
+  uint nx;
+  uint ny;
+  uint stage; // the dispatch within the substep (0 starts the projection over)
+  uint step;
+  uint links;        // strain links of the topology
+  uint cg_cap;       // the most CG iterations of one solve (kernel.hpp projection_cg_cap)
+  uint phase_budget; // the phases one dispatch may run (its loop budget)
+};
+
 #ifdef __cplusplus
+static_assert(sizeof(ProjectionPush) == sizeof(PushConstants));
 static_assert(VKCLOTH_BINDING_PROJ_INCIDENCE == VKCLOTH_BINDING_SELF_DELTA + 1);
 static_assert(sizeof(ProjState) == 48);
 static_assert(sizeof(ProjArgsHead) == 16);

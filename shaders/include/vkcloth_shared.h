@@ -93,16 +93,33 @@ struct vec4 {
 // Flags::first_bad_step before anything diverged.
 #define VKCLOTH_NO_BAD_STEP 0xffffffffu
 
-/// Per-dispatch parameters (32 bytes), the same for every instance of the batch.
+/// Per-dispatch parameters (32 bytes), the same for every instance of the batch. Every pass's push
+/// constants start with these five fields (common.glsl reads count, stage and step); the last three
+/// are each pass's own, named for what they carry: StrainLinksPush below, ImplicitPush
+/// (implicit_shared.h), SelfPush (self_collision_shared.h), ProjectionPush
+/// (strain_projection_shared.h). A shader names its struct with VKCLOTH_PUSH_STRUCT (common.glsl).
 struct PushConstants {
-  uint count;   // particles per instance
-  uint nx;      // grid width (0 for chains)
-  uint ny;      // grid height
-  uint stage;   // RK4 stage 0..3 (0 for Euler); implicit passes: the pass; strain_links.comp: the sweep
-  uint step;    // 1-based step number since the batch's flag epoch (the step being computed)
-  uint pad0;    // implicit passes (implicit_shared.h); strain_links.comp: the colour's first link
-  uint pad1;    // implicit passes; strain_links.comp: the colour's link count
-  float c_next; // implicit passes only
+  uint count; // particles per instance
+  uint nx;    // grid width (0 for chains)
+  uint ny;    // grid height
+  uint stage; // the pass of a multi-pass shader: RK4 stage 0..3 (0 for Euler), a strain_finish stage,
+              // implicit Euler's or self-collision's pass, strain_links' sweep, the projection's dispatch
+  uint step;  // 1-based step number since the batch's flag epoch (the step being computed)
+  uint unused0;
+  uint unused1;
+  uint unused2;
+};
+
+/// strain_links.comp: one colour of one sweep (`stage`: the sweep).
+struct StrainLinksPush {
+  uint count;
+  uint nx;
+  uint ny;
+  uint stage;
+  uint step;
+  uint link_first; // the colour's first link
+  uint link_count; // the colour's links
+  uint unused;
 };
 
 /// Per-instance parameters (80 bytes; InstanceParams[instance] at VKCLOTH_BINDING_INSTANCES).
@@ -199,7 +216,18 @@ struct Flags {
 
 #ifdef __cplusplus
 static_assert(sizeof(PushConstants) == 32);
-static_assert(offsetof(PushConstants, c_next) == 28);
+static_assert(sizeof(StrainLinksPush) == 32);
+
+/// A pass's push constants (one of the structs above) with `pc`'s five common fields.
+template <typename Push> Push push_from(const PushConstants& pc) {
+  Push p{};
+  p.count = pc.count;
+  p.nx = pc.nx;
+  p.ny = pc.ny;
+  p.stage = pc.stage;
+  p.step = pc.step;
+  return p;
+}
 static_assert(sizeof(InstanceParams) == 80);
 static_assert(offsetof(InstanceParams, gravity_damping) == 16);
 static_assert(offsetof(InstanceParams, wind) == 32);

@@ -177,12 +177,15 @@ Result<void> ImplicitGpu::write_sets(const ImplicitInputs& in) {
   return {};
 }
 
-std::uint32_t ImplicitGpu::record_substep(VkCommandBuffer c, std::uint32_t read, sh::PushConstants pc,
-                                          const SimParams& params, std::uint32_t types, bool first) {
+std::uint32_t ImplicitGpu::record_substep(VkCommandBuffer c, std::uint32_t read,
+                                          const sh::PushConstants& main_pc, const SimParams& params,
+                                          std::uint32_t types, bool first) {
   const auto& v = ctx_->vk;
   const float tol = float(params.cg_tolerance);
-  pc.c_next = tol * tol; // as CpuSolver<float>: Real(tol) * Real(tol)
-  pc.pad0 = params.cg_max_iterations;
+  auto pc = sh::push_from<sh::ImplicitPush>(main_pc);
+  pc.tolerance2 = tol * tol; // as CpuSolver<float>: Real(tol) * Real(tol)
+  pc.cg_max_iterations = params.cg_max_iterations;
+  pc.solve_budget = budget_;
   v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &sets_[read], 0, nullptr);
   bool need_barrier = !first;
   std::uint32_t dispatches = 0;
@@ -208,11 +211,8 @@ std::uint32_t ImplicitGpu::record_substep(VkCommandBuffer c, std::uint32_t read,
   pass(VKCLOTH_IMPL_FORCE, Groups::all);
   pass(VKCLOTH_IMPL_SYSTEM, Groups::all); // its last workgroup starts the solve (rz, rr, ref2)
   if (budget_ > 0) {
-    const std::uint32_t nx = pc.nx;
-    pc.nx = budget_; // SOLVE's iteration budget (implicit_shared.h)
     for (std::uint32_t it = 0; it < params.cg_max_iterations; it += budget_)
       pass(VKCLOTH_IMPL_SOLVE, Groups::one);
-    pc.nx = nx;
   } else {
     for (std::uint32_t it = 0; it < params.cg_max_iterations; ++it) {
       pass(VKCLOTH_IMPL_MATVEC, Groups::indirect); // + alpha (its last workgroup)

@@ -60,7 +60,7 @@ public:
   /// push-constant block (the substep's dt is in the InstanceParams); `types`: the batch's collider
   /// types (ensure_collider_passes made their FORCE and FINISH passes); `first`: no barrier needed
   /// before the first pass. Returns the number of dispatches recorded.
-  std::uint32_t record_substep(VkCommandBuffer cmd, std::uint32_t read, shared::PushConstants pc,
+  std::uint32_t record_substep(VkCommandBuffer cmd, std::uint32_t read, const shared::PushConstants& pc,
                                const SimParams& params, std::uint32_t types, bool first);
   bool one_workgroup() const { return budget_ > 0; }
   /// The last completed solve (host-visible state; valid once the recorded work finished).

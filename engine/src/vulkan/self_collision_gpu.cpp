@@ -152,13 +152,14 @@ std::vector<sh::SelfParams> SelfCollisionGpu::packed(std::span<const SimParams* 
   return out;
 }
 
-std::uint32_t SelfCollisionGpu::record_substep(VkCommandBuffer c, std::uint32_t read, sh::PushConstants pc,
-                                               std::uint32_t iterations) {
+std::uint32_t SelfCollisionGpu::record_substep(VkCommandBuffer c, std::uint32_t read,
+                                               const sh::PushConstants& main_pc, std::uint32_t iterations) {
   const auto& v = ctx_->vk;
   const VkDescriptorSet bound[2] = {sets_[read], texel_sets_[read]};
   v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0,
                             access_ == BufferAccess::texel_views ? 2 : 1, bound, 0, nullptr);
-  pc.pad0 = table_;
+  auto pc = sh::push_from<sh::SelfPush>(main_pc);
+  pc.table_size = table_;
   std::uint32_t dispatches = 0;
   // `items` invocations (64 per workgroup, rows of at most groups_max_x_ workgroups), every instance.
   auto pass = [&](std::uint32_t stage, std::uint64_t items) {
@@ -179,7 +180,7 @@ std::uint32_t SelfCollisionGpu::record_substep(VkCommandBuffer c, std::uint32_t 
   pass(VKCLOTH_SELF_SCATTER, count_);
   pass(VKCLOTH_SELF_SORT, table_);
   for (std::uint32_t it = 0; it < iterations; ++it) {
-    pc.pad1 = it;
+    pc.iteration = it;
     pass(VKCLOTH_SELF_COLLIDE, count_);
     pass(VKCLOTH_SELF_APPLY, count_);
   }

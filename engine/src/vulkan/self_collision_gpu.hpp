@@ -49,7 +49,7 @@ public:
   static std::vector<shared::SelfParams> packed(std::span<const SimParams* const> params);
   /// Records one substep's self-collision on positions[read ^ 1] (the positions being written):
   /// `iterations`, the most any instance asks for. Returns the number of dispatches recorded.
-  std::uint32_t record_substep(VkCommandBuffer cmd, std::uint32_t read, shared::PushConstants pc,
+  std::uint32_t record_substep(VkCommandBuffer cmd, std::uint32_t read, const shared::PushConstants& pc,
                                std::uint32_t iterations);
 
 private:

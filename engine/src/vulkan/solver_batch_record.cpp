@@ -146,15 +146,15 @@ void SolverBatch::record_stretch(VkCommandBuffer c, std::uint32_t read) {
   // Set 1 of the positions being written: the sweeps read positions[write] through its texel view.
   const VkDescriptorSet bound_sets[2] = {sets[read][0], texel_sets[read ^ 1u]};
   v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 2, bound_sets, 0, nullptr);
-  sh::PushConstants spc = pc;
+  auto spc = sh::push_from<sh::StrainLinksPush>(pc);
   if (sweeps)
     v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, strain_links_pipeline);
   for (std::uint32_t sweep = 0; sweep < sweeps; ++sweep)
     for (std::size_t k = 0; k + 1 < strain_colours.size(); ++k) {
       spc.stage = sweep;
-      spc.pad0 = strain_colours[k];
-      spc.pad1 = strain_colours[k + 1] - strain_colours[k];
-      const std::uint32_t groups = (spc.pad1 + workgroup - 1) / workgroup;
+      spc.link_first = strain_colours[k];
+      spc.link_count = strain_colours[k + 1] - strain_colours[k];
+      const std::uint32_t groups = (spc.link_count + workgroup - 1) / workgroup;
       const std::uint32_t gx = std::min(groups, groups_x), gy = (groups + gx - 1) / gx;
       v.vkCmdPushConstants(c, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(spc), &spc);
       barriers::dispatch_to_dispatch(v, c); // the previous pass or colour -> this colour

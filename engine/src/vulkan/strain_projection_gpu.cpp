@@ -118,14 +118,15 @@ Result<void> StrainProjectionGpu::write_sets(const OneSetInputs& in) {
   return {};
 }
 
-std::uint32_t StrainProjectionGpu::record_substep(VkCommandBuffer c, std::uint32_t read, sh::PushConstants pc,
-                                                  std::uint32_t newton) {
+std::uint32_t StrainProjectionGpu::record_substep(VkCommandBuffer c, std::uint32_t read,
+                                                  const sh::PushConstants& main_pc, std::uint32_t newton) {
   const auto& v = ctx_->vk;
   v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &sets_[read], 0, nullptr);
   v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, pass_);
-  pc.pad0 = links_;
-  pc.pad1 = cg_cap_;
-  pc.nx = phases_per_dispatch_;
+  auto pc = sh::push_from<sh::ProjectionPush>(main_pc);
+  pc.links = links_;
+  pc.cg_cap = cg_cap_;
+  pc.phase_budget = phases_per_dispatch_;
   // The worst case: every Newton iteration runs LINKS, cg_cap x (GATHER, MATVEC, UPDATE,
   // DIRECTION) and APPLY.
   const std::uint64_t phases = std::uint64_t(newton) * (2 + 4ull * cg_cap_);

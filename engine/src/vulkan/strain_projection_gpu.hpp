@@ -37,7 +37,7 @@ public:
   static std::vector<std::uint32_t> incidence_data(const ClothTopology& topology);
   /// Records one substep's projection on positions[read ^ 1] (the positions being written), for
   /// at most `newton` Newton iterations (the most any instance asks for). Returns the dispatches.
-  std::uint32_t record_substep(VkCommandBuffer cmd, std::uint32_t read, shared::PushConstants pc,
+  std::uint32_t record_substep(VkCommandBuffer cmd, std::uint32_t read, const shared::PushConstants& pc,
                                std::uint32_t newton);
 
 private:
