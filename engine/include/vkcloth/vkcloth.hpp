@@ -11,6 +11,7 @@
 #include "vkcloth/result.hpp"
 #include "vkcloth/system.hpp"
 #include "vkcloth/topology.hpp"
+#include "vkcloth/world_types.hpp"
 #include "vkcloth/scene.hpp"
 #include "vkcloth/gpu/backend_choice.hpp"
 #include "vkcloth/gpu/gpu_solver.hpp"

@@ -37,6 +37,7 @@
 #include "vkcloth/result.hpp"
 #include "vkcloth/system.hpp"
 #include "vkcloth/topology.hpp"
+#include "vkcloth/world_types.hpp"
 
 namespace vkcloth::gpu {
 
@@ -60,15 +61,9 @@ struct WorldOptions {
   GpuSolverOptions solver;
 };
 
-/// An instance's handle; never reused within one world.
-using InstanceId = std::uint64_t;
-
-/// Optional initial state of an instance (instead of the topology's particle positions and
-/// velocities); each vector is empty (topology's value) or has one entry per particle.
-struct InitialState {
-  std::vector<glm::dvec3> positions;
-  std::vector<glm::dvec3> velocities;
-};
+/// The backend-neutral names (world_types.hpp), also under gpu:: as before.
+using vkcloth::InitialState;
+using vkcloth::InstanceId;
 
 class ClothWorld {
 public:
