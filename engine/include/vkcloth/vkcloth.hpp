@@ -6,6 +6,7 @@
 #include "vkcloth/collider_mesh.hpp"
 #include "vkcloth/material.hpp"
 #include "vkcloth/cpu_solver.hpp"
+#include "vkcloth/cpu_world.hpp"
 #include "vkcloth/measure.hpp"
 #include "vkcloth/params.hpp"
 #include "vkcloth/result.hpp"

@@ -21,6 +21,9 @@
 // variants) is made once per Context, when a batch first needs it, and shared by all batches.
 //
 // Thread safety: none; one thread drives a world (as a GpuSolver).
+//
+// vkcloth::CpuWorld (cpu_world.hpp) has the same add / remove / set_params / simulate / positions
+// members on the CPU solver: a host that only steps and reads back switches by changing the type.
 #pragma once
 
 #include <cstdint>
