@@ -16,12 +16,14 @@
 // recording: simulate() runs the steps now and returns when they are done.
 //
 // Divergence, as on the GPU: an instance that blows up is frozen at its bad step (never stepped
-// again), the others finish their steps, and simulate() / check_divergence() return
-// ErrorCode::diverged naming the first such instance (in id order), its step and time.
+// again, set_params included, until its remove()), the others finish their steps, and simulate() /
+// check_divergence() return ErrorCode::diverged naming the first such instance (in id order), its
+// step and time.
 //
 // Thread safety: none; one thread drives a world (as a CpuSolver).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <vector>
