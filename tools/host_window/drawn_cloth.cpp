@@ -35,13 +35,23 @@ Result<DrawnCloth> DrawnCloth::create(gpu::Backend backend, gpu::Context& contex
     d.gpu_.emplace(std::move(*s));
     return d;
   }
-  auto s = CpuSolver<float>::create(system, params);
-  if (!s)
-    return s.error();
-  auto b = render::HostClothBuffers::create(context, *s->topology(), 2);
+  // Validated before the topology is made, then again by add(): as CpuSolver::create(system, ...).
+  SimParams checked = params;
+  VKCLOTH_TRY(checked.validate());
+  auto topology = ClothTopology::create(system);
+  if (!topology)
+    return topology.error();
+  auto world = CpuWorld::create();
+  if (!world)
+    return world.error();
+  auto id = world->add(*topology, std::move(checked));
+  if (!id)
+    return id.error();
+  auto b = render::HostClothBuffers::create(context, **topology, 2);
   if (!b)
     return b.error();
-  d.cpu_.emplace(std::move(*s));
+  d.cpu_.emplace(std::move(*world));
+  d.cpu_id_ = *id;
   d.host_.emplace(std::move(*b));
   return d;
 }
@@ -59,61 +69,73 @@ Result<gpu::InstanceBuffers> DrawnCloth::record_frame(VkCommandBuffer cmd, std::
     gpu_->record_barrier_to(cmd, VK_PIPELINE_STAGE_VERTEX_INPUT_BIT, VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT);
     return gpu_->buffers();
   }
-  if (held && held->index < cpu_->positions().size())
-    VKCLOTH_TRY(cpu_->set_particle(held->index, held->position, glm::vec3(0.0f)));
-  VKCLOTH_TRY(cpu_->run(steps));
+  if (held && held->index < cpu_solver().positions().size())
+    if (auto r = cpu_->set_particle(cpu_id_, held->index, held->position, glm::vec3(0.0f)); !r)
+      return cpu_error(r.error());
+  if (auto r = cpu_->simulate(steps); !r)
+    return cpu_error(r.error());
   // Host-coherent writes before the frame's vkQueueSubmit: visible to its draws, no barrier.
-  return host_->upload(slot, cpu_->positions(), cpu_->normals());
+  return host_->upload(slot, cpu_solver().positions(), cpu_solver().normals());
 }
 
 Result<render::Image> DrawnCloth::render(render::OffscreenTarget& target, render::ClothRenderer& renderer,
                                          const render::Camera& camera, std::uint32_t steps) {
   if (gpu_)
     return target.render(*gpu_, renderer, camera, steps); // draws the solver's colliders as they are
-  VKCLOTH_TRY(cpu_->run(steps));
-  VKCLOTH_TRY(renderer.set_colliders(cpu_->params().colliders)); // where the steps left them
+  if (auto r = cpu_->simulate(steps); !r)
+    return cpu_error(r.error());
+  VKCLOTH_TRY(renderer.set_colliders(cpu_solver().params().colliders)); // where the steps left them
   // Slot 0 every time: render() waits for its submission, so nothing still reads it.
-  auto buffers = host_->upload(0, cpu_->positions(), cpu_->normals());
+  auto buffers = host_->upload(0, cpu_solver().positions(), cpu_solver().normals());
   if (!buffers)
     return buffers.error();
   return target.render(*buffers, renderer, camera);
 }
 
 Result<void> DrawnCloth::simulate(std::uint64_t steps) {
-  return gpu_ ? gpu_->simulate(steps) : cpu_->run(steps);
+  if (gpu_)
+    return gpu_->simulate(steps);
+  if (auto r = cpu_->simulate(steps); !r)
+    return cpu_error(r.error());
+  return {};
 }
 
 Result<std::vector<glm::vec3>> DrawnCloth::positions() {
-  if (gpu_)
-    return gpu_->positions();
-  const auto p = cpu_->positions();
-  return std::vector<glm::vec3>(p.begin(), p.end());
+  return gpu_ ? gpu_->positions() : cpu_->positions(cpu_id_);
 }
 
 Result<void> DrawnCloth::check_divergence() {
   if (gpu_)
     return gpu_->check_divergence();
-  return {};
+  return {}; // the CPU steps returned it
 }
 
 Result<void> DrawnCloth::set_params(const SimParams& params) {
-  return gpu_ ? gpu_->set_params(params) : cpu_->set_params(params);
+  return gpu_ ? gpu_->set_params(params) : cpu_->set_params(cpu_id_, params);
 }
 
 const SimParams& DrawnCloth::params() const {
-  return gpu_ ? gpu_->params() : cpu_->params();
+  return gpu_ ? gpu_->params() : cpu_solver().params();
 }
 
 const std::shared_ptr<const ClothTopology>& DrawnCloth::topology() const {
-  return gpu_ ? gpu_->topology() : cpu_->topology();
+  return gpu_ ? gpu_->topology() : cpu_solver().topology();
 }
 
 std::uint64_t DrawnCloth::step_index() const {
-  return gpu_ ? gpu_->step_index() : cpu_->step_index();
+  return gpu_ ? gpu_->step_index() : cpu_solver().step_index();
 }
 
 double DrawnCloth::time() const {
-  return gpu_ ? gpu_->time() : cpu_->time();
+  return gpu_ ? gpu_->time() : cpu_solver().time();
+}
+
+Error DrawnCloth::cpu_error(const Error& e) const {
+  Error out = e;
+  const std::string prefix = fmt::format("cloth instance {}: ", cpu_id_);
+  if (out.message.starts_with(prefix))
+    out.message.erase(0, prefix.size());
+  return out;
 }
 
 } // namespace vkcloth::host

@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: MIT
 // The simulation that `vkcloth render`, `view` and the samples draw, on either backend
-// (gpu/backend_choice.hpp): the GpuSolver, drawn straight from its buffers, or CpuSolver<float>
-// (the CPU reference, bit for bit the GPU's explicit integrators on lavapipe), whose positions and
-// normals are uploaded into render::HostClothBuffers for each frame. Their callers see one object.
+// (gpu/backend_choice.hpp): the GpuSolver, drawn straight from its buffers, or a CpuWorld of one
+// cloth (a CpuSolver<float>: the CPU reference, bit for bit the GPU's explicit integrators on
+// lavapipe), whose positions and normals are uploaded into render::HostClothBuffers for each frame.
+// Their callers see one object.
 //
 // Host code shared by the tools and the samples (not installed); it calls no Vulkan function
 // itself, only the engine's.
@@ -17,6 +18,7 @@
 #include <glm/vec3.hpp>
 
 #include "vkcloth/cpu_solver.hpp"
+#include "vkcloth/cpu_world.hpp"
 #include "vkcloth/gpu/backend_choice.hpp"
 #include "vkcloth/gpu/context.hpp"
 #include "vkcloth/gpu/gpu_solver.hpp"
@@ -80,9 +82,14 @@ public:
 
 private:
   DrawnCloth() = default;
+  const CpuSolver<float>& cpu_solver() const { return *cpu_->solver(cpu_id_); }
+  /// A CPU error without the world's "cloth instance 1: " (one cloth: the solver's message).
+  Error cpu_error(const Error& e) const;
+
   gpu::Context* context_ = nullptr;
   std::optional<gpu::GpuSolver> gpu_;
-  std::optional<CpuSolver<float>> cpu_;
+  std::optional<CpuWorld> cpu_; // one instance, cpu_id_
+  InstanceId cpu_id_ = 0;
   std::optional<render::HostClothBuffers> host_;
 };
 

@@ -16,7 +16,8 @@ namespace vkcloth::gpu {
 
 /// Where the simulation runs.
 enum class Backend {
-  cpu,    ///< CpuSolver<float>; its positions and normals are uploaded for drawing each frame
+  cpu, ///< CpuSolver<float> (a CpuWorld of one cloth in DrawnCloth); its positions and normals are uploaded
+       ///< for drawing each frame
   vulkan, ///< GpuSolver; drawn straight from its buffers, nothing crosses the bus
 };
 

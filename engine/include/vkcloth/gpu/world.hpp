@@ -21,6 +21,9 @@
 // variants) is made once per Context, when a batch first needs it, and shared by all batches.
 //
 // Thread safety: none; one thread drives a world (as a GpuSolver).
+//
+// vkcloth::CpuWorld (cpu_world.hpp) has the same add / remove / set_params / simulate / positions
+// members on the CPU solver: a host that only steps and reads back switches by changing the type.
 #pragma once
 
 #include <cstdint>
@@ -37,6 +40,7 @@
 #include "vkcloth/result.hpp"
 #include "vkcloth/system.hpp"
 #include "vkcloth/topology.hpp"
+#include "vkcloth/world_types.hpp"
 
 namespace vkcloth::gpu {
 
@@ -60,15 +64,9 @@ struct WorldOptions {
   GpuSolverOptions solver;
 };
 
-/// An instance's handle; never reused within one world.
-using InstanceId = std::uint64_t;
-
-/// Optional initial state of an instance (instead of the topology's particle positions and
-/// velocities); each vector is empty (topology's value) or has one entry per particle.
-struct InitialState {
-  std::vector<glm::dvec3> positions;
-  std::vector<glm::dvec3> velocities;
-};
+/// The backend-neutral names (world_types.hpp), also under gpu:: as before.
+using vkcloth::InitialState;
+using vkcloth::InstanceId;
 
 class ClothWorld {
 public:
