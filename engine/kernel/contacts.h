@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// vkcloth kernel, colliders: the shape as the kernel takes it, and one distance / normal function per
+// vkcloth kernel: colliders: the shape as the kernel takes it, and one distance / normal function per
 // shape (docs/model.md "Collisions").
 // Part of the kernel that cloth_kernel.h gathers (the rules it states hold here: fixed order,
 // `precise` results, real(...) literals). No include guard: the C++ bridge includes it once per precision.

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// vkcloth kernel, the contact response: the inward part removed (Figure 12), Coulomb friction and the
+// vkcloth kernel: the contact response: the inward part removed (Figure 12), Coulomb friction and the
 // projection out of a collider (docs/model.md "Collisions", "Friction").
 // Part of the kernel that cloth_kernel.h gathers (the rules it states hold here: fixed order,
 // `precise` results, real(...) literals). No include guard: the C++ bridge includes it once per precision.

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// vkcloth kernel, implicit Euler: the spring blocks, the system's rows and the preconditioner
+// vkcloth kernel: implicit Euler: the spring blocks, the system's rows and the preconditioner
 // (docs/model.md "Implicit Euler").
 // Part of the kernel that cloth_kernel.h gathers (the rules it states hold here: fixed order,
 // `precise` results, real(...) literals). No include guard: the C++ bridge includes it once per precision.

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// vkcloth kernel, explicit integrators (Euler, semi-implicit Euler, RK4) and the divergence check
+// vkcloth kernel: explicit integrators (Euler, semi-implicit Euler, RK4) and the divergence check
 // (docs/model.md "Integrators", "Divergence").
 // Part of the kernel that cloth_kernel.h gathers (the rules it states hold here: fixed order,
 // `precise` results, real(...) literals). No include guard: the C++ bridge includes it once per precision.

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// vkcloth kernel, self-collision: the hash of cells and the pair repulsion (docs/model.md "Self-collision").
+// vkcloth kernel: self-collision: the hash of cells and the pair repulsion (docs/model.md "Self-collision").
 // Part of the kernel that cloth_kernel.h gathers (the rules it states hold here: fixed order,
 // `precise` results, real(...) literals). No include guard: the C++ bridge includes it once per precision.
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// vkcloth kernel, stretch control: Provot links, tethers and the fast projection (docs/model.md
+// vkcloth kernel: stretch control: Provot links, tethers and the fast projection (docs/model.md
 // "Stretch control").
 // Part of the kernel that cloth_kernel.h gathers (the rules it states hold here: fixed order,
 // `precise` results, real(...) literals). No include guard: the C++ bridge includes it once per precision.
