@@ -15,10 +15,12 @@ KFN void remove_inward(INOUT(vec3) w, vec3 n, bool both) {
 // Contact filter of one collider: within the band (distance < 2 eps) velocity and force lose
 // their parts pointing into the collider, so a hand lifting the cloth keeps its outward pull.
 KFN void contact_filter(INOUT(vec3) v, INOUT(vec3) f, vec3 n, real distance, real band, bool both) {
+  VARYING(bool) in_band = distance < band;
+  if (!any_particle(in_band))
+    return;
   vec3 nv = v, nf = f;
   remove_inward(nv, n, both);
   remove_inward(nf, n, both);
-  VARYING(bool) in_band = distance < band;
   v = select(in_band, nv, v);
   f = select(in_band, nf, f);
 }
@@ -50,6 +52,9 @@ KFN void contact_response(INOUT(vec3) v, INOUT(vec3) f, ColliderShape s, vec3 x,
     contact_filter(v, f, n, distance, band, both);
     return;
   }
+  VARYING(bool) in_band = distance < band;
+  if (!any_particle(in_band))
+    return;
   precise vec3 vs = s.moving ? surface_velocity(s, x) : vec3(real(0));
   precise vec3 w = v - vs;
   vec3 g = f;
@@ -59,13 +64,15 @@ KFN void contact_response(INOUT(vec3) v, INOUT(vec3) f, ColliderShape s, vec3 x,
   precise real j = max(-wn, real(0)) + max(-fn, real(0)) * h_over_m;
   coulomb_friction(w, g, n, j, s.mu_k, s.mu_s, h_over_m);
   precise vec3 nv = w + vs;
-  VARYING(bool) in_band = distance < band;
   v = select(in_band, nv, v);
   f = select(in_band, g, f);
 }
 
 // project_out once the collider's distance and normal at x are known: nothing unless distance < 0.
 KFN void project_back(ColliderShape s, real eps, real distance, vec3 n, INOUT(vec3) x, INOUT(vec3) v) {
+  VARYING(bool) inside = distance < real(0);
+  if (!any_particle(inside))
+    return;
   precise vec3 nx;
   if (s.type == VKCLOTH_COLLIDER_SPHERE) {
     precise real r = s.b + eps;
@@ -83,7 +90,6 @@ KFN void project_back(ColliderShape s, real eps, real distance, vec3 n, INOUT(ve
     remove_inward(w, n, false);
     nv = w + vs;
   }
-  VARYING(bool) inside = distance < real(0);
   x = select(inside, nx, x);
   v = select(inside, nv, v);
 }

@@ -77,17 +77,11 @@ VKCLOTH_AI Lanes3<T> splat3(typename T::Real x, typename T::Real y, typename T::
   return {Lanes<T>(x), Lanes<T>(y), Lanes<T>(z)};
 }
 
-// Every lane of m is set; some lane is.
+// Every lane of m is set.
 template <typename T> VKCLOTH_AI bool all_lanes(Mask<T> m) {
   bool r = true;
   for (int l = 0; l < T::W; ++l)
     r = r && m.m[l] != 0;
-  return r;
-}
-template <typename T> VKCLOTH_AI bool any_lane(Mask<T> m) {
-  bool r = false;
-  for (int l = 0; l < T::W; ++l)
-    r = r || m.m[l] != 0;
   return r;
 }
 // Lane l holds l.
@@ -411,8 +405,7 @@ std::int64_t simd_finish(const vkcloth::detail::FinishArgs<typename T::Real>& a,
       L distance;
       L3 n;
       collider_contact(NoMesh{}, s, x0, x0, band, distance, n);
-      if (any_lane<T>(distance < band)) // else it changes no lane
-        contact_response(v, f, s, x0, n, distance, band, a.both, h_over_m);
+      contact_response(v, f, s, x0, n, distance, band, a.both, h_over_m);
     }
     L3 x = x0;
     euler_update(a.semi, x, v, f, m, dt);

@@ -66,6 +66,12 @@ template <typename T> struct Mask {
   friend Mask operator&(Mask a, Mask b) { return Mask(a.m & b.m); }
   friend Mask operator|(Mask a, Mask b) { return Mask(a.m | b.m); }
   friend Mask select(Mask c, Mask a, Mask b) { return Mask(c.m ? a.m : b.m); }
+  friend bool any_particle(Mask a) { // some lane is set
+    bool r = false;
+    for (int l = 0; l < T::W; ++l)
+      r = r || a.m[l] != 0;
+    return r;
+  }
 };
 
 /// W lanes of a uint (VARYING(uint): a gather-list entry's ring bits), in the width of Real.
