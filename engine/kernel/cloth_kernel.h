@@ -10,12 +10,22 @@
 //   variable, so the shader compiler may neither reassociate nor fuse it into an FMA (the C++
 //   side builds with -ffp-contract=off; `precise` is empty there).
 // - Literals are `real(...)`: a bare 2.0 would be a double in C++.
+// - A condition on a per-particle value chooses with select(c, a, b) (c ? a : b), both computed, never
+//   with an `if` or `?:`: the CPU's SIMD kernels (engine/src/core/row_kernel_simd.inl) run forces.h,
+//   contacts.h, friction.h and integrators.h on lanes of W particles, where such a condition is a mask
+//   (a C++ compile error there if it reaches an `if`). real and vec3 values are per particle; a bool
+//   or uint that is per particle is declared VARYING(bool) / VARYING(uint); a plain bool or uint (a flag, a
+//   collider's type, shapes.h) is the same for every particle of a call and may branch. Work that no
+//   particle of the call needs may be skipped: `if (!any_particle(c)) return;` (c itself for one
+//   particle; on lanes, some lane's c). Exempt: the mesh search (contacts.h, VKCLOTH_KERNEL_NO_MESH)
+//   and the headers the lanes do not include.
 // - Pure functions of values: no buffer (a mesh collider's hierarchy is read through the including
 //   file's accessors), no loop over particles or colliders. Each caller
 //   gathers its inputs its own way (texel fetches, std::vector) and loops itself.
 //
 // Provided by the including file: real, vec3, uint, KFN (function prefix: `inline` in C++),
-// OUT(T) / INOUT(T) (out / inout parameters: T& in C++), precise, sqrt, abs, min, max, and
+// OUT(T) / INOUT(T) (out / inout parameters: T& in C++), precise, VARYING(T) (T; see above),
+// select(c, a, b) (c ? a : b), any_particle(c) (c), sqrt, abs, min, max, and
 // all_finite(vec3) (no component is NaN or inf); for mesh colliders MESH_DATA_PARAM / MESH_DATA
 // (the mesh buffers: a dummy uint in GLSL, whose buffers are global), mesh_node and mesh_triangle;
 // floor; for self_collide (only where SELF_DATA_PARAM is defined) SELF_DATA_PARAM / SELF_DATA,
@@ -30,6 +40,7 @@
 #include "constants.h"
 #include "vector.h"
 #include "forces.h"
+#include "shapes.h"
 #include "contacts.h"
 #include "friction.h"
 #include "strain.h"

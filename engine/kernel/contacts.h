@@ -1,31 +1,10 @@
 // SPDX-License-Identifier: MIT
-// vkcloth kernel: colliders: the shape as the kernel takes it, and one distance / normal function per
-// shape (docs/model.md "Collisions").
+// vkcloth kernel: colliders: one distance / normal function per shape (docs/model.md "Collisions"); the
+// shape as the kernel takes it: shapes.h.
 // Part of the kernel that cloth_kernel.h gathers (the rules it states hold here: fixed order,
 // `precise` results, real(...) literals). No include guard: the C++ bridge includes it once per precision.
 
 // ---- Contacts (docs/model.md "Collisions") ----------------------------------------------------
-
-// A collider as the kernel takes it, in the solver's precision, at its pose for this substep
-// (the host advances moving colliders: vkcloth::Collider::posed_at). GLSL: common.glsl
-// collider_shape(); C++: kernel.hpp kernel_shape().
-struct ColliderShape {
-  uint type; // VKCLOTH_COLLIDER_*
-  vec3 a;    // plane: unit normal; sphere, box, mesh: centre (mesh: its origin); capsule: end a
-  real b;    // plane: offset; sphere, capsule: radius; mesh: thickness
-  vec3 c;    // capsule: end b; box: half extents
-  vec3 ax;   // box, mesh: the body's axes in the world (columns of its rotation)
-  vec3 ay;
-  vec3 az;
-  uint mesh_root; // mesh: its root node and first triangle in the mesh buffers
-  uint mesh_tri0;
-  bool moving;   // the surface moves: velocity, spin and pivot apply
-  vec3 velocity; // linear velocity
-  vec3 spin;     // angular velocity about pivot
-  vec3 pivot;
-  real mu_k; // Coulomb friction: kinetic and static coefficients (0, 0: frictionless)
-  real mu_s;
-};
 
 // The velocity of the collider's surface at p.
 KFN precise vec3 surface_velocity(ColliderShape s, vec3 p) {
@@ -44,6 +23,9 @@ KFN precise vec3 to_world_dir(ColliderShape s, vec3 d) {
   return w;
 }
 
+// Mesh colliders: a search of the triangles' hierarchy per particle. A bridge that cannot run it (the
+// CPU's SIMD lanes, which take no mesh collider) defines VKCLOTH_KERNEL_NO_MESH and its own mesh_contact.
+#ifndef VKCLOTH_KERNEL_NO_MESH
 // The closest point of triangle (a, b, c) to p (Ericson, Real-Time Collision Detection, 5.1.5).
 KFN precise vec3 closest_on_triangle(vec3 p, vec3 a, vec3 b, vec3 c) {
   precise vec3 ab = b - a, ac = c - a, ap = p - a;
@@ -131,6 +113,36 @@ KFN bool mesh_closest(MESH_DATA_PARAM, uint root, uint tri0, vec3 q, real reach,
   return found;
 }
 
+// collider_contact for a mesh collider, q = p in its body frame (to_body).
+KFN void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_side, real reach, OUT(real) distance,
+                      OUT(vec3) normal) {
+  vec3 cp, tn;
+  distance = reach;
+  normal = vec3(real(0), real(0), real(1));
+  if (!VKCLOTH_COLLIDER_PRESENT(VKCLOTH_COLLIDER_MESH) ||
+      !mesh_closest(MESH_DATA, s.mesh_root, s.mesh_tri0, q, s.b + reach, cp, tn))
+    return;
+  precise vec3 r = q - cp;
+  precise real len = sqrt(dot3(r, r));
+  precise real side = select(dot3(to_body(s, p_side) - cp, tn) < real(0), real(-1), real(1));
+  precise vec3 side_n = tn * side;
+  precise real along = dot3(r, side_n);
+  precise vec3 across = r - side_n * along; // beyond an edge: its offset in the triangle's plane
+  if (along < real(0) && dot3(across, across) <= s.b * s.b) {
+    // Crossed to the other side through the triangle (or within the shell of its edge): back out
+    // on the side it came from.
+    precise real d = along - s.b;
+    distance = d;
+    normal = to_world_dir(s, side_n);
+    return;
+  }
+  precise vec3 nb = select(len > real(0), r / len, side_n);
+  precise real d = len - s.b;
+  distance = d;
+  normal = to_world_dir(s, nb);
+}
+#endif // VKCLOTH_KERNEL_NO_MESH
+
 // Signed distance of p to a collider's surface (negative inside; a mesh: to the shell `thickness`
 // around its triangles) and the outward unit normal there. A mesh's side is the side of the
 // nearest triangle that `p_side` is on (where the particle came from), so a particle that crossed
@@ -149,7 +161,8 @@ KFN void collider_contact(MESH_DATA_PARAM, ColliderShape s, vec3 p, vec3 p_side,
   if (VKCLOTH_COLLIDER_PRESENT(VKCLOTH_COLLIDER_SPHERE) && s.type == VKCLOTH_COLLIDER_SPHERE) {
     precise vec3 r = p - s.a;
     precise real len = sqrt(dot3(r, r));
-    precise vec3 n = len > real(0) ? r / len : vec3(real(0), real(0), real(1)); // at the centre: push up
+    precise vec3 n =
+        select(len > real(0), r / len, vec3(real(0), real(0), real(1))); // at the centre: push up
     precise real d = len - s.b;
     distance = d;
     normal = n;
@@ -158,11 +171,11 @@ KFN void collider_contact(MESH_DATA_PARAM, ColliderShape s, vec3 p, vec3 p_side,
   if (VKCLOTH_COLLIDER_PRESENT(VKCLOTH_COLLIDER_CAPSULE) && s.type == VKCLOTH_COLLIDER_CAPSULE) {
     precise vec3 axis = s.c - s.a;
     precise real len2 = dot3(axis, axis);
-    precise real t = len2 > real(0) ? dot3(p - s.a, axis) / len2 : real(0);
+    precise real t = select(len2 > real(0), dot3(p - s.a, axis) / len2, real(0));
     t = min(max(t, real(0)), real(1));
     precise vec3 r = p - (s.a + axis * t);
     precise real len = sqrt(dot3(r, r));
-    precise vec3 n = len > real(0) ? r / len : vec3(real(0), real(0), real(1));
+    precise vec3 n = select(len > real(0), r / len, vec3(real(0), real(0), real(1)));
     precise real d = len - s.b;
     distance = d;
     normal = n;
@@ -173,52 +186,23 @@ KFN void collider_contact(MESH_DATA_PARAM, ColliderShape s, vec3 p, vec3 p_side,
     precise vec3 over = abs(q) - s.c; // > 0 along the axes where q is beyond a face
     precise vec3 out_part = max(over, vec3(real(0)));
     precise real out_len = sqrt(dot3(out_part, out_part));
-    precise vec3 sgn = vec3(q.x < real(0) ? real(-1) : real(1), q.y < real(0) ? real(-1) : real(1),
-                            q.z < real(0) ? real(-1) : real(1));
-    if (out_len > real(0)) { // outside: towards the nearest face, edge or corner
-      precise vec3 nb = (out_part * sgn) / out_len;
-      distance = out_len;
-      normal = to_world_dir(s, nb);
-      return;
-    }
-    // Inside: out through the nearest face.
-    vec3 nb = vec3(sgn.x, real(0), real(0));
-    precise real d = over.x;
-    if (over.y > d) {
-      d = over.y;
-      nb = vec3(real(0), sgn.y, real(0));
-    }
-    if (over.z > d) {
-      d = over.z;
-      nb = vec3(real(0), real(0), sgn.z);
-    }
-    distance = d;
-    normal = to_world_dir(s, nb);
+    precise vec3 sgn =
+        vec3(select(q.x < real(0), real(-1), real(1)), select(q.y < real(0), real(-1), real(1)),
+             select(q.z < real(0), real(-1), real(1)));
+    // Outside (out_len > 0): towards the nearest face, edge or corner.
+    precise vec3 nb_out = (out_part * sgn) / out_len;
+    // Inside: out through the nearest face (x, then y if deeper, then z if deeper still).
+    VARYING(bool) y_deeper = over.y > over.x;
+    precise real d = select(y_deeper, over.y, over.x);
+    vec3 nb = select(y_deeper, vec3(real(0), sgn.y, real(0)), vec3(sgn.x, real(0), real(0)));
+    VARYING(bool) z_deeper = over.z > d;
+    d = select(z_deeper, over.z, d);
+    nb = select(z_deeper, vec3(real(0), real(0), sgn.z), nb);
+    VARYING(bool) outside = out_len > real(0);
+    distance = select(outside, out_len, d);
+    normal = to_world_dir(s, select(outside, nb_out, nb));
     return;
   }
   // VKCLOTH_COLLIDER_MESH
-  vec3 cp, tn;
-  distance = reach;
-  normal = vec3(real(0), real(0), real(1));
-  if (!VKCLOTH_COLLIDER_PRESENT(VKCLOTH_COLLIDER_MESH) ||
-      !mesh_closest(MESH_DATA, s.mesh_root, s.mesh_tri0, q, s.b + reach, cp, tn))
-    return;
-  precise vec3 r = q - cp;
-  precise real len = sqrt(dot3(r, r));
-  precise real side = dot3(to_body(s, p_side) - cp, tn) < real(0) ? real(-1) : real(1);
-  precise vec3 side_n = tn * side;
-  precise real along = dot3(r, side_n);
-  precise vec3 across = r - side_n * along; // beyond an edge: its offset in the triangle's plane
-  if (along < real(0) && dot3(across, across) <= s.b * s.b) {
-    // Crossed to the other side through the triangle (or within the shell of its edge): back out
-    // on the side it came from.
-    precise real d = along - s.b;
-    distance = d;
-    normal = to_world_dir(s, side_n);
-    return;
-  }
-  precise vec3 nb = len > real(0) ? r / len : side_n;
-  precise real d = len - s.b;
-  distance = d;
-  normal = to_world_dir(s, nb);
+  mesh_contact(MESH_DATA, s, q, p_side, reach, distance, normal);
 }

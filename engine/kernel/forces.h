@@ -15,20 +15,21 @@ KFN void add_fan_triangle(INOUT(vec3) sum, vec3 ea, vec3 eb) {
 // A gather-list entry's part in its particle's fan (Edge::ring, VKCLOTH_RING_*), u its edge: the
 // list walks the fan's triangles as chains of neighbours, so the normal reuses the springs' edges.
 // `prev` and `first` carry the previous entry's edge and the chain's first between calls.
-KFN void add_ring_term(INOUT(vec3) sum, INOUT(vec3) prev, INOUT(vec3) first, vec3 u, uint ring) {
-  if ((ring & VKCLOTH_RING_START) != 0u)
-    first = u;
-  if ((ring & VKCLOTH_RING_PREV) != 0u)
-    add_fan_triangle(sum, prev, u);
-  if ((ring & VKCLOTH_RING_CLOSE) != 0u)
-    add_fan_triangle(sum, u, first);
+KFN void add_ring_term(INOUT(vec3) sum, INOUT(vec3) prev, INOUT(vec3) first, vec3 u, VARYING(uint) ring) {
+  first = select((ring & VKCLOTH_RING_START) != 0u, u, first);
+  vec3 t = sum;
+  add_fan_triangle(t, prev, u);
+  sum = select((ring & VKCLOTH_RING_PREV) != 0u, t, sum);
+  t = sum;
+  add_fan_triangle(t, u, first);
+  sum = select((ring & VKCLOTH_RING_CLOSE) != 0u, t, sum);
   prev = u;
 }
 
 // The unit normal of a fan sum; zero for a degenerate fan (and for particles without a surface).
 KFN precise vec3 unit_or_zero(vec3 sum) {
   precise real len = sqrt(dot3(sum, sum));
-  precise vec3 n = len > real(0) ? sum / len : vec3(real(0));
+  precise vec3 n = select(len > real(0), sum / len, vec3(real(0)));
   return n;
 }
 
@@ -38,10 +39,8 @@ KFN precise vec3 unit_or_zero(vec3 sum) {
 // f += K (|u| - L0) u / |u|. A zero-length spring has no direction and adds nothing.
 KFN void add_spring_edge(INOUT(vec3) f, vec3 u, real rest, real k) {
   precise real len = sqrt(dot3(u, u));
-  if (len > real(0)) {
-    precise vec3 t = f + u * (k * (len - rest) / len);
-    f = t;
-  }
+  precise vec3 t = f + u * (k * (len - rest) / len);
+  f = select(len > real(0), t, f);
 }
 
 KFN void add_spring(INOUT(vec3) f, vec3 x, vec3 xq, real rest, real k) {

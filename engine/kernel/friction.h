@@ -8,19 +8,21 @@
 // (Figure 12's variant) the outward part as well.
 KFN void remove_inward(INOUT(vec3) w, vec3 n, bool both) {
   precise real wn = dot3(w, n);
-  if (wn < real(0) || (both && wn != real(0))) {
-    precise vec3 t = w - n * wn;
-    w = t;
-  }
+  precise vec3 t = w - n * wn;
+  w = select(wn < real(0) || (both && wn != real(0)), t, w);
 }
 
 // Contact filter of one collider: within the band (distance < 2 eps) velocity and force lose
 // their parts pointing into the collider, so a hand lifting the cloth keeps its outward pull.
 KFN void contact_filter(INOUT(vec3) v, INOUT(vec3) f, vec3 n, real distance, real band, bool both) {
-  if (!(distance < band))
+  VARYING(bool) in_band = distance < band;
+  if (!any_particle(in_band))
     return;
-  remove_inward(v, n, both);
-  remove_inward(f, n, both);
+  vec3 nv = v, nf = f;
+  remove_inward(nv, n, both);
+  remove_inward(nf, n, both);
+  v = select(in_band, nv, v);
+  f = select(in_band, nf, f);
 }
 
 // Coulomb friction on the relative velocity w and the force f once their inward normal parts are
@@ -34,7 +36,7 @@ KFN void coulomb_friction(INOUT(vec3) w, INOUT(vec3) f, vec3 n, real j, real mu_
   precise vec3 slip = wt + ft * h_over_m;
   precise real slip_len = sqrt(dot3(slip, slip));
   precise real hold = mu_s * j;
-  precise real k = slip_len > hold ? mu_k * j / slip_len : real(1);
+  precise real k = select(slip_len > hold, mu_k * j / slip_len, real(1));
   precise vec3 nw = w - wt * k;
   precise vec3 nf = f - ft * k;
   w = nw;
@@ -46,21 +48,50 @@ KFN void coulomb_friction(INOUT(vec3) w, INOUT(vec3) f, vec3 n, real j, real mu_
 // then friction. A still, frictionless collider is exactly contact_filter (the report's model).
 KFN void contact_response(INOUT(vec3) v, INOUT(vec3) f, ColliderShape s, vec3 x, vec3 n, real distance,
                           real band, bool both, real h_over_m) {
-  if (!s.moving && s.mu_s == real(0) && s.mu_k == real(0)) {
+  if (still_frictionless(s)) {
     contact_filter(v, f, n, distance, band, both);
     return;
   }
-  if (!(distance < band))
+  VARYING(bool) in_band = distance < band;
+  if (!any_particle(in_band))
     return;
   precise vec3 vs = s.moving ? surface_velocity(s, x) : vec3(real(0));
   precise vec3 w = v - vs;
-  precise real wn = dot3(w, n), fn = dot3(f, n);
+  vec3 g = f;
+  precise real wn = dot3(w, n), fn = dot3(g, n);
   remove_inward(w, n, both);
-  remove_inward(f, n, both);
+  remove_inward(g, n, both);
   precise real j = max(-wn, real(0)) + max(-fn, real(0)) * h_over_m;
-  coulomb_friction(w, f, n, j, s.mu_k, s.mu_s, h_over_m);
+  coulomb_friction(w, g, n, j, s.mu_k, s.mu_s, h_over_m);
   precise vec3 nv = w + vs;
-  v = nv;
+  v = select(in_band, nv, v);
+  f = select(in_band, g, f);
+}
+
+// project_out once the collider's distance and normal at x are known: nothing unless distance < 0.
+KFN void project_back(ColliderShape s, real eps, real distance, vec3 n, INOUT(vec3) x, INOUT(vec3) v) {
+  VARYING(bool) inside = distance < real(0);
+  if (!any_particle(inside))
+    return;
+  precise vec3 nx;
+  if (s.type == VKCLOTH_COLLIDER_SPHERE) {
+    precise real r = s.b + eps;
+    nx = s.a + n * r;
+  } else {
+    precise real back = eps - distance;
+    nx = x + n * back;
+  }
+  precise vec3 nv = v;
+  if (!s.moving) {
+    remove_inward(nv, n, false);
+  } else {
+    precise vec3 vs = surface_velocity(s, nx);
+    precise vec3 w = v - vs;
+    remove_inward(w, n, false);
+    nv = w + vs;
+  }
+  x = select(inside, nx, x);
+  v = select(inside, nv, v);
 }
 
 // Eq. 5 / eq. 6: a point inside a collider goes back to its surface + eps, and loses its
@@ -73,28 +104,5 @@ KFN void project_out(MESH_DATA_PARAM, ColliderShape s, real eps, vec3 p_side, IN
   precise vec3 moved = x - p_side;
   precise real reach = s.type == VKCLOTH_COLLIDER_MESH ? sqrt(dot3(moved, moved)) : real(0);
   collider_contact(MESH_DATA, s, x, p_side, reach, distance, n);
-  if (!(distance < real(0)))
-    return;
-  if (s.type == VKCLOTH_COLLIDER_PLANE) {
-    precise real back = eps - distance;
-    precise vec3 t = x + n * back;
-    x = t;
-  } else if (s.type == VKCLOTH_COLLIDER_SPHERE) {
-    precise real r = s.b + eps;
-    precise vec3 t = s.a + n * r;
-    x = t;
-  } else {
-    precise real back = eps - distance;
-    precise vec3 t = x + n * back;
-    x = t;
-  }
-  if (!s.moving) {
-    remove_inward(v, n, false);
-    return;
-  }
-  precise vec3 vs = surface_velocity(s, x);
-  precise vec3 w = v - vs;
-  remove_inward(w, n, false);
-  precise vec3 nv = w + vs;
-  v = nv;
+  project_back(s, eps, distance, n, x, v);
 }

@@ -32,14 +32,10 @@ KFN precise vec3 rk4_stage_point(vec3 y0, vec3 k_prev, real c) {
   return y;
 }
 // The stage's derivative (k_pos, k_vel) = (v, F / m) after contacts; zero for a pinned particle.
-KFN void rk4_derivative(bool pinned, vec3 v, vec3 f, real m, OUT(vec3) k_pos, OUT(vec3) k_vel) {
-  k_pos = vec3(real(0));
-  k_vel = vec3(real(0));
-  if (!pinned) { // a pinned particle may have no mass
-    precise vec3 a = f / m;
-    k_pos = v;
-    k_vel = a;
-  }
+KFN void rk4_derivative(VARYING(bool) pinned, vec3 v, vec3 f, real m, OUT(vec3) k_pos, OUT(vec3) k_vel) {
+  precise vec3 a = f / m; // a pinned particle may have no mass: its a is not used
+  k_pos = select(pinned, vec3(real(0)), v);
+  k_vel = select(pinned, vec3(real(0)), a);
 }
 // Running sum k1 + 2 k2 + 2 k3 + k4, one stage at a time (same order as summing at the end).
 KFN precise vec3 rk4_accumulate(uint stage, vec3 sum, vec3 k) {
@@ -55,6 +51,6 @@ KFN precise vec3 rk4_finish(vec3 y0, vec3 sum, real dt_over_6) {
 // ---- Divergence (docs/model.md "Divergence") -------------------------------------------
 
 // A particle has diverged when a component of x or v is NaN or inf, or |x_i| > limit.
-KFN bool diverged(vec3 x, vec3 v, real limit) {
+KFN VARYING(bool) diverged(vec3 x, vec3 v, real limit) {
   return !all_finite(x) || !all_finite(v) || abs(x.x) > limit || abs(x.y) > limit || abs(x.z) > limit;
 }

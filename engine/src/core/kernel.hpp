@@ -32,6 +32,9 @@ static_assert(VKCLOTH_INTEGRATOR_RK4 == std::uint32_t(vkcloth::Integrator::rk4))
 #define OUT(T) T&
 #define INOUT(T) T&
 #define precise
+#define VARYING(T) T
+#define select(c, a, b) ((c) ? (a) : (b))
+#define any_particle(c) (c)
 #define MESH_DATA_PARAM const MeshData& mesh_data
 #define MESH_DATA mesh_data
 #define VKCLOTH_COLLIDER_PRESENT(type) true
@@ -198,5 +201,8 @@ kernel::ColliderShape<Real> kernel_shape(const Collider& c, std::uint32_t mesh_r
 #undef OUT
 #undef INOUT
 #undef precise
+#undef VARYING
+#undef select
+#undef any_particle
 #undef MESH_DATA_PARAM
 #undef MESH_DATA

@@ -2,9 +2,9 @@
 // The CPU solver's SIMD kernels (the grid row kernel, the list kernel for meshes, the contacts'
 // finish): their arguments and the per-ISA entry points.
 // The reference is the shared kernel (engine/kernel/cloth_kernel.h, per particle in
-// cpu_solver.cpp); row_kernel_avx2.cpp and row_kernel_avx512.cpp hold the same arithmetic with
-// 8 / 16 (float) particles per vector, each file compiled with its own -m flags and only called
-// after __builtin_cpu_supports said yes.
+// cpu_solver.cpp); row_kernel_avx2.cpp and row_kernel_avx512.cpp run the same kernel functions on
+// 8 / 16 (float) particles per vector (row_kernel_simd.inl), each file compiled with its own -m flags
+// and only called after __builtin_cpu_supports said yes.
 #pragma once
 
 #include <cstddef>

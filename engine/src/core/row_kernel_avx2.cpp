@@ -9,7 +9,7 @@
 #error "row_kernel_avx2.cpp must be compiled with -mavx2"
 #endif
 
-#include "row_kernel_simd.inl"
+#include "simd_lanes.inl"
 
 namespace {
 
@@ -101,6 +101,8 @@ struct IsaD : IsaGeneric<double, vd4, vl4, 4> {
 };
 
 } // namespace
+
+#include "row_kernel_simd.inl"
 
 namespace vkcloth::detail {
 std::int64_t row_kernel_avx2(const RowArgs<float>& a, std::int64_t q0, std::int64_t q1, bool& bad) {

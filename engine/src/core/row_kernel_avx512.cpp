@@ -9,7 +9,7 @@
 #error "row_kernel_avx512.cpp must be compiled with -mavx512f"
 #endif
 
-#include "row_kernel_simd.inl"
+#include "simd_lanes.inl"
 
 namespace {
 
@@ -117,6 +117,8 @@ struct IsaD : IsaGeneric<double, vd8, vl8, 8> {
 };
 
 } // namespace
+
+#include "row_kernel_simd.inl"
 
 namespace vkcloth::detail {
 std::int64_t row_kernel_avx512(const RowArgs<float>& a, std::int64_t q0, std::int64_t q1, bool& bad) {
