@@ -23,7 +23,8 @@
 //   file's accessors), no loop over particles or colliders. Each caller
 //   gathers its inputs its own way (texel fetches, std::vector) and loops itself.
 //
-// Provided by the including file: real, vec3, uint, KFN (function prefix: `inline` in C++),
+// Provided by the including file: real, vec3, uint, KFN (function prefix: `inline` and always
+// inlined in C++), KFN_NOINLINE (the mesh search's prefix: kept out of line in C++),
 // OUT(T) / INOUT(T) (out / inout parameters: T& in C++), precise, VARYING(T) (T; see above),
 // select(c, a, b) (c ? a : b), any_particle(c) (c), sqrt, abs, min, max, and
 // all_finite(vec3) (no component is NaN or inf); for mesh colliders MESH_DATA_PARAM / MESH_DATA

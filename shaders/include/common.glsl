@@ -112,6 +112,7 @@ bool frozen() { return flags[inst].first_bad_step < pc.step; }
 // by engine/src/core/kernel.hpp): its language prelude for GLSL.
 #define real float
 #define KFN
+#define KFN_NOINLINE
 #define OUT(T) out T
 #define INOUT(T) inout T
 #define VARYING(T) T

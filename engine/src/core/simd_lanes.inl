@@ -66,12 +66,7 @@ template <typename T> struct Mask {
   friend Mask operator&(Mask a, Mask b) { return Mask(a.m & b.m); }
   friend Mask operator|(Mask a, Mask b) { return Mask(a.m | b.m); }
   friend Mask select(Mask c, Mask a, Mask b) { return Mask(c.m ? a.m : b.m); }
-  friend bool any_particle(Mask a) { // some lane is set
-    bool r = false;
-    for (int l = 0; l < T::W; ++l)
-      r = r || a.m[l] != 0;
-    return r;
-  }
+  friend bool any_particle(Mask a) { return T::any(a.m); } // some lane is set
 };
 
 /// W lanes of a uint (VARYING(uint): a gather-list entry's ring bits), in the width of Real.
@@ -168,6 +163,14 @@ template <typename Real, typename V, typename M, int W> struct IsaGeneric {
     for (int l = 0; l < W; ++l)
       m[l] = p[l];
     return m;
+  }
+  // Some lane of m is nonzero.
+  static bool any(M m) {
+    std::uint64_t w[sizeof(M) / 8], acc = 0;
+    __builtin_memcpy(w, &m, sizeof m);
+    for (std::size_t k = 0; k < sizeof(M) / 8; ++k)
+      acc |= w[k];
+    return acc != 0;
   }
 };
 
