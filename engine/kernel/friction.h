@@ -9,7 +9,7 @@
 KFN void remove_inward(INOUT(vec3) w, vec3 n, bool both) {
   precise real wn = dot3(w, n);
   VARYING(bool) remove = wn < real(0) || (both && wn != real(0));
-  if (!any_particle(remove))
+  if (!maybe_any_particle(remove))
     return;
   precise vec3 t = w - n * wn;
   w = select(remove, t, w);

@@ -118,6 +118,7 @@ bool frozen() { return flags[inst].first_bad_step < pc.step; }
 #define VARYING(T) T
 #define select(c, a, b) ((c) ? (a) : (b))
 #define any_particle(c) (c)
+#define maybe_any_particle(c) (c)
 // No component is NaN or inf, from the bits: a compiler that assumes finite floats cannot fold it.
 bool all_finite(vec3 v) {
   const uvec3 bits = floatBitsToUint(v) & 0x7f800000u; // exponent all ones: inf or NaN

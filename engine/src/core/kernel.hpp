@@ -37,6 +37,7 @@ static_assert(VKCLOTH_INTEGRATOR_RK4 == std::uint32_t(vkcloth::Integrator::rk4))
 #define precise
 #define VARYING(T) T
 #define any_particle(c) (c)
+#define maybe_any_particle(c) (c)
 #define MESH_DATA_PARAM const MeshData& mesh_data
 #define MESH_DATA mesh_data
 #define VKCLOTH_COLLIDER_PRESENT(type) true
@@ -211,5 +212,6 @@ kernel::ColliderShape<Real> kernel_shape(const Collider& c, std::uint32_t mesh_r
 #undef precise
 #undef VARYING
 #undef any_particle
+#undef maybe_any_particle
 #undef MESH_DATA_PARAM
 #undef MESH_DATA

@@ -2,7 +2,7 @@
 // SIMD lane types for the shared kernel (engine/kernel/*.h) on the CPU: W particles per value, as
 // Jolt's Vec3 / Vec4 wrap a register, over GCC vector extensions. Included first by
 // row_kernel_avx2.cpp / row_kernel_avx512.cpp, whose ISA traits T (Real, V = W lanes of Real, M = W
-// lanes of same-width ints, W, sqrt, AoS load3 / store3, gather3, pinmask, loadmask) parameterise
+// lanes of same-width ints, W, sqrt, any, AoS load3 / store3, gather3, pinmask, loadmask) parameterise
 // these templates; row_kernel_simd.inl then compiles the kernel with real = Lanes<T>, vec3 = Lanes3<T>.
 // Everything here has internal linkage, so the two ISA translation units never share (ODR-merge) a
 // function compiled for the other's ISA: include nothing with inline functions here.
@@ -67,6 +67,8 @@ template <typename T> struct Mask {
   friend Mask operator|(Mask a, Mask b) { return Mask(a.m | b.m); }
   friend Mask select(Mask c, Mask a, Mask b) { return Mask(c.m ? a.m : b.m); }
   friend bool any_particle(Mask a) { return T::any(a.m); } // some lane is set
+  // Where a lane almost always needs the work (a spring's len > 0): no test, no branch.
+  friend bool maybe_any_particle(Mask) { return true; }
 };
 
 /// W lanes of a uint (VARYING(uint): a gather-list entry's ring bits), in the width of Real.
