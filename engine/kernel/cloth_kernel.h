@@ -17,15 +17,18 @@
 //   or uint that is per particle is declared VARYING(bool) / VARYING(uint); a plain bool or uint (a flag, a
 //   collider's type, shapes.h) is the same for every particle of a call and may branch. Work that no
 //   particle of the call needs may be skipped: `if (!any_particle(c)) return;` (c itself for one
-//   particle; on lanes, some lane's c). Exempt: the mesh search (contacts.h, VKCLOTH_KERNEL_NO_MESH)
-//   and the headers the lanes do not include.
+//   particle; on lanes, some lane's c), or where the lanes would almost never skip (a spring's
+//   `len > 0`) `if (!maybe_any_particle(c)) return;` (c for one particle; true on lanes, untested).
+//   Exempt: the mesh search (contacts.h, VKCLOTH_KERNEL_NO_MESH) and the headers the lanes do not
+//   include.
 // - Pure functions of values: no buffer (a mesh collider's hierarchy is read through the including
 //   file's accessors), no loop over particles or colliders. Each caller
 //   gathers its inputs its own way (texel fetches, std::vector) and loops itself.
 //
-// Provided by the including file: real, vec3, uint, KFN (function prefix: `inline` in C++),
+// Provided by the including file: real, vec3, uint, KFN (function prefix: `inline` and always
+// inlined in C++), KFN_NOINLINE (the mesh search's prefix: kept out of line in C++),
 // OUT(T) / INOUT(T) (out / inout parameters: T& in C++), precise, VARYING(T) (T; see above),
-// select(c, a, b) (c ? a : b), any_particle(c) (c), sqrt, abs, min, max, and
+// select(c, a, b) (c ? a : b), any_particle(c) and maybe_any_particle(c) (c), sqrt, abs, min, max, and
 // all_finite(vec3) (no component is NaN or inf); for mesh colliders MESH_DATA_PARAM / MESH_DATA
 // (the mesh buffers: a dummy uint in GLSL, whose buffers are global), mesh_node and mesh_triangle;
 // floor; for self_collide (only where SELF_DATA_PARAM is defined) SELF_DATA_PARAM / SELF_DATA,

@@ -72,8 +72,8 @@ KFN precise vec3 closest_on_triangle(vec3 p, vec3 a, vec3 b, vec3 c) {
 // mesh_node(MESH_DATA, i, lo, first, hi, count) and mesh_triangle(MESH_DATA, i, a, b, c)
 // (vkcloth::ColliderMesh's Node and Triangle); MESH_DATA_PARAM declares MESH_DATA.
 #define VKCLOTH_MESH_STACK 32
-KFN bool mesh_closest(MESH_DATA_PARAM, uint root, uint tri0, vec3 q, real reach, OUT(vec3) closest,
-                      OUT(vec3) normal) {
+KFN_NOINLINE bool mesh_closest(MESH_DATA_PARAM, uint root, uint tri0, vec3 q, real reach, OUT(vec3) closest,
+                               OUT(vec3) normal) {
   closest = q;
   normal = vec3(real(0), real(0), real(1));
   precise real best = reach * reach;
@@ -114,8 +114,8 @@ KFN bool mesh_closest(MESH_DATA_PARAM, uint root, uint tri0, vec3 q, real reach,
 }
 
 // collider_contact for a mesh collider, q = p in its body frame (to_body).
-KFN void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_side, real reach, OUT(real) distance,
-                      OUT(vec3) normal) {
+KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_side, real reach,
+                               OUT(real) distance, OUT(vec3) normal) {
   vec3 cp, tn;
   distance = reach;
   normal = vec3(real(0), real(0), real(1));
@@ -191,6 +191,12 @@ KFN void collider_contact(MESH_DATA_PARAM, ColliderShape s, vec3 p, vec3 p_side,
              select(q.z < real(0), real(-1), real(1)));
     // Outside (out_len > 0): towards the nearest face, edge or corner.
     precise vec3 nb_out = (out_part * sgn) / out_len;
+    VARYING(bool) outside = out_len > real(0);
+    if (!any_particle(!outside)) {
+      distance = out_len;
+      normal = to_world_dir(s, nb_out);
+      return;
+    }
     // Inside: out through the nearest face (x, then y if deeper, then z if deeper still).
     VARYING(bool) y_deeper = over.y > over.x;
     precise real d = select(y_deeper, over.y, over.x);
@@ -198,7 +204,6 @@ KFN void collider_contact(MESH_DATA_PARAM, ColliderShape s, vec3 p, vec3 p_side,
     VARYING(bool) z_deeper = over.z > d;
     d = select(z_deeper, over.z, d);
     nb = select(z_deeper, vec3(real(0), real(0), sgn.z), nb);
-    VARYING(bool) outside = out_len > real(0);
     distance = select(outside, out_len, d);
     normal = to_world_dir(s, select(outside, nb_out, nb));
     return;

@@ -17,12 +17,18 @@ KFN void add_fan_triangle(INOUT(vec3) sum, vec3 ea, vec3 eb) {
 // `prev` and `first` carry the previous entry's edge and the chain's first between calls.
 KFN void add_ring_term(INOUT(vec3) sum, INOUT(vec3) prev, INOUT(vec3) first, vec3 u, VARYING(uint) ring) {
   first = select((ring & VKCLOTH_RING_START) != 0u, u, first);
-  vec3 t = sum;
-  add_fan_triangle(t, prev, u);
-  sum = select((ring & VKCLOTH_RING_PREV) != 0u, t, sum);
-  t = sum;
-  add_fan_triangle(t, u, first);
-  sum = select((ring & VKCLOTH_RING_CLOSE) != 0u, t, sum);
+  VARYING(bool) with_prev = (ring & VKCLOTH_RING_PREV) != 0u;
+  if (maybe_any_particle(with_prev)) {
+    vec3 t = sum;
+    add_fan_triangle(t, prev, u);
+    sum = select(with_prev, t, sum);
+  }
+  VARYING(bool) close = (ring & VKCLOTH_RING_CLOSE) != 0u;
+  if (maybe_any_particle(close)) {
+    vec3 t = sum;
+    add_fan_triangle(t, u, first);
+    sum = select(close, t, sum);
+  }
   prev = u;
 }
 
@@ -39,8 +45,11 @@ KFN precise vec3 unit_or_zero(vec3 sum) {
 // f += K (|u| - L0) u / |u|. A zero-length spring has no direction and adds nothing.
 KFN void add_spring_edge(INOUT(vec3) f, vec3 u, real rest, real k) {
   precise real len = sqrt(dot3(u, u));
+  VARYING(bool) has_length = len > real(0);
+  if (!maybe_any_particle(has_length))
+    return;
   precise vec3 t = f + u * (k * (len - rest) / len);
-  f = select(len > real(0), t, f);
+  f = select(has_length, t, f);
 }
 
 KFN void add_spring(INOUT(vec3) f, vec3 x, vec3 xq, real rest, real k) {

@@ -8,8 +8,11 @@
 // (Figure 12's variant) the outward part as well.
 KFN void remove_inward(INOUT(vec3) w, vec3 n, bool both) {
   precise real wn = dot3(w, n);
+  VARYING(bool) remove = wn < real(0) || (both && wn != real(0));
+  if (!maybe_any_particle(remove))
+    return;
   precise vec3 t = w - n * wn;
-  w = select(wn < real(0) || (both && wn != real(0)), t, w);
+  w = select(remove, t, w);
 }
 
 // Contact filter of one collider: within the band (distance < 2 eps) velocity and force lose

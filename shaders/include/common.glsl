@@ -89,11 +89,13 @@ bool frozen() { return flags[inst].first_bad_step < pc.step; }
 // by engine/src/core/kernel.hpp): its language prelude for GLSL.
 #define real float
 #define KFN
+#define KFN_NOINLINE
 #define OUT(T) out T
 #define INOUT(T) inout T
 #define VARYING(T) T
 #define select(c, a, b) ((c) ? (a) : (b))
 #define any_particle(c) (c)
+#define maybe_any_particle(c) (c)
 // No component is NaN or inf, from the bits: a compiler that assumes finite floats cannot fold it.
 bool all_finite(vec3 v) {
   const uvec3 bits = floatBitsToUint(v) & 0x7f800000u; // exponent all ones: inf or NaN

@@ -200,7 +200,9 @@ template <typename Real> void CpuSolver<Real>::Impl::prepare_colliders() {
     meshes.push_back(m);
     any_mesh = any_mesh || c.type == Collider::Type::mesh;
   }
-  for (std::size_t k = 0; !any_mesh && k < shapes.size(); ++k) {
+  // The SIMD finish (row_kernel.hpp FinishShape): no mesh, at most finish_max_shapes colliders.
+  const bool simd = !any_mesh && shapes.size() <= detail::finish_max_shapes;
+  for (std::size_t k = 0; simd && k < shapes.size(); ++k) {
     const kernel::ColliderShape<Real>& s = shapes[k];
     auto put = [](Real* out, glm::vec<3, Real> v) {
       out[0] = v.x;

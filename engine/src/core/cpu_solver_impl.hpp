@@ -22,7 +22,8 @@ template <typename Real> struct ImplicitWorkspace;
 template <typename Real> struct SelfCollisionGrid;
 template <typename Real> struct StrainProjection;
 /// The colliders as the kernel takes them at this substep's pose, and their meshes; the same values
-/// for the SIMD finish of the grid rows (row_kernel.hpp FinishShape), empty when a collider is a mesh.
+/// for the SIMD finish of the grid rows (row_kernel.hpp FinishShape), empty when a collider is a mesh
+/// or there are more than detail::finish_max_shapes.
 template <typename Real> struct ContactShapes {
   std::vector<kernel::ColliderShape<Real>> shapes;
   std::vector<kernel::MeshData> meshes;

@@ -63,9 +63,13 @@ template <typename Real> struct ListArgs : StepArgs<Real> {
   const std::uint8_t* reads_last;
 };
 
+/// The most colliders the SIMD finish takes (it converts them once per call into an array of this size).
+inline constexpr std::uint32_t finish_max_shapes = 16;
+
 /// A collider as the SIMD finish takes it: kernel::ColliderShape<Real>'s values, copied as they are
 /// (cpu_solver.cpp), for the plane, sphere, capsule and box (VKCLOTH_COLLIDER_* 0..3; a mesh
-/// collider keeps the per-particle reference).
+/// collider keeps the per-particle reference), at most finish_max_shapes of them (more: the
+/// per-particle reference too).
 template <typename Real> struct FinishShape {
   std::uint32_t type;
   bool moving;

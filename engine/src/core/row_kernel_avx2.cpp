@@ -48,6 +48,7 @@ struct IsaF : IsaGeneric<float, vf8, vi8, 8> {
   using M = vi8;
   static constexpr int W = 8;
   static V sqrt(V x) { return (V)_mm256_sqrt_ps((__m256)x); }
+  static bool any(M m) { return !_mm256_testz_si256((__m256i)m, (__m256i)m); }
   static __m256i iv(const int* p) { return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)); }
   static __m256 mk(const int* p) { return _mm256_castsi256_ps(iv(p)); }
   static void load3(const float* p, V& x, V& y, V& z) {
@@ -98,6 +99,7 @@ struct IsaD : IsaGeneric<double, vd4, vl4, 4> {
   using M = vl4;
   static constexpr int W = 4;
   static V sqrt(V x) { return (V)_mm256_sqrt_pd((__m256d)x); }
+  static bool any(M m) { return !_mm256_testz_si256((__m256i)m, (__m256i)m); }
 };
 
 } // namespace

@@ -49,6 +49,7 @@ struct IsaF : IsaGeneric<float, vf16, vi16, 16> {
   static constexpr int W = 16;
   // Masked form (all lanes): the plain one reads _mm512_undefined, a GCC 12 -Wmaybe-uninitialized.
   static V sqrt(V x) { return (V)_mm512_mask_sqrt_ps((__m512)x, __mmask16(0xFFFF), (__m512)x); }
+  static bool any(M m) { return _mm512_test_epi32_mask((__m512i)m, (__m512i)m) != 0; }
   static __m512i idx(const int* p) { return _mm512_loadu_si512(p); }
   static void load3(const float* p, V& x, V& y, V& z) {
     const __m512 a = _mm512_loadu_ps(p), b = _mm512_loadu_ps(p + 16), c = _mm512_loadu_ps(p + 32);
@@ -100,6 +101,7 @@ struct IsaD : IsaGeneric<double, vd8, vl8, 8> {
   using M = vl8;
   static constexpr int W = 8;
   static V sqrt(V x) { return (V)_mm512_mask_sqrt_pd((__m512d)x, __mmask8(0xFF), (__m512d)x); }
+  static bool any(M m) { return _mm512_test_epi64_mask((__m512i)m, (__m512i)m) != 0; }
   static __m512i idx(const long long* p) { return _mm512_loadu_si512(p); }
   static void load3(const double* p, V& x, V& y, V& z) {
     const __m512d a = _mm512_loadu_pd(p), b = _mm512_loadu_pd(p + 8), c = _mm512_loadu_pd(p + 16);

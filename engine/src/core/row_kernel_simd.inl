@@ -389,36 +389,59 @@ VKCLOTH_AI typename ShapeOf<T>::type lane_shape(const vkcloth::detail::FinishSha
 template <typename T>
 std::int64_t simd_finish(const vkcloth::detail::FinishArgs<typename T::Real>& a, std::int64_t q0,
                          std::int64_t q1) {
+  using Real = typename T::Real;
   using L = Lanes<T>;
   using L3 = Lanes3<T>;
   constexpr int W = T::W;
+  // Copies of the arguments: stores through the outputs cannot change these.
+  const Real* __restrict px = a.px;
+  const Real* __restrict py = a.py;
+  const Real* __restrict pz = a.pz;
+  const Real* __restrict mass = a.mass;
+  const std::uint8_t* __restrict pinned = a.pinned;
+  Real* __restrict vel = a.vel;
+  Real* __restrict force = a.force;
+  Real* __restrict pos_next = a.pos_next;
+  Real* __restrict sxn = a.sx_next;
+  Real* __restrict syn = a.sy_next;
+  Real* __restrict szn = a.sz_next;
+  const std::uint32_t shape_count = a.shape_count;
+  const bool both = a.both, semi = a.semi;
   const L dt(a.dt), band(a.band), eps(a.eps);
+  // The colliders as the kernel takes them, converted once: the kernel's by-value shapes then read
+  // this array where they are used (converted per vector, each call spilled the shape's fields).
+  using S = typename ShapeOf<T>::type;
+  S shapes[vkcloth::detail::finish_max_shapes];
+  if (shape_count > vkcloth::detail::finish_max_shapes)
+    return q0; // the caller finishes them all
+  for (std::uint32_t k = 0; k < shape_count; ++k)
+    shapes[k] = lane_shape<T>(a.shapes[k]);
   std::int64_t q = q0;
   for (; q + W <= q1; q += W) {
-    const L3 x0(load<T>(a.px + q), load<T>(a.py + q), load<T>(a.pz + q));
-    const L3 f0 = load3<T>(a.force + 3 * q), v0 = load3<T>(a.vel + 3 * q);
-    const L m = load<T>(a.mass + q);
+    const L3 x0(load<T>(px + q), load<T>(py + q), load<T>(pz + q));
+    const L3 f0 = load3<T>(force + 3 * q), v0 = load3<T>(vel + 3 * q);
+    const L m = load<T>(mass + q);
     const L h_over_m = dt / m;
     L3 v = v0, f = f0;
-    for (std::uint32_t k = 0; k < a.shape_count; ++k) { // contact_at
-      const auto s = lane_shape<T>(a.shapes[k]);
+    for (std::uint32_t k = 0; k < shape_count; ++k) { // contact_at
+      const S& s = shapes[k];
       L distance;
       L3 n;
       collider_contact(NoMesh{}, s, x0, x0, band, distance, n);
-      contact_response(v, f, s, x0, n, distance, band, a.both, h_over_m);
+      contact_response(v, f, s, x0, n, distance, band, both, h_over_m);
     }
     L3 x = x0;
-    euler_update(a.semi, x, v, f, m, dt);
-    for (std::uint32_t k = 0; k < a.shape_count; ++k) // project_at
-      project_out(NoMesh{}, lane_shape<T>(a.shapes[k]), eps, x0, x, v);
-    const Mask<T> pin(T::pinmask(a.pinned + q));
-    store3<T>(a.force + 3 * q, select(pin, f0, f));
+    euler_update(semi, x, v, f, m, dt);
+    for (std::uint32_t k = 0; k < shape_count; ++k) // project_at
+      project_out(NoMesh{}, shapes[k], eps, x0, x, v);
+    const Mask<T> pin(T::pinmask(pinned + q));
+    store3<T>(force + 3 * q, select(pin, f0, f));
     x = select(pin, x0, x);
-    store3<T>(a.pos_next + 3 * q, x);
-    store3<T>(a.vel + 3 * q, select(pin, v0, v));
-    __builtin_memcpy(a.sx_next + q, &x.x.v, sizeof x.x.v);
-    __builtin_memcpy(a.sy_next + q, &x.y.v, sizeof x.y.v);
-    __builtin_memcpy(a.sz_next + q, &x.z.v, sizeof x.z.v);
+    store3<T>(pos_next + 3 * q, x);
+    store3<T>(vel + 3 * q, select(pin, v0, v));
+    __builtin_memcpy(sxn + q, &x.x.v, sizeof x.x.v);
+    __builtin_memcpy(syn + q, &x.y.v, sizeof x.y.v);
+    __builtin_memcpy(szn + q, &x.z.v, sizeof x.z.v);
   }
   return q;
 }

@@ -2,7 +2,7 @@
 // SIMD lane types for the shared kernel (engine/kernel/*.h) on the CPU: W particles per value, as
 // Jolt's Vec3 / Vec4 wrap a register, over GCC vector extensions. Included first by
 // row_kernel_avx2.cpp / row_kernel_avx512.cpp, whose ISA traits T (Real, V = W lanes of Real, M = W
-// lanes of same-width ints, W, sqrt, AoS load3 / store3, gather3, pinmask, loadmask) parameterise
+// lanes of same-width ints, W, sqrt, any, AoS load3 / store3, gather3, pinmask, loadmask) parameterise
 // these templates; row_kernel_simd.inl then compiles the kernel with real = Lanes<T>, vec3 = Lanes3<T>.
 // Everything here has internal linkage, so the two ISA translation units never share (ODR-merge) a
 // function compiled for the other's ISA: include nothing with inline functions here.
@@ -66,12 +66,9 @@ template <typename T> struct Mask {
   friend Mask operator&(Mask a, Mask b) { return Mask(a.m & b.m); }
   friend Mask operator|(Mask a, Mask b) { return Mask(a.m | b.m); }
   friend Mask select(Mask c, Mask a, Mask b) { return Mask(c.m ? a.m : b.m); }
-  friend bool any_particle(Mask a) { // some lane is set
-    bool r = false;
-    for (int l = 0; l < T::W; ++l)
-      r = r || a.m[l] != 0;
-    return r;
-  }
+  friend bool any_particle(Mask a) { return T::any(a.m); } // some lane is set
+  // Where a lane almost always needs the work (a spring's len > 0): no test, no branch.
+  friend bool maybe_any_particle(Mask) { return true; }
 };
 
 /// W lanes of a uint (VARYING(uint): a gather-list entry's ring bits), in the width of Real.
@@ -168,6 +165,14 @@ template <typename Real, typename V, typename M, int W> struct IsaGeneric {
     for (int l = 0; l < W; ++l)
       m[l] = p[l];
     return m;
+  }
+  // Some lane of m is nonzero.
+  static bool any(M m) {
+    std::uint64_t w[sizeof(M) / 8], acc = 0;
+    __builtin_memcpy(w, &m, sizeof m);
+    for (std::size_t k = 0; k < sizeof(M) / 8; ++k)
+      acc |= w[k];
+    return acc != 0;
   }
 };
 
