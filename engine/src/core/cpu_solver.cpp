@@ -543,8 +543,8 @@ template <typename Real> auto CpuSolver<Real>::energy() const -> Energy {
   return impl_->energy();
 }
 
-template struct CpuSolver<float>::Impl;
-template struct CpuSolver<double>::Impl;
+// Instantiating the class instantiates its nested Impl too (a second explicit instantiation of
+// Impl is an error under clang).
 template class CpuSolver<float>;
 template class CpuSolver<double>;
 
