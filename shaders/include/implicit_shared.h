@@ -82,6 +82,20 @@ static_assert(VKCLOTH_BINDING_IMPL_VF == VKCLOTH_BINDING_COUNT); // right after 
 static_assert(sizeof(CgState) == 48);
 static_assert(sizeof(ImplicitPush) == sizeof(PushConstants));
 static_assert(sizeof(CgArgs) == 16);
+/// The implicit layout's storage bindings, in descriptor-write order: its one binding table
+/// (engine/src/vulkan/passes/implicit_update.cpp).
+inline constexpr uint implicit_bindings[] = {VKCLOTH_BINDING_POS_IN,     VKCLOTH_BINDING_FORCE_OUT,
+                                             VKCLOTH_BINDING_NORMAL,     VKCLOTH_BINDING_POS_OUT,
+                                             VKCLOTH_BINDING_VEL,        VKCLOTH_BINDING_PARTICLE,
+                                             VKCLOTH_BINDING_OFFSETS,    VKCLOTH_BINDING_EDGES,
+                                             VKCLOTH_BINDING_COLLIDERS,  VKCLOTH_BINDING_FLAGS,
+                                             VKCLOTH_BINDING_INSTANCES,  VKCLOTH_BINDING_IMPL_VF,
+                                             VKCLOTH_BINDING_IMPL_KS,    VKCLOTH_BINDING_IMPL_BLOCK_INV,
+                                             VKCLOTH_BINDING_IMPL_X,     VKCLOTH_BINDING_IMPL_R,
+                                             VKCLOTH_BINDING_IMPL_Z,     VKCLOTH_BINDING_IMPL_D,
+                                             VKCLOTH_BINDING_IMPL_Q,     VKCLOTH_BINDING_IMPL_PARTIALS,
+                                             VKCLOTH_BINDING_IMPL_STATE, VKCLOTH_BINDING_IMPL_ARGS,
+                                             VKCLOTH_BINDING_MESH_NODES, VKCLOTH_BINDING_MESH_TRIS};
 } // namespace vkcloth::gpu::shared
 #endif
 

@@ -71,6 +71,18 @@ struct SelfPush {
 static_assert(sizeof(SelfPush) == sizeof(PushConstants));
 static_assert(VKCLOTH_BINDING_SELF_PARAMS == VKCLOTH_BINDING_IMPL_ARGS + 1);
 static_assert(sizeof(SelfParams) == 16);
+/// Self-collision's storage bindings (set 0) and its texel build's views (set 1), in
+/// descriptor-write order: its one binding table (engine/src/vulkan/passes/self_collision.cpp).
+inline constexpr uint self_collision_bindings[] = {
+    VKCLOTH_BINDING_POS_OUT,     VKCLOTH_BINDING_VEL,         VKCLOTH_BINDING_PARTICLE,
+    VKCLOTH_BINDING_FLAGS,       VKCLOTH_BINDING_INSTANCES,   VKCLOTH_BINDING_SELF_PARAMS,
+    VKCLOTH_BINDING_SELF_REST,   VKCLOTH_BINDING_SELF_COUNTS, VKCLOTH_BINDING_SELF_STARTS,
+    VKCLOTH_BINDING_SELF_BLOCKS, VKCLOTH_BINDING_SELF_KEYS,   VKCLOTH_BINDING_SELF_SORTED,
+    VKCLOTH_BINDING_SELF_DELTA};
+inline constexpr uint self_collision_texel_bindings[] = {VKCLOTH_SELF_TEXEL_POS, VKCLOTH_SELF_TEXEL_VEL,
+                                                         VKCLOTH_SELF_TEXEL_REST, VKCLOTH_SELF_TEXEL_STARTS,
+                                                         VKCLOTH_SELF_TEXEL_SORTED};
+static_assert(sizeof(self_collision_texel_bindings) / sizeof(uint) == VKCLOTH_SELF_TEXEL_COUNT);
 } // namespace vkcloth::gpu::shared
 #endif
 

@@ -67,6 +67,13 @@ static_assert(sizeof(ProjectionPush) == sizeof(PushConstants));
 static_assert(VKCLOTH_BINDING_PROJ_INCIDENCE == VKCLOTH_BINDING_SELF_DELTA + 1);
 static_assert(sizeof(ProjState) == 48);
 static_assert(sizeof(ProjArgsHead) == 16);
+/// The projection's storage bindings, in descriptor-write order: its one binding table
+/// (engine/src/vulkan/passes/stretch.cpp).
+inline constexpr uint strain_project_bindings[] = {
+    VKCLOTH_BINDING_POS_OUT,        VKCLOTH_BINDING_VEL,        VKCLOTH_BINDING_PARTICLE,
+    VKCLOTH_BINDING_FLAGS,          VKCLOTH_BINDING_INSTANCES,  VKCLOTH_BINDING_STRAIN_LINKS,
+    VKCLOTH_BINDING_PROJ_INCIDENCE, VKCLOTH_BINDING_PROJ_LINKS, VKCLOTH_BINDING_PROJ_GATHER,
+    VKCLOTH_BINDING_PROJ_STATE,     VKCLOTH_BINDING_PROJ_ARGS};
 } // namespace vkcloth::gpu::shared
 #endif
 

@@ -218,6 +218,17 @@ struct Flags {
 static_assert(sizeof(PushConstants) == 32);
 static_assert(sizeof(StrainLinksPush) == 32);
 
+/// The state layout (every pass that reads the batch's state through its sets: force, integrate,
+/// fused, strain_links, strain_finish, vertices): set 0 holds every VKCLOTH_BINDING_* (0 ..
+/// VKCLOTH_BINDING_COUNT - 1), set 1 these views. Its one binding table:
+/// engine/src/vulkan/passes/state_set.hpp.
+inline constexpr uint state_texel_bindings[] = {
+    VKCLOTH_TEXEL_BINDING_POS_IN,    VKCLOTH_TEXEL_BINDING_PARTICLE,     VKCLOTH_TEXEL_BINDING_VEL,
+    VKCLOTH_TEXEL_BINDING_FLAGS,     VKCLOTH_TEXEL_BINDING_INSTANCES,    VKCLOTH_TEXEL_BINDING_RANGES,
+    VKCLOTH_TEXEL_BINDING_EDGES,     VKCLOTH_TEXEL_BINDING_STRAIN_LINKS, VKCLOTH_TEXEL_BINDING_TETHERS,
+    VKCLOTH_TEXEL_BINDING_COLLIDERS, VKCLOTH_TEXEL_BINDING_MESH_NODES,   VKCLOTH_TEXEL_BINDING_MESH_TRIS};
+static_assert(sizeof(state_texel_bindings) / sizeof(uint) == VKCLOTH_TEXEL_BINDING_COUNT);
+
 /// A pass's push constants (one of the structs above) with `pc`'s five common fields.
 template <typename Push> Push push_from(const PushConstants& pc) {
   Push p{};

@@ -15,6 +15,7 @@
 #include "barriers.hpp"
 #include "pipelines.hpp"
 #include "implicit_shared.h"
+#include "vkcloth/shaders/implicit_comp_spv.hpp"
 
 namespace vkcloth::gpu {
 
@@ -75,25 +76,34 @@ Result<void> ImplicitGpu::create_buffers(std::uint64_t entries, bool allow_map) 
   return {};
 }
 
+namespace {
+
+/// implicit.comp's one binding table (implicit_shared.h) and its one build (its reductions' shared
+/// arrays are sized with VKCLOTH_WORKGROUP_SIZE).
+constexpr BindingTable kImplicitBindings{"implicit", sh::implicit_bindings};
+constexpr ShaderSource kImplicit{"implicit.comp", spirv::implicit_comp_spv, {}, &kImplicitBindings, true};
+
+} // namespace
+
 // The Context's layouts and pipelines (one per pass this batch records: implicit.comp
 // specialised with its mode, ShaderVariant::stage); this batch's pool and two sets (position parity).
 Result<void> ImplicitGpu::create_pipelines() {
   Context::Impl& ctx = *ctx_;
-  auto layouts = ctx.pipelines->implicit_layouts();
+  auto layouts = ctx.pipelines->layouts(kImplicitBindings);
   if (!layouts)
     return layouts.error();
-  set_layout_ = layouts->set;
+  set_layout_ = layouts->storage;
   layout_ = layouts->layout;
-  VKCLOTH_TRY(create_parity_sets(ctx, set_layout_, static_cast<std::uint32_t>(implicit_bindings().size()),
-                                 pool_, sets_, "implicit"));
+  VKCLOTH_TRY(create_parity_sets(ctx, set_layout_,
+                                 static_cast<std::uint32_t>(std::size(sh::implicit_bindings)), pool_, sets_,
+                                 "implicit"));
   // FORCE and FINISH come per collider types (ensure_collider_passes).
   const std::uint32_t one_workgroup[] = {VKCLOTH_IMPL_SYSTEM, VKCLOTH_IMPL_SOLVE};
   const std::uint32_t per_iteration[] = {VKCLOTH_IMPL_SYSTEM, VKCLOTH_IMPL_MATVEC, VKCLOTH_IMPL_UPDATE,
                                          VKCLOTH_IMPL_DIRECTION};
   for (std::uint32_t mode : budget_ > 0 ? std::span<const std::uint32_t>(one_workgroup)
                                         : std::span<const std::uint32_t>(per_iteration)) {
-    auto pp =
-        ctx.pipelines->pipeline(PipelineRegistry::Shader::implicit, {}, {BufferAccess::texel_views, 0, mode});
+    auto pp = ctx.pipelines->pipeline(kImplicit, {}, {BufferAccess::texel_views, 0, mode});
     if (!pp)
       return pp.error();
     passes_[mode] = *pp;
@@ -107,8 +117,7 @@ Result<void> ImplicitGpu::ensure_collider_passes(std::uint32_t types,
     return {};
   for (auto [mode, pass] : {std::pair{VKCLOTH_IMPL_FORCE, &force_passes_[types]},
                             std::pair{VKCLOTH_IMPL_FINISH, &finish_passes_[types]}}) {
-    auto pp = ctx_->pipelines->pipeline(PipelineRegistry::Shader::implicit, constants,
-                                        {BufferAccess::texel_views, 0, mode});
+    auto pp = ctx_->pipelines->pipeline(kImplicit, constants, {BufferAccess::texel_views, 0, mode});
     if (!pp)
       return pp.error();
     *pass = *pp;
@@ -119,7 +128,7 @@ Result<void> ImplicitGpu::ensure_collider_passes(std::uint32_t types,
 // Long (~60 lines) but flat: one switch that maps each binding of the implicit layout
 // (implicit_shared.h) to its buffer, a table to scan rather than logic to follow.
 Result<void> ImplicitGpu::write_sets(const ImplicitInputs& in) {
-  write_parity_sets(*ctx_, sets_, implicit_bindings(),
+  write_parity_sets(*ctx_, sets_, sh::implicit_bindings,
                     [&](std::uint32_t read, std::uint32_t binding) -> VkBuffer {
                       switch (binding) {
                       case VKCLOTH_BINDING_POS_IN:

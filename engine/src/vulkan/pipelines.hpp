@@ -2,8 +2,10 @@
 // The compute pipelines of one Context, made once and shared by every batch (GpuSolver,
 // ClothWorld) on it: shader modules, descriptor set layouts, pipeline layouts, a VkPipelineCache,
 // and the pipelines keyed by (shader, specialisation constants), e.g. force.comp per grid stencil
-// x SC_NORMAL_FLAGS, fused.comp per stencil x SC_WRITE_AUX x SC_COLLIDER_TYPES x SC_NORMAL_FLAGS. Lookups
-// happen when a batch is created or its parameters change, never per dispatch: batches keep the raw handles,
+// x SC_NORMAL_FLAGS, fused.comp per stencil x SC_WRITE_AUX x SC_COLLIDER_TYPES x SC_NORMAL_FLAGS.
+// The registry knows no shader: each pass declares its shaders (ShaderSource) and the one binding
+// table of their layout (BindingTable), and the registry makes what they name. Lookups happen when
+// a batch is created or its parameters change, never per dispatch: passes keep the raw handles,
 // which live as long as the Context's internals (each batch holds them). Internal to
 // engine/src/vulkan.
 #pragma once
@@ -20,13 +22,6 @@
 #include <vector>
 
 namespace vkcloth::gpu {
-
-/// The storage bindings of implicit.comp, in descriptor-write order.
-std::span<const std::uint32_t> implicit_bindings();
-/// The storage bindings of self_collision.comp, in descriptor-write order.
-std::span<const std::uint32_t> self_collision_bindings();
-/// The storage bindings of strain_project.comp, in descriptor-write order.
-std::span<const std::uint32_t> strain_project_bindings();
 
 /// choose_layout() for `ctx`'s device (layout.cpp).
 DeviceLayout device_layout(const Context::Impl& ctx);
@@ -47,33 +42,32 @@ struct ShaderVariant {
   auto operator<=>(const ShaderVariant&) const = default;
 };
 
+/// A descriptor layout as the pass that owns it declares it, once: set 0's storage buffers and,
+/// for shaders with a texel build, set 1's uniform texel buffer views (binding numbers from the
+/// pass's shared header). The registry makes one layout per table (keyed by its address: declare
+/// tables `inline constexpr` or at namespace scope, never on the stack).
+struct BindingTable {
+  const char* name;
+  std::span<const std::uint32_t> storage;
+  std::span<const std::uint32_t> texel = {}; // empty: no set 1
+};
+
+/// A compute shader as its pass declares it: its SPIR-V builds (shaders/CMakeLists.txt) and the
+/// binding table of its layout. Keyed by address, as BindingTable.
+struct ShaderSource {
+  const char* name;                       // the source, for messages
+  std::span<const std::uint32_t> texel;   // the *_texel build, or the shader's one build
+  std::span<const std::uint32_t> storage; // the *_storage build; empty: one build only
+  const BindingTable* bindings;           // its layout
+  bool fixed_workgroup = false; // sizes shared arrays with VKCLOTH_WORKGROUP_SIZE: never specialised
+};
+
 class PipelineRegistry {
 public:
-  enum class Shader {
-    force,
-    integrate,
-    fused,
-    implicit,
-    strain_links,
-    strain_finish,
-    vertices,
-    self_collision,
-    strain_project
-  };
-
-  /// Set 0 (storage buffers) and set 1 (texel views) of force/integrate/fused.comp and their
-  /// layout (strain_links/strain_finish/vertices.comp use it too, set 0 only).
-  struct SolverLayouts {
+  /// A binding table's set layouts (set 1: VK_NULL_HANDLE without texel bindings) and pipeline layout.
+  struct Layouts {
     VkDescriptorSetLayout storage = VK_NULL_HANDLE, texel = VK_NULL_HANDLE;
     VkPipelineLayout layout = VK_NULL_HANDLE;
-  };
-  /// The layouts of a pass with its own storage set (implicit.comp, self_collision.comp,
-  /// strain_project.comp): that set and the pipeline layout; self_collision.comp's texel build also
-  /// reads set 1, `texel` (the others: none).
-  struct PassLayouts {
-    VkDescriptorSetLayout set = VK_NULL_HANDLE;
-    VkPipelineLayout layout = VK_NULL_HANDLE;
-    VkDescriptorSetLayout texel = VK_NULL_HANDLE;
   };
 
   /// Makes nothing yet (the Context's allocation callbacks may still be unset): every object is
@@ -82,17 +76,15 @@ public:
   PipelineRegistry(const PipelineRegistry&) = delete;
   PipelineRegistry& operator=(const PipelineRegistry&) = delete;
 
-  Result<SolverLayouts> solver_layouts();
-  Result<PassLayouts> implicit_layouts();
-  Result<PassLayouts> self_collision_layouts();
-  Result<PassLayouts> strain_project_layouts();
+  /// The layouts of `table`, made on first request.
+  Result<Layouts> layouts(const BindingTable& table);
   using Variant = ShaderVariant;
   /// The pipeline of `shader` specialised with `constants` (ids 0..size-1, 32 bits each; empty:
   /// none), when `variant.workgroup_size` is set constant kWorkgroupSizeConstant, and when
-  /// `variant.stage` is set constant VKCLOTH_STAGE_CONSTANT; created on
-  /// first request; its layout is solver_layouts(), implicit_layouts(), self_collision_layouts() or
-  /// strain_project_layouts().
-  Result<VkPipeline> pipeline(Shader shader, std::span<const std::uint32_t> constants, Variant variant = {});
+  /// `variant.stage` is set constant VKCLOTH_STAGE_CONSTANT; created on first request, with the
+  /// layout of its binding table.
+  Result<VkPipeline> pipeline(const ShaderSource& shader, std::span<const std::uint32_t> constants,
+                              Variant variant = {});
   /// The Context's pipeline cache (VK_NULL_HANDLE when it could not be made: caching is optional).
   VkPipelineCache cache();
   /// Compute pipelines made so far (testing::pipeline_count).
@@ -102,22 +94,21 @@ public:
   }
 
 private:
-  Result<SolverLayouts> solver_layouts_locked();
-  /// The layouts of a shader with one set of storage buffers (implicit.comp, self_collision.comp).
-  Result<PassLayouts> single_set_layouts_locked(std::span<const std::uint32_t> bindings, const char* name,
-                                                DescriptorSetLayout& set, PipelineLayout& layout);
-  Result<PassLayouts> self_collision_layouts_locked();
+  struct LayoutObjects {
+    DescriptorSetLayout storage, texel;
+    PipelineLayout layout;
+  };
+  Result<Layouts> layouts_locked(const BindingTable& table);
   VkPipelineCache cache_locked();
-  Result<VkShaderModule> module_locked(Shader shader, BufferAccess access);
+  Result<VkShaderModule> module_locked(const ShaderSource& shader, BufferAccess access);
 
   Context::Impl& ctx_;
   std::mutex mutex_; // several solvers may be created on one Context from different threads
   PipelineCache cache_;
   bool cache_tried_ = false;
-  DescriptorSetLayout solver_storage_, solver_texel_, implicit_set_, self_set_, self_texel_set_, project_set_;
-  PipelineLayout solver_layout_, implicit_layout_, self_layout_, project_layout_;
-  std::map<std::pair<Shader, BufferAccess>, ShaderModule> modules_;
-  std::map<std::tuple<Shader, Variant, std::vector<std::uint32_t>>, Pipeline> pipelines_;
+  std::map<const BindingTable*, LayoutObjects> layouts_;
+  std::map<std::pair<const ShaderSource*, BufferAccess>, ShaderModule> modules_;
+  std::map<std::tuple<const ShaderSource*, Variant, std::vector<std::uint32_t>>, Pipeline> pipelines_;
 };
 
 /// The solver's buffers a one-set pass (self_collision.comp, strain_project.comp) shares with the
@@ -136,9 +127,9 @@ struct OneSetPass {
   VkPipelineLayout layout = VK_NULL_HANDLE;
   VkDescriptorSetLayout texel_set = VK_NULL_HANDLE;
 };
-/// `shader`'s (self_collision or strain_project) layouts from `ctx`'s registry, and `pool` with
-/// the two parity sets of its layout (create_parity_sets), named `name`.
-Result<OneSetPass> create_one_set_pass(Context::Impl& ctx, PipelineRegistry::Shader shader,
-                                       DescriptorPool& pool, VkDescriptorSet (&sets)[2], const char* name);
+/// `table`'s layouts from `ctx`'s registry, and `pool` with the two parity sets of its storage set
+/// (create_parity_sets), named after the table.
+Result<OneSetPass> create_one_set_pass(Context::Impl& ctx, const BindingTable& table, DescriptorPool& pool,
+                                       VkDescriptorSet (&sets)[2]);
 
 } // namespace vkcloth::gpu

@@ -9,6 +9,8 @@
 #include "../core/kernel.hpp"
 #include "barriers.hpp"
 #include "pipelines.hpp"
+#include "vkcloth/shaders/self_collision_storage_comp_spv.hpp"
+#include "vkcloth/shaders/self_collision_texel_comp_spv.hpp"
 
 namespace vkcloth::gpu {
 
@@ -64,16 +66,26 @@ Result<void> SelfCollisionGpu::create_buffers(bool allow_map) {
   return {};
 }
 
+namespace {
+
+/// self_collision.comp's one binding table (self_collision_shared.h) and its two builds (its
+/// scan's shared arrays are sized with VKCLOTH_WORKGROUP_SIZE).
+constexpr BindingTable kSelfCollisionBindings{"self-collision", sh::self_collision_bindings,
+                                              sh::self_collision_texel_bindings};
+constexpr ShaderSource kSelfCollision{"self_collision.comp", spirv::self_collision_texel_comp_spv,
+                                      spirv::self_collision_storage_comp_spv, &kSelfCollisionBindings, true};
+
+} // namespace
+
 // The Context's layout and pipelines (one per pass: ShaderVariant::stage); this batch's pool and two
 // sets (position parity), and for the texel build a pool and two sets of views.
 Result<void> SelfCollisionGpu::create_sets() {
-  auto pass =
-      create_one_set_pass(*ctx_, PipelineRegistry::Shader::self_collision, pool_, sets_, "self-collision");
+  auto pass = create_one_set_pass(*ctx_, kSelfCollisionBindings, pool_, sets_);
   if (!pass)
     return pass.error();
   layout_ = pass->layout;
   for (std::uint32_t stage = 0; stage < kPasses; ++stage) {
-    auto p = ctx_->pipelines->pipeline(PipelineRegistry::Shader::self_collision, {}, {access_, 0, stage});
+    auto p = ctx_->pipelines->pipeline(kSelfCollision, {}, {access_, 0, stage});
     if (!p)
       return p.error();
     passes_[stage] = *p;
@@ -115,7 +127,7 @@ Result<void> SelfCollisionGpu::write_texel_sets(const OneSetInputs& in) {
 }
 
 Result<void> SelfCollisionGpu::write_sets(const OneSetInputs& in) {
-  write_parity_sets(*ctx_, sets_, self_collision_bindings(),
+  write_parity_sets(*ctx_, sets_, sh::self_collision_bindings,
                     [&](std::uint32_t read, std::uint32_t binding) -> VkBuffer {
                       switch (binding) {
                       case VKCLOTH_BINDING_SELF_PARAMS:

@@ -17,7 +17,7 @@
 #include "../core/kernel.hpp"
 #include "barriers.hpp"
 #include "batch_limits.hpp"
-#include "implicit_gpu.hpp"
+#include "passes/implicit_update.hpp"
 #include "vkcloth/gpu/world.hpp"
 #include "vkcloth_shared.h"
 
@@ -209,10 +209,8 @@ void SolverBatch::write_params_now() {
   const auto col = packed_colliders();
   if (!col.empty())
     std::memcpy(colliders.mapped, col.data(), col.size() * sizeof(sh::Collider));
-  if (self_collision) {
-    const auto sp = packed_self_params();
-    std::memcpy(self_collision->params().mapped, sp.data(), sp.size() * sizeof(sh::SelfParams));
-  }
+  for (const auto& pass : passes)
+    pass->write_params(*this, VK_NULL_HANDLE);
   params_dirty = false;
 }
 
@@ -328,11 +326,7 @@ Result<void> SolverBatch::set_params(std::uint32_t slot, SimParams params) {
   auto done = [&]() -> Result<void> {
     VKCLOTH_TRY(ensure_collider_capacity());
     VKCLOTH_TRY(ensure_mesh_buffers());
-    VKCLOTH_TRY(ensure_implicit());
-    VKCLOTH_TRY(ensure_fused());
-    VKCLOTH_TRY(ensure_collider_pipelines());
-    VKCLOTH_TRY(ensure_self_collision());
-    VKCLOTH_TRY(ensure_projection());
+    VKCLOTH_TRY(prepare_passes());
     return ensure_tethers();
   }();
   if (!done) // e.g. no room for the tethers: the instance keeps stepping with its old parameters
@@ -373,87 +367,62 @@ Result<void> SolverBatch::ensure_tethers() {
   return write_sets();
 }
 
-Result<void> SolverBatch::ensure_implicit() {
-  if (family().integrator != Integrator::implicit_euler || implicit)
-    return {};
-  using D = GpuSolverOptions::CgDispatch;
-  std::uint32_t max_degree = 0;
-  const auto gather = batch_topology->edge_offsets();
-  for (std::size_t p = 0; p + 1 < gather.size(); ++p)
-    max_degree = std::max(max_degree, gather[p + 1] - gather[p]);
-  const std::uint32_t budget = ImplicitGpu::iteration_budget(count, max_degree);
-  if (options.cg_dispatch == D::one_workgroup && budget == 0)
-    return make_error(
-        ErrorCode::unsupported,
-        fmt::format("GpuSolverOptions::cg_dispatch = one_workgroup: {} particles with up to {} springs "
-                    "each are too many for one workgroup; use automatic or per_iteration",
-                    count, max_degree));
-  // automatic: one workgroup only where it was measured to win (lavapipe, docs/performance.md);
-  // a GPU runs a single workgroup on one of its many compute units.
-  const bool cpu_device = ctx->properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
-  const bool one_workgroup = options.cg_dispatch == D::one_workgroup ||
-                             (options.cg_dispatch == D::automatic && cpu_device && budget > 0 &&
-                              count <= implicit_one_workgroup_max_particles);
-  auto r = ImplicitGpu::create(ctx, count, edges_count, groups_x, groups_y, one_workgroup ? budget : 0,
-                               !knobs.force_staging);
-  if (!r)
-    return r.error();
-  implicit = std::move(*r);
-  return write_sets();
+Result<void> SolverBatch::prepare_passes() {
+  for (const auto& pass : passes)
+    VKCLOTH_TRY(pass->prepare(*this));
+  return {};
 }
 
-// Made when an instance first turns self-collision on: its buffers (the rest positions uploaded,
-// the counts zeroed) and descriptor sets, which nothing recorded so far uses. Its parameters are
-// written straight into the mapped buffer here: no recorded work reads it yet.
-Result<void> SolverBatch::ensure_self_collision() {
-  if (self_collision || self_iterations() == 0)
-    return {};
-  // Its largest buffer holds two vec4 per particle of every instance (a move and a velocity change).
-  VKCLOTH_TRY(check_buffer(*ctx, storage_limit(*ctx, knobs), "self-collision moves",
-                           std::uint64_t(size()) * count, 32));
-  auto r = SelfCollisionGpu::create(ctx, count, size(), ctx->properties.limits.maxComputeWorkGroupCount[0],
-                                    !knobs.force_staging, access);
-  if (!r)
-    return r.error();
-  self_collision = std::move(*r);
-  std::vector<sh::vec4> rest(count);
-  for (std::uint32_t p = 0; p < count; ++p) { // as CpuSolver<float>::self_collide makes them
-    const Particle& q = batch_topology->system().particles[p];
-    rest[p] = {float(q.position.x), float(q.position.y), float(q.position.z),
-               kernel::inverse_mass(float(q.mass), q.pinned)};
-  }
-  const Upload up[] = {{&self_collision->rest_positions(), rest.data(), rest.size() * sizeof(sh::vec4)},
-                       {&self_collision->counts(), nullptr, 0}};
-  VKCLOTH_TRY(upload(up));
-  const auto sp = packed_self_params();
-  std::memcpy(self_collision->params().mapped, sp.data(), sp.size() * sizeof(sh::SelfParams));
-  // Only its own new sets: the main ones may be in use by recorded work (set_params).
-  return self_collision->write_sets(one_set_inputs());
+SolveStats SolverBatch::last_solve() const {
+  for (const auto& pass : passes)
+    if (const auto* implicit = dynamic_cast<const ImplicitUpdate*>(pass.get()))
+      return implicit->stats();
+  return {};
 }
 
-// Made when an instance first asks for the fast projection: its buffers (each particle's links
-// uploaded) and its own descriptor sets, which nothing recorded so far uses.
-Result<void> SolverBatch::ensure_projection() {
-  if (projection || projection_iterations() == 0)
-    return {};
-  // Its largest buffer holds two vec4 per strain link of every instance.
-  VKCLOTH_TRY(check_buffer(*ctx, storage_limit(*ctx, knobs), "strain projection links",
-                           std::uint64_t(size()) * strain_link_count(), 32));
-  auto r = StrainProjectionGpu::create(ctx, *batch_topology, size(), !knobs.force_staging);
-  if (!r)
-    return r.error();
-  projection = std::move(*r);
-  const std::vector<std::uint32_t> incidence = StrainProjectionGpu::incidence_data(*batch_topology);
-  const Upload up[] = {{&projection->incidence(), incidence.data(), incidence.size() * 4}};
-  VKCLOTH_TRY(upload(up));
-  return projection->write_sets(one_set_inputs());
+bool SolverBatch::implicit_one_workgroup() const {
+  for (const auto& pass : passes)
+    if (const auto* implicit = dynamic_cast<const ImplicitUpdate*>(pass.get()))
+      return implicit->one_workgroup();
+  return false;
 }
 
-std::vector<sh::SelfParams> SolverBatch::packed_self_params() const {
-  std::vector<const SimParams*> params;
+bool SolverBatch::any_stretch() const {
+  return std::any_of(slots.begin(), slots.end(),
+                     [](const Slot& s) { return s.params.stretch_limit.enabled(); });
+}
+
+bool SolverBatch::any_tethers() const {
+  return std::any_of(slots.begin(), slots.end(),
+                     [](const Slot& s) { return s.params.stretch_limit.tethers(); });
+}
+
+bool SolverBatch::any_colliders() const {
+  return std::any_of(slots.begin(), slots.end(), [](const Slot& s) { return !s.params.colliders.empty(); });
+}
+
+std::uint32_t SolverBatch::projection_iterations() const {
+  std::uint32_t most = 0;
   for (const Slot& s : slots)
-    params.push_back(&s.params);
-  return SelfCollisionGpu::packed(params);
+    if (s.params.stretch_limit.projection())
+      most = std::max(most, s.params.stretch_limit.iterations);
+  return most;
+}
+
+std::uint32_t SolverBatch::self_iterations() const {
+  std::uint32_t most = 0;
+  for (const Slot& s : slots)
+    if (s.params.self_collision.enabled)
+      most = std::max(most, s.params.self_collision.iterations);
+  return most;
+}
+
+std::uint32_t SolverBatch::collider_types() const {
+  std::uint32_t types = 0;
+  for (const Slot& s : slots)
+    for (const Collider& c : s.params.colliders)
+      types |= 1u << std::uint32_t(c.type);
+  return types;
 }
 
 } // namespace vkcloth::gpu

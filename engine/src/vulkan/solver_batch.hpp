@@ -3,8 +3,11 @@
 // and one integrator family, stepped together: one dispatch per pass serves every instance
 // (instance = gl_WorkGroupID.z, vkcloth_shared.h). ClothWorld owns its batches and groups its
 // instances into them (world.cpp); a GpuSolver is a world of one instance (gpu_solver.cpp).
-// Buffers, descriptor sets and texel views are the batch's; layouts and pipelines the Context's
-// (pipelines.hpp). Internal to engine/src/vulkan.
+// The batch owns the state (per-particle buffers, the shared topology, colliders, parameters,
+// flags) and the state set that binds it; each feature of the step is a pass (passes/pass.hpp) that
+// owns its pipelines and its own buffers, and the batch records its passes in list order
+// (passes/passes.cpp). Layouts and pipelines are the Context's (pipelines.hpp). Internal to
+// engine/src/vulkan.
 //
 // Topology: create() reads a prepared ClothTopology (gather lists, grid stencil, normal fans,
 // triangles, uvs, particles); the world keys batches by the shared topology object.
@@ -22,8 +25,8 @@
 #include <glm/vec3.hpp>
 
 #include "implicit_gpu.hpp"
-#include "self_collision_gpu.hpp"
-#include "strain_projection_gpu.hpp"
+#include "passes/pass.hpp"
+#include "pipelines.hpp"
 #include "resources.hpp"
 #include "vkcloth/gpu/gpu_solver.hpp"
 #include "vkcloth/gpu/testing.hpp"
@@ -100,8 +103,8 @@ public:
   VkBuffer position_buffer(std::uint32_t index) const { return pos[index & 1u].buffer; }
   VkBuffer velocity_buffer() const { return vel.buffer; }
   const std::vector<glm::vec2>& uvs() const { return uvs_; }
-  SolveStats last_solve() const { return implicit ? implicit->stats() : SolveStats{}; }
-  bool implicit_one_workgroup() const { return implicit && implicit->one_workgroup(); }
+  SolveStats last_solve() const;
+  bool implicit_one_workgroup() const;
   /// The buffer access and workgroup size this batch's shaders use (resolve_layout).
   BufferAccess buffer_access() const { return access; }
   std::uint32_t workgroup_size() const { return workgroup; }
@@ -135,6 +138,69 @@ public:
     float rest[12] = {}, stiffness[12] = {};
     std::uint32_t border = 0; // VkBool32: border particles use the stencil too (SC_BORDER)
   };
+
+  // What the passes read (passes/pass.hpp).
+  Context::Impl& context() const { return *ctx; }
+  const std::shared_ptr<Context::Impl>& shared_context() const { return ctx; }
+  const DeviceFns& vk() const { return ctx->vk; }
+  const GpuSolverOptions& solver_options() const { return options; }
+  const testing::SolverKnobs& solver_knobs() const { return knobs; }
+  /// The topology the batch was made from: alive as long as the batch (every instance holds it).
+  const ClothTopology& topology() const { return *batch_topology; }
+  std::span<const Slot> instance_slots() const { return slots; }
+  const SimParams& family() const { return slots.front().params; } // integrator family, substeps
+  bool any_stretch() const;
+  bool any_tethers() const;
+  bool any_colliders() const;
+  /// The most Newton iterations of the fast projection an instance asks for (0: none uses it).
+  std::uint32_t projection_iterations() const;
+  /// The most self-collision passes an instance asks for (0: none has it on).
+  std::uint32_t self_iterations() const;
+  /// Bit t (VKCLOTH_COLLIDER_*) for each collider type some instance has; 0 without colliders.
+  std::uint32_t collider_types() const;
+  /// The batch's shader build and workgroup size, the pass fixed to `stage` (VKCLOTH_ANY_STAGE:
+  /// the push constants' stage).
+  ShaderVariant variant(std::uint32_t stage = VKCLOTH_ANY_STAGE) const { return {access, workgroup, stage}; }
+  /// The specialisation constants of force, integrate and fused.comp (solver_pipelines.cpp): the
+  /// grid stencil, SC_WRITE_AUX, SC_COLLIDER_TYPES = `types` and SC_NORMAL_FLAGS; `csr` the
+  /// defaults instead of the stencil and every normal path (the implicit passes' gather).
+  std::array<std::uint32_t, 43> state_constants(bool write_aux, std::uint32_t types, bool csr = false) const;
+  static constexpr std::uint32_t no_texel_set = ~0u;
+  /// Binds the state sets for a state pass: set 0 of position parity `read` (`stage_input`: the
+  /// RK4 stage set), set 1 the texel views of `texel` (0, 1: positions[k]; 2: the stage positions;
+  /// no_texel_set: set 0 only).
+  void bind_state(VkCommandBuffer cmd, std::uint32_t read, bool stage_input, std::uint32_t texel) const;
+  /// The state layout's push constants (32 bytes: PushConstants or a pass's own struct).
+  void push_state(VkCommandBuffer cmd, const void* push) const;
+  /// One invocation per particle of every instance (the grid of workgroups x the instances).
+  void dispatch_particles(VkCommandBuffer cmd) const;
+  std::uint32_t dispatch_x() const { return groups_x; }
+  std::uint32_t dispatch_y() const { return groups_y; }
+  std::uint64_t edge_count() const { return edges_count; }
+  /// The strain links' colour offsets (colours + 1 entries; empty without links).
+  std::span<const std::uint32_t> strain_colour_offsets() const { return strain_colours; }
+  std::size_t strain_link_count() const { return strain_colours.empty() ? 0 : strain_colours.back(); }
+  /// The state buffers the one-set passes (self-collision, projection) bind at the same numbers.
+  OneSetInputs one_set_inputs() const {
+    return {{pos[0].buffer, pos[1].buffer},
+            vel.buffer,
+            particle.buffer,
+            flags.buffer,
+            instances.buffer,
+            strain_links.buffer};
+  }
+  /// The state buffers the implicit passes bind.
+  ImplicitInputs implicit_inputs() const;
+  struct Upload {
+    Buffer* dst;
+    const void* data; // null: zero fill
+    VkDeviceSize bytes;
+  };
+  /// Into mapped memory, or through one staging submission (waited for).
+  Result<void> upload(std::span<const Upload> uploads);
+  /// vkCmdUpdateBuffer of `bytes` from the start of `dst`, in pieces of at most 64 KiB (its limit).
+  void record_buffer_update(VkCommandBuffer cmd, const Buffer& dst, const void* data,
+                            std::size_t bytes) const;
 
 private:
   SolverBatch() = default;
@@ -181,22 +247,6 @@ private:
   // Layouts and pipelines: the Context's (PipelineRegistry, pipelines.hpp), shared by every batch.
   VkDescriptorSetLayout set_layout = VK_NULL_HANDLE, texel_layout = VK_NULL_HANDLE;
   VkPipelineLayout layout = VK_NULL_HANDLE;
-  // force.comp and integrate.comp (the two-pass layout, RK4) per collider types (as fused_pipes),
-  // looked up when first needed (ensure_collider_pipelines).
-  VkPipeline force_pipes[VKCLOTH_COLLIDER_ALL_TYPES + 1] = {};
-  VkPipeline integrate_pipes[VKCLOTH_COLLIDER_ALL_TYPES + 1] = {};
-  VkPipeline strain_links_pipeline = VK_NULL_HANDLE;
-  VkPipeline vertices_pipeline = VK_NULL_HANDLE;
-  // strain_finish.comp per stage (SC_STAGE: 0 tethers, 1 after stretch control, 2 after
-  // self-collision) and collider types (as fused_pipes; the tethers' always 0): [stage][types],
-  // looked up when first needed (ensure_collider_pipelines).
-  VkPipeline finish_pipes[3][VKCLOTH_COLLIDER_ALL_TYPES + 1] = {};
-  // fused.comp variants, looked up when first needed (ensure_fused): [write_aux][collider types].
-  // write_aux = 0 (SC_WRITE_AUX false: no force and normal stores) for every fused substep of a
-  // recorded batch of steps but the last, since only the last one's forces and normals can be
-  // observed; collider types (SC_COLLIDER_TYPES: bit t for a collider of type t in some instance)
-  // 0, no contact loops, while no instance has colliders; absent shapes' code compiled out.
-  VkPipeline fused_pipes[2][VKCLOTH_COLLIDER_ALL_TYPES + 1] = {};
   DescriptorPool pool;
   VkDescriptorSet sets[2][2] = {}; // [positions read index][0: state input, 1: RK4 stage input]
   // Set 1 of force.comp / fused.comp: POS_IN as an RGBA32F uniform texel buffer (buffer_access.glsl
@@ -215,59 +265,13 @@ private:
   Stencil stencil;
   std::uint64_t edges_count = 0;
 
-  shared::PushConstants pc{};            // per dispatch (count, grid, stage, step)
-  std::uint64_t recorded = 0;            // recorded steps since the flag epoch: flag step numbers
-  std::uint32_t parity = 0;              // positions[parity] is current; flipped by every recorded substep
-  std::unique_ptr<ImplicitGpu> implicit; // created when the integrator is implicit_euler (batch of one)
-  std::unique_ptr<SelfCollisionGpu> self_collision; // created when an instance first turns it on
-  std::unique_ptr<StrainProjectionGpu> projection;  // created when an instance first asks for it
-  std::vector<glm::vec2> uvs_;                      // per particle of one instance (as uploaded)
-  std::uint64_t dispatches_ = 0;                    // recorded so far (ClothWorld::dispatches_recorded)
+  shared::PushConstants pc{}; // per dispatch (count, grid, stage, step)
+  std::uint64_t recorded = 0; // recorded steps since the flag epoch: flag step numbers
+  std::uint32_t parity = 0;   // positions[parity] is current; flipped by every recorded substep
+  std::vector<std::unique_ptr<Pass>> passes; // make_solver_passes(): in the order they record
+  std::vector<glm::vec2> uvs_;               // per particle of one instance (as uploaded)
+  std::uint64_t dispatches_ = 0;             // recorded so far (ClothWorld::dispatches_recorded)
 
-  const SimParams& family() const { return slots.front().params; } // integrator family, substeps
-  bool any_stretch() const {
-    for (const Slot& s : slots)
-      if (s.params.stretch_limit.enabled())
-        return true;
-    return false;
-  }
-  bool any_tethers() const {
-    for (const Slot& s : slots)
-      if (s.params.stretch_limit.tethers())
-        return true;
-    return false;
-  }
-  /// The most Newton iterations of the fast projection an instance asks for (0: none uses it).
-  std::uint32_t projection_iterations() const {
-    std::uint32_t most = 0;
-    for (const Slot& s : slots)
-      if (s.params.stretch_limit.projection())
-        most = std::max(most, s.params.stretch_limit.iterations);
-    return most;
-  }
-  /// The most self-collision passes an instance asks for (0: none has it on).
-  std::uint32_t self_iterations() const {
-    std::uint32_t most = 0;
-    for (const Slot& s : slots)
-      if (s.params.self_collision.enabled)
-        most = std::max(most, s.params.self_collision.iterations);
-    return most;
-  }
-  bool any_colliders() const {
-    for (const Slot& s : slots)
-      if (!s.params.colliders.empty())
-        return true;
-    return false;
-  }
-  /// Bit t (VKCLOTH_COLLIDER_*) for each collider type some instance has; 0 without colliders.
-  std::uint32_t collider_types() const {
-    std::uint32_t types = 0;
-    for (const Slot& s : slots)
-      for (const Collider& c : s.params.colliders)
-        types |= 1u << std::uint32_t(c.type);
-    return types;
-  }
-  const DeviceFns& vk() const { return ctx->vk; }
   VkDeviceSize slot_offset(std::uint32_t slot) const {
     return VkDeviceSize(slot) * count * GpuSolver::stride;
   }
@@ -275,32 +279,20 @@ private:
   VkDeviceSize vertex_offset(std::uint32_t slot) const {
     return VkDeviceSize(slot) * count * sizeof(shared::Vertex);
   }
-  std::size_t strain_link_count() const { return strain_colours.empty() ? 0 : strain_colours.back(); }
   const Buffer& buffer_of(Field field) const;
   Result<std::vector<float>> read_floats(const Buffer& b, VkDeviceSize offset, VkDeviceSize bytes);
 
   // Creation phases (create()), in order.
   Result<void> create_buffers();
   void set_stencil(const ClothTopology& topology);
-  Result<void> init_pipelines();
+  Result<void> init_state_sets();
   Result<void> create_descriptor_sets();
   Result<void> create_texel_views();
   Result<void> create_buffer_views();
-  Result<void> create_pipelines();
   Result<void> write_sets();
-  Result<void> ensure_implicit();
-  Result<void> ensure_fused();
-  Result<void> ensure_collider_pipelines();
+  /// Every pass's prepare() (creation, set_params).
+  Result<void> prepare_passes();
   Result<void> ensure_tethers();
-  Result<void> ensure_self_collision();
-  Result<void> ensure_projection();
-  /// The interleaved vertex pass at the end of a recording (vertices.comp).
-  void record_vertices(VkCommandBuffer cmd);
-  /// Stretch control after a substep's update (strain_links.comp sweeps, strain_finish.comp).
-  void record_stretch(VkCommandBuffer cmd, std::uint32_t read);
-  /// One per-particle pass of strain_finish.comp on the positions being written: `stage` 0 the
-  /// tethers, 1 the projection after stretch control, 2 the projection after self-collision.
-  void record_finish_pass(VkCommandBuffer cmd, std::uint32_t read, std::uint32_t stage);
   Result<void> ensure_collider_capacity();
   Result<void> ensure_mesh_buffers();
   std::vector<shared::Collider> packed_colliders() const;
@@ -308,33 +300,11 @@ private:
   /// (Collider::posed_at, as CpuSolver does) and the new poses are recorded into the collider buffer.
   void record_collider_motion(VkCommandBuffer cmd, double h);
   std::vector<shared::InstanceParams> packed_instance_params() const;
-  std::vector<shared::SelfParams> packed_self_params() const;
-  /// What self-collision's and the projection's passes share with the main layout.
-  OneSetInputs one_set_inputs() const {
-    return {{pos[0].buffer, pos[1].buffer},
-            vel.buffer,
-            particle.buffer,
-            flags.buffer,
-            instances.buffer,
-            strain_links.buffer};
-  }
   void write_params_now();
   void record_params_update(VkCommandBuffer cmd);
-  /// vkCmdUpdateBuffer of `bytes` from the start of `dst`, in pieces of at most 64 KiB (its limit).
-  void record_buffer_update(VkCommandBuffer cmd, const Buffer& dst, const void* data,
-                            std::size_t bytes) const;
   Result<void> upload_initial_state(const ClothTopology& topology, const std::vector<SlotState>& states);
-  struct Upload {
-    Buffer* dst;
-    const void* data; // null: zero fill
-    VkDeviceSize bytes;
-  };
-  Result<void> upload(std::span<const Upload> uploads);
-
-  /// `last`: the last substep of this recording (the fused variant that stores forces and normals).
-  void record_substep(VkCommandBuffer cmd, bool first, bool last);
-  /// One substep's update (force and integrate passes, fused.comp, or the implicit solve).
-  void record_update(VkCommandBuffer cmd, bool first, bool last);
+  /// The passes of `when`, each active one after the other.
+  void record_passes(VkCommandBuffer cmd, Pass::When when, bool first, bool last);
 };
 
 } // namespace vkcloth::gpu

@@ -372,16 +372,13 @@ SolverBatch::create(const std::shared_ptr<Context::Impl>& ctx, CommandContext& c
   VKCLOTH_TRY(s.create_buffers());
   if (!knobs.csr_only)
     s.set_stencil(topology);
-  VKCLOTH_TRY(s.init_pipelines());
+  s.passes = make_solver_passes();
+  VKCLOTH_TRY(s.init_state_sets());
   VKCLOTH_TRY(s.write_sets());
-  VKCLOTH_TRY(s.ensure_implicit());
-  VKCLOTH_TRY(s.ensure_fused());
-  VKCLOTH_TRY(s.ensure_collider_pipelines());
   s.write_params_now();
   VKCLOTH_TRY(s.upload_initial_state(topology, states));
   VKCLOTH_TRY(s.ensure_tethers());
-  VKCLOTH_TRY(s.ensure_self_collision());
-  VKCLOTH_TRY(s.ensure_projection());
+  VKCLOTH_TRY(s.prepare_passes());
   return impl;
 }
 

@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: MIT
-// SolverBatch (solver_batch.hpp): descriptor set layouts, sets and texel views, the compute
-// pipelines (force, integrate, the fused variants) and their specialisation constants (the grid
-// stencil, the fused variant, the fan-normal switch). The buffers and readbacks are in
-// solver_batch.cpp, the recording of the steps in solver_batch_record.cpp.
+// SolverBatch (solver_batch.hpp): the state set (its layout: passes/state_set.hpp; the batch's
+// descriptor sets and texel views), how a pass binds it, and the specialisation constants of the
+// state passes (the grid stencil, the fused variant, the fan-normal switch). The passes' pipelines
+// are theirs (passes/); the buffers and readbacks are in solver_batch.cpp, the recording of the
+// steps in solver_batch_record.cpp.
 #include "resources.hpp"
 
 #include <algorithm>
@@ -14,6 +15,7 @@
 #include <fmt/format.h>
 
 #include "pipelines.hpp"
+#include "passes/state_set.hpp"
 #include "solver_batch.hpp"
 #include "vkcloth_shared.h"
 
@@ -21,25 +23,39 @@ namespace vkcloth::gpu {
 
 namespace sh = shared;
 
-namespace {
-
-/// The specialisation constants of force.comp and fused.comp, as 32-bit words by constant_id:
-/// 0..39 the grid stencil (force_body.glsl), 40 SC_WRITE_AUX (fused.comp only, a VkBool32; force.comp
-/// has no constant 40, and an entry for an id a shader lacks is ignored), 41 SC_COLLIDER_TYPES
-/// (common.glsl: a mask of collider types), 42 SC_NORMAL_FLAGS (force_body.glsl: the batch's normal
-/// path as its instance flag).
-std::array<std::uint32_t, 43> solver_constants(const SolverBatch::Stencil& st, bool write_aux,
-                                               std::uint32_t collider_types, SolverBatch::Normals normals) {
-  static_assert(sizeof(SolverBatch::Stencil) == 40 * 4);
+// The specialisation constants of force.comp and fused.comp, as 32-bit words by constant_id:
+// 0..39 the grid stencil (force_body.glsl), 40 SC_WRITE_AUX (fused.comp only, a VkBool32; force.comp
+// has no constant 40, and an entry for an id a shader lacks is ignored), 41 SC_COLLIDER_TYPES
+// (common.glsl: a mask of collider types), 42 SC_NORMAL_FLAGS (force_body.glsl: the batch's normal
+// path as its instance flag).
+std::array<std::uint32_t, 43> SolverBatch::state_constants(bool write_aux, std::uint32_t types,
+                                                           bool csr) const {
+  static_assert(sizeof(Stencil) == 40 * 4);
+  const Stencil st = csr ? Stencil{} : stencil; // Stencil{}: the defaults, no stencil
   std::array<std::uint32_t, 43> words{};
   std::memcpy(words.data(), &st, sizeof(st));
   words[40] = write_aux ? 1u : 0u;
-  words[41] = collider_types;
-  words[42] = SolverBatch::normal_flag(normals);
+  words[41] = types;
+  words[42] = csr ? VKCLOTH_FLAG_HAS_GRID | VKCLOTH_FLAG_RING_NORMALS : normal_flag(normals);
   return words;
 }
 
-} // namespace
+void SolverBatch::bind_state(VkCommandBuffer c, std::uint32_t read, bool stage_input,
+                             std::uint32_t texel) const {
+  const VkDescriptorSet bound[2] = {sets[read][stage_input ? 1 : 0],
+                                    texel == no_texel_set ? VK_NULL_HANDLE : texel_sets[texel]};
+  vk().vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, texel == no_texel_set ? 1 : 2,
+                               bound, 0, nullptr);
+}
+
+void SolverBatch::push_state(VkCommandBuffer c, const void* push) const {
+  static_assert(sizeof(sh::PushConstants) == 32, "every pass's push constants are 32 bytes");
+  vk().vkCmdPushConstants(c, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(sh::PushConstants), push);
+}
+
+void SolverBatch::dispatch_particles(VkCommandBuffer c) const {
+  vk().vkCmdDispatch(c, groups_x, groups_y, size()); // one dispatch serves every instance (gl_WorkGroupID.z)
+}
 
 Result<DeviceLayout> SolverBatch::resolve_layout(const Context::Impl& ctx, const GpuSolverOptions& options,
                                                  bool implicit) {
@@ -65,10 +81,10 @@ Result<DeviceLayout> SolverBatch::resolve_layout(const Context::Impl& ctx, const
   return out;
 }
 
-// The Context's layouts (set 0: storage buffers, set 1: texel views), then this batch's sets and
-// views, then the Context's pipelines for this batch's stencil.
-Result<void> SolverBatch::init_pipelines() {
-  auto layouts = ctx->pipelines->solver_layouts();
+// The Context's layouts of the state set (set 0: storage buffers, set 1: texel views), then this
+// batch's sets and views.
+Result<void> SolverBatch::init_state_sets() {
+  auto layouts = ctx->pipelines->layouts(kStateBindings);
   if (!layouts)
     return layouts.error();
   set_layout = layouts->storage;
@@ -77,7 +93,7 @@ Result<void> SolverBatch::init_pipelines() {
   VKCLOTH_TRY(create_descriptor_sets());
   if (access == BufferAccess::texel_views) // the storage builds leave set 1 bound but unwritten, unused
     VKCLOTH_TRY(create_texel_views());
-  return create_pipelines();
+  return {};
 }
 
 // Four storage sets ([read][state / RK4 stage input], written by write_sets()) and three texel sets.
@@ -165,85 +181,6 @@ Result<void> SolverBatch::create_buffer_views() {
   return {};
 }
 
-// Provot's sweeps and vertices.comp, from the Context's registry, in the batch's build (texel
-// views or storage buffers) and workgroup size (resolve_layout); the passes specialised with the
-// batch's collider types come from ensure_fused and ensure_collider_pipelines.
-Result<void> SolverBatch::create_pipelines() {
-  using Shader = PipelineRegistry::Shader;
-  const PipelineRegistry::Variant variant{access, workgroup};
-  auto lp = ctx->pipelines->pipeline(Shader::strain_links, {}, variant);
-  if (!lp)
-    return lp.error();
-  strain_links_pipeline = *lp;
-  if (options.interleaved_vertices) {
-    auto vp = ctx->pipelines->pipeline(Shader::vertices, {}, variant);
-    if (!vp)
-      return vp.error();
-    vertices_pipeline = *vp;
-  }
-  return {};
-}
-
-// The fused.comp variants the current parameters need ([0] and [1] x the collider types in the
-// batch); the registry makes each variant once per Context.
-Result<void> SolverBatch::ensure_fused() {
-  const std::uint32_t types = collider_types();
-  if (!options.fused || (fused_pipes[0][types] && fused_pipes[1][types]))
-    return {};
-  for (std::uint32_t aux = 0; aux < 2; ++aux) {
-    const auto constants = solver_constants(stencil, aux != 0, types, normals);
-    auto p = ctx->pipelines->pipeline(PipelineRegistry::Shader::fused, constants, {access, workgroup});
-    if (!p)
-      return p.error();
-    fused_pipes[aux][types] = *p;
-  }
-  return {};
-}
-
-// The variants the current parameters need of the passes specialised with the batch's collider
-// types (SC_COLLIDER_TYPES, as ensure_fused): force.comp (with the grid stencil and the fan
-// switch) and integrate.comp where the batch runs the two-pass layout, and strain_finish.comp per
-// stage (the tethers' with no collider code); each made once per Context.
-Result<void> SolverBatch::ensure_collider_pipelines() {
-  using Shader = PipelineRegistry::Shader;
-  const std::uint32_t types = collider_types();
-  const Integrator integrator = family().integrator;
-  const bool two_pass =
-      integrator != Integrator::implicit_euler && (!options.fused || integrator == Integrator::rk4);
-  if (implicit) { // its FORCE and FINISH passes: CSR gather (no stencil), every normal path as the flags say
-    auto words = solver_constants(Stencil{}, true, types, Normals::grid); // Stencil{}: the defaults
-    words[42] = VKCLOTH_FLAG_HAS_GRID | VKCLOTH_FLAG_RING_NORMALS; // SC_NORMAL_FLAGS: both, the default
-    VKCLOTH_TRY(implicit->ensure_collider_passes(types, words));
-  }
-  if (two_pass && !force_pipes[types]) {
-    const auto constants = solver_constants(stencil, true, types, normals);
-    auto fp = ctx->pipelines->pipeline(Shader::force, constants, {access, workgroup});
-    if (!fp)
-      return fp.error();
-    auto ip = ctx->pipelines->pipeline(Shader::integrate, constants, {access, workgroup});
-    if (!ip)
-      return ip.error();
-    force_pipes[types] = *fp;
-    integrate_pipes[types] = *ip;
-  }
-  // strain_finish.comp's stages where record_stretch and record_substep use them: the tethers, the
-  // colliders after stretch control, the colliders after self-collision.
-  const bool needed[3] = {any_tethers(), any_stretch() && any_colliders(),
-                          self_iterations() > 0 && any_colliders()};
-  for (std::uint32_t stage = 0; stage < 3; ++stage) {
-    const std::uint32_t t = stage == 0 ? 0u : types;
-    if (!needed[stage] || finish_pipes[stage][t])
-      continue;
-    std::array<std::uint32_t, 42> constants{}; // ids 0..41, of which strain_finish.comp has only 41
-    constants[41] = t;                         // SC_COLLIDER_TYPES
-    auto p = ctx->pipelines->pipeline(Shader::strain_finish, constants, {access, workgroup, stage});
-    if (!p)
-      return p.error();
-    finish_pipes[stage][t] = *p;
-  }
-  return {};
-}
-
 // The topology's grid stencil (ClothTopology: the one detection rule, shared with the CPU) as
 // specialisation constants, its constants in float as the edges are uploaded.
 void SolverBatch::set_stencil(const ClothTopology& topology) {
@@ -306,24 +243,24 @@ Result<void> SolverBatch::write_sets() {
     }
   vk().vkUpdateDescriptorSets(ctx->device, static_cast<std::uint32_t>(writes.size()), writes.data(), 0,
                               nullptr);
-  if (self_collision)
-    VKCLOTH_TRY(self_collision->write_sets(one_set_inputs()));
-  if (projection)
-    VKCLOTH_TRY(projection->write_sets(one_set_inputs()));
-  if (implicit)
-    return implicit->write_sets({{pos[0].buffer, pos[1].buffer},
-                                 vel.buffer,
-                                 force.buffer,
-                                 normal.buffer,
-                                 particle.buffer,
-                                 offsets.buffer,
-                                 edges.buffer,
-                                 colliders.buffer,
-                                 flags.buffer,
-                                 instances.buffer,
-                                 mesh_nodes.buffer,
-                                 mesh_tris.buffer});
+  for (const auto& pass : passes) // the sets of the passes that bind state buffers in their own
+    VKCLOTH_TRY(pass->write_sets(*this));
   return {};
+}
+
+ImplicitInputs SolverBatch::implicit_inputs() const {
+  return {{pos[0].buffer, pos[1].buffer},
+          vel.buffer,
+          force.buffer,
+          normal.buffer,
+          particle.buffer,
+          offsets.buffer,
+          edges.buffer,
+          colliders.buffer,
+          flags.buffer,
+          instances.buffer,
+          mesh_nodes.buffer,
+          mesh_tris.buffer};
 }
 
 } // namespace vkcloth::gpu

@@ -9,6 +9,7 @@
 #include "../core/kernel.hpp"
 #include "barriers.hpp"
 #include "pipelines.hpp"
+#include "vkcloth/shaders/strain_project_comp_spv.hpp"
 
 namespace vkcloth::gpu {
 
@@ -83,14 +84,23 @@ Result<void> StrainProjectionGpu::create_buffers(std::uint64_t incidence_words, 
   return {};
 }
 
+namespace {
+
+/// strain_project.comp's one binding table (strain_projection_shared.h) and its one build (shared
+/// arrays sized with VKCLOTH_WORKGROUP_SIZE).
+constexpr BindingTable kStrainProjectBindings{"strain projection", sh::strain_project_bindings};
+constexpr ShaderSource kStrainProject{
+    "strain_project.comp", spirv::strain_project_comp_spv, {}, &kStrainProjectBindings, true};
+
+} // namespace
+
 // The Context's layout and pipeline; this batch's pool and two sets (position parity).
 Result<void> StrainProjectionGpu::create_sets() {
-  auto pass =
-      create_one_set_pass(*ctx_, PipelineRegistry::Shader::strain_project, pool_, sets_, "strain projection");
+  auto pass = create_one_set_pass(*ctx_, kStrainProjectBindings, pool_, sets_);
   if (!pass)
     return pass.error();
   layout_ = pass->layout;
-  auto pipeline = ctx_->pipelines->pipeline(PipelineRegistry::Shader::strain_project, {});
+  auto pipeline = ctx_->pipelines->pipeline(kStrainProject, {});
   if (!pipeline)
     return pipeline.error();
   pass_ = *pipeline;
@@ -98,7 +108,7 @@ Result<void> StrainProjectionGpu::create_sets() {
 }
 
 Result<void> StrainProjectionGpu::write_sets(const OneSetInputs& in) {
-  write_parity_sets(*ctx_, sets_, strain_project_bindings(),
+  write_parity_sets(*ctx_, sets_, sh::strain_project_bindings,
                     [&](std::uint32_t read, std::uint32_t binding) -> VkBuffer {
                       switch (binding) {
                       case VKCLOTH_BINDING_PROJ_INCIDENCE:

@@ -1,0 +1,41 @@
+// SPDX-License-Identifier: MIT
+// The solver's passes, in the order a substep runs them: the one list. Each pass decides from the
+// batch's parameters whether it runs (Pass::active), so the list is the same for every batch. A new
+// pass is one factory declared and listed here (docs/architecture.md "Adding a pass").
+#include <memory>
+#include <vector>
+
+#include "implicit_update.hpp"
+#include "pass.hpp"
+
+namespace vkcloth::gpu {
+
+// Defined next to each pass (passes/*.cpp).
+std::unique_ptr<Pass> make_explicit_update();
+std::unique_ptr<Pass> make_tethers();
+std::unique_ptr<Pass> make_strain_links();
+std::unique_ptr<Pass> make_strain_projection();
+std::unique_ptr<Pass> make_contacts_after_stretch();
+std::unique_ptr<Pass> make_self_collision();
+std::unique_ptr<Pass> make_contacts_after_self_collision();
+std::unique_ptr<Pass> make_vertices();
+
+std::vector<std::unique_ptr<Pass>> make_solver_passes() {
+  std::vector<std::unique_ptr<Pass>> passes;
+  // The update: forces, contacts and the integrator (one of the two runs).
+  passes.push_back(make_explicit_update());
+  passes.push_back(std::make_unique<ImplicitUpdate>());
+  // Stretch control: tethers, Provot's sweeps, the fast projection, then the colliders again.
+  passes.push_back(make_tethers());
+  passes.push_back(make_strain_links());
+  passes.push_back(make_strain_projection());
+  passes.push_back(make_contacts_after_stretch());
+  // Self-collision, then the colliders again.
+  passes.push_back(make_self_collision());
+  passes.push_back(make_contacts_after_self_collision());
+  // Once per recording, after the last substep.
+  passes.push_back(make_vertices());
+  return passes;
+}
+
+} // namespace vkcloth::gpu

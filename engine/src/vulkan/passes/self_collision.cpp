@@ -1,0 +1,85 @@
+// SPDX-License-Identifier: MIT
+// Self-collision after a substep's update and stretch control: SelfCollisionGpu (the spatial
+// hash and the Jacobi passes of self_collision.comp, its own buffers, sets and parameters), made
+// when an instance first turns it on.
+#include <cstring>
+#include <memory>
+#include <vector>
+
+#include "../../core/kernel.hpp"
+#include "../batch_limits.hpp"
+#include "../self_collision_gpu.hpp"
+#include "../solver_batch.hpp"
+#include "pass.hpp"
+
+namespace vkcloth::gpu {
+
+namespace {
+
+class SelfCollision final : public Pass {
+public:
+  const char* name() const override { return "self-collision"; }
+  bool active(const SolverBatch& b) const override { return b.self_iterations() > 0; }
+
+  // Its buffers (the rest positions uploaded, the counts zeroed) and descriptor sets, which nothing
+  // recorded so far uses; its parameters straight into the mapped buffer (no recorded work reads it).
+  Result<void> prepare(SolverBatch& b) override {
+    if (gpu_ || !active(b))
+      return {};
+    const std::uint32_t count = b.particle_count();
+    // Its largest buffer holds two vec4 per particle of every instance (a move and a velocity change).
+    VKCLOTH_TRY(check_buffer(b.context(), storage_limit(b.context(), b.solver_knobs()), "self-collision moves",
+                             std::uint64_t(b.size()) * count, 32));
+    auto r = SelfCollisionGpu::create(b.shared_context(), count, b.size(),
+                                      b.context().properties.limits.maxComputeWorkGroupCount[0],
+                                      !b.solver_knobs().force_staging, b.buffer_access());
+    if (!r)
+      return r.error();
+    std::vector<shared::vec4> rest(count);
+    for (std::uint32_t p = 0; p < count; ++p) { // as CpuSolver<float>::self_collide makes them
+      const Particle& q = b.topology().system().particles[p];
+      rest[p] = {float(q.position.x), float(q.position.y), float(q.position.z),
+                 kernel::inverse_mass(float(q.mass), q.pinned)};
+    }
+    const SolverBatch::Upload up[] = {{&(*r)->rest_positions(), rest.data(), rest.size() * sizeof(shared::vec4)},
+                                      {&(*r)->counts(), nullptr, 0}};
+    VKCLOTH_TRY(b.upload(up));
+    gpu_ = std::move(*r);
+    write_params(b, VK_NULL_HANDLE);
+    // Only its own new sets: the state sets may be in use by recorded work (set_params).
+    return gpu_->write_sets(b.one_set_inputs());
+  }
+
+  Result<void> write_sets(const SolverBatch& b) override {
+    return gpu_ ? gpu_->write_sets(b.one_set_inputs()) : Result<void>{};
+  }
+
+  void write_params(const SolverBatch& b, VkCommandBuffer cmd) override {
+    if (!gpu_)
+      return;
+    std::vector<const SimParams*> params;
+    for (const SolverBatch::Slot& s : b.instance_slots())
+      params.push_back(&s.params);
+    const auto packed = SelfCollisionGpu::packed(params);
+    const std::size_t bytes = packed.size() * sizeof(shared::SelfParams);
+    if (cmd)
+      b.record_buffer_update(cmd, gpu_->params(), packed.data(), bytes);
+    else
+      std::memcpy(gpu_->params().mapped, packed.data(), bytes);
+  }
+
+  std::uint32_t record(const SolverBatch& b, PassFrame& f) override {
+    return gpu_->record_substep(f.cmd, f.read, *f.pc, b.self_iterations());
+  }
+
+private:
+  std::unique_ptr<SelfCollisionGpu> gpu_;
+};
+
+} // namespace
+
+std::unique_ptr<Pass> make_self_collision() {
+  return std::make_unique<SelfCollision>();
+}
+
+} // namespace vkcloth::gpu

@@ -1,0 +1,120 @@
+// SPDX-License-Identifier: MIT
+// Stretch control after a substep's update (the tethers before these: finish.cpp). Provot's
+// sweeps: strain_links.comp, one dispatch per colour of the strain links (a colour's links share
+// no particle), the most sweeps any instance asks for. The fast projection: StrainProjectionGpu
+// (strain_project.comp, its own buffers and sets), made when an instance first asks for it.
+#include <algorithm>
+#include <memory>
+
+#include "../barriers.hpp"
+#include "../batch_limits.hpp"
+#include "../solver_batch.hpp"
+#include "../strain_projection_gpu.hpp"
+#include "pass.hpp"
+#include "state_set.hpp"
+#include "vkcloth/shaders/strain_links_storage_comp_spv.hpp"
+#include "vkcloth/shaders/strain_links_texel_comp_spv.hpp"
+
+namespace vkcloth::gpu {
+
+namespace {
+
+constexpr ShaderSource kStrainLinks{"strain_links.comp", spirv::strain_links_texel_comp_spv,
+                                    spirv::strain_links_storage_comp_spv, &kStateBindings};
+
+/// The most Provot sweeps an instance asks for (0: none uses them).
+std::uint32_t provot_sweeps(const SolverBatch& b) {
+  std::uint32_t sweeps = 0;
+  for (const SolverBatch::Slot& s : b.instance_slots())
+    if (s.params.stretch_limit.provot())
+      sweeps = std::max(sweeps, s.params.stretch_limit.iterations);
+  return sweeps;
+}
+
+class StrainLinks final : public Pass {
+public:
+  const char* name() const override { return "Provot's sweeps"; }
+  bool active(const SolverBatch& b) const override { return provot_sweeps(b) > 0 && b.strain_link_count() > 0; }
+
+  Result<void> prepare(SolverBatch& b) override {
+    if (pipeline_ || !active(b))
+      return {};
+    auto p = b.context().pipelines->pipeline(kStrainLinks, {}, b.variant());
+    if (!p)
+      return p.error();
+    pipeline_ = *p;
+    return {};
+  }
+
+  std::uint32_t record(const SolverBatch& b, PassFrame& f) override {
+    const auto& v = b.vk();
+    // Set 1 of the positions being written: the sweeps read positions[write] through its texel view.
+    b.bind_state(f.cmd, f.read, false, f.read ^ 1u);
+    v.vkCmdBindPipeline(f.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
+    auto pc = shared::push_from<shared::StrainLinksPush>(*f.pc);
+    const auto colours = b.strain_colour_offsets();
+    const std::uint32_t sweeps = provot_sweeps(b);
+    std::uint32_t dispatches = 0;
+    for (std::uint32_t sweep = 0; sweep < sweeps; ++sweep)
+      for (std::size_t k = 0; k + 1 < colours.size(); ++k) {
+        pc.stage = sweep;
+        pc.link_first = colours[k];
+        pc.link_count = colours[k + 1] - colours[k];
+        const std::uint32_t groups = (pc.link_count + b.workgroup_size() - 1) / b.workgroup_size();
+        const std::uint32_t gx = std::min(groups, b.dispatch_x()), gy = (groups + gx - 1) / gx;
+        b.push_state(f.cmd, &pc);
+        barriers::dispatch_to_dispatch(v, f.cmd); // the previous pass or colour -> this colour
+        v.vkCmdDispatch(f.cmd, gx, gy, b.size());
+        ++dispatches;
+      }
+    return dispatches;
+  }
+
+private:
+  VkPipeline pipeline_ = VK_NULL_HANDLE;
+};
+
+class StrainProjection final : public Pass {
+public:
+  const char* name() const override { return "fast projection"; }
+  bool active(const SolverBatch& b) const override { return b.projection_iterations() > 0; }
+
+  // Made when an instance first asks for the fast projection: its buffers (each particle's links
+  // uploaded) and its own descriptor sets, which nothing recorded so far uses.
+  Result<void> prepare(SolverBatch& b) override {
+    if (gpu_ || !active(b))
+      return {};
+    // Its largest buffer holds two vec4 per strain link of every instance.
+    VKCLOTH_TRY(check_buffer(b.context(), storage_limit(b.context(), b.solver_knobs()), "strain projection links",
+                             std::uint64_t(b.size()) * b.strain_link_count(), 32));
+    auto r = StrainProjectionGpu::create(b.shared_context(), b.topology(), b.size(), !b.solver_knobs().force_staging);
+    if (!r)
+      return r.error();
+    const std::vector<std::uint32_t> incidence = StrainProjectionGpu::incidence_data(b.topology());
+    const SolverBatch::Upload up[] = {{&(*r)->incidence(), incidence.data(), incidence.size() * 4}};
+    VKCLOTH_TRY(b.upload(up));
+    VKCLOTH_TRY((*r)->write_sets(b.one_set_inputs()));
+    gpu_ = std::move(*r);
+    return {};
+  }
+  Result<void> write_sets(const SolverBatch& b) override {
+    return gpu_ ? gpu_->write_sets(b.one_set_inputs()) : Result<void>{};
+  }
+  std::uint32_t record(const SolverBatch& b, PassFrame& f) override {
+    return gpu_->record_substep(f.cmd, f.read, *f.pc, b.projection_iterations());
+  }
+
+private:
+  std::unique_ptr<StrainProjectionGpu> gpu_;
+};
+
+} // namespace
+
+std::unique_ptr<Pass> make_strain_links() {
+  return std::make_unique<StrainLinks>();
+}
+std::unique_ptr<Pass> make_strain_projection() {
+  return std::make_unique<StrainProjection>();
+}
+
+} // namespace vkcloth::gpu
