@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #version 450
 #extension GL_GOOGLE_include_directive : require
+// vkcloth-builds: texel-and-storage workgroup-constant (shaders/CMakeLists.txt)
 // Force pass of the two-pass layout, one invocation per particle (CpuSolver::normal_at, force_at
 // and contact_at for one particle; the body is in force_body.glsl, shared with fused.comp).
 // Reads POS_IN (all particles) and VEL_IN (own); writes FORCE_OUT, VEL_FILT, NORMAL (own).

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #version 450
 #extension GL_GOOGLE_include_directive : require
+// vkcloth-builds: texel-and-storage workgroup-constant (shaders/CMakeLists.txt)
 // Fused Euler step, one invocation per particle of every instance of the batch, one dispatch per
 // step (GpuSolverOptions::fused): the force pass (force_body.glsl: normal rebuilt from the neighbours' POS_IN, spring gather,
 // contacts) followed by the Euler update and projection (finish.glsl) in registers. Valid in one
@@ -22,7 +23,7 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_VEL) buffer VelBuf { vec4 vel[
 
 #include "finish.glsl"
 
-// False for every substep of a recorded batch but the last (GpuSolver fused_pipes[0][*]): the
+// False for every substep of a recorded batch but the last (passes/explicit_update.cpp fused_[0][*]): the
 // forces and normals of the other substeps are overwritten before anyone can read them, so they
 // are not stored (docs/performance.md "lavapipe (llvmpipe) notes").
 layout(constant_id = 40) const bool SC_WRITE_AUX = true;

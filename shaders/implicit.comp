@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #version 450
 #extension GL_GOOGLE_include_directive : require
+// vkcloth-builds: one (shaders/CMakeLists.txt)
 // Implicit Euler passes (engine/src/core/implicit_euler.hpp for the method), one invocation per
 // particle; PushConstants::stage selects the pass (VKCLOTH_IMPL_*). The reducing passes write one
 // partial dot-product vec4 per workgroup (fixed-shape shared-memory tree), and the last workgroup

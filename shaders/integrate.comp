@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #version 450
 #extension GL_GOOGLE_include_directive : require
+// vkcloth-builds: texel-and-storage workgroup-constant (shaders/CMakeLists.txt)
 // Integration pass, one invocation per particle (the CPU reference's update after the forces,
 // then projection and the divergence check; formulas from cloth_kernel.h). Euler: one pass per
 // step. RK4: one pass per stage;

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #version 450
 #extension GL_GOOGLE_include_directive : require
+// vkcloth-builds: texel-and-storage (shaders/CMakeLists.txt)
 // Self-collision (CpuSolver::self_collide; docs/model.md "Self-collision"), one pass per stage
 // (self_collision_shared.h), after the substep's update and stretch control, on the positions
 // being written (POS_OUT). The spatial hash is a counting sort of the particles by

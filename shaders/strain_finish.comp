@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #version 450
 #extension GL_GOOGLE_include_directive : require
+// vkcloth-builds: texel-and-storage workgroup-constant (shaders/CMakeLists.txt)
 // Stretch control's per-particle passes (CpuSolver::limit_stretch), one invocation per particle:
 // pc.stage 0, before Provot's sweeps: the particle's tethers in slot order (cloth_kernel.h
 // tether_move, apply_correction; anchors are pinned, so no invocation writes what another
@@ -19,7 +20,7 @@
 #define VKCLOTH_ACCESS_TETHERS
 #include "buffer_access.glsl"
 
-// One pipeline per stage (SC_STAGE; SolverBatch::ensure_finish_passes): the tether pass has no
+// One pipeline per stage (SC_STAGE; passes/finish.cpp): the tether pass has no
 // collider code (docs/performance.md "lavapipe (llvmpipe) notes"); SC_COLLIDER_TYPES compiles out
 // the shapes the batch lacks (all of them for the tethers).
 void main() {

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #version 450
 #extension GL_GOOGLE_include_directive : require
+// vkcloth-builds: texel-and-storage workgroup-constant (shaders/CMakeLists.txt)
 // Stretch control, Provot's sweep over one colour of strain links (CpuSolver::limit_stretch; the
 // formulas: cloth_kernel.h provot_link, apply_correction). One invocation per link of the colour
 // (pc.link_first: its first link, pc.link_count: its count; pc.stage: the sweep), of every instance of the

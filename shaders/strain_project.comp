@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #version 450
 #extension GL_GOOGLE_include_directive : require
+// vkcloth-builds: one (shaders/CMakeLists.txt)
 // Stretch control by fast projection (CpuSolver::project_strain; docs/model.md "Stretch
 // control"), after the tethers on the positions being written (POS_OUT). ONE workgroup per
 // instance runs the whole projection: Newton iterations, each a Jacobi-preconditioned CG over the

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #version 450
 #extension GL_GOOGLE_include_directive : require
+// vkcloth-builds: one workgroup-constant (shaders/CMakeLists.txt)
 // The interleaved vertex output (GpuSolverOptions::interleaved_vertices), one invocation per
 // particle, after the last step of a recording: the current position, the normal as stored and
 // the uv, packed into one Vertex (32 bytes) for hosts whose pipeline reads one vertex binding.

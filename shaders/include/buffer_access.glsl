@@ -133,7 +133,7 @@ Edge read_edge(uint e) { return edges[e]; }
 
 // POS_OUT (strain_*.comp): the positions and velocities a pass corrects in place, POS_OUT
 // (positions[write]) and VEL, which it declares (writeonly in the texel builds: they read them
-// through set 1, whose POS_IN view SolverBatch::record_stretch points at positions[write]). Within
+// through set 1, whose POS_IN view passes/stretch.cpp and finish.cpp point at positions[write]). Within
 // one pass no invocation reads what another writes (a colour's links share no particle; tether
 // anchors are pinned and never written). With VEL_FLAGS for the velocities.
 //   vec3 read_pos_out(uint q)                POS_OUT[base + q].xyz  view: set 1's POS_IN, RGBA32F

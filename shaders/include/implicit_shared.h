@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Declarations shared by the implicit-Euler shader (implicit.comp) and the
-// C++ side (engine/src/vulkan/implicit_gpu.cpp). The implicit passes use their own descriptor set
+// C++ side (engine/src/vulkan/passes/implicit_gpu.cpp). The implicit passes use their own descriptor set
 // layout: the main layout's bindings they need (same numbers, same buffers, vkcloth_shared.h)
 // plus the CG buffers below. The implicit passes run batches of one instance. Push constants: the main
 // PushConstants, with fields the implicit passes do not otherwise use carrying the pass parameters

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Declarations shared by self_collision.comp and the C++ side (engine/src/vulkan/
-// self_collision_gpu.cpp). Self-collision's passes use their own descriptor set layout: the main
+// passes/self_collision_gpu.cpp). Self-collision's passes use their own descriptor set layout: the main
 // layout's bindings they need (same numbers, same buffers, vkcloth_shared.h) plus the spatial
 // hash's buffers below. Push constants: SelfPush below, `stage` selecting the pass.
 #ifndef VKCLOTH_SELF_COLLISION_SHARED_H

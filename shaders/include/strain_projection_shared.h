@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Declarations shared by strain_project.comp and the C++ side (engine/src/vulkan/
-// strain_projection_gpu.cpp). The fast projection's pass uses its own descriptor set layout: the
+// passes/strain_projection_gpu.cpp). The fast projection's pass uses its own descriptor set layout: the
 // main layout's bindings it needs (same numbers, same buffers, vkcloth_shared.h) plus its own
 // below. Push constants: ProjectionPush below.
 #ifndef VKCLOTH_STRAIN_PROJECTION_SHARED_H

@@ -359,7 +359,7 @@ TEST_CASE("GPU blow-up detection names the exact step") {
 
 // The two-pass layout's force and integrate passes (and RK4's, and implicit Euler's FORCE and
 // FINISH) are specialised with the collider types of the batch, as the fused pass
-// (SolverBatch::ensure_collider_pipelines): colliders that set_params adds between steps must
+// (each pass's prepare(), passes/): colliders that set_params adds between steps must
 // reach them. The falling cloth without its colliders for 30 steps, then with its plane and
 // sphere (two new types) for 60.
 TEST_CASE("GPU two-pass, RK4 and implicit passes follow colliders added by set_params, as the CPU") {

@@ -119,7 +119,7 @@ inline void after_host_edit(const VolkDeviceTable& vk, VkCommandBuffer cmd) {
 
 namespace vkcloth::gpu::barriers {
 
-/// Between two passes of the implicit step (implicit_gpu.hpp): like dispatch_to_dispatch, and the
+/// Between two passes of the implicit step (passes/implicit_gpu.hpp): like dispatch_to_dispatch, and the
 /// writes of the indirect dispatch arguments (by a reducing pass's last workgroup) become visible
 /// to the next indirect dispatches' argument reads (DRAW_INDIRECT stage). The WAR on those
 /// arguments (read by an earlier dispatch, rewritten by a later pass) is covered because

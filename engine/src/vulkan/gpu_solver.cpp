@@ -9,7 +9,7 @@
 #include <utility>
 
 #include "barriers.hpp"
-#include "implicit_gpu.hpp"
+#include "passes/implicit_gpu.hpp"
 #include "vkcloth/gpu/gpu_solver.hpp"
 #include "vkcloth/gpu/testing.hpp"
 #include "world_impl.hpp"

@@ -27,7 +27,7 @@ namespace vkcloth::gpu {
 DeviceLayout device_layout(const Context::Impl& ctx);
 
 /// The specialisation constant of the workgroup size (common.glsl local_size_x_id), beyond the
-/// solver's constants 0..42 (solver_pipelines.cpp).
+/// solver's constants 0..42 (solver_state_set.cpp).
 inline constexpr std::uint32_t kWorkgroupSizeConstant = 43;
 
 /// Which build of a shader, its workgroup size (DeviceLayout) and the pass it runs. force,

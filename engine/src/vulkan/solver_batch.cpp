@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // SolverBatch: buffers, uploads, readbacks and divergence flags of one batch (the recording of
-// the steps: solver_batch_record.cpp; the descriptor sets and pipelines: solver_pipelines.cpp).
+// the steps: solver_batch_record.cpp; the state set: solver_state_set.cpp; the passes: passes/).
 #include "solver_batch.hpp"
 
 #include <algorithm>

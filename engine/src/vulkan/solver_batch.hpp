@@ -24,7 +24,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
-#include "implicit_gpu.hpp"
+#include "passes/implicit_gpu.hpp"
 #include "passes/pass.hpp"
 #include "pipelines.hpp"
 #include "resources.hpp"
@@ -161,7 +161,7 @@ public:
   /// The batch's shader build and workgroup size, the pass fixed to `stage` (VKCLOTH_ANY_STAGE:
   /// the push constants' stage).
   ShaderVariant variant(std::uint32_t stage = VKCLOTH_ANY_STAGE) const { return {access, workgroup, stage}; }
-  /// The specialisation constants of force, integrate and fused.comp (solver_pipelines.cpp): the
+  /// The specialisation constants of force, integrate and fused.comp (solver_state_set.cpp): the
   /// grid stencil, SC_WRITE_AUX, SC_COLLIDER_TYPES = `types` and SC_NORMAL_FLAGS; `csr` the
   /// defaults instead of the stencil and every normal path (the implicit passes' gather).
   std::array<std::uint32_t, 43> state_constants(bool write_aux, std::uint32_t types, bool csr = false) const;

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // SolverBatch's creation: the device limits checked first (batch_limits.hpp), then the buffers and
-// the upload of the topology and the initial state (the descriptor sets and pipelines:
-// solver_pipelines.cpp; the rest of the batch: solver_batch.cpp).
+// the upload of the topology and the initial state (the state set:
+// solver_state_set.cpp; the passes: passes/; the rest of the batch: solver_batch.cpp).
 #include "solver_batch.hpp"
 
 #include <algorithm>

@@ -2,7 +2,7 @@
 // SolverBatch's recording: the passes of each step (passes/passes.cpp) into the caller's command
 // buffer, in list order, each after the barrier that orders it (barriers.hpp says why each barrier
 // is there); before them, what the host changed (parameters, collider poses). The buffers, uploads
-// and readbacks: solver_batch.cpp; the state set: solver_pipelines.cpp.
+// and readbacks: solver_batch.cpp; the state set: solver_state_set.cpp.
 #include "solver_batch.hpp"
 
 #include <algorithm>

@@ -9,7 +9,8 @@
 // Per step (implicit):   force -> system -> cg_max_iterations x (matvec -> update -> direction,
 //                        indirect: empty once converged; the sums in each pass's last workgroup),
 //                        or a few one-workgroup CG dispatches (GpuSolverOptions::cg_dispatch)
-//                        -> finish (implicit_gpu.hpp); every scheme repeats its passes `substeps` times
+//                        -> finish (passes/implicit_gpu.hpp); every scheme repeats its passes `substeps`
+//                        times
 //
 // Buffers (device-local storage buffers, vec4 per particle, w unused; positions have w = 1):
 // positions[2] (ping-pong), velocities, forces, normals (unit, zero for chains; fused Euler

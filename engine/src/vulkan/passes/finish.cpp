@@ -27,8 +27,9 @@ public:
   explicit FinishPass(Stage stage) : stage_(stage) {}
 
   const char* name() const override {
-    return stage_ == tethers ? "tethers" : stage_ == after_stretch ? "contacts after stretch control"
-                                                                   : "contacts after self-collision";
+    return stage_ == tethers         ? "tethers"
+           : stage_ == after_stretch ? "contacts after stretch control"
+                                     : "contacts after self-collision";
   }
   bool active(const SolverBatch& b) const override {
     switch (stage_) {
@@ -71,7 +72,9 @@ public:
   }
 
 private:
-  std::uint32_t collider_types(const SolverBatch& b) const { return stage_ == tethers ? 0u : b.collider_types(); }
+  std::uint32_t collider_types(const SolverBatch& b) const {
+    return stage_ == tethers ? 0u : b.collider_types();
+  }
   Stage stage_;
   VkPipeline pipelines_[VKCLOTH_COLLIDER_ALL_TYPES + 1] = {}; // [collider types]
 };

@@ -6,7 +6,7 @@
 
 #include <memory>
 
-#include "../implicit_gpu.hpp"
+#include "implicit_gpu.hpp"
 #include "pass.hpp"
 
 namespace vkcloth::gpu {

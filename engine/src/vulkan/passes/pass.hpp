@@ -23,10 +23,10 @@ class SolverBatch;
 /// One substep (or the end of a recording) as its passes see it.
 struct PassFrame {
   VkCommandBuffer cmd = VK_NULL_HANDLE;
-  std::uint32_t read = 0;               // positions[read]: the substep's input; positions[read ^ 1]: its output
-  shared::PushConstants* pc = nullptr;  // the common fields (count, grid, step); a pass may set `stage`
-  bool first = false;                   // the recording's first dispatch: before_steps() ordered it already
-  bool last = false;                    // the recording's last substep (the one whose forces are observed)
+  std::uint32_t read = 0; // positions[read]: the substep's input; positions[read ^ 1]: its output
+  shared::PushConstants* pc = nullptr; // the common fields (count, grid, step); a pass may set `stage`
+  bool first = false;                  // the recording's first dispatch: before_steps() ordered it already
+  bool last = false;                   // the recording's last substep (the one whose forces are observed)
 };
 
 class Pass {

@@ -8,7 +8,7 @@
 
 #include "../../core/kernel.hpp"
 #include "../batch_limits.hpp"
-#include "../self_collision_gpu.hpp"
+#include "self_collision_gpu.hpp"
 #include "../solver_batch.hpp"
 #include "pass.hpp"
 
@@ -28,8 +28,8 @@ public:
       return {};
     const std::uint32_t count = b.particle_count();
     // Its largest buffer holds two vec4 per particle of every instance (a move and a velocity change).
-    VKCLOTH_TRY(check_buffer(b.context(), storage_limit(b.context(), b.solver_knobs()), "self-collision moves",
-                             std::uint64_t(b.size()) * count, 32));
+    VKCLOTH_TRY(check_buffer(b.context(), storage_limit(b.context(), b.solver_knobs()),
+                             "self-collision moves", std::uint64_t(b.size()) * count, 32));
     auto r = SelfCollisionGpu::create(b.shared_context(), count, b.size(),
                                       b.context().properties.limits.maxComputeWorkGroupCount[0],
                                       !b.solver_knobs().force_staging, b.buffer_access());
@@ -41,8 +41,9 @@ public:
       rest[p] = {float(q.position.x), float(q.position.y), float(q.position.z),
                  kernel::inverse_mass(float(q.mass), q.pinned)};
     }
-    const SolverBatch::Upload up[] = {{&(*r)->rest_positions(), rest.data(), rest.size() * sizeof(shared::vec4)},
-                                      {&(*r)->counts(), nullptr, 0}};
+    const SolverBatch::Upload up[] = {
+        {&(*r)->rest_positions(), rest.data(), rest.size() * sizeof(shared::vec4)},
+        {&(*r)->counts(), nullptr, 0}};
     VKCLOTH_TRY(b.upload(up));
     gpu_ = std::move(*r);
     write_params(b, VK_NULL_HANDLE);

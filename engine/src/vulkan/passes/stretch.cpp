@@ -9,7 +9,7 @@
 #include "../barriers.hpp"
 #include "../batch_limits.hpp"
 #include "../solver_batch.hpp"
-#include "../strain_projection_gpu.hpp"
+#include "strain_projection_gpu.hpp"
 #include "pass.hpp"
 #include "state_set.hpp"
 #include "vkcloth/shaders/strain_links_storage_comp_spv.hpp"
@@ -34,7 +34,9 @@ std::uint32_t provot_sweeps(const SolverBatch& b) {
 class StrainLinks final : public Pass {
 public:
   const char* name() const override { return "Provot's sweeps"; }
-  bool active(const SolverBatch& b) const override { return provot_sweeps(b) > 0 && b.strain_link_count() > 0; }
+  bool active(const SolverBatch& b) const override {
+    return provot_sweeps(b) > 0 && b.strain_link_count() > 0;
+  }
 
   Result<void> prepare(SolverBatch& b) override {
     if (pipeline_ || !active(b))
@@ -85,9 +87,10 @@ public:
     if (gpu_ || !active(b))
       return {};
     // Its largest buffer holds two vec4 per strain link of every instance.
-    VKCLOTH_TRY(check_buffer(b.context(), storage_limit(b.context(), b.solver_knobs()), "strain projection links",
-                             std::uint64_t(b.size()) * b.strain_link_count(), 32));
-    auto r = StrainProjectionGpu::create(b.shared_context(), b.topology(), b.size(), !b.solver_knobs().force_staging);
+    VKCLOTH_TRY(check_buffer(b.context(), storage_limit(b.context(), b.solver_knobs()),
+                             "strain projection links", std::uint64_t(b.size()) * b.strain_link_count(), 32));
+    auto r = StrainProjectionGpu::create(b.shared_context(), b.topology(), b.size(),
+                                         !b.solver_knobs().force_staging);
     if (!r)
       return r.error();
     const std::vector<std::uint32_t> incidence = StrainProjectionGpu::incidence_data(b.topology());

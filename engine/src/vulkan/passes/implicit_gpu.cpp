@@ -12,8 +12,8 @@
 
 #include <fmt/format.h>
 
-#include "barriers.hpp"
-#include "pipelines.hpp"
+#include "../barriers.hpp"
+#include "../pipelines.hpp"
 #include "implicit_shared.h"
 #include "vkcloth/shaders/implicit_comp_spv.hpp"
 

@@ -6,9 +6,9 @@
 #include <utility>
 #include <tuple>
 
-#include "../core/kernel.hpp"
-#include "barriers.hpp"
-#include "pipelines.hpp"
+#include "../../core/kernel.hpp"
+#include "../barriers.hpp"
+#include "../pipelines.hpp"
 #include "vkcloth/shaders/self_collision_storage_comp_spv.hpp"
 #include "vkcloth/shaders/self_collision_texel_comp_spv.hpp"
 

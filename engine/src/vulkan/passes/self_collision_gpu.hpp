@@ -18,8 +18,8 @@
 
 #include <glm/vec3.hpp>
 
-#include "pipelines.hpp"
-#include "resources.hpp"
+#include "../pipelines.hpp"
+#include "../resources.hpp"
 #include "self_collision_shared.h"
 #include "vkcloth/params.hpp"
 

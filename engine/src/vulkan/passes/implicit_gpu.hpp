@@ -22,7 +22,7 @@
 #include <memory>
 #include <span>
 
-#include "resources.hpp"
+#include "../resources.hpp"
 #include "vkcloth/params.hpp"
 #include "implicit_shared.h"
 #include "vkcloth_shared.h"
@@ -54,7 +54,7 @@ public:
   Result<void> write_sets(const ImplicitInputs& in);
   /// The FORCE and FINISH passes (the ones that meet colliders) for collider types `types`,
   /// specialised with `constants` (force_body.glsl's, SC_COLLIDER_TYPES = types); made once per
-  /// types (SolverBatch::ensure_collider_pipelines), before a substep with them is recorded.
+  /// types (passes/implicit_update.cpp prepare), before a substep with them is recorded.
   Result<void> ensure_collider_passes(std::uint32_t types, std::span<const std::uint32_t> constants);
   /// Records one substep reading positions[read], writing positions[read ^ 1]. `pc` is the main
   /// push-constant block (the substep's dt is in the InstanceParams); `types`: the batch's collider

@@ -13,8 +13,8 @@
 #include <span>
 #include <vector>
 
-#include "pipelines.hpp"
-#include "resources.hpp"
+#include "../pipelines.hpp"
+#include "../resources.hpp"
 #include "strain_projection_shared.h"
 #include "vkcloth/topology.hpp"
 
