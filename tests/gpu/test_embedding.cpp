@@ -713,8 +713,8 @@ TEST_CASE("set_collider_pose: a pose per frame with two frames in flight on the 
   std::vector<glm::vec3> cpu =
       posed_frames(*cpu_world, *c, frames, [&](int) { REQUIRE(cpu_world->simulate(steps_per_frame).ok()); });
   CHECK_MESSAGE(diff(gpu, cpu).max_abs <= 1e-5, "GPU vs CPU: " << diff(gpu, cpu).max_abs << " m");
-  MESSAGE("pose updates, GPU in flight vs CPU: max |dp| = " << diff(gpu, cpu).max_abs << " m"
-                                                            << std::string(diff(gpu, cpu).bitwise ? " (bitwise)" : ""));
+  MESSAGE("pose updates, GPU in flight vs CPU: max |dp| = "
+          << diff(gpu, cpu).max_abs << " m" << std::string(diff(gpu, cpu).bitwise ? " (bitwise)" : ""));
 
   // The cloth met the moving sphere and the floor (the poses were not a no-op).
   float lowest = 1e9f;
@@ -754,7 +754,8 @@ TEST_CASE("set_collider_pose: a pose per frame with two frames in flight on the 
   bad.angular_velocity = {0.0, 0.0, 1.0}; // a plane cannot turn
   r = gpu_world->set_collider_pose(*g, 0, bad);
   REQUIRE_FALSE(r.ok());
-  CHECK_MESSAGE(r.error().message.find("colliders[0].angular_velocity") != std::string::npos, r.error().message);
+  CHECK_MESSAGE(r.error().message.find("colliders[0].angular_velocity") != std::string::npos,
+                r.error().message);
   r = cpu_world->set_collider_pose(*c + 100, 0, ColliderPose{});
   REQUIRE_FALSE(r.ok());
   CHECK_MESSAGE(r.error().message.find("no cloth instance") != std::string::npos, r.error().message);
@@ -830,8 +831,8 @@ void hand_over(HostVulkan& host, Context& reference_ctx, bool ownership = true) 
     // (TRANSFER), so synchronization validation sees a real read after the compute writes.
     // Without ownership transfers the wait on `simulated` at TRANSFER alone orders the reads.
     if (ownership)
-      world->record_acquire(
-          g, {compute, graphics, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT});
+      world->record_acquire(g,
+                            {compute, graphics, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT});
     const InstanceBuffers b = world->buffers(*id).value();
     const VkDeviceSize bytes = b.count * b.stride, at = 2 * bytes * VkDeviceSize(f);
     REQUIRE(host.record_read(g, b.positions, bytes, at)); // each frame its own regions

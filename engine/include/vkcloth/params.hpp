@@ -43,7 +43,7 @@ const char* to_string(Integrator integrator);
 std::optional<Integrator> parse_integrator(std::string_view name);
 
 struct ColliderPose; // below: a collider's pose for a per-frame update
-class ColliderMesh; // vkcloth/collider_mesh.hpp: a static triangle mesh and its bounding-volume hierarchy
+class ColliderMesh;  // vkcloth/collider_mesh.hpp: a static triangle mesh and its bounding-volume hierarchy
 
 /// A collider (docs/model.md "Collisions", docs/scene-format.md "colliders"): a shape, its friction and
 /// its motion. Every shape has the report's semantics: within 2 eps of the surface the inward parts of

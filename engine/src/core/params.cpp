@@ -238,8 +238,8 @@ Result<void> ColliderPose::validate() const {
         return bad(fmt::format("pose.rotation must be finite, got column {} = {}", col, str(r[col])));
     const double off = rotation_error(r);
     if (!(off < 1e-6))
-      return bad(fmt::format("pose.rotation must be a rotation matrix (orthonormal, determinant 1); it is off by {}",
-                             off));
+      return bad(fmt::format(
+          "pose.rotation must be a rotation matrix (orthonormal, determinant 1); it is off by {}", off));
   }
   return {};
 }

@@ -259,6 +259,7 @@ private:
   std::unique_ptr<Impl> impl_;
 };
 
-static_assert(InstanceBuffers::stride == GpuSolver::stride, "one vec4 per particle in every per-particle buffer");
+static_assert(InstanceBuffers::stride == GpuSolver::stride,
+              "one vec4 per particle in every per-particle buffer");
 
 } // namespace vkcloth::gpu
