@@ -798,8 +798,9 @@ namespace {
 /// (family), the graphics side in graphics_cmd on graphics_queue (graphics_family), a semaphore
 /// each way, a copy standing in for the draw; then the positions against a plain run.
 /// `ownership` false: section 4's "Two submissions on one queue family", the semaphores alone (no
-/// release / acquire, no record_barrier_to).
-void hand_over(HostVulkan& host, Context& reference_ctx, bool ownership = true) {
+/// release / acquire, no record_barrier_to); `drawn_semaphore` false: on ONE queue, no semaphore
+/// from the graphics submission to the next compute one (the recording's first barrier orders it).
+void hand_over(HostVulkan& host, Context& reference_ctx, bool ownership = true, bool drawn_semaphore = true) {
   auto adopted = Context::adopt(handles_of(host, nullptr));
   REQUIRE(adopted.ok());
   auto topo = make_topology(10, 8);
@@ -810,7 +811,7 @@ void hand_over(HostVulkan& host, Context& reference_ctx, bool ownership = true) 
   auto id = world->add(topo, p);
   REQUIRE(id.ok());
   const std::uint32_t compute = host.family, graphics = host.graphics_family;
-  VkSemaphore simulated = host.semaphores[0], drawn = host.semaphores[1];
+  VkSemaphore simulated = host.semaphores[0], drawn = drawn_semaphore ? host.semaphores[1] : VK_NULL_HANDLE;
   constexpr int frames = 6;
   for (int f = 0; f < frames; ++f) {
     REQUIRE(host.begin_frame(0)); // the compute queue's command buffer
@@ -822,7 +823,8 @@ void hand_over(HostVulkan& host, Context& reference_ctx, bool ownership = true) 
     if (ownership)
       world->record_release(
           c, {compute, graphics, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT});
-    REQUIRE(host.submit_frame(0, f > 0 ? drawn : VK_NULL_HANDLE, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+    REQUIRE(host.submit_frame(0, f > 0 ? drawn : VK_NULL_HANDLE,
+                              drawn ? VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT : VkPipelineStageFlags(0),
                               simulated));
 
     REQUIRE(host.begin_graphics());
@@ -880,7 +882,13 @@ TEST_CASE("Two submissions on one queue family (computecloth's pattern): the sem
   if (!host)
     return;
   REQUIRE(host->graphics_family == host->family);
-  hand_over(*host, ctx, false);
+  REQUIRE(host->graphics_queue == host->queue);
+  SUBCASE("a semaphore each way (also what two queues of the family need)") {
+    hand_over(*host, ctx, false);
+  }
+  SUBCASE("one queue: the compute submission's semaphore only") {
+    hand_over(*host, ctx, false, false);
+  }
 }
 
 TEST_CASE("Queue-family hand-over between a compute-only family and a graphics family (where a "
