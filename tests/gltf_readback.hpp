@@ -24,8 +24,9 @@ namespace vkcloth::test {
 /// An exported animation as the file holds it: vertices in the file's order.
 struct GltfAnimation {
   tinygltf::Model model;
-  std::vector<float> times;                   ///< one per frame
-  std::vector<std::vector<glm::vec3>> frames; ///< positions per frame, rebuilt from the encoding
+  std::vector<float> times;                    ///< one per frame
+  std::vector<std::vector<glm::vec3>> frames;  ///< positions per frame, rebuilt from the encoding
+  std::vector<std::vector<glm::vec3>> normals; ///< NORMAL per frame, rebuilt the same way
   std::vector<glm::vec2> uvs;
   std::vector<std::uint32_t> indices;
 };
@@ -62,14 +63,34 @@ inline std::vector<std::uint32_t> read_indices(const tinygltf::Model& m, int ind
   return accessor_values<std::uint32_t>(m, index);
 }
 
-/// Frame f = base + sum_i w_f[i] target_i, with w_f the weights animation's output at key f.
+/// Frame f = base + sum_i w_f[i] target_i, with w_f the weights animation's output at key f:
+/// `attribute` ("POSITION" or "NORMAL") of every frame.
+inline std::vector<std::vector<glm::vec3>>
+rebuild_attribute(const GltfAnimation& g, const std::string& attribute, const std::vector<float>& weights) {
+  const tinygltf::Primitive& prim = g.model.meshes.at(0).primitives.at(0);
+  const auto base = as_vec3(accessor_values<float>(g.model, prim.attributes.at(attribute)));
+  const std::size_t targets = prim.targets.size();
+  std::vector<std::vector<glm::vec3>> deltas;
+  for (const auto& t : prim.targets)
+    deltas.push_back(as_vec3(accessor_values<float>(g.model, t.at(attribute))));
+  std::vector<std::vector<glm::vec3>> out;
+  for (std::size_t f = 0; f < g.times.size(); ++f) {
+    std::vector<glm::vec3> frame = base;
+    for (std::size_t i = 0; i < targets; ++i)
+      for (std::size_t k = 0; k < frame.size(); ++k)
+        frame[k] += weights[f * targets + i] * deltas[i][k];
+    out.push_back(std::move(frame));
+  }
+  return out;
+}
+
 inline void rebuild_frames(GltfAnimation& g) {
   const tinygltf::Primitive& prim = g.model.meshes.at(0).primitives.at(0);
-  const auto base = as_vec3(accessor_values<float>(g.model, prim.attributes.at("POSITION")));
   if (g.model.animations.empty()) {
     REQUIRE(prim.targets.empty());
     g.times = {0.0f};
-    g.frames = {base};
+    g.frames = rebuild_attribute(g, "POSITION", {});
+    g.normals = rebuild_attribute(g, "NORMAL", {});
     return;
   }
   const tinygltf::Animation& anim = g.model.animations.at(0);
@@ -82,16 +103,8 @@ inline void rebuild_frames(GltfAnimation& g) {
   const auto weights = accessor_values<float>(g.model, s.output);
   const std::size_t targets = prim.targets.size();
   REQUIRE(weights.size() == g.times.size() * targets);
-  std::vector<std::vector<glm::vec3>> deltas;
-  for (const auto& t : prim.targets)
-    deltas.push_back(as_vec3(accessor_values<float>(g.model, t.at("POSITION"))));
-  for (std::size_t f = 0; f < g.times.size(); ++f) {
-    std::vector<glm::vec3> frame = base;
-    for (std::size_t i = 0; i < targets; ++i)
-      for (std::size_t k = 0; k < frame.size(); ++k)
-        frame[k] += weights[f * targets + i] * deltas[i][k];
-    g.frames.push_back(std::move(frame));
-  }
+  g.frames = rebuild_attribute(g, "POSITION", weights);
+  g.normals = rebuild_attribute(g, "NORMAL", weights);
 }
 
 /// Images are not decoded: the tests compare the embedded bytes.

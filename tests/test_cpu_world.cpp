@@ -5,6 +5,8 @@
 // state, and a divergence that freezes and names one instance while the others go on.
 #include <doctest/doctest.h>
 
+#include <glm/geometric.hpp>
+
 #include <cstring>
 #include <limits>
 #include <string>
@@ -335,4 +337,61 @@ TEST_CASE("CpuWorld: a diverging instance is frozen and named, the others go on"
   REQUIRE(world->remove(*b).ok());
   CHECK(world->check_divergence().ok());
   CHECK(world->simulate(1).ok());
+}
+
+TEST_CASE("Collider::with_pose: each shape moved and turned as ColliderPose says, the rest kept") {
+  const glm::dmat3 quarter_x(glm::dvec3(1, 0, 0), glm::dvec3(0, 0, 1), glm::dvec3(0, -1, 0)); // z -> -y
+  ColliderPose pose;
+  pose.position = {1.0, 2.0, 3.0};
+  pose.linear_velocity = {0.5, 0.0, 0.0};
+  pose.angular_velocity = {0.0, 0.0, 2.0};
+
+  Collider sphere = Collider::sphere({0, 0, 0}, 0.3);
+  sphere.friction = 0.8;
+  const Collider s = sphere.with_pose(pose);
+  CHECK(s.center == pose.position);
+  CHECK(s.radius == 0.3);
+  CHECK(s.friction == 0.8);
+  CHECK(s.linear_velocity == pose.linear_velocity);
+  CHECK(s.angular_velocity == pose.angular_velocity);
+
+  const Collider capsule = Collider::capsule({0, 0, -0.5}, {0, 0, 0.5}, 0.1);
+  const Collider moved = capsule.with_pose(pose); // no rotation: only moved
+  CHECK(moved.a == glm::dvec3(1.0, 2.0, 2.5));
+  CHECK(moved.b == glm::dvec3(1.0, 2.0, 3.5));
+  pose.rotation = quarter_x; // the axis becomes the rotation's third column, its length kept
+  const Collider turned = capsule.with_pose(pose);
+  CHECK(glm::length(turned.a - glm::dvec3(1.0, 2.5, 3.0)) < 1e-15);
+  CHECK(glm::length(turned.b - glm::dvec3(1.0, 1.5, 3.0)) < 1e-15);
+
+  const Collider box = Collider::box({0, 0, 0}, {0.1, 0.2, 0.3}).with_pose(pose);
+  CHECK(box.center == pose.position);
+  CHECK(box.rotation == quarter_x);
+  CHECK(box.half_extents == glm::dvec3(0.1, 0.2, 0.3));
+
+  pose.angular_velocity = {};
+  const Collider plane = Collider::plane({0, 0, 2}, 1.0).with_pose(pose); // normal -> -y, through (1, 2, 3)
+  CHECK(glm::length(plane.normal - glm::dvec3(0, -1, 0)) < 1e-15);
+  CHECK(plane.offset == doctest::Approx(-2.0));
+  pose.rotation.reset();
+  const Collider level = Collider::plane({0, 0, 2}, 1.0).with_pose(pose); // an unnormalised normal
+  CHECK(level.offset == doctest::Approx(3.0)); // along the unit normal, as validate() reads it
+
+  // with_collider_pose: the index and the pose are checked, the errors name them.
+  SimParams p;
+  p.colliders = {sphere};
+  auto r = with_collider_pose(p, 1, pose);
+  REQUIRE_FALSE(r.ok());
+  CHECK_MESSAGE(r.error().message.find("colliders[1]: no such collider to pose, the cloth has 1 collider") !=
+                    std::string::npos,
+                r.error().message);
+  pose.linear_velocity.y = std::numeric_limits<double>::infinity();
+  r = with_collider_pose(p, 0, pose);
+  REQUIRE_FALSE(r.ok());
+  CHECK_MESSAGE(r.error().message.find("pose.linear_velocity") != std::string::npos, r.error().message);
+  pose.linear_velocity.y = 0.0;
+  r = with_collider_pose(p, 0, pose);
+  REQUIRE(r.ok());
+  CHECK(r->colliders[0].center == pose.position);
+  CHECK(r->colliders[0].friction == 0.8);
 }

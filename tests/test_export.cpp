@@ -202,6 +202,64 @@ TEST_CASE("export: a shuffled mesh cloth is written in its file's vertex order")
     CHECK(g.indices == std::vector<std::uint32_t>(file_triangles.begin(), file_triangles.end()));
     for (std::uint32_t v = 0; v < 6; ++v)
       CHECK(g.uvs[v] == file_uv(v));
+    // Normals follow the vertices into the file's order.
+    const auto topology = ClothTopology::create(system).value();
+    const auto order = file_order(system);
+    for (std::size_t f = 0; f < r.frames.size(); ++f) {
+      const std::vector<glm::vec3> x(r.frames[f].begin(), r.frames[f].end());
+      const std::vector<glm::vec3> n = topology->vertex_normals(x).value();
+      for (std::size_t k = 0; k < order.size(); ++k)
+        CHECK(glm::length(g.normals[f][k] - n[order[k]]) <= 1e-6f);
+    }
+  }
+}
+
+TEST_CASE("export: NORMAL and its morph deltas are the renderer's smooth normals of each frame, unit "
+          "length; the positions are unchanged") {
+  // The renderer draws the solver's normals buffer; CpuSolver<float>::normals() is what the GPU
+  // tests compare it with. A step's normals are those of the positions it starts from (the force
+  // pass), so frame f's reference normals are read after the step that starts at frame f.
+  ClothDesc desc;
+  desc.nx = 9;
+  desc.ny = 7;
+  SimParams params;
+  params.wind.strength = 0.05; // a curved, twisted cloth: normals far from one another
+  params.wind.direction = {0.3, 1.0, 0.2};
+  const ParticleSystem system = make_cloth(desc).value();
+  auto solver = CpuSolver<float>::create(system, params);
+  REQUIRE(solver);
+  Recorded r;
+  std::vector<std::vector<glm::vec3>> renderer;
+  for (int f = 0; f < 5; ++f) {
+    REQUIRE(solver->run(f == 0 ? 0 : 7));
+    r.times.push_back(0.14 * f);
+    r.frames.emplace_back(solver->positions().begin(), solver->positions().end());
+    REQUIRE(solver->step());
+    renderer.emplace_back(solver->normals().begin(), solver->normals().end());
+  }
+  const AnimationRecorder rec = record(system, r);
+  for (const char* name : {"normals.glb", "normals.gltf"}) {
+    CAPTURE(name);
+    REQUIRE(rec.write_gltf(tmp(name)));
+    const GltfAnimation g = read_gltf_animation(tmp(name));
+    check_frames(g, system, r); // positions exactly as before
+    REQUIRE(g.normals.size() == r.frames.size());
+    double worst = 0.0, worst_length = 0.0, spread = 0.0;
+    for (std::size_t f = 0; f < g.normals.size(); ++f)
+      for (std::size_t k = 0; k < system.size(); ++k) { // a grid: file order = particle order
+        const glm::vec3 n = g.normals[f][k];
+        worst = std::max(worst, double(glm::length(n - renderer[f][k])));
+        worst_length = std::max(worst_length, std::abs(double(glm::length(n)) - 1.0));
+        spread = std::max(spread, double(glm::length(n - g.normals[0][0])));
+      }
+    MESSAGE("normals vs the renderer's: max |dn| = " << worst << ", max ||n| - 1| = " << worst_length);
+    CHECK(worst <= 1e-3);
+    CHECK(worst_length <= 1e-5);
+    CHECK(spread > 0.1); // not one flat normal
+    // The base NORMAL itself is unit (the validator checks it).
+    const tinygltf::Primitive& prim = g.model.meshes.at(0).primitives.at(0);
+    for (const glm::vec3 n : as_vec3(accessor_values<float>(g.model, prim.attributes.at("NORMAL"))))
+      CHECK(std::abs(glm::length(n) - 1.0f) <= 1e-6f);
   }
 }
 

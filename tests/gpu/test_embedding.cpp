@@ -11,6 +11,9 @@
 #include <cstring>
 #include <map>
 #include <mutex>
+#include <utility>
+
+#include <glm/gtc/matrix_transform.hpp>
 
 namespace {
 
@@ -633,6 +636,133 @@ TEST_CASE("Per-frame parameters: two frames in flight changing dt, gravity, wind
   CHECK(host->messages.load() == 0);
 }
 
+namespace {
+
+/// Colliders set once (shape, friction): a frictionless floor, a sticky sphere ("stick on
+/// contact", docs/embedding.md) and a turning box.
+SimParams posed_start_params() {
+  SimParams p;
+  p.dt = 0.005;
+  Collider sphere = Collider::sphere({-0.2, 0.0, 0.05}, 0.2);
+  sphere.friction = 0.8;
+  Collider box = Collider::box({0.3, 0.0, 0.1}, {0.08, 0.3, 0.05});
+  box.friction = 0.4;
+  p.colliders = {Collider::plane({0, 0, 1}, 0.0), sphere, box};
+  return p;
+}
+
+/// Frame k's poses of colliders 1 (the sphere slides along x) and 2 (the box turns about z).
+std::pair<ColliderPose, ColliderPose> frame_poses(int k) {
+  ColliderPose sphere;
+  sphere.position = {-0.2 + 0.01 * k, 0.03 * std::sin(0.4 * k), 0.05};
+  sphere.linear_velocity = {1.0, 0.0, 0.0};
+  ColliderPose box;
+  box.position = {0.3, 0.0, 0.1};
+  box.rotation = glm::dmat3(glm::rotate(glm::dmat4(1.0), 0.05 * k, glm::dvec3(0, 0, 1)));
+  box.angular_velocity = {0.0, 0.0, 5.0};
+  return {sphere, box};
+}
+
+/// The host's frame loop for either world: each frame poses two colliders (nothing else resent),
+/// then `run_frame` steps it.
+template <typename World, typename RunFrame>
+std::vector<glm::vec3> posed_frames(World& world, InstanceId id, int frames, RunFrame run_frame) {
+  for (int k = 0; k < frames; ++k) {
+    const auto [sphere, box] = frame_poses(k);
+    REQUIRE(world.set_collider_pose(id, 1, sphere).ok());
+    REQUIRE(world.set_collider_pose(id, 2, box).ok());
+    run_frame(k);
+  }
+  return world.positions(id).value();
+}
+
+} // namespace
+
+TEST_CASE("set_collider_pose: a pose per frame with two frames in flight on the GPU, the CPU world's "
+          "positions within 1e-5 m; shape and friction kept, bad poses refused") {
+  VKCLOTH_GPU_TEST_BEGIN(ctx);
+  std::string error;
+  auto host = host_or_skip(error);
+  if (!host)
+    return;
+  auto adopted = Context::adopt(handles_of(*host, nullptr));
+  REQUIRE(adopted.ok());
+  auto topo = make_topology(16, 12, true);
+  constexpr int frames = 40;
+  constexpr std::uint32_t steps_per_frame = 2;
+
+  auto gpu_world = ClothWorld::create(*adopted);
+  REQUIRE(gpu_world.ok());
+  auto g = gpu_world->add(topo, posed_start_params());
+  REQUIRE(g.ok());
+  std::vector<glm::vec3> gpu = posed_frames(*gpu_world, *g, frames, [&](int k) {
+    const std::uint32_t slot = std::uint32_t(k) % HostVulkan::frames_in_flight; // waits for frame k - 2 only
+    REQUIRE(host->begin_frame(slot));
+    gpu_world->record_steps(host->frame_cmd[slot], steps_per_frame);
+    gpu_world->record_barrier_to(host->frame_cmd[slot], VK_PIPELINE_STAGE_TRANSFER_BIT,
+                                 VK_ACCESS_TRANSFER_READ_BIT);
+    REQUIRE(host->submit_frame(slot));
+  });
+  REQUIRE(host->wait_frames());
+  REQUIRE(gpu_world->check_divergence().ok());
+
+  auto cpu_world = CpuWorld::create();
+  REQUIRE(cpu_world.ok());
+  auto c = cpu_world->add(topo, posed_start_params());
+  REQUIRE(c.ok());
+  std::vector<glm::vec3> cpu =
+      posed_frames(*cpu_world, *c, frames, [&](int) { REQUIRE(cpu_world->simulate(steps_per_frame).ok()); });
+  CHECK_MESSAGE(diff(gpu, cpu).max_abs <= 1e-5, "GPU vs CPU: " << diff(gpu, cpu).max_abs << " m");
+  MESSAGE("pose updates, GPU in flight vs CPU: max |dp| = "
+          << diff(gpu, cpu).max_abs << " m" << std::string(diff(gpu, cpu).bitwise ? " (bitwise)" : ""));
+
+  // The cloth met the moving sphere and the floor (the poses were not a no-op).
+  float lowest = 1e9f;
+  for (const auto& x : gpu)
+    lowest = std::min(lowest, x.z);
+  CHECK(lowest < 0.1f);
+
+  // Only the pose changed: shape and friction are the ones given at add(); the sphere is where
+  // the last pose put it, advanced by its velocity over that frame's steps.
+  for (const SimParams& p : {gpu_world->params(*g).value(), cpu_world->params(*c).value()}) {
+    REQUIRE(p.colliders.size() == 3);
+    CHECK(p.colliders[1].radius == 0.2);
+    CHECK(p.colliders[1].friction == 0.8);
+    CHECK(p.colliders[2].half_extents == glm::dvec3(0.08, 0.3, 0.05));
+    CHECK(p.colliders[2].friction == 0.4);
+    const double t = steps_per_frame * 0.005;
+    CHECK(p.colliders[1].center.x == doctest::Approx(-0.2 + 0.01 * (frames - 1) + t).epsilon(1e-12));
+  }
+
+  // Bad poses: named, nothing changed.
+  const SimParams before = cpu_world->params(*c).value();
+  ColliderPose bad;
+  auto r = cpu_world->set_collider_pose(*c, 3, bad);
+  REQUIRE_FALSE(r.ok());
+  CHECK_MESSAGE(r.error().message.find("colliders[3]") != std::string::npos, r.error().message);
+  CHECK_MESSAGE(r.error().message.find("3 colliders") != std::string::npos, r.error().message);
+  bad.rotation = glm::dmat3(2.0);
+  r = gpu_world->set_collider_pose(*g, 2, bad);
+  REQUIRE_FALSE(r.ok());
+  CHECK_MESSAGE(r.error().message.find("pose.rotation") != std::string::npos, r.error().message);
+  bad.rotation.reset();
+  bad.position.x = std::nan("");
+  r = cpu_world->set_collider_pose(*c, 1, bad);
+  REQUIRE_FALSE(r.ok());
+  CHECK_MESSAGE(r.error().message.find("pose.position") != std::string::npos, r.error().message);
+  bad.position = {};
+  bad.angular_velocity = {0.0, 0.0, 1.0}; // a plane cannot turn
+  r = gpu_world->set_collider_pose(*g, 0, bad);
+  REQUIRE_FALSE(r.ok());
+  CHECK_MESSAGE(r.error().message.find("colliders[0].angular_velocity") != std::string::npos,
+                r.error().message);
+  r = cpu_world->set_collider_pose(*c + 100, 0, ColliderPose{});
+  REQUIRE_FALSE(r.ok());
+  CHECK_MESSAGE(r.error().message.find("no cloth instance") != std::string::npos, r.error().message);
+  CHECK(cpu_world->params(*c)->colliders[1].center == before.colliders[1].center);
+  CHECK(host->messages.load() == 0);
+}
+
 TEST_CASE("flip_normals: the normals buffer points the other way, the physics is unchanged (bitwise)") {
   VKCLOTH_GPU_TEST_BEGIN(ctx);
   auto topo = make_topology(12, 9, true); // horizontal: normals +z by default (the header's rule)
@@ -667,7 +797,10 @@ namespace {
 /// docs/embedding.md section 6, frame by frame: the compute side in frame_cmd[0] on `queue`
 /// (family), the graphics side in graphics_cmd on graphics_queue (graphics_family), a semaphore
 /// each way, a copy standing in for the draw; then the positions against a plain run.
-void hand_over(HostVulkan& host, Context& reference_ctx) {
+/// `ownership` false: section 4's "Two submissions on one queue family", the semaphores alone (no
+/// release / acquire, no record_barrier_to); `drawn_semaphore` false: on ONE queue, no semaphore
+/// from the graphics submission to the next compute one (the recording's first barrier orders it).
+void hand_over(HostVulkan& host, Context& reference_ctx, bool ownership = true, bool drawn_semaphore = true) {
   auto adopted = Context::adopt(handles_of(host, nullptr));
   REQUIRE(adopted.ok());
   auto topo = make_topology(10, 8);
@@ -678,31 +811,36 @@ void hand_over(HostVulkan& host, Context& reference_ctx) {
   auto id = world->add(topo, p);
   REQUIRE(id.ok());
   const std::uint32_t compute = host.family, graphics = host.graphics_family;
-  VkSemaphore simulated = host.semaphores[0], drawn = host.semaphores[1];
+  VkSemaphore simulated = host.semaphores[0], drawn = drawn_semaphore ? host.semaphores[1] : VK_NULL_HANDLE;
   constexpr int frames = 6;
   for (int f = 0; f < frames; ++f) {
     REQUIRE(host.begin_frame(0)); // the compute queue's command buffer
     VkCommandBuffer c = host.frame_cmd[0];
-    if (f > 0) // the buffers come back from the graphics family
+    if (ownership && f > 0) // the buffers come back from the graphics family
       world->record_acquire(c, {graphics, compute, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                                 VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT});
     world->record_steps(c, 3);
-    world->record_release(
-        c, {compute, graphics, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT});
-    REQUIRE(host.submit_frame(0, f > 0 ? drawn : VK_NULL_HANDLE, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+    if (ownership)
+      world->record_release(
+          c, {compute, graphics, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT});
+    REQUIRE(host.submit_frame(0, f > 0 ? drawn : VK_NULL_HANDLE,
+                              drawn ? VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT : VkPipelineStageFlags(0),
                               simulated));
 
     REQUIRE(host.begin_graphics());
     VkCommandBuffer g = host.graphics_cmd;
     // A renderer acquires for VERTEX_INPUT and draws; this host reads the buffers with a copy
     // (TRANSFER), so synchronization validation sees a real read after the compute writes.
-    world->record_acquire(g,
-                          {compute, graphics, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT});
+    // Without ownership transfers the wait on `simulated` at TRANSFER alone orders the reads.
+    if (ownership)
+      world->record_acquire(g,
+                            {compute, graphics, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT});
     const InstanceBuffers b = world->buffers(*id).value();
     const VkDeviceSize bytes = b.count * b.stride, at = 2 * bytes * VkDeviceSize(f);
     REQUIRE(host.record_read(g, b.positions, bytes, at)); // each frame its own regions
     REQUIRE(host.record_read(g, b.normals, bytes, at + bytes));
-    world->record_release(g, {graphics, compute, VK_PIPELINE_STAGE_TRANSFER_BIT, 0});
+    if (ownership)
+      world->record_release(g, {graphics, compute, VK_PIPELINE_STAGE_TRANSFER_BIT, 0});
     REQUIRE(host.submit_graphics(simulated, VK_PIPELINE_STAGE_TRANSFER_BIT, drawn));
   }
   REQUIRE(host.wait_frames());
@@ -734,6 +872,23 @@ TEST_CASE("Queue-family hand-over in the documented order, one queue: release/ac
     return;
   REQUIRE(host->graphics_family == host->family);
   hand_over(*host, ctx);
+}
+
+TEST_CASE("Two submissions on one queue family (computecloth's pattern): the semaphores replace "
+          "record_barrier_to, validation-clean, the bits of a plain run") {
+  VKCLOTH_GPU_TEST_BEGIN(ctx);
+  std::string error;
+  auto host = host_or_skip(error);
+  if (!host)
+    return;
+  REQUIRE(host->graphics_family == host->family);
+  REQUIRE(host->graphics_queue == host->queue);
+  SUBCASE("a semaphore each way (also what two queues of the family need)") {
+    hand_over(*host, ctx, false);
+  }
+  SUBCASE("one queue: the compute submission's semaphore only") {
+    hand_over(*host, ctx, false, false);
+  }
 }
 
 TEST_CASE("Queue-family hand-over between a compute-only family and a graphics family (where a "

@@ -488,3 +488,53 @@ TEST_CASE("self_collision: a thickness below half the smallest rest length is a 
             "self_collision.thickness 0.2 m is below half the smallest rest length (1 m)") == 0);
   CHECK(load_in_tmp("self_collision_mesh", mesh + R"({"thickness": 0.6}})").warnings.empty());
 }
+
+TEST_CASE("up: \"y\" turns the grid's plane and the defaults of gravity and a plane, \"z\" is the default") {
+  const std::string body = R"("system": "cloth", "cloth": {"resolution": [5, 4], "orientation": "horizontal",
+                               "origin": [0, 0, 0.5]}, "colliders": [{"type": "plane"}])";
+  const Scene z = load_ok("{" + body + "}");
+  const Scene z_named = load_ok(R"({"up": "z", )" + body + "}");
+  const Scene y = load_ok(R"({"up": "y", )" + body + "}");
+  CHECK(z.up == UpAxis::z);
+  CHECK(z_named.up == UpAxis::z);
+  CHECK(y.up == UpAxis::y);
+  CHECK(z.params.gravity == glm::dvec3(0, 0, -9.81));
+  CHECK(z_named.params.gravity == z.params.gravity);
+  CHECK(y.params.gravity == glm::dvec3(0, -9.81, 0));
+  CHECK(z.params.colliders.at(0).normal == glm::dvec3(0, 0, 1));
+  CHECK(y.params.colliders.at(0).normal == glm::dvec3(0, 1, 0));
+  // The grid lies in x-z with y up, each particle the z-up one turned about the (given) origin.
+  REQUIRE(y.system.size() == z.system.size());
+  const glm::dvec3 o(0, 0, 0.5);
+  for (std::size_t p = 0; p < z.system.size(); ++p) {
+    CHECK(z_named.system.particles[p].position == z.system.particles[p].position);
+    CHECK(glm::length(y.system.particles[p].position -
+                      (o + z_up_to(UpAxis::y) * (z.system.particles[p].position - o))) < 1e-15);
+    CHECK(y.system.particles[p].position.y == 0.0);
+  }
+  // An explicit gravity wins over the up axis's default; overrides set "up" too.
+  CHECK(load_ok(R"({"up": "y", "physics": {"gravity": [0, 0, -1]}, )" + body + "}").params.gravity ==
+        glm::dvec3(0, 0, -1));
+  CHECK(load_ok("{" + body + "}", {"up=y"}).up == UpAxis::y);
+  // A chain hangs along -up.
+  const Scene chain =
+      load_ok(R"({"up": "y", "system": "chain", "chain": {"anchor": [1, 2, 3], "masses": [1]}})");
+  CHECK(chain.system.particles[1].position.x == 1.0);
+  CHECK(chain.system.particles[1].position.y == doctest::Approx(1.6));
+  CHECK(chain.system.particles[1].position.z == 3.0);
+}
+
+TEST_CASE("up: a value other than \"z\" or \"y\" is an error naming it") {
+  for (const char* text : {R"({"up": "x", "system": "cloth"})", R"({"up": "Y", "system": "cloth"})"}) {
+    auto s = parse_scene(text, "up.json");
+    REQUIRE_FALSE(s.ok());
+    CHECK_MESSAGE(s.error().message.find("up must be \"z\" or \"y\"") != std::string::npos,
+                  s.error().message);
+    CHECK_MESSAGE(s.error().message.find(std::string("got \"") + (text[8] == 'x' ? "x" : "Y") + "\"") !=
+                      std::string::npos,
+                  s.error().message);
+  }
+  auto s = parse_scene(R"({"up": 1, "system": "cloth"})", "up.json");
+  REQUIRE_FALSE(s.ok());
+  CHECK_MESSAGE(s.error().message.find("up") != std::string::npos, s.error().message);
+}

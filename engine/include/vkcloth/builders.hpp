@@ -6,8 +6,10 @@
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <string_view>
 #include <vector>
 
+#include <glm/mat3x3.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
@@ -16,6 +18,27 @@
 #include "vkcloth/system.hpp"
 
 namespace vkcloth {
+
+/// Which world axis is up. vkcloth's own frame (the report's) is z up; a y-up host (most game
+/// engines, glTF) names y. The y-up frame is the z-up one turned -90 degrees about x,
+/// (x, y, z) -> (x, z, -y) (z_up_to), as glTF exporters do: a z-up scene and its y-up twin give the
+/// same motion, turned. What follows the axis: a grid's plane (ClothOrientation), a chain's
+/// default hanging direction, and in scene files gravity's and a plane collider's defaults
+/// (default_gravity, up_vector). Positions given explicitly (origin, anchor, a mesh's vertices,
+/// colliders) are the host's coordinates as they are.
+enum class UpAxis : std::uint32_t { z = 0, y = 1 };
+
+const char* to_string(UpAxis up);
+/// "z" or "y"; anything else: nullopt.
+std::optional<UpAxis> parse_up_axis(std::string_view name);
+/// ErrorCode::invalid_argument naming `what` and the value for a value that is no UpAxis.
+Result<void> check_up_axis(UpAxis up, std::string_view what);
+/// The rotation from the z-up frame to `up`'s: the identity for z; for y, (x, y, z) -> (x, z, -y).
+glm::dmat3 z_up_to(UpAxis up);
+/// The unit up vector: (0, 0, 1) or (0, 1, 0).
+glm::dvec3 up_vector(UpAxis up);
+/// 9.81 m/s^2 down: (0, 0, -9.81) (SimParams' default) or (0, -9.81, 0).
+glm::dvec3 default_gravity(UpAxis up);
 
 /// A fixed anchor (particle 0, pinned) followed by masses joined in a line: spring k joins
 /// particle k and k+1. Coordinates: z is up and the anchor is the ceiling; the report's
@@ -27,13 +50,17 @@ struct ChainDesc {
   std::vector<double> stiffness{20.0};
   std::vector<double> rest_lengths{0.4};
   std::vector<glm::dvec3> positions{{0.0, 0.0, -0.4}};
+  /// The up axis: when `positions` is empty, the masses hang from the anchor along -up_vector(up).
+  UpAxis up = UpAxis::z;
 };
 
 Result<ParticleSystem> make_chain(const ChainDesc& desc);
 
+/// The plane of a grid, relative to the up axis (ClothDesc::up): `vertical` hangs (it contains the
+/// up axis), `horizontal` lies flat. Rows run along x in both.
 enum class ClothOrientation : std::uint32_t {
-  vertical = 0,   ///< spans x (i) and z (j); row j = ny-1 is the top
-  horizontal = 1, ///< spans x (i) and y (j), at constant z
+  vertical = 0,   ///< z up: spans x (i) and z (j); y up: x (i) and y (j). Row j = ny-1 is the top
+  horizontal = 1, ///< z up: spans x (i) and y (j), at constant z; y up: x (i) and -z (j), at constant y
 };
 
 struct ClothStiffness {
@@ -65,6 +92,9 @@ struct ClothDesc {
   glm::dvec2 size{1.0, 1.0};
   glm::dvec3 origin{0.0, 0.0, 0.0};
   ClothOrientation orientation = ClothOrientation::vertical;
+  /// The world's up axis, which `orientation` is relative to (UpAxis): with y, the grid is the
+  /// z-up one turned by z_up_to(y) about `origin` (its normals point up, +y, when horizontal).
+  UpAxis up = UpAxis::z;
   double particle_mass =
       0.05; ///< vkcloth's choice (the report gives no mass); docs/model.md "The report's observations"
   ClothStiffness stiffness;

@@ -66,6 +66,12 @@ public:
   Result<void> set_params(InstanceId id, SimParams params);
   /// set_params(id, step.applied_to(params(id))): the per-frame fields (dt, gravity, wind, colliders).
   Result<void> set_step_params(InstanceId id, const StepParams& step);
+  /// The per-frame pose of ONE animated collider, without resending its shape and friction:
+  /// set_params(id, with_collider_pose(params(id), collider, pose)), `collider` its index in
+  /// params(id).colliders (ColliderPose says what the pose sets). The same rule as set_step_params
+  /// (from the next step); the errors name an unknown id, an index past the list or the pose's
+  /// field, and leave the parameters as they were.
+  Result<void> set_collider_pose(InstanceId id, std::size_t collider, const ColliderPose& pose);
   /// The instance's parameters; moving colliders where its steps left them.
   Result<SimParams> params(InstanceId id) const;
 

@@ -21,10 +21,11 @@ namespace vkcloth {
 /// Collects frames of one cloth (a grid or a mesh) and writes them as one animated glTF 2.0
 /// file (docs/scene-format.md "Export"): one mesh whose POSITION is the first frame, one morph
 /// target per later frame (float position deltas) and a "weights" animation with STEP
-/// interpolation, one-hot per frame; TEXCOORD_0, no normals (viewers compute them); the node
-/// rotates vkcloth's z up to glTF's y up. Size per frame: 12 N bytes of deltas + 4 F bytes of
-/// weights + ~250 bytes of JSON (N vertices, F frames; measured 24,646 B at N = 2000, F = 100).
-/// Frames are kept in memory (12 N bytes each) until write_gltf.
+/// interpolation, one-hot per frame; TEXCOORD_0; NORMAL and each target's normal deltas, the
+/// renderer's smooth normals of each frame (ClothTopology::vertex_normals); the node rotates
+/// vkcloth's z up to glTF's y up. Size per frame: 24 N bytes of deltas (positions and normals) + 4 F
+/// bytes of weights + ~400 bytes of JSON (N vertices, F frames). Frames are kept in memory (12 N
+/// bytes each, positions; the normals are computed by write_gltf) until write_gltf.
 class AnimationRecorder {
 public:
   /// `system` must have a surface (a grid or a mesh): chains have no triangles to export.

@@ -3,6 +3,7 @@
 // Units: metres, seconds, kilograms; z is up.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -41,7 +42,8 @@ struct SolveStats {
 const char* to_string(Integrator integrator);
 std::optional<Integrator> parse_integrator(std::string_view name);
 
-class ColliderMesh; // vkcloth/collider_mesh.hpp: a static triangle mesh and its bounding-volume hierarchy
+struct ColliderPose; // below: a collider's pose for a per-frame update
+class ColliderMesh;  // vkcloth/collider_mesh.hpp: a static triangle mesh and its bounding-volume hierarchy
 
 /// A collider (docs/model.md "Collisions", docs/scene-format.md "colliders"): a shape, its friction and
 /// its motion. Every shape has the report's semantics: within 2 eps of the surface the inward parts of
@@ -92,6 +94,28 @@ struct Collider {
   /// This collider `seconds` later: moved by linear_velocity * seconds and turned by angular_velocity
   /// * seconds about centre() (Rodrigues, in double); velocities and friction unchanged.
   Collider posed_at(double seconds) const;
+  /// This collider moved to `pose` (ColliderPose says what each field sets); shape, friction and
+  /// the rest unchanged. Not validated: ColliderPose::validate and SimParams::validate do that.
+  Collider with_pose(const ColliderPose& pose) const;
+};
+
+/// A collider's pose for a per-frame update that keeps everything else (shape, size, friction,
+/// thickness, mesh): ClothWorld::set_collider_pose and CpuWorld::set_collider_pose, or
+/// Collider::with_pose. `position` is where centre() goes (sphere, box: centre; mesh: its origin;
+/// capsule: the middle of a b; plane: any point of the plane). `rotation`, when given, is the body's
+/// orientation, its columns the body's axes in the world: box and mesh take it as theirs; a
+/// capsule's axis (a to b) and a plane's normal become its third column (their lengths kept); a
+/// sphere ignores it. Without it the collider keeps its orientation. The velocities replace the
+/// collider's (a plane takes linear velocity only, as always).
+struct ColliderPose {
+  glm::dvec3 position{0.0};
+  std::optional<glm::dmat3> rotation;
+  glm::dvec3 linear_velocity{0.0};  ///< m/s
+  glm::dvec3 angular_velocity{0.0}; ///< rad/s about `position`
+
+  /// Finite values and a rotation matrix (orthonormal, determinant 1, within 1e-6); the message
+  /// names the field and the value.
+  Result<void> validate() const;
 };
 
 /// Wind F = Kw <n, u_w> n on each cloth vertex, n its unit normal, u_w the unit wind direction.
@@ -185,6 +209,12 @@ struct SimParams {
 /// can then pass between two particles). Nothing to check when self-collision is off.
 Result<std::vector<std::string>> check_self_collision(const SelfCollision& self,
                                                       const ParticleSystem& system);
+
+/// `params` with colliders[collider] moved to `pose` (Collider::with_pose), what the worlds'
+/// set_collider_pose apply. ErrorCode::invalid_argument for an index past the list (the message
+/// names it and the list's size) or a bad pose (ColliderPose::validate); the result is validated
+/// by the solvers as any SimParams.
+Result<SimParams> with_collider_pose(SimParams params, std::size_t collider, const ColliderPose& pose);
 
 /// What a host changes every frame (its frame time, its wind, its animated colliders), applied
 /// from the next recorded step: GpuSolver::record_steps(cmd, steps, step), ClothWorld::

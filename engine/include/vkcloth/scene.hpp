@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "vkcloth/mesh.hpp"
+#include "vkcloth/builders.hpp"
 #include "vkcloth/params.hpp"
 #include "vkcloth/result.hpp"
 #include "vkcloth/system.hpp"
@@ -23,6 +24,8 @@ struct Scene {
   std::string name;      ///< "name" key, else the file stem (or the source name)
   ParticleSystem system; ///< finalized
   SimParams params;      ///< validated (directions normalised)
+  /// The file's "up" ("z" by default): the grid's plane, gravity's and a plane's default follow it.
+  UpAxis up = UpAxis::z;
   std::uint64_t steps = 500;
   /// A mesh cloth's base-colour texture (a glTF material's), for the renderer and the exporter.
   std::optional<MeshTexture> texture;

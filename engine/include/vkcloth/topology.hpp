@@ -129,6 +129,12 @@ public:
   /// solvers read them for grids; other surfaces carry them in their gather lists (ring_normals).
   std::span<const std::uint32_t> fan_offsets() const { return fan_offsets_; }
   std::span<const FanTriangle> fans() const { return fans_; }
+  /// The unit vertex normals the solvers write to their normals buffer (and the renderer draws),
+  /// for `positions` (one per particle, solver order): each particle's fan summed in fans() order
+  /// and normalised, with the kernel's own add_fan_triangle / unit_or_zero (engine/kernel/forces.h)
+  /// in float; zero for a degenerate fan and without a surface. The glTF export's NORMAL.
+  /// ErrorCode::invalid_argument naming both counts when the sizes differ.
+  Result<std::vector<glm::vec3>> vertex_normals(std::span<const glm::vec3> positions) const;
   /// Texture coordinates per particle; a grid's (i, j) maps to (i / (nx-1), j / (ny-1)); zero for
   /// chains.
   std::span<const glm::vec2> uvs() const { return uvs_; }

@@ -71,6 +71,7 @@ Result<ParticleSystem> make_chain(const ChainDesc& d) {
     return l0.error();
   if (!finite(d.anchor))
     return bad("chain.anchor must be finite");
+  VKCLOTH_TRY(check_up_axis(d.up, "chain.up"));
   if (!d.positions.empty() && d.positions.size() != n)
     return bad(
         fmt::format("chain.positions must hold {} positions (one per mass), got {}", n, d.positions.size()));
@@ -85,7 +86,7 @@ Result<ParticleSystem> make_chain(const ChainDesc& d) {
       return bad(fmt::format("chain.stiffness[{}] must be finite and >= 0, got {}", i, (*k)[i]));
     if (!std::isfinite((*l0)[i]) || (*l0)[i] < 0.0)
       return bad(fmt::format("chain.rest_lengths[{}] must be finite and >= 0, got {}", i, (*l0)[i]));
-    below.z -= (*l0)[i]; // default: hanging straight down, each spring at rest length
+    below -= up_vector(d.up) * (*l0)[i]; // default: hanging straight down, each spring at rest length
     const glm::dvec3 p = d.positions.empty() ? below : d.positions[i];
     if (!finite(p))
       return bad(fmt::format("chain.positions[{}] must be finite", i));
@@ -95,6 +96,43 @@ Result<ParticleSystem> make_chain(const ChainDesc& d) {
   }
   sys.finalize();
   return sys;
+}
+
+const char* to_string(UpAxis up) {
+  switch (up) {
+  case UpAxis::z:
+    return "z";
+  case UpAxis::y:
+    return "y";
+  }
+  return "?";
+}
+
+std::optional<UpAxis> parse_up_axis(std::string_view name) {
+  for (UpAxis up : {UpAxis::z, UpAxis::y})
+    if (name == to_string(up))
+      return up;
+  return std::nullopt;
+}
+
+Result<void> check_up_axis(UpAxis up, std::string_view what) {
+  if (up != UpAxis::z && up != UpAxis::y)
+    return bad(fmt::format("{}: unknown up axis {} (z = 0 or y = 1)", what, std::uint32_t(up)));
+  return {};
+}
+
+glm::dmat3 z_up_to(UpAxis up) {
+  if (up == UpAxis::y) // columns: where x, y, z go
+    return glm::dmat3(glm::dvec3(1, 0, 0), glm::dvec3(0, 0, -1), glm::dvec3(0, 1, 0));
+  return glm::dmat3(1.0);
+}
+
+glm::dvec3 up_vector(UpAxis up) {
+  return z_up_to(up) * glm::dvec3(0, 0, 1);
+}
+
+glm::dvec3 default_gravity(UpAxis up) {
+  return up == UpAxis::y ? glm::dvec3(0.0, -9.81, 0.0) : glm::dvec3(0.0, 0.0, -9.81); // SimParams' for z
 }
 
 glm::vec2 default_grid_uv(std::uint32_t i, std::uint32_t j, std::uint32_t nx, std::uint32_t ny) {
@@ -116,6 +154,9 @@ Result<void> check_cloth_desc(const ClothDesc& d) {
     return bad(fmt::format("cloth.size must be finite and > 0, got [{}, {}]", d.size.x, d.size.y));
   if (!finite(d.origin))
     return bad("cloth.origin must be finite");
+  if (std::uint32_t(d.orientation) > std::uint32_t(ClothOrientation::horizontal))
+    return bad(fmt::format("cloth.orientation: unknown orientation {}", std::uint32_t(d.orientation)));
+  VKCLOTH_TRY(check_up_axis(d.up, "cloth.up"));
   if (!d.material)
     return check_cloth_material(d.particle_mass, d.stiffness);
   VKCLOTH_TRY(check_material(*d.material));
@@ -260,9 +301,11 @@ Result<ParticleSystem> make_cloth(const ClothDesc& d) {
 
   ParticleSystem sys;
   sys.grid = Grid{nx, ny, std::move(*uvs)};
+  // z up: vertical spans x and z, horizontal x and y. y up: the same sheets turned by z_up_to(up)
+  // ((x, y, z) -> (x, z, -y)): vertical spans x and y, horizontal x and -z (normals still up).
   const glm::dvec3 eu{1, 0, 0};
-  const glm::dvec3 ev =
-      d.orientation == ClothOrientation::vertical ? glm::dvec3{0, 0, 1} : glm::dvec3{0, 1, 0};
+  const glm::dvec3 ev = z_up_to(d.up) * (d.orientation == ClothOrientation::vertical ? glm::dvec3{0, 0, 1}
+                                                                                     : glm::dvec3{0, 1, 0});
   sys.particles.resize(std::size_t(nx) * ny);
   for (std::uint32_t j = 0; j < ny; ++j)
     for (std::uint32_t i = 0; i < nx; ++i)

@@ -141,6 +141,16 @@ Result<void> CpuWorld::set_step_params(InstanceId id, const StepParams& step) {
   return (*inst)->solver.set_params(step.applied_to((*inst)->solver.params()));
 }
 
+Result<void> CpuWorld::set_collider_pose(InstanceId id, std::size_t collider, const ColliderPose& pose) {
+  auto inst = impl_->find(id);
+  if (!inst)
+    return inst.error();
+  auto posed = with_collider_pose((*inst)->solver.params(), collider, pose);
+  if (!posed)
+    return posed.error();
+  return (*inst)->solver.set_params(std::move(*posed));
+}
+
 Result<SimParams> CpuWorld::params(InstanceId id) const {
   auto inst = impl_->find(id);
   if (!inst)

@@ -28,6 +28,16 @@ bool positive(double x) {
   return std::isfinite(x) && x > 0.0;
 }
 
+// How far R is from an orthonormal right-handed frame (its columns; 0 for a rotation matrix).
+double rotation_error(const glm::dmat3& r) {
+  const glm::dmat3 e = glm::transpose(r) * r;
+  double off = std::abs(glm::determinant(r) - 1.0);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      off = std::max(off, std::abs(e[i][j] - (i == j ? 1.0 : 0.0)));
+  return off;
+}
+
 // One collider's fields (the message names `at`.field and the value); normalises a plane's normal.
 Result<void> validate_collider(Collider& c, const std::string& at) {
   const auto vec = [&](const char* key, glm::dvec3 v) -> Result<void> {
@@ -79,12 +89,7 @@ Result<void> validate_collider(Collider& c, const std::string& at) {
   for (int col = 0; col < 3; ++col)
     VKCLOTH_TRY(vec("rotation", c.rotation[col]));
   if (c.type == Collider::Type::box || c.type == Collider::Type::mesh) {
-    // R's columns must be an orthonormal right-handed frame (within float rounding).
-    const glm::dmat3 e = glm::transpose(c.rotation) * c.rotation;
-    double off = std::abs(glm::determinant(c.rotation) - 1.0);
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j)
-        off = std::max(off, std::abs(e[i][j] - (i == j ? 1.0 : 0.0)));
+    const double off = rotation_error(c.rotation);
     if (!(off < 1e-6))
       return bad(fmt::format(
           "{}.rotation must be a rotation matrix (orthonormal, determinant 1); it is off by {}", at, off));
@@ -186,6 +191,57 @@ Collider Collider::posed_at(double seconds) const {
   c.b = pivot + shift + turn * (b - pivot);
   c.rotation = turn * rotation;
   return c;
+}
+
+Collider Collider::with_pose(const ColliderPose& pose) const {
+  Collider c = *this;
+  c.linear_velocity = pose.linear_velocity;
+  c.angular_velocity = pose.angular_velocity;
+  switch (type) {
+  case Type::plane:
+    if (pose.rotation)
+      c.normal = (*pose.rotation)[2];
+    if (const double len = glm::length(c.normal); len > 0.0) // validate() normalises n, keeping the offset
+      c.offset = glm::dot(c.normal, pose.position) / len;
+    break;
+  case Type::capsule: {
+    const glm::dvec3 half = (b - a) * 0.5;
+    const glm::dvec3 axis = pose.rotation ? (*pose.rotation)[2] * glm::length(half) : half;
+    c.a = pose.position - axis;
+    c.b = pose.position + axis;
+    break;
+  }
+  case Type::box:
+  case Type::mesh:
+    if (pose.rotation)
+      c.rotation = *pose.rotation;
+    c.center = pose.position;
+    break;
+  default: // sphere
+    c.center = pose.position;
+    break;
+  }
+  return c;
+}
+
+Result<void> ColliderPose::validate() const {
+  if (!finite(position))
+    return bad("pose.position must be finite, got " + str(position));
+  if (!finite(linear_velocity))
+    return bad("pose.linear_velocity must be finite, got " + str(linear_velocity));
+  if (!finite(angular_velocity))
+    return bad("pose.angular_velocity must be finite, got " + str(angular_velocity));
+  if (rotation) {
+    const glm::dmat3& r = *rotation;
+    for (int col = 0; col < 3; ++col)
+      if (!finite(r[col]))
+        return bad(fmt::format("pose.rotation must be finite, got column {} = {}", col, str(r[col])));
+    const double off = rotation_error(r);
+    if (!(off < 1e-6))
+      return bad(fmt::format(
+          "pose.rotation must be a rotation matrix (orthonormal, determinant 1); it is off by {}", off));
+  }
+  return {};
 }
 
 const char* to_string(Integrator integrator) {
@@ -326,6 +382,15 @@ Result<std::vector<std::string>> check_self_collision(const SelfCollision& self,
                                    "of at least {:.4g} m closes the gaps",
                                    self.thickness, smallest, 1.42 * mean));
   return warnings;
+}
+
+Result<SimParams> with_collider_pose(SimParams params, std::size_t collider, const ColliderPose& pose) {
+  if (collider >= params.colliders.size())
+    return bad(fmt::format("colliders[{}]: no such collider to pose, the cloth has {} collider{}", collider,
+                           params.colliders.size(), params.colliders.size() == 1 ? "" : "s"));
+  VKCLOTH_TRY(pose.validate());
+  params.colliders[collider] = params.colliders[collider].with_pose(pose);
+  return params;
 }
 
 SimParams StepParams::applied_to(SimParams params) const {

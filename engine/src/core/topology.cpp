@@ -2,9 +2,12 @@
 #include "vkcloth/topology.hpp"
 
 #include "vkcloth/builders.hpp"
+#include "kernel.hpp"         // add_fan_triangle, unit_or_zero: the solvers' normal
 #include "kernel/constants.h" // VKCLOTH_RING_*
 
 #include "stretch_topology.hpp"
+
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <limits>
@@ -336,6 +339,21 @@ std::span<const Tether> ClothTopology::tethers(StretchLimit::TetherDistance dist
   const int k = geodesic ? 1 : 0;
   std::call_once(tethers_once_[k], [&] { tethers_[k] = detail::find_tethers(system_, geodesic); });
   return tethers_[k];
+}
+
+Result<std::vector<glm::vec3>> ClothTopology::vertex_normals(std::span<const glm::vec3> positions) const {
+  if (positions.size() != size())
+    return make_error(ErrorCode::invalid_argument,
+                      fmt::format("vertex_normals: {} positions for {} particles", positions.size(), size()));
+  std::vector<glm::vec3> normals(positions.size(), glm::vec3(0.0f));
+  for (std::size_t p = 0; p < positions.size(); ++p) {
+    const glm::vec3 x = positions[p];
+    glm::vec3 fan(0.0f); // the solvers' fan sum and normalisation (engine/kernel/forces.h), in float
+    for (std::uint32_t t = fan_offsets_[p]; t < fan_offsets_[p + 1]; ++t)
+      kernel::add_fan_triangle(fan, positions[fans_[t].a] - x, positions[fans_[t].b] - x);
+    normals[p] = kernel::unit_or_zero(fan);
+  }
+  return normals;
 }
 
 } // namespace vkcloth

@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <numeric>
 #include <sstream>
 #include <string>
@@ -30,9 +31,10 @@ Error invalid(std::string message) {
 
 /// The cloth's surface in output (file) vertex order.
 struct ExportSurface {
-  std::vector<std::uint32_t> order;     ///< output vertex k is particle order[k]
-  std::vector<std::uint32_t> triangles; ///< output vertex indices, counter-clockwise
-  std::vector<glm::vec2> uvs;           ///< per output vertex, v down (glTF's and the renderer's)
+  std::shared_ptr<const ClothTopology> topology; ///< its normal fans (vertex_normals)
+  std::vector<std::uint32_t> order;              ///< output vertex k is particle order[k]
+  std::vector<std::uint32_t> triangles;          ///< output vertex indices, counter-clockwise
+  std::vector<glm::vec2> uvs;                    ///< per output vertex, v down (glTF's and the renderer's)
 };
 
 /// A mesh's particles map to distinct file vertices, else its outputs would be ambiguous.
@@ -63,6 +65,7 @@ Result<ExportSurface> export_surface(const ParticleSystem& system) {
     return invalid(fmt::format("the cloth ({} particles) has no triangles to export", system.size()));
 
   ExportSurface out;
+  out.topology = *topology;
   out.order = file_order(system);
   VKCLOTH_TRY(check_distinct_sources(system, out.order));
   std::vector<std::uint32_t> rank(system.size());
@@ -103,6 +106,23 @@ std::vector<float> output_positions(const ExportSurface& surface, std::span<cons
   for (const std::uint32_t p : surface.order)
     for (int c = 0; c < 3; ++c)
       out.push_back(static_cast<float>(positions[p][c]));
+  return out;
+}
+
+/// The renderer's smooth normals of one output frame (x, y, z per output vertex, as stored):
+/// ClothTopology::vertex_normals, the solvers' formula, on these float positions, in output order.
+/// glTF requires unit normals: a degenerate fan's (zero) becomes +z, vkcloth's up.
+std::vector<float> output_normals(const ExportSurface& surface, const std::vector<float>& frame) {
+  std::vector<glm::vec3> positions(surface.order.size());
+  for (std::size_t k = 0; k < surface.order.size(); ++k)
+    positions[surface.order[k]] = {frame[3 * k], frame[3 * k + 1], frame[3 * k + 2]};
+  const std::vector<glm::vec3> normals = surface.topology->vertex_normals(positions).value(); // sizes match
+  std::vector<float> out;
+  out.reserve(frame.size());
+  for (const std::uint32_t p : surface.order) {
+    const glm::vec3 n = normals[p] == glm::vec3(0.0f) ? glm::vec3(0.0f, 0.0f, 1.0f) : normals[p];
+    out.insert(out.end(), {n.x, n.y, n.z});
+  }
   return out;
 }
 
@@ -181,6 +201,12 @@ int add_vec3_attribute(tinygltf::Model& m, const std::vector<float>& xyz) {
   return a;
 }
 
+/// A float VEC3 vertex attribute without bounds (NORMAL and its morph deltas).
+int add_vec3_values(tinygltf::Model& m, const std::vector<float>& xyz) {
+  const int view = add_view(m, xyz.data(), xyz.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER);
+  return add_accessor(m, view, TINYGLTF_COMPONENT_TYPE_FLOAT, xyz.size() / 3, TINYGLTF_TYPE_VEC3);
+}
+
 int add_uvs(tinygltf::Model& m, const std::vector<glm::vec2>& uvs) {
   static_assert(sizeof(glm::vec2) == 2 * sizeof(float));
   const int view = add_view(m, uvs.data(), uvs.size() * sizeof(glm::vec2), TINYGLTF_TARGET_ARRAY_BUFFER);
@@ -227,7 +253,7 @@ int add_material(tinygltf::Model& m, const std::optional<MeshTexture>& texture,
   return 0;
 }
 
-/// Frame f > 0 as a morph target: its positions minus the first frame's.
+/// Frame f > 0 as a morph target: its positions (or normals) minus the first frame's.
 std::vector<float> frame_delta(const std::vector<float>& frame, const std::vector<float>& base) {
   std::vector<float> delta(frame.size());
   for (std::size_t k = 0; k < frame.size(); ++k)
@@ -307,7 +333,7 @@ struct AnimationRecorder::Impl {
   /// Checked as frames come, before they fill the memory: `frame_total` frames must fit in a glb.
   Result<void> check_size(std::size_t frame_total) const {
     const std::size_t n = surface.order.size();
-    const std::size_t bytes = frame_total * n * 12 + n * 8 + surface.triangles.size() * 4 +
+    const std::size_t bytes = frame_total * n * 24 + n * 8 + surface.triangles.size() * 4 +
                               frame_total * frame_total * 4 + (texture ? texture->encoded.size() : 0);
     if (bytes > max_gltf_buffer_bytes)
       return invalid(
@@ -329,11 +355,14 @@ tinygltf::Model AnimationRecorder::Impl::model() const {
   primitive.mode = TINYGLTF_MODE_TRIANGLES;
   primitive.indices = add_indices(m, surface.triangles, surface.order.size());
   primitive.attributes["POSITION"] = add_vec3_attribute(m, frames.front());
+  const std::vector<float> base_normals = output_normals(surface, frames.front());
+  primitive.attributes["NORMAL"] = add_vec3_values(m, base_normals);
   primitive.attributes["TEXCOORD_0"] = add_uvs(m, surface.uvs);
   primitive.material = add_material(m, texture, texture_mime);
   for (std::size_t f = 1; f < frames.size(); ++f)
     primitive.targets.push_back(
-        {{"POSITION", add_vec3_attribute(m, frame_delta(frames[f], frames.front()))}});
+        {{"POSITION", add_vec3_attribute(m, frame_delta(frames[f], frames.front()))},
+         {"NORMAL", add_vec3_values(m, frame_delta(output_normals(surface, frames[f]), base_normals))}});
   tinygltf::Mesh mesh;
   mesh.name = "cloth";
   mesh.primitives.push_back(std::move(primitive));

@@ -34,7 +34,7 @@ Result<Scene> build_scene(const json& doc, std::string_view source_name) {
   VKCLOTH_TRY(sd::check_keys(doc, "",
                              {"name", "system", "integrator", "physics", "chain", "cloth", "wind",
                               "colliders", "contact_epsilon", "contact_inward_only", "divergence_limit",
-                              "stretch_limit", "self_collision"}));
+                              "stretch_limit", "self_collision", "up"}));
   Scene scene;
   if (!doc.contains("system"))
     return sd::shape_error("missing required key system (\"chain\" or \"cloth\")");
@@ -49,6 +49,16 @@ Result<Scene> build_scene(const json& doc, std::string_view source_name) {
 
   scene.name = std::filesystem::path(source_name).stem().string();
   VKCLOTH_TRY(sd::read(doc, "", "name", scene.name));
+  // "up" first: the defaults that follow it (gravity, a plane's normal, the grid's plane).
+  if (doc.contains("up")) {
+    std::string up;
+    VKCLOTH_TRY(sd::read(doc, "", "up", up));
+    const std::optional<UpAxis> axis = parse_up_axis(up);
+    if (!axis)
+      return sd::shape_error(fmt::format("up must be \"z\" or \"y\" (the world's up axis), got \"{}\"", up));
+    scene.up = *axis;
+  }
+  scene.params.gravity = default_gravity(scene.up); // physics.gravity, when given, replaces it
   VKCLOTH_TRY(sd::read_integrator(doc, scene.params, scene.steps));
   VKCLOTH_TRY(sd::read_physics(doc, scene.params));
   std::optional<Material> material; // cloth.material: its damping is mu, so it is read before validate()
@@ -78,7 +88,7 @@ Result<Scene> build_scene(const json& doc, std::string_view source_name) {
       cloth && cloth->is_object() && cloth->contains("mesh")) {
     VKCLOTH_TRY(sd::read_mesh_cloth(*cloth, scene_dir, material, scene));
   } else {
-    auto system = kind == "chain" ? sd::read_chain(doc) : sd::read_cloth(doc, material);
+    auto system = kind == "chain" ? sd::read_chain(doc, scene.up) : sd::read_cloth(doc, material, scene.up);
     if (!system)
       return system.error();
     scene.system = std::move(*system);

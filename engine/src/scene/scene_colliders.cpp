@@ -108,7 +108,7 @@ Result<void> read_colliders(const json& doc, const std::filesystem::path& scene_
     Collider col;
     if (type == "plane") {
       VKCLOTH_TRY(sd::check_keys(c, path, {VKCLOTH_COLLIDER_COMMON_KEYS, "normal", "offset"}));
-      col = Collider::plane({0.0, 0.0, 1.0}, 0.0);
+      col = Collider::plane(up_vector(scene.up), 0.0); // default: the ground, facing up
       VKCLOTH_TRY(sd::read(c, path, "normal", col.normal));
       VKCLOTH_TRY(sd::read(c, path, "offset", col.offset));
     } else if (type == "sphere") {

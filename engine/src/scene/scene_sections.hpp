@@ -42,9 +42,9 @@ Result<void> read_colliders(const json& doc, const std::filesystem::path& scene_
 /// "cloth.material": a preset name or an object with all five values; absent: nothing.
 Result<std::optional<Material>> read_material(const json& cloth);
 /// "chain" -> make_chain().
-Result<ParticleSystem> read_chain(const json& doc);
+Result<ParticleSystem> read_chain(const json& doc, UpAxis up);
 /// A grid cloth: "cloth" -> make_cloth().
-Result<ParticleSystem> read_cloth(const json& doc, const std::optional<Material>& material);
+Result<ParticleSystem> read_cloth(const json& doc, const std::optional<Material>& material, UpAxis up);
 /// A cloth made from a mesh file ("cloth": {"mesh": ...}) into scene.system, its warnings and texture.
 Result<void> read_mesh_cloth(const json& cloth, const std::filesystem::path& scene_dir,
                              const std::optional<Material>& material, Scene& scene);

@@ -11,8 +11,9 @@
 
 namespace vkcloth::scene_detail {
 
-Result<ParticleSystem> read_chain(const json& doc) {
+Result<ParticleSystem> read_chain(const json& doc, UpAxis up) {
   ChainDesc d;
+  d.up = up;
   SCENE_TRY_ASSIGN(obj, sd::read_object(doc, "", "chain"));
   if (obj) {
     VKCLOTH_TRY(
@@ -166,8 +167,9 @@ Result<void> read_mesh_cloth(const json& cloth, const std::filesystem::path& sce
   return {};
 }
 
-Result<ParticleSystem> read_cloth(const json& doc, const std::optional<Material>& material) {
+Result<ParticleSystem> read_cloth(const json& doc, const std::optional<Material>& material, UpAxis up) {
   ClothDesc d;
+  d.up = up;
   d.material = material;
   SCENE_TRY_ASSIGN(obj, sd::read_object(doc, "", "cloth"));
   if (obj) {

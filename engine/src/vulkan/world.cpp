@@ -298,6 +298,16 @@ Result<void> ClothWorld::set_step_params(InstanceId id, const StepParams& step) 
   return set_params(id, step.applied_to((*found)->params));
 }
 
+Result<void> ClothWorld::set_collider_pose(InstanceId id, std::size_t collider, const ColliderPose& pose) {
+  auto found = impl_->find(id);
+  if (!found)
+    return found.error();
+  auto posed = with_collider_pose((*found)->params, collider, pose);
+  if (!posed)
+    return posed.error();
+  return set_params(id, std::move(*posed));
+}
+
 Result<SimParams> ClothWorld::params(InstanceId id) const {
   auto inst = impl_->find(id);
   if (!inst)

@@ -104,7 +104,10 @@ struct InstanceBuffers {
   /// uv_transform; a mesh's: its file's).
   VkBuffer uvs = VK_NULL_HANDLE;
   VkDeviceSize offset = 0;
-  VkDeviceSize stride = 16; ///< GpuSolver::stride
+  /// Byte stride of positions, normals and uvs (GpuSolver::stride). Like vertex_stride a layout
+  /// constant, static so that a pipeline's VkVertexInputBindingDescription can name it before any
+  /// buffer exists (`InstanceBuffers::stride`); `b.stride` reads the same value.
+  static constexpr VkDeviceSize stride = 16;
   std::uint32_t count = 0;
   std::uint32_t nx = 0, ny = 0; ///< grid size (0 for chains and meshes)
   /// ClothTopology::triangles() on the device (VK_INDEX_TYPE_UINT32, index_count entries; a grid's
@@ -116,7 +119,7 @@ struct InstanceBuffers {
   /// `vertex_offset`, `vertex_stride` apart (VK_NULL_HANDLE otherwise).
   VkBuffer vertices = VK_NULL_HANDLE;
   VkDeviceSize vertex_offset = 0;
-  static constexpr VkDeviceSize vertex_stride = 32;
+  static constexpr VkDeviceSize vertex_stride = 32; ///< bytes per interleaved vertex
 };
 
 /// One half of a queue-family ownership transfer of the buffers a host draws from (current
@@ -256,5 +259,8 @@ private:
   explicit GpuSolver(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };
+
+static_assert(InstanceBuffers::stride == GpuSolver::stride,
+              "one vec4 per particle in every per-particle buffer");
 
 } // namespace vkcloth::gpu

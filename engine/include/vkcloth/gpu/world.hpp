@@ -26,6 +26,7 @@
 // members on the CPU solver: a host that only steps and reads back switches by changing the type.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -100,6 +101,12 @@ public:
   Result<void> set_params(InstanceId id, SimParams params);
   /// set_params(id, step.applied_to(params(id))): the per-frame fields (dt, gravity, wind, colliders).
   Result<void> set_step_params(InstanceId id, const StepParams& step);
+  /// The per-frame pose of ONE animated collider, without resending its shape and friction:
+  /// set_params(id, with_collider_pose(params(id), collider, pose)), `collider` its index in
+  /// params(id).colliders (ColliderPose says what the pose sets). The same rule as set_step_params
+  /// (from the next step; frames in flight allowed); the errors name an unknown id, an index past
+  /// the list or the pose's field, and leave the parameters as they were.
+  Result<void> set_collider_pose(InstanceId id, std::size_t collider, const ColliderPose& pose);
   Result<SimParams> params(InstanceId id) const;
 
   /// Records one step of every instance into the host's command buffer (see GpuSolver::record_steps
