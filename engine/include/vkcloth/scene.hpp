@@ -24,14 +24,15 @@ struct Scene {
   std::string name;      ///< "name" key, else the file stem (or the source name)
   ParticleSystem system; ///< finalized
   SimParams params;      ///< validated (directions normalised)
-  /// The file's "up" ("z" by default): the grid's plane, gravity's and a plane's default follow it.
-  UpAxis up = UpAxis::z;
   std::uint64_t steps = 500;
   /// A mesh cloth's base-colour texture (a glTF material's), for the renderer and the exporter.
   std::optional<MeshTexture> texture;
   /// What loading dropped or ignored (degenerate faces, a pin region that pins nothing, ...):
   /// the CLI prints each as "warning: ...".
   std::vector<std::string> warnings;
+  /// The file's "up" ("z" by default): the grid's plane, gravity's and a plane's default follow it.
+  /// Last, so that hosts' aggregate initialisers of the fields above keep compiling.
+  UpAxis up = UpAxis::z;
   // The file's "system" key ("chain" | "cloth") is not stored: a cloth is system.grid.has_value().
 };
 
