@@ -37,8 +37,10 @@ int detect_simd() {
   __builtin_cpu_init();
   if (__builtin_cpu_supports("avx2"))
     best = 1;
+#if VKCLOTH_ROW_AVX512
   if (__builtin_cpu_supports("avx512f"))
     best = 2;
+#endif
 #endif
   if (const char* env = std::getenv("VKCLOTH_CPU_SIMD")) {
     if (std::strcmp(env, "scalar") == 0)

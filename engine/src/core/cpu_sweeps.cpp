@@ -121,17 +121,23 @@ template <typename Real> void CpuSolver<Real>::Impl::row_sweep(const Real h, con
     std::int64_t done = q0;
     bool simd_bad = false;
 #if VKCLOTH_ROW_SIMD
-    if (simd_ == 2)
-      done = detail::row_kernel_avx512(ra, done, q1, simd_bad);
-    else if (simd_ == 1)
+    if (simd_ == 1)
       done = detail::row_kernel_avx2(ra, done, q1, simd_bad);
+#if VKCLOTH_ROW_AVX512
+    else if (simd_ == 2)
+      done = detail::row_kernel_avx512(ra, done, q1, simd_bad);
+#endif
 #endif
     std::int64_t unchecked = done;
     if (!ra.integrate) { // the SIMD kernels' forces go through the contacts here
       std::int64_t finished = q0;
 #if VKCLOTH_ROW_SIMD
       if (simd_finish)
+#if VKCLOTH_ROW_AVX512
         finished = simd_ == 2 ? detail::finish_avx512(fa, q0, done) : detail::finish_avx2(fa, q0, done);
+#else
+        finished = detail::finish_avx2(fa, q0, done);
+#endif
 #endif
       for (std::int64_t q = finished; q < done; ++q)
         finish(q, force_[std::size_t(q)]);
@@ -243,8 +249,12 @@ template <typename Real> void CpuSolver<Real>::Impl::list_sweep(const Real h, co
         bool simd_bad = false;
 #if VKCLOTH_ROW_SIMD
         if (qv > q0)
+#if VKCLOTH_ROW_AVX512
           (void)(simd_ == 2 ? detail::list_kernel_avx512(la, b, qv / width, simd_bad)
                             : detail::list_kernel_avx2(la, b, qv / width, simd_bad));
+#else
+          (void)detail::list_kernel_avx2(la, b, qv / width, simd_bad);
+#endif
 #endif
         std::size_t unchecked = qv;
         if (!la.integrate) { // the forces through the contacts, update, projection
