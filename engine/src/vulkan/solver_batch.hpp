@@ -161,6 +161,11 @@ public:
   /// The batch's shader build and workgroup size, the pass fixed to `stage` (VKCLOTH_ANY_STAGE:
   /// the push constants' stage).
   ShaderVariant variant(std::uint32_t stage = VKCLOTH_ANY_STAGE) const { return {access, workgroup, stage}; }
+  /// `slot` := the Context's pipeline of `shader` with `constants` in this batch's variant (`stage`
+  /// fixed, as variant()), looked up once: nothing to do when `slot` is set already.
+  Result<void> ensure_pipeline(VkPipeline& slot, const ShaderSource& shader,
+                               std::span<const std::uint32_t> constants = {},
+                               std::uint32_t stage = VKCLOTH_ANY_STAGE) const;
   /// The specialisation constants of force, integrate and fused.comp (solver_state_set.cpp): the
   /// grid stencil, SC_WRITE_AUX, SC_COLLIDER_TYPES = `types` and SC_NORMAL_FLAGS; `csr` the
   /// defaults instead of the stencil and every normal path (the implicit passes' gather).

@@ -40,6 +40,18 @@ std::array<std::uint32_t, 43> SolverBatch::state_constants(bool write_aux, std::
   return words;
 }
 
+Result<void> SolverBatch::ensure_pipeline(VkPipeline& slot, const ShaderSource& shader,
+                                          std::span<const std::uint32_t> constants,
+                                          std::uint32_t stage) const {
+  if (slot)
+    return {};
+  auto p = ctx->pipelines->pipeline(shader, constants, variant(stage));
+  if (!p)
+    return p.error();
+  slot = *p;
+  return {};
+}
+
 void SolverBatch::bind_state(VkCommandBuffer c, std::uint32_t read, bool stage_input,
                              std::uint32_t texel) const {
   const VkDescriptorSet bound[2] = {sets[read][stage_input ? 1 : 0],

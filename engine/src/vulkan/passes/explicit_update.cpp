@@ -38,30 +38,15 @@ public:
   Result<void> prepare(SolverBatch& b) override {
     if (!active(b))
       return {};
-    PipelineRegistry& registry = *b.context().pipelines;
     const std::uint32_t types = b.collider_types();
     if (fused(b)) {
       for (std::uint32_t aux = 0; aux < 2; ++aux)
-        if (!fused_[aux][types]) {
-          auto p = registry.pipeline(kFused, b.state_constants(aux != 0, types), b.variant());
-          if (!p)
-            return p.error();
-          fused_[aux][types] = *p;
-        }
+        VKCLOTH_TRY(b.ensure_pipeline(fused_[aux][types], kFused, b.state_constants(aux != 0, types)));
       return {};
     }
-    if (force_[types])
-      return {};
     const auto constants = b.state_constants(true, types);
-    auto fp = registry.pipeline(kForce, constants, b.variant());
-    if (!fp)
-      return fp.error();
-    auto ip = registry.pipeline(kIntegrate, constants, b.variant());
-    if (!ip)
-      return ip.error();
-    force_[types] = *fp;
-    integrate_[types] = *ip;
-    return {};
+    VKCLOTH_TRY(b.ensure_pipeline(force_[types], kForce, constants));
+    return b.ensure_pipeline(integrate_[types], kIntegrate, constants);
   }
 
   std::uint32_t record(const SolverBatch& b, PassFrame& f) override {

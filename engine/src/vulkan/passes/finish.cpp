@@ -47,15 +47,9 @@ public:
     if (!active(b))
       return {};
     const std::uint32_t types = collider_types(b);
-    if (pipelines_[types])
-      return {};
     std::array<std::uint32_t, 42> constants{}; // ids 0..41, of which strain_finish.comp has only 41
     constants[41] = types;                     // SC_COLLIDER_TYPES
-    auto p = b.context().pipelines->pipeline(kStrainFinish, constants, b.variant(stage_));
-    if (!p)
-      return p.error();
-    pipelines_[types] = *p;
-    return {};
+    return b.ensure_pipeline(pipelines_[types], kStrainFinish, constants, stage_);
   }
 
   std::uint32_t record(const SolverBatch& b, PassFrame& f) override {

@@ -39,13 +39,7 @@ public:
   }
 
   Result<void> prepare(SolverBatch& b) override {
-    if (pipeline_ || !active(b))
-      return {};
-    auto p = b.context().pipelines->pipeline(kStrainLinks, {}, b.variant());
-    if (!p)
-      return p.error();
-    pipeline_ = *p;
-    return {};
+    return active(b) ? b.ensure_pipeline(pipeline_, kStrainLinks) : Result<void>{};
   }
 
   std::uint32_t record(const SolverBatch& b, PassFrame& f) override {

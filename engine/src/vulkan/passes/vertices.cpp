@@ -23,13 +23,7 @@ public:
   bool active(const SolverBatch& b) const override { return b.solver_options().interleaved_vertices; }
 
   Result<void> prepare(SolverBatch& b) override {
-    if (pipeline_ || !active(b))
-      return {};
-    auto p = b.context().pipelines->pipeline(kVertices, {}, b.variant());
-    if (!p)
-      return p.error();
-    pipeline_ = *p;
-    return {};
+    return active(b) ? b.ensure_pipeline(pipeline_, kVertices) : Result<void>{};
   }
 
   std::uint32_t record(const SolverBatch& b, PassFrame& f) override {
