@@ -50,3 +50,4 @@
 #include "self_collision.h"
 #include "integrators.h"
 #include "implicit.h"
+#include "vbd.h"

@@ -38,6 +38,8 @@
 #define VKCLOTH_INTEGRATOR_EXPLICIT_EULER 0u
 #define VKCLOTH_INTEGRATOR_SEMI_IMPLICIT_EULER 1u
 #define VKCLOTH_INTEGRATOR_RK4 2u
+#define VKCLOTH_INTEGRATOR_IMPLICIT_EULER 3u
+#define VKCLOTH_INTEGRATOR_VBD 4u
 
 // Collider::type (the vkcloth::Collider::Type values; engine/src/core/kernel.hpp asserts it).
 #define VKCLOTH_COLLIDER_PLANE 0u

@@ -27,6 +27,8 @@ enum class Integrator : std::uint32_t {
   semi_implicit_euler = 1, ///< v += dt a; p += dt v_new   (what the report observed; the default)
   rk4 = 2,                 ///< classic 4-stage Runge-Kutta on (p, v)
   implicit_euler = 3,      ///< backward Euler (Baraff & Witkin 1998), linearised, solved by PCG
+  vbd = 4, ///< backward Euler by vertex block descent (Chen et al. 2024): coloured Gauss-Seidel, one 3x3
+           ///< Newton step per particle (docs/model.md "Vertex block descent")
 };
 
 /// What the last implicit solve achieved (zero for the explicit integrators).
@@ -180,6 +182,9 @@ struct SimParams {
   double cg_tolerance = 1e-6;
   /// ... or after this many iterations (then the step uses the last iterate).
   std::uint32_t cg_max_iterations = 200;
+  /// vbd: Gauss-Seidel sweeps over the colours per substep (1..1000; docs/model.md "Vertex block
+  /// descent", docs/performance.md for the default's cost and quality).
+  std::uint32_t vbd_iterations = 10;
   glm::dvec3 gravity{0.0, 0.0, -9.81};
   /// Fluid damping mu (1/s): the force -mu m v. With m = 1 it is the report's -mu v; on a cloth
   /// it is the (1 - dt mu) velocity factor (docs/model.md "Forces").

@@ -153,6 +153,13 @@ public:
   /// 2 l + e for link l = strain_links()[l], e = 1 when p is its end b (0: end a), in link order.
   std::span<const std::uint32_t> strain_incidence_offsets() const { return strain_incidence_offsets_; }
   std::span<const std::uint32_t> strain_incidence() const { return strain_incidence_; }
+  /// Vertex block descent's colours (Integrator::vbd; docs/model.md "Vertex block descent"): colour
+  /// c is vertex_order()[vertex_colour_offsets()[c] .. [c+1]), in index order, and no spring joins
+  /// two particles of one colour, so each colour is solved in parallel with the same result as in
+  /// order. A grid of structural, shear and bend springs: (i + 2 j) mod 5, five colours; otherwise
+  /// a greedy colouring of the gather lists in index order.
+  std::span<const std::uint32_t> vertex_order() const { return vertex_order_; }
+  std::span<const std::uint32_t> vertex_colour_offsets() const { return vertex_colour_offsets_; }
   /// tethers_per_particle slots per particle (particle p's at [p * tethers_per_particle, ...)): the
   /// pinned particles nearest to p along the springs (structural, shear and chain springs at their
   /// rest lengths), nearest first, with rest distances measured straight (euclidean) or along
@@ -176,6 +183,7 @@ private:
   std::vector<StrainLink> strain_links_;
   std::vector<std::uint32_t> strain_colour_offsets_;
   std::vector<std::uint32_t> strain_incidence_offsets_, strain_incidence_;
+  std::vector<std::uint32_t> vertex_order_, vertex_colour_offsets_;
   // Tethers, computed on first use (tethers()): [0] euclidean, [1] geodesic.
   mutable std::once_flag tethers_once_[2];
   mutable std::vector<Tether> tethers_[2];

@@ -311,6 +311,10 @@ template <typename Real> void CpuSolver<Real>::Impl::substep(const Real h) {
     soa_valid_ = false;
     implicit_substep(h);
     break;
+  case Integrator::vbd:
+    soa_valid_ = false;
+    vbd_substep(h);
+    break;
   }
   if (params_.stretch_limit.enabled())
     limit_stretch(h);

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // CpuSolver's internals (the public header holds the API only): the state in the solver's
 // precision and the per-particle loops of one substep. Defined in cpu_solver.cpp (Euler, RK4, the
-// row and list sweeps), implicit_euler.cpp, self_collision.cpp and strain_projection.cpp.
+// row and list sweeps), implicit_euler.cpp, vbd.cpp, self_collision.cpp and strain_projection.cpp.
 #pragma once
 
 #include <array>
@@ -21,6 +21,13 @@ class ThreadPool;
 template <typename Real> struct ImplicitWorkspace;
 template <typename Real> struct SelfCollisionGrid;
 template <typename Real> struct StrainProjection;
+/// Vertex block descent's per-particle state of a substep (vbd.cpp).
+template <typename Real> struct VbdWorkspace {
+  using Vec3 = glm::vec<3, Real, glm::defaultp>;
+  std::vector<Vec3> x0;   ///< positions at the substep's start
+  std::vector<Vec3> y;    ///< inertia targets
+  std::vector<Vec3> push; ///< the colliders' projection move of the last iteration
+};
 /// The colliders as the kernel takes them at this substep's pose, and their meshes; the same values
 /// for the SIMD finish of the grid rows (row_kernel.hpp FinishShape), empty when a collider is a mesh
 /// or there are more than detail::finish_max_shapes.
@@ -93,6 +100,11 @@ template <typename Real> struct CpuSolver<Real>::Impl {
   void implicit_system(Real h);
   void implicit_cg(Real h);
   void implicit_update(Real h);
+  // Vertex block descent (vbd.cpp): the targets, the coloured sweeps, then velocities and friction.
+  void vbd_substep(Real h);
+  void vbd_begin(Real h);
+  void vbd_solve_colour(std::uint32_t colour, Real h);
+  void vbd_finish(Real h);
   // Stretch control after a substep (docs/model.md "Stretch control").
   void limit_stretch(Real h);
   // Self-collision after that (self_collision.cpp; docs/model.md "Self-collision").
@@ -151,6 +163,7 @@ template <typename Real> struct CpuSolver<Real>::Impl {
   std::unique_ptr<detail::SelfCollisionGrid<Real>> self_;      // created by the first self-collision substep
   std::unique_ptr<detail::StrainProjection<Real>> projection_; // created by the first fast-projection substep
   std::unique_ptr<detail::PaddedLists<Real>> lists_;           // created by the first list sweep
+  std::unique_ptr<detail::VbdWorkspace<Real>> vbd_;            // created by the first vbd substep
   SolveStats solve_;
 };
 

@@ -27,6 +27,8 @@ static_assert(VKCLOTH_INTEGRATOR_EXPLICIT_EULER == std::uint32_t(vkcloth::Integr
 static_assert(VKCLOTH_INTEGRATOR_SEMI_IMPLICIT_EULER ==
               std::uint32_t(vkcloth::Integrator::semi_implicit_euler));
 static_assert(VKCLOTH_INTEGRATOR_RK4 == std::uint32_t(vkcloth::Integrator::rk4));
+static_assert(VKCLOTH_INTEGRATOR_IMPLICIT_EULER == std::uint32_t(vkcloth::Integrator::implicit_euler));
+static_assert(VKCLOTH_INTEGRATOR_VBD == std::uint32_t(vkcloth::Integrator::vbd));
 
 // Every kernel function inlined into its caller (GCC's own choice varies with their size, and an
 // out-of-line collider_contact costs the contact path ~40 %), but the mesh search.

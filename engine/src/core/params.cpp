@@ -254,13 +254,15 @@ const char* to_string(Integrator integrator) {
     return "rk4";
   case Integrator::implicit_euler:
     return "implicit_euler";
+  case Integrator::vbd:
+    return "vbd";
   }
   return "?";
 }
 
 std::optional<Integrator> parse_integrator(std::string_view name) {
   for (Integrator i : {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::rk4,
-                       Integrator::implicit_euler})
+                       Integrator::implicit_euler, Integrator::vbd})
     if (name == to_string(i))
       return i;
   return std::nullopt;
@@ -303,7 +305,7 @@ std::optional<StretchLimit::TetherDistance> parse_tether_distance(std::string_vi
 }
 
 Result<void> SimParams::validate() {
-  if (static_cast<std::uint32_t>(integrator) > static_cast<std::uint32_t>(Integrator::implicit_euler))
+  if (static_cast<std::uint32_t>(integrator) > static_cast<std::uint32_t>(Integrator::vbd))
     return bad(
         fmt::format("integrator.method: unknown integrator {}", static_cast<std::uint32_t>(integrator)));
   if (!std::isfinite(dt) || dt <= 0.0)
@@ -314,6 +316,8 @@ Result<void> SimParams::validate() {
     return bad(fmt::format("integrator.cg_tolerance must be finite and in [0, 1), got {}", cg_tolerance));
   if (cg_max_iterations < 1 || cg_max_iterations > 100000)
     return bad(fmt::format("integrator.cg_max_iterations must be in 1..100000, got {}", cg_max_iterations));
+  if (vbd_iterations < 1 || vbd_iterations > 1000)
+    return bad(fmt::format("integrator.iterations (vbd) must be in 1..1000, got {}", vbd_iterations));
   if (!finite(gravity))
     return bad("physics.gravity must be finite, got " + str(gravity));
   if (!std::isfinite(damping) || damping < 0.0)

@@ -6,6 +6,7 @@
 #include "kernel/constants.h" // VKCLOTH_RING_*
 
 #include "stretch_topology.hpp"
+#include "vertex_colouring.hpp"
 
 #include <fmt/format.h>
 
@@ -331,6 +332,7 @@ Result<std::shared_ptr<const ClothTopology>> ClothTopology::create(const Particl
   }
   detail::colour_strain_links(s, t->strain_links_, t->strain_colour_offsets_);
   detail::link_incidence(n, t->strain_links_, t->strain_incidence_offsets_, t->strain_incidence_);
+  detail::colour_vertices(s, t->edge_offsets_, t->edges_, t->vertex_order_, t->vertex_colour_offsets_);
   return std::shared_ptr<const ClothTopology>(std::move(t));
 }
 

@@ -13,14 +13,15 @@ Result<void> read_integrator(const json& doc, SimParams& params, std::uint64_t& 
   if (!obj)
     return {};
   VKCLOTH_TRY(sd::check_keys(*obj, "integrator",
-                             {"method", "dt", "steps", "substeps", "cg_tolerance", "cg_max_iterations"}));
+                             {"method", "dt", "steps", "substeps", "cg_tolerance", "cg_max_iterations",
+                              "iterations"}));
   std::string method = to_string(params.integrator);
   VKCLOTH_TRY(sd::read(*obj, "integrator", "method", method));
   const auto integ = parse_integrator(method);
   if (!integ)
     return make_error(ErrorCode::invalid_argument,
                       fmt::format("integrator.method: unknown integrator \"{}\" (known: explicit_euler, "
-                                  "semi_implicit_euler, rk4, implicit_euler)",
+                                  "semi_implicit_euler, rk4, implicit_euler, vbd)",
                                   method));
   params.integrator = *integ;
   VKCLOTH_TRY(sd::read(*obj, "integrator", "dt", params.dt));
@@ -32,6 +33,10 @@ Result<void> read_integrator(const json& doc, SimParams& params, std::uint64_t& 
   if (auto it = obj->find("cg_max_iterations"); it != obj->end()) {
     SCENE_TRY_ASSIGN(n, sd::as_integer(*it, "integrator.cg_max_iterations", 100000));
     params.cg_max_iterations = static_cast<std::uint32_t>(n);
+  }
+  if (auto it = obj->find("iterations"); it != obj->end()) {
+    SCENE_TRY_ASSIGN(n, sd::as_integer(*it, "integrator.iterations", 1000000));
+    params.vbd_iterations = static_cast<std::uint32_t>(n); // the range (1..1000) is validate()'s
   }
   if (auto it = obj->find("steps"); it != obj->end()) {
     SCENE_TRY_ASSIGN(n, sd::as_integer(*it, "integrator.steps", max_scene_steps));

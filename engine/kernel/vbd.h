@@ -1,0 +1,75 @@
+// SPDX-License-Identifier: MIT
+// vkcloth kernel: implicit Euler by vertex block descent (Chen, Liu, Yang, Yuksel, SIGGRAPH 2024):
+// the inertia target, one vertex's Newton step, and the velocity and contact force a step leaves
+// (docs/model.md "Vertex block descent").
+// Part of the kernel that cloth_kernel.h gathers (the rules it states hold here: fixed order,
+// `precise` results, real(...) literals). No include guard: the C++ bridge includes it once per precision.
+
+// ---- Vertex block descent (docs/model.md "Vertex block descent") --------------------------------
+
+// The inertia target y = x0 + h v0 + (h^2 / m) f_ext: where the particle would go with its velocity
+// and the forces that do not depend on the solve (gravity and wind at the step's start).
+KFN precise vec3 vbd_inertia_target(vec3 x0, vec3 v0, vec3 f_ext, real m, real h) {
+  precise real h2_m = h * h / m;
+  precise vec3 y = x0 + v0 * h;
+  y = y + f_ext * h2_m;
+  return y;
+}
+
+// One spring's part in a vertex's step, u = x_q - x: its force (add_spring_edge) and its stiffness
+// block (spring_block: the positive semi-definite part of the Hessian).
+KFN void vbd_add_spring(INOUT(vec3) f, INOUT(SpringBlock) hessian, vec3 u, real rest, real k) {
+  add_spring_edge(f, u, rest, k);
+  add_block(hessian, spring_block(u, rest, k));
+}
+
+// One vertex's Newton step on its part of implicit Euler's variational energy
+//   G(x) = m / (2 h^2) |x - y|^2 + mu m / (2 h) |x - x0|^2 + sum of its springs' energies
+// (the second term is the fluid damping -mu m v with v = (x - x0) / h): the gradient
+// g = m / h^2 (x - y) + (mu m / h) (x - x0) - f (f: the springs' force at x) and the Hessian
+// H = (1 + h mu) m / h^2 I + sum K_s, positive definite (K_s positive semi-definite); x - H^-1 g.
+KFN precise vec3 vbd_step(vec3 x, vec3 y, vec3 x0, vec3 f, SpringBlock hessian, real m, real h, real mu) {
+  precise real m_h2 = m / (h * h);
+  precise real mu_m_h = mu * m / h;
+  precise vec3 g = (x - y) * m_h2 + (x - x0) * mu_m_h;
+  g = g - f;
+  SpringBlock a;
+  precise vec3 d = hessian.diag + vec3(m_h2 + mu_m_h);
+  a.diag = d;
+  a.off = hessian.off;
+  precise vec3 nx = x - apply_block(invert_block(a), g);
+  return nx;
+}
+
+// After the iterations: the velocity the step implies, v = (x - x0) / h ...
+KFN precise vec3 vbd_velocity(vec3 x, vec3 x0, real h) {
+  precise vec3 v = (x - x0) / h;
+  return v;
+}
+// ... the force a collider held back in the last iteration, -m push / h^2 (push: the collider
+// projection's move of that iteration), so that friction's normal impulse (contact_response) is the
+// push's normal part over h ...
+KFN precise vec3 vbd_held_force(vec3 push, real m, real h) {
+  precise real s = -m / (h * h);
+  precise vec3 f = push * s;
+  return f;
+}
+// ... and the position of the velocity friction left, x = x0 + h v.
+KFN precise vec3 vbd_position(vec3 x0, vec3 v, real h) {
+  precise vec3 x = x0 + v * h;
+  return x;
+}
+
+// A vertex's part of the variational energy G without its springs (the tests sum the springs' apart):
+// m / (2 h^2) |x - y|^2 + mu m / (2 h) |x - x0|^2.
+KFN precise real vbd_inertia_energy(vec3 x, vec3 y, vec3 x0, real m, real h, real mu) {
+  precise vec3 a = x - y, b = x - x0;
+  precise real e = m / (real(2) * h * h) * dot3(a, a);
+  e = e + mu * m / (real(2) * h) * dot3(b, b);
+  return e;
+}
+// The net force of the step, m (v - v0) / h (what a host observes as the particle's force).
+KFN precise vec3 vbd_net_force(vec3 v, vec3 v0, real m, real h) {
+  precise vec3 f = (v - v0) * (m / h);
+  return f;
+}

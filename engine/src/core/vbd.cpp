@@ -1,0 +1,104 @@
+// SPDX-License-Identifier: MIT
+// CpuSolver's vertex block descent substep (docs/model.md "Vertex block descent"; each formula:
+// engine/kernel/vbd.h). The GPU runs the same phases in the same order (shaders/vbd.comp):
+//   begin:   normals and external forces at the substep's start, the inertia targets y, and the
+//            first guess x = y projected out of the colliders;
+//   sweeps:  `vbd_iterations` times, the colours in order; each particle of a colour takes one Newton
+//            step on its springs and its inertia, from its neighbours' latest positions, and is
+//            projected out of the colliders (no two particles of a colour share a spring, so a
+//            colour runs in parallel with the result of running it in order);
+//   finish:  v = (x - x0) / h, the contact response (the inward part, Coulomb friction with the
+//            projection's push as normal impulse), x = x0 + h v, projected.
+#include <algorithm>
+
+#include "cpu_solver_impl.hpp"
+#include "thread_pool.hpp"
+
+namespace vkcloth {
+
+template <typename Real> void CpuSolver<Real>::Impl::vbd_substep(const Real h) {
+  vbd_begin(h);
+  const std::uint32_t colours = std::uint32_t(topology_->vertex_colour_offsets().size()) - 1;
+  for (std::uint32_t it = 0; it < params_.vbd_iterations; ++it)
+    for (std::uint32_t c = 0; c < colours; ++c)
+      vbd_solve_colour(c, h);
+  vbd_finish(h);
+  solve_.iterations = params_.vbd_iterations;
+  solve_.residual = 0.0;
+  solve_.total_iterations += params_.vbd_iterations;
+  ++solve_.solves;
+}
+
+template <typename Real> void CpuSolver<Real>::Impl::vbd_begin(const Real h) {
+  const std::size_t n = pos_.size();
+  if (!vbd_)
+    vbd_ = std::make_unique<detail::VbdWorkspace<Real>>();
+  auto& w = *vbd_;
+  w.x0 = pos_;
+  w.y.resize(n);
+  w.push.assign(n, Vec3(0));
+  const Real kw = Real(params_.wind.strength);
+  const Vec3 g{params_.gravity}, wind_dir{params_.wind.direction};
+  pool_->for_each(n, [&](std::size_t p) {
+    normal_force_at(pos_, vel_, p); // the normal at the start (wind; what a host observes)
+    const Vec3 f_ext = kernel::add_body_forces(Vec3(0), mass_[p], Vec3(0), g, Real(0), kw != Real(0),
+                                               normal_[p], wind_dir, kw);
+    w.y[p] = pinned_[p] ? w.x0[p] : kernel::vbd_inertia_target(w.x0[p], vel_[p], f_ext, mass_[p], h);
+  });
+  pool_->for_each(n, [&](std::size_t p) { // the first guess: the targets, out of the colliders
+    if (pinned_[p])
+      return;
+    Vec3 x = w.y[p], unused(0);
+    project_at(w.x0[p], x, unused);
+    pos_[p] = x;
+  });
+}
+
+template <typename Real> void CpuSolver<Real>::Impl::vbd_solve_colour(const std::uint32_t colour, const Real h) {
+  auto& w = *vbd_;
+  const auto order = topology_->vertex_order();
+  const std::uint32_t first = topology_->vertex_colour_offsets()[colour];
+  const std::uint32_t count = topology_->vertex_colour_offsets()[colour + 1] - first;
+  const Real mu = Real(params_.damping);
+  pool_->for_each(count, [&](std::size_t k) {
+    const std::uint32_t p = order[first + k];
+    if (pinned_[p])
+      return;
+    const Vec3 x = pos_[p];
+    Vec3 f(0);
+    kernel::SpringBlock<Real> hessian{Vec3(0), Vec3(0)};
+    for (std::uint32_t e = edge_offsets_[p]; e < edge_offsets_[p + 1]; ++e) {
+      const Edge& s = edges_[e];
+      kernel::vbd_add_spring(f, hessian, pos_[s.other] - x, s.rest_length, s.stiffness);
+    }
+    const Vec3 stepped = kernel::vbd_step(x, w.y[p], w.x0[p], f, hessian, mass_[p], h, mu);
+    Vec3 projected = stepped, unused(0);
+    project_at(w.x0[p], projected, unused);
+    w.push[p] = projected - stepped;
+    pos_[p] = projected;
+  });
+}
+
+template <typename Real> void CpuSolver<Real>::Impl::vbd_finish(const Real h) {
+  auto& w = *vbd_;
+  pool_->for_each(pos_.size(), [&](std::size_t p) {
+    if (pinned_[p]) {
+      force_[p] = Vec3(0);
+      return; // stays put with its velocity
+    }
+    const Vec3 x0 = w.x0[p];
+    Vec3 v = kernel::vbd_velocity(pos_[p], x0, h);
+    Vec3 held = kernel::vbd_held_force(w.push[p], mass_[p], h);
+    contact_at(pos_[p], v, held, h / mass_[p]);
+    Vec3 x = kernel::vbd_position(x0, v, h);
+    project_at(x0, x, v);
+    force_[p] = kernel::vbd_net_force(v, vel_[p], mass_[p], h);
+    pos_[p] = x;
+    vel_[p] = v;
+  });
+}
+
+template void CpuSolver<float>::Impl::vbd_substep(float);
+template void CpuSolver<double>::Impl::vbd_substep(double);
+
+} // namespace vkcloth
