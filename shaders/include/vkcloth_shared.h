@@ -58,7 +58,8 @@ struct vec4 {
   21 // interleaved Vertex per particle (GpuSolverOptions::interleaved_vertices)
 #define VKCLOTH_BINDING_MESH_NODES 22 // MeshNode: every mesh collider's hierarchy (Collider::mesh_root)
 #define VKCLOTH_BINDING_MESH_TRIS 23  // MeshTriangle: their triangles in leaf order (Collider::mesh_tri0)
-#define VKCLOTH_BINDING_COUNT 24
+#define VKCLOTH_BINDING_VBD_ORDER 24 // vbd: the particles in colour order (ClothTopology::vertex_order)
+#define VKCLOTH_BINDING_COUNT 25
 
 // Set 1 (force.comp, fused.comp, strain_*.comp): POS_IN again, as an RGBA32F uniform texel buffer view,
 // PARTICLE as an RG32UI one (x: the mass's bits, y: pinned), and (fused.comp) VEL as RGBA32F and
@@ -119,6 +120,21 @@ struct StrainLinksPush {
   uint step;
   uint link_first; // the colour's first link
   uint link_count; // the colour's links
+  uint unused;
+};
+
+/// vbd.comp (VKCLOTH_VBD_*: `stage`): one colour of one sweep in VKCLOTH_VBD_SOLVE.
+#define VKCLOTH_VBD_BEGIN 0u  // normals, inertia targets (VEL_FILT), first guess (POS_OUT)
+#define VKCLOTH_VBD_SOLVE 1u  // one colour's Newton steps in place on POS_OUT, the push (STAGE_POS)
+#define VKCLOTH_VBD_FINISH 2u // velocities, friction, projection, divergence
+struct VbdPush {
+  uint count;
+  uint nx;
+  uint ny;
+  uint stage;
+  uint step;
+  uint colour_first; // the colour's first entry of VBD_ORDER
+  uint colour_count; // its particles
   uint unused;
 };
 
@@ -217,6 +233,7 @@ struct Flags {
 #ifdef __cplusplus
 static_assert(sizeof(PushConstants) == 32);
 static_assert(sizeof(StrainLinksPush) == 32);
+static_assert(sizeof(VbdPush) == 32);
 
 /// The state layout (every pass that reads the batch's state through its sets: force, integrate,
 /// fused, strain_links, strain_finish, vertices): set 0 holds every VKCLOTH_BINDING_* (0 ..

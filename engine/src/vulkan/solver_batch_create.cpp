@@ -181,6 +181,7 @@ Result<void> SolverBatch::create_buffers() {
       {&strain_links, std::max<VkDeviceSize>(strain_link_count() * sizeof(sh::StrainLink), 16),
        "strain links"},
       {&tethers, 16, "tethers (none yet)"},
+      {&vbd_order, std::max<VkDeviceSize>(n * sizeof(std::uint32_t), 16), "vbd colour order"},
       // GpuSolverOptions::interleaved_vertices: one Vertex (32 bytes) per particle; else one.
       {&vertices, options.interleaved_vertices ? VkDeviceSize(size()) * n * sizeof(sh::Vertex) : 32,
        "interleaved vertices"}};
@@ -273,6 +274,7 @@ Result<void> SolverBatch::upload_initial_state(const ClothTopology& topology,
       {&offsets, topology.edge_offsets().data(), (n + 1) * sizeof(std::uint32_t)},
       {&ranges, range_data.empty() ? nullptr : range_data.data(), range_data.size() * sizeof(std::uint32_t)},
       {&edges, edge_data.data(), edges_count * sizeof(sh::Edge)},
+      {&vbd_order, topology.vertex_order().data(), n * sizeof(std::uint32_t)},
       {&indices, triangles.data(), triangles.size() * sizeof(std::uint32_t)},
       {&force, nullptr, 0},
       {&force_stage, nullptr, 0},

@@ -70,8 +70,10 @@ ClothWorld::Impl::BatchKey ClothWorld::Impl::key_of(const Instance& inst, Instan
   k.topology = inst.topology.get();
   k.family = inst.params.integrator == Integrator::rk4              ? 1
              : inst.params.integrator == Integrator::implicit_euler ? 2
+             : inst.params.integrator == Integrator::vbd            ? 3
                                                                     : 0;
   k.substeps = inst.params.substeps;
+  k.iterations = k.family == 3 ? inst.params.vbd_iterations : 0;
   k.only = k.family == 2 ? id : 0;
   return k;
 }

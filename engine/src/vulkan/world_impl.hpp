@@ -29,8 +29,10 @@ struct ClothWorld::Impl {
   /// What instances must agree on to share a batch (and so its dispatches).
   struct BatchKey {
     const ClothTopology* topology = nullptr;
-    int family = 0; // 0: explicit / semi-implicit Euler, 1: RK4, 2: implicit Euler (one instance per batch)
+    int family = 0; // 0: explicit / semi-implicit Euler, 1: RK4, 2: implicit Euler (one instance per batch),
+                    // 3: vbd
     std::uint32_t substeps = 1;
+    std::uint32_t iterations = 0; // vbd: its sweeps (the batch's dispatches)
     InstanceId only = 0; // implicit Euler: the instance (its CG reductions are per batch)
     auto operator<=>(const BatchKey&) const = default;
   };

@@ -32,7 +32,8 @@ class ExplicitUpdate final : public Pass {
 public:
   const char* name() const override { return "explicit update"; }
   bool active(const SolverBatch& b) const override {
-    return b.family().integrator != Integrator::implicit_euler;
+    const Integrator i = b.family().integrator;
+    return i != Integrator::implicit_euler && i != Integrator::vbd;
   }
 
   Result<void> prepare(SolverBatch& b) override {

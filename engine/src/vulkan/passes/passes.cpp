@@ -12,6 +12,7 @@ namespace vkcloth::gpu {
 
 // Defined next to each pass (passes/*.cpp).
 std::unique_ptr<Pass> make_explicit_update();
+std::unique_ptr<Pass> make_vbd_update();
 std::unique_ptr<Pass> make_tethers();
 std::unique_ptr<Pass> make_strain_links();
 std::unique_ptr<Pass> make_strain_projection();
@@ -22,9 +23,10 @@ std::unique_ptr<Pass> make_vertices();
 
 std::vector<std::unique_ptr<Pass>> make_solver_passes() {
   std::vector<std::unique_ptr<Pass>> passes;
-  // The update: forces, contacts and the integrator (one of the two runs).
+  // The update: forces, contacts and the integrator (one of the three runs).
   passes.push_back(make_explicit_update());
   passes.push_back(std::make_unique<ImplicitUpdate>());
+  passes.push_back(make_vbd_update());
   // Stretch control: tethers, Provot's sweeps, the fast projection, then the colliders again.
   passes.push_back(make_tethers());
   passes.push_back(make_strain_links());

@@ -1,0 +1,82 @@
+// SPDX-License-Identifier: MIT
+// Vertex block descent's update of a substep (Integrator::vbd; the method: engine/src/core/vbd.cpp).
+// vbd.comp, one pipeline per phase: BEGIN over every particle, then for each iteration one dispatch
+// per colour of the topology (ClothTopology::vertex_order, uploaded as VBD_ORDER), then FINISH.
+// The state set of the substep's parity: POS_IN = positions[read] (the start), POS_OUT the iterate.
+// VEL_FILT and STAGE_POS, the explicit integrators' scratch, hold the targets and the pushes.
+#include <algorithm>
+#include <memory>
+
+#include "../barriers.hpp"
+#include "../solver_batch.hpp"
+#include "pass.hpp"
+#include "state_set.hpp"
+#include "vkcloth/shaders/vbd_comp_spv.hpp"
+
+namespace vkcloth::gpu {
+
+namespace {
+
+constexpr ShaderSource kVbd{"vbd.comp", spirv::vbd_comp_spv, {}, &kStateBindings};
+
+class VbdUpdate final : public Pass {
+public:
+  const char* name() const override { return "vbd update"; }
+  bool active(const SolverBatch& b) const override { return b.family().integrator == Integrator::vbd; }
+
+  Result<void> prepare(SolverBatch& b) override {
+    if (!active(b))
+      return {};
+    const std::uint32_t types = b.collider_types();
+    const auto constants = b.state_constants(true, types, true); // the CSR gather, every normal path
+    for (std::uint32_t stage : {VKCLOTH_VBD_BEGIN, VKCLOTH_VBD_SOLVE, VKCLOTH_VBD_FINISH})
+      VKCLOTH_TRY(b.ensure_pipeline(pipelines_[stage][types], kVbd, constants, stage));
+    return {};
+  }
+
+  std::uint32_t record(const SolverBatch& b, PassFrame& f) override {
+    const auto& v = b.vk();
+    const std::uint32_t types = b.collider_types();
+    b.bind_state(f.cmd, f.read, false, SolverBatch::no_texel_set); // vbd.comp has one (storage) build
+    auto pc = shared::push_from<shared::VbdPush>(*f.pc);
+    auto run = [&](std::uint32_t stage) {
+      pc.stage = stage;
+      b.push_state(f.cmd, &pc);
+      v.vkCmdBindPipeline(f.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipelines_[stage][types]);
+    };
+    run(VKCLOTH_VBD_BEGIN);
+    if (!f.first)
+      barriers::dispatch_to_dispatch(v, f.cmd); // the previous substep's passes -> this one
+    b.dispatch_particles(f.cmd);
+    std::uint32_t dispatches = 1;
+    const auto colours = b.topology().vertex_colour_offsets();
+    run(VKCLOTH_VBD_SOLVE);
+    // Instances of a batch share their sweeps: the world batches vbd instances by their iterations.
+    for (std::uint32_t it = 0; it < b.family().vbd_iterations; ++it)
+      for (std::size_t c = 0; c + 1 < colours.size(); ++c) {
+        pc.colour_first = colours[c];
+        pc.colour_count = colours[c + 1] - colours[c];
+        const std::uint32_t groups = (pc.colour_count + b.workgroup_size() - 1) / b.workgroup_size();
+        const std::uint32_t gx = std::min(groups, b.dispatch_x()), gy = (groups + gx - 1) / gx;
+        b.push_state(f.cmd, &pc);
+        barriers::dispatch_to_dispatch(v, f.cmd); // the begin or the previous colour -> this colour
+        v.vkCmdDispatch(f.cmd, gx, gy, b.size());
+        ++dispatches;
+      }
+    run(VKCLOTH_VBD_FINISH);
+    barriers::dispatch_to_dispatch(v, f.cmd); // the last colour -> the velocities
+    b.dispatch_particles(f.cmd);
+    return dispatches + 1;
+  }
+
+private:
+  VkPipeline pipelines_[3][VKCLOTH_COLLIDER_ALL_TYPES + 1] = {}; // [VKCLOTH_VBD_*][collider types]
+};
+
+} // namespace
+
+std::unique_ptr<Pass> make_vbd_update() {
+  return std::make_unique<VbdUpdate>();
+}
+
+} // namespace vkcloth::gpu

@@ -1,0 +1,121 @@
+// SPDX-License-Identifier: MIT
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// vkcloth-builds: one workgroup-constant (shaders/CMakeLists.txt)
+// Vertex block descent (Integrator::vbd), the phases of CpuSolver's vbd.cpp in the same order, each
+// formula from cloth_kernel.h (vbd.h); one pipeline per phase (SC_STAGE, VKCLOTH_VBD_*):
+//   BEGIN:  one invocation per particle: the normal at the substep's start (particle_force, as the
+//           CPU's normal_force_at), the inertia target y -> VEL_FILT, the first guess y projected
+//           out of the colliders -> POS_OUT, no push yet -> STAGE_POS;
+//   SOLVE:  one invocation per particle of one colour (VBD_ORDER[colour_first ..]): one Newton step
+//           from the neighbours' latest positions in POS_OUT, projected; writes its own POS_OUT
+//           entry and its push. No two particles of a colour share a spring, so no invocation reads
+//           what another writes;
+//   FINISH: one invocation per particle: v = (x - x0) / h, the contact response with the held
+//           force, x = x0 + h v, projection and divergence flags (finish.glsl), the net force.
+// Reads POS_IN (= POS_BASE: positions[read], the start), VEL; writes POS_OUT, VEL, NORMAL, FORCE_OUT.
+#include "vkcloth_shared.h"
+#define VKCLOTH_PUSH_STRUCT VbdPush
+#include "common.glsl"
+#include "force_body.glsl"
+
+layout(std430, set = 0, binding = VKCLOTH_BINDING_FORCE_OUT) writeonly buffer ForceOut { vec4 force_out[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_NORMAL) writeonly buffer NormalOut { vec4 normal_out[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_POS_OUT) buffer PosOut { vec4 pos_out[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_VEL) buffer VelBuf { vec4 vel[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_VEL_FILT) buffer TargetBuf { vec4 target[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_STAGE_POS) buffer PushBuf { vec4 push_of[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_VBD_ORDER) readonly buffer OrderBuf { uint vbd_order[]; };
+
+#include "finish.glsl"
+
+// Particle p's position projected out of every collider (side: where it started the substep).
+vec3 projected(vec3 side, vec3 x) {
+  vec3 v = vec3(0.0);
+  for (uint c = 0u; c < (SC_COLLIDERS ? ip.collider_count : 0u); ++c)
+    project_out(0u, collider_shape(c), ip.eps, side, x, v);
+  return x;
+}
+
+void begin(uint p, uint g, bool pinned) {
+  vec3 v = vel[g].xyz, f, nrm;
+  const vec3 v0 = v;
+  particle_force(p, v, f, nrm); // for its normal
+  normal_out[g] = normal_output(nrm);
+  const vec3 x0 = read_pos_in(p);
+  const float m = read_particle(p).mass;
+  const vec3 f_ext = add_body_forces(vec3(0.0), m, vec3(0.0), ip.gravity_damping.xyz, 0.0,
+                                     (ip.flags & VKCLOTH_FLAG_WIND) != 0u, nrm, ip.wind.xyz, ip.wind.w);
+  const vec3 y = pinned ? x0 : vbd_inertia_target(x0, v0, f_ext, m, ip.dt);
+  target[g] = vec4(y, 0.0);
+  push_of[g] = vec4(0.0);
+  pos_out[g] = vec4(pinned ? x0 : projected(x0, y), 1.0);
+}
+
+void solve(uint p, uint g) {
+  const vec3 x = pos_out[g].xyz;
+  vec3 f = vec3(0.0);
+  SpringBlock hessian;
+  hessian.diag = vec3(0.0);
+  hessian.off = vec3(0.0);
+  const uvec3 range = read_list_range(p);
+  for (uint e = range.x; e < range.z; ++e) {
+    const Edge s = read_edge(e);
+    vbd_add_spring(f, hessian, pos_out[base + s.other].xyz - x, s.rest_length, s.stiffness);
+  }
+  const vec3 x0 = read_pos_in(p);
+  const float m = read_particle(p).mass;
+  const vec3 stepped = vbd_step(x, target[g].xyz, x0, f, hessian, m, ip.dt, ip.gravity_damping.w);
+  const vec3 x1 = projected(x0, stepped);
+  push_of[g] = vec4(x1 - stepped, 0.0);
+  pos_out[g] = vec4(x1, 1.0);
+}
+
+void finish_step(uint p, uint g, bool pinned) {
+  const vec3 x0 = read_pos_in(p);
+  const vec3 v0 = vel[g].xyz;
+  if (pinned) {
+    force_out[g] = vec4(0.0);
+    finish(p, true, x0, x0, v0); // stays put with its velocity
+    return;
+  }
+  const float m = read_particle(p).mass;
+  const float h = ip.dt;
+  const vec3 x = pos_out[g].xyz;
+  vec3 v = vbd_velocity(x, x0, h);
+  vec3 held = vbd_held_force(push_of[g].xyz, m, h);
+  const bool both = (ip.flags & VKCLOTH_FLAG_CONTACT_BOTH) != 0u;
+  precise float h_over_m = h / m;
+  for (uint c = 0u; c < (SC_COLLIDERS ? ip.collider_count : 0u); ++c) {
+    ColliderShape s = collider_shape(c);
+    float dist;
+    vec3 n;
+    collider_contact(0u, s, x, x, ip.band, dist, n);
+    contact_response(v, held, s, x, n, dist, ip.band, both, h_over_m);
+  }
+  force_out[g] = vec4(vbd_net_force(v, v0, m, h), 0.0);
+  finish(p, false, x0, vbd_position(x0, v, h), v);
+}
+
+void main() {
+  begin_instance();
+  const uint stage = pass_stage();
+  uint p = particle_index();
+  if (stage == VKCLOTH_VBD_SOLVE) {
+    if (p >= pc.colour_count) return;
+    p = vbd_order[pc.colour_first + p];
+  } else if (p >= pc.count) {
+    return;
+  }
+  const uint g = base + p;
+  const bool pinned = read_particle(p).pinned != 0u;
+  const bool fr = frozen();
+  if (stage == VKCLOTH_VBD_BEGIN) {
+    if (fr) pos_out[g] = vec4(read_pos_in(p), 1.0);
+    else begin(p, g, pinned);
+  } else if (stage == VKCLOTH_VBD_SOLVE) {
+    if (!pinned && !fr) solve(p, g);
+  } else {
+    finish_step(p, g, pinned || fr);
+  }
+}
