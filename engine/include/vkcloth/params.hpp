@@ -184,7 +184,7 @@ struct SimParams {
   std::uint32_t cg_max_iterations = 200;
   /// vbd: Gauss-Seidel sweeps over the colours per substep (1..1000; docs/model.md "Vertex block
   /// descent", docs/performance.md for the default's cost and quality).
-  std::uint32_t vbd_iterations = 10;
+  std::uint32_t vbd_iterations = 5;
   glm::dvec3 gravity{0.0, 0.0, -9.81};
   /// Fluid damping mu (1/s): the force -mu m v. With m = 1 it is the report's -mu v; on a cloth
   /// it is the (1 - dt mu) velocity factor (docs/model.md "Forces").
