@@ -178,6 +178,8 @@ int time_scene(BenchRun& run, const BenchScene& sc, std::uint32_t n, const std::
     r->scene = scene;
     r->order = order;
     r->cost = cost_of(r->variant, sc.params.integrator, s, scene != "mesh", fans, true, o.steps_per_submit);
+    if (sc.params.integrator == Integrator::vbd)
+      r->vbd_sweeps = sc.params.vbd_iterations * sc.params.substeps;
     run.rows.push_back(*r);
     return exit_ok;
   };
@@ -213,6 +215,13 @@ int grid_rows(BenchRun& run) {
       if (!base)
         return report(base.error());
       if (int e = time_scene(run, *base, n, "grid", ""))
+        return e;
+    }
+    if (run.integrator == Integrator::vbd) { // implicit Euler by CG beside it, at the same size and dt
+      auto cg = bench_scene(n, Integrator::implicit_euler, run.dt, o);
+      if (!cg)
+        return report(cg.error());
+      if (int e = time_scene(run, *cg, n, "grid", ""))
         return e;
     }
   }
@@ -387,7 +396,8 @@ void add_bench_command(CLI::App& app, int* exit) {
   cmd->add_option("--reps", opt->reps, "Repetitions; the median is reported")->capture_default_str();
   cmd->add_option("--integrator", opt->integrator,
                   "explicit_euler | semi_implicit_euler | rk4 | implicit_euler (adds a semi-implicit "
-                  "baseline row and the cost ratio)")
+                  "baseline row and the cost ratio) | vbd (adds implicit Euler by CG beside it; ns per "
+                  "particle-sweep)")
       ->capture_default_str();
   cmd->add_option("--threads", opt->threads, "CPU solver threads (0: the host's hardware threads)")
       ->capture_default_str();

@@ -203,6 +203,10 @@ nlohmann::json row_json(const std::vector<Row>& rows, const Row& r, const BenchO
           r.contact.empty() && e.contact.empty() && !is_self(r) && !is_self(e))
         j["implicit_over_explicit"] = r.wall_ms / e.wall_ms;
   }
+  if (r.integrator == "vbd") {
+    j["vbd_sweeps_per_step"] = r.vbd_sweeps;
+    j["ns_per_particle_sweep"] = 1e6 * r.wall_ms / (double(r.steps) * double(r.particles) * r.vbd_sweeps);
+  }
   j["size"] = r.size;
   j["scene"] = r.scene;
   add_scene_keys(j, rows, r);
@@ -240,6 +244,18 @@ void print_ratios(const std::vector<Row>& rows) {
               r.backend, r.cg_dispatch.empty() ? "" : " (" + r.cg_dispatch + ")", r.size,
               r.wall_ms / double(r.steps), e.wall_ms / double(e.steps), r.wall_ms / e.wall_ms, r.cg_per_step,
               r.cg_iterations);
+  for (const Row& r : rows)
+    if (r.integrator == "vbd") {
+      fmt::print("{} {} n = {}: vbd {:.4f} ms per step, {} sweeps per step: {:.1f} ns per particle-sweep", r.backend,
+                 r.variant, r.size, r.wall_ms / double(r.steps), r.vbd_sweeps,
+                 1e6 * r.wall_ms / (double(r.steps) * double(r.particles) * r.vbd_sweeps));
+      for (const Row& e : rows)
+        if (e.backend == r.backend && e.variant == r.variant && e.size == r.size &&
+            e.integrator == "implicit_euler" && e.scene == r.scene)
+          fmt::print("; CG {:.4f} ms per step ({:.1f} iterations per step): vbd {:.2f}x its cost",
+                     e.wall_ms / double(e.steps), e.cg_per_step, r.wall_ms / e.wall_ms);
+      fmt::print("\n");
+    }
   for (const Row& r : rows)
     if (r.scene == "mesh")
       fmt::print(
