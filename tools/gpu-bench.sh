@@ -4,8 +4,9 @@
 # Khronos validation layer with synchronization validation (CI=true: no device is a failure, not a
 # skip), then times the Vulkan solver with `vkcloth bench`: explicit fused Euler up to 4096 x 4096
 # with both buffer accesses (texel views, storage buffers; alternated, each result's `layout` key)
-# and implicit Euler at 256 x 256. Writes ONE JSON file: the device, the CPU, the test outcome and
-# both bench results (their keys: docs/performance.md).
+# implicit Euler at 256 x 256, and vbd (one dispatch per colour per sweep) at 256, 1024 and 4096 with
+# CG beside it at 256. Writes ONE JSON file: the device, the CPU, the test outcome and the three
+# bench results (their keys: docs/bench-json.md).
 #
 #   tools/gpu-bench.sh [OUT.json] [--quick] [--skip-tests]
 #     OUT.json      default gpu-bench.json
@@ -57,19 +58,24 @@ if ((tests)); then
 fi
 
 if ((quick)); then
-  sizes=64,128,256 steps=50 reps=2 implicit_size=64
+  sizes=64,128,256 steps=50 reps=2 implicit_size=64 vbd_sizes=64,128
 else
-  sizes=256,512,1024,2048,4096 steps=200 reps=3 implicit_size=256
+  sizes=256,512,1024,2048,4096 steps=200 reps=3 implicit_size=256 vbd_sizes=256,1024,4096
 fi
 explicit=$(mktemp)
 implicit=$(mktemp)
-trap 'rm -f "$explicit" "$implicit"' EXIT
+vbd=$(mktemp)
+trap 'rm -f "$explicit" "$implicit" "$vbd"' EXIT
 "$cli" bench --backend vulkan --sizes "$sizes" --steps "$steps" --reps "$reps" --variants fused --layout texel,storage \
   --json "$explicit" || status=1
 "$cli" bench --backend vulkan --sizes "$implicit_size" --steps "$steps" --reps "$reps" \
   --integrator implicit_euler --json "$implicit" || status=1
+# vbd on a cotton-like cloth (500 / 50 N/m, 0.15 kg) at a stiff step (1/300 s): 5 sweeps of 5 colours.
+"$cli" bench --backend vulkan --sizes "$vbd_sizes" --steps "$steps" --reps "$reps" --integrator vbd \
+  --dt 0.0033333 --stiffness 500,50,0.02 --cloth-mass 0.15 --json "$vbd" || status=1
 [[ -s $explicit ]] || echo null >"$explicit"
 [[ -s $implicit ]] || echo null >"$implicit"
+[[ -s $vbd ]] || echo null >"$vbd"
 
 {
   printf '{\n  "schema": "vkcloth-gpu-bench/1",\n'
@@ -79,6 +85,8 @@ trap 'rm -f "$explicit" "$implicit"' EXIT
   cat "$explicit"
   printf ',\n  "implicit_euler": '
   cat "$implicit"
+  printf ',\n  "vbd": '
+  cat "$vbd"
   printf '\n}\n'
 } >"$out"
 echo "gpu-bench: wrote $out (device: $device; tests: $test_result)" >&2

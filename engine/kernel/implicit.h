@@ -14,11 +14,11 @@ struct SpringBlock {
 
 // The positive semi-definite part of a spring's Jacobian: k along the spring, and the transverse
 // tension term k max(0, 1 - L0 / |u|) across it (the compressive part is dropped).
-KFN SpringBlock spring_block(vec3 u, real rest, real k) {
+// len = |u|, computed by the caller (vbd_add_spring shares it with the force).
+KFN SpringBlock spring_block_of(vec3 u, real len, real rest, real k) {
   SpringBlock s;
   s.diag = vec3(real(0));
   s.off = vec3(real(0));
-  precise real len = sqrt(dot3(u, u));
   if (len > real(0)) {
     precise vec3 n = u / len;
     precise real c = k * max(real(0), real(1) - rest / len);
@@ -29,6 +29,10 @@ KFN SpringBlock spring_block(vec3 u, real rest, real k) {
     s.off = vec3(xy, xz, yz);
   }
   return s;
+}
+KFN SpringBlock spring_block(vec3 u, real rest, real k) {
+  precise real len = sqrt(dot3(u, u));
+  return spring_block_of(u, len, rest, k);
 }
 
 // K w for a symmetric block.

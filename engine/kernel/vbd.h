@@ -16,11 +16,14 @@ KFN precise vec3 vbd_inertia_target(vec3 x0, vec3 v0, vec3 f_ext, real m, real h
   return y;
 }
 
-// One spring's part in a vertex's step, u = x_q - x: its force (add_spring_edge) and its stiffness
-// block (spring_block: the positive semi-definite part of the Hessian).
+// One spring's part in a vertex's step, u = x_q - x: its force (add_spring_edge's) and its stiffness
+// block (spring_block's: the positive semi-definite part of the Hessian), one length for both.
 KFN void vbd_add_spring(INOUT(vec3) f, INOUT(SpringBlock) hessian, vec3 u, real rest, real k) {
-  add_spring_edge(f, u, rest, k);
-  add_block(hessian, spring_block(u, rest, k));
+  precise real len = sqrt(dot3(u, u));
+  VARYING(bool) has_length = len > real(0);
+  precise vec3 t = f + u * spring_scale(len, rest, k);
+  f = select(has_length, t, f);
+  add_block(hessian, spring_block_of(u, len, rest, k));
 }
 
 // One vertex's Newton step on its part of implicit Euler's variational energy
