@@ -1,6 +1,10 @@
 // SPDX-License-Identifier: MIT
 #include "thread_pool.hpp"
 
+#ifdef __linux__
+#include <sched.h>
+#endif
+
 #include <algorithm>
 #include <chrono>
 
@@ -12,6 +16,16 @@
 #endif
 
 namespace vkcloth::detail {
+
+unsigned ThreadPool::available_cores() {
+#ifdef __linux__
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  if (sched_getaffinity(0, sizeof(set), &set) == 0 && CPU_COUNT(&set) > 0)
+    return static_cast<unsigned>(CPU_COUNT(&set));
+#endif
+  return std::max(1u, std::thread::hardware_concurrency());
+}
 
 namespace {
 // How long a worker spins for the next job before it sleeps: back-to-back steps (the usual case)

@@ -19,6 +19,10 @@ class ThreadPool {
 public:
   using Fn = std::function<void(std::size_t, std::size_t)>;
 
+  /// The cores this process may run on: its CPU affinity (taskset, a container's cpuset), which
+  /// std::thread::hardware_concurrency() does not see; at least 1.
+  static unsigned available_cores();
+
   /// `threads` = total threads including the caller's (1 = run everything inline).
   explicit ThreadPool(unsigned threads);
   ~ThreadPool();
