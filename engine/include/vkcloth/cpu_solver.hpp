@@ -37,8 +37,7 @@ namespace vkcloth {
 
 struct CpuSolverOptions {
   /// Threads that share a step (including the caller's); 0 = the cores this process may run on (its CPU
-  /// affinity: taskset, a container's cpuset), capped at one per ~1000 particles.
-  /// Small systems use fewer (one per ~1000 particles).
+  /// affinity: taskset, a container's cpuset). Small systems use fewer (one per ~1000 particles).
   /// Every particle's arithmetic is independent of the others', so results are bit-identical
   /// for any thread count.
   unsigned threads = 0;
