@@ -43,17 +43,12 @@ KFN precise vec3 unit_or_zero(vec3 sum) {
 
 // Eq. 2, one spring of a particle towards its neighbour, u = x_q - x the edge between them:
 // f += K (|u| - L0) u / |u|. A zero-length spring has no direction and adds nothing.
-// Its scale K (|u| - L0) / |u| (the force is u times it), for a spring of length |u| = len > 0.
-KFN precise real spring_scale(real len, real rest, real k) {
-  precise real s = k * (len - rest) / len;
-  return s;
-}
 KFN void add_spring_edge(INOUT(vec3) f, vec3 u, real rest, real k) {
   precise real len = sqrt(dot3(u, u));
   VARYING(bool) has_length = len > real(0);
   if (!maybe_any_particle(has_length))
     return;
-  precise vec3 t = f + u * spring_scale(len, rest, k);
+  precise vec3 t = f + u * (k * (len - rest) / len);
   f = select(has_length, t, f);
 }
 

@@ -13,26 +13,30 @@ struct SpringBlock {
 };
 
 // The positive semi-definite part of a spring's Jacobian: k along the spring, and the transverse
-// tension term k max(0, 1 - L0 / |u|) across it (the compressive part is dropped).
-// len = |u|, computed by the caller (vbd_add_spring shares it with the force).
-KFN SpringBlock spring_block_of(vec3 u, real len, real rest, real k) {
+// tension term k max(0, 1 - L0 / |u|) across it (the compressive part is dropped); n = u / |u|, the
+// unit direction, and r = L0 / |u|, as the caller computes them (spring_block: by division;
+// vbd_add_spring: from one reciprocal it shares with the force).
+KFN SpringBlock spring_block_n(vec3 n, real r, real k) {
   SpringBlock s;
-  s.diag = vec3(real(0));
-  s.off = vec3(real(0));
-  if (len > real(0)) {
-    precise vec3 n = u / len;
-    precise real c = k * max(real(0), real(1) - rest / len);
-    precise real al = k - c;
-    precise real xx = al * n.x * n.x + c, yy = al * n.y * n.y + c, zz = al * n.z * n.z + c;
-    precise real xy = al * n.x * n.y, xz = al * n.x * n.z, yz = al * n.y * n.z;
-    s.diag = vec3(xx, yy, zz);
-    s.off = vec3(xy, xz, yz);
-  }
+  precise real c = k * max(real(0), real(1) - r);
+  precise real al = k - c;
+  precise real xx = al * n.x * n.x + c, yy = al * n.y * n.y + c, zz = al * n.z * n.z + c;
+  precise real xy = al * n.x * n.y, xz = al * n.x * n.z, yz = al * n.y * n.z;
+  s.diag = vec3(xx, yy, zz);
+  s.off = vec3(xy, xz, yz);
   return s;
 }
 KFN SpringBlock spring_block(vec3 u, real rest, real k) {
+  SpringBlock s;
+  s.diag = vec3(real(0));
+  s.off = vec3(real(0));
   precise real len = sqrt(dot3(u, u));
-  return spring_block_of(u, len, rest, k);
+  if (len > real(0)) {
+    precise vec3 n = u / len;
+    precise real r = rest / len;
+    s = spring_block_n(n, r, k);
+  }
+  return s;
 }
 
 // K w for a symmetric block.

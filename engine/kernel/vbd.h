@@ -16,14 +16,25 @@ KFN precise vec3 vbd_inertia_target(vec3 x0, vec3 v0, vec3 f_ext, real m, real h
   return y;
 }
 
-// One spring's part in a vertex's step, u = x_q - x: its force (add_spring_edge's) and its stiffness
-// block (spring_block's: the positive semi-definite part of the Hessian), one length for both.
+// One spring's part in a vertex's step, u = x_q - x: its force, eq. 2 as K (|u| - L0) n with the
+// unit direction n (add_spring_edge keeps the explicit step's rounding, u K (|u| - L0) / |u|), and
+// its stiffness block (spring_block_n: the positive semi-definite part of the Hessian), from one
+// length and one reciprocal. A zero-length spring adds nothing.
 KFN void vbd_add_spring(INOUT(vec3) f, INOUT(SpringBlock) hessian, vec3 u, real rest, real k) {
   precise real len = sqrt(dot3(u, u));
   VARYING(bool) has_length = len > real(0);
-  precise vec3 t = f + u * spring_scale(len, rest, k);
+  if (!maybe_any_particle(has_length))
+    return;
+  precise real inv = real(1) / len;
+  precise vec3 n = u * inv;
+  precise real r = rest * inv;
+  precise vec3 t = f + n * (k * (len - rest));
+  SpringBlock b = spring_block_n(n, r, k);
+  precise vec3 d = hessian.diag + b.diag;
+  precise vec3 o = hessian.off + b.off;
   f = select(has_length, t, f);
-  add_block(hessian, spring_block_of(u, len, rest, k));
+  hessian.diag = select(has_length, d, hessian.diag);
+  hessian.off = select(has_length, o, hessian.off);
 }
 
 // One vertex's Newton step on its part of implicit Euler's variational energy
