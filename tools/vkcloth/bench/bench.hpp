@@ -123,7 +123,7 @@ struct Cost {
 };
 
 Cost cost_of(const std::string& variant, Integrator integrator, double s, bool grid, double fans, bool wind,
-             std::uint32_t steps_per_submit);
+             std::uint32_t steps_per_submit, std::uint32_t sweeps = 0);
 
 // ---- Rows and their timing (timing.cpp) -------------------------------------------------------
 

@@ -116,11 +116,12 @@ int time_scene_vulkan(BenchRun& run, const BenchScene& sc, std::uint32_t n, cons
   const bool two_pass = o.variants.find("two_pass") != std::string::npos;
   const bool rk4 = sc.params.integrator == Integrator::rk4;
   const bool imp = sc.params.integrator == Integrator::implicit_euler;
+  const bool vbd = sc.params.integrator == Integrator::vbd; // one variant: the vbd pass
   // Each variant once per --layout entry, back to back (alternated: a machine whose speed drifts
   // during the run affects both layouts alike). Implicit with --cg-dispatch other than auto: the
   // CG loop's two dispatch layouts, forced.
   using D = gpu::GpuSolverOptions::CgDispatch;
-  if (fused || rk4 || imp)
+  if (fused || rk4 || imp || vbd)
     for (gpu::BufferAccess access : run.layouts) {
       if (imp && o.cg_dispatch != "auto") {
         for (const char* name : {"one_workgroup", "per_iteration"})
@@ -134,7 +135,7 @@ int time_scene_vulkan(BenchRun& run, const BenchScene& sc, std::uint32_t n, cons
       if (int e = add(bench_vulkan(ctx, sc, n, true, access, o, D::automatic, partner)))
         return e;
     }
-  if (two_pass && !rk4 && !imp)
+  if (two_pass && !rk4 && !imp && !vbd)
     for (gpu::BufferAccess access : run.layouts)
       if (int e = add(bench_vulkan(ctx, sc, n, false, access, o, D::automatic, partner)))
         return e;
@@ -177,9 +178,10 @@ int time_scene(BenchRun& run, const BenchScene& sc, std::uint32_t n, const std::
     r->reps = o.reps;
     r->scene = scene;
     r->order = order;
-    r->cost = cost_of(r->variant, sc.params.integrator, s, scene != "mesh", fans, true, o.steps_per_submit);
     if (sc.params.integrator == Integrator::vbd)
       r->vbd_sweeps = sc.params.vbd_iterations * sc.params.substeps;
+    r->cost = cost_of(r->variant, sc.params.integrator, s, scene != "mesh", fans, true, o.steps_per_submit,
+                      r->vbd_sweeps);
     run.rows.push_back(*r);
     return exit_ok;
   };

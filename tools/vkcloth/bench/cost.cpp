@@ -25,9 +25,20 @@ double kernel_flops(double s, bool grid, double fans, bool wind) {
 // in the last step of a submission.
 // `fans`: a mesh's mean normal-fan terms per particle (0 for grids and chains), read from CSR lists.
 Cost cost_of(const std::string& variant, Integrator integrator, double s, bool grid, double fans, bool wind,
-             std::uint32_t steps_per_submit) {
+             std::uint32_t steps_per_submit, std::uint32_t sweeps) {
   Cost c;
   const double eval = kernel_flops(s, grid, fans, wind);
+  if (integrator == Integrator::vbd) {
+    // The begin's force evaluation (its normal), then per sweep each spring's force and block
+    // (~35 flops from one sqrt and one reciprocal, the gather list's entries: vbd works from CSR
+    // lists on both backends) and the vertex's 3x3 step (~45); the finish ~30. Bytes per sweep:
+    // read x, y, x0, the particle's constants and its list (offsets + entries), write x and the push
+    // (the neighbours' positions are counted as cached).
+    const double vec = variant == "cpu" ? 12.0 : 16.0, entry = variant == "cpu" ? 12.0 : 16.0;
+    c.flops = eval + double(sweeps) * (35.0 * s + 45.0) + 30.0;
+    c.bytes = 4.0 * vec + 8.0 + double(sweeps) * (5.0 * vec + 8.0 + 4.0 + entry * s) + 4.0 * vec;
+    return c;
+  }
   const bool rk4 = integrator == Integrator::rk4;
   // Euler update: a = f/m 3, two axpys 12. RK4: 4 stages (eval + k sums 6 + next stage 12), final 12.
   c.flops = rk4 ? 4.0 * (eval + 18.0) + 12.0 : eval + 15.0;

@@ -250,8 +250,7 @@ void print_ratios(const std::vector<Row>& rows) {
                  r.variant, r.size, r.wall_ms / double(r.steps), r.vbd_sweeps,
                  1e6 * r.wall_ms / (double(r.steps) * double(r.particles) * r.vbd_sweeps));
       for (const Row& e : rows)
-        if (e.backend == r.backend && e.variant == r.variant && e.size == r.size &&
-            e.integrator == "implicit_euler" && e.scene == r.scene)
+        if (e.backend == r.backend && e.size == r.size && e.integrator == "implicit_euler" && e.scene == r.scene)
           fmt::print("; CG {:.4f} ms per step ({:.1f} iterations per step): vbd {:.2f}x its cost",
                      e.wall_ms / double(e.steps), e.cg_per_step, r.wall_ms / e.wall_ms);
       fmt::print("\n");
