@@ -12,8 +12,8 @@
 //           from the neighbours' latest positions in POS_OUT, projected; writes its own POS_OUT
 //           entry and its push. No two particles of a colour share a spring, so no invocation reads
 //           what another writes;
-//   FINISH: one invocation per particle: v = (x - x0) / h, the contact response with the held
-//           force, x = x0 + h v, projection and divergence flags (finish.glsl), the net force,
+//   FINISH: one invocation per particle: v = (x - x0) / h before the last projection, the contact
+//           response, x = x0 + h v, projection and divergence flags (finish.glsl), the net force,
 //           v0 -> ACC_VEL for the next first guess.
 // Reads POS_IN (= POS_BASE: positions[read], the start), VEL; writes POS_OUT, VEL, NORMAL, FORCE_OUT.
 #include "vkcloth_shared.h"
@@ -86,8 +86,8 @@ void finish_step(uint p, uint g, bool pinned) {
   const float m = read_particle(p).mass;
   const float h = ip.dt;
   const vec3 x = pos_out[g].xyz;
-  vec3 v = vbd_velocity(x, x0, h);
-  vec3 held = vbd_held_force(push_of[g].xyz, m, h);
+  vec3 v = vbd_velocity(x, push_of[g].xyz, x0, h);
+  vec3 no_force = vec3(0.0);
   const bool both = (ip.flags & VKCLOTH_FLAG_CONTACT_BOTH) != 0u;
   precise float h_over_m = h / m;
   for (uint c = 0u; c < (SC_COLLIDERS ? ip.collider_count : 0u); ++c) {
@@ -95,7 +95,7 @@ void finish_step(uint p, uint g, bool pinned) {
     float dist;
     vec3 n;
     collider_contact(0u, s, x, x, ip.band, dist, n);
-    contact_response(v, held, s, x, n, dist, ip.band, both, h_over_m);
+    contact_response(v, no_force, s, x, n, dist, ip.band, both, h_over_m);
   }
   force_out[g] = vec4(vbd_net_force(v, v0, m, h), 0.0);
   v_prev[g] = vec4(v0, 0.0);

@@ -4,7 +4,8 @@
 // commit before the "one source of truth" redesign (the table below). A refactor that changes one
 // rounding anywhere in the per-particle physics (CPU scalar, SIMD row kernel or shaders) fails here.
 // The implicit_euler rows were recorded again when the method itself changed (issue 18: block-
-// Jacobi preconditioner, warm start, tolerance relative to max(|S b|, |S h M g|)); every other row
+// Jacobi preconditioner, warm start, tolerance relative to max(|S b|, |S h M g|)), and those with
+// colliders again when the solve learnt Baraff-Witkin's contact filter (issue 37); every other row
 // is unchanged since the redesign.
 //
 // CPU float and double: the bits are the reference's on any x86-64 (the SIMD kernels are bitwise

@@ -109,7 +109,7 @@ TEST_CASE("vbd: the topology's colours separate every spring, five on a grid") {
       }
     for (const Spring& s : c.system.springs)
       CHECK(colour[s.a] != colour[s.b]);
-    MESSAGE(c.name << ": " << offsets.size() - 1 << " colours");
+    MESSAGE(std::string(c.name) << ": " << offsets.size() - 1 << " colours");
     CHECK(offsets.size() - 1 <= c.max_colours);
   }
 }
@@ -178,7 +178,7 @@ TEST_CASE("vbd: leather at 64 x 64 and dt = 1/30 stays stable") {
       speed = std::max(speed, glm::length(v));
     for (const auto& x : sim->positions())
       lowest = std::min(lowest, x.z);
-    MESSAGE(to_string(b) << ": leather 64 x 64, dt 1/30, after 3 s: largest speed " << speed
+    MESSAGE(std::string(to_string(b)) << ": leather 64 x 64, dt 1/30, after 3 s: largest speed " << speed
                          << " m/s, lowest point z = " << lowest << " m");
     CHECK(speed < 0.1);
     CHECK(lowest > 0.4);
@@ -211,7 +211,7 @@ TEST_CASE("vbd: no particle ends a step inside the sphere (cotton drop)") {
       for (const glm::dvec3& x : sim->positions())
         closest = std::min(closest, glm::length(x) - sphere.radius);
     }
-    MESSAGE(to_string(b) << ": closest particle " << closest << " m from the sphere");
+    MESSAGE(std::string(to_string(b)) << ": closest particle " << closest << " m from the sphere");
     CHECK(closest >= p.contact_epsilon - 1e-6);
   }
 }
@@ -255,4 +255,46 @@ TEST_CASE("vbd: the scene's integrator.iterations, with its range") {
     CHECK(r.error().message.find("integrator.iterations") != std::string::npos);
   }
   CHECK(SimParams{}.vbd_iterations == 5);
+}
+
+TEST_CASE("implicit solvers on the cotton drop onto a sphere: strain within 10 % without friction, no "
+          "particle flung with it") {
+  // Issue 37's drop at 32 x 32 and dt 1/300 for 2 s, for both implicit solvers (CG, vbd). CG used to
+  // fling particles at 10-18 m/s here (278 % strain at 64 x 64, now 58 %): its solve pulled contact
+  // particles into the sphere; Baraff-Witkin's contact filter (cloth_kernel.h contact_axis) keeps
+  // them on it. Frictionless: at most 10 % strain over the run (measured CG 4.8 %, vbd 7.3 %; the
+  // cloth then slides off the sphere). With friction 0.5 the Coulomb step after the solve holds
+  // stretched springs (CG 22 %, vbd 10 %; docs/model.md): there under 30 %, and no particle faster
+  // than 8 m/s over the run (the fall reaches 2.2 m/s at the impact, the corners wrapping under the
+  // sphere whip at up to ~5 m/s under vbd).
+  const ParticleSystem s = material_cloth("cotton", 32, ClothOrientation::horizontal, {-0.5, -0.5, 0.5}, true);
+  for (double friction : {0.0, 0.5})
+    for (Integrator integrator : {Integrator::implicit_euler, Integrator::vbd}) {
+      SimParams p = vbd_params(1.0 / 300.0, SimParams{}.vbd_iterations);
+      p.integrator = integrator;
+      Collider sphere = Collider::sphere({0.0, 0.0, 0.0}, 0.25);
+      sphere.friction = friction;
+      p.colliders = {sphere};
+      auto solver = CpuSolver<float>::create(s, p);
+      REQUIRE(solver.ok());
+      double strain = 0.0, speed = 0.0;
+      for (int step = 0; step < 600; ++step) {
+        REQUIRE(solver->step().ok());
+        if (step % 5 == 4) {
+          auto st = structural_strain(s, solver->positions());
+          REQUIRE(st.ok());
+          strain = std::max(strain, st->max);
+        }
+        for (const auto& v : solver->velocities())
+          speed = std::max(speed, double(glm::length(v)));
+      }
+      MESSAGE(std::string(to_string(integrator)) << ", friction " << friction << ": largest strain " << strain
+                                                 << ", fastest particle " << speed << " m/s");
+      if (friction == 0.0) {
+        CHECK(strain <= 0.10);
+      } else {
+        CHECK(strain <= 0.30);
+        CHECK(speed < 8.0);
+      }
+    }
 }

@@ -113,3 +113,17 @@ KFN precise vec3 residual_of(vec3 b, vec3 ax) {
   precise vec3 r = b - ax;
   return r;
 }
+// Baraff-Witkin's filter for a particle in contact (docs/model.md "Implicit Euler"): the solve may
+// not move it along the contact's normal, the axis of what the contact filter took from its v and
+// F before the solve (`removed` = (v - v_filtered) + (h / m) (F - F_filtered), zero when the
+// particle does not press on a collider). Without it the solve pulled a contact particle into the
+// collider, its neighbours followed, and the projection afterwards flung them.
+KFN precise vec3 contact_axis(vec3 removed_v, vec3 removed_f, real h_over_m) {
+  precise vec3 r = removed_v + removed_f * h_over_m;
+  return unit_or_zero(r);
+}
+// w without its part along the unit axis a (a = 0: w unchanged).
+KFN precise vec3 constrain_to(vec3 w, vec3 a) {
+  precise vec3 c = w - a * dot3(a, w);
+  return c;
+}

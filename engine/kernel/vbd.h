@@ -55,18 +55,14 @@ KFN precise vec3 vbd_step(vec3 x, vec3 y, vec3 x0, vec3 f, SpringBlock hessian, 
   return nx;
 }
 
-// After the iterations: the velocity the step implies, v = (x - x0) / h ...
-KFN precise vec3 vbd_velocity(vec3 x, vec3 x0, real h) {
-  precise vec3 v = (x - x0) / h;
+// After the iterations: the velocity the step implies, v = (x - x0) / h, from the last sweep's
+// position before the colliders' projection (x - push): the projection's move is not a velocity
+// (it would throw the particle off the collider); the contact response then removes v's inward part,
+// whose size is friction's normal impulse, as in the explicit step ...
+KFN precise vec3 vbd_velocity(vec3 x, vec3 push, vec3 x0, real h) {
+  precise vec3 free_x = x - push;
+  precise vec3 v = (free_x - x0) / h;
   return v;
-}
-// ... the force a collider held back in the last iteration, -m push / h^2 (push: the collider
-// projection's move of that iteration), so that friction's normal impulse (contact_response) is the
-// push's normal part over h ...
-KFN precise vec3 vbd_held_force(vec3 push, real m, real h) {
-  precise real s = -m / (h * h);
-  precise vec3 f = push * s;
-  return f;
 }
 // ... and the position of the velocity friction left, x = x0 + h v.
 KFN precise vec3 vbd_position(vec3 x0, vec3 v, real h) {

@@ -32,7 +32,7 @@ template <typename Real> void CpuSolver<Real>::Impl::implicit_substep(const Real
   if (w.x.size() != n) {
     w.ks.assign(edges_.size(), {});
     w.block_inv.assign(n, {});
-    for (auto* v : {&w.vf, &w.fc, &w.x, &w.b, &w.r, &w.z, &w.d, &w.q})
+    for (auto* v : {&w.vf, &w.fc, &w.x, &w.b, &w.axis, &w.r, &w.z, &w.d, &w.q})
       v->assign(n, Vec3(0)); // x = 0: the first solve starts cold
   }
   // 1. Forces and contact filtering as in the explicit step.
@@ -45,6 +45,8 @@ template <typename Real> void CpuSolver<Real>::Impl::implicit_substep(const Real
     force_[p] = f;
     w.vf[p] = v;
     w.fc[p] = unfiltered - f;
+    w.axis[p] = pinned_[p] ? Vec3(0) : kernel::contact_axis(vel_[p] - v, w.fc[p], h / mass_[p]);
+    w.x[p] = kernel::constrain_to(w.x[p], w.axis[p]); // the warm start within the constraint
   });
   implicit_system(h);
   implicit_cg(h);
@@ -77,10 +79,11 @@ template <typename Real> void CpuSolver<Real>::Impl::implicit_system(const Real 
       w.b[p] = w.r[p] = w.z[p] = w.d[p] = Vec3(0);
       return;
     }
+    const Vec3 a = w.axis[p];
     w.block_inv[p] = kernel::invert_block(kernel::implicit_diagonal_block(mu_h, mass_[p], ksum, h2));
-    w.b[p] = kernel::implicit_rhs(force_[p], lv, h);
-    w.r[p] = kernel::residual_of(w.b[p], kernel::implicit_row(x0, mu_h, mass_[p], lx, h2));
-    w.z[p] = kernel::apply_block(w.block_inv[p], w.r[p]);
+    w.b[p] = kernel::constrain_to(kernel::implicit_rhs(force_[p], lv, h), a);
+    w.r[p] = kernel::constrain_to(kernel::residual_of(w.b[p], kernel::implicit_row(x0, mu_h, mass_[p], lx, h2)), a);
+    w.z[p] = kernel::constrain_to(kernel::apply_block(w.block_inv[p], w.r[p]), a);
     w.d[p] = w.z[p];
   });
 }
@@ -102,7 +105,7 @@ template <typename Real> void CpuSolver<Real>::Impl::implicit_cg(const Real h) {
     pool_->for_each(pos_.size(), [&](std::size_t p) {
       w.x[p] = Vec3(0);
       w.r[p] = w.b[p];
-      w.z[p] = w.d[p] = kernel::apply_block(w.block_inv[p], w.b[p]);
+      w.z[p] = w.d[p] = kernel::constrain_to(kernel::apply_block(w.block_inv[p], w.b[p]), w.axis[p]);
     });
     rr = bb;
   }
@@ -119,7 +122,7 @@ template <typename Real> void CpuSolver<Real>::Impl::implicit_cg(const Real h) {
       Vec3 s(0);
       for (std::uint32_t e = edge_offsets_[p]; e < edge_offsets_[p + 1]; ++e)
         s += kernel::apply_block(w.ks[e], dp - w.d[edges_[e].other]);
-      w.q[p] = kernel::implicit_row(dp, mu_h, mass_[p], s, h2);
+      w.q[p] = kernel::constrain_to(kernel::implicit_row(dp, mu_h, mass_[p], s, h2), w.axis[p]);
     });
     const Real dq = dot_all<Real>(w.d, w.q);
     if (!(dq > Real(0)))
@@ -128,7 +131,7 @@ template <typename Real> void CpuSolver<Real>::Impl::implicit_cg(const Real h) {
     pool_->for_each(pos_.size(), [&](std::size_t p) {
       w.x[p] += w.d[p] * alpha;
       w.r[p] -= w.q[p] * alpha;
-      w.z[p] = kernel::apply_block(w.block_inv[p], w.r[p]);
+      w.z[p] = kernel::constrain_to(kernel::apply_block(w.block_inv[p], w.r[p]), w.axis[p]);
     });
     const Real rz_new = dot_all<Real>(w.r, w.z);
     rr = dot_all<Real>(w.r, w.r);

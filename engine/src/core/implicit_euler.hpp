@@ -54,6 +54,8 @@ template <typename Real> struct ImplicitWorkspace {
   std::vector<kernel::SpringBlock<Real>> block_inv;
   std::vector<Vec3> x; ///< dv: kept from one solve to the next (the warm start)
   std::vector<Vec3> b; ///< S b, for |S b| (the tolerance's reference) and a cold restart
+  /// The contact axis each particle's unknowns lose (cloth_kernel.h contact_axis; zero: free).
+  std::vector<Vec3> axis;
   std::vector<Vec3> r, z, d, q;
 };
 

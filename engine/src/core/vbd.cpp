@@ -8,8 +8,9 @@
 //            step on its springs and its inertia, from its neighbours' latest positions, and is
 //            projected out of the colliders (no two particles of a colour share a spring, so a
 //            colour runs in parallel with the result of running it in order);
-//   finish:  v = (x - x0) / h, the contact response (the inward part, Coulomb friction with the
-//            projection's push as normal impulse), x = x0 + h v, projected.
+//   finish:  v = (x - x0) / h from the last sweep's position before its projection, the contact
+//            response (the inward part, Coulomb friction with it as normal impulse), x = x0 + h v,
+//            projected.
 #include <algorithm>
 
 #include "cpu_solver_impl.hpp"
@@ -89,9 +90,9 @@ template <typename Real> void CpuSolver<Real>::Impl::vbd_finish(const Real h) {
       return; // stays put with its velocity
     }
     const Vec3 x0 = w.x0[p];
-    Vec3 v = kernel::vbd_velocity(pos_[p], x0, h);
-    Vec3 held = kernel::vbd_held_force(w.push[p], mass_[p], h);
-    contact_at(pos_[p], v, held, h / mass_[p]);
+    Vec3 v = kernel::vbd_velocity(pos_[p], w.push[p], x0, h);
+    Vec3 no_force(0);
+    contact_at(pos_[p], v, no_force, h / mass_[p]);
     Vec3 x = kernel::vbd_position(x0, v, h);
     project_at(x0, x, v);
     force_[p] = kernel::vbd_net_force(v, vel_[p], mass_[p], h);
