@@ -87,11 +87,10 @@ TEST_CASE("vbd: the topology's colours separate every spring, five on a grid") {
   chain.positions = {{0.0, 0.0, -0.4}, {0.0, 0.0, -0.8}};
   auto mesh_scene = load_scene_file(std::string(VKCLOTH_SCENES_DIR) + "/flag_with_hole.json");
   REQUIRE(mesh_scene.ok());
-  Case cases[] = {
-      {"grid 64 x 64", material_cloth("cotton", 64, ClothOrientation::horizontal, {0, 0, 0}), 5},
-      {"grid 7 x 3", material_cloth("cotton", 7, ClothOrientation::horizontal, {0, 0, 0}), 5},
-      {"chain of 3", *make_chain(chain), 2},
-      {"mesh (flag with a hole)", mesh_scene->system, 16}};
+  Case cases[] = {{"grid 64 x 64", material_cloth("cotton", 64, ClothOrientation::horizontal, {0, 0, 0}), 5},
+                  {"grid 7 x 3", material_cloth("cotton", 7, ClothOrientation::horizontal, {0, 0, 0}), 5},
+                  {"chain of 3", *make_chain(chain), 2},
+                  {"mesh (flag with a hole)", mesh_scene->system, 16}};
   for (const Case& c : cases) {
     CAPTURE(std::string(c.name));
     auto t = ClothTopology::create(c.system);
@@ -179,7 +178,7 @@ TEST_CASE("vbd: leather at 64 x 64 and dt = 1/30 stays stable") {
     for (const auto& x : sim->positions())
       lowest = std::min(lowest, x.z);
     MESSAGE(std::string(to_string(b)) << ": leather 64 x 64, dt 1/30, after 3 s: largest speed " << speed
-                         << " m/s, lowest point z = " << lowest << " m");
+                                      << " m/s, lowest point z = " << lowest << " m");
     CHECK(speed < 0.1);
     CHECK(lowest > 0.4);
   }
@@ -193,7 +192,8 @@ TEST_CASE("vbd: leather at 64 x 64 and dt = 1/30 stays stable") {
 TEST_CASE("vbd: no particle ends a step inside the sphere (cotton drop)") {
   // The issue's drop at 32 x 32: 1 m of cotton 0.25 m above a sphere of radius 0.25 (friction 0.5),
   // dt 1/300; after every step each particle is at least contact_epsilon - 1e-6 m from the surface.
-  const ParticleSystem s = material_cloth("cotton", 32, ClothOrientation::horizontal, {-0.5, -0.5, 0.5}, true);
+  const ParticleSystem s =
+      material_cloth("cotton", 32, ClothOrientation::horizontal, {-0.5, -0.5, 0.5}, true);
   SimParams p = vbd_params(1.0 / 300.0, 10);
   Collider sphere;
   sphere.type = Collider::Type::sphere;
@@ -267,7 +267,8 @@ TEST_CASE("implicit solvers on the cotton drop onto a sphere: strain within 10 %
   // stretched springs (CG 22 %, vbd 10 %; docs/model.md): there under 30 %, and no particle faster
   // than 8 m/s over the run (the fall reaches 2.2 m/s at the impact, the corners wrapping under the
   // sphere whip at up to ~5 m/s under vbd).
-  const ParticleSystem s = material_cloth("cotton", 32, ClothOrientation::horizontal, {-0.5, -0.5, 0.5}, true);
+  const ParticleSystem s =
+      material_cloth("cotton", 32, ClothOrientation::horizontal, {-0.5, -0.5, 0.5}, true);
   for (double friction : {0.0, 0.5})
     for (Integrator integrator : {Integrator::implicit_euler, Integrator::vbd}) {
       SimParams p = vbd_params(1.0 / 300.0, SimParams{}.vbd_iterations);

@@ -58,7 +58,7 @@ struct vec4 {
   21 // interleaved Vertex per particle (GpuSolverOptions::interleaved_vertices)
 #define VKCLOTH_BINDING_MESH_NODES 22 // MeshNode: every mesh collider's hierarchy (Collider::mesh_root)
 #define VKCLOTH_BINDING_MESH_TRIS 23  // MeshTriangle: their triangles in leaf order (Collider::mesh_tri0)
-#define VKCLOTH_BINDING_VBD_ORDER 24 // vbd: the particles in colour order (ClothTopology::vertex_order)
+#define VKCLOTH_BINDING_VBD_ORDER 24  // vbd: the particles in colour order (ClothTopology::vertex_order)
 #define VKCLOTH_BINDING_COUNT 25
 
 // Set 1 (force.comp, fused.comp, strain_*.comp): POS_IN again, as an RGBA32F uniform texel buffer view,

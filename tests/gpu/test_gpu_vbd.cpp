@@ -35,9 +35,8 @@ TEST_CASE("GPU vbd matches the CPU vbd on every sample scene: 100 steps") {
     REQUIRE(gv.ok());
     const auto d = gpu::test::diff(cpu->positions(), *gp);
     const auto dv = gpu::test::diff(cpu->velocities(), *gv);
-    MESSAGE(entry.path().filename().string() << ": max |p_cpu - p_gpu| after " << steps
-                                             << " vbd steps = " << d.max_abs << " m, velocities "
-                                             << dv.max_abs << " m/s");
+    MESSAGE(entry.path().filename().string() << ": max |p_cpu - p_gpu| after " << steps << " vbd steps = "
+                                             << d.max_abs << " m, velocities " << dv.max_abs << " m/s");
     CHECK(d.max_abs <= 1e-5);
     CHECK(dv.max_abs <= 1e-3);
   }

@@ -75,9 +75,9 @@ void add_scene_options(CLI::App& cmd, SceneArgs& args, bool sugar) {
     return;
   cmd.add_option("--steps", args.steps, "Number of steps (sugar for --set integrator.steps=N)");
   cmd.add_option("--dt", args.dt, "Time step in seconds (sugar for --set integrator.dt=X)");
-  cmd.add_option(
-      "--integrator", args.integrator,
-      "explicit_euler | semi_implicit_euler | rk4 | implicit_euler | vbd (sugar for --set integrator.method=NAME)");
+  cmd.add_option("--integrator", args.integrator,
+                 "explicit_euler | semi_implicit_euler | rk4 | implicit_euler | vbd (sugar for --set "
+                 "integrator.method=NAME)");
 }
 
 } // namespace vkcloth::cli

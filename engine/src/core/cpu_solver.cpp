@@ -109,8 +109,7 @@ Result<CpuSolver<Real>> CpuSolver<Real>::create(std::shared_ptr<const ClothTopol
     s.soa_pad_ = s.stencil_->reach;
   }
   // Below ~1000 particles per thread the fork-join costs more than it saves.
-  const unsigned wanted =
-      options.threads ? options.threads : detail::ThreadPool::available_cores();
+  const unsigned wanted = options.threads ? options.threads : detail::ThreadPool::available_cores();
   const auto useful = static_cast<unsigned>(std::max<std::size_t>(1, n / 1024));
   s.pool_ = std::make_unique<detail::ThreadPool>(std::min(wanted, useful));
   s.simd_ = detect_simd();

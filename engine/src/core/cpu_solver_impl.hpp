@@ -24,9 +24,9 @@ template <typename Real> struct StrainProjection;
 /// Vertex block descent's per-particle state of a substep (vbd.cpp).
 template <typename Real> struct VbdWorkspace {
   using Vec3 = glm::vec<3, Real, glm::defaultp>;
-  std::vector<Vec3> x0;   ///< positions at the substep's start
-  std::vector<Vec3> y;    ///< inertia targets
-  std::vector<Vec3> push; ///< the colliders' projection move of the last iteration
+  std::vector<Vec3> x0;     ///< positions at the substep's start
+  std::vector<Vec3> y;      ///< inertia targets
+  std::vector<Vec3> push;   ///< the colliders' projection move of the last iteration
   std::vector<Vec3> v_prev; ///< the velocities at the last substep's start (the first guess)
 };
 /// The colliders as the kernel takes them at this substep's pose, and their meshes; the same values

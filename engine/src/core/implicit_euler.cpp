@@ -82,7 +82,8 @@ template <typename Real> void CpuSolver<Real>::Impl::implicit_system(const Real 
     const Vec3 a = w.axis[p];
     w.block_inv[p] = kernel::invert_block(kernel::implicit_diagonal_block(mu_h, mass_[p], ksum, h2));
     w.b[p] = kernel::constrain_to(kernel::implicit_rhs(force_[p], lv, h), a);
-    w.r[p] = kernel::constrain_to(kernel::residual_of(w.b[p], kernel::implicit_row(x0, mu_h, mass_[p], lx, h2)), a);
+    w.r[p] = kernel::constrain_to(
+        kernel::residual_of(w.b[p], kernel::implicit_row(x0, mu_h, mass_[p], lx, h2)), a);
     w.z[p] = kernel::constrain_to(kernel::apply_block(w.block_inv[p], w.r[p]), a);
     w.d[p] = w.z[p];
   });

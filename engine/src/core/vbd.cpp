@@ -57,7 +57,8 @@ template <typename Real> void CpuSolver<Real>::Impl::vbd_begin(const Real h) {
   });
 }
 
-template <typename Real> void CpuSolver<Real>::Impl::vbd_solve_colour(const std::uint32_t colour, const Real h) {
+template <typename Real>
+void CpuSolver<Real>::Impl::vbd_solve_colour(const std::uint32_t colour, const Real h) {
   auto& w = *vbd_;
   const auto order = topology_->vertex_order();
   const std::uint32_t first = topology_->vertex_colour_offsets()[colour];

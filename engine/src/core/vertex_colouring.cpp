@@ -10,8 +10,8 @@ namespace {
 constexpr std::uint32_t no_colour = 0xffffffffu;
 
 /// (i + 2 j) mod 5 for each grid particle, or nothing when a spring joins two of one colour.
-std::optional<std::vector<std::uint32_t>> grid_colours(const Grid& grid, std::span<const std::uint32_t> offsets,
-                                                       std::span<const GatherEdge> edges) {
+std::optional<std::vector<std::uint32_t>>
+grid_colours(const Grid& grid, std::span<const std::uint32_t> offsets, std::span<const GatherEdge> edges) {
   const std::size_t n = offsets.size() - 1;
   if (std::size_t(grid.nx) * grid.ny != n)
     return std::nullopt;

@@ -12,9 +12,9 @@ Result<void> read_integrator(const json& doc, SimParams& params, std::uint64_t& 
   SCENE_TRY_ASSIGN(obj, sd::read_object(doc, "", "integrator"));
   if (!obj)
     return {};
-  VKCLOTH_TRY(sd::check_keys(*obj, "integrator",
-                             {"method", "dt", "steps", "substeps", "cg_tolerance", "cg_max_iterations",
-                              "iterations"}));
+  VKCLOTH_TRY(sd::check_keys(
+      *obj, "integrator",
+      {"method", "dt", "steps", "substeps", "cg_tolerance", "cg_max_iterations", "iterations"}));
   std::string method = to_string(params.integrator);
   VKCLOTH_TRY(sd::read(*obj, "integrator", "method", method));
   const auto integ = parse_integrator(method);

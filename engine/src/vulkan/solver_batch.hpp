@@ -232,7 +232,7 @@ private:
   // an instance asks for tethers: ensure_tethers()).
   Buffer strain_links, tethers;
   std::vector<std::uint32_t> strain_colours; // the topology's colour offsets (colours + 1)
-  Buffer vbd_order; // VKCLOTH_BINDING_VBD_ORDER: ClothTopology::vertex_order
+  Buffer vbd_order;                          // VKCLOTH_BINDING_VBD_ORDER: ClothTopology::vertex_order
   bool tethers_uploaded = false;
   // The batch's topology, for what is uploaded when first needed (the tethers): alive as long as
   // the batch, since every instance of the batch holds it (ClothWorld::Impl::Instance).

@@ -33,7 +33,7 @@ struct ClothWorld::Impl {
                     // 3: vbd
     std::uint32_t substeps = 1;
     std::uint32_t iterations = 0; // vbd: its sweeps (the batch's dispatches)
-    InstanceId only = 0; // implicit Euler: the instance (its CG reductions are per batch)
+    InstanceId only = 0;          // implicit Euler: the instance (its CG reductions are per batch)
     auto operator<=>(const BatchKey&) const = default;
   };
   struct BatchEntry {

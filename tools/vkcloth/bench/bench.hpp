@@ -129,8 +129,8 @@ Cost cost_of(const std::string& variant, Integrator integrator, double s, bool g
 
 /// One row of the table and of --json's results.
 struct Row {
-  std::string cg_dispatch; // implicit on Vulkan: "one_workgroup" or "per_iteration"
-  double cg_per_step = 0;  // implicit_euler: mean CG iterations per step over the timed steps
+  std::string cg_dispatch;      // implicit on Vulkan: "one_workgroup" or "per_iteration"
+  double cg_per_step = 0;       // implicit_euler: mean CG iterations per step over the timed steps
   std::uint32_t vbd_sweeps = 0; // vbd: sweeps per step (iterations x substeps)
   std::string backend, variant;
   std::uint32_t size = 0;

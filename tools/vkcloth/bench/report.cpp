@@ -246,11 +246,12 @@ void print_ratios(const std::vector<Row>& rows) {
               r.cg_iterations);
   for (const Row& r : rows)
     if (r.integrator == "vbd") {
-      fmt::print("{} {} n = {}: vbd {:.4f} ms per step, {} sweeps per step: {:.1f} ns per particle-sweep", r.backend,
-                 r.variant, r.size, r.wall_ms / double(r.steps), r.vbd_sweeps,
+      fmt::print("{} {} n = {}: vbd {:.4f} ms per step, {} sweeps per step: {:.1f} ns per particle-sweep",
+                 r.backend, r.variant, r.size, r.wall_ms / double(r.steps), r.vbd_sweeps,
                  1e6 * r.wall_ms / (double(r.steps) * double(r.particles) * r.vbd_sweeps));
       for (const Row& e : rows)
-        if (e.backend == r.backend && e.size == r.size && e.integrator == "implicit_euler" && e.scene == r.scene)
+        if (e.backend == r.backend && e.size == r.size && e.integrator == "implicit_euler" &&
+            e.scene == r.scene)
           fmt::print("; CG {:.4f} ms per step ({:.1f} iterations per step): vbd {:.2f}x its cost",
                      e.wall_ms / double(e.steps), e.cg_per_step, r.wall_ms / e.wall_ms);
       fmt::print("\n");

@@ -143,7 +143,7 @@ Result<Row> bench_vulkan(gpu::Context& ctx, const BenchScene& sc, std::uint32_t 
   Row row;
   row.backend = "vulkan";
   row.variant = sc.params.integrator == Integrator::implicit_euler ? "implicit"
-                : sc.params.integrator == Integrator::vbd           ? "vbd"
+                : sc.params.integrator == Integrator::vbd          ? "vbd"
                 : fused && sc.params.integrator != Integrator::rk4 ? "fused"
                                                                    : "two_pass";
   row.integrator = to_string(sc.params.integrator);
@@ -310,7 +310,7 @@ Result<std::array<Row, 2>> bench_vulkan_pair(gpu::Context& ctx, const ParticleSy
   for (Row& r : *rows) {
     r.backend = "vulkan";
     r.variant = integrator == Integrator::implicit_euler ? "implicit"
-                : integrator == Integrator::vbd           ? "vbd"
+                : integrator == Integrator::vbd          ? "vbd"
                 : fused && integrator != Integrator::rk4 ? "fused"
                                                          : "two_pass";
     std::tie(r.layout, r.workgroup) = layout_of(ctx, go, integrator == Integrator::implicit_euler);
