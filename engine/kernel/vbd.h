@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // vkcloth kernel: implicit Euler by vertex block descent (Chen, Liu, Yang, Yuksel, SIGGRAPH 2024):
-// the inertia target, one vertex's Newton step, and the velocity and contact force a step leaves
-// (docs/model.md "Vertex block descent").
+// the inertia target, the first guess, one vertex's Newton step, and the velocity, position and
+// net force a substep leaves (docs/model.md "Vertex block descent").
 // Part of the kernel that cloth_kernel.h gathers (the rules it states hold here: fixed order,
 // `precise` results, real(...) literals). No include guard: the C++ bridge includes it once per precision.
 
@@ -70,14 +70,6 @@ KFN precise vec3 vbd_position(vec3 x0, vec3 v, real h) {
   return x;
 }
 
-// A vertex's part of the variational energy G without its springs (the tests sum the springs' apart):
-// m / (2 h^2) |x - y|^2 + mu m / (2 h) |x - x0|^2.
-KFN precise real vbd_inertia_energy(vec3 x, vec3 y, vec3 x0, real m, real h, real mu) {
-  precise vec3 a = x - y, b = x - x0;
-  precise real e = m / (real(2) * h * h) * dot3(a, a);
-  e = e + mu * m / (real(2) * h) * dot3(b, b);
-  return e;
-}
 // The net force of the step, m (v - v0) / h (what a host observes as the particle's force).
 KFN precise vec3 vbd_net_force(vec3 v, vec3 v0, real m, real h) {
   precise vec3 f = (v - v0) * (m / h);

@@ -85,7 +85,11 @@ TEST_CASE("GPU matches CPU with capsule, box and mesh colliders, friction and mo
         // threshold (the 2 eps band, static or kinetic friction) that rounding decides which side
         // it takes, a jump of up to mu g h^2 at one particle on one backend only, whenever it
         // happens to come. So implicit Euler is compared over the fall and the first contacts (50
-        // steps, 1e-4 m), then both run on and must keep every particle out of the colliders.
+        // steps), then both run on and must keep every particle out of the colliders. Since CG
+        // constrains a particle that presses on a collider along the contact's axis (Baraff-Witkin's
+        // filter, docs/model.md "Implicit Euler"), that on/off decision at the band's edge moves the
+        // particle and, through the solve, its neighbours by up to one step's fall, g dt^2 = 3.9e-3 m
+        // (measured 1.9e-3 m on the turning box); before it, 1e-4 m held.
         const bool implicit = integrator == Integrator::implicit_euler;
         const std::uint32_t steps = implicit ? 50 : 100;
         REQUIRE(cpu->run(steps).ok());
@@ -100,7 +104,7 @@ TEST_CASE("GPU matches CPU with capsule, box and mesh colliders, friction and mo
             "{:<18} {:<20} substeps {} max|dp| = {:.3g}{} after {} steps (lowest point {:.3f} m)", name,
             to_string(integrator), substeps, d.max_abs, d.bitwise ? " (bitwise)" : "", steps, lowest));
         CHECK(lowest < 0.44); // it fell and met the collider
-        CHECK(d.max_abs <= (implicit ? 1e-4 : tolerance));
+        CHECK(d.max_abs <= (implicit ? 9.81 * p.dt * p.dt : tolerance));
         if (implicit) {
           REQUIRE(cpu->run(50).ok());
           REQUIRE(gpu->simulate(50, 32).ok());
