@@ -29,9 +29,13 @@ if(MODE MATCHES "^installed")
 else()
   # The whole engine compiles again inside the consumer: unoptimised (-O0, no debug info), since
   # this checks the CMake integration, not speed (cold on a 2-core VM: 78 s against 133 s for a
-  # Release build, and nothing else runs beside this test).
+  # Release build, and nothing else runs beside this test). VKCLOTH_FMT_HEADER_ONLY=OFF (allowed: a
+  # subproject installs nothing) links libfmt instead of compiling fmt's implementation into each of
+  # the ~40 engine sources that format: 1.5 s less per source at -O0, ~25 % of this build. The
+  # header-only default is what the release tree builds and the installed-package tests check.
   run(${CMAKE_COMMAND} -S ${SOURCE_DIR}/tests/consumer -B ${work}/build -G Ninja -DCMAKE_BUILD_TYPE=Debug
-      -DCMAKE_CXX_FLAGS_DEBUG=-O0 -DCMAKE_C_FLAGS_DEBUG=-O0 -DVKCLOTH_SOURCE_DIR=${SOURCE_DIR})
+      -DCMAKE_CXX_FLAGS_DEBUG=-O0 -DCMAKE_C_FLAGS_DEBUG=-O0 -DVKCLOTH_SOURCE_DIR=${SOURCE_DIR}
+      -DVKCLOTH_FMT_HEADER_ONLY=OFF)
 endif()
 run(${CMAKE_COMMAND} --build ${work}/build)
 run(${work}/build/consumer ${work})
