@@ -41,6 +41,10 @@ asan_skips=(
   'the same self-collision run at four thread counts (~30 s there): the other self-collision tests run its code, and the invariance is arithmetic, which the release run checks'
   'implicit Euler: the stiff 64x64 cloth hangs stably'
   'a long CPU run of the implicit solver (~25 s there); the smaller implicit tests run the same code'
+  'GPU vbd matches the CPU vbd on every sample scene'
+  'vbd on every sample scene on lavapipe (~29 s there); "instances with different sweeps" runs the same host code'
+  'implicit solvers on the cotton drop onto a sphere'
+  'four 2 s drops of CG and vbd (~16 s there); the other vbd and implicit tests run the same code'
   'cli: soak runs a short soak'
   "its RSS-growth limit (1 MiB over 500 steps) measures the sanitizer's allocator: under clang's ASan the RSS grows 2.5 MiB there whatever the quarantine (0.2 MiB under GCC's), under both ~55 MiB over 400 000 steps; the release run keeps it"
 )
