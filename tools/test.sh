@@ -28,7 +28,7 @@ asan_skips=(
   'vkcloth figures --backend vulkan'
   'every figure on lavapipe; vkcloth figures (cpu) runs the same figure code under the sanitizers'
   '^cli:run-every-sample$'
-  'every sample through the CLI; "every sample scene loads and runs" runs the same solvers in-process'
+  'every sample through the CLI; "every sample scene loads and runs" runs the same solvers in-process (200 steps each there)'
   'self-collision per instance in one batch'
   'three 64 x 64 self-colliding cloths on lavapipe and the CPU; the per-instance batch tests run the same code'
   'the fast projection holds the report.s super-elastic cloth'
