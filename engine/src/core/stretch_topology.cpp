@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 #include "stretch_topology.hpp"
+#include "vertex_colouring.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -33,34 +34,18 @@ void colour_strain_links(const ParticleSystem& system, std::vector<StrainLink>& 
   const SpringAdjacency& adj = system.adjacency;
   std::vector<std::uint32_t> colour(springs.size(), no_tether);
   std::vector<std::size_t> seen;
-  std::uint32_t colours = 0;
   for (std::size_t s = 0; s < springs.size(); ++s) {
     if (!is_strain_link(springs[s].kind))
       continue;
     for (std::uint32_t end : {springs[s].a, springs[s].b})
       for (std::uint32_t r = adj.offsets[end]; r < adj.offsets[end + 1]; ++r)
         if (const std::uint32_t c = colour[adj.refs[r].spring]; c != no_tether)
-          seen[c] = s + 1;
-    std::uint32_t c = 0;
-    while (c < colours && seen[c] == s + 1)
-      ++c;
-    if (c == colours) {
-      ++colours;
-      seen.push_back(0);
-    }
-    colour[s] = c;
+          mark_colour(seen, c, s + 1);
+    colour[s] = smallest_free_colour(seen, s + 1);
   }
-  offsets.assign(colours + 1, 0);
-  for (std::size_t s = 0; s < springs.size(); ++s)
-    if (colour[s] != no_tether)
-      ++offsets[colour[s] + 1];
-  for (std::uint32_t c = 0; c < colours; ++c)
-    offsets[c + 1] += offsets[c];
-  links.resize(offsets.back());
-  std::vector<std::uint32_t> next(offsets.begin(), offsets.end() - 1);
-  for (std::size_t s = 0; s < springs.size(); ++s)
-    if (colour[s] != no_tether)
-      links[next[colour[s]]++] = StrainLink{springs[s].a, springs[s].b, springs[s].rest_length};
+  links.clear();
+  for (const std::uint32_t s : group_by_colour(colour, no_tether, offsets)) // spring order within a colour
+    links.push_back(StrainLink{springs[s].a, springs[s].b, springs[s].rest_length});
 }
 
 void link_incidence(std::size_t particles, const std::vector<StrainLink>& links,
