@@ -130,12 +130,9 @@ void store_precond(uint p, SpringBlock s) {
   block_inv[2u * p + 1u] = vec4(s.off.y, s.off.z, 0.0, 0.0);
 }
 
-// Particle p's contact axis (cloth_kernel.h contact_axis): what the FORCE pass's filter took from
-// its velocity (vel - vf) and force (vf[count + p]); zero for a pinned or free particle.
-vec3 axis_of(uint p, bool pinned) {
-  if (pinned) return vec3(0.0);
-  return contact_axis(vel[p].xyz - vf[p].xyz, vf[pc.count + p].xyz, ip.dt / particle[p].mass);
-}
+// Particle p's contact axis (cloth_kernel.h contact_axis), as the FORCE pass stored it once per
+// solve; zero for a pinned or free particle.
+vec3 axis_of(uint p) { return vf[2u * pc.count + p].xyz; }
 
 // q = S A d for particle p (zero for a pinned one).
 vec3 matvec_row(uint p, bool pinned, float mu_h, float h2) {
@@ -145,7 +142,7 @@ vec3 matvec_row(uint p, bool pinned, float mu_h, float h2) {
     precise vec3 s = vec3(0.0);
     const uint end = offsets[p + 1];
     for (uint e = offsets[p]; e < end; ++e) s = s + apply_block(block_at(e), dp - cd[edges[e].other].xyz);
-    q = constrain_to(implicit_row(dp, mu_h, particle[p].mass, s, h2), axis_of(p, false));
+    q = constrain_to(implicit_row(dp, mu_h, particle[p].mass, s, h2), axis_of(p));
   }
   return q;
 }
@@ -154,7 +151,7 @@ vec3 matvec_row(uint p, bool pinned, float mu_h, float h2) {
 vec4 update_row(uint p, float alpha) {
   precise vec3 x = cx[p].xyz + cd[p].xyz * alpha;
   precise vec3 r = cr[p].xyz - cq[p].xyz * alpha;
-  const vec3 z = constrain_to(apply_block(precond_at(p), r), axis_of(p, particle[p].pinned != 0u));
+  const vec3 z = constrain_to(apply_block(precond_at(p), r), axis_of(p));
   cx[p] = vec4(x, 0.0);
   cr[p] = vec4(r, 0.0);
   cz[p] = vec4(z, 0.0);
@@ -238,9 +235,13 @@ void main() {
     normal_out[p] = normal_output(nrm);
     vf[p] = vec4(v, 0.0);
     vf[pc.count + p] = vec4(contact_removed_force, 0.0); // friction's impulse in FINISH
+    const vec3 axis = particle[p].pinned != 0u
+                          ? vec3(0.0)
+                          : contact_axis(vel[p].xyz - v, contact_removed_force, ip.dt / particle[p].mass);
+    vf[2u * pc.count + p] = vec4(axis, 0.0); // the CG passes' constraint (axis_of)
     // The warm start within this solve's contact constraint (SYSTEM reads the neighbours' cx).
-    if (cg.solves != 0u && particle[p].pinned == 0u)
-      cx[p] = vec4(constrain_to(cx[p].xyz, contact_axis(vel[p].xyz - v, contact_removed_force, ip.dt / particle[p].mass)), 0.0);
+    if (cg.solves != 0u)
+      cx[p] = vec4(constrain_to(cx[p].xyz, axis), 0.0);
     return;
   }
   if (mode == VKCLOTH_IMPL_SYSTEM) {
@@ -274,7 +275,7 @@ void main() {
         cr[p] = cz[p] = cd[p] = vec4(0.0);
       } else {
         const float m = particle[p].mass;
-        const vec3 a = axis_of(p, false);
+        const vec3 a = axis_of(p);
         const SpringBlock pinv = invert_block(implicit_diagonal_block(mu_h, m, ksum, h2));
         const vec3 b = constrain_to(implicit_rhs(force_out[p].xyz, lv, h), a);
         const vec3 r = constrain_to(residual_of(b, implicit_row(x0, mu_h, m, lx, h2)), a);

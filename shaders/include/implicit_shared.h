@@ -14,7 +14,8 @@
 namespace vkcloth::gpu::shared {
 #endif
 
-#define VKCLOTH_BINDING_IMPL_VF 25 // (after VKCLOTH_BINDING_COUNT) contact-filtered velocity (vec4)
+#define VKCLOTH_BINDING_IMPL_VF                                                                              \
+  25 // (after VKCLOTH_BINDING_COUNT) contact-filtered velocity, removed force, contact axis (vec4 each)
 #define VKCLOTH_BINDING_IMPL_KS 26 // per CSR entry: K_s as 2 vec4 (xx yy zz xy | xz yz - -)
 #define VKCLOTH_BINDING_IMPL_BLOCK_INV                                                                       \
   27                              // P^-1: inverse diagonal block of A, 2 vec4 (xx yy zz xy | xz yz - -)

@@ -42,7 +42,8 @@ Result<void> ImplicitGpu::create_buffers(std::uint64_t entries, bool allow_map) 
   const VkDeviceSize vec4_bytes = std::max<VkDeviceSize>(VkDeviceSize(count_) * 16, 16);
   const std::uint64_t groups = std::uint64_t(groups_x_) * groups_y_;
   const std::tuple<Buffer*, VkDeviceSize, const char*> device_buffers[] = {
-      {&vf_, 2 * vec4_bytes, "implicit: filtered velocities, then the forces the filter removed"},
+      {&vf_, 3 * vec4_bytes,
+       "implicit: filtered velocities, then the forces the filter removed, then the contact axes"},
       {&block_inv_, 2 * vec4_bytes, "implicit: block-Jacobi preconditioner"},
       {&x_, vec4_bytes, "implicit: CG x"},
       {&r_, vec4_bytes, "implicit: CG r"},
