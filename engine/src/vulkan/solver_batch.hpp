@@ -179,6 +179,9 @@ public:
   void push_state(VkCommandBuffer cmd, const void* push) const;
   /// One invocation per particle of every instance (the grid of workgroups x the instances).
   void dispatch_particles(VkCommandBuffer cmd) const;
+  /// One invocation per item of a range (a colour's links or particles) of every instance: as many
+  /// workgroups as the items need, in rows no wider than the particles' (nothing for no items).
+  void dispatch_items(VkCommandBuffer cmd, std::uint32_t items) const;
   std::uint32_t dispatch_x() const { return groups_x; }
   std::uint32_t dispatch_y() const { return groups_y; }
   std::uint64_t edge_count() const { return edges_count; }

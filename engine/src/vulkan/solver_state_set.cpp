@@ -69,6 +69,14 @@ void SolverBatch::dispatch_particles(VkCommandBuffer c) const {
   vk().vkCmdDispatch(c, groups_x, groups_y, size()); // one dispatch serves every instance (gl_WorkGroupID.z)
 }
 
+void SolverBatch::dispatch_items(VkCommandBuffer c, std::uint32_t items) const {
+  const std::uint32_t groups = (items + workgroup - 1) / workgroup;
+  if (groups == 0)
+    return;
+  const std::uint32_t gx = std::min(groups, groups_x), gy = (groups + gx - 1) / gx;
+  vk().vkCmdDispatch(c, gx, gy, size());
+}
+
 Result<DeviceLayout> SolverBatch::resolve_layout(const Context::Impl& ctx, const GpuSolverOptions& options,
                                                  bool implicit) {
   const bool decided = options.buffer_access != BufferAccess::automatic && options.workgroup_size != 0;

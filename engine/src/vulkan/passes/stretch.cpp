@@ -56,11 +56,9 @@ public:
         pc.stage = sweep;
         pc.link_first = colours[k];
         pc.link_count = colours[k + 1] - colours[k];
-        const std::uint32_t groups = (pc.link_count + b.workgroup_size() - 1) / b.workgroup_size();
-        const std::uint32_t gx = std::min(groups, b.dispatch_x()), gy = (groups + gx - 1) / gx;
         b.push_state(f.cmd, &pc);
         barriers::dispatch_to_dispatch(v, f.cmd); // the previous pass or colour -> this colour
-        v.vkCmdDispatch(f.cmd, gx, gy, b.size());
+        b.dispatch_items(f.cmd, pc.link_count);
         ++dispatches;
       }
     return dispatches;

@@ -5,7 +5,6 @@
 // The state set of the substep's parity: POS_IN = positions[read] (the start), POS_OUT the iterate.
 // VEL_FILT, STAGE_POS and ACC_VEL, the explicit integrators' scratch, hold the targets, the pushes
 // and the velocities at the last substep's start (zero at first, as the CPU's).
-#include <algorithm>
 #include <memory>
 
 #include "../barriers.hpp"
@@ -57,11 +56,9 @@ public:
       for (std::size_t c = 0; c + 1 < colours.size(); ++c) {
         pc.colour_first = colours[c];
         pc.colour_count = colours[c + 1] - colours[c];
-        const std::uint32_t groups = (pc.colour_count + b.workgroup_size() - 1) / b.workgroup_size();
-        const std::uint32_t gx = std::min(groups, b.dispatch_x()), gy = (groups + gx - 1) / gx;
         b.push_state(f.cmd, &pc);
         barriers::dispatch_to_dispatch(v, f.cmd); // the begin or the previous colour -> this colour
-        v.vkCmdDispatch(f.cmd, gx, gy, b.size());
+        b.dispatch_items(f.cmd, pc.colour_count);
         ++dispatches;
       }
     run(VKCLOTH_VBD_FINISH);
