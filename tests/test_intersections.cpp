@@ -16,8 +16,10 @@
 
 #include "vkcloth/mesh.hpp"
 #include "vkcloth/vkcloth.hpp"
+#include "rest_positions.hpp"
 
 using namespace vkcloth;
+using vkcloth::test::rest_positions;
 
 namespace {
 
@@ -70,13 +72,6 @@ ParticleSystem flat_grid(std::uint32_t n) {
   auto s = make_cloth(d);
   REQUIRE(s.ok());
   return std::move(*s);
-}
-
-std::vector<glm::dvec3> rest_positions(const ParticleSystem& s) {
-  std::vector<glm::dvec3> x;
-  for (const Particle& p : s.particles)
-    x.push_back(p.position);
-  return x;
 }
 
 std::span<const std::uint32_t> topology_triangles(const ParticleSystem& s,

@@ -6,8 +6,10 @@
 #include <vector>
 
 #include "vkcloth/vkcloth.hpp"
+#include "rest_positions.hpp"
 
 using namespace vkcloth;
+using vkcloth::test::rest_positions;
 
 namespace {
 
@@ -20,13 +22,6 @@ ParticleSystem grid(std::uint32_t nx, std::uint32_t ny) {
   auto s = make_cloth(d);
   REQUIRE(s.ok());
   return std::move(s.value());
-}
-
-std::vector<glm::dvec3> rest_positions(const ParticleSystem& s) {
-  std::vector<glm::dvec3> p;
-  for (const Particle& q : s.particles)
-    p.push_back(q.position);
-  return p;
 }
 
 std::uint32_t spring_between(const ParticleSystem& s, std::uint32_t a, std::uint32_t b) {

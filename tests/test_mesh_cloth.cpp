@@ -15,8 +15,10 @@
 #include "sim_backends.hpp"
 #include "vkcloth/mesh.hpp"
 #include "vkcloth/vkcloth.hpp"
+#include "rest_positions.hpp"
 
 using namespace vkcloth;
+using vkcloth::test::rest_positions;
 
 namespace {
 
@@ -34,13 +36,6 @@ ParticleSystem grid_system(const ClothDesc& d) {
   auto s = make_cloth(d);
   REQUIRE(s.ok());
   return std::move(*s);
-}
-
-std::vector<glm::dvec3> rest_positions(const ParticleSystem& s) {
-  std::vector<glm::dvec3> x;
-  for (const Particle& p : s.particles)
-    x.push_back(p.position);
-  return x;
 }
 
 /// The grid's quads split into the two triangles a quad exporter writes.

@@ -16,6 +16,7 @@
 
 #include "sim_backends.hpp"
 #include "vkcloth/material.hpp"
+#include "rest_positions.hpp"
 
 using namespace vkcloth;
 using namespace vkcloth::test;
@@ -63,13 +64,6 @@ double variational_energy(const ParticleSystem& s, const SimParams& p, const std
     e += 0.5 * sp.stiffness * stretch * stretch;
   }
   return e;
-}
-
-std::vector<glm::dvec3> rest_positions(const ParticleSystem& s) {
-  std::vector<glm::dvec3> x;
-  for (const Particle& q : s.particles)
-    x.push_back(q.position);
-  return x;
 }
 
 } // namespace

@@ -17,6 +17,9 @@
 
 namespace vkcloth::gpu::test {
 
+/// GPU = CPU float: how far apart their positions may be after 100 steps (m).
+inline constexpr double gpu_cpu_tolerance = 1e-5;
+
 inline bool on_ci() {
   const char* v = std::getenv("CI");
   return v && (std::strcmp(v, "true") == 0 || std::strcmp(v, "1") == 0);

@@ -14,9 +14,7 @@ using namespace vkcloth::gpu::test;
 
 namespace {
 
-constexpr double tolerance = 1e-5;
-
-ParticleSystem falling_cloth() {
+ParticleSystem falling_grid() {
   ClothDesc d;
   d.nx = 15;
   d.ny = 13;
@@ -64,7 +62,7 @@ std::vector<std::pair<std::string, std::vector<Collider>>> contact_scenes() {
 
 TEST_CASE("GPU matches CPU with capsule, box and mesh colliders, friction and moving colliders") {
   VKCLOTH_GPU_TEST_BEGIN(ctx);
-  const ParticleSystem sys = falling_cloth();
+  const ParticleSystem sys = falling_grid();
   for (const auto& [name, colliders] : contact_scenes())
     for (Integrator integrator :
          {Integrator::semi_implicit_euler, Integrator::rk4, Integrator::implicit_euler})
@@ -104,7 +102,7 @@ TEST_CASE("GPU matches CPU with capsule, box and mesh colliders, friction and mo
             "{:<18} {:<20} substeps {} max|dp| = {:.3g}{} after {} steps (lowest point {:.3f} m)", name,
             to_string(integrator), substeps, d.max_abs, d.bitwise ? " (bitwise)" : "", steps, lowest));
         CHECK(lowest < 0.44); // it fell and met the collider
-        CHECK(d.max_abs <= (implicit ? 9.81 * p.dt * p.dt : tolerance));
+        CHECK(d.max_abs <= (implicit ? 9.81 * p.dt * p.dt : gpu_cpu_tolerance));
         if (implicit) {
           REQUIRE(cpu->run(50).ok());
           REQUIRE(gpu->simulate(50, 32).ok());
@@ -132,7 +130,7 @@ TEST_CASE("a host moving a collider every frame (StepParams) steps the GPU as th
   // animating a character's limb would (StepParams::colliders; record_steps(cmd, steps, step) is
   // set_params(step.applied_to(params())) + record_steps), on both solvers.
   VKCLOTH_GPU_TEST_BEGIN(ctx);
-  const ParticleSystem sys = falling_cloth();
+  const ParticleSystem sys = falling_grid();
   SimParams p;
   p.colliders = {Collider::plane({0, 0, 1}, 0.0)};
   auto cpu = CpuSolver<float>::create(sys, p);
@@ -155,7 +153,7 @@ TEST_CASE("a host moving a collider every frame (StepParams) steps the GPU as th
   REQUIRE(gp.ok());
   const Diff d = diff(*gp, cpu->positions());
   MESSAGE(fmt::format("paddle: max|dp| = {:.3g}{}", d.max_abs, d.bitwise ? " (bitwise)" : ""));
-  CHECK(d.max_abs <= tolerance);
+  CHECK(d.max_abs <= gpu_cpu_tolerance);
   double pushed = -1e9;
   for (const glm::vec3& x : *gp)
     pushed = std::max(pushed, double(x.x));

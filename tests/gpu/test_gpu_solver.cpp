@@ -21,7 +21,6 @@ using namespace vkcloth::gpu::test;
 
 namespace {
 
-constexpr double tolerance = 1e-5;
 constexpr Integrator integrators[] = {Integrator::explicit_euler, Integrator::semi_implicit_euler,
                                       Integrator::rk4};
 
@@ -106,9 +105,9 @@ void check_against_cpu(Context& ctx, const std::string& name, TestScene scene, s
                         name, method, scene.params.dt, dp.max_abs, dp.bitwise ? " (bitwise)" : "", dv.max_abs,
                         dn.max_abs, moved, gpu->last_gpu_ms()));
     CHECK(moved > 1e-3);
-    CHECK(dp.max_abs <= tolerance);
-    CHECK(dv.max_abs <= 100 * tolerance); // velocities ~ positions / dt
-    CHECK(dn.max_abs <= 100 * tolerance); // unit normals of nearly flat fans are sensitive
+    CHECK(dp.max_abs <= gpu_cpu_tolerance);
+    CHECK(dv.max_abs <= 100 * gpu_cpu_tolerance); // velocities ~ positions / dt
+    CHECK(dn.max_abs <= 100 * gpu_cpu_tolerance); // unit normals of nearly flat fans are sensitive
   }
 }
 
@@ -218,7 +217,7 @@ TEST_CASE("GPU double buffering: the current index follows the step parity") {
     CHECK(gpu->current_position_buffer() == gpu->position_buffer(gpu->current_position_index()));
     auto p = gpu->positions();
     REQUIRE(p.ok());
-    CHECK(diff(*p, cpu->positions()).max_abs <= tolerance);
+    CHECK(diff(*p, cpu->positions()).max_abs <= gpu_cpu_tolerance);
   }
   CHECK(gpu->step_index() == 7);
   CHECK(gpu->time() == doctest::Approx(7 * 0.02));
@@ -288,13 +287,13 @@ TEST_CASE("GPU record_steps into a caller's command buffer") {
   const Diff d = diff(*p, cpu->positions());
   MESSAGE(fmt::format("record_steps 5 + 4 rk4 steps: max|dp| = {:.3g}{}", d.max_abs,
                       d.bitwise ? " (bitwise)" : ""));
-  CHECK(d.max_abs <= tolerance);
+  CHECK(d.max_abs <= gpu_cpu_tolerance);
   // simulate() continues from there.
   REQUIRE(gpu->simulate(3).ok());
   REQUIRE(cpu->run(3).ok());
   auto p2 = gpu->positions();
   REQUIRE(p2.ok());
-  CHECK(diff(*p2, cpu->positions()).max_abs <= tolerance);
+  CHECK(diff(*p2, cpu->positions()).max_abs <= gpu_cpu_tolerance);
 }
 
 TEST_CASE("GPU set_params between steps matches the CPU") {
@@ -319,7 +318,7 @@ TEST_CASE("GPU set_params between steps matches the CPU") {
   REQUIRE(cpu->run(30).ok());
   auto gp = gpu->positions();
   REQUIRE(gp.ok());
-  CHECK(diff(*gp, cpu->positions()).max_abs <= tolerance);
+  CHECK(diff(*gp, cpu->positions()).max_abs <= gpu_cpu_tolerance);
   SimParams bad = p;
   bad.dt = -1;
   CHECK(gpu->set_params(bad).error().code == ErrorCode::invalid_argument);
@@ -350,7 +349,8 @@ TEST_CASE("GPU blow-up detection names the exact step") {
     // The state is left as after the bad step, as on the CPU.
     auto gp = gpu->positions();
     REQUIRE(gp.ok());
-    CHECK(diff(*gp, cpu->positions()).max_abs <= tolerance * std::max(1.0f, std::abs(cpu->positions()[1].z)));
+    CHECK(diff(*gp, cpu->positions()).max_abs <=
+          gpu_cpu_tolerance * std::max(1.0f, std::abs(cpu->positions()[1].z)));
     // Further simulation is refused with the same error.
     const auto again = gpu->simulate(1);
     CHECK(again.error().code == ErrorCode::diverged);
@@ -390,7 +390,7 @@ TEST_CASE("GPU two-pass, RK4 and implicit passes follow colliders added by set_p
     const Diff d = diff(*gp, cpu->positions());
     MESSAGE(std::string(to_string(integrator))
             << " (fused = false), colliders from step 30: max |p_gpu - p_cpu| = " << d.max_abs);
-    CHECK(d.max_abs <= tolerance);
+    CHECK(d.max_abs <= gpu_cpu_tolerance);
     // The colliders acted: the cloth ends higher than it would without them.
     auto free_fall = CpuSolver<float>::create(with.system, bare);
     REQUIRE(free_fall.ok());

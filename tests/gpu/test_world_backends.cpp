@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // One host, two backends: the host code below is written once, as a template over the world type,
 // and run with vkcloth::CpuWorld and vkcloth::gpu::ClothWorld (only their create() differs). The
-// two agree within test_gpu_solver.cpp's tolerance for the same scenes (1e-5 on positions after
+// two agree within gpu_cpu_tolerance (gpu_test_util.hpp) for the same scenes (1e-5 on positions after
 // 100 steps; bit-identical on lavapipe, reported), and a divergence is reported the same way.
 #include "gpu_test_util.hpp"
 
@@ -12,10 +12,9 @@
 using namespace vkcloth;
 using vkcloth::gpu::test::diff;
 using vkcloth::gpu::test::Diff;
+using vkcloth::gpu::test::gpu_cpu_tolerance;
 
 namespace {
-
-constexpr double tolerance = 1e-5; // test_gpu_solver.cpp's, for the same step count
 
 std::shared_ptr<const ClothTopology> topology_of(ClothDesc d) {
   auto s = make_cloth(d);
@@ -145,9 +144,9 @@ TEST_CASE("One host template, two worlds: CpuWorld and gpu::ClothWorld agree (GP
     const Diff dn = diff(gpu.normals[k], cpu.normals[k]);
     MESSAGE(fmt::format("instance {}: max|dp| = {:.3g}{} max|dv| = {:.3g} max|dn| = {:.3g}", k, dp.max_abs,
                         dp.bitwise ? " (bitwise)" : "", dv.max_abs, dn.max_abs));
-    CHECK(dp.max_abs <= tolerance);
-    CHECK(dv.max_abs <= 100 * tolerance); // velocities ~ positions / dt
-    CHECK(dn.max_abs <= 100 * tolerance); // unit normals of nearly flat fans are sensitive
+    CHECK(dp.max_abs <= gpu_cpu_tolerance);
+    CHECK(dv.max_abs <= 100 * gpu_cpu_tolerance); // velocities ~ positions / dt
+    CHECK(dn.max_abs <= 100 * gpu_cpu_tolerance); // unit normals of nearly flat fans are sensitive
   }
 
   auto cpu_wild = CpuWorld::create();

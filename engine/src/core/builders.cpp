@@ -7,18 +7,11 @@
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
 
+#include "argument_checks.hpp"
+
 namespace vkcloth {
-namespace {
-
-Error bad(std::string message) {
-  return make_error(ErrorCode::invalid_argument, std::move(message));
-}
-bool finite(glm::dvec3 v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
-
-} // namespace
-
+using detail::bad_argument;
+using detail::finite;
 glm::dvec3 polygon_vector_area(std::span<const std::uint32_t> face, std::span<const glm::dvec3> x) {
   glm::dvec3 sum(0.0);
   const glm::dvec3 o = x[face[0]];
@@ -41,26 +34,28 @@ void lump_masses(std::span<const std::uint32_t> face_offsets, std::span<const st
 
 Result<void> check_cloth_material(double particle_mass, const ClothStiffness& stiffness) {
   if (!std::isfinite(particle_mass) || particle_mass <= 0.0)
-    return bad(fmt::format("cloth.particle_mass must be finite and > 0, got {}", particle_mass));
+    return bad_argument(fmt::format("cloth.particle_mass must be finite and > 0, got {}", particle_mass));
   const std::pair<const char*, double> ks[] = {
       {"structural", stiffness.structural}, {"shear", stiffness.shear}, {"bend", stiffness.bend}};
   for (auto [name, k] : ks)
     if (!std::isfinite(k) || k < 0.0)
-      return bad(fmt::format("cloth.stiffness.{} must be finite and >= 0, got {}", name, k));
+      return bad_argument(fmt::format("cloth.stiffness.{} must be finite and >= 0, got {}", name, k));
   return {};
 }
 
 Result<ParticleSystem> make_chain(const ChainDesc& d) {
   const std::size_t n = d.masses.size();
   if (n == 0)
-    return bad("chain.masses must hold at least one mass");
+    return bad_argument("chain.masses must hold at least one mass");
   if (n > max_particles)
-    return bad(fmt::format("chain.masses holds {} masses, more than the limit {}", n, max_particles));
+    return bad_argument(
+        fmt::format("chain.masses holds {} masses, more than the limit {}", n, max_particles));
   auto per_spring = [&](const std::vector<double>& v, const char* key) -> Result<std::vector<double>> {
     if (v.size() == 1)
       return std::vector<double>(n, v[0]); // one value for every spring
     if (v.size() != n)
-      return bad(fmt::format("chain.{} must hold 1 or {} values (one per mass), got {}", key, n, v.size()));
+      return bad_argument(
+          fmt::format("chain.{} must hold 1 or {} values (one per mass), got {}", key, n, v.size()));
     return v;
   };
   auto k = per_spring(d.stiffness, "stiffness");
@@ -70,10 +65,10 @@ Result<ParticleSystem> make_chain(const ChainDesc& d) {
   if (!l0)
     return l0.error();
   if (!finite(d.anchor))
-    return bad("chain.anchor must be finite");
+    return bad_argument("chain.anchor must be finite");
   VKCLOTH_TRY(check_up_axis(d.up, "chain.up"));
   if (!d.positions.empty() && d.positions.size() != n)
-    return bad(
+    return bad_argument(
         fmt::format("chain.positions must hold {} positions (one per mass), got {}", n, d.positions.size()));
 
   ParticleSystem sys;
@@ -81,15 +76,15 @@ Result<ParticleSystem> make_chain(const ChainDesc& d) {
   glm::dvec3 below = d.anchor;
   for (std::size_t i = 0; i < n; ++i) {
     if (!std::isfinite(d.masses[i]) || d.masses[i] <= 0.0)
-      return bad(fmt::format("chain.masses[{}] must be finite and > 0, got {}", i, d.masses[i]));
+      return bad_argument(fmt::format("chain.masses[{}] must be finite and > 0, got {}", i, d.masses[i]));
     if (!std::isfinite((*k)[i]) || (*k)[i] < 0.0)
-      return bad(fmt::format("chain.stiffness[{}] must be finite and >= 0, got {}", i, (*k)[i]));
+      return bad_argument(fmt::format("chain.stiffness[{}] must be finite and >= 0, got {}", i, (*k)[i]));
     if (!std::isfinite((*l0)[i]) || (*l0)[i] < 0.0)
-      return bad(fmt::format("chain.rest_lengths[{}] must be finite and >= 0, got {}", i, (*l0)[i]));
+      return bad_argument(fmt::format("chain.rest_lengths[{}] must be finite and >= 0, got {}", i, (*l0)[i]));
     below -= up_vector(d.up) * (*l0)[i]; // default: hanging straight down, each spring at rest length
     const glm::dvec3 p = d.positions.empty() ? below : d.positions[i];
     if (!finite(p))
-      return bad(fmt::format("chain.positions[{}] must be finite", i));
+      return bad_argument(fmt::format("chain.positions[{}] must be finite", i));
     sys.particles.push_back(Particle{p, {}, d.masses[i], false});
     sys.springs.push_back(Spring{static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(i + 1), (*l0)[i],
                                  (*k)[i], SpringKind::plain});
@@ -117,7 +112,7 @@ std::optional<UpAxis> parse_up_axis(std::string_view name) {
 
 Result<void> check_up_axis(UpAxis up, std::string_view what) {
   if (up != UpAxis::z && up != UpAxis::y)
-    return bad(fmt::format("{}: unknown up axis {} (z = 0 or y = 1)", what, std::uint32_t(up)));
+    return bad_argument(fmt::format("{}: unknown up axis {} (z = 0 or y = 1)", what, std::uint32_t(up)));
   return {};
 }
 
@@ -144,24 +139,26 @@ namespace {
 /// The description's sizes, extent, origin and material (or per-particle mass and stiffness).
 Result<void> check_cloth_desc(const ClothDesc& d) {
   if (d.nx < 1 || d.ny < 1 || d.nx > max_cloth_side || d.ny > max_cloth_side)
-    return bad(fmt::format("cloth.resolution [{}, {}] is out of range: each side must be in 1..{}", d.nx,
-                           d.ny, max_cloth_side));
+    return bad_argument(fmt::format("cloth.resolution [{}, {}] is out of range: each side must be in 1..{}",
+                                    d.nx, d.ny, max_cloth_side));
   const std::uint64_t count = std::uint64_t(d.nx) * d.ny;
   if (count > max_particles)
-    return bad(fmt::format("cloth.resolution [{}, {}] makes {} particles, more than the limit {}", d.nx, d.ny,
-                           count, max_particles));
+    return bad_argument(fmt::format("cloth.resolution [{}, {}] makes {} particles, more than the limit {}",
+                                    d.nx, d.ny, count, max_particles));
   if (!std::isfinite(d.size.x) || !std::isfinite(d.size.y) || d.size.x <= 0.0 || d.size.y <= 0.0)
-    return bad(fmt::format("cloth.size must be finite and > 0, got [{}, {}]", d.size.x, d.size.y));
+    return bad_argument(fmt::format("cloth.size must be finite and > 0, got [{}, {}]", d.size.x, d.size.y));
   if (!finite(d.origin))
-    return bad("cloth.origin must be finite");
+    return bad_argument("cloth.origin must be finite");
   if (std::uint32_t(d.orientation) > std::uint32_t(ClothOrientation::horizontal))
-    return bad(fmt::format("cloth.orientation: unknown orientation {}", std::uint32_t(d.orientation)));
+    return bad_argument(
+        fmt::format("cloth.orientation: unknown orientation {}", std::uint32_t(d.orientation)));
   VKCLOTH_TRY(check_up_axis(d.up, "cloth.up"));
   if (!d.material)
     return check_cloth_material(d.particle_mass, d.stiffness);
   VKCLOTH_TRY(check_material(*d.material));
   if (d.nx < 2 || d.ny < 2)
-    return bad(fmt::format("cloth.material needs a grid of at least 2 x 2 points, got [{}, {}]", d.nx, d.ny));
+    return bad_argument(
+        fmt::format("cloth.material needs a grid of at least 2 x 2 points, got [{}, {}]", d.nx, d.ny));
   return {};
 }
 
@@ -193,12 +190,12 @@ Result<std::vector<glm::vec2>> grid_uvs(const ClothDesc& d) {
   const std::size_t count = std::size_t(nx) * ny;
   if (!d.uvs.empty()) {
     if (d.uvs.size() != count)
-      return bad(fmt::format("cloth uvs: {} texture coordinates for a {} x {} grid of {} particles",
-                             d.uvs.size(), nx, ny, count));
+      return bad_argument(fmt::format("cloth uvs: {} texture coordinates for a {} x {} grid of {} particles",
+                                      d.uvs.size(), nx, ny, count));
     for (std::size_t k = 0; k < count; ++k)
       if (!std::isfinite(d.uvs[k].x) || !std::isfinite(d.uvs[k].y))
-        return bad(fmt::format("cloth uvs: texture coordinate {} is not finite ({}, {})", k, d.uvs[k].x,
-                               d.uvs[k].y));
+        return bad_argument(fmt::format("cloth uvs: texture coordinate {} is not finite ({}, {})", k,
+                                        d.uvs[k].x, d.uvs[k].y));
     return d.uvs;
   }
   if (d.uv_transform == UvTransform{})
@@ -206,7 +203,7 @@ Result<std::vector<glm::vec2>> grid_uvs(const ClothDesc& d) {
   const UvTransform& m = d.uv_transform;
   for (const glm::vec2 a : {m.offset, m.u_axis, m.v_axis})
     if (!std::isfinite(a.x) || !std::isfinite(a.y))
-      return bad("cloth uv_transform must be finite");
+      return bad_argument("cloth uv_transform must be finite");
   std::vector<glm::vec2> uvs(count);
   for (std::uint32_t j = 0; j < ny; ++j)
     for (std::uint32_t i = 0; i < nx; ++i) {
@@ -225,7 +222,8 @@ Result<void> pin_grid(const ClothDesc& d, ParticleSystem& sys) {
   for (std::size_t k = 0; k < pins.size(); ++k) {
     const auto [i, j] = pins[k];
     if (i >= nx || j >= ny)
-      return bad(fmt::format("cloth.pins[{}] = [{}, {}] is outside the {} x {} grid", k, i, j, nx, ny));
+      return bad_argument(
+          fmt::format("cloth.pins[{}] = [{}, {}] is outside the {} x {} grid", k, i, j, nx, ny));
     sys.particles[j * nx + i].pinned = true;
   }
   return {};

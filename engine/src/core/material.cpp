@@ -8,7 +8,10 @@
 
 #include <fmt/format.h>
 
+#include "argument_checks.hpp"
+
 namespace vkcloth {
+using detail::bad_argument;
 namespace {
 
 struct Preset {
@@ -36,10 +39,6 @@ constexpr std::array<std::string_view, presets.size()> names = [] {
     n[k] = presets[k].name;
   return n;
 }();
-
-Error bad(std::string message) {
-  return make_error(ErrorCode::invalid_argument, std::move(message));
-}
 
 /// C11 of the lattice for the uniaxial-stress modulus E: C - C12^2 / C = E with C12 = G.
 double membrane_c11(const Material& m) {
@@ -79,14 +78,15 @@ Result<void> check_material(const Material& m, std::string_view key) {
                                                    {"damping", m.damping}};
   for (auto [name, v] : fields)
     if (!std::isfinite(v) || v <= 0.0)
-      return bad(fmt::format("{}.{} must be finite and > 0, got {}", key, name, v));
+      return bad_argument(fmt::format("{}.{} must be finite and > 0, got {}", key, name, v));
   return {};
 }
 
 Result<double> spring_stiffness(const Material& m, SpringKind kind, double along, double across,
                                 std::string_view key) {
   if (!(along > 0.0) || !(across > 0.0) || !std::isfinite(along) || !std::isfinite(across))
-    return bad(fmt::format("{}: spring spacing must be finite and > 0, got {} and {}", key, along, across));
+    return bad_argument(
+        fmt::format("{}: spring spacing must be finite and > 0, got {} and {}", key, along, across));
   switch (kind) {
   case SpringKind::bend:
     return bend_spring(m, along, across);
@@ -101,7 +101,7 @@ Result<double> spring_stiffness(const Material& m, SpringKind kind, double along
     // Square grid: 4 K_b(h) = C - G at h_min = (32 B / (kappa_ref^2 (C - G)))^(1/4).
     const double h_min =
         std::pow(32.0 * m.bend / (bend_reference_curvature * bend_reference_curvature * (c - m.shear)), 0.25);
-    return bad(fmt::format(
+    return bad_argument(fmt::format(
         "{}: at spacing {:.4g} m the bend springs (K = {:.4g} N/m each, from bend = {} N m) are stiffer "
         "in-plane than the membrane (stretch = {} N/m, shear = {} N/m) allows: the structural springs "
         "would need K = {:.4g} N/m < 0; use a spacing of at least {:.3g} m (a coarser grid) or a smaller "
@@ -111,7 +111,7 @@ Result<double> spring_stiffness(const Material& m, SpringKind kind, double along
   case SpringKind::plain:
     break;
   }
-  return bad(fmt::format("{}: no material stiffness for a {} spring", key, to_string(kind)));
+  return bad_argument(fmt::format("{}: no material stiffness for a {} spring", key, to_string(kind)));
 }
 
 } // namespace vkcloth

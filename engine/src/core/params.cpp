@@ -11,17 +11,15 @@
 
 #include "vkcloth/collider_mesh.hpp"
 
+#include "argument_checks.hpp"
+
 namespace vkcloth {
+using detail::bad_argument;
+using detail::finite;
 namespace {
 
-bool finite(glm::dvec3 v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
 std::string str(glm::dvec3 v) {
   return fmt::format("[{}, {}, {}]", v.x, v.y, v.z);
-}
-Error bad(std::string message) {
-  return make_error(ErrorCode::invalid_argument, std::move(message));
 }
 
 bool positive(double x) {
@@ -42,7 +40,7 @@ double rotation_error(const glm::dmat3& r) {
 Result<void> validate_collider(Collider& c, const std::string& at) {
   const auto vec = [&](const char* key, glm::dvec3 v) -> Result<void> {
     if (!finite(v))
-      return bad(fmt::format("{}.{} must be finite, got {}", at, key, str(v)));
+      return bad_argument(fmt::format("{}.{} must be finite, got {}", at, key, str(v)));
     return {};
   };
   switch (c.type) {
@@ -50,12 +48,12 @@ Result<void> validate_collider(Collider& c, const std::string& at) {
     VKCLOTH_TRY(vec("normal", c.normal));
     const double len = glm::length(c.normal);
     if (!(len > 0.0))
-      return bad(fmt::format("{}.normal must be non-zero, got {}", at, str(c.normal)));
+      return bad_argument(fmt::format("{}.normal must be non-zero, got {}", at, str(c.normal)));
     c.normal /= len;
     if (!std::isfinite(c.offset))
-      return bad(fmt::format("{}.offset must be finite, got {}", at, c.offset));
+      return bad_argument(fmt::format("{}.offset must be finite, got {}", at, c.offset));
     if (c.angular_velocity != glm::dvec3(0.0))
-      return bad(
+      return bad_argument(
           fmt::format("{}.angular_velocity: a plane cannot turn (it takes linear_velocity only), got {}", at,
                       str(c.angular_velocity)));
     break;
@@ -63,44 +61,45 @@ Result<void> validate_collider(Collider& c, const std::string& at) {
   case Collider::Type::sphere:
     VKCLOTH_TRY(vec("center", c.center));
     if (!positive(c.radius))
-      return bad(fmt::format("{}.radius must be finite and > 0, got {}", at, c.radius));
+      return bad_argument(fmt::format("{}.radius must be finite and > 0, got {}", at, c.radius));
     break;
   case Collider::Type::capsule:
     VKCLOTH_TRY(vec("a", c.a));
     VKCLOTH_TRY(vec("b", c.b));
     if (!positive(c.radius))
-      return bad(fmt::format("{}.radius must be finite and > 0, got {}", at, c.radius));
+      return bad_argument(fmt::format("{}.radius must be finite and > 0, got {}", at, c.radius));
     break;
   case Collider::Type::box:
     VKCLOTH_TRY(vec("center", c.center));
     if (!positive(c.half_extents.x) || !positive(c.half_extents.y) || !positive(c.half_extents.z))
-      return bad(fmt::format("{}.half_extents must be finite and > 0, got {}", at, str(c.half_extents)));
+      return bad_argument(
+          fmt::format("{}.half_extents must be finite and > 0, got {}", at, str(c.half_extents)));
     break;
   case Collider::Type::mesh:
     VKCLOTH_TRY(vec("center", c.center));
     if (!c.mesh)
-      return bad(fmt::format("{}: a mesh collider needs its mesh (ColliderMesh::create)", at));
+      return bad_argument(fmt::format("{}: a mesh collider needs its mesh (ColliderMesh::create)", at));
     if (!positive(c.thickness))
-      return bad(fmt::format("{}.thickness must be finite and > 0, got {}", at, c.thickness));
+      return bad_argument(fmt::format("{}.thickness must be finite and > 0, got {}", at, c.thickness));
     break;
   default:
-    return bad(fmt::format("{}.type is unknown ({})", at, std::uint32_t(c.type)));
+    return bad_argument(fmt::format("{}.type is unknown ({})", at, std::uint32_t(c.type)));
   }
   for (int col = 0; col < 3; ++col)
     VKCLOTH_TRY(vec("rotation", c.rotation[col]));
   if (c.type == Collider::Type::box || c.type == Collider::Type::mesh) {
     const double off = rotation_error(c.rotation);
     if (!(off < 1e-6))
-      return bad(fmt::format(
+      return bad_argument(fmt::format(
           "{}.rotation must be a rotation matrix (orthonormal, determinant 1); it is off by {}", at, off));
   }
   if (!std::isfinite(c.friction) || c.friction < 0.0)
-    return bad(fmt::format("{}.friction must be finite and >= 0, got {}", at, c.friction));
+    return bad_argument(fmt::format("{}.friction must be finite and >= 0, got {}", at, c.friction));
   if (!std::isfinite(c.static_friction))
-    return bad(fmt::format("{}.static_friction must be finite, got {}", at, c.static_friction));
+    return bad_argument(fmt::format("{}.static_friction must be finite, got {}", at, c.static_friction));
   if (c.static_friction >= 0.0 && c.static_friction < c.friction)
-    return bad(fmt::format("{}.static_friction must be >= friction ({}), got {}", at, c.friction,
-                           c.static_friction));
+    return bad_argument(fmt::format("{}.static_friction must be >= friction ({}), got {}", at, c.friction,
+                                    c.static_friction));
   VKCLOTH_TRY(vec("linear_velocity", c.linear_velocity));
   VKCLOTH_TRY(vec("angular_velocity", c.angular_velocity));
   return {};
@@ -226,19 +225,20 @@ Collider Collider::with_pose(const ColliderPose& pose) const {
 
 Result<void> ColliderPose::validate() const {
   if (!finite(position))
-    return bad("pose.position must be finite, got " + str(position));
+    return bad_argument("pose.position must be finite, got " + str(position));
   if (!finite(linear_velocity))
-    return bad("pose.linear_velocity must be finite, got " + str(linear_velocity));
+    return bad_argument("pose.linear_velocity must be finite, got " + str(linear_velocity));
   if (!finite(angular_velocity))
-    return bad("pose.angular_velocity must be finite, got " + str(angular_velocity));
+    return bad_argument("pose.angular_velocity must be finite, got " + str(angular_velocity));
   if (rotation) {
     const glm::dmat3& r = *rotation;
     for (int col = 0; col < 3; ++col)
       if (!finite(r[col]))
-        return bad(fmt::format("pose.rotation must be finite, got column {} = {}", col, str(r[col])));
+        return bad_argument(
+            fmt::format("pose.rotation must be finite, got column {} = {}", col, str(r[col])));
     const double off = rotation_error(r);
     if (!(off < 1e-6))
-      return bad(fmt::format(
+      return bad_argument(fmt::format(
           "pose.rotation must be a rotation matrix (orthonormal, determinant 1); it is off by {}", off));
   }
   return {};
@@ -306,53 +306,60 @@ std::optional<StretchLimit::TetherDistance> parse_tether_distance(std::string_vi
 
 Result<void> SimParams::validate() {
   if (static_cast<std::uint32_t>(integrator) > static_cast<std::uint32_t>(Integrator::vbd))
-    return bad(
+    return bad_argument(
         fmt::format("integrator.method: unknown integrator {}", static_cast<std::uint32_t>(integrator)));
   if (!std::isfinite(dt) || dt <= 0.0)
-    return bad(fmt::format("integrator.dt must be finite and > 0, got {}", dt));
+    return bad_argument(fmt::format("integrator.dt must be finite and > 0, got {}", dt));
   if (substeps < 1 || substeps > 1000000)
-    return bad(fmt::format("integrator.substeps must be in 1..1000000, got {}", substeps));
+    return bad_argument(fmt::format("integrator.substeps must be in 1..1000000, got {}", substeps));
   if (!std::isfinite(cg_tolerance) || cg_tolerance < 0.0 || cg_tolerance >= 1.0)
-    return bad(fmt::format("integrator.cg_tolerance must be finite and in [0, 1), got {}", cg_tolerance));
+    return bad_argument(
+        fmt::format("integrator.cg_tolerance must be finite and in [0, 1), got {}", cg_tolerance));
   if (cg_max_iterations < 1 || cg_max_iterations > 100000)
-    return bad(fmt::format("integrator.cg_max_iterations must be in 1..100000, got {}", cg_max_iterations));
+    return bad_argument(
+        fmt::format("integrator.cg_max_iterations must be in 1..100000, got {}", cg_max_iterations));
   if (vbd_iterations < 1 || vbd_iterations > 1000)
-    return bad(fmt::format("integrator.iterations (vbd) must be in 1..1000, got {}", vbd_iterations));
+    return bad_argument(
+        fmt::format("integrator.iterations (vbd) must be in 1..1000, got {}", vbd_iterations));
   if (!finite(gravity))
-    return bad("physics.gravity must be finite, got " + str(gravity));
+    return bad_argument("physics.gravity must be finite, got " + str(gravity));
   if (!std::isfinite(damping) || damping < 0.0)
-    return bad(fmt::format("physics.damping must be finite and >= 0, got {}", damping));
+    return bad_argument(fmt::format("physics.damping must be finite and >= 0, got {}", damping));
   if (!std::isfinite(wind.strength))
-    return bad(fmt::format("wind.strength must be finite, got {}", wind.strength));
+    return bad_argument(fmt::format("wind.strength must be finite, got {}", wind.strength));
   if (!finite(wind.direction))
-    return bad("wind.direction must be finite, got " + str(wind.direction));
+    return bad_argument("wind.direction must be finite, got " + str(wind.direction));
   if (wind.strength != 0.0) {
     const double len = glm::length(wind.direction);
     if (!(len > 0.0))
-      return bad("wind.direction must be non-zero when wind.strength != 0, got " + str(wind.direction));
+      return bad_argument("wind.direction must be non-zero when wind.strength != 0, got " +
+                          str(wind.direction));
     wind.direction /= len;
   }
   if (!std::isfinite(contact_epsilon) || contact_epsilon < 0.0)
-    return bad(fmt::format("contact_epsilon must be finite and >= 0, got {}", contact_epsilon));
+    return bad_argument(fmt::format("contact_epsilon must be finite and >= 0, got {}", contact_epsilon));
   if (!std::isfinite(divergence_limit) || divergence_limit <= 0.0)
-    return bad(fmt::format("divergence_limit must be finite and > 0, got {}", divergence_limit));
+    return bad_argument(fmt::format("divergence_limit must be finite and > 0, got {}", divergence_limit));
   if (std::uint32_t(stretch_limit.method) > std::uint32_t(StretchLimit::Method::projection))
-    return bad(fmt::format("stretch_limit.method: unknown method {}", std::uint32_t(stretch_limit.method)));
+    return bad_argument(
+        fmt::format("stretch_limit.method: unknown method {}", std::uint32_t(stretch_limit.method)));
   if (!std::isfinite(stretch_limit.max_strain) || stretch_limit.max_strain <= 0.0)
-    return bad(
+    return bad_argument(
         fmt::format("stretch_limit.max_strain must be finite and > 0, got {}", stretch_limit.max_strain));
   if (stretch_limit.iterations < 1 || stretch_limit.iterations > 100)
-    return bad(fmt::format("stretch_limit.iterations must be in 1..100, got {}", stretch_limit.iterations));
+    return bad_argument(
+        fmt::format("stretch_limit.iterations must be in 1..100, got {}", stretch_limit.iterations));
   for (std::size_t k = 0; k < colliders.size(); ++k)
     VKCLOTH_TRY(validate_collider(colliders[k], fmt::format("colliders[{}]", k)));
   if (!std::isfinite(self_collision.thickness) || self_collision.thickness <= 0.0)
-    return bad(fmt::format("self_collision.thickness must be finite and > 0 (metres), got {}",
-                           self_collision.thickness));
+    return bad_argument(fmt::format("self_collision.thickness must be finite and > 0 (metres), got {}",
+                                    self_collision.thickness));
   if (!std::isfinite(self_collision.friction) || self_collision.friction < 0.0)
-    return bad(
+    return bad_argument(
         fmt::format("self_collision.friction must be finite and >= 0, got {}", self_collision.friction));
   if (self_collision.iterations < 1 || self_collision.iterations > 16)
-    return bad(fmt::format("self_collision.iterations must be in 1..16, got {}", self_collision.iterations));
+    return bad_argument(
+        fmt::format("self_collision.iterations must be in 1..16, got {}", self_collision.iterations));
   return {};
 }
 
@@ -376,10 +383,11 @@ Result<std::vector<std::string>> check_self_collision(const SelfCollision& self,
     return warnings; // no spring lengths to compare with (free particles)
   const double mean = sum / double(n);
   if (self.thickness > 10.0 * mean)
-    return bad(fmt::format("self_collision.thickness {} m is more than 10 x the mean rest length of the "
-                           "system's {} ({:.4g} m): every particle would touch most of the cloth; "
-                           "use a thickness near the particle spacing",
-                           self.thickness, structural ? "structural springs" : "springs", mean));
+    return bad_argument(
+        fmt::format("self_collision.thickness {} m is more than 10 x the mean rest length of the "
+                    "system's {} ({:.4g} m): every particle would touch most of the cloth; "
+                    "use a thickness near the particle spacing",
+                    self.thickness, structural ? "structural springs" : "springs", mean));
   if (self.thickness < 0.5 * smallest)
     warnings.push_back(fmt::format("self_collision.thickness {} m is below half the smallest rest length "
                                    "({:.4g} m): a triangle can pass between two particles; a thickness "
@@ -390,8 +398,9 @@ Result<std::vector<std::string>> check_self_collision(const SelfCollision& self,
 
 Result<SimParams> with_collider_pose(SimParams params, std::size_t collider, const ColliderPose& pose) {
   if (collider >= params.colliders.size())
-    return bad(fmt::format("colliders[{}]: no such collider to pose, the cloth has {} collider{}", collider,
-                           params.colliders.size(), params.colliders.size() == 1 ? "" : "s"));
+    return bad_argument(fmt::format("colliders[{}]: no such collider to pose, the cloth has {} collider{}",
+                                    collider, params.colliders.size(),
+                                    params.colliders.size() == 1 ? "" : "s"));
   VKCLOTH_TRY(pose.validate());
   params.colliders[collider] = params.colliders[collider].with_pose(pose);
   return params;

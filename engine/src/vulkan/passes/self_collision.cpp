@@ -16,7 +16,7 @@ namespace vkcloth::gpu {
 
 namespace {
 
-class SelfCollision final : public Pass {
+class SelfCollisionPass final : public Pass {
 public:
   const char* name() const override { return "self-collision"; }
   bool active(const SolverBatch& b) const override { return b.self_iterations() > 0; }
@@ -80,7 +80,7 @@ private:
 } // namespace
 
 std::unique_ptr<Pass> make_self_collision() {
-  return std::make_unique<SelfCollision>();
+  return std::make_unique<SelfCollisionPass>();
 }
 
 } // namespace vkcloth::gpu
