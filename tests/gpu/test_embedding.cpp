@@ -824,7 +824,8 @@ void hand_over(HostVulkan& host, Context& reference_ctx, bool ownership = true, 
       world->record_release(
           c, {compute, graphics, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT});
     REQUIRE(host.submit_frame(0, f > 0 ? drawn : VK_NULL_HANDLE,
-                              drawn ? VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT : VkPipelineStageFlags(0),
+                              drawn ? VkPipelineStageFlags(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT)
+                                    : VkPipelineStageFlags(0),
                               simulated));
 
     REQUIRE(host.begin_graphics());

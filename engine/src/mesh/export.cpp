@@ -23,19 +23,26 @@
 #include "vkcloth/topology.hpp"
 
 namespace vkcloth {
-namespace {
+namespace detail {
 
-Error invalid(std::string message) {
-  return make_error(ErrorCode::invalid_argument, std::move(message));
-}
-
-/// The cloth's surface in output (file) vertex order.
+/// The cloth's surface in output (file) vertex order (AnimationRecorder::Impl holds one, hence not
+/// file-local).
 struct ExportSurface {
   std::shared_ptr<const ClothTopology> topology; ///< its normal fans (vertex_normals)
   std::vector<std::uint32_t> order;              ///< output vertex k is particle order[k]
   std::vector<std::uint32_t> triangles;          ///< output vertex indices, counter-clockwise
   std::vector<glm::vec2> uvs;                    ///< per output vertex, v down (glTF's and the renderer's)
 };
+
+} // namespace detail
+
+using detail::ExportSurface;
+
+namespace {
+
+Error invalid(std::string message) {
+  return make_error(ErrorCode::invalid_argument, std::move(message));
+}
 
 /// A mesh's particles map to distinct file vertices, else its outputs would be ambiguous.
 Result<void> check_distinct_sources(const ParticleSystem& system, std::span<const std::uint32_t> order) {
