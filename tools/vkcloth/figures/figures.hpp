@@ -72,5 +72,9 @@ Result<void> contact_figures(Gallery& gallery);
 Result<void> self_collision_figures(Gallery& gallery);
 /// The (K_struct, dt) stability map of semi-implicit Euler, RK4 and implicit Euler (stability.cpp).
 Result<void> stability_figures(Gallery& gallery);
+/// Real fabric (issue 37): a cotton drop onto a sphere by semi-implicit Euler with substeps, implicit
+/// Euler by CG and vbd (two settings), always on the CPU solver: the largest strain and the wall time
+/// over the run (SVG), the final states (an image grid) and metrics["stiff"] (stiff.cpp).
+Result<void> stiff_figures(Gallery& gallery);
 
 } // namespace vkcloth::figures
