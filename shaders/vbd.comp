@@ -5,16 +5,14 @@
 // Vertex block descent (Integrator::vbd), the phases of CpuSolver's vbd.cpp in the same order, each
 // formula from cloth_kernel.h (vbd.h); one pipeline per phase (SC_STAGE, VKCLOTH_VBD_*):
 //   BEGIN:  one invocation per particle: the normal at the substep's start (particle_force, as the
-//           CPU's normal_force_at), the inertia target y -> VEL_FILT, the first guess (from the
-//           velocity at the last substep's start, ACC_VEL) projected out of the colliders ->
-//           POS_OUT, no push yet -> STAGE_POS;
+//           CPU's normal_force_at), the inertia target y -> VEL_FILT, the first guess x0 + h v0
+//           projected out of the colliders -> POS_OUT, no push yet -> STAGE_POS;
 //   SOLVE:  one invocation per particle of one colour (VBD_ORDER[colour_first ..]): one Newton step
 //           from the neighbours' latest positions in POS_OUT, projected; writes its own POS_OUT
 //           entry and its push. No two particles of a colour share a spring, so no invocation reads
 //           what another writes;
 //   FINISH: one invocation per particle: v = (x - x0) / h before the last projection, the contact
-//           response, x = x0 + h v, projection and divergence flags (finish.glsl), the net force,
-//           v0 -> ACC_VEL for the next first guess.
+//           response, x = x0 + h v, projection and divergence flags (finish.glsl), the net force.
 // Reads POS_IN (= POS_BASE: positions[read], the start), VEL; writes POS_OUT, VEL, NORMAL, FORCE_OUT.
 #include "vkcloth_shared.h"
 #define VKCLOTH_PUSH_STRUCT VbdPush
@@ -27,7 +25,6 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_POS_OUT) buffer PosOut { vec4 
 layout(std430, set = 0, binding = VKCLOTH_BINDING_VEL) buffer VelBuf { vec4 vel[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_VEL_FILT) buffer TargetBuf { vec4 target[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_STAGE_POS) buffer PushBuf { vec4 push_of[]; };
-layout(std430, set = 0, binding = VKCLOTH_BINDING_ACC_VEL) buffer PrevVelBuf { vec4 v_prev[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_VBD_ORDER) readonly buffer OrderBuf { uint vbd_order[]; };
 
 #include "finish.glsl"
@@ -52,7 +49,7 @@ void begin(uint p, uint g, bool pinned) {
   const vec3 y = pinned ? x0 : vbd_inertia_target(x0, v0, f_ext, m, ip.dt);
   target[g] = vec4(y, 0.0);
   push_of[g] = vec4(0.0);
-  const vec3 guess = vbd_first_guess(x0, v0, v_prev[g].xyz, ip.gravity_damping.xyz, ip.dt);
+  const vec3 guess = vbd_first_guess(x0, v0, ip.dt);
   pos_out[g] = vec4(pinned ? x0 : projected(x0, guess), 1.0);
 }
 
@@ -98,7 +95,6 @@ void finish_step(uint p, uint g, bool pinned) {
     contact_response(v, no_force, s, x, n, dist, ip.band, both, h_over_m);
   }
   force_out[g] = vec4(vbd_net_force(v, v0, m, h), 0.0);
-  v_prev[g] = vec4(v0, 0.0);
   finish(p, false, x0, vbd_position(x0, v, h), v);
 }
 

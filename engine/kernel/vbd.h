@@ -76,15 +76,11 @@ KFN precise vec3 vbd_net_force(vec3 v, vec3 v0, real m, real h) {
   return f;
 }
 
-// The first guess (the paper's adaptive initialisation, section 3.7): x0 + h v0 + h^2 a~, with a~
-// the last substep's acceleration (v0 - v_prev) / h along gravity, clamped to [0, |g|]: a cloth
-// that gravity no longer accelerates (hanging, resting) starts where it is, not a fall below.
-KFN precise vec3 vbd_first_guess(vec3 x0, vec3 v0, vec3 v_prev, vec3 g, real h) {
-  precise real g_len = sqrt(dot3(g, g));
-  precise vec3 g_dir = select(g_len > real(0), g / g_len, vec3(real(0)));
-  precise real a = dot3(v0 - v_prev, g_dir) / h;
-  a = min(max(a, real(0)), g_len);
+// The first guess, x0 + h v0: the particle carried by its velocity (the paper's "inertia" start,
+// section 3.7), without the step's acceleration. Few sweeps stay near the guess; one that adds
+// gravity (the inertia target y, or the paper's adaptive h^2 a~ along it) lets a hanging cloth fall
+// a little further each step and bounce ever harder (docs/model.md "Vertex block descent").
+KFN precise vec3 vbd_first_guess(vec3 x0, vec3 v0, real h) {
   precise vec3 x = x0 + v0 * h;
-  x = x + g_dir * (a * h * h);
   return x;
 }

@@ -18,7 +18,7 @@ TEST_CASE("GPU vbd matches the CPU vbd on every sample scene: 100 steps") {
   for (const auto& entry : std::filesystem::directory_iterator(VKCLOTH_SAMPLES_SCENES_DIR)) {
     if (entry.path().extension() != ".json")
       continue;
-    // Two substeps: the first guess then reads the velocities a substep left (vbd_first_guess).
+    // Two substeps: the second starts from the state the first left in the batch's buffers.
     const std::vector<std::string> overrides = {"integrator.method=vbd", "integrator.substeps=2"};
     auto scene = load_scene_file(entry.path(), overrides);
     REQUIRE_MESSAGE(scene.ok(), (scene.ok() ? "" : scene.error().message));

@@ -27,7 +27,6 @@ template <typename Real> struct VbdWorkspace {
   std::vector<Vec3> x0;     ///< positions at the substep's start
   std::vector<Vec3> y;      ///< inertia targets
   std::vector<Vec3> push;   ///< the colliders' projection move of the last iteration
-  std::vector<Vec3> v_prev; ///< the velocities at the last substep's start (the first guess)
 };
 /// The colliders as the kernel takes them at this substep's pose, and their meshes; the same values
 /// for the SIMD finish of the grid rows (row_kernel.hpp FinishShape), empty when a collider is a mesh

@@ -2,8 +2,7 @@
 // CpuSolver's vertex block descent substep (docs/model.md "Vertex block descent"; each formula:
 // engine/kernel/vbd.h). The GPU runs the same phases in the same order (shaders/vbd.comp):
 //   begin:   normals and external forces at the substep's start, the inertia targets y, and the
-//            first guess (vbd_first_guess: the last substep's acceleration along gravity) projected
-//            out of the colliders;
+//            first guess (vbd_first_guess: x0 + h v0) projected out of the colliders;
 //   sweeps:  `vbd_iterations` times, the colours in order; each particle of a colour takes one Newton
 //            step on its springs and its inertia, from its neighbours' latest positions, and is
 //            projected out of the colliders (no two particles of a colour share a spring, so a
@@ -38,7 +37,6 @@ template <typename Real> void CpuSolver<Real>::Impl::vbd_begin(const Real h) {
   auto& w = *vbd_;
   w.x0 = pos_;
   w.y.resize(n);
-  w.v_prev.resize(n, Vec3(0)); // zero before the first substep, as the GPU's buffer
   w.push.assign(n, Vec3(0));
   const Real kw = Real(params_.wind.strength);
   const Vec3 g{params_.gravity}, wind_dir{params_.wind.direction};
@@ -51,7 +49,7 @@ template <typename Real> void CpuSolver<Real>::Impl::vbd_begin(const Real h) {
   pool_->for_each(n, [&](std::size_t p) { // the first guess, out of the colliders
     if (pinned_[p])
       return;
-    Vec3 x = kernel::vbd_first_guess(w.x0[p], vel_[p], w.v_prev[p], g, h), unused(0);
+    Vec3 x = kernel::vbd_first_guess(w.x0[p], vel_[p], h), unused(0);
     project_at(w.x0[p], x, unused);
     pos_[p] = x;
   });
@@ -97,7 +95,6 @@ template <typename Real> void CpuSolver<Real>::Impl::vbd_finish(const Real h) {
     Vec3 x = kernel::vbd_position(x0, v, h);
     project_at(x0, x, v);
     force_[p] = kernel::vbd_net_force(v, vel_[p], mass_[p], h);
-    w.v_prev[p] = vel_[p];
     pos_[p] = x;
     vel_[p] = v;
   });

@@ -3,8 +3,7 @@
 // vbd.comp, one pipeline per phase: BEGIN over every particle, then for each iteration one dispatch
 // per colour of the topology (ClothTopology::vertex_order, uploaded as VBD_ORDER), then FINISH.
 // The state set of the substep's parity: POS_IN = positions[read] (the start), POS_OUT the iterate.
-// VEL_FILT, STAGE_POS and ACC_VEL, the explicit integrators' scratch, hold the targets, the pushes
-// and the velocities at the last substep's start (zero at first, as the CPU's).
+// VEL_FILT and STAGE_POS, the explicit integrators' scratch, hold the targets and the pushes.
 #include <memory>
 
 #include "../barriers.hpp"
