@@ -5,8 +5,9 @@
 // rounding anywhere in the per-particle physics (CPU scalar, SIMD row kernel or shaders) fails here.
 // The implicit_euler rows were recorded again when the method itself changed (issue 18: block-
 // Jacobi preconditioner, warm start, tolerance relative to max(|S b|, |S h M g|)), and those with
-// colliders again when the solve learnt Baraff-Witkin's contact filter (issue 37); every other row
-// is unchanged since the redesign.
+// colliders again when the solve learnt Baraff-Witkin's contact filter (issue 37); the vbd rows
+// were added with vbd's first guess x0 + h v0 (issue 37); every other row is unchanged since the
+// redesign.
 //
 // CPU float and double: the bits are the reference's on any x86-64 (the SIMD kernels are bitwise
 // equal to the scalar code, -ffp-contract=off). Vulkan: checked bit for bit on lavapipe (llvmpipe),
@@ -47,13 +48,13 @@ struct Case {
   const char* resolution; // "" = the scene's own
 };
 
-// Sample scenes x {own, explicit, rk4, implicit}; the cloth scenes also at 37 x 23 (odd, non-square,
+// Sample scenes x {own, explicit, rk4, implicit, vbd}; the cloth scenes also at 37 x 23 (odd, non-square,
 // border masks) and 64 x 64 (full SIMD vectors).
 std::vector<Case> cases() {
   std::vector<Case> r;
   for (const char* scene :
        {"spring", "double_spring", "cloth_hanging", "cloth_on_plane", "cloth_on_sphere", "cloth_wind"})
-    for (const char* integ : {"", "explicit_euler", "rk4", "implicit_euler"})
+    for (const char* integ : {"", "explicit_euler", "rk4", "implicit_euler", "vbd"})
       r.push_back({scene, integ, ""});
   for (const char* scene : {"cloth_hanging", "cloth_on_sphere", "cloth_wind"})
     for (const char* res : {"[37, 23]", "[64, 64]"})
