@@ -551,7 +551,8 @@ std::size_t bitwise_differences(const std::vector<glm::vec<3, Real>>& a,
 TEST_CASE_TEMPLATE("the SIMD row kernels (AVX2, AVX-512) give the shared reference's bits", Real, float,
                    double) {
   // Odd sizes: interior runs of 33 particles = whole vectors plus a scalar remainder, and chunk
-  // boundaries of the 2-thread split fall mid-row. Wind on, an interior pinned particle (the
+  // boundaries of the 2-thread split fall mid-row (vbd: colours of 214-215 particles, whole vectors
+  // and a remainder each). Wind on, an interior pinned particle (the
   // kernel's pin select), a perturbed start so no lane sees a symmetric configuration. On a CPU
   // without AVX-512 / AVX2 the variable caps the ISA, and the comparison is trivially equal.
   ClothDesc d;
@@ -584,10 +585,10 @@ TEST_CASE_TEMPLATE("the SIMD row kernels (AVX2, AVX-512) give the shared referen
       friction(Collider::capsule({-0.4, 0.02, 1.2}, {0.0, -0.03, 1.0}, 0.05), 0.3, 0.5),
       friction(floor, 0.5, -1.0), Collider::sphere({-0.2, 0.1, 0.7}, 0.12)};
   for (int colliders = 0; colliders < 4; ++colliders)
-    for (Integrator integ : {Integrator::explicit_euler, Integrator::semi_implicit_euler}) {
+    for (Integrator integ : {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::vbd}) {
       CAPTURE(to_string(integ));
       CAPTURE(colliders);
-      p.integrator = integ;
+      p.integrator = integ; // vbd: its colour kernel (simd_vbd_colour) on the same lanes
       p.dt = integ == Integrator::explicit_euler ? 0.004 : 0.02;
       p.contact_inward_only = colliders != 3;
       if (colliders == 0)
@@ -628,10 +629,11 @@ TEST_CASE_TEMPLATE(
     SimParams p;
     p.wind = {0.07, {0.2, 1, 0.1}};
     for (int colliders = 0; colliders < 2; ++colliders)
-      for (Integrator integ : {Integrator::explicit_euler, Integrator::semi_implicit_euler}) {
+      for (Integrator integ :
+           {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::vbd}) {
         CAPTURE(to_string(integ));
         CAPTURE(colliders);
-        p.integrator = integ;
+        p.integrator = integ; // vbd: the colour kernel walks the gather lists, of every length here
         p.dt = integ == Integrator::explicit_euler ? 0.002 : 0.01;
         p.colliders.clear();
         if (colliders == 1)

@@ -49,5 +49,6 @@
 #include "strain.h"
 #include "self_collision.h"
 #include "integrators.h"
+#include "blocks.h"
 #include "implicit.h"
 #include "vbd.h"

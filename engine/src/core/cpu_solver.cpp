@@ -179,6 +179,22 @@ CpuSolver<Real>::Impl::normal_force_at(std::span<const Vec3> pos, std::span<cons
                                  kw != Real(0), normal_[p], Vec3{params_.wind.direction}, kw);
 }
 
+template <typename Real> void CpuSolver<Real>::Impl::normal_at(std::span<const Vec3> pos, std::size_t p) {
+  const Vec3 x = pos[p];
+  Vec3 fan(0);
+  if (!topology_->ring_normals()) {
+    const std::span<const std::uint32_t> fan_offsets = topology_->fan_offsets();
+    const std::span<const FanTriangle> fans = topology_->fans();
+    for (std::uint32_t t = fan_offsets[p]; t < fan_offsets[p + 1]; ++t)
+      kernel::add_fan_triangle(fan, pos[fans[t].a] - x, pos[fans[t].b] - x);
+  } else {
+    Vec3 prev(0), first(0);
+    for (std::uint32_t e = edge_offsets_[p]; e < edge_offsets_[p + 1]; ++e)
+      kernel::add_ring_term(fan, prev, first, pos[edges_[e].other] - x, edges_[e].ring);
+  }
+  normal_[p] = kernel::unit_or_zero(fan);
+}
+
 // The colliders at their pose for this substep, as the kernel takes them (kernel_shape: the
 // conversion the GPU solver uses too); a mesh collider's hierarchy is walked in place.
 template <typename Real> void CpuSolver<Real>::Impl::prepare_colliders() {

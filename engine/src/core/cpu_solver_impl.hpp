@@ -24,9 +24,9 @@ template <typename Real> struct StrainProjection;
 /// Vertex block descent's per-particle state of a substep (vbd.cpp).
 template <typename Real> struct VbdWorkspace {
   using Vec3 = glm::vec<3, Real, glm::defaultp>;
-  std::vector<Vec3> x0;     ///< positions at the substep's start
-  std::vector<Vec3> y;      ///< inertia targets
-  std::vector<Vec3> push;   ///< the colliders' projection move of the last iteration
+  std::vector<Vec3> x0;   ///< positions at the substep's start
+  std::vector<Vec3> y;    ///< inertia targets
+  std::vector<Vec3> push; ///< the colliders' projection move of the last iteration
 };
 /// The colliders as the kernel takes them at this substep's pose, and their meshes; the same values
 /// for the SIMD finish of the grid rows (row_kernel.hpp FinishShape), empty when a collider is a mesh
@@ -78,6 +78,8 @@ template <typename Real> struct CpuSolver<Real>::Impl {
   /// Particle p's normal and force: writes normal_[p] (from the grid fan, or from the gather
   /// list's ring terms with ClothTopology::ring_normals), returns the force.
   Vec3 normal_force_at(std::span<const Vec3> pos, std::span<const Vec3> vel, std::size_t p);
+  /// Particle p's normal alone (normal_force_at's, the same terms in the same order): writes normal_[p].
+  void normal_at(std::span<const Vec3> pos, std::size_t p);
   // Contacts (cloth_kernel.h contact_response / project_out) with every collider at this substep's
   // pose; h_over_m: substep / mass (friction's impulse); side: where the particle came from.
   void contact_at(Vec3 pos, Vec3& vel, Vec3& force, Real h_over_m, bool friction = true) const;
@@ -111,13 +113,7 @@ template <typename Real> struct CpuSolver<Real>::Impl {
   void self_collide();
   void project_strain(Real h);
 
-  /// A gather-list entry in the solver's precision (ClothTopology::edges() converted once).
-  struct Edge {
-    std::uint32_t other;
-    Real rest_length;
-    Real stiffness;
-    std::uint32_t ring; // VKCLOTH_RING_*
-  };
+  using Edge = detail::SolverEdge<Real>;
 
   std::shared_ptr<const ClothTopology> topology_;
   SimParams params_;

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // The CPU solver's SIMD kernels (the grid row kernel, the list kernel for meshes, the contacts'
-// finish): their arguments and the per-ISA entry points.
+// finish, a vbd colour): their arguments and the per-ISA entry points.
 // The reference is the shared kernel (engine/kernel/cloth_kernel.h, per particle in
 // cpu_solver.cpp); row_kernel_avx2.cpp and row_kernel_avx512.cpp run the same kernel functions on
 // 8 / 16 (float) particles per vector (row_kernel_simd.inl), each file compiled with its own -m flags
@@ -13,6 +13,14 @@
 #include "kernel/constants.h" // VKCLOTH_RING_*
 
 namespace vkcloth::detail {
+
+/// A gather-list entry in the solver's precision (ClothTopology::edges() converted once).
+template <typename Real> struct SolverEdge {
+  std::uint32_t other;
+  Real rest_length;
+  Real stiffness;
+  std::uint32_t ring; // VKCLOTH_RING_*
+};
 
 /// What the row and list kernels share: the state of the particles they update, and the body
 /// forces' and the integration's constants.
@@ -94,6 +102,26 @@ template <typename Real> struct FinishArgs {
   bool both, semi;    // !contact_inward_only; semi-implicit Euler
 };
 
+/// One colour of a vbd sweep (CpuSolver::vbd_solve_colour), W of its particles per vector: each
+/// takes vbd_step on its springs, walked in its gather list's order (a lane with fewer than the
+/// longest list of its vector walks the rest as zero-length springs to itself, which add nothing:
+/// vbd_add_spring's `len > 0`), then each collider's project_out. Positions are read and written in
+/// place: no two particles of a colour share a spring. Pinned particles are left as they are.
+template <typename Real> struct VbdArgs {
+  const std::uint32_t* order; // the colour's particles
+  Real* pos;                  // AoS, the iterate, updated in place
+  Real* push;                 // AoS, out: the projection's move
+  const Real* target;         // AoS, the inertia targets y
+  const Real* start;          // AoS, the positions at the substep's start x0
+  const Real* mass;
+  const std::uint8_t* pinned;
+  const std::uint32_t* edge_offsets;
+  const SolverEdge<Real>* edges;
+  const FinishShape<Real>* shapes; // every collider (no mesh), at most finish_max_shapes
+  std::uint32_t shape_count;
+  Real eps, h, mu; // contact_epsilon, the substep, the damping
+};
+
 // Each processes whole vectors from q0 and returns where it stopped (q1 minus the remainder, which
 // the caller finishes through the per-particle reference). No finite check (the caller's).
 std::int64_t finish_avx512(const FinishArgs<float>& a, std::int64_t q0, std::int64_t q1);
@@ -115,5 +143,12 @@ std::int64_t list_kernel_avx512(const ListArgs<float>& a, std::int64_t v0, std::
 std::int64_t list_kernel_avx512(const ListArgs<double>& a, std::int64_t v0, std::int64_t v1, bool& bad);
 std::int64_t list_kernel_avx2(const ListArgs<float>& a, std::int64_t v0, std::int64_t v1, bool& bad);
 std::int64_t list_kernel_avx2(const ListArgs<double>& a, std::int64_t v0, std::int64_t v1, bool& bad);
+
+// Each runs the colour's particles [k0, k1) in whole vectors and returns where it stopped (k1 minus
+// the remainder, which the caller steps through the per-particle reference).
+std::int64_t vbd_colour_avx512(const VbdArgs<float>& a, std::int64_t k0, std::int64_t k1);
+std::int64_t vbd_colour_avx512(const VbdArgs<double>& a, std::int64_t k0, std::int64_t k1);
+std::int64_t vbd_colour_avx2(const VbdArgs<float>& a, std::int64_t k0, std::int64_t k1);
+std::int64_t vbd_colour_avx2(const VbdArgs<double>& a, std::int64_t k0, std::int64_t k1);
 
 } // namespace vkcloth::detail

@@ -141,4 +141,10 @@ std::int64_t finish_avx512(const FinishArgs<float>& a, std::int64_t q0, std::int
 std::int64_t finish_avx512(const FinishArgs<double>& a, std::int64_t q0, std::int64_t q1) {
   return simd_finish<IsaD>(a, q0, q1);
 }
+std::int64_t vbd_colour_avx512(const VbdArgs<float>& a, std::int64_t k0, std::int64_t k1) {
+  return simd_vbd_colour<IsaF>(a, k0, k1);
+}
+std::int64_t vbd_colour_avx512(const VbdArgs<double>& a, std::int64_t k0, std::int64_t k1) {
+  return simd_vbd_colour<IsaD>(a, k0, k1);
+}
 } // namespace vkcloth::detail

@@ -52,6 +52,9 @@ using namespace lanes_f64;
 template <typename T> struct ShapeOf;
 template <> struct ShapeOf<IsaF> { using type = lanes_f32::ColliderShape; };
 template <> struct ShapeOf<IsaD> { using type = lanes_f64::ColliderShape; };
+template <typename T> struct BlockOf;
+template <> struct BlockOf<IsaF> { using type = lanes_f32::SpringBlock; };
+template <> struct BlockOf<IsaD> { using type = lanes_f64::SpringBlock; };
 
 #define VKCLOTH_AI inline __attribute__((always_inline))
 
@@ -444,6 +447,94 @@ std::int64_t simd_finish(const vkcloth::detail::FinishArgs<typename T::Real>& a,
     __builtin_memcpy(szn + q, &x.z.v, sizeof x.z.v);
   }
   return q;
+}
+
+// ---- Vertex block descent: one colour of a sweep (VbdArgs) ------------------------------------
+// CpuSolver::vbd_solve_colour, W particles of the colour per vector: vbd_add_spring over each
+// particle's gather list in its order, vbd_step, each collider's project_out from the substep's
+// start. The lists differ in length (a grid's border, a mesh): slot s of a lane past its list is a
+// zero-length spring to itself, which vbd_add_spring's `len > 0` select leaves out, as the
+// reference's early return does. Loads and stores go lane by lane through arrays (the particles of a
+// colour are scattered: a grid's lie 5 apart along a row).
+template <typename T>
+std::int64_t simd_vbd_colour(const vkcloth::detail::VbdArgs<typename T::Real>& a, std::int64_t k0,
+                             std::int64_t k1) {
+  using Real = typename T::Real;
+  using L = Lanes<T>;
+  using L3 = Lanes3<T>;
+  using S = typename ShapeOf<T>::type;
+  using B = typename BlockOf<T>::type;
+  constexpr int W = T::W;
+  if (a.shape_count > vkcloth::detail::finish_max_shapes)
+    return k0; // the caller steps them all
+  S shapes[vkcloth::detail::finish_max_shapes];
+  for (std::uint32_t c = 0; c < a.shape_count; ++c)
+    shapes[c] = lane_shape<T>(a.shapes[c]);
+  const L h(a.h), mu(a.mu), eps(a.eps);
+  // W values into lanes (through memory: element stores into a vector type read as uninitialised).
+  auto lanes = [](const Real(&v)[W]) {
+    L r;
+    __builtin_memcpy(&r.v, v, sizeof r.v);
+    return r;
+  };
+  auto gather = [&](const Real* v, const std::uint32_t* index) {
+    Real c[3][W];
+    for (int l = 0; l < W; ++l)
+      for (int d = 0; d < 3; ++d)
+        c[d][l] = v[3 * std::size_t(index[l]) + d];
+    return L3(lanes(c[0]), lanes(c[1]), lanes(c[2]));
+  };
+  std::int64_t k = k0;
+  for (; k + W <= k1; k += W) {
+    const std::uint32_t* idx = a.order + k;
+    const L3 x = gather(a.pos, idx), y = gather(a.target, idx), x0 = gather(a.start, idx);
+    Real mv[W];
+    std::uint32_t first[W], count[W], longest = 0;
+    for (int l = 0; l < W; ++l) {
+      mv[l] = a.mass[idx[l]];
+      first[l] = a.edge_offsets[idx[l]];
+      count[l] = a.edge_offsets[idx[l] + 1] - first[l];
+      longest = count[l] > longest ? count[l] : longest;
+    }
+    const L m = lanes(mv);
+    L3 f(L(Real(0)));
+    B hessian{L3(L(Real(0))), L3(L(Real(0)))};
+    for (std::uint32_t s = 0; s < longest; ++s) {
+      Real o[3][W], rest[W], stiffness[W];
+      for (int l = 0; l < W; ++l) {
+        std::uint32_t q = idx[l];
+        rest[l] = stiffness[l] = Real(0);
+        if (s < count[l]) {
+          const auto& e = a.edges[first[l] + s];
+          q = e.other;
+          rest[l] = e.rest_length;
+          stiffness[l] = e.stiffness;
+        }
+        for (int d = 0; d < 3; ++d)
+          o[d][l] = a.pos[3 * std::size_t(q) + d];
+      }
+      const L3 other(lanes(o[0]), lanes(o[1]), lanes(o[2]));
+      vbd_add_spring(f, hessian, other - x, lanes(rest), lanes(stiffness));
+    }
+    const L3 stepped = vbd_step(x, y, x0, f, hessian, m, h, mu);
+    L3 projected = stepped, unused(L(Real(0)));
+    for (std::uint32_t c = 0; c < a.shape_count; ++c)
+      project_out(NoMesh{}, shapes[c], eps, x0, projected, unused);
+    const L3 push = projected - stepped;
+    Real out[6][W];
+    const L* parts[6] = {&projected.x, &projected.y, &projected.z, &push.x, &push.y, &push.z};
+    for (int c = 0; c < 6; ++c)
+      __builtin_memcpy(out[c], &parts[c]->v, sizeof out[c]);
+    for (int l = 0; l < W; ++l) {
+      if (a.pinned[idx[l]])
+        continue;
+      for (int d = 0; d < 3; ++d) {
+        a.pos[3 * std::size_t(idx[l]) + d] = out[d][l];
+        a.push[3 * std::size_t(idx[l]) + d] = out[3 + d][l];
+      }
+    }
+  }
+  return k;
 }
 #undef VKCLOTH_AI
 

@@ -30,3 +30,5 @@ inline void mesh_contact(NoMesh, ColliderShape, vec3, vec3, real, real&, vec3&) 
 #include "kernel/contacts.h"
 #include "kernel/friction.h"
 #include "kernel/integrators.h"
+#include "kernel/blocks.h"
+#include "kernel/vbd.h"

@@ -40,16 +40,17 @@ template <typename Real> void CpuSolver<Real>::Impl::vbd_begin(const Real h) {
   w.push.assign(n, Vec3(0));
   const Real kw = Real(params_.wind.strength);
   const Vec3 g{params_.gravity}, wind_dir{params_.wind.direction};
+  // One pass: the normals read the start (x0), so writing the first guesses into pos_ races nothing.
   pool_->for_each(n, [&](std::size_t p) {
-    normal_force_at(pos_, vel_, p); // the normal at the start (wind; what a host observes)
+    normal_at(w.x0, p); // the normal at the start (wind; what a host observes)
     const Vec3 f_ext = kernel::add_body_forces(Vec3(0), mass_[p], Vec3(0), g, Real(0), kw != Real(0),
                                                normal_[p], wind_dir, kw);
-    w.y[p] = pinned_[p] ? w.x0[p] : kernel::vbd_inertia_target(w.x0[p], vel_[p], f_ext, mass_[p], h);
-  });
-  pool_->for_each(n, [&](std::size_t p) { // the first guess, out of the colliders
-    if (pinned_[p])
+    if (pinned_[p]) {
+      w.y[p] = w.x0[p];
       return;
-    Vec3 x = kernel::vbd_first_guess(w.x0[p], vel_[p], h), unused(0);
+    }
+    w.y[p] = kernel::vbd_inertia_target(w.x0[p], vel_[p], f_ext, mass_[p], h);
+    Vec3 x = kernel::vbd_first_guess(w.x0[p], vel_[p], h), unused(0); // out of the colliders
     project_at(w.x0[p], x, unused);
     pos_[p] = x;
   });
@@ -62,7 +63,7 @@ void CpuSolver<Real>::Impl::vbd_solve_colour(const std::uint32_t colour, const R
   const std::uint32_t first = topology_->vertex_colour_offsets()[colour];
   const std::uint32_t count = topology_->vertex_colour_offsets()[colour + 1] - first;
   const Real mu = Real(params_.damping);
-  pool_->for_each(count, [&](std::size_t k) {
+  auto step = [&](std::size_t k) {
     const std::uint32_t p = order[first + k];
     if (pinned_[p])
       return;
@@ -78,7 +79,46 @@ void CpuSolver<Real>::Impl::vbd_solve_colour(const std::uint32_t colour, const R
     project_at(w.x0[p], projected, unused);
     w.push[p] = projected - stepped;
     pos_[p] = projected;
-  });
+  };
+  // Whole vectors of the colour in SIMD (the same kernel functions on lanes: row_kernel.hpp
+  // VbdArgs), when every collider is one the lanes take (no mesh); the rest one by one.
+  std::size_t simd_end = 0;
+#if VKCLOTH_ROW_SIMD
+  const bool lanes = simd_ != 0 && contacts_->finish.size() == contacts_->shapes.size();
+  if (lanes) {
+    const std::size_t width = (simd_ == 2 ? 64 : 32) / sizeof(Real);
+    simd_end = count - count % width;
+    const detail::VbdArgs<Real> a{order.data() + first,
+                                  &pos_[0].x,
+                                  &w.push[0].x,
+                                  &w.y[0].x,
+                                  &w.x0[0].x,
+                                  mass_.data(),
+                                  pinned_.data(),
+                                  edge_offsets_.data(),
+                                  edges_.data(),
+                                  contacts_->finish.data(),
+                                  std::uint32_t(contacts_->finish.size()),
+                                  Real(params_.contact_epsilon),
+                                  h,
+                                  mu};
+    pool_->for_each(simd_end / width, [&](std::size_t b) {
+      const std::int64_t k0 = std::int64_t(b * width), k1 = k0 + std::int64_t(width);
+#if VKCLOTH_ROW_AVX512
+      if (simd_ == 2) {
+        (void)detail::vbd_colour_avx512(a, k0, k1);
+        return;
+      }
+#endif
+      (void)detail::vbd_colour_avx2(a, k0, k1);
+    });
+  }
+#endif
+  if (simd_end > 0) // fewer than one vector left: here, not another fork-join
+    for (std::size_t k = simd_end; k < count; ++k)
+      step(k);
+  else
+    pool_->for_each(count, step);
 }
 
 template <typename Real> void CpuSolver<Real>::Impl::vbd_finish(const Real h) {
