@@ -40,11 +40,15 @@ struct Solver {
 };
 
 const Solver solvers[] = {
-    {"semi_implicit_euler", "semi-implicit Euler, 20 substeps", "semi-impl. x 20",
+    {"semi_implicit_euler",
+     "semi-implicit Euler, 20 substeps",
+     "semi-impl. x 20",
      {"integrator.method=semi_implicit_euler", "integrator.substeps=20"}},
     {"implicit_euler", "implicit Euler (CG)", "CG", {"integrator.method=implicit_euler"}},
     {"vbd", "vbd, 5 sweeps", "vbd 1 x 5", {"integrator.method=vbd"}},
-    {"vbd_substeps", "vbd, 4 substeps of 1 sweep", "vbd 4 x 1",
+    {"vbd_substeps",
+     "vbd, 4 substeps of 1 sweep",
+     "vbd 4 x 1",
      {"integrator.method=vbd", "integrator.substeps=4", "integrator.iterations=1"}},
 };
 
@@ -112,9 +116,15 @@ Result<void> stiff_figures(Gallery& G) {
   auto& M = G.metrics["stiff"];
   const Progress progress("stiff");
   plot::Plot strain{"Largest structural strain over the run (cotton drop, 32 x 32, dt = 1/300 s)",
-                    "t (s)", "largest structural strain (%)", {}, 0, 0, 640, 400};
-  plot::Plot cost{"Wall time spent so far (CPU solver, this machine)", "t (s)", "wall time (s)", {}, 0, 0,
-                  640, 400};
+                    "t (s)",
+                    "largest structural strain (%)",
+                    {},
+                    0,
+                    0,
+                    640,
+                    400};
+  plot::Plot cost{
+      "Wall time spent so far (CPU solver, this machine)", "t (s)", "wall time (s)", {}, 0, 0, 640, 400};
   std::vector<Run> runs;
   std::vector<std::string> labels;
   std::size_t colour = 0;
