@@ -109,6 +109,7 @@ template <typename Real> struct FinishArgs {
 /// place: no two particles of a colour share a spring. Pinned particles are left as they are.
 template <typename Real> struct VbdArgs {
   const std::uint32_t* order; // the colour's particles
+  std::uint32_t particles;    // all of them (the last one's index: T::gather3 reads past it)
   Real* pos;                  // AoS, the iterate, updated in place
   Real* push;                 // AoS, out: the projection's move
   const Real* target;         // AoS, the inertia targets y

@@ -454,8 +454,8 @@ std::int64_t simd_finish(const vkcloth::detail::FinishArgs<typename T::Real>& a,
 // particle's gather list in its order, vbd_step, each collider's project_out from the substep's
 // start. The lists differ in length (a grid's border, a mesh): slot s of a lane past its list is a
 // zero-length spring to itself, which vbd_add_spring's `len > 0` select leaves out, as the
-// reference's early return does. Loads and stores go lane by lane through arrays (the particles of a
-// colour are scattered: a grid's lie 5 apart along a row).
+// reference's early return does. The particles of a colour are scattered (a grid's lie 5 apart along
+// a row): positions come by T::gather3, stores go lane by lane.
 template <typename T>
 std::int64_t simd_vbd_colour(const vkcloth::detail::VbdArgs<typename T::Real>& a, std::int64_t k0,
                              std::int64_t k1) {
@@ -477,12 +477,17 @@ std::int64_t simd_vbd_colour(const vkcloth::detail::VbdArgs<typename T::Real>& a
     __builtin_memcpy(&r.v, v, sizeof r.v);
     return r;
   };
-  auto gather = [&](const Real* v, const std::uint32_t* index) {
-    Real c[3][W];
+  const std::uint32_t last = a.particles - 1;
+  auto gather = [&](const Real* v, const std::uint32_t* index) { // T::gather3 reads past the last
+    typename T::V x, y, z;
+    bool reads_last = false;
     for (int l = 0; l < W; ++l)
-      for (int d = 0; d < 3; ++d)
-        c[d][l] = v[3 * std::size_t(index[l]) + d];
-    return L3(lanes(c[0]), lanes(c[1]), lanes(c[2]));
+      reads_last = reads_last || index[l] == last;
+    if (reads_last)
+      T::gather3_last(v, index, x, y, z);
+    else
+      T::gather3(v, index, x, y, z);
+    return L3(L(x), L(y), L(z));
   };
   std::int64_t k = k0;
   for (; k + W <= k1; k += W) {
@@ -500,20 +505,19 @@ std::int64_t simd_vbd_colour(const vkcloth::detail::VbdArgs<typename T::Real>& a
     L3 f(L(Real(0)));
     B hessian{L3(L(Real(0))), L3(L(Real(0)))};
     for (std::uint32_t s = 0; s < longest; ++s) {
-      Real o[3][W], rest[W], stiffness[W];
+      std::uint32_t others[W];
+      Real rest[W], stiffness[W];
       for (int l = 0; l < W; ++l) {
-        std::uint32_t q = idx[l];
+        others[l] = idx[l];
         rest[l] = stiffness[l] = Real(0);
         if (s < count[l]) {
           const auto& e = a.edges[first[l] + s];
-          q = e.other;
+          others[l] = e.other;
           rest[l] = e.rest_length;
           stiffness[l] = e.stiffness;
         }
-        for (int d = 0; d < 3; ++d)
-          o[d][l] = a.pos[3 * std::size_t(q) + d];
       }
-      const L3 other(lanes(o[0]), lanes(o[1]), lanes(o[2]));
+      const L3 other = gather(a.pos, others);
       vbd_add_spring(f, hessian, other - x, lanes(rest), lanes(stiffness));
     }
     const L3 stepped = vbd_step(x, y, x0, f, hessian, m, h, mu);

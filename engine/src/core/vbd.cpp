@@ -89,6 +89,7 @@ void CpuSolver<Real>::Impl::vbd_solve_colour(const std::uint32_t colour, const R
     const std::size_t width = (simd_ == 2 ? 64 : 32) / sizeof(Real);
     simd_end = count - count % width;
     const detail::VbdArgs<Real> a{order.data() + first,
+                                  std::uint32_t(pos_.size()),
                                   &pos_[0].x,
                                   &w.push[0].x,
                                   &w.y[0].x,
