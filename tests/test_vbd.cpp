@@ -278,14 +278,14 @@ TEST_CASE("vbd: the scene's integrator.iterations, with its range") {
   CHECK(SimParams{}.vbd_iterations == 5);
 }
 
-TEST_CASE("implicit solvers on the cotton drop onto a sphere: strain within 10 % without friction, no "
-          "particle flung with it") {
+TEST_CASE("implicit solvers on the cotton drop onto a sphere: strain within 10 % without friction (vbd "
+          "also with it), no particle flung") {
   // Issue 37's drop at 32 x 32 and dt 1/300 for 2 s, for both implicit solvers (CG, vbd). CG used to
   // fling particles at 10-18 m/s here (278 % strain at 64 x 64, now 58 %): its solve pulled contact
   // particles into the sphere; Baraff-Witkin's contact filter (cloth_kernel.h contact_axis) keeps
   // them on it. Frictionless: at most 10 % strain over the run (measured CG 4.8 %, vbd 6.6 %; the
   // cloth then slides off the sphere). With friction 0.5 the Coulomb step after the solve holds
-  // stretched springs (CG 22 %, vbd 9.5 %; docs/model.md): there under 30 %, and no particle faster
+  // stretched springs: vbd at most 10 % (9.5 %), CG under 30 % (22 %; docs/model.md), and no particle faster
   // than 8 m/s over the run (the fall reaches 2.2 m/s at the impact, the corners wrapping under the
   // sphere whip at up to ~5 m/s under vbd).
   const ParticleSystem s =
@@ -312,11 +312,12 @@ TEST_CASE("implicit solvers on the cotton drop onto a sphere: strain within 10 %
       }
       MESSAGE(std::string(to_string(integrator)) << ", friction " << friction << ": largest strain " << strain
                                                  << ", fastest particle " << speed << " m/s");
-      if (friction == 0.0) {
+      if (friction == 0.0 || integrator == Integrator::vbd) {
         CHECK(strain <= 0.10);
       } else {
         CHECK(strain <= 0.30);
-        CHECK(speed < 8.0);
       }
+      if (friction > 0.0)
+        CHECK(speed < 8.0);
     }
 }

@@ -153,12 +153,8 @@ CpuSolver<Real>::Impl::normal_force_at(std::span<const Vec3> pos, std::span<cons
     const std::size_t i = p % nx, j = p / nx;
     interior = i >= 2 && i + 2 < nx && j >= 2 && j + 2 < ny;
   }
-  if (!topology_->ring_normals()) { // the topology's fan around p, in order
-    const std::span<const std::uint32_t> fan_offsets = topology_->fan_offsets();
-    const std::span<const FanTriangle> fans = topology_->fans();
-    for (std::uint32_t t = fan_offsets[p]; t < fan_offsets[p + 1]; ++t)
-      kernel::add_fan_triangle(fan, pos[fans[t].a] - x, pos[fans[t].b] - x);
-  }
+  if (!topology_->ring_normals())
+    fan = fan_sum(pos, p);
   if (interior) {
     // Same terms, same order as the CSR loop below (the topology's stencil detection checked it).
     for (std::size_t k = 0; k < 12; ++k)
@@ -179,19 +175,27 @@ CpuSolver<Real>::Impl::normal_force_at(std::span<const Vec3> pos, std::span<cons
                                  kw != Real(0), normal_[p], Vec3{params_.wind.direction}, kw);
 }
 
-template <typename Real> void CpuSolver<Real>::Impl::normal_at(std::span<const Vec3> pos, std::size_t p) {
+template <typename Real>
+typename CpuSolver<Real>::Impl::Vec3 CpuSolver<Real>::Impl::fan_sum(std::span<const Vec3> pos,
+                                                                    std::size_t p) const {
   const Vec3 x = pos[p];
   Vec3 fan(0);
+  const std::span<const std::uint32_t> fan_offsets = topology_->fan_offsets();
+  const std::span<const FanTriangle> fans = topology_->fans();
+  for (std::uint32_t t = fan_offsets[p]; t < fan_offsets[p + 1]; ++t)
+    kernel::add_fan_triangle(fan, pos[fans[t].a] - x, pos[fans[t].b] - x);
+  return fan;
+}
+
+template <typename Real> void CpuSolver<Real>::Impl::normal_at(std::span<const Vec3> pos, std::size_t p) {
   if (!topology_->ring_normals()) {
-    const std::span<const std::uint32_t> fan_offsets = topology_->fan_offsets();
-    const std::span<const FanTriangle> fans = topology_->fans();
-    for (std::uint32_t t = fan_offsets[p]; t < fan_offsets[p + 1]; ++t)
-      kernel::add_fan_triangle(fan, pos[fans[t].a] - x, pos[fans[t].b] - x);
-  } else {
-    Vec3 prev(0), first(0);
-    for (std::uint32_t e = edge_offsets_[p]; e < edge_offsets_[p + 1]; ++e)
-      kernel::add_ring_term(fan, prev, first, pos[edges_[e].other] - x, edges_[e].ring);
+    normal_[p] = kernel::unit_or_zero(fan_sum(pos, p));
+    return;
   }
+  const Vec3 x = pos[p];
+  Vec3 fan(0), prev(0), first(0);
+  for (std::uint32_t e = edge_offsets_[p]; e < edge_offsets_[p + 1]; ++e)
+    kernel::add_ring_term(fan, prev, first, pos[edges_[e].other] - x, edges_[e].ring);
   normal_[p] = kernel::unit_or_zero(fan);
 }
 

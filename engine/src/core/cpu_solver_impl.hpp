@@ -80,6 +80,8 @@ template <typename Real> struct CpuSolver<Real>::Impl {
   Vec3 normal_force_at(std::span<const Vec3> pos, std::span<const Vec3> vel, std::size_t p);
   /// Particle p's normal alone (normal_force_at's, the same terms in the same order): writes normal_[p].
   void normal_at(std::span<const Vec3> pos, std::size_t p);
+  /// The area-weighted normal sum of the topology's fan around p, in its order (without ring normals).
+  Vec3 fan_sum(std::span<const Vec3> pos, std::size_t p) const;
   // Contacts (cloth_kernel.h contact_response / project_out) with every collider at this substep's
   // pose; h_over_m: substep / mass (friction's impulse); side: where the particle came from.
   void contact_at(Vec3 pos, Vec3& vel, Vec3& force, Real h_over_m, bool friction = true) const;
@@ -106,6 +108,9 @@ template <typename Real> struct CpuSolver<Real>::Impl {
   void vbd_substep(Real h);
   void vbd_begin(Real h);
   void vbd_solve_colour(std::uint32_t colour, Real h);
+  /// The whole SIMD vectors of a colour's particles (row_kernel.hpp VbdArgs); returns how many it
+  /// stepped (0 without SIMD or with a mesh collider).
+  std::size_t vbd_colour_lanes(std::span<const std::uint32_t> particles, Real h);
   void vbd_finish(Real h);
   // Stretch control after a substep (docs/model.md "Stretch control").
   void limit_stretch(Real h);

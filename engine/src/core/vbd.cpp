@@ -80,46 +80,55 @@ void CpuSolver<Real>::Impl::vbd_solve_colour(const std::uint32_t colour, const R
     w.push[p] = projected - stepped;
     pos_[p] = projected;
   };
-  // Whole vectors of the colour in SIMD (the same kernel functions on lanes: row_kernel.hpp
-  // VbdArgs), when every collider is one the lanes take (no mesh); the rest one by one.
-  std::size_t simd_end = 0;
-#if VKCLOTH_ROW_SIMD
-  const bool lanes = simd_ != 0 && contacts_->finish.size() == contacts_->shapes.size();
-  if (lanes) {
-    const std::size_t width = (simd_ == 2 ? 64 : 32) / sizeof(Real);
-    simd_end = count - count % width;
-    const detail::VbdArgs<Real> a{order.data() + first,
-                                  std::uint32_t(pos_.size()),
-                                  &pos_[0].x,
-                                  &w.push[0].x,
-                                  &w.y[0].x,
-                                  &w.x0[0].x,
-                                  mass_.data(),
-                                  pinned_.data(),
-                                  edge_offsets_.data(),
-                                  edges_.data(),
-                                  contacts_->finish.data(),
-                                  std::uint32_t(contacts_->finish.size()),
-                                  Real(params_.contact_epsilon),
-                                  h,
-                                  mu};
-    pool_->for_each(simd_end / width, [&](std::size_t b) {
-      const std::int64_t k0 = std::int64_t(b * width), k1 = k0 + std::int64_t(width);
-#if VKCLOTH_ROW_AVX512
-      if (simd_ == 2) {
-        (void)detail::vbd_colour_avx512(a, k0, k1);
-        return;
-      }
-#endif
-      (void)detail::vbd_colour_avx2(a, k0, k1);
-    });
-  }
-#endif
+  const std::size_t simd_end = vbd_colour_lanes(order.subspan(first, count), h);
   if (simd_end > 0) // fewer than one vector left: here, not another fork-join
     for (std::size_t k = simd_end; k < count; ++k)
       step(k);
   else
     pool_->for_each(count, step);
+}
+
+// Whole vectors of a colour on SIMD lanes (the kernel's functions on lanes), when every collider is
+// one the lanes take (no mesh).
+template <typename Real>
+std::size_t CpuSolver<Real>::Impl::vbd_colour_lanes(std::span<const std::uint32_t> particles, const Real h) {
+#if VKCLOTH_ROW_SIMD
+  if (simd_ == 0 || contacts_->finish.size() != contacts_->shapes.size())
+    return 0;
+  auto& w = *vbd_;
+  const std::size_t width = (simd_ == 2 ? 64 : 32) / sizeof(Real);
+  const std::size_t end = particles.size() - particles.size() % width;
+  const detail::VbdArgs<Real> a{particles.data(),
+                                std::uint32_t(pos_.size()),
+                                &pos_[0].x,
+                                &w.push[0].x,
+                                &w.y[0].x,
+                                &w.x0[0].x,
+                                mass_.data(),
+                                pinned_.data(),
+                                edge_offsets_.data(),
+                                edges_.data(),
+                                contacts_->finish.data(),
+                                std::uint32_t(contacts_->finish.size()),
+                                Real(params_.contact_epsilon),
+                                h,
+                                Real(params_.damping)};
+  pool_->for_each(end / width, [&](std::size_t b) {
+    const std::int64_t k0 = std::int64_t(b * width), k1 = k0 + std::int64_t(width);
+#if VKCLOTH_ROW_AVX512
+    if (simd_ == 2) {
+      (void)detail::vbd_colour_avx512(a, k0, k1);
+      return;
+    }
+#endif
+    (void)detail::vbd_colour_avx2(a, k0, k1);
+  });
+  return end;
+#else
+  (void)particles;
+  (void)h;
+  return 0;
+#endif
 }
 
 template <typename Real> void CpuSolver<Real>::Impl::vbd_finish(const Real h) {
