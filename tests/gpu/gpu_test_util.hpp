@@ -9,7 +9,9 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -72,6 +74,38 @@ inline Diff diff(std::span<const glm::vec3> a, std::span<const glm::vec3> b) {
         d.bitwise = false;
     }
   return d;
+}
+
+/// The scene files of `dir` (samples/scenes), sorted by name.
+inline std::vector<std::filesystem::path> scene_files(const std::filesystem::path& dir) {
+  std::vector<std::filesystem::path> files;
+  for (const auto& entry : std::filesystem::directory_iterator(dir))
+    if (entry.path().extension() == ".json")
+      files.push_back(entry.path());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+/// A scene run `steps` steps by the CPU solver (float) and by a GpuSolver, from the same start.
+struct CpuGpuRun {
+  Scene scene;
+  std::optional<CpuSolver<float>> cpu;
+  std::optional<GpuSolver> gpu;
+};
+inline CpuGpuRun run_cpu_and_gpu(Context& ctx, const std::filesystem::path& file,
+                                 std::span<const std::string> overrides, std::uint64_t steps) {
+  auto scene = load_scene_file(file, overrides);
+  REQUIRE_MESSAGE(scene.ok(), (scene.ok() ? "" : scene.error().message));
+  CpuGpuRun r{std::move(*scene), std::nullopt, std::nullopt};
+  auto cpu = CpuSolver<float>::create(r.scene.system, r.scene.params);
+  REQUIRE(cpu.ok());
+  auto gpu = GpuSolver::create(ctx, r.scene.system, r.scene.params);
+  REQUIRE(gpu.ok());
+  r.cpu.emplace(std::move(*cpu));
+  r.gpu.emplace(std::move(*gpu));
+  REQUIRE(r.cpu->run(steps).ok());
+  REQUIRE(r.gpu->simulate(steps).ok());
+  return r;
 }
 
 } // namespace vkcloth::gpu::test

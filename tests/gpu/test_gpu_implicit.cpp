@@ -21,38 +21,32 @@ using namespace vkcloth;
 
 TEST_CASE("GPU implicit Euler matches the CPU implicit solver on the sample scenes") {
   VKCLOTH_GPU_TEST_BEGIN(ctx);
-  for (const auto& entry : std::filesystem::directory_iterator(VKCLOTH_SAMPLES_SCENES_DIR)) {
-    if (entry.path().extension() != ".json")
-      continue;
+  for (const auto& file : gpu::test::scene_files(VKCLOTH_SAMPLES_SCENES_DIR)) {
     // The self-collision drops at 24 x 24 instead of 64 x 64: their 1000 implicit substeps at full
     // size take minutes on lavapipe under the validation layer; the self-collision tests run them
     // at full size with their own integrator.
     std::vector<std::string> overrides = {"integrator.method=implicit_euler"};
-    if (entry.path().stem().string().ends_with("_self_collision"))
+    if (file.stem().string().ends_with("_self_collision"))
       overrides.push_back("cloth.resolution=[24,24]");
-    auto scene = load_scene_file(entry.path(), overrides);
-    REQUIRE_MESSAGE(scene.ok(), (scene.ok() ? "" : scene.error().message));
-    auto cpu = CpuSolver<float>::create(scene->system, scene->params);
-    REQUIRE(cpu.ok());
-    auto gpu = gpu::GpuSolver::create(ctx, scene->system, scene->params);
-    REQUIRE(gpu.ok());
     const std::uint64_t steps = 200;
-    REQUIRE(cpu->run(steps).ok());
-    REQUIRE(gpu->simulate(steps).ok());
+    auto run = gpu::test::run_cpu_and_gpu(ctx, file, overrides, steps);
+    const Scene& scene = run.scene;
+    auto& cpu = run.cpu;
+    auto& gpu = run.gpu;
     auto gp = gpu->positions();
     REQUIRE(gp.ok());
     const auto d = gpu::test::diff(cpu->positions(), *gp);
-    MESSAGE(entry.path().filename().string()
-            << ": max |p_cpu - p_gpu| after " << steps << " implicit steps = " << d.max_abs
-            << " m; CG iterations cpu " << cpu->last_solve().iterations << " (residual "
-            << cpu->last_solve().residual << "), gpu " << gpu->last_solve().iterations << " (residual "
-            << gpu->last_solve().residual << ")");
+    MESSAGE(file.filename().string() << ": max |p_cpu - p_gpu| after " << steps << " implicit steps = "
+                                     << d.max_abs << " m; CG iterations cpu " << cpu->last_solve().iterations
+                                     << " (residual " << cpu->last_solve().residual << "), gpu "
+                                     << gpu->last_solve().iterations << " (residual "
+                                     << gpu->last_solve().residual << ")");
     // A scene more sensitive than that (a free tablecloth sliding on a sphere: an unstable
     // equilibrium) amplifies any rounding: there the GPU must stay within 3x of what the CPU's own
     // float rounding does (float vs double), which a wrong GPU step would exceed by far.
     double bound = 1e-4;
     if (d.max_abs >= bound) {
-      auto ref = CpuSolver<double>::create(scene->system, scene->params);
+      auto ref = CpuSolver<double>::create(scene.system, scene.params);
       REQUIRE(ref.ok());
       REQUIRE(ref->run(steps).ok());
       double spread = 0.0;
@@ -62,7 +56,7 @@ TEST_CASE("GPU implicit Euler matches the CPU implicit solver on the sample scen
       bound = std::max(bound, 3.0 * spread);
     }
     CHECK(d.max_abs < bound);
-    CHECK(gpu->last_solve().residual <= scene->params.cg_tolerance); // converged to the scene's tolerance
+    CHECK(gpu->last_solve().residual <= scene.params.cg_tolerance); // converged to the scene's tolerance
   }
 }
 

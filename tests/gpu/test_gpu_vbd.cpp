@@ -15,28 +15,21 @@ using namespace vkcloth;
 
 TEST_CASE("GPU vbd matches the CPU vbd on every sample scene: 100 steps") {
   VKCLOTH_GPU_TEST_BEGIN(ctx);
-  for (const auto& entry : std::filesystem::directory_iterator(VKCLOTH_SAMPLES_SCENES_DIR)) {
-    if (entry.path().extension() != ".json")
-      continue;
+  for (const auto& file : gpu::test::scene_files(VKCLOTH_SAMPLES_SCENES_DIR)) {
     // Two substeps: the second starts from the state the first left in the batch's buffers.
     const std::vector<std::string> overrides = {"integrator.method=vbd", "integrator.substeps=2"};
-    auto scene = load_scene_file(entry.path(), overrides);
-    REQUIRE_MESSAGE(scene.ok(), (scene.ok() ? "" : scene.error().message));
-    auto cpu = CpuSolver<float>::create(scene->system, scene->params);
-    REQUIRE(cpu.ok());
-    auto gpu = gpu::GpuSolver::create(ctx, scene->system, scene->params);
-    REQUIRE(gpu.ok());
     const std::uint64_t steps = 100;
-    REQUIRE(cpu->run(steps).ok());
-    REQUIRE(gpu->simulate(steps).ok());
+    auto run = gpu::test::run_cpu_and_gpu(ctx, file, overrides, steps);
+    auto& cpu = run.cpu;
+    auto& gpu = run.gpu;
     auto gp = gpu->positions();
     REQUIRE(gp.ok());
     auto gv = gpu->velocities();
     REQUIRE(gv.ok());
     const auto d = gpu::test::diff(cpu->positions(), *gp);
     const auto dv = gpu::test::diff(cpu->velocities(), *gv);
-    MESSAGE(entry.path().filename().string() << ": max |p_cpu - p_gpu| after " << steps << " vbd steps = "
-                                             << d.max_abs << " m, velocities " << dv.max_abs << " m/s");
+    MESSAGE(file.filename().string() << ": max |p_cpu - p_gpu| after " << steps << " vbd steps = "
+                                     << d.max_abs << " m, velocities " << dv.max_abs << " m/s");
     CHECK(d.max_abs <= 1e-5);
     CHECK(dv.max_abs <= 1e-3);
   }
