@@ -4,8 +4,8 @@
 // vkcloth-builds: one workgroup-constant (shaders/CMakeLists.txt)
 // Vertex block descent (Integrator::vbd), the phases of CpuSolver's vbd.cpp in the same order, each
 // formula from cloth_kernel.h (vbd.h); one pipeline per phase (SC_STAGE, VKCLOTH_VBD_*):
-//   BEGIN:  one invocation per particle: the normal at the substep's start (particle_force, as the
-//           CPU's normal_force_at), the inertia target y -> VEL_FILT, the first guess x0 + h v0
+//   BEGIN:  one invocation per particle: the normal at the substep's start (particle_normal, as the
+//           CPU's normal_at), the inertia target y -> VEL_FILT, the first guess x0 + h v0
 //           projected out of the colliders -> POS_OUT, no push yet -> STAGE_POS;
 //   SOLVE:  one invocation per particle of one colour (VBD_ORDER[colour_first ..]): one Newton step
 //           from the neighbours' latest positions in POS_OUT, projected; writes its own POS_OUT
@@ -38,9 +38,8 @@ vec3 projected(vec3 side, vec3 x) {
 }
 
 void begin(uint p, uint g, bool pinned) {
-  vec3 v = vel[g].xyz, f, nrm;
-  const vec3 v0 = v;
-  particle_force(p, v, f, nrm); // for its normal
+  const vec3 v0 = vel[g].xyz;
+  const vec3 nrm = particle_normal(p);
   normal_out[g] = normal_output(nrm);
   const vec3 x0 = read_pos_in(p);
   const float m = read_particle(p).mass;

@@ -110,6 +110,24 @@ vec3 grid_normal(uint p) {
   return unit_or_zero(sum);
 }
 
+// Particle p's unit normal alone: particle_force's, the same terms in the same order (the grid fan,
+// or the ring terms of the gather list's fan entries), without its springs and contacts (vbd.comp's
+// BEGIN, as the CPU's normal_at).
+vec3 particle_normal(uint p) {
+  if (SC_GRID_FAN && (ip.flags & VKCLOTH_FLAG_HAS_GRID) != 0u) return grid_normal(p);
+  if (!SC_RING || (ip.flags & VKCLOTH_FLAG_RING_NORMALS) == 0u) return vec3(0.0);
+  const vec3 x = read_pos_in(p);
+  const uvec3 range = read_list_range(p);
+  vec3 fan = vec3(0.0), prev = vec3(0.0), first = vec3(0.0);
+  for (uint e = range.x; e < range.y; ++e) {
+    const Edge s = read_edge(e);
+    if (FAN_EXIT && s.ring == 0u) break;
+    precise vec3 u = read_pos_in(s.other) - x;
+    add_ring_term(fan, prev, first, u, s.ring);
+  }
+  return unit_or_zero(fan);
+}
+
 #ifdef VKCLOTH_FRICTION_AFTER_SOLVE
 // implicit.comp: the force the contact filter removed from this particle (F - filtered F).
 vec3 contact_removed_force = vec3(0.0);
