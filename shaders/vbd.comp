@@ -8,11 +8,12 @@
 //           CPU's normal_at), the inertia target y -> VEL_FILT, the first guess x0 + h v0
 //           projected out of the colliders -> POS_OUT, no push yet -> STAGE_POS;
 //   SOLVE:  one invocation per particle of one colour (VBD_ORDER[colour_first ..]): one Newton step
-//           from the neighbours' latest positions in POS_OUT, projected; writes its own POS_OUT
-//           entry and its push. No two particles of a colour share a spring, so no invocation reads
-//           what another writes;
-//   FINISH: one invocation per particle: v = (x - x0) / h before the last projection, the contact
-//           response, x = x0 + h v, projection and divergence flags (finish.glsl), the net force.
+//           (springs, inertia, friction) from the neighbours' latest positions in
+//           POS_OUT, projected; writes its own POS_OUT entry and its push. No two particles of a
+//           colour share a spring, so no invocation reads what another writes;
+//   FINISH: one invocation per particle: the last sweep's x; v = (x - x0) / h before the last
+//           projection, less its inward part (the contact response without friction); projection
+//           and divergence flags (finish.glsl), the net force.
 // Reads POS_IN (= POS_BASE: positions[read], the start), VEL; writes POS_OUT, VEL, NORMAL, FORCE_OUT.
 #include "vkcloth_shared.h"
 #define VKCLOTH_PUSH_STRUCT VbdPush
@@ -47,8 +48,8 @@ void begin(uint p, uint g, bool pinned) {
                                      (ip.flags & VKCLOTH_FLAG_WIND) != 0u, nrm, ip.wind.xyz, ip.wind.w);
   const vec3 y = pinned ? x0 : vbd_inertia_target(x0, v0, f_ext, m, ip.dt);
   target[g] = vec4(y, 0.0);
-  push_of[g] = vec4(0.0);
   const vec3 guess = vbd_first_guess(x0, v0, ip.dt);
+  push_of[g] = vec4(0.0);
   pos_out[g] = vec4(pinned ? x0 : projected(x0, guess), 1.0);
 }
 
@@ -65,7 +66,10 @@ void solve(uint p, uint g) {
   }
   const vec3 x0 = read_pos_in(p);
   const float m = read_particle(p).mass;
-  const vec3 stepped = vbd_step(x, target[g].xyz, x0, f, hessian, m, ip.dt, ip.gravity_damping.w);
+  vec3 stepped = vbd_step(x, target[g].xyz, x0, f, hessian, m, ip.dt, ip.gravity_damping.w);
+  const float inertia = vbd_inertia_weight(m, ip.dt, ip.gravity_damping.w);
+  for (uint c = 0u; c < (SC_COLLIDERS ? ip.collider_count : 0u); ++c)
+    vbd_friction(stepped, 0u, collider_shape(c), x, x0, hessian, inertia, ip.band, ip.dt);
   const vec3 x1 = projected(x0, stepped);
   push_of[g] = vec4(x1 - stepped, 0.0);
   pos_out[g] = vec4(x1, 1.0);
@@ -87,14 +91,14 @@ void finish_step(uint p, uint g, bool pinned) {
   const bool both = (ip.flags & VKCLOTH_FLAG_CONTACT_BOTH) != 0u;
   precise float h_over_m = h / m;
   for (uint c = 0u; c < (SC_COLLIDERS ? ip.collider_count : 0u); ++c) {
-    ColliderShape s = collider_shape(c);
+    ColliderShape s = without_friction(collider_shape(c)); // friction acted in the sweeps
     float dist;
     vec3 n;
     collider_contact(0u, s, x, x, ip.band, dist, n);
     contact_response(v, no_force, s, x, n, dist, ip.band, both, h_over_m);
   }
   force_out[g] = vec4(vbd_net_force(v, v0, m, h), 0.0);
-  finish(p, false, x0, vbd_position(x0, v, h), v);
+  finish(p, false, x0, x, v);
 }
 
 void main() {

@@ -184,6 +184,43 @@ TEST_CASE("static friction holds on a slope when tan(theta) <= mu_s; kinetic fri
   }
 }
 
+TEST_CASE("vbd: friction in the vertex step holds on a slope when tan(theta) <= mu_s and slides at "
+          "g (sin theta - mu_k cos theta)") {
+  // The slope above under vertex block descent, whose friction acts in each vertex's step (Coulomb's
+  // law on the step's quadratic model, the normal force from the projection's push; vbd.h
+  // vbd_friction). A single particle's step is exact once friction has its normal force (from the
+  // second sweep): held still by mu_s = 0.6 (with mu_k = tan theta = 0.5, which alone would only
+  // balance gravity), and sliding with mu = 0.4 at exactly backward Euler's v = n h a.
+  ValidationScope validation;
+  const double theta = std::atan(0.5);
+  const glm::dvec3 n{-std::sin(theta), 0.0, std::cos(theta)};
+  const glm::dvec3 down_slope{-std::cos(theta), 0.0, -std::sin(theta)};
+  const glm::dvec3 start = n * 0.001;
+  for (Backend b : backends()) {
+    const std::string name = to_string(b);
+    CAPTURE(name);
+    SimParams p = gravity_only();
+    p.integrator = Integrator::vbd;
+    p.colliders = {with_friction(Collider::plane(n, 0.0), 0.5, 0.6)};
+    {
+      auto s = make_sim(b, particle(start, {0, 0, 0}), p);
+      REQUIRE(s->run(100).ok());
+      MESSAGE(name << ": held " << glm::length(s->position(0) - start) << " m from its start");
+      CHECK(glm::length(s->position(0) - start) < 1e-6);
+      CHECK(glm::length(s->velocity(0)) < 1e-6);
+    }
+    p.colliders = {with_friction(Collider::plane(n, 0.0), 0.4)};
+    {
+      auto s = make_sim(b, particle(start, {0, 0, 0}), p);
+      REQUIRE(s->run(50).ok());
+      const double expected = 50 * p.dt * g * (std::sin(theta) - 0.4 * std::cos(theta));
+      MESSAGE(name << ": slides at " << glm::dot(s->velocity(0), down_slope) << " m/s of " << expected);
+      CHECK(glm::dot(s->velocity(0), down_slope) == doctest::Approx(expected).epsilon(1e-5));
+      CHECK(std::abs(glm::dot(s->velocity(0), n)) < 1e-5);
+    }
+  }
+}
+
 TEST_CASE("a moving box carries a resting particle; a frictionless one slides under it") {
   // Friction acts on the velocity relative to the surface: with mu = 1 the particle picks up the
   // box's 0.3 m/s within two steps (kinetic, then static) and keeps it; with mu = 0 it stays put.

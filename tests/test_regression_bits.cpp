@@ -6,8 +6,9 @@
 // The implicit_euler rows were recorded again when the method itself changed (issue 18: block-
 // Jacobi preconditioner, warm start, tolerance relative to max(|S b|, |S h M g|)), and those with
 // colliders again when the solve learnt Baraff-Witkin's contact filter (issue 37); the vbd rows
-// were added with vbd's first guess x0 + h v0 (issue 37); every other row is unchanged since the
-// redesign.
+// were added with vbd's first guess x0 + h v0 (issue 37) and recorded again when friction moved
+// into the vertex step and the step began to end where the sweeps leave each particle (issue 37);
+// every other row is unchanged since the redesign.
 //
 // CPU float and double: the bits are the reference's on any x86-64 (the SIMD kernels are bitwise
 // equal to the scalar code, -ffp-contract=off). Vulkan: checked bit for bit on lavapipe (llvmpipe),

@@ -185,7 +185,9 @@ TEST_CASE("vbd: leather at 64 x 64 and dt = 1/30 stays stable") {
 
 TEST_CASE("vbd: no particle ends a step inside the sphere (cotton drop)") {
   // The issue's drop at 32 x 32: 1 m of cotton 0.25 m above a sphere of radius 0.25 (friction 0.5),
-  // dt 1/300; after every step each particle is at least contact_epsilon - 1e-6 m from the surface.
+  // dt 1/300; after every step each particle is outside the sphere (to 1e-6 m of float rounding; the
+  // issue asks for no deeper than contact_epsilon). A sweep's projection puts a particle that crossed
+  // the surface at surface + eps; one whose step ends within eps of the surface stays there.
   const ParticleSystem s =
       material_cloth("cotton", 32, ClothOrientation::horizontal, {-0.5, -0.5, 0.5}, true);
   SimParams p = vbd_params(1.0 / 300.0, 10);
@@ -206,7 +208,7 @@ TEST_CASE("vbd: no particle ends a step inside the sphere (cotton drop)") {
         closest = std::min(closest, glm::length(x) - sphere.radius);
     }
     MESSAGE(std::string(to_string(b)) << ": closest particle " << closest << " m from the sphere");
-    CHECK(closest >= p.contact_epsilon - 1e-6);
+    CHECK(closest >= -1e-6);
   }
 }
 
@@ -283,11 +285,11 @@ TEST_CASE("implicit solvers on the cotton drop onto a sphere: strain within 10 %
   // Issue 37's drop at 32 x 32 and dt 1/300 for 2 s, for both implicit solvers (CG, vbd). CG used to
   // fling particles at 10-18 m/s here (278 % strain at 64 x 64, now 58 %): its solve pulled contact
   // particles into the sphere; Baraff-Witkin's contact filter (cloth_kernel.h contact_axis) keeps
-  // them on it. Frictionless: at most 10 % strain over the run (measured CG 4.8 %, vbd 6.6 %; the
-  // cloth then slides off the sphere). With friction 0.5 the Coulomb step after the solve holds
-  // stretched springs: vbd at most 10 % (9.5 %), CG under 30 % (22 %; docs/model.md), and no particle faster
-  // than 8 m/s over the run (the fall reaches 2.2 m/s at the impact, the corners wrapping under the
-  // sphere whip at up to ~5 m/s under vbd).
+  // them on it. Frictionless: at most 10 % strain over the run (measured CG 4.8 %, vbd 8.1 %; the
+  // cloth then slides off the sphere). With friction 0.5: vbd, whose friction acts in the vertex
+  // step, at most 10 % (6.5 %); CG, whose Coulomb step after the solve holds stretched springs,
+  // under 30 % (22 %; docs/model.md); and no particle faster than 8 m/s over the run (the fall reaches
+  // 2.2 m/s at the impact, the corners wrapping under the sphere whip at up to ~5 m/s).
   const ParticleSystem s =
       material_cloth("cotton", 32, ClothOrientation::horizontal, {-0.5, -0.5, 0.5}, true);
   for (double friction : {0.0, 0.5})

@@ -32,3 +32,17 @@ struct ColliderShape {
 KFN bool still_frictionless(ColliderShape s) {
   return !s.moving && s.mu_s == real(0) && s.mu_k == real(0);
 }
+
+// A collider with Coulomb friction.
+KFN bool has_friction(ColliderShape s) {
+  return s.mu_s != real(0) || s.mu_k != real(0);
+}
+
+// The same collider without friction: the contact response that only removes the inward part
+// (vertex block descent's finish, whose friction acted inside the solve).
+KFN ColliderShape without_friction(ColliderShape s) {
+  ColliderShape r = s;
+  r.mu_k = real(0);
+  r.mu_s = real(0);
+  return r;
+}

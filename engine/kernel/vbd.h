@@ -37,6 +37,45 @@ KFN void vbd_add_spring(INOUT(vec3) f, INOUT(SpringBlock) hessian, vec3 u, real 
   hessian.off = select(has_length, o, hessian.off);
 }
 
+// The inertia's (and damping's) stiffness in a vertex's Hessian, (1 + h mu) m / h^2 as vbd_step adds it.
+KFN precise real vbd_inertia_weight(real m, real h, real mu) {
+  precise real m_h2 = m / (h * h);
+  precise real mu_m_h = mu * m / h;
+  return m_h2 + mu_m_h;
+}
+
+// Coulomb friction of one collider in a vertex's step (docs/model.md "Vertex block descent"): Coulomb's
+// law on the step's quadratic model, applied to the stepped position before the projection. Within
+// the contact band (at x, where the sweep found the particle; its normal n), the step's move over
+// the substep u = stepped - x0 (relative to the surface) has an inward part, which the contact stops:
+// its normal force is lambda = n^T H n max(-u.n, 0) (H: the springs' block plus the inertia weight).
+// Undoing the tangential part u_t takes the force F_t = (H u_t)_t: it is undone when |F_t| <= mu_s
+// lambda (static), and otherwise shortened by mu_k lambda / |F_t| (kinetic), as coulomb_friction
+// shortens a velocity.
+KFN void vbd_friction(INOUT(vec3) stepped, MESH_DATA_PARAM, ColliderShape s, vec3 x, vec3 x0,
+                      SpringBlock hessian, real inertia, real band, real h) {
+  if (!has_friction(s))
+    return;
+  real distance;
+  vec3 n;
+  collider_contact(MESH_DATA, s, x, x, band, distance, n);
+  precise vec3 vs = s.moving ? surface_velocity(s, x) : vec3(real(0));
+  precise vec3 u = (stepped - x0) - vs * h;
+  precise real un = dot3(u, n);
+  VARYING(bool) touching = distance < band && un < real(0);
+  if (!any_particle(touching))
+    return;
+  precise real lambda = (dot3(n, apply_block(hessian, n)) + inertia) * -un;
+  precise vec3 ut = u - n * un;
+  precise vec3 hold = apply_block(hessian, ut) + ut * inertia;
+  precise vec3 ft = hold - n * dot3(hold, n);
+  precise real ft_len = sqrt(dot3(ft, ft));
+  precise real k =
+      select(ft_len > real(s.mu_s) * lambda, min(real(s.mu_k) * lambda / ft_len, real(1)), real(1));
+  precise vec3 nx = stepped - ut * k;
+  stepped = select(touching, nx, stepped);
+}
+
 // One vertex's Newton step on its part of implicit Euler's variational energy
 //   G(x) = m / (2 h^2) |x - y|^2 + mu m / (2 h) |x - x0|^2 + sum of its springs' energies
 // (the second term is the fluid damping -mu m v with v = (x - x0) / h): the gradient
@@ -48,26 +87,21 @@ KFN precise vec3 vbd_step(vec3 x, vec3 y, vec3 x0, vec3 f, SpringBlock hessian, 
   precise vec3 g = (x - y) * m_h2 + (x - x0) * mu_m_h;
   g = g - f;
   SpringBlock a;
-  precise vec3 d = hessian.diag + vec3(m_h2 + mu_m_h);
+  precise vec3 d = hessian.diag + vec3(vbd_inertia_weight(m, h, mu));
   a.diag = d;
   a.off = hessian.off;
   precise vec3 nx = x - apply_block(invert_block(a), g);
   return nx;
 }
 
-// After the iterations: the velocity the step implies, v = (x - x0) / h, from the last sweep's
-// position before the colliders' projection (x - push): the projection's move is not a velocity
-// (it would throw the particle off the collider); the contact response then removes v's inward part,
-// whose size is friction's normal impulse, as in the explicit step ...
+// After the iterations the particle stays where the last sweep left it, x, and takes the velocity
+// the step implies, v = (x - x0) / h, from x before the colliders' projection (x - push): the
+// projection's move is not a velocity (it would throw the particle off the collider); the contact
+// response then removes v's inward part (without friction, which acted inside the sweeps).
 KFN precise vec3 vbd_velocity(vec3 x, vec3 push, vec3 x0, real h) {
   precise vec3 free_x = x - push;
   precise vec3 v = (free_x - x0) / h;
   return v;
-}
-// ... and the position of the velocity friction left, x = x0 + h v.
-KFN precise vec3 vbd_position(vec3 x0, vec3 v, real h) {
-  precise vec3 x = x0 + v * h;
-  return x;
 }
 
 // The net force of the step, m (v - v0) / h (what a host observes as the particle's force).

@@ -261,9 +261,7 @@ void CpuSolver<Real>::Impl::contact_at(Vec3 pos, Vec3& vel, Vec3& force, Real h_
   const bool both = !params_.contact_inward_only; // Figure 12's variant: outward parts go too
   const auto& shapes = contacts_->shapes;
   for (std::size_t k = 0; k < shapes.size(); ++k) {
-    kernel::ColliderShape<Real> s = shapes[k];
-    if (!friction)
-      s.mu_k = s.mu_s = Real(0);
+    const kernel::ColliderShape<Real> s = friction ? shapes[k] : kernel::without_friction(shapes[k]);
     Real distance;
     Vec3 normal;
     kernel::collider_contact(contacts_->meshes[k], s, pos, pos, band, distance, normal);

@@ -470,7 +470,7 @@ std::int64_t simd_vbd_colour(const vkcloth::detail::VbdArgs<typename T::Real>& a
   S shapes[vkcloth::detail::finish_max_shapes];
   for (std::uint32_t c = 0; c < a.shape_count; ++c)
     shapes[c] = lane_shape<T>(a.shapes[c]);
-  const L h(a.h), mu(a.mu), eps(a.eps);
+  const L h(a.h), mu(a.mu), eps(a.eps), band(Real(2) * a.eps);
   // W values into lanes (through memory: element stores into a vector type read as uninitialised).
   auto lanes = [](const Real(&v)[W]) {
     L r;
@@ -520,7 +520,10 @@ std::int64_t simd_vbd_colour(const vkcloth::detail::VbdArgs<typename T::Real>& a
       const L3 other = gather(a.pos, others);
       vbd_add_spring(f, hessian, other - x, lanes(rest), lanes(stiffness));
     }
-    const L3 stepped = vbd_step(x, y, x0, f, hessian, m, h, mu);
+    L3 stepped = vbd_step(x, y, x0, f, hessian, m, h, mu);
+    const L inertia = vbd_inertia_weight(m, h, mu);
+    for (std::uint32_t c = 0; c < a.shape_count; ++c)
+      vbd_friction(stepped, NoMesh{}, shapes[c], x, x0, hessian, inertia, band, h);
     L3 projected = stepped, unused(L(Real(0)));
     for (std::uint32_t c = 0; c < a.shape_count; ++c)
       project_out(NoMesh{}, shapes[c], eps, x0, projected, unused);

@@ -17,6 +17,7 @@ using vec3 = Uniform3<Isa>;
 #include "kernel/shapes.h"
 } // namespace uniform
 using uniform::ColliderShape;
+using uniform::has_friction;
 using uniform::still_frictionless;
 
 // No mesh collider reaches the lanes (CpuSolver takes a mesh's particles one by one): collider_contact's

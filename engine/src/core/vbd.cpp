@@ -4,12 +4,12 @@
 //   begin:   normals and external forces at the substep's start, the inertia targets y, and the
 //            first guess (vbd_first_guess: x0 + h v0) projected out of the colliders;
 //   sweeps:  `vbd_iterations` times, the colours in order; each particle of a colour takes one Newton
-//            step on its springs and its inertia, from its neighbours' latest positions, and is
-//            projected out of the colliders (no two particles of a colour share a spring, so a
-//            colour runs in parallel with the result of running it in order);
-//   finish:  v = (x - x0) / h from the last sweep's position before its projection, the contact
-//            response (the inward part, Coulomb friction with it as normal impulse), x = x0 + h v,
-//            projected.
+//            step on its springs, its inertia and the colliders' friction, from its neighbours'
+//            latest positions, and is projected out of the colliders
+//            (no two particles of a colour share a spring, so a colour runs in parallel with the
+//            result of running it in order);
+//   finish:  the last sweep's position x; v = (x - x0) / h from its position before the projection,
+//            less its inward part (the contact response without friction).
 #include <algorithm>
 
 #include "cpu_solver_impl.hpp"
@@ -62,7 +62,7 @@ void CpuSolver<Real>::Impl::vbd_solve_colour(const std::uint32_t colour, const R
   const auto order = topology_->vertex_order();
   const std::uint32_t first = topology_->vertex_colour_offsets()[colour];
   const std::uint32_t count = topology_->vertex_colour_offsets()[colour + 1] - first;
-  const Real mu = Real(params_.damping);
+  const Real mu = Real(params_.damping), band = Real(2) * Real(params_.contact_epsilon);
   auto step = [&](std::size_t k) {
     const std::uint32_t p = order[first + k];
     if (pinned_[p])
@@ -74,7 +74,11 @@ void CpuSolver<Real>::Impl::vbd_solve_colour(const std::uint32_t colour, const R
       const Edge& s = edges_[e];
       kernel::vbd_add_spring(f, hessian, pos_[s.other] - x, s.rest_length, s.stiffness);
     }
-    const Vec3 stepped = kernel::vbd_step(x, w.y[p], w.x0[p], f, hessian, mass_[p], h, mu);
+    Vec3 stepped = kernel::vbd_step(x, w.y[p], w.x0[p], f, hessian, mass_[p], h, mu);
+    const Real inertia = kernel::vbd_inertia_weight(mass_[p], h, mu);
+    for (std::size_t c = 0; c < contacts_->shapes.size(); ++c)
+      kernel::vbd_friction(stepped, contacts_->meshes[c], contacts_->shapes[c], x, w.x0[p], hessian, inertia,
+                           band, h);
     Vec3 projected = stepped, unused(0);
     project_at(w.x0[p], projected, unused);
     w.push[p] = projected - stepped;
@@ -139,10 +143,10 @@ template <typename Real> void CpuSolver<Real>::Impl::vbd_finish(const Real h) {
       return; // stays put with its velocity
     }
     const Vec3 x0 = w.x0[p];
-    Vec3 v = kernel::vbd_velocity(pos_[p], w.push[p], x0, h);
+    Vec3 x = pos_[p]; // where the sweeps left it: out of the colliders, friction included
+    Vec3 v = kernel::vbd_velocity(x, w.push[p], x0, h);
     Vec3 no_force(0);
-    contact_at(pos_[p], v, no_force, h / mass_[p]);
-    Vec3 x = kernel::vbd_position(x0, v, h);
+    contact_at(x, v, no_force, h / mass_[p], false); // friction acted in the sweeps
     project_at(x0, x, v);
     force_[p] = kernel::vbd_net_force(v, vel_[p], mass_[p], h);
     pos_[p] = x;
