@@ -4,6 +4,7 @@
 // row and list sweeps), implicit_euler.cpp, vbd.cpp, self_collision.cpp and strain_projection.cpp.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -21,13 +22,6 @@ class ThreadPool;
 template <typename Real> struct ImplicitWorkspace;
 template <typename Real> struct SelfCollisionGrid;
 template <typename Real> struct StrainProjection;
-/// Vertex block descent's per-particle state of a substep (vbd.cpp).
-template <typename Real> struct VbdWorkspace {
-  using Vec3 = glm::vec<3, Real, glm::defaultp>;
-  std::vector<Vec3> x0;   ///< positions at the substep's start
-  std::vector<Vec3> y;    ///< inertia targets
-  std::vector<Vec3> push; ///< the colliders' projection move of the last iteration
-};
 /// The colliders as the kernel takes them at this substep's pose, and their meshes; the same values
 /// for the SIMD finish of the grid rows (row_kernel.hpp FinishShape), empty when a collider is a mesh
 /// or there are more than detail::finish_max_shapes.
@@ -40,9 +34,50 @@ template <typename Real> struct ContactShapes {
 /// `width` particles by pad_lists.
 template <typename Real> struct PaddedLists {
   std::size_t width = 0;
-  std::vector<std::uint32_t> spring_begin, other, ring, ring_end;
+  std::vector<std::uint32_t> spring_begin{0}, other, ring, ring_end;
   std::vector<std::uint8_t> reads_last; ///< per vector: some slot names the last particle
   std::vector<Real> rest, stiff;
+};
+
+/// Appends one vector of particles (l.width of them) to padded gather lists: as many slots as the
+/// longest list among them, slot k holding each particle's k-th edge, or a zero spring to itself
+/// (which adds nothing) past its list's end.
+template <typename Real, typename Edge>
+void pad_vector(PaddedLists<Real>& l, std::span<const std::uint32_t> particles,
+                std::span<const std::uint32_t> edge_offsets, std::span<const std::uint32_t> fan_ends,
+                const std::vector<Edge>& edges) {
+  const std::uint32_t last = std::uint32_t(edge_offsets.size() - 2);
+  std::uint32_t slots = 0, ring_slots = 0;
+  for (const std::uint32_t p : particles) {
+    slots = std::max(slots, edge_offsets[p + 1] - edge_offsets[p]);
+    ring_slots = std::max(ring_slots, fan_ends[p] - edge_offsets[p]);
+  }
+  bool reads_last = false;
+  for (std::uint32_t k = 0; k < slots; ++k)
+    for (const std::uint32_t p : particles) {
+      const bool has = k < edge_offsets[p + 1] - edge_offsets[p];
+      const Edge e = has ? edges[edge_offsets[p] + k] : Edge{p, Real(0), Real(0), 0};
+      l.other.push_back(e.other);
+      l.rest.push_back(e.rest_length);
+      l.stiff.push_back(e.stiffness);
+      l.ring.push_back(e.ring);
+      reads_last = reads_last || e.other == last;
+    }
+  l.ring_end.push_back(l.spring_begin.back() + ring_slots * std::uint32_t(l.width));
+  l.reads_last.push_back(reads_last);
+  l.spring_begin.push_back(std::uint32_t(l.other.size()));
+}
+
+/// Vertex block descent's per-particle state of a substep (vbd.cpp).
+template <typename Real> struct VbdWorkspace {
+  using Vec3 = glm::vec<3, Real, glm::defaultp>;
+  std::vector<Vec3> x0;   ///< positions at the substep's start
+  std::vector<Vec3> y;    ///< inertia targets
+  std::vector<Vec3> push; ///< the colliders' projection move of the last iteration
+  /// The SIMD lanes' gather lists, padded per vector of each colour's whole vectors (pad_vector),
+  /// and each colour's first vector in them; built by the first substep on lanes.
+  std::unique_ptr<PaddedLists<Real>> lists;
+  std::vector<std::uint32_t> colour_vector;
 };
 
 /// check_finite's test, branch-free (vectorisable OR-reduction over flat arrays of n3 components):
@@ -110,7 +145,8 @@ template <typename Real> struct CpuSolver<Real>::Impl {
   void vbd_solve_colour(std::uint32_t colour, Real h);
   /// The whole SIMD vectors of a colour's particles (row_kernel.hpp VbdArgs); returns how many it
   /// stepped (0 without SIMD or with a mesh collider).
-  std::size_t vbd_colour_lanes(std::span<const std::uint32_t> particles, Real h);
+  std::size_t vbd_colour_lanes(std::uint32_t colour, std::span<const std::uint32_t> particles, Real h);
+  void pad_vbd_lists(std::size_t width);
   void vbd_finish(Real h);
   // Stretch control after a substep (docs/model.md "Stretch control").
   void limit_stretch(Real h);

@@ -192,29 +192,13 @@ std::unique_ptr<detail::PaddedLists<Real>>
 pad_lists(std::size_t width, std::span<const std::uint32_t> edge_offsets,
           std::span<const std::uint32_t> fan_ends, const std::vector<Edge>& edges) {
   auto lists = std::make_unique<detail::PaddedLists<Real>>();
-  detail::PaddedLists<Real>& l = *lists;
-  l.width = width;
-  const std::size_t n = edge_offsets.size() - 1, vectors = n / width;
-  l.spring_begin.push_back(0);
+  lists->width = width;
+  const std::size_t vectors = (edge_offsets.size() - 1) / width;
+  std::vector<std::uint32_t> particles(width);
   for (std::size_t b = 0; b < vectors; ++b) {
-    std::uint32_t slots = 0, ring_slots = 0;
-    for (std::size_t p = b * width; p < (b + 1) * width; ++p) {
-      slots = std::max(slots, edge_offsets[p + 1] - edge_offsets[p]);
-      ring_slots = std::max(ring_slots, fan_ends[p] - edge_offsets[p]);
-    }
-    for (std::uint32_t k = 0; k < slots; ++k)
-      for (std::size_t p = b * width; p < (b + 1) * width; ++p) {
-        const bool has = k < edge_offsets[p + 1] - edge_offsets[p];
-        const Edge e = has ? edges[edge_offsets[p] + k] : Edge{std::uint32_t(p), Real(0), Real(0), 0};
-        l.other.push_back(e.other);
-        l.rest.push_back(e.rest_length);
-        l.stiff.push_back(e.stiffness);
-        l.ring.push_back(e.ring);
-      }
-    l.ring_end.push_back(l.spring_begin.back() + ring_slots * std::uint32_t(width));
-    l.reads_last.push_back(std::find(l.other.begin() + l.spring_begin.back(), l.other.end(), n - 1) !=
-                           l.other.end());
-    l.spring_begin.push_back(std::uint32_t(l.other.size()));
+    for (std::size_t l = 0; l < width; ++l)
+      particles[l] = std::uint32_t(b * width + l);
+    detail::pad_vector(*lists, std::span<const std::uint32_t>(particles), edge_offsets, fan_ends, edges);
   }
   return lists;
 }

@@ -116,8 +116,14 @@ template <typename Real> struct VbdArgs {
   const Real* start;          // AoS, the positions at the substep's start x0
   const Real* mass;
   const std::uint8_t* pinned;
-  const std::uint32_t* edge_offsets;
-  const SolverEdge<Real>* edges;
+  // The colour's gather lists padded per vector (as ListArgs'): vector v = vector0 + k / W holds
+  // the particles order[k .. k + W), its slots [spring_begin[v], spring_begin[v + 1]).
+  std::uint32_t vector0;
+  const std::uint32_t* spring_begin;
+  const std::uint32_t* other;
+  const Real* rest;
+  const Real* stiff;
+  const std::uint8_t* reads_last;
   const FinishShape<Real>* shapes; // every collider (no mesh), at most finish_max_shapes
   std::uint32_t shape_count;
   Real eps, h, mu; // contact_epsilon, the substep, the damping

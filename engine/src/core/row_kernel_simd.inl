@@ -494,31 +494,20 @@ std::int64_t simd_vbd_colour(const vkcloth::detail::VbdArgs<typename T::Real>& a
     const std::uint32_t* idx = a.order + k;
     const L3 x = gather(a.pos, idx), y = gather(a.target, idx), x0 = gather(a.start, idx);
     Real mv[W];
-    std::uint32_t first[W], count[W], longest = 0;
-    for (int l = 0; l < W; ++l) {
+    for (int l = 0; l < W; ++l)
       mv[l] = a.mass[idx[l]];
-      first[l] = a.edge_offsets[idx[l]];
-      count[l] = a.edge_offsets[idx[l] + 1] - first[l];
-      longest = count[l] > longest ? count[l] : longest;
-    }
     const L m = lanes(mv);
     L3 f(L(Real(0)));
     B hessian{L3(L(Real(0))), L3(L(Real(0)))};
-    for (std::uint32_t s = 0; s < longest; ++s) {
-      std::uint32_t others[W];
-      Real rest[W], stiffness[W];
-      for (int l = 0; l < W; ++l) {
-        others[l] = idx[l];
-        rest[l] = stiffness[l] = Real(0);
-        if (s < count[l]) {
-          const auto& e = a.edges[first[l] + s];
-          others[l] = e.other;
-          rest[l] = e.rest_length;
-          stiffness[l] = e.stiffness;
-        }
-      }
-      const L3 other = gather(a.pos, others);
-      vbd_add_spring(f, hessian, other - x, lanes(rest), lanes(stiffness));
+    const std::size_t v = a.vector0 + std::size_t(k / W);
+    const bool reads_last = a.reads_last[v];
+    for (std::uint32_t s = a.spring_begin[v]; s < a.spring_begin[v + 1]; s += W) {
+      typename T::V ox, oy, oz;
+      if (reads_last)
+        T::gather3_last(a.pos, a.other + s, ox, oy, oz);
+      else
+        T::gather3(a.pos, a.other + s, ox, oy, oz);
+      vbd_add_spring(f, hessian, L3(L(ox), L(oy), L(oz)) - x, load<T>(a.rest + s), load<T>(a.stiff + s));
     }
     L3 stepped = vbd_step(x, y, x0, f, hessian, m, h, mu);
     const L inertia = vbd_inertia_weight(m, h, mu);

@@ -84,7 +84,7 @@ void CpuSolver<Real>::Impl::vbd_solve_colour(const std::uint32_t colour, const R
     w.push[p] = projected - stepped;
     pos_[p] = projected;
   };
-  const std::size_t simd_end = vbd_colour_lanes(order.subspan(first, count), h);
+  const std::size_t simd_end = vbd_colour_lanes(colour, order.subspan(first, count), h);
   if (simd_end > 0) // fewer than one vector left: here, not another fork-join
     for (std::size_t k = simd_end; k < count; ++k)
       step(k);
@@ -93,14 +93,18 @@ void CpuSolver<Real>::Impl::vbd_solve_colour(const std::uint32_t colour, const R
 }
 
 // Whole vectors of a colour on SIMD lanes (the kernel's functions on lanes), when every collider is
-// one the lanes take (no mesh).
+// one the lanes take (no mesh). The first call pads every colour's gather lists for the lanes.
 template <typename Real>
-std::size_t CpuSolver<Real>::Impl::vbd_colour_lanes(std::span<const std::uint32_t> particles, const Real h) {
+std::size_t CpuSolver<Real>::Impl::vbd_colour_lanes(std::uint32_t colour,
+                                                    std::span<const std::uint32_t> particles, const Real h) {
 #if VKCLOTH_ROW_SIMD
   if (simd_ == 0 || contacts_->finish.size() != contacts_->shapes.size())
     return 0;
   auto& w = *vbd_;
   const std::size_t width = (simd_ == 2 ? 64 : 32) / sizeof(Real);
+  if (!w.lists || w.lists->width != width)
+    pad_vbd_lists(width);
+  const detail::PaddedLists<Real>& l = *w.lists;
   const std::size_t end = particles.size() - particles.size() % width;
   const detail::VbdArgs<Real> a{particles.data(),
                                 std::uint32_t(pos_.size()),
@@ -110,8 +114,12 @@ std::size_t CpuSolver<Real>::Impl::vbd_colour_lanes(std::span<const std::uint32_
                                 &w.x0[0].x,
                                 mass_.data(),
                                 pinned_.data(),
-                                edge_offsets_.data(),
-                                edges_.data(),
+                                w.colour_vector[colour],
+                                l.spring_begin.data(),
+                                l.other.data(),
+                                l.rest.data(),
+                                l.stiff.data(),
+                                l.reads_last.data(),
                                 contacts_->finish.data(),
                                 std::uint32_t(contacts_->finish.size()),
                                 Real(params_.contact_epsilon),
@@ -129,10 +137,26 @@ std::size_t CpuSolver<Real>::Impl::vbd_colour_lanes(std::span<const std::uint32_
   });
   return end;
 #else
+  (void)colour;
   (void)particles;
   (void)h;
   return 0;
 #endif
+}
+
+// Each colour's whole vectors of `width` particles, in the colour's order, padded (pad_vector).
+template <typename Real> void CpuSolver<Real>::Impl::pad_vbd_lists(const std::size_t width) {
+  auto& w = *vbd_;
+  w.lists = std::make_unique<detail::PaddedLists<Real>>();
+  w.lists->width = width;
+  w.colour_vector.clear();
+  const auto order = topology_->vertex_order();
+  const auto offsets = topology_->vertex_colour_offsets();
+  for (std::size_t c = 0; c + 1 < offsets.size(); ++c) {
+    w.colour_vector.push_back(std::uint32_t(w.lists->reads_last.size()));
+    for (std::uint32_t k = offsets[c]; k + width <= offsets[c + 1]; k += std::uint32_t(width))
+      detail::pad_vector(*w.lists, order.subspan(k, width), edge_offsets_, topology_->fan_ends(), edges_);
+  }
 }
 
 template <typename Real> void CpuSolver<Real>::Impl::vbd_finish(const Real h) {
