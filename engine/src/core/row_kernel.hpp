@@ -129,6 +129,24 @@ template <typename Real> struct VbdArgs {
   Real eps, h, mu; // contact_epsilon, the substep, the damping
 };
 
+/// The end of a vbd substep (CpuSolver::vbd_finish), W consecutive particles per vector: each free
+/// particle keeps the last sweep's position, takes vbd_velocity less its inward part (each collider's
+/// contact_response without friction), is projected (project_out) and gets vbd_net_force; a pinned
+/// one keeps its position and velocity, with no force.
+template <typename Real> struct VbdFinishArgs {
+  Real* pos;         // AoS: the last sweep's positions in, the step's out
+  const Real* push;  // AoS: the last sweep's projection moves
+  const Real* start; // AoS: the positions at the substep's start x0
+  Real* vel;         // AoS: v0 in, v out
+  Real* force;       // AoS, out
+  const Real* mass;
+  const std::uint8_t* pinned;
+  const FinishShape<Real>* shapes; // every collider (no mesh), at most finish_max_shapes
+  std::uint32_t shape_count;
+  Real band, eps, h; // 2 contact_epsilon, contact_epsilon, the substep
+  bool both;         // !contact_inward_only
+};
+
 // Each processes whole vectors from q0 and returns where it stopped (q1 minus the remainder, which
 // the caller finishes through the per-particle reference). No finite check (the caller's).
 std::int64_t finish_avx512(const FinishArgs<float>& a, std::int64_t q0, std::int64_t q1);
@@ -157,5 +175,10 @@ std::int64_t vbd_colour_avx512(const VbdArgs<float>& a, std::int64_t k0, std::in
 std::int64_t vbd_colour_avx512(const VbdArgs<double>& a, std::int64_t k0, std::int64_t k1);
 std::int64_t vbd_colour_avx2(const VbdArgs<float>& a, std::int64_t k0, std::int64_t k1);
 std::int64_t vbd_colour_avx2(const VbdArgs<double>& a, std::int64_t k0, std::int64_t k1);
+// Each finishes the whole vectors of particles [q0, q1) and returns where it stopped.
+std::int64_t vbd_finish_avx512(const VbdFinishArgs<float>& a, std::int64_t q0, std::int64_t q1);
+std::int64_t vbd_finish_avx512(const VbdFinishArgs<double>& a, std::int64_t q0, std::int64_t q1);
+std::int64_t vbd_finish_avx2(const VbdFinishArgs<float>& a, std::int64_t q0, std::int64_t q1);
+std::int64_t vbd_finish_avx2(const VbdFinishArgs<double>& a, std::int64_t q0, std::int64_t q1);
 
 } // namespace vkcloth::detail

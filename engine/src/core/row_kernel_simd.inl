@@ -532,6 +532,47 @@ std::int64_t simd_vbd_colour(const vkcloth::detail::VbdArgs<typename T::Real>& a
   }
   return k;
 }
+
+// CpuSolver::vbd_finish on W consecutive particles per vector (VbdFinishArgs).
+template <typename T>
+std::int64_t simd_vbd_finish(const vkcloth::detail::VbdFinishArgs<typename T::Real>& a, std::int64_t q0,
+                             std::int64_t q1) {
+  using Real = typename T::Real;
+  using L = Lanes<T>;
+  using L3 = Lanes3<T>;
+  using S = typename ShapeOf<T>::type;
+  constexpr int W = T::W;
+  if (a.shape_count > vkcloth::detail::finish_max_shapes)
+    return q0; // the caller finishes them all
+  S shapes[vkcloth::detail::finish_max_shapes];
+  for (std::uint32_t c = 0; c < a.shape_count; ++c)
+    shapes[c] = lane_shape<T>(a.shapes[c]);
+  const L h(a.h), band(a.band), eps(a.eps);
+  std::int64_t q = q0;
+  for (; q + W <= q1; q += W) {
+    const L3 x0 = load3<T>(a.start + 3 * q), v0 = load3<T>(a.vel + 3 * q), x_in = load3<T>(a.pos + 3 * q);
+    const L m = load<T>(a.mass + q);
+    const L h_over_m = h / m;
+    L3 x = x_in;
+    L3 v = vbd_velocity(x, load3<T>(a.push + 3 * q), x0, h);
+    L3 no_force(L(Real(0)));
+    for (std::uint32_t c = 0; c < a.shape_count; ++c) { // contact_at without friction
+      const S s = without_friction(shapes[c]);
+      L distance;
+      L3 n;
+      collider_contact(NoMesh{}, s, x, x, band, distance, n);
+      contact_response(v, no_force, s, x, n, distance, band, a.both, h_over_m);
+    }
+    for (std::uint32_t c = 0; c < a.shape_count; ++c) // project_at
+      project_out(NoMesh{}, shapes[c], eps, x0, x, v);
+    const L3 f = vbd_net_force(v, v0, m, h);
+    const Mask<T> pin(T::pinmask(a.pinned + q));
+    store3<T>(a.force + 3 * q, select(pin, L3(L(Real(0))), f));
+    store3<T>(a.pos + 3 * q, select(pin, x_in, x));
+    store3<T>(a.vel + 3 * q, select(pin, v0, v));
+  }
+  return q;
+}
 #undef VKCLOTH_AI
 
 } // namespace

@@ -19,6 +19,7 @@ using vec3 = Uniform3<Isa>;
 using uniform::ColliderShape;
 using uniform::has_friction;
 using uniform::still_frictionless;
+using uniform::without_friction;
 
 // No mesh collider reaches the lanes (CpuSolver takes a mesh's particles one by one): collider_contact's
 // mesh branch is never taken here.

@@ -161,7 +161,7 @@ template <typename Real> void CpuSolver<Real>::Impl::pad_vbd_lists(const std::si
 
 template <typename Real> void CpuSolver<Real>::Impl::vbd_finish(const Real h) {
   auto& w = *vbd_;
-  pool_->for_each(pos_.size(), [&](std::size_t p) {
+  auto finish = [&](std::size_t p) {
     if (pinned_[p]) {
       force_[p] = Vec3(0);
       return; // stays put with its velocity
@@ -175,6 +175,34 @@ template <typename Real> void CpuSolver<Real>::Impl::vbd_finish(const Real h) {
     force_[p] = kernel::vbd_net_force(v, vel_[p], mass_[p], h);
     pos_[p] = x;
     vel_[p] = v;
+  };
+  pool_->parallel_for(pos_.size(), [&](std::size_t begin, std::size_t end) {
+    std::size_t p = begin;
+#if VKCLOTH_ROW_SIMD
+    if (simd_ != 0 && contacts_->finish.size() == contacts_->shapes.size()) { // whole vectors on lanes
+      const detail::VbdFinishArgs<Real> a{&pos_[0].x,
+                                          &w.push[0].x,
+                                          &w.x0[0].x,
+                                          &vel_[0].x,
+                                          &force_[0].x,
+                                          mass_.data(),
+                                          pinned_.data(),
+                                          contacts_->finish.data(),
+                                          std::uint32_t(contacts_->finish.size()),
+                                          Real(2) * Real(params_.contact_epsilon),
+                                          Real(params_.contact_epsilon),
+                                          h,
+                                          !params_.contact_inward_only};
+#if VKCLOTH_ROW_AVX512
+      if (simd_ == 2)
+        p = std::size_t(detail::vbd_finish_avx512(a, std::int64_t(begin), std::int64_t(end)));
+      else
+#endif
+        p = std::size_t(detail::vbd_finish_avx2(a, std::int64_t(begin), std::int64_t(end)));
+    }
+#endif
+    for (; p < end; ++p)
+      finish(p);
   });
 }
 
