@@ -78,6 +78,12 @@ template <typename Real> struct VbdWorkspace {
   /// and each colour's first vector in them; built by the first substep on lanes.
   std::unique_ptr<PaddedLists<Real>> lists;
   std::vector<std::uint32_t> colour_vector;
+  /// The begin's fan triangles padded per vector of consecutive particles (VbdBeginArgs), for
+  /// `fan_width` lanes (0: not built).
+  std::size_t fan_width = 0;
+  std::vector<std::uint32_t> fan_begin, fan_a, fan_b;
+  std::vector<Real> fan_on;
+  std::vector<std::uint8_t> fan_reads_last;
 };
 
 /// check_finite's test, branch-free (vectorisable OR-reduction over flat arrays of n3 components):
@@ -147,6 +153,10 @@ template <typename Real> struct CpuSolver<Real>::Impl {
   /// stepped (0 without SIMD or with a mesh collider).
   std::size_t vbd_colour_lanes(std::uint32_t colour, std::span<const std::uint32_t> particles, Real h);
   void pad_vbd_lists(std::size_t width);
+  void pad_vbd_fans(std::size_t width);
+  /// The SIMD lanes' width in particles; 1 where they do not apply (no SIMD, or a mesh collider).
+  std::size_t vbd_lane_width() const;
+  std::size_t vbd_begin_lanes(std::size_t begin, std::size_t end, Real h);
   void vbd_finish(Real h);
   // Stretch control after a substep (docs/model.md "Stretch control").
   void limit_stretch(Real h);

@@ -129,6 +129,29 @@ template <typename Real> struct VbdArgs {
   Real eps, h, mu; // contact_epsilon, the substep, the damping
 };
 
+/// The start of a vbd substep (CpuSolver::vbd_begin), W consecutive particles per vector: the normal
+/// from the fan triangles (padded per vector like ListArgs' springs: a slot past a particle's fan has
+/// fan_on 0 and adds nothing), the external force, the inertia target and the first guess projected
+/// out of the colliders; a pinned particle's target and position are its start. Grids only (the
+/// topology's fans; ring-ordered normals take the per-particle reference).
+template <typename Real> struct VbdBeginArgs {
+  const Real* start; // AoS: the positions at the substep's start x0
+  const Real* vel;   // AoS: v0
+  const Real* mass;
+  const std::uint8_t* pinned;
+  const std::uint32_t* fan_begin; // per vector: its slots [fan_begin[v], fan_begin[v + 1])
+  const std::uint32_t* fan_a;     // per slot and lane: the triangle's corners
+  const std::uint32_t* fan_b;
+  const Real* fan_on;                 // 1 for a triangle, 0 for padding
+  const std::uint8_t* fan_reads_last; // per vector: some slot names the last particle
+  Real* normal;                       // AoS, out
+  Real* target;                       // AoS, out: y
+  Real* pos;                          // AoS, out: the first guess, projected
+  const FinishShape<Real>* shapes;    // every collider (no mesh), at most finish_max_shapes
+  std::uint32_t shape_count;
+  Real gravity[3], wind_dir[3], kw, eps, h;
+};
+
 /// The end of a vbd substep (CpuSolver::vbd_finish), W consecutive particles per vector: each free
 /// particle keeps the last sweep's position, takes vbd_velocity less its inward part (each collider's
 /// contact_response without friction), is projected (project_out) and gets vbd_net_force; a pinned
@@ -175,6 +198,11 @@ std::int64_t vbd_colour_avx512(const VbdArgs<float>& a, std::int64_t k0, std::in
 std::int64_t vbd_colour_avx512(const VbdArgs<double>& a, std::int64_t k0, std::int64_t k1);
 std::int64_t vbd_colour_avx2(const VbdArgs<float>& a, std::int64_t k0, std::int64_t k1);
 std::int64_t vbd_colour_avx2(const VbdArgs<double>& a, std::int64_t k0, std::int64_t k1);
+// Each begins the whole vectors of particles [q0, q1) (q0 a multiple of W) and returns where it stopped.
+std::int64_t vbd_begin_avx512(const VbdBeginArgs<float>& a, std::int64_t q0, std::int64_t q1);
+std::int64_t vbd_begin_avx512(const VbdBeginArgs<double>& a, std::int64_t q0, std::int64_t q1);
+std::int64_t vbd_begin_avx2(const VbdBeginArgs<float>& a, std::int64_t q0, std::int64_t q1);
+std::int64_t vbd_begin_avx2(const VbdBeginArgs<double>& a, std::int64_t q0, std::int64_t q1);
 // Each finishes the whole vectors of particles [q0, q1) and returns where it stopped.
 std::int64_t vbd_finish_avx512(const VbdFinishArgs<float>& a, std::int64_t q0, std::int64_t q1);
 std::int64_t vbd_finish_avx512(const VbdFinishArgs<double>& a, std::int64_t q0, std::int64_t q1);

@@ -147,6 +147,12 @@ std::int64_t vbd_colour_avx512(const VbdArgs<float>& a, std::int64_t k0, std::in
 std::int64_t vbd_colour_avx512(const VbdArgs<double>& a, std::int64_t k0, std::int64_t k1) {
   return simd_vbd_colour<IsaD>(a, k0, k1);
 }
+std::int64_t vbd_begin_avx512(const VbdBeginArgs<float>& a, std::int64_t q0, std::int64_t q1) {
+  return simd_vbd_begin<IsaF>(a, q0, q1);
+}
+std::int64_t vbd_begin_avx512(const VbdBeginArgs<double>& a, std::int64_t q0, std::int64_t q1) {
+  return simd_vbd_begin<IsaD>(a, q0, q1);
+}
 std::int64_t vbd_finish_avx512(const VbdFinishArgs<float>& a, std::int64_t q0, std::int64_t q1) {
   return simd_vbd_finish<IsaF>(a, q0, q1);
 }

@@ -533,6 +533,58 @@ std::int64_t simd_vbd_colour(const vkcloth::detail::VbdArgs<typename T::Real>& a
   return k;
 }
 
+// CpuSolver::vbd_begin on W consecutive particles per vector (VbdBeginArgs).
+template <typename T>
+std::int64_t simd_vbd_begin(const vkcloth::detail::VbdBeginArgs<typename T::Real>& a, std::int64_t q0,
+                            std::int64_t q1) {
+  using Real = typename T::Real;
+  using L = Lanes<T>;
+  using L3 = Lanes3<T>;
+  using S = typename ShapeOf<T>::type;
+  constexpr int W = T::W;
+  if (a.shape_count > vkcloth::detail::finish_max_shapes)
+    return q0; // the caller begins them all
+  S shapes[vkcloth::detail::finish_max_shapes];
+  for (std::uint32_t c = 0; c < a.shape_count; ++c)
+    shapes[c] = lane_shape<T>(a.shapes[c]);
+  const L h(a.h), eps(a.eps), kw(a.kw), zero(Real(0));
+  const L3 g(L(a.gravity[0]), L(a.gravity[1]), L(a.gravity[2]));
+  const L3 wind_dir(L(a.wind_dir[0]), L(a.wind_dir[1]), L(a.wind_dir[2]));
+  const bool wind = a.kw != Real(0);
+  std::int64_t q = q0;
+  for (; q + W <= q1; q += W) {
+    const std::size_t v = std::size_t(q / W);
+    const L3 x0 = load3<T>(a.start + 3 * q), v0 = load3<T>(a.vel + 3 * q);
+    const L m = load<T>(a.mass + q);
+    L3 fan(zero);
+    const bool reads_last = a.fan_reads_last[v];
+    for (std::uint32_t s = a.fan_begin[v]; s < a.fan_begin[v + 1]; s += W) { // normal_at
+      typename T::V ax, ay, az, bx, by, bz;
+      if (reads_last) {
+        T::gather3_last(a.start, a.fan_a + s, ax, ay, az);
+        T::gather3_last(a.start, a.fan_b + s, bx, by, bz);
+      } else {
+        T::gather3(a.start, a.fan_a + s, ax, ay, az);
+        T::gather3(a.start, a.fan_b + s, bx, by, bz);
+      }
+      L3 sum = fan;
+      add_fan_triangle(sum, L3(L(ax), L(ay), L(az)) - x0, L3(L(bx), L(by), L(bz)) - x0);
+      fan = select(load<T>(a.fan_on + s) != zero, sum, fan); // padding adds nothing, not even +0
+    }
+    const L3 n = unit_or_zero(fan);
+    store3<T>(a.normal + 3 * q, n);
+    const L3 f_ext = add_body_forces(L3(zero), m, L3(zero), g, zero, wind, n, wind_dir, kw);
+    const L3 y = vbd_inertia_target(x0, v0, f_ext, m, h);
+    L3 x = vbd_first_guess(x0, v0, h), unused(zero);
+    for (std::uint32_t c = 0; c < a.shape_count; ++c) // project_at
+      project_out(NoMesh{}, shapes[c], eps, x0, x, unused);
+    const Mask<T> pin(T::pinmask(a.pinned + q));
+    store3<T>(a.target + 3 * q, select(pin, x0, y));
+    store3<T>(a.pos + 3 * q, select(pin, x0, x));
+  }
+  return q;
+}
+
 // CpuSolver::vbd_finish on W consecutive particles per vector (VbdFinishArgs).
 template <typename T>
 std::int64_t simd_vbd_finish(const vkcloth::detail::VbdFinishArgs<typename T::Real>& a, std::int64_t q0,

@@ -40,8 +40,7 @@ template <typename Real> void CpuSolver<Real>::Impl::vbd_begin(const Real h) {
   w.push.assign(n, Vec3(0));
   const Real kw = Real(params_.wind.strength);
   const Vec3 g{params_.gravity}, wind_dir{params_.wind.direction};
-  // One pass: the normals read the start (x0), so writing the first guesses into pos_ races nothing.
-  pool_->for_each(n, [&](std::size_t p) {
+  auto begin_one = [&](std::size_t p) {
     normal_at(w.x0, p); // the normal at the start (wind; what a host observes)
     const Vec3 f_ext = kernel::add_body_forces(Vec3(0), mass_[p], Vec3(0), g, Real(0), kw != Real(0),
                                                normal_[p], wind_dir, kw);
@@ -53,7 +52,97 @@ template <typename Real> void CpuSolver<Real>::Impl::vbd_begin(const Real h) {
     Vec3 x = kernel::vbd_first_guess(w.x0[p], vel_[p], h), unused(0); // out of the colliders
     project_at(w.x0[p], x, unused);
     pos_[p] = x;
+  };
+  const std::size_t width = vbd_lane_width();
+  if (width > 1 && !topology_->ring_normals() && w.fan_width != width)
+    pad_vbd_fans(width);
+  // One pass: the normals read the start (x0), so writing the first guesses into pos_ races nothing.
+  pool_->parallel_for(n, [&](std::size_t begin, std::size_t end) {
+    std::size_t p = begin;
+    if (w.fan_width == width && width > 1) { // to a whole vector, then whole vectors on the lanes
+      for (const std::size_t aligned = std::min(end, (begin + width - 1) / width * width); p < aligned; ++p)
+        begin_one(p);
+      p = vbd_begin_lanes(p, end, h);
+    }
+    for (; p < end; ++p)
+      begin_one(p);
   });
+}
+
+template <typename Real> std::size_t CpuSolver<Real>::Impl::vbd_lane_width() const {
+  if (simd_ == 0 || contacts_->finish.size() != contacts_->shapes.size())
+    return 1;
+  return (simd_ == 2 ? 64 : 32) / sizeof(Real);
+}
+
+// The begin's whole vectors of consecutive particles from q0 (a multiple of the width) on the lanes;
+// returns where they stopped.
+template <typename Real>
+std::size_t CpuSolver<Real>::Impl::vbd_begin_lanes(const std::size_t q0, const std::size_t q1, const Real h) {
+#if VKCLOTH_ROW_SIMD
+  auto& w = *vbd_;
+  const glm::dvec3 g = params_.gravity, wind = params_.wind.direction;
+  const detail::VbdBeginArgs<Real> a{&w.x0[0].x,
+                                     &vel_[0].x,
+                                     mass_.data(),
+                                     pinned_.data(),
+                                     w.fan_begin.data(),
+                                     w.fan_a.data(),
+                                     w.fan_b.data(),
+                                     w.fan_on.data(),
+                                     w.fan_reads_last.data(),
+                                     &normal_[0].x,
+                                     &w.y[0].x,
+                                     &pos_[0].x,
+                                     contacts_->finish.data(),
+                                     std::uint32_t(contacts_->finish.size()),
+                                     {Real(g.x), Real(g.y), Real(g.z)},
+                                     {Real(wind.x), Real(wind.y), Real(wind.z)},
+                                     Real(params_.wind.strength),
+                                     Real(params_.contact_epsilon),
+                                     h};
+#if VKCLOTH_ROW_AVX512
+  if (simd_ == 2)
+    return std::size_t(detail::vbd_begin_avx512(a, std::int64_t(q0), std::int64_t(q1)));
+#endif
+  return std::size_t(detail::vbd_begin_avx2(a, std::int64_t(q0), std::int64_t(q1)));
+#else
+  (void)q1;
+  (void)h;
+  return q0;
+#endif
+}
+
+// The fan triangles of each whole vector of `width` consecutive particles, padded to the vector's
+// largest fan (fan_on 0 past a particle's own).
+template <typename Real> void CpuSolver<Real>::Impl::pad_vbd_fans(const std::size_t width) {
+  auto& w = *vbd_;
+  const auto offsets = topology_->fan_offsets();
+  const auto fans = topology_->fans();
+  const std::size_t n = pos_.size();
+  w.fan_begin.assign(1, 0);
+  w.fan_a.clear();
+  w.fan_b.clear();
+  w.fan_on.clear();
+  w.fan_reads_last.clear();
+  for (std::size_t q = 0; q + width <= n; q += width) {
+    std::uint32_t slots = 0;
+    for (std::size_t p = q; p < q + width; ++p)
+      slots = std::max(slots, offsets[p + 1] - offsets[p]);
+    bool reads_last = false;
+    for (std::uint32_t k = 0; k < slots; ++k)
+      for (std::size_t p = q; p < q + width; ++p) {
+        const bool has = k < offsets[p + 1] - offsets[p];
+        const FanTriangle t = has ? fans[offsets[p] + k] : FanTriangle{std::uint32_t(p), std::uint32_t(p)};
+        w.fan_a.push_back(t.a);
+        w.fan_b.push_back(t.b);
+        w.fan_on.push_back(has ? Real(1) : Real(0));
+        reads_last = reads_last || t.a == n - 1 || t.b == n - 1;
+      }
+    w.fan_reads_last.push_back(reads_last);
+    w.fan_begin.push_back(std::uint32_t(w.fan_a.size()));
+  }
+  w.fan_width = width;
 }
 
 template <typename Real>
@@ -98,10 +187,10 @@ template <typename Real>
 std::size_t CpuSolver<Real>::Impl::vbd_colour_lanes(std::uint32_t colour,
                                                     std::span<const std::uint32_t> particles, const Real h) {
 #if VKCLOTH_ROW_SIMD
-  if (simd_ == 0 || contacts_->finish.size() != contacts_->shapes.size())
+  const std::size_t width = vbd_lane_width();
+  if (width == 1)
     return 0;
   auto& w = *vbd_;
-  const std::size_t width = (simd_ == 2 ? 64 : 32) / sizeof(Real);
   if (!w.lists || w.lists->width != width)
     pad_vbd_lists(width);
   const detail::PaddedLists<Real>& l = *w.lists;
@@ -179,7 +268,7 @@ template <typename Real> void CpuSolver<Real>::Impl::vbd_finish(const Real h) {
   pool_->parallel_for(pos_.size(), [&](std::size_t begin, std::size_t end) {
     std::size_t p = begin;
 #if VKCLOTH_ROW_SIMD
-    if (simd_ != 0 && contacts_->finish.size() == contacts_->shapes.size()) { // whole vectors on lanes
+    if (vbd_lane_width() > 1) { // whole vectors on lanes
       const detail::VbdFinishArgs<Real> a{&pos_[0].x,
                                           &w.push[0].x,
                                           &w.x0[0].x,
