@@ -288,6 +288,26 @@ TEST_CASE("colliders: friction out of range names the key and the value") {
                {"colliders[1].friction", "-2"});
 }
 
+TEST_CASE("colliders: keyframes name the key, the index and the value (issue 39 point 8)") {
+  const std::string box = R"({"type": "box", "center": [0,0,0], "half_extents": [1,1,1], "keyframes": )";
+  expect_error(colliders(box + R"([{"t": 0}, {"t": 2}, {"t": 1}]})"),
+               {"colliders[0].keyframes[2].t", "greater than keyframes[1].t (2)", "time order", "got 1"});
+  expect_error(colliders(box + R"([{"t": 0}, {"t": 0}]})"), {"colliders[0].keyframes[1].t", "got 0"});
+  expect_error(colliders(box + R"([{"t": -1}]})"), {"colliders[0].keyframes[0].t", ">= 0", "got -1"});
+  expect_error(colliders(box + R"([]})"), {"colliders[0].keyframes", "at least one key"});
+  expect_error(colliders(box + R"({"t": 0}})"), {"colliders[0].keyframes", "an array"});
+  expect_error(colliders(box + R"([{"translate": [1,0,0]}]})"), {"colliders[0].keyframes[0]", "t"});
+  expect_error(colliders(box + R"([{"t": 0, "rotate": [0,0,90]}]})"),
+               {"colliders[0].keyframes[0]", "rotate"});
+  expect_error(colliders(box + R"([{"t": 0, "translate": [1,0]}]})"),
+               {"colliders[0].keyframes[0].translate"});
+  const Error both = expect_error(
+      colliders(R"({"type": "sphere", "center": [0,0,0], "radius": 1, "linear_velocity": [1,0,0], )"
+                R"("keyframes": [{"t": 0}]})"),
+      {"colliders[0].keyframes exclude linear_velocity"});
+  CHECK(both.code == ErrorCode::invalid_argument);
+}
+
 TEST_CASE("colliders: capsule radius and box half_extents must be > 0") {
   for (const char* r : {"0", "-0.5"}) {
     CAPTURE(r);

@@ -53,7 +53,10 @@ void print_collider(std::size_t k, const Collider& c) {
     break;
   }
   fmt::print("      friction {:g} (static {:g})", c.friction, c.static_coefficient());
-  if (c.moving())
+  if (c.path)
+    fmt::print(", keyframed: {} keys from t = {:g} s to {:g} s\n", c.path->keys.size(),
+               c.path->keys.front().t, c.path->keys.back().t);
+  else if (c.moving())
     fmt::print(", linear_velocity {} m/s, angular_velocity {} rad/s\n", vec(c.linear_velocity),
                vec(c.angular_velocity));
   else

@@ -47,6 +47,17 @@ std::optional<Integrator> parse_integrator(std::string_view name);
 struct ColliderPose; // below: a collider's pose for a per-frame update
 class ColliderMesh;  // vkcloth/collider_mesh.hpp: a static triangle mesh and its bounding-volume hierarchy
 
+struct ColliderPath;
+
+/// A keyframed collider's pose at time t (docs/scene-format.md "keyframes"): the collider as it was
+/// given (Collider::with_keyframes) turned by rotate_deg about its centre (R = Rz Ry Rx, x first) and
+/// moved by translate.
+struct ColliderKeyframe {
+  double t = 0.0;             ///< s, >= 0, increasing along a path
+  glm::dvec3 translate{0.0};  ///< m
+  glm::dvec3 rotate_deg{0.0}; ///< degrees
+};
+
 /// A collider (docs/model.md "Collisions", docs/scene-format.md "colliders"): a shape, its friction and
 /// its motion. Every shape has the report's semantics: within 2 eps of the surface the inward parts of
 /// v and F go; after the update a point inside is put back at surface + eps.
@@ -77,6 +88,10 @@ struct Collider {
   double static_friction = -1.0;
   glm::dvec3 linear_velocity{0.0};  ///< m/s
   glm::dvec3 angular_velocity{0.0}; ///< rad/s about centre() (a plane takes linear velocity only)
+  /// Keyframed motion (with_keyframes; null: none): posed_at follows the path from path_time, and the
+  /// velocities are the path's over each advance. A host's with_pose ends it.
+  std::shared_ptr<const ColliderPath> path;
+  double path_time = 0.0; ///< s: the time along `path` the fields are posed at
 
   static Collider plane(glm::dvec3 normal, double offset);
   static Collider sphere(glm::dvec3 center, double radius);
@@ -92,13 +107,33 @@ struct Collider {
   glm::dvec3 centre() const;
   /// static_friction, or friction when static_friction < 0.
   double static_coefficient() const { return static_friction < 0.0 ? friction : static_friction; }
-  bool moving() const { return linear_velocity != glm::dvec3(0.0) || angular_velocity != glm::dvec3(0.0); }
+  bool moving() const {
+    return linear_velocity != glm::dvec3(0.0) || angular_velocity != glm::dvec3(0.0) || path != nullptr;
+  }
   /// This collider `seconds` later: moved by linear_velocity * seconds and turned by angular_velocity
-  /// * seconds about centre() (Rodrigues, in double); velocities and friction unchanged.
+  /// * seconds about centre() (Rodrigues, in double); velocities and friction unchanged. A keyframed
+  /// one takes its path's pose at path_time + seconds, and for velocities the path's motion over
+  /// those seconds (the translation's change and the turn, each divided by `seconds`).
   Collider posed_at(double seconds) const;
+  /// This collider moved along keyframes: at time t it is this collider turned by the pose's rotation
+  /// about centre() and moved by its translation; between keys the translation is linear and the
+  /// rotation a slerp; before the first key and past the last the pose holds. Returned posed at t = 0,
+  /// at rest. The keys need t >= 0, strictly increasing, finite values (the message names
+  /// keyframes[k] and the value); linear_velocity and angular_velocity must be zero.
+  Result<Collider> with_keyframes(std::vector<ColliderKeyframe> keys) const;
   /// This collider moved to `pose` (ColliderPose says what each field sets); shape, friction and
   /// the rest unchanged. Not validated: ColliderPose::validate and SimParams::validate do that.
   Collider with_pose(const ColliderPose& pose) const;
+};
+
+/// A keyframed collider's path (Collider::with_keyframes): its keys and the collider they move.
+struct ColliderPath {
+  std::vector<ColliderKeyframe> keys;
+  Collider base; ///< the collider at translate 0, rotate 0 (no path of its own)
+  /// The translation and rotation at time t (held before the first key and past the last).
+  void pose(double t, glm::dvec3& translate, glm::dmat3& rotation) const;
+  /// `base` at the pose of time t (velocities zero).
+  Collider at(double t) const;
 };
 
 /// A collider's pose for a per-frame update that keeps everything else (shape, size, friction,

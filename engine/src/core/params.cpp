@@ -8,6 +8,7 @@
 
 #include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
 
 #include "vkcloth/collider_mesh.hpp"
 
@@ -102,6 +103,13 @@ Result<void> validate_collider(Collider& c, const std::string& at) {
                                     c.static_friction));
   VKCLOTH_TRY(vec("linear_velocity", c.linear_velocity));
   VKCLOTH_TRY(vec("angular_velocity", c.angular_velocity));
+  if (c.path) { // its keys, as with_keyframes checked them (a host may have built the path itself)
+    Collider base = c.path->base;
+    base.path = nullptr;
+    auto checked = base.with_keyframes(c.path->keys);
+    if (!checked)
+      return bad_argument(fmt::format("{}.{}", at, checked.error().message));
+  }
   return {};
 }
 
@@ -171,10 +179,106 @@ glm::dvec3 Collider::centre() const {
   }
 }
 
+namespace {
+// The key of the last key at or before t (0 before the first).
+std::size_t key_before(const std::vector<ColliderKeyframe>& keys, double t) {
+  std::size_t k = 0;
+  while (k + 1 < keys.size() && keys[k + 1].t <= t)
+    ++k;
+  return k;
+}
+} // namespace
+
+void ColliderPath::pose(const double t, glm::dvec3& translate, glm::dmat3& rotation) const {
+  const std::size_t k = key_before(keys, t);
+  const ColliderKeyframe& k0 = keys[k];
+  const glm::dmat3 r0 = Collider::rotation_from_degrees(k0.rotate_deg);
+  if (k + 1 == keys.size() || t <= k0.t) { // held: before the first key, at a key, past the last
+    translate = k0.translate;
+    rotation = r0;
+    return;
+  }
+  const ColliderKeyframe& k1 = keys[k + 1];
+  const double s = (t - k0.t) / (k1.t - k0.t);
+  translate = k0.translate + (k1.translate - k0.translate) * s;
+  const glm::dquat q0 = glm::quat_cast(r0),
+                   q1 = glm::quat_cast(Collider::rotation_from_degrees(k1.rotate_deg));
+  rotation = glm::mat3_cast(glm::slerp(q0, glm::dot(q0, q1) < 0.0 ? -q1 : q1, s)); // the shorter way
+}
+
+Collider ColliderPath::at(const double t) const {
+  glm::dvec3 shift;
+  glm::dmat3 turn;
+  pose(t, shift, turn);
+  Collider c = base;
+  const glm::dvec3 pivot = base.centre();
+  if (base.type == Collider::Type::plane) { // turned about its point nearest the origin, then moved
+    c.normal = turn * base.normal;
+    c.offset = glm::dot(c.normal, pivot + shift);
+    return c;
+  }
+  c.center = pivot + shift + turn * (base.center - pivot);
+  c.a = pivot + shift + turn * (base.a - pivot);
+  c.b = pivot + shift + turn * (base.b - pivot);
+  c.rotation = turn * base.rotation;
+  return c;
+}
+
+Result<Collider> Collider::with_keyframes(std::vector<ColliderKeyframe> keys) const {
+  if (keys.empty())
+    return bad_argument("keyframes must hold at least one key, got none");
+  for (std::size_t k = 0; k < keys.size(); ++k) {
+    const ColliderKeyframe& key = keys[k];
+    if (!std::isfinite(key.t) || key.t < 0.0)
+      return bad_argument(fmt::format("keyframes[{}].t must be finite and >= 0, got {}", k, key.t));
+    if (k > 0 && !(key.t > keys[k - 1].t))
+      return bad_argument(
+          fmt::format("keyframes[{}].t must be greater than keyframes[{}].t ({}): keys in time "
+                      "order, got {}",
+                      k, k - 1, keys[k - 1].t, key.t));
+    if (!finite(key.translate))
+      return bad_argument(
+          fmt::format("keyframes[{}].translate must be finite, got {}", k, str(key.translate)));
+    if (!finite(key.rotate_deg))
+      return bad_argument(
+          fmt::format("keyframes[{}].rotate_deg must be finite, got {}", k, str(key.rotate_deg)));
+  }
+  if (moving())
+    return bad_argument(
+        fmt::format("keyframes exclude linear_velocity and angular_velocity (the path gives the "
+                    "velocity), got {} and {}",
+                    str(linear_velocity), str(angular_velocity)));
+  auto keyed = std::make_shared<ColliderPath>();
+  keyed->keys = std::move(keys);
+  keyed->base = *this;
+  Collider c = keyed->at(0.0);
+  c.path = std::move(keyed);
+  c.path_time = 0.0;
+  return c;
+}
+
 Collider Collider::posed_at(double seconds) const {
   Collider c = *this;
   if (!moving() || seconds == 0.0)
     return c;
+  if (path) { // the path's pose, and its motion over the advance as the velocities
+    const double t1 = path_time + seconds;
+    glm::dvec3 shift0, shift1;
+    glm::dmat3 turn0, turn1;
+    path->pose(path_time, shift0, turn0);
+    path->pose(t1, shift1, turn1);
+    c = path->at(t1);
+    c.path = path;
+    c.path_time = t1;
+    c.linear_velocity = (shift1 - shift0) / seconds;
+    glm::dquat turn = glm::quat_cast(turn1 * glm::transpose(turn0)); // world frame, about the centre
+    if (turn.w < 0.0)
+      turn = -turn; // the same turn, by the angle in [0, pi]
+    const double angle = glm::angle(turn);
+    c.angular_velocity = type == Type::plane || angle == 0.0 ? glm::dvec3(0.0) // a plane takes none
+                                                             : glm::axis(turn) * (angle / seconds);
+    return c;
+  }
   const glm::dvec3 shift = linear_velocity * seconds;
   if (type == Type::plane) { // a plane slides within itself: only its offset along n changes
     c.offset = offset + glm::dot(normal, shift);
@@ -194,6 +298,8 @@ Collider Collider::posed_at(double seconds) const {
 
 Collider Collider::with_pose(const ColliderPose& pose) const {
   Collider c = *this;
+  c.path = nullptr; // the host moves it now
+  c.path_time = 0.0;
   c.linear_velocity = pose.linear_velocity;
   c.angular_velocity = pose.angular_velocity;
   switch (type) {

@@ -18,7 +18,33 @@ constexpr const char* collider_types = R"("plane", "sphere", "capsule", "box" or
 
 /// The keys every collider takes besides its shape's: friction and motion.
 #define VKCLOTH_COLLIDER_COMMON_KEYS                                                                         \
-  "type", "friction", "static_friction", "linear_velocity", "angular_velocity"
+  "type", "friction", "static_friction", "linear_velocity", "angular_velocity", "keyframes"
+
+/// "keyframes": [{"t": T, "translate": [x, y, z], "rotate_deg": [a, b, c]}, ...] (Collider::with_keyframes).
+Result<void> read_keyframes(const json& keys, const std::string& path, Collider& col) {
+  if (!keys.is_array())
+    return sd::shape_error(
+        fmt::format("{}.keyframes must be an array of keys, got {}", path, sd::show(keys)));
+  std::vector<ColliderKeyframe> frames;
+  for (std::size_t k = 0; k < keys.size(); ++k) {
+    const json& key = keys[k];
+    const std::string at = fmt::format("{}.keyframes[{}]", path, k);
+    if (!key.is_object())
+      return sd::shape_error(fmt::format("{} must be an object, got {}", at, sd::show(key)));
+    VKCLOTH_TRY(sd::check_keys(key, at, {"t", "translate", "rotate_deg"}));
+    VKCLOTH_TRY(sd::require_keys(key, at, {"t"}, "a keyframe"));
+    ColliderKeyframe f;
+    VKCLOTH_TRY(sd::read(key, at, "t", f.t));
+    VKCLOTH_TRY(sd::read(key, at, "translate", f.translate));
+    VKCLOTH_TRY(sd::read(key, at, "rotate_deg", f.rotate_deg));
+    frames.push_back(f);
+  }
+  auto moved = col.with_keyframes(std::move(frames));
+  if (!moved)
+    return make_error(ErrorCode::invalid_argument, fmt::format("{}.{}", path, moved.error().message));
+  col = std::move(*moved);
+  return {};
+}
 
 Result<void> read_collider_common(const json& c, const std::string& path, Collider& col) {
   VKCLOTH_TRY(sd::read(c, path, "friction", col.friction));
@@ -142,6 +168,8 @@ Result<void> read_colliders(const json& doc, const std::filesystem::path& scene_
     VKCLOTH_TRY(read_collider_common(c, path, col));
     if (type == "mesh") // the file last, once every other key of this collider is known to be well formed
       VKCLOTH_TRY(read_mesh_collider(c, path, scene_dir, meshes, scene.warnings, col));
+    if (c.contains("keyframes")) // the shape complete: the keys move it
+      VKCLOTH_TRY(read_keyframes(c["keyframes"], path, col));
     scene.params.colliders.push_back(std::move(col));
   }
   return {};
