@@ -187,10 +187,10 @@ TEST_CASE("static friction holds on a slope when tan(theta) <= mu_s; kinetic fri
 TEST_CASE("vbd: friction in the vertex step holds on a slope when tan(theta) <= mu_s and slides at "
           "g (sin theta - mu_k cos theta)") {
   // The slope above under vertex block descent, whose friction acts in each vertex's step (Coulomb's
-  // law on the step's quadratic model, the normal force from the projection's push; vbd.h
-  // vbd_friction). A single particle's step is exact once friction has its normal force (from the
-  // second sweep): held still by mu_s = 0.6 (with mu_k = tan theta = 0.5, which alone would only
-  // balance gravity), and sliding with mu = 0.4 at exactly backward Euler's v = n h a.
+  // law on the step's quadratic model, the normal force from the inward move the contact stops; vbd.h
+  // vbd_friction). A single particle's step is exact: held still by mu_s = 0.6 (with mu_k = tan theta
+  // = 0.5, which alone would only balance gravity), and sliding with mu = 0.4 at exactly backward
+  // Euler's v = n h a.
   ValidationScope validation;
   const double theta = std::atan(0.5);
   const glm::dvec3 n{-std::sin(theta), 0.0, std::cos(theta)};
@@ -277,6 +277,18 @@ TEST_CASE(
   CHECK(glm::length(wall.normal - glm::dvec3(0, -1, 0)) < 1e-12);
   CHECK(std::abs(wall.offset) < 1e-12);            // the point (0, 0, 0.5) lies on y = 0
   CHECK(wall.angular_velocity == glm::dvec3(0.0)); // a plane takes linear velocity only
+  // A plane given a normal of any length moves as its unit normal would (the scene normalises it).
+  auto tall = Collider::plane({0, 0, 2}, 1.0).with_keyframes({{0, {}, {}}, {1, {0, 0, 1}, {}}});
+  REQUIRE(tall.ok());
+  CHECK(std::abs(tall->posed_at(1.0).offset - 2.0) < 1e-12);
+  CHECK(glm::length(tall->posed_at(1.0).normal - glm::dvec3(0, 0, 1)) < 1e-12);
+  // A slow turn keeps its axis: 1e-4 degrees about x over 10 s, advanced by 1/3000 s.
+  auto slow = box.with_keyframes({{0, {}, {}}, {10, {}, {1e-4, 0, 0}}});
+  REQUIRE(slow.ok());
+  const glm::dvec3 w = slow->posed_at(1.0 / 3000.0).angular_velocity;
+  CHECK(w.x == doctest::Approx(1e-4 * std::atan(1.0) / 45.0 / 10.0).epsilon(1e-6));
+  CHECK(std::abs(w.y) + std::abs(w.z) < 1e-15);
+  CHECK_FALSE(keyed->with_keyframes({{0, {}, {}}}).ok()); // one path per collider
   // A host's pose ends the path.
   ColliderPose still;
   CHECK(step.with_pose(still).path == nullptr);

@@ -243,6 +243,8 @@ Result<Collider> Collider::with_keyframes(std::vector<ColliderKeyframe> keys) co
       return bad_argument(
           fmt::format("keyframes[{}].rotate_deg must be finite, got {}", k, str(key.rotate_deg)));
   }
+  if (path)
+    return bad_argument("keyframes: this collider follows keyframes already (give all its keys at once)");
   if (moving())
     return bad_argument(
         fmt::format("keyframes exclude linear_velocity and angular_velocity (the path gives the "
@@ -251,6 +253,12 @@ Result<Collider> Collider::with_keyframes(std::vector<ColliderKeyframe> keys) co
   auto keyed = std::make_shared<ColliderPath>();
   keyed->keys = std::move(keys);
   keyed->base = *this;
+  if (type == Type::plane) { // the poses turn and move a unit normal (validate_collider's normalisation)
+    const double len = glm::length(normal);
+    if (!(len > 0.0) || !finite(normal))
+      return bad_argument(fmt::format("normal must be finite and non-zero, got {}", str(normal)));
+    keyed->base.normal = normal / len;
+  }
   Collider c = keyed->at(0.0);
   c.path = std::move(keyed);
   c.path_time = 0.0;
@@ -271,12 +279,16 @@ Collider Collider::posed_at(double seconds) const {
     c.path = path;
     c.path_time = t1;
     c.linear_velocity = (shift1 - shift0) / seconds;
-    glm::dquat turn = glm::quat_cast(turn1 * glm::transpose(turn0)); // world frame, about the centre
+    // The turn R1 R0^T (world frame, about the centre) as a rotation vector, by the quaternion's log
+    // map: exact for small turns too, where w rounds to 1 (glm::axis then gives up and returns z).
+    glm::dquat turn = glm::quat_cast(turn1 * glm::transpose(turn0));
     if (turn.w < 0.0)
       turn = -turn; // the same turn, by the angle in [0, pi]
-    const double angle = glm::angle(turn);
-    c.angular_velocity = type == Type::plane || angle == 0.0 ? glm::dvec3(0.0) // a plane takes none
-                                                             : glm::axis(turn) * (angle / seconds);
+    const glm::dvec3 im(turn.x, turn.y, turn.z);
+    const double sin_half = glm::length(im);
+    c.angular_velocity = type == Type::plane || sin_half == 0.0 // a plane takes linear velocity only
+                             ? glm::dvec3(0.0)
+                             : im * (2.0 * std::atan2(sin_half, turn.w) / sin_half / seconds);
     return c;
   }
   const glm::dvec3 shift = linear_velocity * seconds;

@@ -105,8 +105,8 @@ template <typename Real> struct FinishArgs {
 /// One colour of a vbd sweep (CpuSolver::vbd_solve_colour), W of its particles per vector: each
 /// takes vbd_step on its springs, walked in its gather list's order (a lane with fewer than the
 /// longest list of its vector walks the rest as zero-length springs to itself, which add nothing:
-/// vbd_add_spring's `len > 0`), then each collider's project_out. Positions are read and written in
-/// place: no two particles of a colour share a spring. Pinned particles are left as they are.
+/// vbd_add_spring's `len > 0`), then each collider's vbd_friction and project_out. Positions are read and
+/// written in place: no two particles of a colour share a spring. Pinned particles are left as they are.
 template <typename Real> struct VbdArgs {
   const std::uint32_t* order; // the colour's particles
   std::uint32_t particles;    // all of them (the last one's index: T::gather3 reads past it)

@@ -451,11 +451,12 @@ std::int64_t simd_finish(const vkcloth::detail::FinishArgs<typename T::Real>& a,
 
 // ---- Vertex block descent: one colour of a sweep (VbdArgs) ------------------------------------
 // CpuSolver::vbd_solve_colour, W particles of the colour per vector: vbd_add_spring over each
-// particle's gather list in its order, vbd_step, each collider's project_out from the substep's
-// start. The lists differ in length (a grid's border, a mesh): slot s of a lane past its list is a
-// zero-length spring to itself, which vbd_add_spring's `len > 0` select leaves out, as the
-// reference's early return does. The particles of a colour are scattered (a grid's lie 5 apart along
-// a row): positions come by T::gather3, stores go lane by lane.
+// particle's gather list in its order (padded per vector: VbdArgs), vbd_step, each collider's
+// vbd_friction, then each collider's project_out from the substep's start. The lists differ in length (a
+// grid's border, a mesh): slot s of a lane past its list is a zero-length spring to itself, which
+// vbd_add_spring's `len > 0` select leaves out, as the reference's early return does. The particles of a
+// colour are scattered (a grid's lie 5 apart along a row): positions come by T::gather3, stores go lane by
+// lane.
 template <typename T>
 std::int64_t simd_vbd_colour(const vkcloth::detail::VbdArgs<typename T::Real>& a, std::int64_t k0,
                              std::int64_t k1) {
