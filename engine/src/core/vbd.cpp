@@ -5,9 +5,8 @@
 //            first guess (vbd_first_guess: x0 + h v0) projected out of the colliders;
 //   sweeps:  `vbd_iterations` times, the colours in order; each particle of a colour takes one Newton
 //            step on its springs, its inertia and the colliders' friction, from its neighbours'
-//            latest positions, and is projected out of the colliders
-//            (no two particles of a colour share a spring, so a colour runs in parallel with the
-//            result of running it in order);
+//            latest positions, and is projected out of the colliders (no two particles of a colour
+//            share a spring, so a colour runs in parallel with the result of running it in order);
 //   finish:  the last sweep's position x; v = (x - x0) / h from its position before the projection,
 //            less its inward part (the contact response without friction).
 #include <algorithm>
