@@ -37,6 +37,30 @@ double rotation_error(const glm::dmat3& r) {
   return off;
 }
 
+// A path's keys: at least one, t finite, >= 0 and strictly increasing, finite poses (the message
+// names keyframes[k] and the value).
+Result<void> check_keyframes(const std::vector<ColliderKeyframe>& keys) {
+  if (keys.empty())
+    return bad_argument("keyframes must hold at least one key, got none");
+  for (std::size_t k = 0; k < keys.size(); ++k) {
+    const ColliderKeyframe& key = keys[k];
+    if (!std::isfinite(key.t) || key.t < 0.0)
+      return bad_argument(fmt::format("keyframes[{}].t must be finite and >= 0, got {}", k, key.t));
+    if (k > 0 && !(key.t > keys[k - 1].t))
+      return bad_argument(
+          fmt::format("keyframes[{}].t must be greater than keyframes[{}].t ({}): keys in time "
+                      "order, got {}",
+                      k, k - 1, keys[k - 1].t, key.t));
+    if (!finite(key.translate))
+      return bad_argument(
+          fmt::format("keyframes[{}].translate must be finite, got {}", k, str(key.translate)));
+    if (!finite(key.rotate_deg))
+      return bad_argument(
+          fmt::format("keyframes[{}].rotate_deg must be finite, got {}", k, str(key.rotate_deg)));
+  }
+  return {};
+}
+
 // One collider's fields (the message names `at`.field and the value); normalises a plane's normal.
 Result<void> validate_collider(Collider& c, const std::string& at) {
   const auto vec = [&](const char* key, glm::dvec3 v) -> Result<void> {
@@ -103,13 +127,9 @@ Result<void> validate_collider(Collider& c, const std::string& at) {
                                     c.static_friction));
   VKCLOTH_TRY(vec("linear_velocity", c.linear_velocity));
   VKCLOTH_TRY(vec("angular_velocity", c.angular_velocity));
-  if (c.path) { // its keys, as with_keyframes checked them (a host may have built the path itself)
-    Collider base = c.path->base;
-    base.path = nullptr;
-    auto checked = base.with_keyframes(c.path->keys);
-    if (!checked)
-      return bad_argument(fmt::format("{}.{}", at, checked.error().message));
-  }
+  if (c.path) // its keys, as with_keyframes checked them (a host may have built the path itself)
+    if (auto keys = check_keyframes(c.path->keys); !keys)
+      return bad_argument(fmt::format("{}.{}", at, keys.error().message));
   return {};
 }
 
@@ -225,24 +245,7 @@ Collider ColliderPath::at(const double t) const {
 }
 
 Result<Collider> Collider::with_keyframes(std::vector<ColliderKeyframe> keys) const {
-  if (keys.empty())
-    return bad_argument("keyframes must hold at least one key, got none");
-  for (std::size_t k = 0; k < keys.size(); ++k) {
-    const ColliderKeyframe& key = keys[k];
-    if (!std::isfinite(key.t) || key.t < 0.0)
-      return bad_argument(fmt::format("keyframes[{}].t must be finite and >= 0, got {}", k, key.t));
-    if (k > 0 && !(key.t > keys[k - 1].t))
-      return bad_argument(
-          fmt::format("keyframes[{}].t must be greater than keyframes[{}].t ({}): keys in time "
-                      "order, got {}",
-                      k, k - 1, keys[k - 1].t, key.t));
-    if (!finite(key.translate))
-      return bad_argument(
-          fmt::format("keyframes[{}].translate must be finite, got {}", k, str(key.translate)));
-    if (!finite(key.rotate_deg))
-      return bad_argument(
-          fmt::format("keyframes[{}].rotate_deg must be finite, got {}", k, str(key.rotate_deg)));
-  }
+  VKCLOTH_TRY(check_keyframes(keys));
   if (path)
     return bad_argument("keyframes: this collider follows keyframes already (give all its keys at once)");
   if (moving())
