@@ -226,10 +226,10 @@ void ColliderPath::pose(const double t, glm::dvec3& translate, glm::dmat3& rotat
   rotation = glm::mat3_cast(glm::slerp(q0, glm::dot(q0, q1) < 0.0 ? -q1 : q1, s)); // the shorter way
 }
 
-Collider ColliderPath::at(const double t) const {
-  glm::dvec3 shift;
-  glm::dmat3 turn;
-  pose(t, shift, turn);
+namespace {
+// `base` turned by `turn` about its centre and moved by `shift` (a plane: about its point nearest
+// the origin).
+Collider moved(const Collider& base, const glm::dvec3 shift, const glm::dmat3& turn) {
   Collider c = base;
   const glm::dvec3 pivot = base.centre();
   if (base.type == Collider::Type::plane) { // turned about its point nearest the origin, then moved
@@ -242,6 +242,14 @@ Collider ColliderPath::at(const double t) const {
   c.b = pivot + shift + turn * (base.b - pivot);
   c.rotation = turn * base.rotation;
   return c;
+}
+} // namespace
+
+Collider ColliderPath::at(const double t) const {
+  glm::dvec3 shift;
+  glm::dmat3 turn;
+  pose(t, shift, turn);
+  return moved(base, shift, turn);
 }
 
 Result<Collider> Collider::with_keyframes(std::vector<ColliderKeyframe> keys) const {
@@ -278,7 +286,7 @@ Collider Collider::posed_at(double seconds) const {
     glm::dmat3 turn0, turn1;
     path->pose(path_time, shift0, turn0);
     path->pose(t1, shift1, turn1);
-    c = path->at(t1);
+    c = moved(path->base, shift1, turn1);
     c.path = path;
     c.path_time = t1;
     c.linear_velocity = (shift1 - shift0) / seconds;
