@@ -7,6 +7,7 @@
 #include <doctest/doctest.h>
 
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,8 @@ public:
   virtual std::vector<glm::dvec3> velocities() = 0;
   virtual std::vector<glm::dvec3> forces() = 0;
   virtual std::vector<glm::dvec3> normals() = 0;
+  virtual Result<void> set_params(SimParams params) = 0;
+  virtual Result<void> set_pin_targets(std::span<const PinTarget> targets) = 0;
   Result<void> step() { return run(1); }
   glm::dvec3 position(std::size_t i) { return positions().at(i); }
   glm::dvec3 velocity(std::size_t i) { return velocities().at(i); }
@@ -52,6 +55,10 @@ public:
   std::vector<glm::dvec3> velocities() override { return widen(s_.velocities()); }
   std::vector<glm::dvec3> forces() override { return widen(s_.forces()); }
   std::vector<glm::dvec3> normals() override { return widen(s_.normals()); }
+  Result<void> set_params(SimParams params) override { return s_.set_params(std::move(params)); }
+  Result<void> set_pin_targets(std::span<const PinTarget> targets) override {
+    return s_.set_pin_targets(targets);
+  }
 
 private:
   CpuSolver<Real> s_;
@@ -65,6 +72,10 @@ public:
   std::vector<glm::dvec3> velocities() override { return read(s_.velocities()); }
   std::vector<glm::dvec3> forces() override { return read(s_.forces()); }
   std::vector<glm::dvec3> normals() override { return read(s_.normals()); }
+  Result<void> set_params(SimParams params) override { return s_.set_params(std::move(params)); }
+  Result<void> set_pin_targets(std::span<const PinTarget> targets) override {
+    return s_.set_pin_targets(targets);
+  }
 
 private:
   static std::vector<glm::dvec3> read(const Result<std::vector<glm::vec3>>& r) {

@@ -47,6 +47,7 @@
 #include "contacts.h"
 #include "friction.h"
 #include "strain.h"
+#include "attach.h"
 #include "self_collision.h"
 #include "integrators.h"
 #include "blocks.h"

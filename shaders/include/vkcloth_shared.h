@@ -59,7 +59,8 @@ struct vec4 {
 #define VKCLOTH_BINDING_MESH_NODES 22 // MeshNode: every mesh collider's hierarchy (Collider::mesh_root)
 #define VKCLOTH_BINDING_MESH_TRIS 23  // MeshTriangle: their triangles in leaf order (Collider::mesh_tri0)
 #define VKCLOTH_BINDING_VBD_ORDER 24  // vbd: the particles in colour order (ClothTopology::vertex_order)
-#define VKCLOTH_BINDING_COUNT 25
+#define VKCLOTH_BINDING_TARGETS 25    // Target per particle of each instance (its attachments' and host's)
+#define VKCLOTH_BINDING_COUNT 26
 
 // Set 1 (force.comp, fused.comp, strain_*.comp): POS_IN again, as an RGBA32F uniform texel buffer view,
 // PARTICLE as an RG32UI one (x: the mass's bits, y: pinned), and (fused.comp) VEL as RGBA32F and
@@ -123,6 +124,19 @@ struct StrainLinksPush {
   uint unused;
 };
 
+/// targets.comp (`stage`: VKCLOTH_TARGETS_DRIVE or _HOLD): the entries of each instance's targets
+/// that this substep's upload wrote (the most any instance has; the rest of its range is stale).
+struct TargetsPush {
+  uint count;
+  uint nx;
+  uint ny;
+  uint stage;
+  uint step;
+  uint target_count;
+  uint unused0;
+  uint unused1;
+};
+
 /// vbd.comp (VKCLOTH_VBD_*: `stage`): one colour of one sweep in VKCLOTH_VBD_SOLVE.
 #define VKCLOTH_VBD_BEGIN 0u  // normals, inertia targets (VEL_FILT), first guess (POS_OUT)
 #define VKCLOTH_VBD_SOLVE 1u  // one colour's Newton steps in place on POS_OUT, the push (STAGE_POS)
@@ -177,6 +191,18 @@ struct Edge {
   float rest_length;
   float stiffness;
   uint ring; // VKCLOTH_RING_* bits: this entry's part in the vertex normal (GatherEdge::ring)
+};
+
+/// One particle's target at a substep's end (targets.comp; the CPU's detail::TargetEntry; std430: 32
+/// bytes). Instance i's targets start at TARGETS[i * count]; VKCLOTH_NO_TARGET ends them.
+#define VKCLOTH_NO_TARGET 0xffffffffu
+#define VKCLOTH_TARGETS_DRIVE 0u // targets.comp stage: pinned particles onto their targets (before a substep)
+#define VKCLOTH_TARGETS_HOLD 1u  // free particles back within reach (after a substep)
+struct Target {
+  float px, py, pz; // the target
+  uint particle;    // VKCLOTH_NO_TARGET: past the instance's last target
+  float vx, vy, vz; // its velocity
+  float reach;      // how far a free particle may be from it (m)
 };
 
 /// A strain link (ClothTopology's StrainLink; std430: 12 bytes).
@@ -234,6 +260,7 @@ struct Flags {
 static_assert(sizeof(PushConstants) == 32);
 static_assert(sizeof(StrainLinksPush) == 32);
 static_assert(sizeof(VbdPush) == 32);
+static_assert(sizeof(TargetsPush) == 32);
 
 /// The state layout (every pass that reads the batch's state through its sets: force, integrate,
 /// fused, strain_links, strain_finish, vertices): set 0 holds every VKCLOTH_BINDING_* (0 ..
@@ -265,6 +292,7 @@ static_assert(sizeof(ParticleInfo) == 8);
 static_assert(sizeof(Vertex) == 32);
 static_assert(sizeof(Edge) == 16);
 static_assert(sizeof(StrainLink) == 12);
+static_assert(sizeof(Target) == 32);
 static_assert(sizeof(TetherSlot) == 8);
 static_assert(offsetof(InstanceParams, max_strain) == 68);
 static_assert(sizeof(Collider) == 144);

@@ -67,7 +67,8 @@ public:
   /// Advances `steps` steps, stopping at the first error.
   Result<void> run(std::uint64_t steps);
 
-  /// Replaces the parameters between steps (validated; the topology stays).
+  /// Replaces the parameters between steps (validated; the topology stays; the attachments'
+  /// particles are checked against the cloth and the host's pin targets).
   Result<void> set_params(SimParams params);
   const SimParams& params() const;
 
@@ -91,6 +92,12 @@ public:
   /// ErrorCode::invalid_argument (state unchanged) when `index` >= the particle count or a
   /// component is NaN/inf.
   Result<void> set_particle(std::uint32_t index, Vec3 position, Vec3 velocity);
+
+  /// The host's targets for the next step (PinTarget: reached at the step's end, interpolated
+  /// across its substeps), replacing the previous ones; a particle left out is released. The
+  /// errors (state unchanged) name the target: a particle past the cloth, one targeted twice (or
+  /// also by params().attachments), a non-finite position, a negative max_distance.
+  Result<void> set_pin_targets(std::span<const PinTarget> targets);
 
   /// Kinetic energy sum 1/2 m v^2, gravitational and spring potential energies (for studies).
   struct Energy {

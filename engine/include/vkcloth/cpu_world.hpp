@@ -26,6 +26,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -72,6 +73,9 @@ public:
   /// (from the next step); the errors name an unknown id, an index past the list or the pose's
   /// field, and leave the parameters as they were.
   Result<void> set_collider_pose(InstanceId id, std::size_t collider, const ColliderPose& pose);
+  /// The host's per-frame targets of the instance's particles for the next step (PinTarget;
+  /// CpuSolver::set_pin_targets, whose errors these are, or an unknown id).
+  Result<void> set_pin_targets(InstanceId id, std::span<const PinTarget> targets);
   /// The instance's parameters; moving colliders where its steps left them.
   Result<SimParams> params(InstanceId id) const;
 

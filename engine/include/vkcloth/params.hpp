@@ -208,6 +208,35 @@ struct SelfCollision {
   std::uint32_t iterations = 1; ///< 1..16 Jacobi passes per substep
 };
 
+/// Particles that follow a collider (docs/model.md "Attachments"): particle particles[i]'s target
+/// is the point offsets[i] of the collider's frame (centre() and `rotation`, as posed at each
+/// substep's end), moving with the collider's velocity there. A pinned particle is put on its target
+/// before each substep; a free one is brought back within `max_distance` of it after each substep
+/// (0: onto it), which is how a particle is attached at run time and released (set_params without it).
+struct Attachment {
+  std::uint32_t collider = 0;           ///< index in SimParams::colliders (not a plane: it has no frame)
+  std::vector<std::uint32_t> particles; ///< the cloth's particles, each in one attachment at most
+  std::vector<glm::dvec3> offsets;      ///< one per particle, in the collider's frame (m)
+  double max_distance = 0.0;            ///< m, >= 0: how far a free particle may stray (pinned: 0)
+
+  /// The attachment of `particles` to `collider` (colliders[index]) that keeps them where
+  /// `positions` (world, indexed by particle) puts them relative to the collider's pose now.
+  /// ErrorCode::invalid_argument for a plane, a particle past `positions` or a negative distance.
+  static Result<Attachment> at_rest(const Collider& collider, std::uint32_t index,
+                                    std::vector<std::uint32_t> particles,
+                                    const std::vector<glm::dvec3>& positions, double max_distance = 0.0);
+};
+
+/// A host's per-frame target for one particle (CpuSolver::set_pin_targets, the worlds'
+/// set_pin_targets): reached at the next step's end, interpolated linearly across its substeps from
+/// the particle's previous host target (a new one is reached at the first substep), and held after.
+/// A pinned particle sits on it; a free one is held within `max_distance` of it (0: on it).
+struct PinTarget {
+  std::uint32_t particle = 0;
+  glm::dvec3 position{0.0};
+  double max_distance = 0.0; ///< m, >= 0
+};
+
 struct SimParams {
   Integrator integrator = Integrator::semi_implicit_euler;
   double dt = 0.02;
@@ -237,6 +266,9 @@ struct SimParams {
   double divergence_limit = 1e4;
   StretchLimit stretch_limit;   ///< off by default
   SelfCollision self_collision; ///< off by default
+  /// Particles that follow colliders (none by default). Their indices are checked against the cloth
+  /// by the solvers (an index past it, or a particle in two attachments, is an error).
+  std::vector<Attachment> attachments;
 
   /// Checks every field (finite, in range) and normalises directions. The message names the field.
   Result<void> validate();

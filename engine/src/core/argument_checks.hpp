@@ -1,9 +1,12 @@
 // SPDX-License-Identifier: MIT
-// What the core's parameter checks share: the error they return and the finiteness of a vector.
+// What the core's parameter checks share: the error they return, the finiteness of a vector and
+// how a message writes one.
 #pragma once
 
 #include <cmath>
 #include <string>
+
+#include <fmt/format.h>
 
 #include <glm/vec3.hpp>
 
@@ -16,6 +19,10 @@ inline Error bad_argument(std::string message) {
 }
 inline bool finite(glm::dvec3 v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+/// A vector as the messages write it: [x, y, z].
+inline std::string str(glm::dvec3 v) {
+  return fmt::format("[{}, {}, {}]", v.x, v.y, v.z);
 }
 
 } // namespace vkcloth::detail

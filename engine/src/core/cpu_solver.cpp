@@ -78,6 +78,8 @@ Result<CpuSolver<Real>> CpuSolver<Real>::create(std::shared_ptr<const ClothTopol
   const ParticleSystem& system = topology->system();
   const std::size_t n = system.size();
 
+  VKCLOTH_TRY(detail::PinTargets::check(params, {}, n));
+
   auto impl = std::make_unique<Impl>();
   Impl& s = *impl;
   s.topology_ = std::move(topology);
@@ -118,6 +120,7 @@ Result<CpuSolver<Real>> CpuSolver<Real>::create(std::shared_ptr<const ClothTopol
 
 template <typename Real> Result<void> CpuSolver<Real>::Impl::set_params(SimParams params) {
   VKCLOTH_TRY(params.validate());
+  VKCLOTH_TRY(targets_.check_params(params, pos_.size()));
   params_ = params;
   return {};
 }
@@ -299,16 +302,38 @@ template <typename Real> Result<void> CpuSolver<Real>::Impl::step() {
   // integrator.substeps = k: k substeps of dt / k (bit-identical to k steps with dt / k).
   const std::uint32_t k = params_.substeps;
   const double h = k == 1 ? params_.dt : params_.dt / double(k);
+  const bool targets = !targets_.empty(params_);
   for (std::uint32_t s = 0; s < k; ++s) {
     advance_colliders(h); // a substep meets the colliders where they are at its end
     prepare_colliders();
+    if (targets)
+      drive_targets(s);
     substep(Real(h));
+    if (targets)
+      hold_targets();
   }
+  targets_.end_step();
   ++step_;
   time_ += params_.dt;
   if (swept_finite_)
     return {}; // the last substep's row sweep already checked every particle
   return check_finite();
+}
+
+template <typename Real> void CpuSolver<Real>::Impl::drive_targets(const std::uint32_t k) {
+  targets_.at_substep(params_, k, params_.substeps, targets_now_);
+  for (const detail::TargetEntry& t : targets_now_)
+    if (pinned_[t.particle])
+      kernel::drive_pinned(Vec3(t.position), Vec3(t.velocity), pos_[t.particle], vel_[t.particle]);
+  soa_valid_ = false; // the row sweep transposes the moved pins
+}
+
+template <typename Real> void CpuSolver<Real>::Impl::hold_targets() {
+  for (const detail::TargetEntry& t : targets_now_)
+    if (!pinned_[t.particle])
+      kernel::hold_within(Vec3(t.position), Vec3(t.velocity), Real(t.reach), pos_[t.particle],
+                          vel_[t.particle]);
+  soa_valid_ = false;
 }
 
 template <typename Real> void CpuSolver<Real>::Impl::substep(const Real h) {
@@ -557,6 +582,9 @@ template <typename Real> const ParticleSystem& CpuSolver<Real>::system() const {
 }
 template <typename Real> const std::shared_ptr<const ClothTopology>& CpuSolver<Real>::topology() const {
   return impl_->topology_;
+}
+template <typename Real> Result<void> CpuSolver<Real>::set_pin_targets(std::span<const PinTarget> targets) {
+  return impl_->targets_.set_host(impl_->params_, targets, impl_->pos_.size());
 }
 template <typename Real>
 Result<void> CpuSolver<Real>::set_particle(std::uint32_t index, Vec3 position, Vec3 velocity) {

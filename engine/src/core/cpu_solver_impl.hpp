@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "kernel.hpp"
+#include "pin_targets.hpp"
 #include "row_kernel.hpp"
 #include "vkcloth/cpu_solver.hpp"
 
@@ -110,6 +111,10 @@ template <typename Real> struct CpuSolver<Real>::Impl {
   Result<void> step();
   Result<void> set_params(SimParams params);
   Result<void> set_particle(std::uint32_t index, Vec3 position, Vec3 velocity);
+  // The targets of substep k (colliders already posed): pinned particles onto them before the
+  // substep (drive_targets), free ones back within reach after it (hold_targets).
+  void drive_targets(std::uint32_t k);
+  void hold_targets();
   Energy energy() const;
   double time() const { return time_; }
   const ParticleSystem& system() const { return topology_->system(); }
@@ -168,6 +173,9 @@ template <typename Real> struct CpuSolver<Real>::Impl {
 
   std::shared_ptr<const ClothTopology> topology_;
   SimParams params_;
+  // Attachments and the host's targets (docs/model.md "Attachments"): each substep's in targets_now_.
+  detail::PinTargets targets_;
+  std::vector<detail::TargetEntry> targets_now_;
   std::span<const std::uint32_t> edge_offsets_; // the topology's
   std::vector<Edge> edges_;
   std::vector<Real> mass_;

@@ -151,6 +151,13 @@ Result<void> CpuWorld::set_collider_pose(InstanceId id, std::size_t collider, co
   return (*inst)->solver.set_params(std::move(*posed));
 }
 
+Result<void> CpuWorld::set_pin_targets(InstanceId id, std::span<const PinTarget> targets) {
+  auto inst = impl_->find(id);
+  if (!inst)
+    return inst.error();
+  return (*inst)->solver.set_pin_targets(targets);
+}
+
 Result<SimParams> CpuWorld::params(InstanceId id) const {
   auto inst = impl_->find(id);
   if (!inst)

@@ -17,11 +17,8 @@
 namespace vkcloth {
 using detail::bad_argument;
 using detail::finite;
+using detail::str;
 namespace {
-
-std::string str(glm::dvec3 v) {
-  return fmt::format("[{}, {}, {}]", v.x, v.y, v.z);
-}
 
 bool positive(double x) {
   return std::isfinite(x) && x > 0.0;
@@ -58,6 +55,28 @@ Result<void> check_keyframes(const std::vector<ColliderKeyframe>& keys) {
       return bad_argument(
           fmt::format("keyframes[{}].rotate_deg must be finite, got {}", k, str(key.rotate_deg)));
   }
+  return {};
+}
+
+// An attachment's collider (in the list, not a plane), offsets (one per particle, finite) and
+// distance; its particles are the solver's to check against the cloth (PinTargets::check).
+Result<void> validate_attachment(const Attachment& a, const std::vector<Collider>& colliders,
+                                 const std::string& at) {
+  if (a.collider >= colliders.size())
+    return bad_argument(
+        fmt::format("{}.collider is {}, but there are {} colliders", at, a.collider, colliders.size()));
+  if (colliders[a.collider].type == Collider::Type::plane)
+    return bad_argument(fmt::format("{}.collider {} is a plane, which has no frame to follow (attach to a "
+                                    "sphere, capsule, box or mesh)",
+                                    at, a.collider));
+  if (a.offsets.size() != a.particles.size())
+    return bad_argument(fmt::format("{} has {} particles but {} offsets (one each)", at, a.particles.size(),
+                                    a.offsets.size()));
+  for (std::size_t i = 0; i < a.offsets.size(); ++i)
+    if (!finite(a.offsets[i]))
+      return bad_argument(fmt::format("{}.offsets[{}] must be finite, got {}", at, i, str(a.offsets[i])));
+  if (!std::isfinite(a.max_distance) || a.max_distance < 0.0)
+    return bad_argument(fmt::format("{}.max_distance must be finite and >= 0, got {}", at, a.max_distance));
   return {};
 }
 
@@ -339,16 +358,12 @@ Collider Collider::with_pose(const ColliderPose& pose) const {
     c.b = pose.position + axis;
     break;
   }
-  case Type::box:
-  case Type::mesh:
-    if (pose.rotation)
-      c.rotation = *pose.rotation;
-    c.center = pose.position;
-    break;
-  default: // sphere
+  default: // sphere, box, mesh
     c.center = pose.position;
     break;
   }
+  if (pose.rotation && type != Type::plane) // every body keeps its frame (attachments follow it)
+    c.rotation = *pose.rotation;
   return c;
 }
 
@@ -489,7 +504,33 @@ Result<void> SimParams::validate() {
   if (self_collision.iterations < 1 || self_collision.iterations > 16)
     return bad_argument(
         fmt::format("self_collision.iterations must be in 1..16, got {}", self_collision.iterations));
+  for (std::size_t k = 0; k < attachments.size(); ++k)
+    VKCLOTH_TRY(validate_attachment(attachments[k], colliders, fmt::format("attachments[{}]", k)));
   return {};
+}
+
+Result<Attachment> Attachment::at_rest(const Collider& collider, std::uint32_t index,
+                                       std::vector<std::uint32_t> particles,
+                                       const std::vector<glm::dvec3>& positions, double max_distance) {
+  if (collider.type == Collider::Type::plane)
+    return bad_argument(fmt::format("attach: collider {} is a plane, which has no frame to follow (attach "
+                                    "to a sphere, capsule, box or mesh)",
+                                    index));
+  if (!std::isfinite(max_distance) || max_distance < 0.0)
+    return bad_argument(fmt::format("attach: max_distance must be finite and >= 0, got {}", max_distance));
+  Attachment a;
+  a.collider = index;
+  a.max_distance = max_distance;
+  const glm::dvec3 centre = collider.centre();
+  const glm::dmat3 to_body = glm::transpose(collider.rotation);
+  for (const std::uint32_t p : particles) {
+    if (p >= positions.size())
+      return bad_argument(
+          fmt::format("attach: particle {} is past the cloth's {} particles", p, positions.size()));
+    a.offsets.push_back(to_body * (positions[p] - centre));
+  }
+  a.particles = std::move(particles);
+  return a;
 }
 
 Result<std::vector<std::string>> check_self_collision(const SelfCollision& self,

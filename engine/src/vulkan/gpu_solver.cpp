@@ -81,6 +81,9 @@ GpuSolver::~GpuSolver() = default;
 Result<void> GpuSolver::set_params(SimParams params) {
   return impl_->world.set_params(impl_->id, std::move(params));
 }
+Result<void> GpuSolver::set_pin_targets(std::span<const PinTarget> targets) {
+  return impl_->world.set_pin_targets(impl_->id, targets);
+}
 const SimParams& GpuSolver::params() const {
   return impl_->instance().params;
 }

@@ -292,7 +292,7 @@ void SolverBatch::refresh_flags() {
   }
 }
 
-void SolverBatch::carry_over(std::uint32_t slot, const Slot& old) {
+Result<void> SolverBatch::carry_over(std::uint32_t slot, const Slot& old) {
   Slot& now = slots[slot];
   now.step = now.epoch_step = old.step; // flag steps count from this batch's creation
   now.time = old.time;
@@ -300,6 +300,9 @@ void SolverBatch::carry_over(std::uint32_t slot, const Slot& old) {
   // first_bad_step 0 is before every recorded step (1-based): frozen() holds from the first one.
   if (now.diverged)
     static_cast<sh::Flags*>(flags.mapped)[slot] = sh::Flags{1, 0, 0, 0};
+  now.targets = old.targets;
+  VKCLOTH_TRY(ensure_targets());
+  return prepare_passes(); // the targets' passes, when only the host's targets ask for them
 }
 
 InstanceBuffers SolverBatch::buffers(std::uint32_t slot) const {
@@ -326,12 +329,54 @@ Result<void> SolverBatch::set_params(std::uint32_t slot, SimParams params) {
   auto done = [&]() -> Result<void> {
     VKCLOTH_TRY(ensure_collider_capacity());
     VKCLOTH_TRY(ensure_mesh_buffers());
+    VKCLOTH_TRY(ensure_targets());
     VKCLOTH_TRY(prepare_passes());
     return ensure_tethers();
   }();
   if (!done) // e.g. no room for the tethers: the instance keeps stepping with its old parameters
     slots[slot].params = std::move(previous);
   return done;
+}
+
+Result<void> SolverBatch::set_pin_targets(std::uint32_t slot, std::span<const PinTarget> targets) {
+  vkcloth::detail::PinTargets previous = slots[slot].targets;
+  VKCLOTH_TRY(slots[slot].targets.set_host(slots[slot].params, targets, count));
+  auto done = [&]() -> Result<void> {
+    VKCLOTH_TRY(ensure_targets());
+    return prepare_passes();
+  }();
+  if (!done)
+    slots[slot].targets = std::move(previous);
+  return done;
+}
+
+bool SolverBatch::any_targets() const {
+  return std::any_of(slots.begin(), slots.end(), [](const Slot& s) { return !s.targets.empty(s.params); });
+}
+
+std::uint32_t SolverBatch::targets_per_slot() const {
+  std::uint32_t most = 0;
+  for (const Slot& s : slots)
+    most = std::max(most, s.targets.size(s.params));
+  return most;
+}
+
+// The targets buffer at its full size (count entries per instance) when an instance first has
+// targets; the descriptor sets are rewritten, so recorded work that may use them is waited for.
+Result<void> SolverBatch::ensure_targets() {
+  if (targets_allocated || !any_targets())
+    return {};
+  const std::uint64_t entries = std::uint64_t(size()) * count;
+  VKCLOTH_TRY(check_buffer(*ctx, storage_limit(*ctx, knobs), "targets", entries, sizeof(sh::Target)));
+  VKCLOTH_TRY(commands->wait_for_earlier_work());
+  auto b = create_buffer(*ctx, entries * sizeof(sh::Target),
+                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                         MemoryUse::device, false, "targets");
+  if (!b)
+    return b.error();
+  targets = std::move(*b);
+  targets_allocated = true;
+  return write_sets();
 }
 
 // The tethers of both rest-length kinds (VKCLOTH_BINDING_TETHERS: euclidean, then geodesic),

@@ -24,6 +24,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "../core/pin_targets.hpp"
 #include "passes/implicit_gpu.hpp"
 #include "passes/pass.hpp"
 #include "pipelines.hpp"
@@ -50,6 +51,8 @@ public:
     std::uint64_t epoch_step = 0; // `step` when this batch's flag epoch began (its creation)
     double time = 0.0;            // simulated time: the sum of the recorded steps' dt
     std::optional<Error> diverged;
+    vkcloth::detail::PinTargets
+        targets; // attachments and the host's pin targets (docs/model.md "Attachments")
   };
   /// The per-particle buffers a readback can copy.
   enum class Field { positions, velocities, normals, forces };
@@ -75,6 +78,11 @@ public:
   /// the pipelines they need. More colliders than the batch has room for, or the first tethers,
   /// need new buffers: those wait for the earlier work on the Context's queue first.
   Result<void> set_params(std::uint32_t slot, SimParams params);
+  /// The host's targets of one instance for the next recorded step (PinTargets::set_host's checks).
+  Result<void> set_pin_targets(std::uint32_t slot, std::span<const PinTarget> targets);
+  /// Whether some instance has targets (targets.comp's passes run), and the most any has.
+  bool any_targets() const;
+  std::uint32_t targets_per_slot() const;
 
   /// Records `steps` steps of every instance; advances the host-side counters now.
   void record(VkCommandBuffer cmd, std::uint32_t steps);
@@ -85,8 +93,8 @@ public:
   void record_copy_slot(VkCommandBuffer cmd, const SolverBatch& from, std::uint32_t from_slot,
                         std::uint32_t to_slot) const;
   /// Instance `slot` continues `old` (an instance of an older batch): its step count and
-  /// divergence (a diverged instance stays frozen).
-  void carry_over(std::uint32_t slot, const Slot& old);
+  /// divergence (a diverged instance stays frozen) and its host's pin targets.
+  Result<void> carry_over(std::uint32_t slot, const Slot& old);
 
   /// Reads the flags of every instance (their work complete and visible to the host); marks the
   /// newly diverged ones (their step, the error).
@@ -206,9 +214,9 @@ public:
   };
   /// Into mapped memory, or through one staging submission (waited for).
   Result<void> upload(std::span<const Upload> uploads);
-  /// vkCmdUpdateBuffer of `bytes` from the start of `dst`, in pieces of at most 64 KiB (its limit).
-  void record_buffer_update(VkCommandBuffer cmd, const Buffer& dst, const void* data,
-                            std::size_t bytes) const;
+  /// vkCmdUpdateBuffer of `bytes` at `offset` of `dst`, in pieces of at most 64 KiB (its limit).
+  void record_buffer_update(VkCommandBuffer cmd, const Buffer& dst, const void* data, std::size_t bytes,
+                            VkDeviceSize offset = 0) const;
 
 private:
   SolverBatch() = default;
@@ -236,6 +244,10 @@ private:
   Buffer strain_links, tethers;
   std::vector<std::uint32_t> strain_colours; // the topology's colour offsets (colours + 1)
   Buffer vbd_order;                          // VKCLOTH_BINDING_VBD_ORDER: ClothTopology::vertex_order
+  // VKCLOTH_BINDING_TARGETS: count entries per instance, each substep's targets recorded into it
+  // (record_targets); one zeroed element until an instance first has targets (ensure_targets).
+  Buffer targets;
+  bool targets_allocated = false;
   bool tethers_uploaded = false;
   // The batch's topology, for what is uploaded when first needed (the tethers): alive as long as
   // the batch, since every instance of the batch holds it (ClothWorld::Impl::Instance).
@@ -304,6 +316,10 @@ private:
   Result<void> ensure_tethers();
   Result<void> ensure_collider_capacity();
   Result<void> ensure_mesh_buffers();
+  Result<void> ensure_targets();
+  /// Before substep k of a step: every instance's targets at the substep's end (colliders posed)
+  /// into TARGETS, VKCLOTH_NO_TARGET after each instance's last.
+  void record_targets(VkCommandBuffer cmd, std::uint32_t k);
   std::vector<shared::Collider> packed_colliders() const;
   /// Before a substep of `h` seconds: moving colliders advance to where they are at its end
   /// (Collider::posed_at, as CpuSolver does) and the new poses are recorded into the collider buffer.

@@ -26,6 +26,33 @@ void SolverBatch::record_collider_motion(VkCommandBuffer c, double h) {
   barriers::transfer_to_compute(vk(), c); // the new poses -> this substep's passes
 }
 
+// Each instance's targets at substep k's end (the colliders posed there) into its TARGETS range,
+// VKCLOTH_NO_TARGET after its last, as many entries as the instance with the most has (the
+// passes' dispatch); in double until the one conversion to float, as CpuSolver's.
+void SolverBatch::record_targets(VkCommandBuffer c, std::uint32_t k) {
+  const std::uint32_t n = targets_per_slot();
+  std::vector<sh::Target> packed(n);
+  std::vector<vkcloth::detail::TargetEntry> entries;
+  barriers::before_host_edit(vk(), c); // the last substep's reads of the targets finish first (WAR)
+  for (std::uint32_t s = 0; s < size(); ++s) {
+    slots[s].targets.at_substep(slots[s].params, k, family().substeps, entries);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      sh::Target& t = packed[i];
+      if (i >= entries.size()) {
+        t = sh::Target{};
+        t.particle = VKCLOTH_NO_TARGET;
+        continue;
+      }
+      const vkcloth::detail::TargetEntry& e = entries[i];
+      const glm::vec3 x(e.position), v(e.velocity);
+      t = sh::Target{x.x, x.y, x.z, e.particle, v.x, v.y, v.z, float(e.reach)};
+    }
+    record_buffer_update(c, targets, packed.data(), packed.size() * sizeof(sh::Target),
+                         VkDeviceSize(s) * count * sizeof(sh::Target));
+  }
+  barriers::transfer_to_compute(vk(), c); // the targets -> this substep's passes
+}
+
 // Later changes travel in the command buffer: each recording carries the values it steps with, so
 // frames in flight never see a buffer the host rewrote under them (docs/embedding.md).
 void SolverBatch::record_params_update(VkCommandBuffer c) {
@@ -42,10 +69,10 @@ void SolverBatch::record_params_update(VkCommandBuffer c) {
 }
 
 void SolverBatch::record_buffer_update(VkCommandBuffer c, const Buffer& dst, const void* data,
-                                       std::size_t bytes) const {
+                                       std::size_t bytes, VkDeviceSize offset) const {
   constexpr std::size_t max_update = 65536; // vkCmdUpdateBuffer's limit per call
   for (std::size_t at = 0; at < bytes; at += max_update)
-    vk().vkCmdUpdateBuffer(c, dst.buffer, at, std::min(max_update, bytes - at),
+    vk().vkCmdUpdateBuffer(c, dst.buffer, offset + at, std::min(max_update, bytes - at),
                            static_cast<const char*>(data) + at);
 }
 
@@ -58,15 +85,20 @@ void SolverBatch::record(VkCommandBuffer c, std::uint32_t steps) {
   for (std::uint32_t s = 0; s < steps; ++s) {
     pc.step = static_cast<std::uint32_t>(recorded + 1); // 1-based number of the step being computed
     const bool moving = any_moving_colliders();
+    const bool targets_now = any_targets();
     const double h = family().substeps == 1 ? family().dt : family().dt / double(family().substeps);
     for (std::uint32_t k = 0; k < family().substeps; ++k) {
       if (moving) // a substep meets the colliders where they are at its end (as CpuSolver::step)
         record_collider_motion(c, h);
+      if (targets_now)
+        record_targets(c, k);
       record_passes(c, Pass::When::substep, first, s + 1 == steps && k + 1 == family().substeps);
       first = false;
       parity ^= 1u; // positions[read ^ 1] now holds the new state
     }
     ++recorded;
+    for (Slot& slot : slots)
+      slot.targets.end_step(); // the host's targets held where they arrived
     for (Slot& slot : slots)
       if (!slot.diverged) {
         ++slot.step;

@@ -125,9 +125,12 @@ Result<void> ClothWorld::Impl::rebuild(const BatchKey& key, const std::vector<In
   for (Batch* source : sources)
     source->refresh_flags();
   for (std::uint32_t k = 0; k < members.size(); ++k) {
+    const Instance& inst = instances.at(members[k]);
+    if (!fresh.count(members[k])) // step count, divergence, the host's targets
+      VKCLOTH_TRY(batch->carry_over(k, inst.batch->slot(inst.slot)));
+  }
+  for (std::uint32_t k = 0; k < members.size(); ++k) {
     Instance& inst = instances.at(members[k]);
-    if (!fresh.count(members[k]))
-      batch->carry_over(k, inst.batch->slot(inst.slot)); // step count, divergence
     inst.batch = batch.get();
     inst.slot = k;
   }
@@ -231,6 +234,7 @@ Result<InstanceId> ClothWorld::add(std::shared_ptr<const ClothTopology> topology
         fmt::format("ClothWorld::add: initial velocities has {} entries, the topology {} particles",
                     initial.velocities.size(), n));
   VKCLOTH_TRY(params.validate());
+  VKCLOTH_TRY(vkcloth::detail::PinTargets::check(params, {}, n));
   Impl& s = *impl_;
   const InstanceId id = s.next;
   s.instances.emplace(id, Impl::Instance{std::move(topology), std::move(params)});
@@ -267,6 +271,7 @@ Result<void> ClothWorld::set_params(InstanceId id, SimParams params) {
   VKCLOTH_TRY(params.validate());
   Impl& s = *impl_;
   Impl::Instance& inst = **found;
+  VKCLOTH_TRY(inst.batch->slot(inst.slot).targets.check_params(params, inst.batch->particle_count()));
   const Impl::BatchKey old_key = Impl::key_of(inst, id);
   SimParams previous = std::move(inst.params);
   inst.params = std::move(params);
@@ -308,6 +313,13 @@ Result<void> ClothWorld::set_collider_pose(InstanceId id, std::size_t collider, 
   if (!posed)
     return posed.error();
   return set_params(id, std::move(*posed));
+}
+
+Result<void> ClothWorld::set_pin_targets(InstanceId id, std::span<const PinTarget> targets) {
+  auto found = impl_->find(id);
+  if (!found)
+    return found.error();
+  return (*found)->batch->set_pin_targets((*found)->slot, targets);
 }
 
 Result<SimParams> ClothWorld::params(InstanceId id) const {

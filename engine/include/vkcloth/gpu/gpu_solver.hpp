@@ -26,6 +26,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include <glm/vec2.hpp>
@@ -168,6 +169,8 @@ public:
   /// re-created.
   Result<void> set_params(SimParams params);
   const SimParams& params() const;
+  /// The host's per-frame pin targets for the next recorded step (ClothWorld::set_pin_targets).
+  Result<void> set_pin_targets(std::span<const PinTarget> targets);
 
   /// Records `steps` steps into the caller's command buffer (recording state, compute-capable
   /// queue family of the Context). Host-side counters (step_index, current_position_index)

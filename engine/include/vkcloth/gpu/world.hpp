@@ -30,6 +30,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -107,6 +108,12 @@ public:
   /// (from the next step; frames in flight allowed); the errors name an unknown id, an index past
   /// the list or the pose's field, and leave the parameters as they were.
   Result<void> set_collider_pose(InstanceId id, std::size_t collider, const ColliderPose& pose);
+  /// The host's per-frame targets of the instance's particles for the next recorded step
+  /// (PinTarget; recorded with it by vkCmdUpdateBuffer, substep by substep: frames in flight
+  /// allowed). The errors (targets unchanged) name an unknown id or the target (CpuSolver::
+  /// set_pin_targets). The first targets of a batch make its targets buffer, which first waits for
+  /// every earlier submission on the Context's queue.
+  Result<void> set_pin_targets(InstanceId id, std::span<const PinTarget> targets);
   Result<SimParams> params(InstanceId id) const;
 
   /// Records one step of every instance into the host's command buffer (see GpuSolver::record_steps

@@ -11,6 +11,8 @@
 namespace vkcloth::gpu {
 
 // Defined next to each pass (passes/*.cpp).
+std::unique_ptr<Pass> make_drive_targets();
+std::unique_ptr<Pass> make_hold_targets();
 std::unique_ptr<Pass> make_explicit_update();
 std::unique_ptr<Pass> make_vbd_update();
 std::unique_ptr<Pass> make_tethers();
@@ -23,6 +25,8 @@ std::unique_ptr<Pass> make_vertices();
 
 std::vector<std::unique_ptr<Pass>> make_solver_passes() {
   std::vector<std::unique_ptr<Pass>> passes;
+  // Pinned particles onto their targets at the substep's end (attachments, the host's targets).
+  passes.push_back(make_drive_targets());
   // The update: forces, contacts and the integrator (one of the three runs).
   passes.push_back(make_explicit_update());
   passes.push_back(std::make_unique<ImplicitUpdate>());
@@ -35,6 +39,8 @@ std::vector<std::unique_ptr<Pass>> make_solver_passes() {
   // Self-collision, then the colliders again.
   passes.push_back(make_self_collision());
   passes.push_back(make_contacts_after_self_collision());
+  // Free particles back within reach of their targets (motion constraints), last.
+  passes.push_back(make_hold_targets());
   // Once per recording, after the last substep.
   passes.push_back(make_vertices());
   return passes;
