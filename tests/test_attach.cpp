@@ -52,7 +52,8 @@ double largest_gap(const std::vector<std::vector<glm::dvec3>>& ends) {
 
 } // namespace
 
-TEST_CASE("attachment: a pinned row follows a keyframed, turning capsule to 1e-5 m at every step, GPU = CPU") {
+TEST_CASE(
+    "attachment: a pinned row follows a keyframed, turning capsule to 1e-5 m at every step, GPU = CPU") {
   // The capsule moves 0.5 m and turns 90 degrees in 0.5 s, then rises and turns on to 180 degrees;
   // the cloth's pinned top row keeps its rest offset in the capsule's frame (issue 39 point 1).
   ValidationScope validation;
@@ -140,7 +141,8 @@ TEST_CASE("motion constraint: free particles held within max_distance of a spinn
       for (std::size_t i = 0; i < 2; ++i) {
         const glm::dvec3 target = in_frame(now, held->offsets[i]);
         on_target = std::max(on_target, glm::length(x[held->particles[i]] - target));
-        const glm::dvec3 target_v = ball.linear_velocity + glm::cross(ball.angular_velocity, target - now.center);
+        const glm::dvec3 target_v =
+            ball.linear_velocity + glm::cross(ball.angular_velocity, target - now.center);
         velocity_gap = std::max(velocity_gap, glm::length(v[held->particles[i]] - target_v));
       }
       past_reach = std::max(past_reach, glm::length(x[60] - in_frame(now, loose->offsets[0])) - 0.05);
@@ -247,7 +249,8 @@ TEST_CASE("attachments and pin targets: bad input is an error naming the entry a
   CHECK(message(bad).find("attachments[0] has 2 particles but 1 offsets") != std::string::npos);
   bad.attachments = {*a};
   bad.attachments[0].max_distance = -1.0;
-  CHECK(message(bad).find("attachments[0].max_distance must be finite and >= 0, got -1") != std::string::npos);
+  CHECK(message(bad).find("attachments[0].max_distance must be finite and >= 0, got -1") !=
+        std::string::npos);
   CHECK_FALSE(Attachment::at_rest(p.colliders[1], 1, {0}, rest).ok());
   CHECK_FALSE(Attachment::at_rest(p.colliders[0], 0, {99}, rest).ok());
 

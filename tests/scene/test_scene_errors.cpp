@@ -455,3 +455,62 @@ TEST_CASE("self_collision: bad input names the key and the value (issue 16 item 
   expect_error(R"({"system": "cloth", "self_collision": {"enabled": false, "thickness": 2}})",
                {"self_collision.thickness 2 m", "10 x"}, {"self_collision.enabled=true"});
 }
+
+namespace {
+/// A 4 x 4 cloth with a sphere (collider 0) and a plane (collider 1), and `attach` in its cloth.
+std::string attached(const std::string& attach) {
+  return R"({"system": "cloth", "cloth": {"resolution": [4, 4], )" + attach +
+         R"(}, "colliders": [{"type": "sphere", "center": [0, 0, 2], "radius": 0.1}, )"
+         R"({"type": "plane", "normal": [0, 0, 1], "offset": -1}]})";
+}
+} // namespace
+
+TEST_CASE("cloth.attach and cloth.max_distance: bad entries name the key and the value (issue 39 point 8)") {
+  expect_error(attached(R"("attach": [{"collider": 7, "vertices": [[0, 3]]}])"),
+               {"cloth.attach[0].collider is 7", "2 colliders"});
+  expect_error(attached(R"("attach": [{"collider": 1, "vertices": [[0, 3]]}])"),
+               {"cloth.attach[0]", "collider 1 is a plane"});
+  expect_error(attached(R"("attach": [{"collider": 0, "region": {"min": [5, 5, 5], "max": [6, 6, 6]}}])"),
+               {"cloth.attach[0].region", "selects no particle"});
+  expect_error(attached(R"("attach": [{"collider": 0, "vertices": [[4, 0]]}])"),
+               {"cloth.attach[0].vertices[0] = [4, 0]", "outside the 4 x 4 grid"});
+  expect_error(attached(R"("attach": [{"collider": 0, "vertices": [3]}])"),
+               {"cloth.attach[0].vertices[0]", "[i, j]"});
+  expect_error(attached(R"("attach": [{"collider": 0}])"), {"cloth.attach[0]", "\"region\" or \"vertices\""});
+  expect_error(attached(R"("attach": [{"vertices": [[0, 0]]}])"), {"cloth.attach[0]", "collider"});
+  expect_error(attached(R"("attach": [{"collider": 0, "vertices": [[0, 0]], "bone": 2}])"),
+               {"cloth.attach[0]", "bone"});
+  expect_error(
+      attached(R"("attach": [{"collider": 0, "vertices": [[0, 0]]}, {"collider": 0, "vertices": [[0, 0]]}])"),
+      {"attachments[1].particles[0] is particle 0", "attachments[0].particles[0]"});
+  expect_error(
+      attached(
+          R"("attach": [{"collider": 0, "vertices": [[0, 0]]}], "max_distance": {"attach": 1, "distance": 0.1})"),
+      {"cloth.max_distance.attach is 1", "1 entries"});
+  expect_error(
+      attached(
+          R"("attach": [{"collider": 0, "vertices": [[0, 0]]}], "max_distance": [{"attach": 0, "distance": -0.1}])"),
+      {"cloth.max_distance[0].distance", ">= 0", "got -0.1"});
+  expect_error(attached(R"("max_distance": {"attach": 0, "distance": 0.1})"),
+               {"cloth.max_distance needs cloth.attach"});
+}
+
+TEST_CASE("cloth.attach: a region pins the particles it selects, max_distance leaves them free, offsets from "
+          "t = 0") {
+  auto s = parse_scene(
+      attached(
+          R"("size": [1, 1], "origin": [0, 0, 0], "attach": [{"collider": 0, "region": {"min": [-1, -1, 0.9], "max": [2, 2, 2]}}, )"
+          R"({"collider": 0, "vertices": [[1, 0]]}], "max_distance": {"attach": 1, "distance": 0.05})"),
+      "attach.json");
+  REQUIRE_MESSAGE(s.ok(), (s.ok() ? "" : s.error().message));
+  REQUIRE(s->params.attachments.size() == 2);
+  const Attachment& top = s->params.attachments[0];
+  CHECK(top.particles == std::vector<std::uint32_t>{12, 13, 14, 15}); // the vertical grid's top row, z = 1
+  CHECK(top.max_distance == 0.0);
+  for (std::uint32_t p : top.particles)
+    CHECK(s->system.particles[p].pinned);
+  CHECK(top.offsets[0].z == doctest::Approx(1.0 - 2.0)); // z = 1 against the sphere's centre at 2
+  CHECK(s->params.attachments[1].particles == std::vector<std::uint32_t>{1});
+  CHECK(s->params.attachments[1].max_distance == 0.05);
+  CHECK_FALSE(s->system.particles[1].pinned);
+}

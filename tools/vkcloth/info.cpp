@@ -102,6 +102,16 @@ int info_command(const SceneArgs& opt) {
   fmt::print("colliders   {}\n", p.colliders.size());
   for (std::size_t k = 0; k < p.colliders.size(); ++k)
     print_collider(k, p.colliders[k]);
+  if (!p.attachments.empty())
+    fmt::print("attach      {}\n", p.attachments.size());
+  for (std::size_t k = 0; k < p.attachments.size(); ++k) {
+    const Attachment& a = p.attachments[k];
+    fmt::print("  [{}] {} particles follow collider {}", k, a.particles.size(), a.collider);
+    if (a.max_distance > 0.0 || (!a.particles.empty() && !s.system.particles[a.particles[0]].pinned))
+      fmt::print(", free within {:g} m (max_distance)\n", a.max_distance);
+    else
+      fmt::print(", pinned\n");
+  }
   fmt::print("contact_epsilon {:g} m, divergence_limit {:g} m\n", p.contact_epsilon, p.divergence_limit);
   return exit_ok;
 }

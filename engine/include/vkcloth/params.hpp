@@ -282,6 +282,11 @@ struct SimParams {
 Result<std::vector<std::string>> check_self_collision(const SelfCollision& self,
                                                       const ParticleSystem& system);
 
+/// The attachments' particles against a cloth of `particles` particles: each index in it, and each
+/// particle in one attachment at most (the solvers check this too; a scene loader, earlier). The
+/// message names the entry (attachments[a].particles[i]) and the particle.
+Result<void> check_attachments(const SimParams& params, std::size_t particles);
+
 /// `params` with colliders[collider] moved to `pose` (Collider::with_pose), what the worlds'
 /// set_collider_pose apply. ErrorCode::invalid_argument for an index past the list (the message
 /// names it and the list's size) or a bad pose (ColliderPose::validate); the result is validated

@@ -26,7 +26,8 @@ Result<void> PinTargets::check(const SimParams& params, std::span<const PinTarge
   };
   for (std::size_t a = 0; a < params.attachments.size(); ++a)
     for (std::size_t i = 0; i < params.attachments[a].particles.size(); ++i)
-      VKCLOTH_TRY(claim(params.attachments[a].particles[i], fmt::format("attachments[{}].particles[{}]", a, i)));
+      VKCLOTH_TRY(
+          claim(params.attachments[a].particles[i], fmt::format("attachments[{}].particles[{}]", a, i)));
   using detail::finite;
   using detail::str;
   for (std::size_t i = 0; i < host.size(); ++i) {
@@ -36,9 +37,10 @@ Result<void> PinTargets::check(const SimParams& params, std::span<const PinTarge
                         fmt::format("pin target {} (particle {}): position must be finite, got {}", i,
                                     t.particle, str(t.position)));
     if (!std::isfinite(t.max_distance) || t.max_distance < 0.0)
-      return make_error(ErrorCode::invalid_argument,
-                        fmt::format("pin target {} (particle {}): max_distance must be finite and >= 0, got {}",
-                                    i, t.particle, t.max_distance));
+      return make_error(
+          ErrorCode::invalid_argument,
+          fmt::format("pin target {} (particle {}): max_distance must be finite and >= 0, got {}", i,
+                      t.particle, t.max_distance));
     VKCLOTH_TRY(claim(t.particle, fmt::format("pin target {}", i)));
   }
   return {};
@@ -52,7 +54,8 @@ Result<void> PinTargets::check_params(const SimParams& params, std::size_t count
   return check(params, host, count);
 }
 
-Result<void> PinTargets::set_host(const SimParams& params, std::span<const PinTarget> targets, std::size_t count) {
+Result<void> PinTargets::set_host(const SimParams& params, std::span<const PinTarget> targets,
+                                  std::size_t count) {
   VKCLOTH_TRY(check(params, targets, count));
   std::unordered_map<std::uint32_t, glm::dvec3> previous;
   for (const Host& h : host_)
@@ -99,3 +102,9 @@ void PinTargets::end_step() {
 }
 
 } // namespace vkcloth::detail
+
+namespace vkcloth {
+Result<void> check_attachments(const SimParams& params, std::size_t particles) {
+  return detail::PinTargets::check(params, {}, particles);
+}
+} // namespace vkcloth

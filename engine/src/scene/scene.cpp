@@ -93,6 +93,11 @@ Result<Scene> build_scene(const json& doc, std::string_view source_name) {
       return system.error();
     scene.system = std::move(*system);
   }
+  if (const json* cloth = kind == "cloth" && doc.contains("cloth") ? &doc["cloth"] : nullptr;
+      cloth && cloth->is_object()) {
+    VKCLOTH_TRY(sd::read_attachments(*cloth, scene));
+    VKCLOTH_TRY(scene.system.validate());
+  }
   VKCLOTH_TRY(check_scene_self_collision(scene));
   return scene;
 }

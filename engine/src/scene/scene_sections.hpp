@@ -49,6 +49,10 @@ Result<ParticleSystem> read_cloth(const json& doc, const std::optional<Material>
 Result<void> read_mesh_cloth(const json& cloth, const std::filesystem::path& scene_dir,
                              const std::optional<Material>& material, Scene& scene);
 
+/// "cloth.attach" and "cloth.max_distance" into scene.params.attachments (the system and the
+/// colliders built; pins the attached particles that have no max_distance).
+Result<void> read_attachments(const json& cloth, Scene& scene);
+
 /// A file a scene names ("cloth.mesh", "colliders[k].path"): relative to the scene file's directory,
 /// or absolute.
 inline std::filesystem::path scene_relative(const std::string& file, const std::filesystem::path& scene_dir) {

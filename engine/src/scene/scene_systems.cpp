@@ -137,7 +137,7 @@ Result<void> read_mesh_cloth(const json& cloth, const std::filesystem::path& sce
           grid_key));
   VKCLOTH_TRY(sd::check_keys(cloth, "cloth",
                              {"mesh", "mesh_transform", "density", "particle_mass", "stiffness", "material",
-                              "pin_vertices", "pin_region"}));
+                              "pin_vertices", "pin_region", "attach", "max_distance"}));
   std::string file;
   VKCLOTH_TRY(sd::read(cloth, "cloth", "mesh", file));
   MeshClothDesc d;
@@ -173,9 +173,9 @@ Result<ParticleSystem> read_cloth(const json& doc, const std::optional<Material>
   d.material = material;
   SCENE_TRY_ASSIGN(obj, sd::read_object(doc, "", "cloth"));
   if (obj) {
-    VKCLOTH_TRY(sd::check_keys(
-        *obj, "cloth",
-        {"resolution", "size", "origin", "orientation", "particle_mass", "stiffness", "material", "pins"}));
+    VKCLOTH_TRY(sd::check_keys(*obj, "cloth",
+                               {"resolution", "size", "origin", "orientation", "particle_mass", "stiffness",
+                                "material", "pins", "attach", "max_distance"}));
     if (auto it = obj->find("resolution"); it != obj->end()) {
       if (!it->is_array() || it->size() != 2)
         return sd::shape_error(
