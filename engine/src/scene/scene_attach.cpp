@@ -96,8 +96,8 @@ Result<std::map<std::size_t, double>> read_max_distances(const json& cloth, std:
     const std::string at = it->is_array() ? fmt::format("cloth.max_distance[{}]", k) : "cloth.max_distance";
     const json& e = list[k];
     if (!e.is_object())
-      return shape_error(fmt::format("{} must be an object {{\"attach\": N, \"distance\": D}}, got {}", at,
-                                     show(e)));
+      return shape_error(
+          fmt::format("{} must be an object {{\"attach\": N, \"distance\": D}}, got {}", at, show(e)));
     VKCLOTH_TRY(check_keys(e, at, {"attach", "distance"}));
     VKCLOTH_TRY(require_keys(e, at, {"attach", "distance"}, "a max_distance"));
     SCENE_TRY_ASSIGN(n, as_integer(e["attach"], at + ".attach", std::numeric_limits<std::uint32_t>::max()));
@@ -131,21 +131,23 @@ Result<void> read_attachments(const json& cloth, Scene& scene) {
     const std::string at = fmt::format("cloth.attach[{}]", k);
     const json& e = (*list)[k];
     if (!e.is_object())
-      return shape_error(fmt::format("{} must be an object {{\"collider\": K, \"region\" or \"vertices\"}}, got {}",
-                                     at, show(e)));
+      return shape_error(fmt::format(
+          "{} must be an object {{\"collider\": K, \"region\" or \"vertices\"}}, got {}", at, show(e)));
     VKCLOTH_TRY(check_keys(e, at, {"collider", "region", "vertices"}));
     VKCLOTH_TRY(require_keys(e, at, {"collider"}, "an attachment"));
     if (e.contains("region") == e.contains("vertices"))
       return shape_error(fmt::format("{} needs one of \"region\" or \"vertices\"", at));
-    SCENE_TRY_ASSIGN(index, as_integer(e["collider"], at + ".collider", std::numeric_limits<std::uint32_t>::max()));
+    SCENE_TRY_ASSIGN(index,
+                     as_integer(e["collider"], at + ".collider", std::numeric_limits<std::uint32_t>::max()));
     if (index >= scene.params.colliders.size())
       return bad(fmt::format("{}.collider is {}, but the scene has {} colliders", at, index,
                              scene.params.colliders.size()));
-    SCENE_TRY_ASSIGN(particles, e.contains("region") ? read_region(e["region"], at + ".region", scene.system)
-                                                    : read_vertices(e["vertices"], at + ".vertices", scene.system));
+    SCENE_TRY_ASSIGN(particles, e.contains("region")
+                                    ? read_region(e["region"], at + ".region", scene.system)
+                                    : read_vertices(e["vertices"], at + ".vertices", scene.system));
     const auto distance = distances.find(k);
-    auto a = Attachment::at_rest(scene.params.colliders[index], static_cast<std::uint32_t>(index), particles, rest,
-                                 distance == distances.end() ? 0.0 : distance->second);
+    auto a = Attachment::at_rest(scene.params.colliders[index], static_cast<std::uint32_t>(index), particles,
+                                 rest, distance == distances.end() ? 0.0 : distance->second);
     if (!a)
       return bad(fmt::format("{}: {}", at, a.error().message));
     if (distance == distances.end()) // no max_distance: pinned, driven onto the targets
