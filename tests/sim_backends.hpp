@@ -38,6 +38,7 @@ public:
   virtual std::vector<glm::dvec3> normals() = 0;
   virtual Result<void> set_params(SimParams params) = 0;
   virtual Result<void> set_pin_targets(std::span<const PinTarget> targets) = 0;
+  virtual Result<void> teleport(const RigidJump& jump) = 0;
   Result<void> step() { return run(1); }
   glm::dvec3 position(std::size_t i) { return positions().at(i); }
   glm::dvec3 velocity(std::size_t i) { return velocities().at(i); }
@@ -59,6 +60,7 @@ public:
   Result<void> set_pin_targets(std::span<const PinTarget> targets) override {
     return s_.set_pin_targets(targets);
   }
+  Result<void> teleport(const RigidJump& jump) override { return s_.teleport(jump); }
 
 private:
   CpuSolver<Real> s_;
@@ -76,6 +78,7 @@ public:
   Result<void> set_pin_targets(std::span<const PinTarget> targets) override {
     return s_.set_pin_targets(targets);
   }
+  Result<void> teleport(const RigidJump& jump) override { return s_.teleport(jump); }
 
 private:
   static std::vector<glm::dvec3> read(const Result<std::vector<glm::vec3>>& r) {

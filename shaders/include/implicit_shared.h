@@ -15,18 +15,18 @@ namespace vkcloth::gpu::shared {
 #endif
 
 #define VKCLOTH_BINDING_IMPL_VF                                                                              \
-  26 // (after VKCLOTH_BINDING_COUNT) contact-filtered velocity, removed force, contact axis (vec4 each)
-#define VKCLOTH_BINDING_IMPL_KS 27 // per CSR entry: K_s as 2 vec4 (xx yy zz xy | xz yz - -)
+  27 // (after VKCLOTH_BINDING_COUNT) contact-filtered velocity, removed force, contact axis (vec4 each)
+#define VKCLOTH_BINDING_IMPL_KS 28 // per CSR entry: K_s as 2 vec4 (xx yy zz xy | xz yz - -)
 #define VKCLOTH_BINDING_IMPL_BLOCK_INV                                                                       \
-  28                              // P^-1: inverse diagonal block of A, 2 vec4 (xx yy zz xy | xz yz - -)
-#define VKCLOTH_BINDING_IMPL_X 29 // CG solution dv (vec4), kept between solves (warm start)
-#define VKCLOTH_BINDING_IMPL_R 30 // residual
-#define VKCLOTH_BINDING_IMPL_Z 31 // preconditioned residual
-#define VKCLOTH_BINDING_IMPL_D 32 // search direction
-#define VKCLOTH_BINDING_IMPL_Q 33 // S A d
-#define VKCLOTH_BINDING_IMPL_PARTIALS 34 // one vec4 per workgroup: its partial dot products (coherent)
-#define VKCLOTH_BINDING_IMPL_STATE 35    // CgState
-#define VKCLOTH_BINDING_IMPL_ARGS 36     // indirect dispatch arguments (CgArgs)
+  29                              // P^-1: inverse diagonal block of A, 2 vec4 (xx yy zz xy | xz yz - -)
+#define VKCLOTH_BINDING_IMPL_X 30 // CG solution dv (vec4), kept between solves (warm start)
+#define VKCLOTH_BINDING_IMPL_R 31 // residual
+#define VKCLOTH_BINDING_IMPL_Z 32 // preconditioned residual
+#define VKCLOTH_BINDING_IMPL_D 33 // search direction
+#define VKCLOTH_BINDING_IMPL_Q 34 // S A d
+#define VKCLOTH_BINDING_IMPL_PARTIALS 35 // one vec4 per workgroup: its partial dot products (coherent)
+#define VKCLOTH_BINDING_IMPL_STATE 36    // CgState
+#define VKCLOTH_BINDING_IMPL_ARGS 37     // indirect dispatch arguments (CgArgs)
 
 // implicit.comp passes (PushConstants::stage). SYSTEM, MATVEC and UPDATE end with a reduction:
 // every workgroup writes its partial sums, and the LAST workgroup to arrive (CgState::arrived)

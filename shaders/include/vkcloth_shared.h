@@ -60,7 +60,8 @@ struct vec4 {
 #define VKCLOTH_BINDING_MESH_TRIS 23  // MeshTriangle: their triangles in leaf order (Collider::mesh_tri0)
 #define VKCLOTH_BINDING_VBD_ORDER 24  // vbd: the particles in colour order (ClothTopology::vertex_order)
 #define VKCLOTH_BINDING_TARGETS 25    // Target per particle of each instance (its attachments' and host's)
-#define VKCLOTH_BINDING_COUNT 26
+#define VKCLOTH_BINDING_FRAMES 26     // FrameMotion per instance: its frame's jump and carry this substep
+#define VKCLOTH_BINDING_COUNT 27
 
 // Set 1 (force.comp, fused.comp, strain_*.comp): POS_IN again, as an RGBA32F uniform texel buffer view,
 // PARTICLE as an RG32UI one (x: the mass's bits, y: pinned), and (fused.comp) VEL as RGBA32F and
@@ -198,11 +199,31 @@ struct Edge {
 #define VKCLOTH_NO_TARGET 0xffffffffu
 #define VKCLOTH_TARGETS_DRIVE 0u // targets.comp stage: pinned particles onto their targets (before a substep)
 #define VKCLOTH_TARGETS_HOLD 1u  // free particles back within reach (after a substep)
+#define VKCLOTH_FRAME_JUMP 2u    // every particle moved by its frame's jump (before a substep)
+#define VKCLOTH_FRAME_CARRY 3u   // free particles carried with the frame (after a substep)
 struct Target {
   float px, py, pz; // the target
   uint particle;    // VKCLOTH_NO_TARGET: past the instance's last target
   float vx, vy, vz; // its velocity
   float reach;      // how far a free particle may be from it (m)
+};
+
+/// The cloth's frame over one substep (targets.comp's FRAME stages; the CPU's detail::FrameStep;
+/// std430: 144 bytes): the jump x -> (row0.xyz . x, row1.xyz . x, row2.xyz . x) + (row0.w, row1.w,
+/// row2.w), and the carry's inputs (kernel attach.h carried_velocity).
+struct FrameMotion {
+  vec4 row0; // the jump's rotation rows, w: its shift
+  vec4 row1;
+  vec4 row2;
+  vec4 dv;     // xyz: the frame's linear velocity change, w: 1 - inertia.linear
+  vec4 omega0; // xyz: its angular velocity at the substep's start, w: 1 - inertia.angular
+  vec4 omega1; // xyz: at its end
+  vec4 c0;     // xyz: its centre at the start
+  vec4 c1;     // xyz: at the end
+  uint jump;   // 1: this substep jumps
+  uint carry;  // 1: this substep carries
+  uint unused0;
+  uint unused1;
 };
 
 /// A strain link (ClothTopology's StrainLink; std430: 12 bytes).
@@ -293,6 +314,7 @@ static_assert(sizeof(Vertex) == 32);
 static_assert(sizeof(Edge) == 16);
 static_assert(sizeof(StrainLink) == 12);
 static_assert(sizeof(Target) == 32);
+static_assert(sizeof(FrameMotion) == 144);
 static_assert(sizeof(TetherSlot) == 8);
 static_assert(offsetof(InstanceParams, max_strain) == 68);
 static_assert(sizeof(Collider) == 144);

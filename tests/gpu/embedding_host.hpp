@@ -15,7 +15,7 @@
 namespace vkcloth::gpu::test {
 
 inline std::shared_ptr<const ClothTopology> make_topology(std::uint32_t nx, std::uint32_t ny,
-                                                   bool horizontal = false) {
+                                                          bool horizontal = false) {
   ClothDesc d;
   d.nx = nx;
   d.ny = ny;

@@ -323,7 +323,8 @@ TEST_CASE("set_pin_targets: targets every frame with two frames in flight on the
     const std::uint32_t slot = std::uint32_t(k) % HostVulkan::frames_in_flight; // waits for frame k - 2 only
     REQUIRE(host->begin_frame(slot));
     gpu_world->record_steps(host->frame_cmd[slot], steps_per_frame);
-    gpu_world->record_barrier_to(host->frame_cmd[slot], VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
+    gpu_world->record_barrier_to(host->frame_cmd[slot], VK_PIPELINE_STAGE_TRANSFER_BIT,
+                                 VK_ACCESS_TRANSFER_READ_BIT);
     REQUIRE(host->submit_frame(slot));
     REQUIRE(cpu_world->set_pin_targets(*c, targets).ok());
     REQUIRE(cpu_world->simulate(steps_per_frame).ok());
@@ -345,6 +346,7 @@ TEST_CASE("set_pin_targets: targets every frame with two frames in flight on the
   const PinTarget past{10000, {0, 0, 0}, 0.0};
   r = gpu_world->set_pin_targets(*g, {&past, 1});
   REQUIRE_FALSE(r.ok());
-  CHECK_MESSAGE(r.error().message.find("past the cloth's 120 particles") != std::string::npos, r.error().message);
+  CHECK_MESSAGE(r.error().message.find("past the cloth's 120 particles") != std::string::npos,
+                r.error().message);
   CHECK(host->messages.load() == 0);
 }

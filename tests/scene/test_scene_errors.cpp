@@ -513,4 +513,38 @@ TEST_CASE("cloth.attach: a region pins the particles it selects, max_distance le
   CHECK(s->params.attachments[1].particles == std::vector<std::uint32_t>{1});
   CHECK(s->params.attachments[1].max_distance == 0.05);
   CHECK_FALSE(s->system.particles[1].pinned);
+  CHECK_FALSE(s->params.inertia.enabled());
+  // The frame and a teleport key.
+  auto framed = parse_scene(
+      R"({"system": "cloth", "inertia": {"collider": 0, "linear": 0.25}, "colliders": [{"type": "capsule", )"
+      R"("a": [0, 0, 0], "b": [0, 0, 1], "radius": 0.1, "keyframes": [{"t": 0}, {"t": 1, "translate": [5, 0, 0], )"
+      R"("teleport": true}]}]})",
+      "framed.json");
+  REQUIRE_MESSAGE(framed.ok(), (framed.ok() ? "" : framed.error().message));
+  CHECK(framed->params.inertia.collider == 0u);
+  CHECK(framed->params.inertia.linear == 0.25);
+  CHECK(framed->params.inertia.angular == 1.0);
+  CHECK(framed->params.colliders[0].path->keys[1].teleport);
+}
+
+TEST_CASE("inertia and keyframes' teleport: bad entries name the key and the value (issue 39 point 8)") {
+  const std::string sphere = R"({"type": "sphere", "center": [0, 0, 2], "radius": 0.1})";
+  const auto scene = [&](const std::string& inertia) {
+    return R"({"system": "cloth", "colliders": [)" + sphere + R"(, {"type": "plane"}], "inertia": )" +
+           inertia + "}";
+  };
+  expect_error(scene(R"({"collider": 3})"), {"inertia.collider is 3, but there are 2 colliders"});
+  expect_error(scene(R"({"collider": 1})"), {"inertia.collider 1 is a plane"});
+  expect_error(scene(R"({"collider": 0, "linear": 1.5})"), {"inertia.linear must be in [0, 1], got 1.5"});
+  expect_error(scene(R"({"collider": 0, "angular": -1})"), {"inertia.angular must be in [0, 1], got -1"});
+  expect_error(scene(R"({"linear": 0.5})"), {"inertia", "collider"});
+  expect_error(scene(R"({"collider": 0, "spin": 0.5})"), {"inertia", "spin"});
+  expect_error(
+      colliders(
+          R"({"type": "box", "center": [0,0,0], "half_extents": [1,1,1], "keyframes": [{"t": 0, "teleport": true}]})"),
+      {"colliders[0].keyframes[0].teleport", "first key"});
+  expect_error(
+      colliders(
+          R"({"type": "box", "center": [0,0,0], "half_extents": [1,1,1], "keyframes": [{"t": 0}, {"t": 1, "teleport": 1}]})"),
+      {"colliders[0].keyframes[1].teleport"});
 }

@@ -53,10 +53,14 @@ void print_collider(std::size_t k, const Collider& c) {
     break;
   }
   fmt::print("      friction {:g} (static {:g})", c.friction, c.static_coefficient());
-  if (c.path)
-    fmt::print(", keyframed: {} keys from t = {:g} s to {:g} s\n", c.path->keys.size(),
-               c.path->keys.front().t, c.path->keys.back().t);
-  else if (c.moving())
+  if (c.path) {
+    fmt::print(", keyframed: {} keys from t = {:g} s to {:g} s", c.path->keys.size(), c.path->keys.front().t,
+               c.path->keys.back().t);
+    for (const ColliderKeyframe& key : c.path->keys)
+      if (key.teleport)
+        fmt::print(", teleport at t = {:g} s", key.t);
+    fmt::print("\n");
+  } else if (c.moving())
     fmt::print(", linear_velocity {} m/s, angular_velocity {} rad/s\n", vec(c.linear_velocity),
                vec(c.angular_velocity));
   else
@@ -102,6 +106,9 @@ int info_command(const SceneArgs& opt) {
   fmt::print("colliders   {}\n", p.colliders.size());
   for (std::size_t k = 0; k < p.colliders.size(); ++k)
     print_collider(k, p.colliders[k]);
+  if (p.inertia.enabled())
+    fmt::print("inertia     the frame of collider {}: linear {:g}, angular {:g}\n", *p.inertia.collider,
+               p.inertia.linear, p.inertia.angular);
   if (!p.attachments.empty())
     fmt::print("attach      {}\n", p.attachments.size());
   for (std::size_t k = 0; k < p.attachments.size(); ++k) {

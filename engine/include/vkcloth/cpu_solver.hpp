@@ -98,6 +98,12 @@ public:
   /// errors (state unchanged) name the target: a particle past the cloth, one targeted twice (or
   /// also by params().attachments), a non-finite position, a negative max_distance.
   Result<void> set_pin_targets(std::span<const PinTarget> targets);
+  /// Moves the whole cloth by `jump` at the start of the next step, unfelt: positions, velocities
+  /// (turned) and the host's targets (docs/model.md "Inertia and teleport"). A host that moves
+  /// the cloth's frame collider moves it too (set_params); a keyframe's `teleport` does both by
+  /// itself. ErrorCode::invalid_argument (nothing changed) for non-finite values or a rotation
+  /// that is not one.
+  Result<void> teleport(const RigidJump& jump);
 
   /// Kinetic energy sum 1/2 m v^2, gravitational and spring potential energies (for studies).
   struct Energy {

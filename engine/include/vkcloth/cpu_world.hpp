@@ -76,6 +76,8 @@ public:
   /// The host's per-frame targets of the instance's particles for the next step (PinTarget;
   /// CpuSolver::set_pin_targets, whose errors these are, or an unknown id).
   Result<void> set_pin_targets(InstanceId id, std::span<const PinTarget> targets);
+  /// The instance's whole cloth moved by `jump` at its next step, unfelt (CpuSolver::teleport).
+  Result<void> teleport(InstanceId id, const RigidJump& jump);
   /// The instance's parameters; moving colliders where its steps left them.
   Result<SimParams> params(InstanceId id) const;
 

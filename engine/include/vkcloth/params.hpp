@@ -56,6 +56,20 @@ struct ColliderKeyframe {
   double t = 0.0;             ///< s, >= 0, increasing along a path
   glm::dvec3 translate{0.0};  ///< m
   glm::dvec3 rotate_deg{0.0}; ///< degrees
+  /// Reached by a jump at t (the previous key's pose held until then), which a cloth simulated in
+  /// this collider's frame (SimParams::inertia) does not feel. Not on the first key.
+  bool teleport = false;
+};
+
+/// A rigid jump (a teleport): x -> pivot + translation + rotation (x - pivot); velocities turn by
+/// `rotation`.
+struct RigidJump {
+  glm::dvec3 pivot{0.0};
+  glm::dvec3 translation{0.0};
+  glm::dmat3 rotation{1.0};
+  glm::dvec3 apply(glm::dvec3 x) const { return pivot + translation + rotation * (x - pivot); }
+  /// Finite values and a rotation matrix (within 1e-6); the message names the field and the value.
+  Result<void> validate() const;
 };
 
 /// A collider (docs/model.md "Collisions", docs/scene-format.md "colliders"): a shape, its friction and
@@ -130,8 +144,12 @@ struct Collider {
 struct ColliderPath {
   std::vector<ColliderKeyframe> keys;
   Collider base; ///< the collider at translate 0, rotate 0 (no path of its own)
-  /// The translation and rotation at time t (held before the first key and past the last).
+  /// The translation and rotation at time t (held before the first key and past the last, and
+  /// before a teleport key).
   void pose(double t, glm::dvec3& translate, glm::dmat3& rotation) const;
+  /// Whether a teleport key lies in (t0, t1]: then `jump` is its jump (about the collider's centre
+  /// before it) and `at` its time.
+  bool jump_between(double t0, double t1, RigidJump& jump, double& at) const;
   /// `base` at the pose of time t (velocities zero).
   Collider at(double t) const;
 };
@@ -237,6 +255,18 @@ struct PinTarget {
   double max_distance = 0.0; ///< m, >= 0
 };
 
+/// The frame a cloth is simulated in (docs/model.md "Inertia and teleport"; NvCloth's inertia scales):
+/// a collider's. The cloth feels `linear` of the frame's linear acceleration and `angular` of its
+/// angular motion (its angular acceleration, centrifugal and Coriolis parts); the rest carries it
+/// along with the frame. A teleport of the frame (a keyframe's `teleport`) moves the cloth with it,
+/// unfelt. Off by default: world space.
+struct Inertia {
+  std::optional<std::uint32_t> collider; ///< index in SimParams::colliders (not a plane); none: off
+  double linear = 1.0;                   ///< 0..1 (1: world space, 0: carried rigidly)
+  double angular = 1.0;                  ///< 0..1
+  bool enabled() const { return collider.has_value(); }
+};
+
 struct SimParams {
   Integrator integrator = Integrator::semi_implicit_euler;
   double dt = 0.02;
@@ -269,6 +299,7 @@ struct SimParams {
   /// Particles that follow colliders (none by default). Their indices are checked against the cloth
   /// by the solvers (an index past it, or a particle in two attachments, is an error).
   std::vector<Attachment> attachments;
+  Inertia inertia; ///< off by default (world space)
 
   /// Checks every field (finite, in range) and normalises directions. The message names the field.
   Result<void> validate();

@@ -303,15 +303,27 @@ template <typename Real> Result<void> CpuSolver<Real>::Impl::step() {
   const std::uint32_t k = params_.substeps;
   const double h = k == 1 ? params_.dt : params_.dt / double(k);
   const bool targets = !targets_.empty(params_);
+  const std::optional<std::uint32_t> frame = params_.inertia.collider;
   for (std::uint32_t s = 0; s < k; ++s) {
+    const Collider frame_before = frame ? params_.colliders[*frame] : Collider{};
     advance_colliders(h); // a substep meets the colliders where they are at its end
     prepare_colliders();
+    const detail::FrameStep f =
+        detail::frame_step(params_, frame_before, frame ? params_.colliders[*frame] : Collider{},
+                           s == 0 ? host_jump_ : std::nullopt);
+    if (f.jump)
+      jump_cloth(*f.jump);
     if (targets)
       drive_targets(s);
+    if (f.carry)
+      frame_x0_ = pos_;
     substep(Real(h));
     if (targets)
       hold_targets();
+    if (f.carry)
+      carry_cloth(f);
   }
+  host_jump_.reset();
   targets_.end_step();
   ++step_;
   time_ += params_.dt;
@@ -334,6 +346,24 @@ template <typename Real> void CpuSolver<Real>::Impl::hold_targets() {
       kernel::hold_within(Vec3(t.position), Vec3(t.velocity), Real(t.reach), pos_[t.particle],
                           vel_[t.particle]);
   soa_valid_ = false;
+}
+
+template <typename Real> void CpuSolver<Real>::Impl::jump_cloth(const RigidJump& jump) {
+  const detail::JumpRows rows = detail::jump_rows(jump);
+  const Vec3 r0(rows.r0), r1(rows.r1), r2(rows.r2), t(rows.shift);
+  for (std::size_t p = 0; p < pos_.size(); ++p)
+    kernel::rigid_jump(r0, r1, r2, t, pos_[p], vel_[p]);
+  targets_.teleport(jump);
+  soa_valid_ = false;
+}
+
+template <typename Real> void CpuSolver<Real>::Impl::carry_cloth(const detail::FrameStep& f) {
+  const Vec3 dv(f.dv), omega0(f.omega0), omega1(f.omega1), c0(f.c0), c1(f.c1);
+  const Real lin = Real(f.carry_linear), ang = Real(f.carry_angular);
+  for (std::size_t p = 0; p < pos_.size(); ++p)
+    if (!pinned_[p])
+      vel_[p] =
+          vel_[p] + kernel::carried_velocity(frame_x0_[p], pos_[p], dv, omega0, omega1, c0, c1, lin, ang);
 }
 
 template <typename Real> void CpuSolver<Real>::Impl::substep(const Real h) {
@@ -582,6 +612,11 @@ template <typename Real> const ParticleSystem& CpuSolver<Real>::system() const {
 }
 template <typename Real> const std::shared_ptr<const ClothTopology>& CpuSolver<Real>::topology() const {
   return impl_->topology_;
+}
+template <typename Real> Result<void> CpuSolver<Real>::teleport(const RigidJump& jump) {
+  VKCLOTH_TRY(jump.validate());
+  impl_->host_jump_ = impl_->host_jump_ ? detail::then(*impl_->host_jump_, jump) : jump;
+  return {};
 }
 template <typename Real> Result<void> CpuSolver<Real>::set_pin_targets(std::span<const PinTarget> targets) {
   return impl_->targets_.set_host(impl_->params_, targets, impl_->pos_.size());

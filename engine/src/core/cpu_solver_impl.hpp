@@ -11,6 +11,7 @@
 #include <span>
 #include <vector>
 
+#include "cloth_frame.hpp"
 #include "kernel.hpp"
 #include "pin_targets.hpp"
 #include "row_kernel.hpp"
@@ -115,6 +116,9 @@ template <typename Real> struct CpuSolver<Real>::Impl {
   // substep (drive_targets), free ones back within reach after it (hold_targets).
   void drive_targets(std::uint32_t k);
   void hold_targets();
+  // The frame's jump (every particle, the host's targets) and its carry after a substep.
+  void jump_cloth(const RigidJump& jump);
+  void carry_cloth(const detail::FrameStep& frame);
   Energy energy() const;
   double time() const { return time_; }
   const ParticleSystem& system() const { return topology_->system(); }
@@ -176,6 +180,10 @@ template <typename Real> struct CpuSolver<Real>::Impl {
   // Attachments and the host's targets (docs/model.md "Attachments"): each substep's in targets_now_.
   detail::PinTargets targets_;
   std::vector<detail::TargetEntry> targets_now_;
+  // The cloth's frame (docs/model.md "Inertia and teleport"): the host's teleport for the next
+  // step, and the positions at the substep's start while the frame carries the cloth.
+  std::optional<RigidJump> host_jump_;
+  std::vector<Vec3> frame_x0_;
   std::span<const std::uint32_t> edge_offsets_; // the topology's
   std::vector<Edge> edges_;
   std::vector<Real> mass_;

@@ -158,6 +158,13 @@ Result<void> CpuWorld::set_pin_targets(InstanceId id, std::span<const PinTarget>
   return (*inst)->solver.set_pin_targets(targets);
 }
 
+Result<void> CpuWorld::teleport(InstanceId id, const RigidJump& jump) {
+  auto inst = impl_->find(id);
+  if (!inst)
+    return inst.error();
+  return (*inst)->solver.teleport(jump);
+}
+
 Result<SimParams> CpuWorld::params(InstanceId id) const {
   auto inst = impl_->find(id);
   if (!inst)

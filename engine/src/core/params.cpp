@@ -55,6 +55,9 @@ Result<void> check_keyframes(const std::vector<ColliderKeyframe>& keys) {
       return bad_argument(
           fmt::format("keyframes[{}].rotate_deg must be finite, got {}", k, str(key.rotate_deg)));
   }
+  if (keys.front().teleport)
+    return bad_argument(
+        "keyframes[0].teleport: the first key has no pose to jump from (teleport a later key)");
   return {};
 }
 
@@ -232,7 +235,8 @@ void ColliderPath::pose(const double t, glm::dvec3& translate, glm::dmat3& rotat
   const std::size_t k = key_before(keys, t);
   const ColliderKeyframe& k0 = keys[k];
   const glm::dmat3 r0 = Collider::rotation_from_degrees(k0.rotate_deg);
-  if (k + 1 == keys.size() || t <= k0.t) { // held: before the first key, at a key, past the last
+  // Held: before the first key, at a key, past the last, and until a teleport key's jump.
+  if (k + 1 == keys.size() || t <= k0.t || keys[k + 1].teleport) {
     translate = k0.translate;
     rotation = r0;
     return;
@@ -263,6 +267,22 @@ Collider moved(const Collider& base, const glm::dvec3 shift, const glm::dmat3& t
   return c;
 }
 } // namespace
+
+bool ColliderPath::jump_between(const double t0, const double t1, RigidJump& jump, double& at) const {
+  for (std::size_t k = 1; k < keys.size(); ++k)
+    if (keys[k].teleport && keys[k].t > t0 && keys[k].t <= t1) {
+      glm::dvec3 shift0, shift1;
+      glm::dmat3 turn0, turn1;
+      pose(std::nextafter(keys[k].t, 0.0), shift0, turn0); // the pose held until the jump
+      pose(keys[k].t, shift1, turn1);
+      jump.pivot = base.centre() + shift0;
+      jump.translation = shift1 - shift0;
+      jump.rotation = turn1 * glm::transpose(turn0);
+      at = keys[k].t;
+      return true;
+    }
+  return false;
+}
 
 Collider ColliderPath::at(const double t) const {
   glm::dvec3 shift;
@@ -301,13 +321,23 @@ Collider Collider::posed_at(double seconds) const {
     return c;
   if (path) { // the path's pose, and its motion over the advance as the velocities
     const double t1 = path_time + seconds;
+    // Across a teleport key the motion starts after its jump (the jump is no velocity).
+    RigidJump jump;
+    double jumped_at = 0.0;
+    const bool jumped = path->jump_between(path_time, t1, jump, jumped_at);
+    const double from = jumped ? jumped_at : path_time;
     glm::dvec3 shift0, shift1;
     glm::dmat3 turn0, turn1;
-    path->pose(path_time, shift0, turn0);
+    path->pose(from, shift0, turn0);
     path->pose(t1, shift1, turn1);
     c = moved(path->base, shift1, turn1);
     c.path = path;
     c.path_time = t1;
+    if (t1 == from) { // the jump is the whole advance: at rest
+      c.linear_velocity = c.angular_velocity = glm::dvec3(0.0);
+      return c;
+    }
+    seconds = t1 - from;
     c.linear_velocity = (shift1 - shift0) / seconds;
     // The turn R1 R0^T (world frame, about the centre) as a rotation vector, by the quaternion's log
     // map: exact for small turns too, where w rounds to 1 (glm::axis then gives up and returns z).
@@ -365,6 +395,18 @@ Collider Collider::with_pose(const ColliderPose& pose) const {
   if (pose.rotation && type != Type::plane) // every body keeps its frame (attachments follow it)
     c.rotation = *pose.rotation;
   return c;
+}
+
+Result<void> RigidJump::validate() const {
+  if (!finite(pivot))
+    return bad_argument("teleport: pivot must be finite, got " + str(pivot));
+  if (!finite(translation))
+    return bad_argument("teleport: translation must be finite, got " + str(translation));
+  const double off = rotation_error(rotation);
+  if (!(off < 1e-6))
+    return bad_argument(fmt::format(
+        "teleport: rotation must be a rotation matrix (orthonormal, determinant 1); it is off by {}", off));
+  return {};
 }
 
 Result<void> ColliderPose::validate() const {
@@ -506,6 +548,19 @@ Result<void> SimParams::validate() {
         fmt::format("self_collision.iterations must be in 1..16, got {}", self_collision.iterations));
   for (std::size_t k = 0; k < attachments.size(); ++k)
     VKCLOTH_TRY(validate_attachment(attachments[k], colliders, fmt::format("attachments[{}]", k)));
+  if (inertia.collider) {
+    if (*inertia.collider >= colliders.size())
+      return bad_argument(fmt::format("inertia.collider is {}, but there are {} colliders", *inertia.collider,
+                                      colliders.size()));
+    if (colliders[*inertia.collider].type == Collider::Type::plane)
+      return bad_argument(fmt::format("inertia.collider {} is a plane, which has no frame (use a sphere, "
+                                      "capsule, box or mesh)",
+                                      *inertia.collider));
+  }
+  for (const auto& [key, value] :
+       {std::pair{"linear", inertia.linear}, std::pair{"angular", inertia.angular}})
+    if (!(value >= 0.0 && value <= 1.0))
+      return bad_argument(fmt::format("inertia.{} must be in [0, 1], got {}", key, value));
   return {};
 }
 

@@ -96,6 +96,13 @@ std::uint32_t PinTargets::size(const SimParams& params) const {
   return static_cast<std::uint32_t>(n);
 }
 
+void PinTargets::teleport(const RigidJump& jump) {
+  for (Host& h : host_) {
+    h.from = jump.apply(h.from);
+    h.target.position = jump.apply(h.target.position);
+  }
+}
+
 void PinTargets::end_step() {
   for (Host& h : host_)
     h.from = h.target.position;

@@ -43,6 +43,8 @@ public:
                   std::vector<TargetEntry>& out) const;
   /// After a step: the host's targets stay where they arrived.
   void end_step();
+  /// The host's targets move with the cloth's jump (a teleport), so none of them pulls it back.
+  void teleport(const RigidJump& jump);
 
 private:
   struct Host {

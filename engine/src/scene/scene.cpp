@@ -34,7 +34,7 @@ Result<Scene> build_scene(const json& doc, std::string_view source_name) {
   VKCLOTH_TRY(sd::check_keys(doc, "",
                              {"name", "system", "integrator", "physics", "chain", "cloth", "wind",
                               "colliders", "contact_epsilon", "contact_inward_only", "divergence_limit",
-                              "stretch_limit", "self_collision", "up"}));
+                              "stretch_limit", "self_collision", "up", "inertia"}));
   Scene scene;
   if (!doc.contains("system"))
     return sd::shape_error("missing required key system (\"chain\" or \"cloth\")");
@@ -77,6 +77,7 @@ Result<Scene> build_scene(const json& doc, std::string_view source_name) {
   VKCLOTH_TRY(sd::read_wind(doc, scene.params));
   const std::filesystem::path scene_dir = std::filesystem::path(source_name).parent_path();
   VKCLOTH_TRY(sd::read_colliders(doc, scene_dir, scene));
+  VKCLOTH_TRY(sd::read_inertia(doc, scene.params));
   VKCLOTH_TRY(sd::read_stretch_limit(doc, scene.params));
   VKCLOTH_TRY(sd::read_self_collision(doc, scene.params));
   VKCLOTH_TRY(sd::read(doc, "", "contact_epsilon", scene.params.contact_epsilon));

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
-// "cloth.attach" and "cloth.max_distance" (docs/scene-format.md "attach"): the cloth's particles
+// The cloth on a moving character: "inertia" (the frame it is simulated in) and "cloth.attach" and
+// "cloth.max_distance" (docs/scene-format.md "Attachments"): the cloth's particles
 // that follow a collider, read once the system and the colliders are built. An attachment without
 // a max_distance pins its particles (they are driven onto their targets); with one they stay free
 // and are held within that distance (a motion constraint). The offsets are the particles' rest
@@ -114,6 +115,20 @@ Result<std::map<std::size_t, double>> read_max_distances(const json& cloth, std:
 }
 
 } // namespace
+
+Result<void> read_inertia(const json& doc, SimParams& params) {
+  SCENE_TRY_ASSIGN(obj, read_object(doc, "", "inertia"));
+  if (!obj)
+    return {};
+  VKCLOTH_TRY(check_keys(*obj, "inertia", {"collider", "linear", "angular"}));
+  VKCLOTH_TRY(require_keys(*obj, "inertia", {"collider"}, "inertia"));
+  SCENE_TRY_ASSIGN(
+      index, as_integer((*obj)["collider"], "inertia.collider", std::numeric_limits<std::uint32_t>::max()));
+  params.inertia.collider = static_cast<std::uint32_t>(index);
+  VKCLOTH_TRY(read(*obj, "inertia", "linear", params.inertia.linear));
+  VKCLOTH_TRY(read(*obj, "inertia", "angular", params.inertia.angular));
+  return {}; // the ranges and the collider: SimParams::validate
+}
 
 Result<void> read_attachments(const json& cloth, Scene& scene) {
   SCENE_TRY_ASSIGN(list, read_array(cloth, "cloth", "attach"));

@@ -31,12 +31,13 @@ Result<void> read_keyframes(const json& keys, const std::string& path, Collider&
     const std::string at = fmt::format("{}.keyframes[{}]", path, k);
     if (!key.is_object())
       return sd::shape_error(fmt::format("{} must be an object, got {}", at, sd::show(key)));
-    VKCLOTH_TRY(sd::check_keys(key, at, {"t", "translate", "rotate_deg"}));
+    VKCLOTH_TRY(sd::check_keys(key, at, {"t", "translate", "rotate_deg", "teleport"}));
     VKCLOTH_TRY(sd::require_keys(key, at, {"t"}, "a keyframe"));
     ColliderKeyframe f;
     VKCLOTH_TRY(sd::read(key, at, "t", f.t));
     VKCLOTH_TRY(sd::read(key, at, "translate", f.translate));
     VKCLOTH_TRY(sd::read(key, at, "rotate_deg", f.rotate_deg));
+    VKCLOTH_TRY(sd::read(key, at, "teleport", f.teleport));
     frames.push_back(f);
   }
   auto moved = col.with_keyframes(std::move(frames));

@@ -49,6 +49,8 @@ Result<ParticleSystem> read_cloth(const json& doc, const std::optional<Material>
 Result<void> read_mesh_cloth(const json& cloth, const std::filesystem::path& scene_dir,
                              const std::optional<Material>& material, Scene& scene);
 
+/// "inertia": the collider whose frame the cloth is simulated in, and its scales.
+Result<void> read_inertia(const json& doc, SimParams& params);
 /// "cloth.attach" and "cloth.max_distance" into scene.params.attachments (the system and the
 /// colliders built; pins the attached particles that have no max_distance).
 Result<void> read_attachments(const json& cloth, Scene& scene);

@@ -84,6 +84,9 @@ Result<void> GpuSolver::set_params(SimParams params) {
 Result<void> GpuSolver::set_pin_targets(std::span<const PinTarget> targets) {
   return impl_->world.set_pin_targets(impl_->id, targets);
 }
+Result<void> GpuSolver::teleport(const RigidJump& jump) {
+  return impl_->world.teleport(impl_->id, jump);
+}
 const SimParams& GpuSolver::params() const {
   return impl_->instance().params;
 }

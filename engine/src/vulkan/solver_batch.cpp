@@ -301,7 +301,9 @@ Result<void> SolverBatch::carry_over(std::uint32_t slot, const Slot& old) {
   if (now.diverged)
     static_cast<sh::Flags*>(flags.mapped)[slot] = sh::Flags{1, 0, 0, 0};
   now.targets = old.targets;
+  now.host_jump = old.host_jump;
   VKCLOTH_TRY(ensure_targets());
+  VKCLOTH_TRY(ensure_frames());
   return prepare_passes(); // the targets' passes, when only the host's targets ask for them
 }
 
@@ -330,6 +332,7 @@ Result<void> SolverBatch::set_params(std::uint32_t slot, SimParams params) {
     VKCLOTH_TRY(ensure_collider_capacity());
     VKCLOTH_TRY(ensure_mesh_buffers());
     VKCLOTH_TRY(ensure_targets());
+    VKCLOTH_TRY(ensure_frames());
     VKCLOTH_TRY(prepare_passes());
     return ensure_tethers();
   }();
@@ -348,6 +351,40 @@ Result<void> SolverBatch::set_pin_targets(std::uint32_t slot, std::span<const Pi
   if (!done)
     slots[slot].targets = std::move(previous);
   return done;
+}
+
+Result<void> SolverBatch::teleport(std::uint32_t slot, const RigidJump& jump) {
+  VKCLOTH_TRY(jump.validate());
+  std::optional<RigidJump> previous = slots[slot].host_jump;
+  slots[slot].host_jump = previous ? vkcloth::detail::then(*previous, jump) : jump;
+  auto done = [&]() -> Result<void> {
+    VKCLOTH_TRY(ensure_frames());
+    return prepare_passes();
+  }();
+  if (!done)
+    slots[slot].host_jump = std::move(previous);
+  return done;
+}
+
+bool SolverBatch::any_frame() const {
+  return std::any_of(slots.begin(), slots.end(),
+                     [](const Slot& s) { return s.params.inertia.enabled() || s.host_jump.has_value(); });
+}
+
+// The frames buffer (one FrameMotion per instance) when an instance first has a frame; as
+// ensure_targets.
+Result<void> SolverBatch::ensure_frames() {
+  if (frames_allocated || !any_frame())
+    return {};
+  VKCLOTH_TRY(commands->wait_for_earlier_work());
+  auto b = create_buffer(*ctx, VkDeviceSize(size()) * sizeof(sh::FrameMotion),
+                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                         MemoryUse::device, false, "frames");
+  if (!b)
+    return b.error();
+  frames = std::move(*b);
+  frames_allocated = true;
+  return write_sets();
 }
 
 bool SolverBatch::any_targets() const {

@@ -24,6 +24,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "../core/cloth_frame.hpp"
 #include "../core/pin_targets.hpp"
 #include "passes/implicit_gpu.hpp"
 #include "passes/pass.hpp"
@@ -51,8 +52,9 @@ public:
     std::uint64_t epoch_step = 0; // `step` when this batch's flag epoch began (its creation)
     double time = 0.0;            // simulated time: the sum of the recorded steps' dt
     std::optional<Error> diverged;
-    vkcloth::detail::PinTargets
-        targets; // attachments and the host's pin targets (docs/model.md "Attachments")
+    // Attachments and the host's pin targets (docs/model.md "Attachments and motion constraints").
+    vkcloth::detail::PinTargets targets;
+    std::optional<RigidJump> host_jump; // the host's teleport, for the next recorded step
   };
   /// The per-particle buffers a readback can copy.
   enum class Field { positions, velocities, normals, forces };
@@ -83,6 +85,13 @@ public:
   /// Whether some instance has targets (targets.comp's passes run), and the most any has.
   bool any_targets() const;
   std::uint32_t targets_per_slot() const;
+  /// The host's teleport of one instance, at the start of the next recorded step (checked).
+  Result<void> teleport(std::uint32_t slot, const RigidJump& jump);
+  /// Whether some instance has a frame (inertia) or a teleport pending (the frame passes' pipelines),
+  /// and whether the substep being recorded jumps or carries some instance (they run).
+  bool any_frame() const;
+  bool frame_jumps_now() const { return frame_jump_now; }
+  bool frame_carries_now() const { return frame_carry_now; }
 
   /// Records `steps` steps of every instance; advances the host-side counters now.
   void record(VkCommandBuffer cmd, std::uint32_t steps);
@@ -248,6 +257,11 @@ private:
   // (record_targets); one zeroed element until an instance first has targets (ensure_targets).
   Buffer targets;
   bool targets_allocated = false;
+  // VKCLOTH_BINDING_FRAMES: one FrameMotion per instance, recorded before each substep while some
+  // instance has a frame (record_frames); one zeroed element until then (ensure_frames).
+  Buffer frames;
+  bool frames_allocated = false;
+  bool frame_jump_now = false, frame_carry_now = false;
   bool tethers_uploaded = false;
   // The batch's topology, for what is uploaded when first needed (the tethers): alive as long as
   // the batch, since every instance of the batch holds it (ClothWorld::Impl::Instance).
@@ -320,6 +334,10 @@ private:
   /// Before substep k of a step: every instance's targets at the substep's end (colliders posed)
   /// into TARGETS, VKCLOTH_NO_TARGET after each instance's last.
   void record_targets(VkCommandBuffer cmd, std::uint32_t k);
+  Result<void> ensure_frames();
+  /// Before substep k: each instance's frame step (`before`: its frame collider at the substep's
+  /// start; the colliders already posed at its end) into FRAMES; sets frame_jump_now / _carry_now.
+  void record_frames(VkCommandBuffer cmd, std::uint32_t k, const std::vector<Collider>& before);
   std::vector<shared::Collider> packed_colliders() const;
   /// Before a substep of `h` seconds: moving colliders advance to where they are at its end
   /// (Collider::posed_at, as CpuSolver does) and the new poses are recorded into the collider buffer.

@@ -183,6 +183,7 @@ Result<void> SolverBatch::create_buffers() {
       {&tethers, 16, "tethers (none yet)"},
       {&vbd_order, std::max<VkDeviceSize>(n * sizeof(std::uint32_t), 16), "vbd colour order"},
       {&targets, sizeof(sh::Target), "targets (none yet)"},
+      {&frames, sizeof(sh::FrameMotion), "frames (none yet)"},
       // GpuSolverOptions::interleaved_vertices: one Vertex (32 bytes) per particle; else one.
       {&vertices, options.interleaved_vertices ? VkDeviceSize(size()) * n * sizeof(sh::Vertex) : 32,
        "interleaved vertices"}};
@@ -382,6 +383,7 @@ SolverBatch::create(const std::shared_ptr<Context::Impl>& ctx, CommandContext& c
   VKCLOTH_TRY(s.upload_initial_state(topology, states));
   VKCLOTH_TRY(s.ensure_tethers());
   VKCLOTH_TRY(s.ensure_targets());
+  VKCLOTH_TRY(s.ensure_frames());
   VKCLOTH_TRY(s.prepare_passes());
   return impl;
 }

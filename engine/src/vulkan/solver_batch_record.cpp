@@ -53,6 +53,49 @@ void SolverBatch::record_targets(VkCommandBuffer c, std::uint32_t k) {
   barriers::transfer_to_compute(vk(), c); // the targets -> this substep's passes
 }
 
+// Each instance's frame step (detail::frame_step, as CpuSolver::step) into FRAMES: the jump as
+// rows and shift, the carry's inputs, in float as the CPU converts them.
+void SolverBatch::record_frames(VkCommandBuffer c, std::uint32_t k, const std::vector<Collider>& before) {
+  std::vector<sh::FrameMotion> packed(size());
+  frame_jump_now = frame_carry_now = false;
+  const auto put = [](sh::vec4& out, glm::dvec3 v, double w) {
+    const glm::vec3 f(v);
+    out = sh::vec4{f.x, f.y, f.z, float(w)};
+  };
+  for (std::uint32_t s = 0; s < size(); ++s) {
+    Slot& slot = slots[s];
+    const std::optional<std::uint32_t> frame = slot.params.inertia.collider;
+    const vkcloth::detail::FrameStep f = vkcloth::detail::frame_step(
+        slot.params, before[s], frame ? slot.params.colliders[*frame] : Collider{},
+        k == 0 ? slot.host_jump : std::nullopt);
+    sh::FrameMotion& m = packed[s];
+    if (f.jump) {
+      const vkcloth::detail::JumpRows rows = vkcloth::detail::jump_rows(*f.jump);
+      const glm::vec3 shift(rows.shift);
+      put(m.row0, rows.r0, shift.x);
+      put(m.row1, rows.r1, shift.y);
+      put(m.row2, rows.r2, shift.z);
+      m.jump = 1;
+      slot.targets.teleport(*f.jump);
+      frame_jump_now = true;
+    }
+    if (f.carry) {
+      put(m.dv, f.dv, f.carry_linear);
+      put(m.omega0, f.omega0, f.carry_angular);
+      put(m.omega1, f.omega1, 0.0);
+      put(m.c0, f.c0, 0.0);
+      put(m.c1, f.c1, 0.0);
+      m.carry = 1;
+      frame_carry_now = true;
+    }
+  }
+  if (!frame_jump_now && !frame_carry_now)
+    return;
+  barriers::before_host_edit(vk(), c); // the last substep's reads of the frames finish first (WAR)
+  record_buffer_update(c, frames, packed.data(), packed.size() * sizeof(sh::FrameMotion));
+  barriers::transfer_to_compute(vk(), c); // the frames -> this substep's passes
+}
+
 // Later changes travel in the command buffer: each recording carries the values it steps with, so
 // frames in flight never see a buffer the host rewrote under them (docs/embedding.md).
 void SolverBatch::record_params_update(VkCommandBuffer c) {
@@ -86,10 +129,17 @@ void SolverBatch::record(VkCommandBuffer c, std::uint32_t steps) {
     pc.step = static_cast<std::uint32_t>(recorded + 1); // 1-based number of the step being computed
     const bool moving = any_moving_colliders();
     const bool targets_now = any_targets();
+    const bool frames_now = any_frame();
     const double h = family().substeps == 1 ? family().dt : family().dt / double(family().substeps);
     for (std::uint32_t k = 0; k < family().substeps; ++k) {
+      std::vector<Collider> frame_before(frames_now ? size() : 0);
+      for (std::uint32_t i = 0; i < frame_before.size(); ++i)
+        if (const auto frame = slots[i].params.inertia.collider)
+          frame_before[i] = slots[i].params.colliders[*frame];
       if (moving) // a substep meets the colliders where they are at its end (as CpuSolver::step)
         record_collider_motion(c, h);
+      if (frames_now) // before the targets: a jump moves the host's targets too
+        record_frames(c, k, frame_before);
       if (targets_now)
         record_targets(c, k);
       record_passes(c, Pass::When::substep, first, s + 1 == steps && k + 1 == family().substeps);
@@ -97,8 +147,11 @@ void SolverBatch::record(VkCommandBuffer c, std::uint32_t steps) {
       parity ^= 1u; // positions[read ^ 1] now holds the new state
     }
     ++recorded;
-    for (Slot& slot : slots)
+    for (Slot& slot : slots) {
       slot.targets.end_step(); // the host's targets held where they arrived
+      slot.host_jump.reset();  // recorded into this step's first substep
+    }
+    frame_jump_now = frame_carry_now = false;
     for (Slot& slot : slots)
       if (!slot.diverged) {
         ++slot.step;

@@ -252,6 +252,7 @@ Result<void> SolverBatch::write_sets() {
       by_binding[VKCLOTH_BINDING_MESH_TRIS] = &mesh_tris;
       by_binding[VKCLOTH_BINDING_VBD_ORDER] = &vbd_order;
       by_binding[VKCLOTH_BINDING_TARGETS] = &targets;
+      by_binding[VKCLOTH_BINDING_FRAMES] = &frames;
       for (std::uint32_t b = 0; b < VKCLOTH_BINDING_COUNT; ++b, ++k) {
         infos[k] = VkDescriptorBufferInfo{by_binding[b]->buffer, 0, VK_WHOLE_SIZE};
         writes[k] = VkWriteDescriptorSet{};

@@ -322,6 +322,13 @@ Result<void> ClothWorld::set_pin_targets(InstanceId id, std::span<const PinTarge
   return (*found)->batch->set_pin_targets((*found)->slot, targets);
 }
 
+Result<void> ClothWorld::teleport(InstanceId id, const RigidJump& jump) {
+  auto found = impl_->find(id);
+  if (!found)
+    return found.error();
+  return (*found)->batch->teleport((*found)->slot, jump);
+}
+
 Result<SimParams> ClothWorld::params(InstanceId id) const {
   auto inst = impl_->find(id);
   if (!inst)

@@ -171,6 +171,8 @@ public:
   const SimParams& params() const;
   /// The host's per-frame pin targets for the next recorded step (ClothWorld::set_pin_targets).
   Result<void> set_pin_targets(std::span<const PinTarget> targets);
+  /// The whole cloth moved by `jump` at the next recorded step, unfelt (ClothWorld::teleport).
+  Result<void> teleport(const RigidJump& jump);
 
   /// Records `steps` steps into the caller's command buffer (recording state, compute-capable
   /// queue family of the Context). Host-side counters (step_index, current_position_index)

@@ -114,6 +114,9 @@ public:
   /// set_pin_targets). The first targets of a batch make its targets buffer, which first waits for
   /// every earlier submission on the Context's queue.
   Result<void> set_pin_targets(InstanceId id, std::span<const PinTarget> targets);
+  /// Moves the instance's whole cloth by `jump` at the start of the next recorded step, unfelt
+  /// (CpuSolver::teleport); the first of a batch makes its frames buffer (a wait, as above).
+  Result<void> teleport(InstanceId id, const RigidJump& jump);
   Result<SimParams> params(InstanceId id) const;
 
   /// Records one step of every instance into the host's command buffer (see GpuSolver::record_steps

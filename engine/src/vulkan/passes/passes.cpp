@@ -11,6 +11,8 @@
 namespace vkcloth::gpu {
 
 // Defined next to each pass (passes/*.cpp).
+std::unique_ptr<Pass> make_frame_jump();
+std::unique_ptr<Pass> make_frame_carry();
 std::unique_ptr<Pass> make_drive_targets();
 std::unique_ptr<Pass> make_hold_targets();
 std::unique_ptr<Pass> make_explicit_update();
@@ -25,7 +27,9 @@ std::unique_ptr<Pass> make_vertices();
 
 std::vector<std::unique_ptr<Pass>> make_solver_passes() {
   std::vector<std::unique_ptr<Pass>> passes;
-  // Pinned particles onto their targets at the substep's end (attachments, the host's targets).
+  // The cloth's frame jumps (a teleport), then pinned particles onto their targets at the
+  // substep's end (attachments, the host's targets).
+  passes.push_back(make_frame_jump());
   passes.push_back(make_drive_targets());
   // The update: forces, contacts and the integrator (one of the three runs).
   passes.push_back(make_explicit_update());
@@ -41,6 +45,8 @@ std::vector<std::unique_ptr<Pass>> make_solver_passes() {
   passes.push_back(make_contacts_after_self_collision());
   // Free particles back within reach of their targets (motion constraints), last.
   passes.push_back(make_hold_targets());
+  // The share of the frame's motion the cloth does not feel (inertia < 1), last.
+  passes.push_back(make_frame_carry());
   // Once per recording, after the last substep.
   passes.push_back(make_vertices());
   return passes;
