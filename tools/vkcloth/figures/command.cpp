@@ -47,6 +47,8 @@ int figures_command(const FiguresOptions& opt) {
     return report(r.error());
   if (auto r = figures::stiff_figures(gallery); !r)
     return report(r.error());
+  if (auto r = figures::character_figures(gallery); !r)
+    return report(r.error());
   if (auto r = gallery.write_index(); !r)
     return report(r.error());
   fmt::print("{} figures in {}/index.html ({:.1f} s)\n", gallery.figures.size(), opt.out,

@@ -72,6 +72,10 @@ Result<void> contact_figures(Gallery& gallery);
 Result<void> self_collision_figures(Gallery& gallery);
 /// The (K_struct, dt) stability map of semi-implicit Euler, RK4 and implicit Euler (stability.cpp).
 Result<void> stability_figures(Gallery& gallery);
+/// Cloth on a moving character (issue 39): samples/scenes/character_cape.json on the CPU solver,
+/// measured every step, drawn at four instants centred on the torso (character.cpp) and
+/// metrics["character"].
+Result<void> character_figures(Gallery& gallery);
 /// Real fabric (issue 37): a cotton drop onto a sphere by semi-implicit Euler with substeps, implicit
 /// Euler by CG and vbd (two settings), always on the CPU solver: the largest strain and the wall time
 /// over the run (SVG), the final states (an image grid) and metrics["stiff"] (stiff.cpp).
