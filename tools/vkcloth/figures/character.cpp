@@ -92,7 +92,7 @@ Result<void> character_figures(Gallery& G) {
       "A cape on a walking, turning, teleporting character",
       fmt::format("samples/scenes/character_cape.json: a torso and two arms (keyframed capsules) walk 1.5 m "
                   "at 1 m/s, turn 180 degrees in 0.5 s, walk back 0.5 m and teleport 10 m at t = 4 s; a "
-                  "cotton cape (vbd, 2 x 5 sweeps at dt = 1/300) hangs from the torso by its top row "
+                  "cotton cape (vbd, 6 substeps of 5 sweeps at dt = 1/300) hangs from the torso by its top row "
                   "(cloth.attach) in the torso's frame (inertia). Each panel is centred on the torso. "
                   "Over the run: deepest in the body {:.2g} m (contact_epsilon 0.001), largest strain "
                   "{:.1f} %, fastest particle after the jump {:.2f} m/s.",
