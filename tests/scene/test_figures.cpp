@@ -256,6 +256,15 @@ void check_gallery(const fs::path& dir) {
 constexpr std::uint64_t self_collision_steps = 100;
 const std::string self_collision_option = " --self-collision-steps " + std::to_string(self_collision_steps);
 
+/// The character figure's numbers (issue 39; always the CPU solver): the cape stays out of the body,
+/// within 10 % strain, and calm after the teleport.
+void check_character(const nlohmann::json& m) {
+  const auto& c = m["character"];
+  CHECK(c["deepest_in_body"].get<double>() <= 1e-3);
+  CHECK(c["largest_strain"].get<double>() <= 0.10);
+  CHECK(c["fastest_after_teleport"].get<double>() < 2.0);
+}
+
 TEST_CASE("vkcloth figures (cpu): the gallery and the physics behind it") {
   const fs::path out = tmp_dir() / "figures_cpu";
   fs::remove_all(out);
@@ -274,13 +283,15 @@ TEST_CASE("vkcloth figures (cpu): the gallery and the physics behind it") {
   check_self_collision(m, self_collision_steps);
   check_stability_map(m);
   check_stiff(m);
+  check_character(m);
   if (have_vulkan_device())
-    for (const char* f :
-         {"cloth_k_struct.png", "cloth_k_shear.png", "cloth_k_bend.png", "cloth_wind.png",
-          "cloth_contact.png", "cloth_collisions.png", "cloth_no_structural.png", "cloth_gpu.png",
-          "cloth_meshes.png", "cloth_strain_limit.png", "cloth_resolution.png", "cloth_presets.png",
-          "contact_tablecloth.png", "contact_sphere.png", "contact_spinning.png", "contact_shapes.png",
-          "self_collision_drop.png", "self_collision_slide.png", "stiff_final.png"})
+    for (const char* f : {"cloth_k_struct.png",      "cloth_k_shear.png",       "cloth_k_bend.png",
+                          "cloth_wind.png",          "cloth_contact.png",       "cloth_collisions.png",
+                          "cloth_no_structural.png", "cloth_gpu.png",           "cloth_meshes.png",
+                          "cloth_strain_limit.png",  "cloth_resolution.png",    "cloth_presets.png",
+                          "contact_tablecloth.png",  "contact_sphere.png",      "contact_spinning.png",
+                          "contact_shapes.png",      "self_collision_drop.png", "self_collision_slide.png",
+                          "stiff_final.png",         "character_cape.png"})
       CHECK_MESSAGE(fs::exists(out / f), f);
 }
 

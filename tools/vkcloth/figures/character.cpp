@@ -57,7 +57,8 @@ Result<void> character_figures(Gallery& G) {
       return r.error();
     const std::span<const glm::vec3> x = solver->positions();
     const std::vector<glm::dvec3> xd(x.begin(), x.end());
-    const std::vector<Collider> body(solver->params().colliders.begin(), solver->params().colliders.begin() + 3);
+    const std::vector<Collider> body(solver->params().colliders.begin(),
+                                     solver->params().colliders.begin() + 3);
     auto depth = penetration(scene->system, body, xd);
     if (!depth)
       return depth.error();
@@ -65,7 +66,8 @@ Result<void> character_figures(Gallery& G) {
     strain = std::max(strain, structural_strain(scene->system, x)->max);
     if (double(step) * dt > 4.0) {
       const auto v = solver->velocities();
-      fastest_after = std::max(fastest_after, max_free_speed(scene->system, std::vector<glm::dvec3>(v.begin(), v.end())));
+      fastest_after =
+          std::max(fastest_after, max_free_speed(scene->system, std::vector<glm::dvec3>(v.begin(), v.end())));
     }
     if (double(step) * dt + 1e-9 < instants[next])
       continue;
@@ -84,19 +86,19 @@ Result<void> character_figures(Gallery& G) {
     runs.push_back(std::move(run));
     ++next;
   }
-  G.metrics["character"] = {{"deepest_in_body", deepest},
-                            {"largest_strain", strain},
-                            {"fastest_after_teleport", fastest_after}};
+  G.metrics["character"] = {
+      {"deepest_in_body", deepest}, {"largest_strain", strain}, {"fastest_after_teleport", fastest_after}};
   return grid_figure(
       G, d, runs, labels, "character_cape.png", "Cloth on a moving character",
       "A cape on a walking, turning, teleporting character",
-      fmt::format("samples/scenes/character_cape.json: a torso and two arms (keyframed capsules) walk 1.5 m "
-                  "at 1 m/s, turn 180 degrees in 0.5 s, walk back 0.5 m and teleport 10 m at t = 4 s; a "
-                  "cotton cape (vbd, 6 substeps of 5 sweeps at dt = 1/300) hangs from the torso by its top row "
-                  "(cloth.attach) in the torso's frame (inertia). Each panel is centred on the torso. "
-                  "Over the run: deepest in the body {:.2g} m (contact_epsilon 0.001), largest strain "
-                  "{:.1f} %, fastest particle after the jump {:.2f} m/s.",
-                  deepest, 100.0 * strain, fastest_after),
+      fmt::format(
+          "samples/scenes/character_cape.json: a torso and two arms (keyframed capsules) walk 1.5 m "
+          "at 1 m/s, turn 180 degrees in 0.5 s, walk back 0.5 m and teleport 10 m at t = 4 s; a "
+          "cotton cape (vbd, 6 substeps of 5 sweeps at dt = 1/300) hangs from the torso by its top row "
+          "(cloth.attach) in the torso's frame (inertia). Each panel is centred on the torso. "
+          "Over the run: deepest in the body {:.2g} m (contact_epsilon 0.001), largest strain "
+          "{:.1f} %, fastest particle after the jump {:.2f} m/s.",
+          deepest, 100.0 * strain, fastest_after),
       {1.6f, -1.4f, 0.5f}, false);
 }
 
