@@ -2,6 +2,8 @@
 #include "pin_targets.hpp"
 
 #include <cmath>
+#include <cstdint>
+#include <string>
 #include <unordered_map>
 
 #include <fmt/format.h>
@@ -11,25 +13,34 @@
 
 namespace vkcloth::detail {
 
+namespace {
+// Who targets a particle, as the messages name it: attachments[a].particles[i] or pin target i.
+struct Claim {
+  std::size_t attachment; // SIZE_MAX: a host target
+  std::size_t index;
+  std::string name() const {
+    return attachment == SIZE_MAX ? fmt::format("pin target {}", index)
+                                  : fmt::format("attachments[{}].particles[{}]", attachment, index);
+  }
+};
+} // namespace
+
 Result<void> PinTargets::check(const SimParams& params, std::span<const PinTarget> host, std::size_t count) {
-  std::unordered_map<std::uint32_t, std::string> owner; // particle -> who targets it
-  const auto claim = [&](std::uint32_t p, std::string who) -> Result<void> {
+  std::unordered_map<std::uint32_t, Claim> owner; // particle -> who targets it (names made on an error)
+  const auto claim = [&](std::uint32_t p, Claim who) -> Result<void> {
     if (p >= count)
       return make_error(ErrorCode::invalid_argument,
-                        fmt::format("{} is particle {}, past the cloth's {} particles", who, p, count));
+                        fmt::format("{} is particle {}, past the cloth's {} particles", who.name(), p, count));
     const auto [it, fresh] = owner.emplace(p, who);
     if (!fresh)
       return make_error(ErrorCode::invalid_argument,
                         fmt::format("{} is particle {}, which {} targets already (one target per particle)",
-                                    who, p, it->second));
+                                    who.name(), p, it->second.name()));
     return {};
   };
   for (std::size_t a = 0; a < params.attachments.size(); ++a)
     for (std::size_t i = 0; i < params.attachments[a].particles.size(); ++i)
-      VKCLOTH_TRY(
-          claim(params.attachments[a].particles[i], fmt::format("attachments[{}].particles[{}]", a, i)));
-  using detail::finite;
-  using detail::str;
+      VKCLOTH_TRY(claim(params.attachments[a].particles[i], Claim{a, i}));
   for (std::size_t i = 0; i < host.size(); ++i) {
     const PinTarget& t = host[i];
     if (!finite(t.position))
@@ -41,7 +52,7 @@ Result<void> PinTargets::check(const SimParams& params, std::span<const PinTarge
           ErrorCode::invalid_argument,
           fmt::format("pin target {} (particle {}): max_distance must be finite and >= 0, got {}", i,
                       t.particle, t.max_distance));
-    VKCLOTH_TRY(claim(t.particle, fmt::format("pin target {}", i)));
+    VKCLOTH_TRY(claim(t.particle, Claim{SIZE_MAX, i}));
   }
   return {};
 }

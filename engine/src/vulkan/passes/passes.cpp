@@ -43,7 +43,7 @@ std::vector<std::unique_ptr<Pass>> make_solver_passes() {
   // Self-collision, then the colliders again.
   passes.push_back(make_self_collision());
   passes.push_back(make_contacts_after_self_collision());
-  // Free particles back within reach of their targets (motion constraints), last.
+  // Free particles back within reach of their targets (motion constraints).
   passes.push_back(make_hold_targets());
   // The share of the frame's motion the cloth does not feel (inertia < 1), last.
   passes.push_back(make_frame_carry());
