@@ -29,8 +29,9 @@ Result<void> PinTargets::check(const SimParams& params, std::span<const PinTarge
   std::unordered_map<std::uint32_t, Claim> owner; // particle -> who targets it (names made on an error)
   const auto claim = [&](std::uint32_t p, Claim who) -> Result<void> {
     if (p >= count)
-      return make_error(ErrorCode::invalid_argument,
-                        fmt::format("{} is particle {}, past the cloth's {} particles", who.name(), p, count));
+      return make_error(
+          ErrorCode::invalid_argument,
+          fmt::format("{} is particle {}, past the cloth's {} particles", who.name(), p, count));
     const auto [it, fresh] = owner.emplace(p, who);
     if (!fresh)
       return make_error(ErrorCode::invalid_argument,
