@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include <glm/vec3.hpp>
+
 #include "cli_util.hpp"
 #include "vkcloth/mesh.hpp"
 #include "vkcloth/scene.hpp"
@@ -63,6 +65,35 @@ TEST_CASE("cloth.mesh: the path is relative to the scene file, and transform, de
   }
   CHECK(mass == doctest::Approx(0.4 * 1.5 * 0.5)); // 1.5 m x 0.5 m after the scale
   CHECK(pinned == 3);                              // vertex 4, and 3 and 7 at x = 1.5
+}
+
+TEST_CASE("cloth.attach on a mesh cloth: vertices are the file's, a region its rest positions") {
+  write_strip("attach_strip.obj");
+  const std::string sphere = R"(, "colliders": [{"type": "sphere", "center": [0, 0, 3], "radius": 0.2}])";
+  const auto parse = [&](const std::string& attach) {
+    const std::string text = R"({"system": "cloth", "cloth": {"mesh": "attach_strip.obj", "attach": )" +
+                             attach + "}" + sphere + "}";
+    return parse_scene(text, (tmp_dir() / "attach_scene.json").string());
+  };
+  auto s = parse(R"([{"collider": 0, "vertices": [4, 7]}])");
+  REQUIRE_MESSAGE(s.ok(), s.error().message);
+  const ParticleSystem& sys = s->system;
+  const Attachment& a = s->params.attachments.at(0);
+  REQUIRE(a.particles.size() == 2);
+  // The solver's particles are renumbered (meshoptimizer): each is the file's vertex 4 and 7.
+  CHECK(sys.surface->source_vertex[a.particles[0]] == 4u);
+  CHECK(sys.surface->source_vertex[a.particles[1]] == 7u);
+  CHECK(sys.particles[a.particles[0]].position == glm::dvec3(0, 0, 1));
+  CHECK(sys.particles[a.particles[0]].pinned);
+  CHECK(a.offsets[0] == glm::dvec3(0, 0, -2)); // the vertex against the sphere's centre
+  auto region = parse(R"([{"collider": 0, "region": {"min": [-1, -1, 0.5], "max": [9, 1, 2]}}])");
+  REQUIRE_MESSAGE(region.ok(), region.error().message);
+  CHECK(region->params.attachments.at(0).particles.size() == 4); // the top row
+  auto bad = parse(R"([{"collider": 0, "vertices": [8]}])");
+  REQUIRE_FALSE(bad.ok());
+  CHECK_MESSAGE(bad.error().message.find("cloth.attach[0].vertices[0] = 8 is not a vertex of the cloth") !=
+                    std::string::npos,
+                bad.error().message);
 }
 
 TEST_CASE("cloth.mesh errors name the key, the file and the element") {
