@@ -5,8 +5,8 @@
 // Attachments and motion constraints (CpuSolver drive_targets / hold_targets; the formulas:
 // cloth_kernel.h attach.h drive_pinned, hold_within). One invocation per entry of the instance's
 // targets (TARGETS[inst * count ..], the first pc.target_count uploaded before each substep; no
-// particle has two), so each
-// writes only its own particle. SC_STAGE VKCLOTH_TARGETS_DRIVE, before the substep's update:
+// particle has two), so each writes only its own particle. SC_STAGE VKCLOTH_TARGETS_DRIVE, before
+// the substep's update:
 // pinned particles onto their targets in positions[read] (POS_BASE) with the target's velocity.
 // VKCLOTH_TARGETS_HOLD, after the substep's last pass: free particles back within reach in
 // positions[write] (POS_OUT). The cloth's frame (docs/model.md "Inertia and teleport"), one
