@@ -127,6 +127,47 @@ TEST_CASE("inertia: angular 0 turns the cloth with a frame spinning at pi rad/s 
   CHECK(largest_gap(ends) < 1e-5);
 }
 
+TEST_CASE("inertia: a host frame (no collider) that the host sets moving carries the cloth by 1 - linear") {
+  // The host's transform starts at rest, then the host gives it 2 m/s along y (set_params, as each
+  // frame would): with linear 0.25 the cloth takes 0.75 of that change and keeps it.
+  const ParticleSystem cloth = free_cloth();
+  SimParams p = weightless();
+  p.dt = 0.01;
+  p.inertia.frame = ColliderPose{};
+  p.inertia.linear = 0.25;
+  ValidationScope validation;
+  std::vector<std::vector<glm::dvec3>> ends;
+  for (Backend b : backends()) {
+    CAPTURE(to_string(b));
+    auto s = make_sim(b, cloth, p);
+    REQUIRE(s->run(5).ok());
+    CHECK(glm::length(s->velocity(0)) < 1e-5); // the springs' rounding only
+    SimParams moving = p;
+    moving.inertia.frame->linear_velocity = {0, 2, 0};
+    REQUIRE(s->set_params(moving).ok());
+    REQUIRE(s->run(10).ok());
+    for (std::size_t i = 0; i < cloth.size(); ++i) {
+      CHECK(s->velocity(i).y == doctest::Approx(1.5).epsilon(1e-5));
+      CHECK(s->position(i).y - cloth.particles[i].position.y ==
+            doctest::Approx(1.5 * 9 * p.dt).epsilon(1e-4));
+    }
+    if (is_float(b))
+      ends.push_back(s->positions());
+  }
+  CHECK(largest_gap(ends) < 1e-5);
+  SimParams both = p;
+  both.colliders = {Collider::sphere({0, 0, 1}, 0.1)};
+  both.inertia.collider = 0;
+  auto s = CpuSolver<float>::create(cloth, both);
+  REQUIRE_FALSE(s.ok());
+  CHECK(s.error().message.find("inertia: give a collider or a frame, not both") != std::string::npos);
+  both.inertia.collider.reset();
+  both.inertia.frame->rotation = glm::dmat3(3.0);
+  s = CpuSolver<float>::create(cloth, both);
+  REQUIRE_FALSE(s.ok());
+  CHECK(s.error().message.find("inertia.frame: pose.rotation") != std::string::npos);
+}
+
 TEST_CASE("teleport: a keyframe's jump moves an attached cloth 10 m unfelt (as its twin that stays); no "
           "particle then faster than its twin; GPU = CPU") {
   // A vertical cloth hangs from a capsule by its pinned top row; the capsule walks at 1 m/s for

@@ -256,15 +256,19 @@ struct PinTarget {
 };
 
 /// The frame a cloth is simulated in (docs/model.md "Inertia and teleport"; NvCloth's inertia scales):
-/// a collider's. The cloth feels `linear` of the frame's linear acceleration and `angular` of its
-/// angular motion (its angular acceleration, centrifugal and Coriolis parts); the rest carries it
-/// along with the frame. A teleport of the frame (a keyframe's `teleport`) moves the cloth with it,
-/// unfelt. Off by default: world space.
+/// a collider's, or a host transform. The cloth feels `linear` of the frame's linear acceleration and
+/// `angular` of its angular motion (its angular acceleration, centrifugal and Coriolis parts); the
+/// rest carries it along with the frame. A teleport of the frame (a keyframe's `teleport`, or the
+/// solvers' teleport()) moves the cloth with it, unfelt. Off by default: world space.
 struct Inertia {
-  std::optional<std::uint32_t> collider; ///< index in SimParams::colliders (not a plane); none: off
-  double linear = 1.0;                   ///< 0..1 (1: world space, 0: carried rigidly)
-  double angular = 1.0;                  ///< 0..1
-  bool enabled() const { return collider.has_value(); }
+  std::optional<std::uint32_t> collider; ///< index in SimParams::colliders (not a plane)
+  /// ... or (not with `collider`) a host transform: its origin (`position`), `rotation` (none:
+  /// identity) and velocities now, advanced by those velocities over the substeps as a moving
+  /// collider is; a host sets it every frame (set_params, like a collider's pose).
+  std::optional<ColliderPose> frame;
+  double linear = 1.0;  ///< 0..1 (1: world space, 0: carried rigidly)
+  double angular = 1.0; ///< 0..1
+  bool enabled() const { return collider.has_value() || frame.has_value(); }
 };
 
 struct SimParams {

@@ -18,6 +18,31 @@ RigidJump then(const RigidJump& a, const RigidJump& b) {
   return j;
 }
 
+Collider frame_collider(const SimParams& params) {
+  if (params.inertia.collider)
+    return params.colliders[*params.inertia.collider];
+  if (!params.inertia.frame)
+    return Collider{};
+  const ColliderPose& f = *params.inertia.frame;
+  Collider c = Collider::sphere(f.position, 0.0);
+  c.rotation = f.rotation.value_or(glm::dmat3(1.0));
+  c.linear_velocity = f.linear_velocity;
+  c.angular_velocity = f.angular_velocity;
+  return c;
+}
+
+bool same_frame(const Inertia& a, const Inertia& b) {
+  return a.collider == b.collider && a.frame.has_value() == b.frame.has_value();
+}
+
+void advance_host_frame(SimParams& params, const double seconds) {
+  if (!params.inertia.frame)
+    return;
+  const Collider c = frame_collider(params).posed_at(seconds);
+  params.inertia.frame->position = c.centre();
+  params.inertia.frame->rotation = c.rotation;
+}
+
 FrameStep frame_step(const SimParams& params, const Collider& before, const Collider& after,
                      const std::optional<RigidJump>& host) {
   FrameStep f;

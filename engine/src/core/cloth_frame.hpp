@@ -31,9 +31,18 @@ JumpRows jump_rows(const RigidJump& jump);
 /// `b` after `a`: x -> b.apply(a.apply(x)).
 RigidJump then(const RigidJump& a, const RigidJump& b);
 
-/// The substep of `params`' frame: `before` is its collider at the substep's start, `after` posed
-/// at its end (params.colliders' entry; ignored without inertia); `host` a teleport the host asked
-/// for, applied first.
+/// The cloth's frame as a collider (params.colliders[inertia.collider], or the host's frame as a
+/// point with its pose and velocities; a default collider without a frame).
+Collider frame_collider(const SimParams& params);
+/// Whether two parameter sets name the same frame (the same collider, or both a host frame): a
+/// solver keeps the frame as its last substep left it only while they do.
+bool same_frame(const Inertia& a, const Inertia& b);
+/// The host's frame (inertia.frame) advanced by `seconds` along its velocities (Collider::posed_at).
+void advance_host_frame(SimParams& params, double seconds);
+
+/// The substep of `params`' frame: `before` is its frame_collider as the last substep left it (so a
+/// velocity the host set between steps is a change the cloth may not feel), `after` at the
+/// substep's end (ignored without inertia); `host` a teleport the host asked for, applied first.
 FrameStep frame_step(const SimParams& params, const Collider& before, const Collider& after,
                      const std::optional<RigidJump>& host);
 

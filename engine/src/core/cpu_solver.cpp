@@ -121,6 +121,8 @@ Result<CpuSolver<Real>> CpuSolver<Real>::create(std::shared_ptr<const ClothTopol
 template <typename Real> Result<void> CpuSolver<Real>::Impl::set_params(SimParams params) {
   VKCLOTH_TRY(params.validate());
   VKCLOTH_TRY(targets_.check_params(params, pos_.size()));
+  if (!detail::same_frame(params.inertia, params_.inertia))
+    frame_last_.reset();
   params_ = params;
   return {};
 }
@@ -303,14 +305,15 @@ template <typename Real> Result<void> CpuSolver<Real>::Impl::step() {
   const std::uint32_t k = params_.substeps;
   const double h = k == 1 ? params_.dt : params_.dt / double(k);
   const bool targets = !targets_.empty(params_);
-  const std::optional<std::uint32_t> frame = params_.inertia.collider;
   for (std::uint32_t s = 0; s < k; ++s) {
-    const Collider frame_before = frame ? params_.colliders[*frame] : Collider{};
-    advance_colliders(h); // a substep meets the colliders where they are at its end
+    const Collider frame_before = frame_last_ ? *frame_last_ : detail::frame_collider(params_);
+    advance_colliders(h); // a substep meets the colliders (and the host's frame) where they are at its end
+    detail::advance_host_frame(params_, h);
     prepare_colliders();
-    const detail::FrameStep f =
-        detail::frame_step(params_, frame_before, frame ? params_.colliders[*frame] : Collider{},
-                           s == 0 ? host_jump_ : std::nullopt);
+    const detail::FrameStep f = detail::frame_step(params_, frame_before, detail::frame_collider(params_),
+                                                   s == 0 ? host_jump_ : std::nullopt);
+    if (params_.inertia.enabled())
+      frame_last_ = detail::frame_collider(params_);
     if (f.jump)
       jump_cloth(*f.jump);
     if (targets)

@@ -184,6 +184,7 @@ template <typename Real> struct CpuSolver<Real>::Impl {
   // step, and the positions at the substep's start while the frame carries the cloth.
   std::optional<RigidJump> host_jump_;
   std::vector<Vec3> frame_x0_;
+  std::optional<Collider> frame_last_; // the frame as the last substep left it (frame_step's `before`)
   std::span<const std::uint32_t> edge_offsets_; // the topology's
   std::vector<Edge> edges_;
   std::vector<Real> mass_;

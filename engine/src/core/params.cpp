@@ -557,6 +557,12 @@ Result<void> SimParams::validate() {
                                       "capsule, box or mesh)",
                                       *inertia.collider));
   }
+  if (inertia.frame) {
+    if (inertia.collider)
+      return bad_argument("inertia: give a collider or a frame, not both");
+    if (auto r = inertia.frame->validate(); !r)
+      return bad_argument("inertia.frame: " + r.error().message);
+  }
   for (const auto& [key, value] :
        {std::pair{"linear", inertia.linear}, std::pair{"angular", inertia.angular}})
     if (!(value >= 0.0 && value <= 1.0))

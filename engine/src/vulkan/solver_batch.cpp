@@ -302,6 +302,7 @@ Result<void> SolverBatch::carry_over(std::uint32_t slot, const Slot& old) {
     static_cast<sh::Flags*>(flags.mapped)[slot] = sh::Flags{1, 0, 0, 0};
   now.targets = old.targets;
   now.host_jump = old.host_jump;
+  now.frame_last = old.frame_last;
   VKCLOTH_TRY(ensure_targets());
   VKCLOTH_TRY(ensure_frames());
   return prepare_passes(); // the targets' passes, when only the host's targets ask for them
@@ -326,6 +327,9 @@ InstanceBuffers SolverBatch::buffers(std::uint32_t slot) const {
 }
 
 Result<void> SolverBatch::set_params(std::uint32_t slot, SimParams params) {
+  std::optional<Collider> frame_last = slots[slot].frame_last;
+  if (!vkcloth::detail::same_frame(params.inertia, slots[slot].params.inertia))
+    slots[slot].frame_last.reset();
   SimParams previous = std::exchange(slots[slot].params, std::move(params));
   params_dirty = true;
   auto done = [&]() -> Result<void> {
@@ -336,8 +340,10 @@ Result<void> SolverBatch::set_params(std::uint32_t slot, SimParams params) {
     VKCLOTH_TRY(prepare_passes());
     return ensure_tethers();
   }();
-  if (!done) // e.g. no room for the tethers: the instance keeps stepping with its old parameters
+  if (!done) { // e.g. no room for the tethers: the instance keeps stepping with its old parameters
     slots[slot].params = std::move(previous);
+    slots[slot].frame_last = std::move(frame_last);
+  }
   return done;
 }
 

@@ -55,6 +55,7 @@ public:
     // Attachments and the host's pin targets (docs/model.md "Attachments and motion constraints").
     vkcloth::detail::PinTargets targets;
     std::optional<RigidJump> host_jump; // the host's teleport, for the next recorded step
+    std::optional<Collider> frame_last; // its frame as the last recorded substep left it
   };
   /// The per-particle buffers a readback can copy.
   enum class Field { positions, velocities, normals, forces };

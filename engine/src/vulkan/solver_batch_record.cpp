@@ -64,10 +64,11 @@ void SolverBatch::record_frames(VkCommandBuffer c, std::uint32_t k, const std::v
   };
   for (std::uint32_t s = 0; s < size(); ++s) {
     Slot& slot = slots[s];
-    const std::optional<std::uint32_t> frame = slot.params.inertia.collider;
-    const vkcloth::detail::FrameStep f = vkcloth::detail::frame_step(
-        slot.params, before[s], frame ? slot.params.colliders[*frame] : Collider{},
-        k == 0 ? slot.host_jump : std::nullopt);
+    const vkcloth::detail::FrameStep f =
+        vkcloth::detail::frame_step(slot.params, before[s], vkcloth::detail::frame_collider(slot.params),
+                                    k == 0 ? slot.host_jump : std::nullopt);
+    if (slot.params.inertia.enabled())
+      slot.frame_last = vkcloth::detail::frame_collider(slot.params);
     sh::FrameMotion& m = packed[s];
     if (f.jump) {
       const vkcloth::detail::JumpRows rows = vkcloth::detail::jump_rows(*f.jump);
@@ -134,10 +135,12 @@ void SolverBatch::record(VkCommandBuffer c, std::uint32_t steps) {
     for (std::uint32_t k = 0; k < family().substeps; ++k) {
       std::vector<Collider> frame_before(frames_now ? size() : 0);
       for (std::uint32_t i = 0; i < frame_before.size(); ++i)
-        if (const auto frame = slots[i].params.inertia.collider)
-          frame_before[i] = slots[i].params.colliders[*frame];
+        frame_before[i] =
+            slots[i].frame_last ? *slots[i].frame_last : vkcloth::detail::frame_collider(slots[i].params);
       if (moving) // a substep meets the colliders where they are at its end (as CpuSolver::step)
         record_collider_motion(c, h);
+      for (Slot& slot : slots) // and the hosts' frames
+        vkcloth::detail::advance_host_frame(slot.params, h);
       if (frames_now) // before the targets: a jump moves the host's targets too
         record_frames(c, k, frame_before);
       if (targets_now)
