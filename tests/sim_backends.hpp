@@ -39,6 +39,7 @@ public:
   virtual Result<void> set_params(SimParams params) = 0;
   virtual Result<void> set_pin_targets(std::span<const PinTarget> targets) = 0;
   virtual Result<void> teleport(const RigidJump& jump) = 0;
+  virtual SimParams params() = 0;
   Result<void> step() { return run(1); }
   glm::dvec3 position(std::size_t i) { return positions().at(i); }
   glm::dvec3 velocity(std::size_t i) { return velocities().at(i); }
@@ -61,6 +62,7 @@ public:
     return s_.set_pin_targets(targets);
   }
   Result<void> teleport(const RigidJump& jump) override { return s_.teleport(jump); }
+  SimParams params() override { return s_.params(); }
 
 private:
   CpuSolver<Real> s_;
@@ -79,6 +81,7 @@ public:
     return s_.set_pin_targets(targets);
   }
   Result<void> teleport(const RigidJump& jump) override { return s_.teleport(jump); }
+  SimParams params() override { return s_.params(); }
 
 private:
   static std::vector<glm::dvec3> read(const Result<std::vector<glm::vec3>>& r) {

@@ -146,6 +146,9 @@ TEST_CASE("inertia: a host frame (no collider) that the host sets moving carries
     moving.inertia.frame->linear_velocity = {0, 2, 0};
     REQUIRE(s->set_params(moving).ok());
     REQUIRE(s->run(10).ok());
+    // The frame itself moved on by its velocity (params() as the steps left it, for a host's next
+    // set_step_params).
+    CHECK(s->params().inertia.frame->position.y == doctest::Approx(2.0 * 10 * p.dt).epsilon(1e-9));
     for (std::size_t i = 0; i < cloth.size(); ++i) {
       CHECK(s->velocity(i).y == doctest::Approx(1.5).epsilon(1e-5));
       CHECK(s->position(i).y - cloth.particles[i].position.y ==

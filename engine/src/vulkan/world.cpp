@@ -143,10 +143,14 @@ void ClothWorld::Impl::record_steps(VkCommandBuffer cmd, std::uint32_t steps) {
     const std::uint64_t before = entry.solver->dispatches();
     entry.solver->record(cmd, steps);
     dispatches += entry.solver->dispatches() - before;
-    // Moving colliders advanced in the batch: params(id) (and a later rebuild) start from there.
+    // Moving colliders and host frames advanced in the batch: params(id) (and a later rebuild)
+    // start from there.
     if (entry.solver->any_moving_colliders())
       for (std::uint32_t k = 0; k < entry.members.size(); ++k)
         instances.at(entry.members[k]).params.colliders = entry.solver->slot(k).params.colliders;
+    for (std::uint32_t k = 0; k < entry.members.size(); ++k)
+      if (entry.solver->slot(k).params.inertia.frame)
+        instances.at(entry.members[k]).params.inertia.frame = entry.solver->slot(k).params.inertia.frame;
   }
 }
 
