@@ -6,11 +6,13 @@
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <memory>
 #include <span>
 #include <string>
 #include <vector>
 
+#include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
 #include "gpu/gpu_test_util.hpp"
@@ -131,6 +133,16 @@ inline std::unique_ptr<Sim> make_sim(Backend b, const ParticleSystem& system, co
   }
   }
   return nullptr;
+}
+
+/// The largest distance between the first run's positions and each other run's (the float
+/// backends' ends: GPU = CPU checks).
+inline double largest_gap(const std::vector<std::vector<glm::dvec3>>& ends) {
+  double worst = 0.0;
+  for (std::size_t k = 1; k < ends.size(); ++k)
+    for (std::size_t i = 0; i < ends[0].size(); ++i)
+      worst = std::max(worst, glm::length(ends[k][i] - ends[0][i]));
+  return worst;
 }
 
 /// Fails the test case if the shared Vulkan context reported validation messages during it.

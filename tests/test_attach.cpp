@@ -42,14 +42,6 @@ glm::dvec3 in_frame(const Collider& c, glm::dvec3 offset) {
   return c.centre() + c.rotation * offset;
 }
 
-double largest_gap(const std::vector<std::vector<glm::dvec3>>& ends) {
-  double worst = 0.0;
-  for (std::size_t k = 1; k < ends.size(); ++k)
-    for (std::size_t i = 0; i < ends[0].size(); ++i)
-      worst = std::max(worst, glm::length(ends[k][i] - ends[0][i]));
-  return worst;
-}
-
 } // namespace
 
 TEST_CASE(

@@ -42,14 +42,6 @@ SimParams weightless() {
   return p;
 }
 
-double largest_gap(const std::vector<std::vector<glm::dvec3>>& ends) {
-  double worst = 0.0;
-  for (std::size_t k = 1; k < ends.size(); ++k)
-    for (std::size_t i = 0; i < ends[0].size(); ++i)
-      worst = std::max(worst, glm::length(ends[k][i] - ends[0][i]));
-  return worst;
-}
-
 } // namespace
 
 TEST_CASE("inertia: a frame that starts moving at 1 m/s carries the cloth by 1 - linear; linear 1 is "
@@ -329,7 +321,7 @@ TEST_CASE("sample character_cape: the walk, the 180-degree turn in 0.5 s and the
       off_target =
           std::max(off_target, glm::length(glm::dvec3(x[shoulders.particles[i]]) -
                                            (torso.centre() + torso.rotation * shoulders.offsets[i])));
-    if (step * scene->params.dt > 4.0)
+    if (double(step) * scene->params.dt > 4.0)
       for (const glm::vec3& v : s->velocities())
         fastest_after = std::max(fastest_after, double(glm::length(v)));
     strain = std::max(strain, structural_strain(scene->system, x)->max);

@@ -347,9 +347,9 @@ Result<void> SolverBatch::set_params(std::uint32_t slot, SimParams params) {
   return done;
 }
 
-Result<void> SolverBatch::set_pin_targets(std::uint32_t slot, std::span<const PinTarget> targets) {
+Result<void> SolverBatch::set_pin_targets(std::uint32_t slot, std::span<const PinTarget> host) {
   vkcloth::detail::PinTargets previous = slots[slot].targets;
-  VKCLOTH_TRY(slots[slot].targets.set_host(slots[slot].params, targets, count));
+  VKCLOTH_TRY(slots[slot].targets.set_host(slots[slot].params, host, count));
   auto done = [&]() -> Result<void> {
     VKCLOTH_TRY(ensure_targets());
     return prepare_passes();

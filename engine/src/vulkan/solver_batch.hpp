@@ -82,7 +82,7 @@ public:
   /// need new buffers: those wait for the earlier work on the Context's queue first.
   Result<void> set_params(std::uint32_t slot, SimParams params);
   /// The host's targets of one instance for the next recorded step (PinTargets::set_host's checks).
-  Result<void> set_pin_targets(std::uint32_t slot, std::span<const PinTarget> targets);
+  Result<void> set_pin_targets(std::uint32_t slot, std::span<const PinTarget> host);
   /// Whether some instance has targets (targets.comp's passes run), and the most any has.
   bool any_targets() const;
   std::uint32_t targets_per_slot() const;
