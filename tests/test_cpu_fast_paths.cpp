@@ -350,4 +350,3 @@ TEST_CASE_TEMPLATE(
       }
   }
 }
-
