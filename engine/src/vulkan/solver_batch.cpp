@@ -382,14 +382,23 @@ bool SolverBatch::any_frame() const {
 Result<void> SolverBatch::ensure_frames() {
   if (frames_allocated || !any_frame())
     return {};
+  VKCLOTH_TRY(replace_state_buffer(frames, size(), sizeof(sh::FrameMotion), "frames"));
+  frames_allocated = true;
+  return {};
+}
+
+// `dst` replaced by a device buffer of `entries` x `stride` bytes, filled by vkCmdUpdateBuffer
+// later; recorded work that may use the descriptor sets is waited for before they are rewritten.
+Result<void> SolverBatch::replace_state_buffer(Buffer& dst, std::uint64_t entries, VkDeviceSize stride,
+                                               const char* what) {
+  VKCLOTH_TRY(check_buffer(*ctx, storage_limit(*ctx, knobs), what, entries, stride));
   VKCLOTH_TRY(commands->wait_for_earlier_work());
-  auto b = create_buffer(*ctx, VkDeviceSize(size()) * sizeof(sh::FrameMotion),
+  auto b = create_buffer(*ctx, entries * stride,
                          VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                         MemoryUse::device, false, "frames");
+                         MemoryUse::device, false, what);
   if (!b)
     return b.error();
-  frames = std::move(*b);
-  frames_allocated = true;
+  dst = std::move(*b);
   return write_sets();
 }
 
@@ -409,17 +418,9 @@ std::uint32_t SolverBatch::targets_per_slot() const {
 Result<void> SolverBatch::ensure_targets() {
   if (targets_allocated || !any_targets())
     return {};
-  const std::uint64_t entries = std::uint64_t(size()) * count;
-  VKCLOTH_TRY(check_buffer(*ctx, storage_limit(*ctx, knobs), "targets", entries, sizeof(sh::Target)));
-  VKCLOTH_TRY(commands->wait_for_earlier_work());
-  auto b = create_buffer(*ctx, entries * sizeof(sh::Target),
-                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                         MemoryUse::device, false, "targets");
-  if (!b)
-    return b.error();
-  targets = std::move(*b);
+  VKCLOTH_TRY(replace_state_buffer(targets, std::uint64_t(size()) * count, sizeof(sh::Target), "targets"));
   targets_allocated = true;
-  return write_sets();
+  return {};
 }
 
 // The tethers of both rest-length kinds (VKCLOTH_BINDING_TETHERS: euclidean, then geodesic),

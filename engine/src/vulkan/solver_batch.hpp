@@ -336,6 +336,9 @@ private:
   /// into TARGETS, VKCLOTH_NO_TARGET after each instance's last.
   void record_targets(VkCommandBuffer cmd, std::uint32_t k);
   Result<void> ensure_frames();
+  /// ensure_targets' and ensure_frames' replacement of a zeroed element by the real buffer.
+  Result<void> replace_state_buffer(Buffer& dst, std::uint64_t entries, VkDeviceSize stride,
+                                    const char* what);
   /// Before substep k: each instance's frame step (`before`: its frame collider at the substep's
   /// start; the colliders already posed at its end) into FRAMES; sets frame_jump_now / _carry_now.
   void record_frames(VkCommandBuffer cmd, std::uint32_t k, const std::vector<Collider>& before);
