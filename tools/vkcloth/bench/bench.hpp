@@ -46,7 +46,7 @@ struct BenchOptions {
   std::optional<double> cloth_mass; // kg, the whole grid's (default: 0.05 kg per particle at 64 x 64)
   double wind = 2.0; // m/s^2 on a particle facing the wind (the wind force scales with the mass)
   std::string cg_dispatch = "auto"; // implicit on Vulkan: auto | one_workgroup | per_iteration | both
-  std::string contact;              // also time the contact scenes (issue 15): table | mesh | both
+  std::string contact;              // also time the contact scenes (issue 15): table | mesh (+ sphere) | both
   bool self_collision = false;      // also time each size folded, self-collision on vs off (issue 16)
 };
 
@@ -71,7 +71,7 @@ Result<BenchScene> mesh_bench_scene(const Mesh& file, const std::string& order, 
 /// A cloth resting on colliders, and what the contact rows report about it. `params` has the
 /// colliders; the baseline row times the same system with params.colliders cleared.
 struct ContactScene {
-  std::string name; // "table" | "mesh"
+  std::string name; // "table" | "mesh" | "sphere"
   std::uint32_t n = 0;
   ParticleSystem system;
   SimParams params;
@@ -84,7 +84,7 @@ constexpr std::uint32_t sphere_frequency =
     22; // the mesh scene's geodesic sphere: 20 x 22^2 = 9 680 triangles
 
 Result<ContactScene> table_scene(Integrator integrator, double dt, const BenchOptions& o);
-Result<ContactScene> mesh_scene(Integrator integrator, double dt, const BenchOptions& o);
+Result<ContactScene> mesh_scene(Integrator integrator, double dt, const BenchOptions& o, bool analytic);
 Result<std::size_t> particles_in_contact(const ContactScene& sc, std::span<const glm::dvec3> positions);
 
 // ---- Self-collision scene (issue 16) -----------------------------------------------------------
@@ -147,7 +147,7 @@ struct Row {
   std::string order;               // mesh rows: "meshopt", "file" or "shuffled"
   std::string layout;              // Vulkan rows: the buffer access that ran ("texel" | "storage")
   std::uint32_t workgroup = 0;     // Vulkan rows: the workgroup size that ran
-  std::string contact;             // contact rows: "table" | "mesh" (scene "contact" or "contact_free")
+  std::string contact; // contact rows: "table" | "mesh" | "sphere" (scene "contact" or "contact_free")
   std::size_t in_contact_start = 0, in_contact_end = 0; // scene "contact": particles within 2 eps;
                                                         // "self_collision": in self-contact
   std::vector<std::string> colliders;                   // scene "contact": their types

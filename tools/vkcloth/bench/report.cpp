@@ -63,6 +63,22 @@ const Row* contact_free_of(const std::vector<Row>& rows, const Row& r) {
   return nullptr;
 }
 
+/// A contact row's contact phase: its time per step over its bare row's (ms; < 0: no bare row).
+double contact_phase_ms(const std::vector<Row>& rows, const Row& r) {
+  const Row* f = contact_free_of(rows, r);
+  return f ? (r.wall_ms - f->wall_ms) / double(r.steps) : -1.0;
+}
+
+/// The sphere row timed with a mesh contact row (same backend, variant, layout and integrator): the
+/// mesh query's cost is quoted against the sphere's (issue 39: at most 3x).
+const Row* sphere_of(const std::vector<Row>& rows, const Row& r) {
+  for (const Row& e : rows)
+    if (e.scene == "contact" && e.contact == "sphere" && e.backend == r.backend && e.variant == r.variant &&
+        e.layout == r.layout && e.integrator == r.integrator)
+      return &e;
+  return nullptr;
+}
+
 /// The lines above the table: the scene, the ceilings, the Vulkan device and each family of rows.
 void print_preamble(const BenchRun& run) {
   const BenchOptions& o = run.o;
@@ -90,7 +106,8 @@ void print_preamble(const BenchRun& run) {
   if (!o.contact.empty())
     fmt::print(
         "contact rows: n+table: 256 x 256 cloth draped on a box (0.5 x 1.2 x 0.2 m) on the floor plane; "
-        "n+mesh: 64 x 64 cloth draped on a {}-triangle geodesic sphere (mesh collider); friction "
+        "n+mesh: 64 x 64 cloth draped on a {}-triangle geodesic sphere (mesh collider); n+sphere: the same "
+        "cloth on a sphere collider of the same size; friction "
         "{:g}; no wind; n free: the same cloth without colliders (n column)\n",
         20 * sphere_frequency * sphere_frequency, contact_friction);
   if (o.self_collision)
@@ -166,6 +183,13 @@ void add_scene_keys(nlohmann::json& j, const std::vector<Row>& rows, const Row& 
       j["particles_in_contact_end"] = r.in_contact_end;
       if (const Row* f = contact_free_of(rows, r))
         j["contact_phase_fraction"] = (r.wall_ms - f->wall_ms) / f->wall_ms;
+      // The mesh query against the sphere's (null where either phase did not come out positive).
+      const Row* sphere = r.contact == "mesh" ? sphere_of(rows, r) : nullptr;
+      if (sphere)
+        j["contact_phase_over_sphere"] =
+            contact_phase_ms(rows, *sphere) > 0.0 && contact_phase_ms(rows, r) >= 0.0
+                ? nlohmann::json(contact_phase_ms(rows, r) / contact_phase_ms(rows, *sphere))
+                : nlohmann::json(nullptr);
     }
   }
   if (is_self(r)) {
@@ -278,6 +302,13 @@ void print_ratios(const std::vector<Row>& rows) {
           r.backend, r.variant, r.contact, r.size, r.size, 100.0 * (r.wall_ms - f->wall_ms) / f->wall_ms,
           r.wall_ms / double(r.steps), f->wall_ms / double(f->steps), r.in_contact_start, r.particles,
           r.in_contact_end);
+  for (const Row& r : rows)
+    if (const Row* sphere = r.scene == "contact" && r.contact == "mesh" ? sphere_of(rows, r) : nullptr)
+      if (contact_phase_ms(rows, *sphere) > 0.0 && contact_phase_ms(rows, r) >= 0.0)
+        fmt::print("{} {} mesh (64 x 64): its contact phase is {:.2f}x the sphere's ({:.4f} vs {:.4f} ms per "
+                   "step)\n",
+                   r.backend, r.variant, contact_phase_ms(rows, r) / contact_phase_ms(rows, *sphere),
+                   contact_phase_ms(rows, r), contact_phase_ms(rows, *sphere));
 }
 
 /// The self-collision rows on against off, a table of their own (none without them).

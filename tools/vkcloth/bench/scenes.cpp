@@ -235,7 +235,9 @@ Result<std::shared_ptr<const ColliderMesh>> geodesic_sphere(std::uint32_t freque
 /// compressed, up to 21 % at the corners, 67 degrees from the top). Every particle starts within
 /// 2 eps of the shell (the faces lie within 0.23 mm inside the sphere through their corners); as
 /// the heavy cloth settles, its border slides and lifts off (particles_in_contact_end).
-Result<ContactScene> mesh_scene(Integrator integrator, double dt, const BenchOptions& o) {
+/// `analytic`: the same cloth on a sphere collider of radius 0.6 + thickness instead (the "sphere"
+/// row, the yardstick of the mesh query's cost).
+Result<ContactScene> mesh_scene(Integrator integrator, double dt, const BenchOptions& o, bool analytic) {
   constexpr std::uint32_t n = 64;
   constexpr double radius = 0.6, thickness = 0.005;
   auto cloth = horizontal_cloth(n, integrator, dt, o);
@@ -246,7 +248,9 @@ Result<ContactScene> mesh_scene(Integrator integrator, double dt, const BenchOpt
     return sphere.error();
   SimParams p = cloth->params;
   const glm::dvec3 centre{0.0, 0.0, radius};
-  p.colliders = {with_contact_friction(Collider::triangle_mesh(*sphere, centre, glm::dmat3(1.0), thickness))};
+  p.colliders = {
+      with_contact_friction(analytic ? Collider::sphere(centre, radius + thickness)
+                                     : Collider::triangle_mesh(*sphere, centre, glm::dmat3(1.0), thickness))};
   VKCLOTH_TRY(p.validate());
   const double r = radius + thickness + p.contact_epsilon;
   for (Particle& q : cloth->system.particles) {
@@ -256,6 +260,8 @@ Result<ContactScene> mesh_scene(Integrator integrator, double dt, const BenchOpt
                                : glm::dvec3(0, 0, 1);
     q.position = centre + r * dir;
   }
+  if (analytic)
+    return ContactScene{"sphere", n, std::move(cloth->system), std::move(p), {"sphere"}, 0};
   const auto triangles = std::uint32_t((*sphere)->triangles().size());
   return ContactScene{"mesh", n, std::move(cloth->system), std::move(p), {"mesh"}, triangles};
 }
