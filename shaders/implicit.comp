@@ -337,7 +337,7 @@ void main() {
     const ColliderShape s = collider_shape(c);
     float dist;
     vec3 n;
-    collider_contact(0u, s, x0, x0, ip.band, dist, n);
+    collider_contact(base + p, s, x0, x0, ip.band, dist, n);
     contact_response(v, removed, s, x0, n, dist, ip.band, both, h_over_m);
   }
   precise vec3 x = x0 + v * h;

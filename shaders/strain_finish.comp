@@ -53,7 +53,7 @@ void main() {
     }
   } else {
     for (uint c = 0u; c < (SC_COLLIDERS ? ip.collider_count : 0u); ++c)
-      project_out(0u, collider_shape(c), ip.eps, x, x, v); // side: where the stretch control left it
+      project_out(base + p, collider_shape(c), ip.eps, x, x, v); // side: where the stretch control left it
     moved = true;
   }
   if (!moved) return;

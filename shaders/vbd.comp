@@ -30,11 +30,11 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_VBD_ORDER) readonly buffer Ord
 
 #include "finish.glsl"
 
-// Particle p's position projected out of every collider (side: where it started the substep).
-vec3 projected(vec3 side, vec3 x) {
+// Particle g's position projected out of every collider (side: where it started the substep).
+vec3 projected(uint g, vec3 side, vec3 x) {
   vec3 v = vec3(0.0);
   for (uint c = 0u; c < (SC_COLLIDERS ? ip.collider_count : 0u); ++c)
-    project_out(0u, collider_shape(c), ip.eps, side, x, v);
+    project_out(g, collider_shape(c), ip.eps, side, x, v);
   return x;
 }
 
@@ -50,7 +50,7 @@ void begin(uint p, uint g, bool pinned) {
   target[g] = vec4(y, 0.0);
   const vec3 guess = vbd_first_guess(x0, v0, ip.dt);
   push_of[g] = vec4(0.0);
-  pos_out[g] = vec4(pinned ? x0 : projected(x0, guess), 1.0);
+  pos_out[g] = vec4(pinned ? x0 : projected(g, x0, guess), 1.0);
 }
 
 void solve(uint p, uint g) {
@@ -69,8 +69,8 @@ void solve(uint p, uint g) {
   vec3 stepped = vbd_step(x, target[g].xyz, x0, f, hessian, m, ip.dt, ip.gravity_damping.w);
   const float inertia = vbd_inertia_weight(m, ip.dt, ip.gravity_damping.w);
   for (uint c = 0u; c < (SC_COLLIDERS ? ip.collider_count : 0u); ++c)
-    vbd_friction(stepped, 0u, collider_shape(c), x, x0, hessian, inertia, ip.band, ip.dt);
-  const vec3 x1 = projected(x0, stepped);
+    vbd_friction(stepped, g, collider_shape(c), x, x0, hessian, inertia, ip.band, ip.dt);
+  const vec3 x1 = projected(g, x0, stepped);
   push_of[g] = vec4(x1 - stepped, 0.0);
   pos_out[g] = vec4(x1, 1.0);
 }
@@ -94,7 +94,7 @@ void finish_step(uint p, uint g, bool pinned) {
     ColliderShape s = without_friction(collider_shape(c)); // friction acted in the sweeps
     float dist;
     vec3 n;
-    collider_contact(0u, s, x, x, ip.band, dist, n);
+    collider_contact(g, s, x, x, ip.band, dist, n);
     contact_response(v, no_force, s, x, n, dist, ip.band, both, h_over_m);
   }
   force_out[g] = vec4(vbd_net_force(v, v0, m, h), 0.0);

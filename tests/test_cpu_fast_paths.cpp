@@ -221,6 +221,31 @@ TEST_CASE("the CPU row sweep's finite check catches a bad particle in any lane, 
 }
 
 namespace {
+
+/// A bumpy height field of 2 x 16 x 16 triangles over [-0.6, 0.6]^2 (z = 0.03 sin(9x) cos(7y)): a mesh
+/// collider with convex and concave edges for the SIMD finish's mesh lanes.
+std::shared_ptr<const ColliderMesh> bumpy_mesh() {
+  constexpr int n = 16;
+  std::vector<glm::dvec3> v;
+  std::vector<std::uint32_t> t;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      const double x = 1.2 * (double(i) / n - 0.5), y = 1.2 * (double(j) / n - 0.5);
+      v.push_back({x, y, 0.03 * std::sin(9 * x) * std::cos(7 * y)});
+    }
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const auto a = std::uint32_t(j * (n + 1) + i), b = a + 1, c = a + std::uint32_t(n + 1), d = c + 1;
+      t.insert(t.end(), {a, b, d, a, d, c});
+    }
+  auto m = ColliderMesh::create(v, t, "bumps");
+  REQUIRE(m.ok());
+  return *m;
+}
+
+} // namespace
+
+namespace {
 /// Runs `steps` steps of a CpuSolver<Real> created while VKCLOTH_CPU_SIMD = `isa` (the row kernel's
 /// ISA is chosen at creation; "scalar": every particle through the shared kernel, cloth_kernel.h),
 /// returning positions, velocities, forces and normals end to end.
@@ -285,7 +310,13 @@ TEST_CASE_TEMPLATE("the SIMD row kernels (AVX2, AVX-512) give the shared referen
       friction(box, 0.4, -1.0),
       friction(Collider::capsule({-0.4, 0.02, 1.2}, {0.0, -0.03, 1.0}, 0.05), 0.3, 0.5),
       friction(floor, 0.5, -1.0), Collider::sphere({-0.2, 0.1, 0.7}, 0.12)};
-  for (int colliders = 0; colliders < 4; ++colliders)
+  // 4: a mesh collider whose bumps cut through the cloth (its lanes' search entries, the scalar
+  // search where they miss) and the sphere.
+  const Collider bumps =
+      friction(Collider::triangle_mesh(bumpy_mesh(), {0, -0.005, 0.7},
+                                       Collider::rotation_from_degrees({-90, 0, 0}), 0.004),
+               0.3, -1.0);
+  for (int colliders = 0; colliders < 5; ++colliders)
     for (Integrator integ : {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::vbd}) {
       CAPTURE(to_string(integ));
       CAPTURE(colliders);
@@ -296,6 +327,8 @@ TEST_CASE_TEMPLATE("the SIMD row kernels (AVX2, AVX-512) give the shared referen
         p.colliders.clear();
       else if (colliders == 1)
         p.colliders = {Collider::sphere({0, 0.2, 0.2}, 0.3)};
+      else if (colliders == 4)
+        p.colliders = {bumps, Collider::sphere({-0.2, 0.1, 0.7}, 0.12)};
       else
         p.colliders = shapes;
       for (unsigned threads : {1u, 2u}) {

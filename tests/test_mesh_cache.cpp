@@ -74,8 +74,8 @@ Walked walk(const std::shared_ptr<const ColliderMesh>& mesh, glm::dvec3 centre, 
             std::uint32_t seed) {
   using V = glm::vec<3, Real>;
   constexpr std::uint32_t particles = 48, steps = 300;
-  const Collider c = Collider::triangle_mesh(mesh, {0.1, -0.2, 0.3}, Collider::rotation_from_degrees({10, 0, 30}),
-                                             0.005);
+  const Collider c =
+      Collider::triangle_mesh(mesh, {0.1, -0.2, 0.3}, Collider::rotation_from_degrees({10, 0, 30}), 0.005);
   std::vector<Real> entries(8 * particles, Real(0));
   kernel::MeshData cached{mesh->nodes().data(), mesh->triangles().data(), entries.data(), 0};
   const kernel::MeshData searching{mesh->nodes().data(), mesh->triangles().data()};
@@ -125,8 +125,9 @@ TEST_CASE_TEMPLATE("mesh contact: a particle's search entry gives the search's b
   for (const Case& k : cases) {
     CAPTURE(k.name);
     const Walked w = walk<Real>(k.mesh, k.centre, k.half, seed++);
-    MESSAGE(std::string(k.name) << ": " << w.queries << " queries, " << w.searches << " searches, worst distance vs brute "
-                   << "force " << w.worst_vs_brute_force << " m");
+    MESSAGE(std::string(k.name) << ": " << w.queries << " queries, " << w.searches
+                                << " searches, worst distance vs brute "
+                                << "force " << w.worst_vs_brute_force << " m");
     CHECK(w.differences == 0);
     // The entries do answer: most queries search nothing (the walks move 2 mm a step on average).
     CHECK(w.searches < w.queries / 3);

@@ -23,8 +23,70 @@ KFN precise vec3 to_world_dir(ColliderShape s, vec3 d) {
   return w;
 }
 
-// Mesh colliders: a search of the triangles' hierarchy per particle. A bridge that cannot run it (the
-// CPU's SIMD lanes, which take no mesh collider) defines VKCLOTH_KERNEL_NO_MESH and its own mesh_contact.
+// ---- Mesh colliders (docs/model.md "Mesh contact") ------------------------------------------
+// A particle's contact with a mesh collider comes from the nearest triangle. A search of the
+// triangles' hierarchy finds it; each particle keeps what its last search found (an entry per
+// particle and mesh collider, on both backends), which answers the queries that follow while the
+// particle stays within the entry's bounds: the same triangle as the search, by the same formula.
+
+// A particle's entry for one mesh collider (body frame), read and written through the including
+// file's mesh_cache_load / mesh_cache_store(MESH_DATA, slot, n, tri, centre, radius):
+// - face (n != 0): triangle `tri` (unit normal n, turned towards q's side) holds the nearest point of
+//   the mesh inside its face for every q in front of it whose projection lies inside the face
+//   (face_margin > guard) and with |q - centre| < radius (no other triangle comes as near);
+// - empty (n = 0): no triangle nearer to q than radius - |q - centre| (radius <= 0: nothing).
+// The rounding of the distances in float at q's scale (guard) shrinks every bound.
+KFN precise real mesh_guard(vec3 q) {
+  precise real g = real(0.000003814697265625) * (real(1) + max(max(abs(q.x), abs(q.y)), abs(q.z))); // 2^-18
+  return g;
+}
+
+// How far q's projection on the plane of triangle (a, b, c) (unit normal n, counter-clockwise) lies
+// inside it: its distance to the nearest edge's line, negative outside.
+KFN precise real edge_margin(vec3 q, vec3 n, vec3 a, vec3 b) {
+  precise vec3 e = b - a;
+  precise real m = dot3(cross3(n, e), q - a) / sqrt(dot3(e, e));
+  return m;
+}
+KFN precise real face_margin(vec3 q, vec3 n, vec3 a, vec3 b, vec3 c) {
+  precise real m = min(min(edge_margin(q, n, a, b), edge_margin(q, n, b, c)), edge_margin(q, n, c, a));
+  return m;
+}
+
+// The entry (n, centre, radius; a face's triangle a, b, c) answers a query at q (body frame) that
+// reaches reach_total (the thickness + reach).
+KFN VARYING(bool)
+    mesh_cache_hit(vec3 n, vec3 centre, real radius, vec3 a, vec3 b, vec3 c, vec3 q, real reach_total) {
+  precise vec3 d = q - centre;
+  precise real d2 = dot3(d, d);
+  VARYING(bool) face = dot3(n, n) > real(0);
+  precise real r = select(face, radius, radius - reach_total);
+  VARYING(bool) within = r > real(0) && d2 < r * r;
+  precise real guard = mesh_guard(q);
+  VARYING(bool) on_face = dot3(q - a, n) > guard && face_margin(q, n, a, b, c) > guard;
+  return within && (!face || on_face);
+}
+
+// collider_contact for a mesh from a face entry (the nearest point of the mesh to q lies inside the
+// face of unit normal n through corner a) or an empty one (nothing within reach): the particle's
+// height over the plane on the side p_side is on, less the thickness; the face's normal towards that
+// side. Farther than the thickness + reach: distance = reach (no contact).
+KFN void mesh_face_contact(ColliderShape s, vec3 n, vec3 a, vec3 q, vec3 p_side, real reach,
+                           OUT(real) distance, OUT(vec3) normal) {
+  precise real offset = dot3(a, n);
+  precise real h = dot3(q, n) - offset;
+  precise real h_side = dot3(to_body(s, p_side), n) - offset;
+  precise real side = select(h_side < real(0), real(-1), real(1));
+  precise real reach_total = s.b + reach;
+  VARYING(bool) found = dot3(n, n) > real(0) && h * h < reach_total * reach_total;
+  precise real d = h * side - s.b;
+  distance = select(found, d, reach);
+  normal = select(found, to_world_dir(s, n * side), vec3(real(0), real(0), real(1)));
+}
+
+// The search of the hierarchy and the entry it leaves. A bridge that cannot run it (the CPU's SIMD
+// lanes, which call the scalar mesh_contact lane by lane where their entries miss) defines
+// VKCLOTH_KERNEL_NO_MESH.
 #ifndef VKCLOTH_KERNEL_NO_MESH
 // The closest point of triangle (a, b, c) to p (Ericson, Real-Time Collision Detection, 5.1.5).
 KFN precise vec3 closest_on_triangle(vec3 p, vec3 a, vec3 b, vec3 c) {
@@ -66,62 +128,76 @@ KFN precise vec3 closest_on_triangle(vec3 p, vec3 a, vec3 b, vec3 c) {
   return q;
 }
 
-// The triangle of a mesh collider nearest to q (body frame) within `reach`: its closest point and
-// unit normal. Walks the bounding-volume hierarchy depth first, nearer-or-equal boxes only, in
-// a fixed order, so both backends pick the same triangle. The including file provides
-// mesh_node(MESH_DATA, i, lo, first, hi, count) and mesh_triangle(MESH_DATA, i, a, b, c)
-// (vkcloth::ColliderMesh's Node and Triangle); MESH_DATA_PARAM declares MESH_DATA.
+// The triangle of a mesh collider nearest to q (body frame) within `reach` (its index in `nearest`,
+// VKCLOTH_MESH_NONE: none; its squared distance returned, reach^2: none), among those other than
+// `skip` that reach in front of the plane {x: m.x = offset} by more than `tol` (m = 0, tol < 0: all).
+// Walks the bounding-volume hierarchy depth first, the nearer child first, boxes no farther than the
+// nearest so far only, in a fixed order, so both backends find the same triangle (ties: the first
+// found). The including file provides mesh_node(MESH_DATA, i, lo, first, hi, count) and
+// mesh_triangle(MESH_DATA, i, a, b, c) (vkcloth::ColliderMesh's Node and Triangle); MESH_DATA_PARAM
+// declares MESH_DATA.
+#define VKCLOTH_MESH_NONE 0xffffffffu
 #define VKCLOTH_MESH_STACK 32
-KFN_NOINLINE bool mesh_closest(MESH_DATA_PARAM, uint root, uint tri0, vec3 q, real reach, OUT(vec3) closest,
-                               OUT(vec3) normal) {
-  closest = q;
-  normal = vec3(real(0), real(0), real(1));
+KFN precise real box_gap2(vec3 lo, vec3 hi, vec3 q) {
+  precise vec3 gap = max(max(lo - q, q - hi), vec3(real(0)));
+  return dot3(gap, gap);
+}
+KFN_NOINLINE real mesh_nearest(MESH_DATA_PARAM, uint root, uint tri0, vec3 q, real reach, uint skip, vec3 m,
+                               real offset, real tol, OUT(uint) nearest) {
+  nearest = VKCLOTH_MESH_NONE;
   precise real best = reach * reach;
-  bool found = false;
+  // The stack holds nodes with their boxes' squared gaps to q (measured with their parent's).
   uint stack[VKCLOTH_MESH_STACK];
+  real stack_gap[VKCLOTH_MESH_STACK];
   uint top = 1u;
   stack[0] = 0u;
+  stack_gap[0] = real(0);
   while (top > 0u) {
     top = top - 1u;
+    if (stack_gap[top] > best) // too far
+      continue;
     vec3 lo, hi;
     uint first, count;
     mesh_node(MESH_DATA, root + stack[top], lo, first, hi, count);
-    precise vec3 out_lo = lo - q, out_hi = q - hi;
-    precise vec3 gap = max(max(out_lo, out_hi), vec3(real(0)));
-    if (dot3(gap, gap) > best)
+    precise real ahead = dot3(m, (lo + hi) * real(0.5)) + dot3(abs(m), (hi - lo) * real(0.5)) - offset;
+    if (ahead <= tol) // wholly behind the plane
       continue;
-    if (count == 0u) { // the first child is walked first
-      stack[top] = first + 1u;
-      stack[top + 1u] = first;
+    if (count == 0u) { // the nearer child is walked first (the first one on a tie)
+      vec3 lo1, hi1;
+      uint f1, c1;
+      mesh_node(MESH_DATA, root + first, lo, f1, hi, c1);
+      mesh_node(MESH_DATA, root + first + 1u, lo1, f1, hi1, c1);
+      precise real g0 = box_gap2(lo, hi, q), g1 = box_gap2(lo1, hi1, q);
+      const bool swap = g1 < g0;
+      stack[top] = swap ? first : first + 1u;
+      stack_gap[top] = swap ? g0 : g1;
+      stack[top + 1u] = swap ? first + 1u : first;
+      stack_gap[top + 1u] = swap ? g1 : g0;
       top = top + 2u;
       continue;
     }
     for (uint t = first; t < first + count; ++t) {
       vec3 ta, tb, tc;
       mesh_triangle(MESH_DATA, tri0 + t, ta, tb, tc);
-      precise vec3 cp = closest_on_triangle(q, ta, tb, tc);
-      precise vec3 d = q - cp;
+      if (tri0 + t == skip || max(max(dot3(m, ta), dot3(m, tb)), dot3(m, tc)) - offset <= tol)
+        continue;
+      precise vec3 d = q - closest_on_triangle(q, ta, tb, tc);
       precise real d2 = dot3(d, d);
       if (d2 < best) {
         best = d2;
-        closest = cp;
-        normal = unit_or_zero(cross3(tb - ta, tc - ta));
-        found = true;
+        nearest = tri0 + t;
       }
     }
   }
-  return found;
+  return best;
 }
 
-// collider_contact for a mesh collider, q = p in its body frame (to_body).
-KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_side, real reach,
-                               OUT(real) distance, OUT(vec3) normal) {
-  vec3 cp, tn;
-  distance = reach;
-  normal = vec3(real(0), real(0), real(1));
-  if (!VKCLOTH_COLLIDER_PRESENT(VKCLOTH_COLLIDER_MESH) ||
-      !mesh_closest(MESH_DATA, s.mesh_root, s.mesh_tri0, q, s.b + reach, cp, tn))
-    return;
+// The contact with triangle (a, b, c), the nearest to q: the general case (an edge, a corner, or a particle
+// that crossed through the triangle).
+KFN void triangle_contact(ColliderShape s, vec3 a, vec3 b, vec3 c, vec3 q, vec3 p_side, OUT(real) distance,
+                          OUT(vec3) normal) {
+  precise vec3 tn = unit_or_zero(cross3(b - a, c - a));
+  precise vec3 cp = closest_on_triangle(q, a, b, c);
   precise vec3 r = q - cp;
   precise real len = sqrt(dot3(r, r));
   precise real side = select(dot3(to_body(s, p_side) - cp, tn) < real(0), real(-1), real(1));
@@ -140,6 +216,54 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
   precise real d = len - s.b;
   distance = d;
   normal = to_world_dir(s, nb);
+}
+
+// collider_contact for a mesh collider, q = p in its body frame (to_body). The particle's entry
+// answers where it can; otherwise the search answers and leaves a new entry (slot:
+// ColliderShape::mesh_cache; the bridge adds the particle): a face entry where the nearest point
+// lies inside a face within twice the reach, else an empty one.
+KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_side, real reach,
+                               OUT(real) distance, OUT(vec3) normal) {
+  distance = reach;
+  normal = vec3(real(0), real(0), real(1));
+  if (!VKCLOTH_COLLIDER_PRESENT(VKCLOTH_COLLIDER_MESH))
+    return;
+  precise real reach_total = s.b + reach;
+  vec3 n, centre, a, b, c;
+  uint t;
+  real radius;
+  mesh_cache_load(MESH_DATA, s.mesh_cache, n, t, centre, radius);
+  const bool face = dot3(n, n) > real(0);
+  a = b = c = vec3(real(0));
+  if (face)
+    mesh_triangle(MESH_DATA, t, a, b, c);
+  if (mesh_cache_hit(n, centre, radius, a, b, c, q, reach_total)) {
+    mesh_face_contact(s, n, a, q, p_side, reach, distance, normal);
+    return;
+  }
+  precise real guard = mesh_guard(q);
+  precise real best = mesh_nearest(MESH_DATA, s.mesh_root, s.mesh_tri0, q, real(1e18), VKCLOTH_MESH_NONE,
+                                   vec3(real(0)), real(0), real(-1), t);
+  mesh_triangle(MESH_DATA, t, a, b, c);
+  precise vec3 tn = unit_or_zero(cross3(b - a, c - a));
+  precise real d1 = sqrt(best);
+  if (d1 < real(2) * reach_total && face_margin(q, tn, a, b, c) > guard) { // near, inside the face
+    // The normal towards q's side (the face formula's bits do not depend on its sign). The ball: no
+    // triangle reaching in front of the plane comes as near as the face (each moves at most as far as
+    // q; one wholly behind it is never nearer than the plane while q is in front and its projection
+    // inside the face: a convex edge's neighbour), searched 4 reaches beyond d1.
+    precise vec3 m = tn * select(dot3(q - a, tn) < real(0), real(-1), real(1));
+    uint unused;
+    precise real next = mesh_nearest(MESH_DATA, s.mesh_root, s.mesh_tri0, q, d1 + real(4) * reach_total, t, m,
+                                     dot3(a, m), guard, unused);
+    mesh_cache_store(MESH_DATA, s.mesh_cache, m, t, q, (sqrt(next) - d1) * real(0.5) - guard);
+    mesh_face_contact(s, m, a, q, p_side, reach, distance, normal);
+    return;
+  }
+  // Far, or on an edge or a corner: no triangle nearer than d1.
+  mesh_cache_store(MESH_DATA, s.mesh_cache, vec3(real(0)), 0u, q, d1 - guard);
+  if (best < reach_total * reach_total)
+    triangle_contact(s, a, b, c, q, p_side, distance, normal);
 }
 #endif // VKCLOTH_KERNEL_NO_MESH
 

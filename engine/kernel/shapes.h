@@ -19,9 +19,10 @@ struct ColliderShape {
   vec3 az;
   uint mesh_root; // mesh: its root node and first triangle in the mesh buffers
   uint mesh_tri0;
-  bool moving;   // the surface moves: velocity, spin and pivot apply
-  vec3 velocity; // linear velocity
-  vec3 spin;     // angular velocity about pivot
+  uint mesh_cache; // mesh: where its particles' MeshCacheEntry start (the bridge adds the particle)
+  bool moving;     // the surface moves: velocity, spin and pivot apply
+  vec3 velocity;   // linear velocity
+  vec3 spin;       // angular velocity about pivot
   vec3 pivot;
   real mu_k; // Coulomb friction: kinetic and static coefficients (0, 0: frictionless)
   real mu_s;

@@ -101,21 +101,37 @@ bool all_finite(vec3 v) {
   const uvec3 bits = floatBitsToUint(v) & 0x7f800000u; // exponent all ones: inf or NaN
   return all(notEqual(bits, uvec3(0x7f800000u)));
 }
-// Mesh colliders' hierarchies and triangles: global buffers, so MESH_DATA is a dummy argument.
+// Mesh colliders' hierarchies and triangles: global buffers; MESH_DATA is the particle (its index in
+// the batch), whose search entries (cloth_kernel.h mesh_contact) it reads and writes.
 #define MESH_DATA_PARAM uint mesh_data
 #define MESH_DATA mesh_data
-void mesh_node(uint unused, uint i, out vec3 lo, out uint first, out vec3 hi, out uint count) {
+void mesh_node(uint particle, uint i, out vec3 lo, out uint first, out vec3 hi, out uint count) {
   const MeshNode n = read_mesh_node(i);
   lo = n.lo_first.xyz;
   first = floatBitsToUint(n.lo_first.w);
   hi = n.hi_count.xyz;
   count = floatBitsToUint(n.hi_count.w);
 }
-void mesh_triangle(uint unused, uint i, out vec3 a, out vec3 b, out vec3 c) {
+void mesh_triangle(uint particle, uint i, out vec3 a, out vec3 b, out vec3 c) {
   const MeshTriangle t = read_mesh_triangle(i);
   a = t.a.xyz;
   b = t.b.xyz;
   c = t.c.xyz;
+}
+layout(std430, set = 0, binding = VKCLOTH_BINDING_MESH_CACHE) buffer MeshCacheBuf { vec4 mesh_entries[]; };
+void mesh_cache_load(uint particle, uint slot, out vec3 n, out uint tri, out vec3 centre, out float radius) {
+  const uint i = 2u * (slot + particle);
+  const vec4 a = mesh_entries[i];
+  const vec4 b = mesh_entries[i + 1u];
+  n = a.xyz;
+  tri = floatBitsToUint(a.w);
+  centre = b.xyz;
+  radius = b.w;
+}
+void mesh_cache_store(uint particle, uint slot, vec3 n, uint tri, vec3 centre, float radius) {
+  const uint i = 2u * (slot + particle);
+  mesh_entries[i] = vec4(n, uintBitsToFloat(tri));
+  mesh_entries[i + 1u] = vec4(centre, radius);
 }
 #define VKCLOTH_COLLIDER_PRESENT(type) ((SC_COLLIDER_TYPES & (1u << (type))) != 0u)
 #include "kernel/cloth_kernel.h"
@@ -133,6 +149,7 @@ ColliderShape collider_shape(uint c) {
   s.az = col.axis_z.xyz;
   s.mesh_root = col.mesh_root;
   s.mesh_tri0 = col.mesh_tri0;
+  s.mesh_cache = floatBitsToUint(col.pivot.w);
   s.moving = col.moving != 0u;
   s.velocity = col.velocity.xyz;
   s.spin = col.spin.xyz;

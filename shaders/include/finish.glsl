@@ -13,7 +13,7 @@ void finish(uint p, bool pinned, vec3 side, vec3 x_in, vec3 v_in) {
   vec3 v = v_in;
   if (!pinned) {
     for (uint c = 0u; c < (SC_COLLIDERS ? ip.collider_count : 0u); ++c)
-      project_out(0u, collider_shape(c), ip.eps, side, x, v);
+      project_out(base + p, collider_shape(c), ip.eps, side, x, v);
   }
   pos_out[base + p] = vec4(x, 1.0);
   vel[base + p] = vec4(v, 0.0);

@@ -212,7 +212,7 @@ void particle_force(uint p, inout vec3 v_io, out vec3 f_out, out vec3 nrm_out) {
 #endif
       float dist;
       vec3 n;
-      collider_contact(0u, s, x, x, ip.band, dist, n);
+      collider_contact(base + p, s, x, x, ip.band, dist, n);
       contact_response(v, f, s, x, n, dist, ip.band, both, h_over_m);
     }
   }

@@ -15,18 +15,18 @@ namespace vkcloth::gpu::shared {
 #endif
 
 #define VKCLOTH_BINDING_IMPL_VF                                                                              \
-  27 // (after VKCLOTH_BINDING_COUNT) contact-filtered velocity, removed force, contact axis (vec4 each)
-#define VKCLOTH_BINDING_IMPL_KS 28 // per CSR entry: K_s as 2 vec4 (xx yy zz xy | xz yz - -)
+  28 // (after VKCLOTH_BINDING_COUNT) contact-filtered velocity, removed force, contact axis (vec4 each)
+#define VKCLOTH_BINDING_IMPL_KS 29 // per CSR entry: K_s as 2 vec4 (xx yy zz xy | xz yz - -)
 #define VKCLOTH_BINDING_IMPL_BLOCK_INV                                                                       \
-  29                              // P^-1: inverse diagonal block of A, 2 vec4 (xx yy zz xy | xz yz - -)
-#define VKCLOTH_BINDING_IMPL_X 30 // CG solution dv (vec4), kept between solves (warm start)
-#define VKCLOTH_BINDING_IMPL_R 31 // residual
-#define VKCLOTH_BINDING_IMPL_Z 32 // preconditioned residual
-#define VKCLOTH_BINDING_IMPL_D 33 // search direction
-#define VKCLOTH_BINDING_IMPL_Q 34 // S A d
-#define VKCLOTH_BINDING_IMPL_PARTIALS 35 // one vec4 per workgroup: its partial dot products (coherent)
-#define VKCLOTH_BINDING_IMPL_STATE 36    // CgState
-#define VKCLOTH_BINDING_IMPL_ARGS 37     // indirect dispatch arguments (CgArgs)
+  30                              // P^-1: inverse diagonal block of A, 2 vec4 (xx yy zz xy | xz yz - -)
+#define VKCLOTH_BINDING_IMPL_X 31 // CG solution dv (vec4), kept between solves (warm start)
+#define VKCLOTH_BINDING_IMPL_R 32 // residual
+#define VKCLOTH_BINDING_IMPL_Z 33 // preconditioned residual
+#define VKCLOTH_BINDING_IMPL_D 34 // search direction
+#define VKCLOTH_BINDING_IMPL_Q 35 // S A d
+#define VKCLOTH_BINDING_IMPL_PARTIALS 36 // one vec4 per workgroup: its partial dot products (coherent)
+#define VKCLOTH_BINDING_IMPL_STATE 37    // CgState
+#define VKCLOTH_BINDING_IMPL_ARGS 38     // indirect dispatch arguments (CgArgs)
 
 // implicit.comp passes (PushConstants::stage). SYSTEM, MATVEC and UPDATE end with a reduction:
 // every workgroup writes its partial sums, and the LAST workgroup to arrive (CgState::arrived)
@@ -96,7 +96,8 @@ inline constexpr uint implicit_bindings[] = {VKCLOTH_BINDING_POS_IN,     VKCLOTH
                                              VKCLOTH_BINDING_IMPL_Z,     VKCLOTH_BINDING_IMPL_D,
                                              VKCLOTH_BINDING_IMPL_Q,     VKCLOTH_BINDING_IMPL_PARTIALS,
                                              VKCLOTH_BINDING_IMPL_STATE, VKCLOTH_BINDING_IMPL_ARGS,
-                                             VKCLOTH_BINDING_MESH_NODES, VKCLOTH_BINDING_MESH_TRIS};
+                                             VKCLOTH_BINDING_MESH_NODES, VKCLOTH_BINDING_MESH_TRIS,
+                                             VKCLOTH_BINDING_MESH_CACHE};
 } // namespace vkcloth::gpu::shared
 #endif
 

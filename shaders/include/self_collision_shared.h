@@ -12,16 +12,16 @@
 namespace vkcloth::gpu::shared {
 #endif
 
-#define VKCLOTH_BINDING_SELF_PARAMS 38 // (after implicit Euler's) SelfParams per instance
-#define VKCLOTH_BINDING_SELF_REST 39   // rest positions, w: inverse mass (vec4 per particle of the topology)
+#define VKCLOTH_BINDING_SELF_PARAMS 39 // (after implicit Euler's) SelfParams per instance
+#define VKCLOTH_BINDING_SELF_REST 40   // rest positions, w: inverse mass (vec4 per particle of the topology)
 #define VKCLOTH_BINDING_SELF_COUNTS                                                                          \
-  40 // particles per bucket (uint, table size per instance; zero between substeps)
-#define VKCLOTH_BINDING_SELF_STARTS 41 // each bucket's first entry (uint, table size + 1 per instance)
+  41 // particles per bucket (uint, table size per instance; zero between substeps)
+#define VKCLOTH_BINDING_SELF_STARTS 42 // each bucket's first entry (uint, table size + 1 per instance)
 #define VKCLOTH_BINDING_SELF_BLOCKS                                                                          \
-  42 // each scan block's first entry (uint, table size / SCAN_BLOCK per instance)
-#define VKCLOTH_BINDING_SELF_KEYS 43   // each particle's cell key when sorted (uint, per particle)
-#define VKCLOTH_BINDING_SELF_SORTED 44 // the particles by bucket, then by index, with their keys (uvec2)
-#define VKCLOTH_BINDING_SELF_DELTA 45  // this Jacobi pass's move and velocity change (2 vec4 per particle)
+  43 // each scan block's first entry (uint, table size / SCAN_BLOCK per instance)
+#define VKCLOTH_BINDING_SELF_KEYS 44   // each particle's cell key when sorted (uint, per particle)
+#define VKCLOTH_BINDING_SELF_SORTED 45 // the particles by bucket, then by index, with their keys (uvec2)
+#define VKCLOTH_BINDING_SELF_DELTA 46  // this Jacobi pass's move and velocity change (2 vec4 per particle)
 
 // Set 1 of the self_collision_texel build: what COLLIDE's walk reads, through uniform texel buffer
 // views (llvmpipe turns a storage-buffer load into a per-lane loop, a texel fetch into one

@@ -13,11 +13,11 @@ namespace vkcloth::gpu::shared {
 #endif
 
 #define VKCLOTH_BINDING_PROJ_INCIDENCE                                                                       \
-  46 // uint: the topology's strain_incidence_offsets, then its strain_incidence
-#define VKCLOTH_BINDING_PROJ_LINKS 47  // 2 vec4 per link per instance: (g, 1 / A_ll), (lambda, r, d, q)
-#define VKCLOTH_BINDING_PROJ_GATHER 48 // vec4 per particle per instance: grad C^T of d or lambda
-#define VKCLOTH_BINDING_PROJ_STATE 49  // ProjState per instance
-#define VKCLOTH_BINDING_PROJ_ARGS 50   // ProjArgsHead, then a uint per instance: reset every substep
+  47 // uint: the topology's strain_incidence_offsets, then its strain_incidence
+#define VKCLOTH_BINDING_PROJ_LINKS 48  // 2 vec4 per link per instance: (g, 1 / A_ll), (lambda, r, d, q)
+#define VKCLOTH_BINDING_PROJ_GATHER 49 // vec4 per particle per instance: grad C^T of d or lambda
+#define VKCLOTH_BINDING_PROJ_STATE 50  // ProjState per instance
+#define VKCLOTH_BINDING_PROJ_ARGS 51   // ProjArgsHead, then a uint per instance: reset every substep
 
 // The phases of one Newton iteration (ProjState::phase), as CpuSolver::project_strain runs them.
 #define VKCLOTH_PROJ_LINKS 0u     // per link: C, g, in the solve, r = d = rhs; sums r.z, r.r; max C

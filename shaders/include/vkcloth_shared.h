@@ -61,7 +61,9 @@ struct vec4 {
 #define VKCLOTH_BINDING_VBD_ORDER 24  // vbd: the particles in colour order (ClothTopology::vertex_order)
 #define VKCLOTH_BINDING_TARGETS 25    // Target per particle of each instance (its attachments' and host's)
 #define VKCLOTH_BINDING_FRAMES 26     // FrameMotion per instance: its frame's jump and carry this substep
-#define VKCLOTH_BINDING_COUNT 27
+#define VKCLOTH_BINDING_MESH_CACHE                                                                           \
+  27 // MeshCacheEntry as 2 vec4 per particle and mesh collider (Collider::pivot.w)
+#define VKCLOTH_BINDING_COUNT 28
 
 // Set 1 (force.comp, fused.comp, strain_*.comp): POS_IN again, as an RGBA32F uniform texel buffer view,
 // PARTICLE as an RG32UI one (x: the mass's bits, y: pinned), and (fused.comp) VEL as RGBA32F and
@@ -253,7 +255,7 @@ struct Collider {
   vec4 axis_z;
   vec4 velocity; // xyz: linear velocity; w: kinetic friction
   vec4 spin;     // xyz: angular velocity; w: static friction
-  vec4 pivot;    // xyz: the point spin turns about
+  vec4 pivot;    // xyz: the point spin turns about; w: mesh: the bits of its first MESH_CACHE entry
 };
 
 /// A node of a mesh collider's hierarchy (vkcloth::ColliderMesh::Node; std430: 32 bytes).

@@ -215,19 +215,29 @@ template <typename Real> void CpuSolver<Real>::Impl::prepare_colliders() {
   shapes.clear();
   meshes.clear();
   finish.clear();
-  bool any_mesh = false;
+  std::vector<const ColliderMesh*> mesh_list;
+  for (const Collider& c : params_.colliders)
+    if (c.type == Collider::Type::mesh)
+      mesh_list.push_back(c.mesh.get());
+  if (mesh_list != mesh_cache_meshes_) { // other meshes: their entries start empty
+    mesh_cache_.assign(8 * mesh_list.size() * pos_.size(), Real(0));
+    mesh_cache_meshes_ = mesh_list;
+  }
+  std::uint32_t mesh_ordinal = 0;
   for (const Collider& c : params_.colliders) {
-    shapes.push_back(kernel::kernel_shape<Real>(c));
     kernel::MeshData m;
-    if (c.mesh) {
+    std::uint32_t cache = 0;
+    if (c.mesh && c.type == Collider::Type::mesh) {
       m.nodes = c.mesh->nodes().data();
       m.triangles = c.mesh->triangles().data();
+      m.cache = mesh_cache_.data();
+      cache = mesh_ordinal++ * std::uint32_t(pos_.size());
     }
+    shapes.push_back(kernel::kernel_shape<Real>(c, 0, 0, cache));
     meshes.push_back(m);
-    any_mesh = any_mesh || c.type == Collider::Type::mesh;
   }
-  // The SIMD finish (row_kernel.hpp FinishShape): no mesh, at most finish_max_shapes colliders.
-  const bool simd = !any_mesh && shapes.size() <= detail::finish_max_shapes;
+  // The SIMD finish (row_kernel.hpp FinishShape): at most finish_max_shapes colliders.
+  const bool simd = shapes.size() <= detail::finish_max_shapes;
   for (std::size_t k = 0; simd && k < shapes.size(); ++k) {
     const kernel::ColliderShape<Real>& s = shapes[k];
     auto put = [](Real* out, glm::vec<3, Real> v) {
@@ -249,6 +259,8 @@ template <typename Real> void CpuSolver<Real>::Impl::prepare_colliders() {
     put(f.pivot, s.pivot);
     f.mu_k = s.mu_k;
     f.mu_s = s.mu_s;
+    f.mesh = s.type == VKCLOTH_COLLIDER_MESH ? &meshes[k] : nullptr;
+    f.scalar = &s;
     finish.push_back(f);
   }
 }
@@ -261,7 +273,8 @@ template <typename Real> void CpuSolver<Real>::Impl::advance_colliders(double h)
 }
 
 template <typename Real>
-void CpuSolver<Real>::Impl::contact_at(Vec3 pos, Vec3& vel, Vec3& force, Real h_over_m, bool friction) const {
+void CpuSolver<Real>::Impl::contact_at(std::size_t p, Vec3 pos, Vec3& vel, Vec3& force, Real h_over_m,
+                                       bool friction) const {
   const Real band = Real(2) * Real(params_.contact_epsilon);
   const bool both = !params_.contact_inward_only; // Figure 12's variant: outward parts go too
   const auto& shapes = contacts_->shapes;
@@ -269,15 +282,16 @@ void CpuSolver<Real>::Impl::contact_at(Vec3 pos, Vec3& vel, Vec3& force, Real h_
     const kernel::ColliderShape<Real> s = friction ? shapes[k] : kernel::without_friction(shapes[k]);
     Real distance;
     Vec3 normal;
-    kernel::collider_contact(contacts_->meshes[k], s, pos, pos, band, distance, normal);
+    kernel::collider_contact(mesh_of(k, p), s, pos, pos, band, distance, normal);
     kernel::contact_response(vel, force, s, pos, normal, distance, band, both, h_over_m);
   }
 }
 
-template <typename Real> void CpuSolver<Real>::Impl::project_at(Vec3 side, Vec3& pos, Vec3& vel) const {
+template <typename Real>
+void CpuSolver<Real>::Impl::project_at(std::size_t p, Vec3 side, Vec3& pos, Vec3& vel) const {
   const Real eps = Real(params_.contact_epsilon);
   for (std::size_t k = 0; k < contacts_->shapes.size(); ++k)
-    kernel::project_out(contacts_->meshes[k], contacts_->shapes[k], eps, side, pos, vel);
+    kernel::project_out(mesh_of(k, p), contacts_->shapes[k], eps, side, pos, vel);
 }
 
 template <typename Real> Result<void> CpuSolver<Real>::Impl::check_finite() const {
@@ -463,7 +477,7 @@ template <typename Real> void CpuSolver<Real>::Impl::limit_stretch(const Real h)
   if (!params_.colliders.empty())
     pool_->for_each(pos_.size(), [&](std::size_t p) {
       if (!pinned_[p]) {
-        project_at(pos_[p], pos_[p], vel_[p]);
+        project_at(p, pos_[p], pos_[p], vel_[p]);
         moved(p);
       }
     });
@@ -478,11 +492,11 @@ void CpuSolver<Real>::Impl::euler_finish(std::size_t p, Vec3 f, const Real h, co
     return;
   }
   Vec3 v = vel_[p];
-  contact_at(pos_[p], v, f, h / mass_[p]);
+  contact_at(p, pos_[p], v, f, h / mass_[p]);
   force_[p] = f;
   Vec3 x = pos_[p];
   kernel::euler_update(semi, x, v, f, mass_[p], h);
-  project_at(pos_[p], x, v);
+  project_at(p, pos_[p], x, v);
   pos_next_[p] = x;
   vel_[p] = v; // only particle p reads its own velocity: updating in place is safe
 }
@@ -529,7 +543,7 @@ template <typename Real> void CpuSolver<Real>::Impl::rk4_substep(const Real h) {
     pool_->for_each(pos_.size(), [&](std::size_t p) {
       Vec3 f = normal_force_at(stage_pos_, stage_vel_, p);
       if (!pinned_[p])
-        contact_at(stage_pos_[p], stage_vel_[p], f, h / mass_[p]);
+        contact_at(p, stage_pos_[p], stage_vel_[p], f, h / mass_[p]);
       if (st == 0)
         force_[p] = f;
       kernel::rk4_derivative(pinned_[p] != 0, stage_vel_[p], f, mass_[p], k_pos_[st][p], k_vel_[st][p]);
@@ -547,7 +561,7 @@ template <typename Real> void CpuSolver<Real>::Impl::rk4_substep(const Real h) {
     const Vec3 start = pos_[p];
     pos_[p] = kernel::rk4_finish(pos_[p], dp, w);
     vel_[p] = kernel::rk4_finish(vel_[p], dv, w);
-    project_at(start, pos_[p], vel_[p]);
+    project_at(p, start, pos_[p], vel_[p]);
   });
 }
 

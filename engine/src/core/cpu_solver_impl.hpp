@@ -25,8 +25,8 @@ template <typename Real> struct ImplicitWorkspace;
 template <typename Real> struct SelfCollisionGrid;
 template <typename Real> struct StrainProjection;
 /// The colliders as the kernel takes them at this substep's pose, and their meshes; the same values
-/// for the SIMD finish of the grid rows (row_kernel.hpp FinishShape), empty when a collider is a mesh
-/// or there are more than detail::finish_max_shapes.
+/// for the SIMD finish of the grid rows (row_kernel.hpp FinishShape), empty when there are more
+/// than detail::finish_max_shapes.
 template <typename Real> struct ContactShapes {
   std::vector<kernel::ColliderShape<Real>> shapes;
   std::vector<kernel::MeshData> meshes;
@@ -132,10 +132,16 @@ template <typename Real> struct CpuSolver<Real>::Impl {
   void normal_at(std::span<const Vec3> pos, std::size_t p);
   /// The area-weighted normal sum of the topology's fan around p, in its order (without ring normals).
   Vec3 fan_sum(std::span<const Vec3> pos, std::size_t p) const;
-  // Contacts (cloth_kernel.h contact_response / project_out) with every collider at this substep's
-  // pose; h_over_m: substep / mass (friction's impulse); side: where the particle came from.
-  void contact_at(Vec3 pos, Vec3& vel, Vec3& force, Real h_over_m, bool friction = true) const;
-  void project_at(Vec3 side, Vec3& pos, Vec3& vel) const;
+  // Contacts of particle p (cloth_kernel.h contact_response / project_out) with every collider at this
+  // substep's pose; h_over_m: substep / mass (friction's impulse); side: where the particle came from.
+  void contact_at(std::size_t p, Vec3 pos, Vec3& vel, Vec3& force, Real h_over_m, bool friction = true) const;
+  void project_at(std::size_t p, Vec3 side, Vec3& pos, Vec3& vel) const;
+  /// Collider k's mesh as the kernel reads it for particle p (its hierarchy and p's search entry).
+  kernel::MeshData mesh_of(std::size_t k, std::size_t p) const {
+    kernel::MeshData m = contacts_->meshes[k];
+    m.particle = std::uint32_t(p);
+    return m;
+  }
   void prepare_colliders();
   void advance_colliders(double h);
   Result<void> check_finite() const;
@@ -222,8 +228,12 @@ template <typename Real> struct CpuSolver<Real>::Impl {
   std::uint64_t step_ = 0;
   double time_ = 0.0;
   std::unique_ptr<detail::ThreadPool> pool_;
-  std::unique_ptr<detail::ImplicitWorkspace<Real>> implicit_;  // created by the first implicit step
-  std::unique_ptr<detail::ContactShapes<Real>> contacts_;      // this substep's colliders (prepare_colliders)
+  std::unique_ptr<detail::ImplicitWorkspace<Real>> implicit_; // created by the first implicit step
+  std::unique_ptr<detail::ContactShapes<Real>> contacts_;     // this substep's colliders (prepare_colliders)
+  // Each particle's search entry per mesh collider (cloth_kernel.h MeshCacheEntry, 8 reals; collider
+  // ordinal-major), and the meshes they were found on (a different mesh empties them).
+  std::vector<Real> mesh_cache_;
+  std::vector<const ColliderMesh*> mesh_cache_meshes_;
   std::unique_ptr<detail::SelfCollisionGrid<Real>> self_;      // created by the first self-collision substep
   std::unique_ptr<detail::StrainProjection<Real>> projection_; // created by the first fast-projection substep
   std::unique_ptr<detail::PaddedLists<Real>> lists_;           // created by the first list sweep

@@ -41,7 +41,7 @@ template <typename Real> void CpuSolver<Real>::Impl::implicit_substep(const Real
     const Vec3 unfiltered = f;
     Vec3 v = vel_[p];
     if (!pinned_[p]) // friction once, on the new velocity (implicit_update)
-      contact_at(pos_[p], v, f, h / mass_[p], false);
+      contact_at(p, pos_[p], v, f, h / mass_[p], false);
     force_[p] = f;
     w.vf[p] = v;
     w.fc[p] = unfiltered - f;
@@ -161,9 +161,9 @@ template <typename Real> void CpuSolver<Real>::Impl::implicit_update(const Real 
     // impulse also counts the force the filter removed before the solve (w.fc: e.g. the weight of
     // a cloth resting on a table, which the solve never saw).
     Vec3 removed = w.fc[p];
-    contact_at(pos_[p], v, removed, h / mass_[p]);
+    contact_at(p, pos_[p], v, removed, h / mass_[p]);
     Vec3 x = pos_[p] + v * h;
-    project_at(pos_[p], x, v);
+    project_at(p, pos_[p], x, v);
     pos_[p] = x;
     vel_[p] = v;
   });

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <type_traits>
@@ -64,11 +65,15 @@ template <typename V> bool all_finite(V v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
 
-/// A mesh collider's hierarchy and triangles (ColliderMesh's arrays, read in place), and the
-/// accessors cloth_kernel.h mesh_closest walks them with (float, converted to the solver's precision).
+/// A mesh collider's hierarchy and triangles (ColliderMesh's arrays, read in place), the particles'
+/// search entries (cloth_kernel.h MeshCacheEntry: 8 reals each, in the solver's precision; null:
+/// none, every query searches) and the particle a query is for; the accessors cloth_kernel.h
+/// mesh_contact reads them with (the mesh in float, converted to the solver's precision).
 struct MeshData {
   const ColliderMesh::Node* nodes = nullptr;
   const ColliderMesh::Triangle* triangles = nullptr;
+  void* cache = nullptr;
+  std::uint32_t particle = 0;
 };
 template <typename V> void mesh_node(const MeshData& m, uint i, V& lo, uint& first, V& hi, uint& count) {
   const ColliderMesh::Node& n = m.nodes[i];
@@ -83,7 +88,45 @@ template <typename V> void mesh_triangle(const MeshData& m, uint i, V& a, V& b, 
   b = V(t.b);
   c = V(t.c);
 }
-
+/// A particle's search entry (cloth_kernel.h mesh_contact): 8 reals; the triangle's index is stored
+/// as the bits of a float (double: as its value).
+template <typename R> R mesh_cache_word(uint w) {
+  if constexpr (sizeof(R) == sizeof(uint))
+    return std::bit_cast<R>(w);
+  else
+    return R(w);
+}
+template <typename R> uint mesh_cache_uint(R w) {
+  if constexpr (sizeof(R) == sizeof(uint))
+    return std::bit_cast<uint>(w);
+  else
+    return uint(w);
+}
+template <typename R> R* mesh_cache_entry(const MeshData& m, uint slot) {
+  return static_cast<R*>(m.cache) + 8 * (std::size_t(slot) + m.particle);
+}
+template <typename V, typename R>
+void mesh_cache_load(const MeshData& m, uint slot, V& n, uint& tri, V& centre, R& radius) {
+  if (!m.cache) {
+    n = centre = V(0);
+    tri = 0;
+    radius = R(0);
+    return;
+  }
+  const R* e = mesh_cache_entry<R>(m, slot);
+  n = V(e[0], e[1], e[2]);
+  tri = mesh_cache_uint(e[3]);
+  centre = V(e[4], e[5], e[6]);
+  radius = e[7];
+}
+template <typename V, typename R>
+void mesh_cache_store(const MeshData& m, uint slot, V n, uint tri, V centre, R radius) {
+  if (!m.cache)
+    return;
+  R* e = mesh_cache_entry<R>(m, slot);
+  const R w[8] = {n.x, n.y, n.z, mesh_cache_word<R>(tri), centre.x, centre.y, centre.z, radius};
+  std::copy(w, w + 8, e);
+}
 /// Self-collision's spatial hash as cloth_kernel.h self_collide walks it, in the solver's precision:
 /// the table (`start`: each bucket's first entry, size + 1 of them; `sorted`: the particles, by bucket
 /// and then index; `key`: each particle's cell key when sorted) and the particles' state, read in
@@ -161,10 +204,11 @@ using ColliderShape = std::conditional_t<std::is_same_v<Real, float>, f32::Colli
 /// A collider as the kernel takes it, every double field cast once to Real: the one conversion
 /// both backends use (CpuSolver; the GPU solver packs kernel_shape<float> into its Collider
 /// buffer), so the CPU float solver and the GPU see the same values. mesh_root / mesh_tri0: where
-/// the collider's mesh starts in the buffers the caller walks (0 when it walks the mesh in place).
+/// the collider's mesh starts in the buffers the caller walks (0 when it walks the mesh in place);
+/// mesh_cache: where its particles' search entries start.
 template <typename Real>
 kernel::ColliderShape<Real> kernel_shape(const Collider& c, std::uint32_t mesh_root = 0,
-                                         std::uint32_t mesh_tri0 = 0) {
+                                         std::uint32_t mesh_tri0 = 0, std::uint32_t mesh_cache = 0) {
   using V = glm::vec<3, Real>;
   kernel::ColliderShape<Real> s{};
   s.type = std::uint32_t(c.type);
@@ -196,6 +240,7 @@ kernel::ColliderShape<Real> kernel_shape(const Collider& c, std::uint32_t mesh_r
   s.az = V(c.rotation[2]);
   s.mesh_root = mesh_root;
   s.mesh_tri0 = mesh_tri0;
+  s.mesh_cache = mesh_cache;
   s.moving = c.moving();
   s.velocity = V(c.linear_velocity);
   s.spin = V(c.angular_velocity);

@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "kernel.hpp"
 #include "kernel/constants.h" // VKCLOTH_RING_*
 
 namespace vkcloth::detail {
@@ -75,13 +76,15 @@ template <typename Real> struct ListArgs : StepArgs<Real> {
 inline constexpr std::uint32_t finish_max_shapes = 16;
 
 /// A collider as the SIMD finish takes it: kernel::ColliderShape<Real>'s values, copied as they are
-/// (cpu_solver.cpp), for the plane, sphere, capsule and box (VKCLOTH_COLLIDER_* 0..3; a mesh
-/// collider keeps the per-particle reference), at most finish_max_shapes of them (more: the
-/// per-particle reference too).
+/// (cpu_solver.cpp), at most finish_max_shapes of them (more: the per-particle reference). A mesh
+/// collider's lanes read their search entries and, where those miss, search lane by lane with the
+/// scalar kernel: `mesh` and `scalar` are its hierarchy and its shape as that kernel takes them.
 template <typename Real> struct FinishShape {
   std::uint32_t type;
   bool moving;
   Real a[3], b, c[3], ax[3], ay[3], az[3], velocity[3], spin[3], pivot[3], mu_k, mu_s;
+  const kernel::MeshData* mesh;              // a mesh collider's; null for the other shapes
+  const kernel::ColliderShape<Real>* scalar; // the same collider as the scalar kernel takes it
 };
 
 /// The rest of a grid substep after the row kernel's forces when there are colliders (the kernel
@@ -124,7 +127,7 @@ template <typename Real> struct VbdArgs {
   const Real* rest;
   const Real* stiff;
   const std::uint8_t* reads_last;
-  const FinishShape<Real>* shapes; // every collider (no mesh), at most finish_max_shapes
+  const FinishShape<Real>* shapes; // every collider at most finish_max_shapes
   std::uint32_t shape_count;
   Real eps, h, mu; // contact_epsilon, the substep, the damping
 };
@@ -147,7 +150,7 @@ template <typename Real> struct VbdBeginArgs {
   Real* normal;                       // AoS, out
   Real* target;                       // AoS, out: y
   Real* pos;                          // AoS, out: the first guess, projected
-  const FinishShape<Real>* shapes;    // every collider (no mesh), at most finish_max_shapes
+  const FinishShape<Real>* shapes;    // every collider at most finish_max_shapes
   std::uint32_t shape_count;
   Real gravity[3], wind_dir[3], kw, eps, h;
 };
@@ -164,7 +167,7 @@ template <typename Real> struct VbdFinishArgs {
   Real* force;       // AoS, out
   const Real* mass;
   const std::uint8_t* pinned;
-  const FinishShape<Real>* shapes; // every collider (no mesh), at most finish_max_shapes
+  const FinishShape<Real>* shapes; // every collider at most finish_max_shapes
   std::uint32_t shape_count;
   Real band, eps, h; // 2 contact_epsilon, contact_epsilon, the substep
   bool both;         // !contact_inward_only

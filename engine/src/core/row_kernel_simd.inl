@@ -13,12 +13,24 @@
 // (simd_lanes.inl); tests/test_cloth.cpp "the SIMD row kernels ... give the shared reference's
 // bits" and "the SIMD list kernel ..." fail when they differ.
 
+#include "kernel.hpp" // the scalar kernel: a mesh collider's search, lane by lane
+
+/// MESH_DATA on lanes: a mesh collider's hierarchy and search entries and its shape as the scalar
+/// kernel takes them (null for the other shapes), and the lanes' particles: index[l], or first + l.
+template <typename Isa> struct LaneMesh {
+  const vkcloth::kernel::MeshData* mesh = nullptr;
+  const vkcloth::kernel::ColliderShape<typename Isa::Real>* scalar = nullptr;
+  const std::uint32_t* index = nullptr;
+  std::uint32_t first = 0;
+  std::uint32_t particle(int l) const { return index ? index[l] : first + std::uint32_t(l); }
+};
+
 #define KFN inline __attribute__((always_inline))
 #define OUT(T) T&
 #define INOUT(T) T&
 #define precise
 #define VARYING(T) varying<T>
-#define MESH_DATA_PARAM NoMesh mesh_data
+#define MESH_DATA_PARAM const LaneMesh<Isa>& mesh_data
 #define MESH_DATA mesh_data
 #define VKCLOTH_COLLIDER_PRESENT(type) true
 #define VKCLOTH_KERNEL_NO_MESH
@@ -57,6 +69,13 @@ template <> struct BlockOf<IsaF> { using type = lanes_f32::SpringBlock; };
 template <> struct BlockOf<IsaD> { using type = lanes_f64::SpringBlock; };
 
 #define VKCLOTH_AI inline __attribute__((always_inline))
+
+// The lanes' view of collider f for the particles first .. first + W - 1, or index[0 .. W).
+template <typename T>
+VKCLOTH_AI LaneMesh<T> lane_mesh(const vkcloth::detail::FinishShape<typename T::Real>& f, std::uint32_t first,
+                                 const std::uint32_t* index = nullptr) {
+  return LaneMesh<T>{f.mesh, f.scalar, index, first};
+}
 
 template <bool B> struct Flag { static constexpr bool value = B; };
 
@@ -430,13 +449,13 @@ std::int64_t simd_finish(const vkcloth::detail::FinishArgs<typename T::Real>& a,
       const S& s = shapes[k];
       L distance;
       L3 n;
-      collider_contact(NoMesh{}, s, x0, x0, band, distance, n);
+      collider_contact(lane_mesh<T>(a.shapes[k], std::uint32_t(q)), s, x0, x0, band, distance, n);
       contact_response(v, f, s, x0, n, distance, band, both, h_over_m);
     }
     L3 x = x0;
     euler_update(semi, x, v, f, m, dt);
     for (std::uint32_t k = 0; k < shape_count; ++k) // project_at
-      project_out(NoMesh{}, shapes[k], eps, x0, x, v);
+      project_out(lane_mesh<T>(a.shapes[k], std::uint32_t(q)), shapes[k], eps, x0, x, v);
     const Mask<T> pin(T::pinmask(pinned + q));
     store3<T>(force + 3 * q, select(pin, f0, f));
     x = select(pin, x0, x);
@@ -513,10 +532,10 @@ std::int64_t simd_vbd_colour(const vkcloth::detail::VbdArgs<typename T::Real>& a
     L3 stepped = vbd_step(x, y, x0, f, hessian, m, h, mu);
     const L inertia = vbd_inertia_weight(m, h, mu);
     for (std::uint32_t c = 0; c < a.shape_count; ++c)
-      vbd_friction(stepped, NoMesh{}, shapes[c], x, x0, hessian, inertia, band, h);
+      vbd_friction(stepped, lane_mesh<T>(a.shapes[c], 0, idx), shapes[c], x, x0, hessian, inertia, band, h);
     L3 projected = stepped, unused(L(Real(0)));
     for (std::uint32_t c = 0; c < a.shape_count; ++c)
-      project_out(NoMesh{}, shapes[c], eps, x0, projected, unused);
+      project_out(lane_mesh<T>(a.shapes[c], 0, idx), shapes[c], eps, x0, projected, unused);
     const L3 push = projected - stepped;
     Real out[6][W];
     const L* parts[6] = {&projected.x, &projected.y, &projected.z, &push.x, &push.y, &push.z};
@@ -578,7 +597,7 @@ std::int64_t simd_vbd_begin(const vkcloth::detail::VbdBeginArgs<typename T::Real
     const L3 y = vbd_inertia_target(x0, v0, f_ext, m, h);
     L3 x = vbd_first_guess(x0, v0, h), unused(zero);
     for (std::uint32_t c = 0; c < a.shape_count; ++c) // project_at
-      project_out(NoMesh{}, shapes[c], eps, x0, x, unused);
+      project_out(lane_mesh<T>(a.shapes[c], std::uint32_t(q)), shapes[c], eps, x0, x, unused);
     const Mask<T> pin(T::pinmask(a.pinned + q));
     store3<T>(a.target + 3 * q, select(pin, x0, y));
     store3<T>(a.pos + 3 * q, select(pin, x0, x));
@@ -613,11 +632,11 @@ std::int64_t simd_vbd_finish(const vkcloth::detail::VbdFinishArgs<typename T::Re
       const S s = without_friction(shapes[c]);
       L distance;
       L3 n;
-      collider_contact(NoMesh{}, s, x, x, band, distance, n);
+      collider_contact(lane_mesh<T>(a.shapes[c], std::uint32_t(q)), s, x, x, band, distance, n);
       contact_response(v, no_force, s, x, n, distance, band, a.both, h_over_m);
     }
     for (std::uint32_t c = 0; c < a.shape_count; ++c) // project_at
-      project_out(NoMesh{}, shapes[c], eps, x0, x, v);
+      project_out(lane_mesh<T>(a.shapes[c], std::uint32_t(q)), shapes[c], eps, x0, x, v);
     const L3 f = vbd_net_force(v, v0, m, h);
     const Mask<T> pin(T::pinmask(a.pinned + q));
     store3<T>(a.force + 3 * q, select(pin, L3(L(Real(0))), f));

@@ -63,7 +63,7 @@ template <typename Real> void CpuSolver<Real>::Impl::self_collide() {
   if (!params_.colliders.empty()) // a move may have pushed a particle into a collider
     pool_->for_each(n, [&](std::size_t p) {
       if (!pinned_[p])
-        project_at(pos_[p], pos_[p], vel_[p]);
+        project_at(p, pos_[p], pos_[p], vel_[p]);
     });
   soa_valid_ = false;
   swept_finite_ = false; // checked with the rest of the state (check_finite)

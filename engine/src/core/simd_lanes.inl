@@ -122,9 +122,6 @@ template <typename T, typename X> struct Varying;
 template <typename T> struct Varying<T, bool> { using type = Mask<T>; };
 template <typename T> struct Varying<T, std::uint32_t> { using type = ULanes<T>; };
 
-/// MESH_DATA on lanes: none (no mesh collider reaches the SIMD kernels).
-struct NoMesh {};
-
 // Generic AoS <-> SoA and pin mask by lanes (the ISA files specialise the hot float cases).
 template <typename Real, typename V, typename M, int W> struct IsaGeneric {
   static void load3(const Real* p, V& x, V& y, V& z) {

@@ -49,7 +49,7 @@ template <typename Real> void CpuSolver<Real>::Impl::vbd_begin(const Real h) {
     }
     w.y[p] = kernel::vbd_inertia_target(w.x0[p], vel_[p], f_ext, mass_[p], h);
     Vec3 x = kernel::vbd_first_guess(w.x0[p], vel_[p], h), unused(0); // out of the colliders
-    project_at(w.x0[p], x, unused);
+    project_at(p, w.x0[p], x, unused);
     pos_[p] = x;
   };
   const std::size_t width = vbd_lane_width();
@@ -165,10 +165,10 @@ void CpuSolver<Real>::Impl::vbd_solve_colour(const std::uint32_t colour, const R
     Vec3 stepped = kernel::vbd_step(x, w.y[p], w.x0[p], f, hessian, mass_[p], h, mu);
     const Real inertia = kernel::vbd_inertia_weight(mass_[p], h, mu);
     for (std::size_t c = 0; c < contacts_->shapes.size(); ++c)
-      kernel::vbd_friction(stepped, contacts_->meshes[c], contacts_->shapes[c], x, w.x0[p], hessian, inertia,
-                           band, h);
+      kernel::vbd_friction(stepped, mesh_of(c, p), contacts_->shapes[c], x, w.x0[p], hessian, inertia, band,
+                           h);
     Vec3 projected = stepped, unused(0);
-    project_at(w.x0[p], projected, unused);
+    project_at(p, w.x0[p], projected, unused);
     w.push[p] = projected - stepped;
     pos_[p] = projected;
   };
@@ -258,8 +258,8 @@ template <typename Real> void CpuSolver<Real>::Impl::vbd_finish(const Real h) {
     Vec3 x = pos_[p]; // where the sweeps left it: out of the colliders, friction included
     Vec3 v = kernel::vbd_velocity(x, w.push[p], x0, h);
     Vec3 no_force(0);
-    contact_at(x, v, no_force, h / mass_[p], false); // friction acted in the sweeps
-    project_at(x0, x, v);
+    contact_at(p, x, v, no_force, h / mass_[p], false); // friction acted in the sweeps
+    project_at(p, x0, x, v);
     force_[p] = kernel::vbd_net_force(v, vel_[p], mass_[p], h);
     pos_[p] = x;
     vel_[p] = v;

@@ -4,6 +4,7 @@
 #include "solver_batch.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -72,7 +73,7 @@ Result<void> SolverBatch::ensure_mesh_buffers() {
       if (c.mesh && std::find(wanted.begin(), wanted.end(), c.mesh) == wanted.end())
         wanted.push_back(c.mesh);
   if (mesh_nodes.buffer && wanted == meshes)
-    return {};
+    return ensure_mesh_cache();
   std::vector<ColliderMesh::Node> nodes;
   std::vector<ColliderMesh::Triangle> tris;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> starts;
@@ -124,18 +125,46 @@ Result<void> SolverBatch::ensure_mesh_buffers() {
   VKCLOTH_TRY(create_buffer_views());
   if (sets[0][0])
     VKCLOTH_TRY(write_sets());
+  return ensure_mesh_cache();
+}
+
+// The particles' search entries for the instances' mesh colliders: a new, emptied buffer when the
+// meshes the entries were found on change (entries only save searches: emptied, they change no result).
+Result<void> SolverBatch::ensure_mesh_cache() {
+  std::vector<std::vector<const ColliderMesh*>> key;
+  std::size_t most = 0;
+  for (const Slot& slot : slots) {
+    std::vector<const ColliderMesh*> m;
+    for (const Collider& c : slot.params.colliders)
+      if (c.type == Collider::Type::mesh)
+        m.push_back(c.mesh.get());
+    most = std::max(most, m.size());
+    key.push_back(std::move(m));
+  }
+  if (key == mesh_cache_key || most == 0) {
+    mesh_cache_key = std::move(key);
+    return {};
+  }
+  VKCLOTH_TRY(replace_state_buffer(mesh_cache, std::uint64_t(most) * size() * count, 2 * sizeof(sh::vec4),
+                                   "mesh collider search entries"));
+  mesh_cache_key = std::move(key);
+  mesh_cache_clear = true;
   return {};
 }
 
 // Each collider as the kernel takes it (kernel_shape<float>: CpuSolver<float>'s conversion).
 std::vector<sh::Collider> SolverBatch::packed_colliders() const {
   std::vector<sh::Collider> out;
-  for (const Slot& slot : slots)
+  for (const Slot& slot : slots) {
+    std::uint32_t mesh_ordinal = 0;
     for (const Collider& c : slot.params.colliders) {
       std::pair<std::uint32_t, std::uint32_t> start{0, 0};
+      std::uint32_t cache = 0;
       if (c.mesh)
         start = mesh_starts[std::size_t(std::find(meshes.begin(), meshes.end(), c.mesh) - meshes.begin())];
-      const auto k = kernel::kernel_shape<float>(c, start.first, start.second);
+      if (c.type == Collider::Type::mesh)
+        cache = mesh_ordinal++ * size() * count;
+      const auto k = kernel::kernel_shape<float>(c, start.first, start.second, cache);
       const auto v4 = [](glm::vec3 v, float w) { return sh::vec4{v.x, v.y, v.z, w}; };
       sh::Collider g{};
       g.shape = v4(k.a, k.b);
@@ -149,9 +178,10 @@ std::vector<sh::Collider> SolverBatch::packed_colliders() const {
       g.axis_z = v4(k.az, 0.0f);
       g.velocity = v4(k.velocity, k.mu_k);
       g.spin = v4(k.spin, k.mu_s);
-      g.pivot = v4(k.pivot, 0.0f);
+      g.pivot = v4(k.pivot, std::bit_cast<float>(k.mesh_cache));
       out.push_back(g);
     }
+  }
   return out;
 }
 
@@ -399,6 +429,8 @@ Result<void> SolverBatch::replace_state_buffer(Buffer& dst, std::uint64_t entrie
   if (!b)
     return b.error();
   dst = std::move(*b);
+  if (!sets[0][0]) // creation: the sets are written once they exist
+    return {};
   return write_sets();
 }
 

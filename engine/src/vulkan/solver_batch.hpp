@@ -278,6 +278,14 @@ private:
   Buffer mesh_nodes, mesh_tris;
   std::vector<std::shared_ptr<const ColliderMesh>> meshes;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> mesh_starts;
+  // VKCLOTH_BINDING_MESH_CACHE: each particle's search entry (2 vec4) per mesh collider of its
+  // instance, the k-th mesh collider's entries for every particle of the batch at k x size() x count
+  // (Collider::pivot.w); one element while no instance has a mesh collider. `mesh_cache_key`: each
+  // instance's mesh colliders' meshes, for which the entries were found (other meshes: emptied, by
+  // a fill record() records first while `mesh_cache_clear`).
+  Buffer mesh_cache;
+  std::vector<std::vector<const ColliderMesh*>> mesh_cache_key;
+  bool mesh_cache_clear = false;
   bool params_dirty = false; // set_params() since the last record(): record_params_update() due
 
   // Layouts and pipelines: the Context's (PipelineRegistry, pipelines.hpp), shared by every batch.
@@ -337,6 +345,7 @@ private:
   void record_targets(VkCommandBuffer cmd, std::uint32_t k);
   Result<void> ensure_frames();
   /// ensure_targets' and ensure_frames' replacement of a zeroed element by the real buffer.
+  Result<void> ensure_mesh_cache();
   Result<void> replace_state_buffer(Buffer& dst, std::uint64_t entries, VkDeviceSize stride,
                                     const char* what);
   /// Before substep k: each instance's frame step (`before`: its frame collider at the substep's

@@ -184,6 +184,7 @@ Result<void> SolverBatch::create_buffers() {
       {&vbd_order, std::max<VkDeviceSize>(n * sizeof(std::uint32_t), 16), "vbd colour order"},
       {&targets, sizeof(sh::Target), "targets (none yet)"},
       {&frames, sizeof(sh::FrameMotion), "frames (none yet)"},
+      {&mesh_cache, 2 * sizeof(sh::vec4), "mesh collider search entries (none yet)"},
       // GpuSolverOptions::interleaved_vertices: one Vertex (32 bytes) per particle; else one.
       {&vertices, options.interleaved_vertices ? VkDeviceSize(size()) * n * sizeof(sh::Vertex) : 32,
        "interleaved vertices"}};

@@ -124,6 +124,10 @@ void SolverBatch::record(VkCommandBuffer c, std::uint32_t steps) {
   if (steps == 0)
     return;
   record_params_update(c);
+  if (mesh_cache_clear) { // a new buffer of search entries: every entry empty (radius 0)
+    vk().vkCmdFillBuffer(c, mesh_cache.buffer, 0, VK_WHOLE_SIZE, 0);
+    mesh_cache_clear = false;
+  }
   barriers::before_steps(vk(), c);
   bool first = true;
   for (std::uint32_t s = 0; s < steps; ++s) {

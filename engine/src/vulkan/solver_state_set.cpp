@@ -253,6 +253,7 @@ Result<void> SolverBatch::write_sets() {
       by_binding[VKCLOTH_BINDING_VBD_ORDER] = &vbd_order;
       by_binding[VKCLOTH_BINDING_TARGETS] = &targets;
       by_binding[VKCLOTH_BINDING_FRAMES] = &frames;
+      by_binding[VKCLOTH_BINDING_MESH_CACHE] = &mesh_cache;
       for (std::uint32_t b = 0; b < VKCLOTH_BINDING_COUNT; ++b, ++k) {
         infos[k] = VkDescriptorBufferInfo{by_binding[b]->buffer, 0, VK_WHOLE_SIZE};
         writes[k] = VkWriteDescriptorSet{};
@@ -283,7 +284,8 @@ ImplicitInputs SolverBatch::implicit_inputs() const {
           flags.buffer,
           instances.buffer,
           mesh_nodes.buffer,
-          mesh_tris.buffer};
+          mesh_tris.buffer,
+          mesh_cache.buffer};
 }
 
 } // namespace vkcloth::gpu

@@ -158,6 +158,8 @@ Result<void> ImplicitGpu::write_sets(const ImplicitInputs& in) {
                         return in.mesh_nodes;
                       case VKCLOTH_BINDING_MESH_TRIS:
                         return in.mesh_tris;
+                      case VKCLOTH_BINDING_MESH_CACHE:
+                        return in.mesh_cache;
                       case VKCLOTH_BINDING_IMPL_VF:
                         return vf_.buffer;
                       case VKCLOTH_BINDING_IMPL_KS:

@@ -33,7 +33,7 @@ namespace vkcloth::gpu {
 /// implicit passes run batches of one instance (the CG reductions are per instance).
 struct ImplicitInputs {
   VkBuffer pos[2], vel, force, normal, particle, offsets, edges, colliders, flags, instances, mesh_nodes,
-      mesh_tris;
+      mesh_tris, mesh_cache;
 };
 
 class ImplicitGpu {
