@@ -336,9 +336,9 @@ void main() {
   for (uint c = 0u; c < ip.collider_count; ++c) {
     const ColliderShape s = collider_shape(c);
     float dist;
-    vec3 n;
-    collider_contact(base + p, s, x0, x0, ip.band, dist, n);
-    contact_response(v, removed, s, x0, n, dist, ip.band, both, h_over_m);
+    vec3 n, deform;
+    collider_contact(base + p, s, x0, x0, ip.band, dist, n, deform);
+    contact_response(v, removed, s, x0, n, dist, ip.band, both, h_over_m, deform);
   }
   precise vec3 x = x0 + v * h;
   finish(p, false, x0, x, v);

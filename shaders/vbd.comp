@@ -93,9 +93,9 @@ void finish_step(uint p, uint g, bool pinned) {
   for (uint c = 0u; c < (SC_COLLIDERS ? ip.collider_count : 0u); ++c) {
     ColliderShape s = without_friction(collider_shape(c)); // friction acted in the sweeps
     float dist;
-    vec3 n;
-    collider_contact(g, s, x, x, ip.band, dist, n);
-    contact_response(v, no_force, s, x, n, dist, ip.band, both, h_over_m);
+    vec3 n, deform;
+    collider_contact(g, s, x, x, ip.band, dist, n, deform);
+    contact_response(v, no_force, s, x, n, dist, ip.band, both, h_over_m, deform);
   }
   force_out[g] = vec4(vbd_net_force(v, v0, m, h), 0.0);
   finish(p, false, x0, x, v);

@@ -78,8 +78,8 @@ double distance_to(const Collider& c, glm::dvec3 p) {
     md.triangles = c.mesh->triangles().data();
   }
   double d;
-  glm::dvec3 n;
-  kernel::collider_contact(md, kernel::kernel_shape<double>(c), p, p, 1.0, d, n);
+  glm::dvec3 n, deform;
+  kernel::collider_contact(md, kernel::kernel_shape<double>(c), p, p, 1.0, d, n, deform);
   return d;
 }
 

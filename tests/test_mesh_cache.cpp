@@ -93,9 +93,9 @@ Walked walk(const std::shared_ptr<const ColliderMesh>& mesh, glm::dvec3 centre, 
       for (Real reach : {Real(2e-3), Real(0.012)}) {
         const std::vector<Real> before(entries.begin() + 8 * p, entries.begin() + 8 * p + 8);
         Real d_cached, d_searched;
-        V n_cached, n_searched;
-        kernel::collider_contact(cached, shape, V(world), V(world), reach, d_cached, n_cached);
-        kernel::collider_contact(searching, shape, V(world), V(world), reach, d_searched, n_searched);
+        V n_cached, n_searched, deform;
+        kernel::collider_contact(cached, shape, V(world), V(world), reach, d_cached, n_cached, deform);
+        kernel::collider_contact(searching, shape, V(world), V(world), reach, d_searched, n_searched, deform);
         ++w.queries;
         w.searches += !std::equal(before.begin(), before.end(), entries.begin() + 8 * p);
         w.differences += d_cached != d_searched || n_cached != n_searched;

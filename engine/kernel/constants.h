@@ -47,6 +47,8 @@
 #define VKCLOTH_COLLIDER_CAPSULE 2u
 #define VKCLOTH_COLLIDER_BOX 3u
 #define VKCLOTH_COLLIDER_MESH 4u
+// No triangle (a mesh search that found none; a mesh collider without corner velocities).
+#define VKCLOTH_MESH_NONE 0xffffffffu
 #define VKCLOTH_COLLIDER_ALL_TYPES 0x1fu // bit t for every type t above (SC_COLLIDER_TYPES)
 
 // Self-collision's buckets per workgroup of the GPU's SCAN_BLOCKS pass (64 invocations x 8): the

@@ -84,6 +84,23 @@ KFN void mesh_face_contact(ColliderShape s, vec3 n, vec3 a, vec3 q, vec3 p_side,
   normal = select(found, to_world_dir(s, n * side), vec3(real(0), real(0), real(1)));
 }
 
+// A skinned mesh's surface velocity at point p of triangle (a, b, c) whose corners move at va, vb, vc
+// (barycentric interpolation, Ericson 3.4; a degenerate triangle: their mean), in the world.
+KFN precise vec3 triangle_velocity(ColliderShape s, vec3 p, vec3 a, vec3 b, vec3 c, vec3 va, vec3 vb,
+                                   vec3 vc) {
+  precise vec3 e0 = b - a, e1 = c - a, e2 = p - a;
+  precise real d00 = dot3(e0, e0), d01 = dot3(e0, e1), d11 = dot3(e1, e1);
+  precise real d20 = dot3(e2, e0), d21 = dot3(e2, e1);
+  precise real denom = d00 * d11 - d01 * d01;
+  VARYING(bool) proper = denom > real(0);
+  precise real safe = select(proper, denom, real(1));
+  precise real v = select(proper, (d11 * d20 - d01 * d21) / safe, real(1) / real(3));
+  precise real w = select(proper, (d00 * d21 - d01 * d20) / safe, real(1) / real(3));
+  precise vec3 vel = va * (real(1) - v - w) + vb * v;
+  vel = vel + vc * w;
+  return to_world_dir(s, vel);
+}
+
 // The search of the hierarchy and the entry it leaves. A bridge that cannot run it (the CPU's SIMD
 // lanes, which call the scalar mesh_contact lane by lane where their entries miss) defines
 // VKCLOTH_KERNEL_NO_MESH.
@@ -136,7 +153,6 @@ KFN precise vec3 closest_on_triangle(vec3 p, vec3 a, vec3 b, vec3 c) {
 // found). The including file provides mesh_node(MESH_DATA, i, lo, first, hi, count) and
 // mesh_triangle(MESH_DATA, i, a, b, c) (vkcloth::ColliderMesh's Node and Triangle); MESH_DATA_PARAM
 // declares MESH_DATA.
-#define VKCLOTH_MESH_NONE 0xffffffffu
 #define VKCLOTH_MESH_STACK 32
 KFN precise real box_gap2(vec3 lo, vec3 hi, vec3 q) {
   precise vec3 gap = max(max(lo - q, q - hi), vec3(real(0)));
@@ -218,14 +234,28 @@ KFN void triangle_contact(ColliderShape s, vec3 a, vec3 b, vec3 c, vec3 q, vec3 
   normal = to_world_dir(s, nb);
 }
 
+// A skinned mesh's surface velocity at point p of its triangle t (a, b, c); zero for a rigid mesh. The
+// including file provides mesh_velocity(MESH_DATA, i, va, vb, vc) (ColliderMesh::triangle_velocities).
+KFN void mesh_deformation(MESH_DATA_PARAM, ColliderShape s, uint t, vec3 p, vec3 a, vec3 b, vec3 c,
+                          OUT(vec3) deform) {
+  deform = vec3(real(0));
+  if (!deforming(s))
+    return;
+  vec3 va, vb, vc;
+  mesh_velocity(MESH_DATA, s.mesh_vel0 + (t - s.mesh_tri0), va, vb, vc);
+  deform = triangle_velocity(s, p, a, b, c, va, vb, vc);
+}
+
 // collider_contact for a mesh collider, q = p in its body frame (to_body). The particle's entry
 // answers where it can; otherwise the search answers and leaves a new entry (slot:
 // ColliderShape::mesh_cache; the bridge adds the particle): a face entry where the nearest point
 // lies inside a face within twice the reach, else an empty one.
+// A skinned mesh: `deform`, the surface's velocity at the nearest point from its corners' (zero otherwise).
 KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_side, real reach,
-                               OUT(real) distance, OUT(vec3) normal) {
+                               OUT(real) distance, OUT(vec3) normal, OUT(vec3) deform) {
   distance = reach;
   normal = vec3(real(0), real(0), real(1));
+  deform = vec3(real(0));
   if (!VKCLOTH_COLLIDER_PRESENT(VKCLOTH_COLLIDER_MESH))
     return;
   precise real reach_total = s.b + reach;
@@ -239,6 +269,7 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
     mesh_triangle(MESH_DATA, t, a, b, c);
   if (mesh_cache_hit(n, centre, radius, a, b, c, q, reach_total)) {
     mesh_face_contact(s, n, a, q, p_side, reach, distance, normal);
+    mesh_deformation(MESH_DATA, s, t, q - n * (dot3(q, n) - dot3(a, n)), a, b, c, deform);
     return;
   }
   precise real guard = mesh_guard(q);
@@ -258,12 +289,15 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
                                      dot3(a, m), guard, unused);
     mesh_cache_store(MESH_DATA, s.mesh_cache, m, t, q, (sqrt(next) - d1) * real(0.5) - guard);
     mesh_face_contact(s, m, a, q, p_side, reach, distance, normal);
+    mesh_deformation(MESH_DATA, s, t, q - m * (dot3(q, m) - dot3(a, m)), a, b, c, deform);
     return;
   }
   // Far, or on an edge or a corner: no triangle nearer than d1.
   mesh_cache_store(MESH_DATA, s.mesh_cache, vec3(real(0)), 0u, q, d1 - guard);
-  if (best < reach_total * reach_total)
+  if (best < reach_total * reach_total) {
     triangle_contact(s, a, b, c, q, p_side, distance, normal);
+    mesh_deformation(MESH_DATA, s, t, closest_on_triangle(q, a, b, c), a, b, c, deform);
+  }
 }
 #endif // VKCLOTH_KERNEL_NO_MESH
 
@@ -273,9 +307,11 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
 // a thin mesh within one step is still pushed back to its side (its distance: the depth below the
 // triangle's plane plus the thickness). Farther than `reach` from a mesh's shell: distance = reach
 // (no contact). Plane {n.p = offset}; sphere; capsule: the segment
-// a-c swept by the radius; box: edges and corners included.
+// a-c swept by the radius; box: edges and corners included. `deform`: a skinned mesh's surface
+// velocity at the nearest point beyond its rigid motion (zero for every other collider).
 KFN void collider_contact(MESH_DATA_PARAM, ColliderShape s, vec3 p, vec3 p_side, real reach,
-                          OUT(real) distance, OUT(vec3) normal) {
+                          OUT(real) distance, OUT(vec3) normal, OUT(vec3) deform) {
+  deform = vec3(real(0));
   if (VKCLOTH_COLLIDER_PRESENT(VKCLOTH_COLLIDER_PLANE) && s.type == VKCLOTH_COLLIDER_PLANE) {
     precise real d = dot3(s.a, p) - s.b;
     distance = d;
@@ -333,5 +369,5 @@ KFN void collider_contact(MESH_DATA_PARAM, ColliderShape s, vec3 p, vec3 p_side,
     return;
   }
   // VKCLOTH_COLLIDER_MESH
-  mesh_contact(MESH_DATA, s, q, p_side, reach, distance, normal);
+  mesh_contact(MESH_DATA, s, q, p_side, reach, distance, normal, deform);
 }

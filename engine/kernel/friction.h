@@ -46,11 +46,21 @@ KFN void coulomb_friction(INOUT(vec3) w, INOUT(vec3) f, vec3 n, real j, real mu_
   f = nf;
 }
 
+// The surface's velocity at x: the collider's rigid motion, plus a skinned mesh's `deform` there
+// (collider_contact's).
+KFN precise vec3 contact_surface_velocity(ColliderShape s, vec3 x, vec3 deform) {
+  precise vec3 vs = s.moving ? surface_velocity(s, x) : vec3(real(0));
+  if (deforming(s))
+    vs = vs + deform;
+  return vs;
+}
+
 // The contact response of one collider for particle x with velocity v and force f (mass m,
-// substep h: h_over_m = h / m): the report's filter relative to the collider's surface velocity,
-// then friction. A still, frictionless collider is exactly contact_filter (the report's model).
+// substep h: h_over_m = h / m): the report's filter relative to the collider's surface velocity
+// (`deform`: collider_contact's), then friction. A still, frictionless collider is exactly
+// contact_filter (the report's model).
 KFN void contact_response(INOUT(vec3) v, INOUT(vec3) f, ColliderShape s, vec3 x, vec3 n, real distance,
-                          real band, bool both, real h_over_m) {
+                          real band, bool both, real h_over_m, vec3 deform) {
   if (still_frictionless(s)) {
     contact_filter(v, f, n, distance, band, both);
     return;
@@ -58,7 +68,7 @@ KFN void contact_response(INOUT(vec3) v, INOUT(vec3) f, ColliderShape s, vec3 x,
   VARYING(bool) in_band = distance < band;
   if (!any_particle(in_band))
     return;
-  precise vec3 vs = s.moving ? surface_velocity(s, x) : vec3(real(0));
+  precise vec3 vs = contact_surface_velocity(s, x, deform);
   precise vec3 w = v - vs;
   vec3 g = f;
   precise real wn = dot3(w, n), fn = dot3(g, n);
@@ -72,7 +82,8 @@ KFN void contact_response(INOUT(vec3) v, INOUT(vec3) f, ColliderShape s, vec3 x,
 }
 
 // project_out once the collider's distance and normal at x are known: nothing unless distance < 0.
-KFN void project_back(ColliderShape s, real eps, real distance, vec3 n, INOUT(vec3) x, INOUT(vec3) v) {
+KFN void project_back(ColliderShape s, real eps, real distance, vec3 n, vec3 deform, INOUT(vec3) x,
+                      INOUT(vec3) v) {
   VARYING(bool) inside = distance < real(0);
   if (!any_particle(inside))
     return;
@@ -88,7 +99,7 @@ KFN void project_back(ColliderShape s, real eps, real distance, vec3 n, INOUT(ve
   if (!s.moving) {
     remove_inward(nv, n, false);
   } else {
-    precise vec3 vs = surface_velocity(s, nx);
+    precise vec3 vs = contact_surface_velocity(s, nx, deform);
     precise vec3 w = v - vs;
     remove_inward(w, n, false);
     nv = w + vs;
@@ -103,9 +114,9 @@ KFN void project_back(ColliderShape s, real eps, real distance, vec3 n, INOUT(ve
 // is found even when it ended farther than the thickness beyond.
 KFN void project_out(MESH_DATA_PARAM, ColliderShape s, real eps, vec3 p_side, INOUT(vec3) x, INOUT(vec3) v) {
   real distance;
-  vec3 n;
+  vec3 n, deform;
   precise vec3 moved = x - p_side;
   precise real reach = s.type == VKCLOTH_COLLIDER_MESH ? sqrt(dot3(moved, moved)) : real(0);
-  collider_contact(MESH_DATA, s, x, p_side, reach, distance, n);
-  project_back(s, eps, distance, n, x, v);
+  collider_contact(MESH_DATA, s, x, p_side, reach, distance, n, deform);
+  project_back(s, eps, distance, n, deform, x, v);
 }

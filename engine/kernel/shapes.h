@@ -19,7 +19,8 @@ struct ColliderShape {
   vec3 az;
   uint mesh_root; // mesh: its root node and first triangle in the mesh buffers
   uint mesh_tri0;
-  uint mesh_cache; // mesh: where its particles' MeshCacheEntry start (the bridge adds the particle)
+  uint mesh_cache; // mesh: where its particles' search entries start (the bridge adds the particle)
+  uint mesh_vel0;  // mesh: its first triangle's corner velocities (VKCLOTH_MESH_NONE: a rigid mesh)
   bool moving;     // the surface moves: velocity, spin and pivot apply
   vec3 velocity;   // linear velocity
   vec3 spin;       // angular velocity about pivot
@@ -32,6 +33,11 @@ struct ColliderShape {
 // (contact_response).
 KFN bool still_frictionless(ColliderShape s) {
   return !s.moving && s.mu_s == real(0) && s.mu_k == real(0);
+}
+
+// A skinned mesh: its triangles' corners move (per-corner velocities; it counts as moving).
+KFN bool deforming(ColliderShape s) {
+  return s.mesh_vel0 != VKCLOTH_MESH_NONE;
 }
 
 // A collider with Coulomb friction.

@@ -57,9 +57,9 @@ KFN void vbd_friction(INOUT(vec3) stepped, MESH_DATA_PARAM, ColliderShape s, vec
   if (!has_friction(s))
     return;
   real distance;
-  vec3 n;
-  collider_contact(MESH_DATA, s, x, x, band, distance, n);
-  precise vec3 vs = s.moving ? surface_velocity(s, x) : vec3(real(0));
+  vec3 n, deform;
+  collider_contact(MESH_DATA, s, x, x, band, distance, n, deform);
+  precise vec3 vs = contact_surface_velocity(s, x, deform);
   precise vec3 u = (stepped - x0) - vs * h;
   precise real un = dot3(u, n);
   VARYING(bool) touching = distance < band && un < real(0);

@@ -119,6 +119,12 @@ void mesh_triangle(uint particle, uint i, out vec3 a, out vec3 b, out vec3 c) {
   c = t.c.xyz;
 }
 layout(std430, set = 0, binding = VKCLOTH_BINDING_MESH_CACHE) buffer MeshCacheBuf { vec4 mesh_entries[]; };
+void mesh_velocity(uint particle, uint i, out vec3 va, out vec3 vb, out vec3 vc) {
+  const MeshTriangle t = read_mesh_triangle(i); // a skinned mesh's velocities follow the triangles
+  va = t.a.xyz;
+  vb = t.b.xyz;
+  vc = t.c.xyz;
+}
 void mesh_cache_load(uint particle, uint slot, out vec3 n, out uint tri, out vec3 centre, out float radius) {
   const uint i = 2u * (slot + particle);
   const vec4 a = mesh_entries[i];
@@ -150,6 +156,7 @@ ColliderShape collider_shape(uint c) {
   s.mesh_root = col.mesh_root;
   s.mesh_tri0 = col.mesh_tri0;
   s.mesh_cache = floatBitsToUint(col.pivot.w);
+  s.mesh_vel0 = floatBitsToUint(col.end_b.w);
   s.moving = col.moving != 0u;
   s.velocity = col.velocity.xyz;
   s.spin = col.spin.xyz;

@@ -211,9 +211,9 @@ void particle_force(uint p, inout vec3 v_io, out vec3 f_out, out vec3 nrm_out) {
       s.mu_s = 0.0;
 #endif
       float dist;
-      vec3 n;
-      collider_contact(base + p, s, x, x, ip.band, dist, n);
-      contact_response(v, f, s, x, n, dist, ip.band, both, h_over_m);
+      vec3 n, deform;
+      collider_contact(base + p, s, x, x, ip.band, dist, n, deform);
+      contact_response(v, f, s, x, n, dist, ip.band, both, h_over_m, deform);
     }
   }
 #ifdef VKCLOTH_FRICTION_AFTER_SOLVE

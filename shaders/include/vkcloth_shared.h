@@ -249,7 +249,8 @@ struct Collider {
   uint moving;    // 1: velocity, spin and pivot apply
   uint mesh_root; // mesh: its root in MESH_NODES
   uint mesh_tri0; // mesh: its first triangle in MESH_TRIS
-  vec4 end_b;     // capsule: (b, 0); box: (half extents, 0)
+  vec4 end_b;     // capsule: (b, 0); box: (half extents, 0); mesh: w: the bits of its first corner
+                  // velocities in MESH_TRIS (VKCLOTH_MESH_NONE: rigid)
   vec4 axis_x;    // box, mesh: the body's axes in the world (the rotation's columns)
   vec4 axis_y;
   vec4 axis_z;

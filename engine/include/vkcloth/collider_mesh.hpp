@@ -54,6 +54,16 @@ public:
   static Result<std::shared_ptr<const ColliderMesh>> from_mesh(const Mesh& mesh, double scale,
                                                                std::string name);
 
+  /// A skinned mesh's next pose: the same triangles over new vertex `positions` (the create() /
+  /// from_mesh() vertices, in their order, metres, the mesh's own frame), the hierarchy refitted
+  /// (the same nodes, their boxes recomputed; not rebuilt), and each triangle corner's velocity
+  /// (new - old) / dt, which the contact's friction carries (triangle_velocities()). Hand it to the
+  /// solver in the collider (Collider::mesh, then set_params) once per frame; `dt` is the time
+  /// from this pose to the new one. ErrorCode::invalid_argument, naming the mesh and the value, for
+  /// a vertex count other than vertex_count(), a vertex that is not finite, or dt not > 0.
+  Result<std::shared_ptr<const ColliderMesh>> deformed(std::span<const glm::dvec3> positions,
+                                                       double dt) const;
+
   std::span<const Node> nodes() const { return nodes_; }
   /// In leaf order (Node::first indexes this).
   std::span<const Triangle> triangles() const { return triangles_; }
@@ -63,10 +73,18 @@ public:
   std::uint32_t depth() const { return depth_; }
   /// Zero-area triangles create() dropped.
   std::uint32_t dropped_triangles() const { return dropped_; }
+  /// The vertices create() was given (deformed() takes as many).
+  std::uint32_t vertex_count() const { return static_cast<std::uint32_t>(positions_.size()); }
+  /// Per triangle (leaf order), its corners' velocities in Triangle's layout (a, b, c); empty for a
+  /// mesh that never moved (create(), from_mesh()).
+  std::span<const Triangle> triangle_velocities() const { return velocities_; }
 
 private:
   std::vector<Node> nodes_;
   std::vector<Triangle> triangles_;
+  std::vector<Triangle> velocities_;
+  std::vector<std::uint32_t> corners_; // per triangle (leaf order): its three vertices
+  std::vector<glm::vec3> positions_;   // the vertices, rounded to float
   std::string name_;
   std::uint32_t depth_ = 0;
   std::uint32_t dropped_ = 0;

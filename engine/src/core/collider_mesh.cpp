@@ -18,6 +18,7 @@ namespace {
 
 struct Builder {
   std::vector<ColliderMesh::Triangle> tris;
+  std::vector<std::uint32_t> corners; // per triangle: its vertices
   std::vector<glm::vec3> centroid;
   std::vector<std::uint32_t> order;
   std::vector<ColliderMesh::Node> nodes;
@@ -80,18 +81,21 @@ Result<std::shared_ptr<const ColliderMesh>> ColliderMesh::create(std::span<const
   std::uint32_t dropped = 0;
   for (std::size_t t = 0; t + 2 < triangles.size(); t += 3) {
     glm::vec3 corner[3];
+    std::uint32_t vertex[3];
     for (int k = 0; k < 3; ++k) {
       const std::uint32_t i = triangles[t + std::size_t(k)];
       if (i >= positions.size())
         return bad(name, fmt::format("triangle {} uses vertex {} but there are {} vertices", t / 3, i,
                                      positions.size()));
       corner[k] = glm::vec3(positions[i]);
+      vertex[k] = i;
     }
     if (glm::length(glm::cross(corner[1] - corner[0], corner[2] - corner[0])) == 0.0f) {
       ++dropped; // no normal, no area: nothing to collide with
       continue;
     }
     b.tris.push_back({corner[0], 0.0f, corner[1], 0.0f, corner[2], 0.0f});
+    b.corners.insert(b.corners.end(), vertex, vertex + 3);
     b.centroid.push_back((corner[0] + corner[1] + corner[2]) / 3.0f);
   }
   if (b.tris.empty())
@@ -106,12 +110,64 @@ Result<std::shared_ptr<const ColliderMesh>> ColliderMesh::create(std::span<const
   b.build(0, 0, static_cast<std::uint32_t>(b.tris.size()), 1);
   auto mesh = std::make_shared<ColliderMesh>();
   mesh->triangles_.reserve(b.tris.size());
-  for (const std::uint32_t i : b.order)
+  for (const std::uint32_t i : b.order) {
     mesh->triangles_.push_back(b.tris[i]);
+    mesh->corners_.insert(mesh->corners_.end(), b.corners.begin() + 3 * i, b.corners.begin() + 3 * i + 3);
+  }
+  for (const glm::dvec3& p : positions)
+    mesh->positions_.emplace_back(p);
   mesh->nodes_ = std::move(b.nodes);
   mesh->name_ = std::move(name);
   mesh->depth_ = b.depth;
   mesh->dropped_ = dropped;
+  return std::shared_ptr<const ColliderMesh>(std::move(mesh));
+}
+
+Result<std::shared_ptr<const ColliderMesh>> ColliderMesh::deformed(std::span<const glm::dvec3> positions,
+                                                                   double dt) const {
+  if (positions.size() != positions_.size())
+    return bad(name_, fmt::format("the skinned update has {} vertices, but the mesh has {}", positions.size(),
+                                  positions_.size()));
+  if (!std::isfinite(dt) || dt <= 0.0)
+    return bad(name_, fmt::format("the skinned update's dt must be finite and > 0, got {}", dt));
+  for (std::size_t v = 0; v < positions.size(); ++v)
+    for (int k = 0; k < 3; ++k)
+      if (!std::isfinite(positions[v][k]))
+        return bad(name_, fmt::format("skinned vertex {} is not finite ({}, {}, {})", v, positions[v].x,
+                                      positions[v].y, positions[v].z));
+  auto mesh = std::make_shared<ColliderMesh>(*this);
+  for (std::size_t v = 0; v < positions.size(); ++v)
+    mesh->positions_[v] = glm::vec3(positions[v]);
+  const float inv_dt = float(1.0 / dt);
+  mesh->velocities_.resize(triangles_.size());
+  for (std::size_t t = 0; t < triangles_.size(); ++t) {
+    glm::vec3 now[3], vel[3];
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t v = corners_[3 * t + std::size_t(k)];
+      now[k] = mesh->positions_[v];
+      vel[k] = (now[k] - positions_[v]) * inv_dt;
+    }
+    mesh->triangles_[t] = {now[0], 0.0f, now[1], 0.0f, now[2], 0.0f};
+    mesh->velocities_[t] = {vel[0], 0.0f, vel[1], 0.0f, vel[2], 0.0f};
+  }
+  // Refit: children follow their parent in nodes_, so one backward pass sees every child first.
+  for (std::size_t i = mesh->nodes_.size(); i-- > 0;) {
+    Node& n = mesh->nodes_[i];
+    glm::vec3 lo(INFINITY), hi(-INFINITY);
+    if (n.count > 0)
+      for (std::uint32_t t = n.first; t < n.first + n.count; ++t) {
+        const Triangle& tri = mesh->triangles_[t];
+        lo = glm::min(glm::min(lo, tri.a), glm::min(tri.b, tri.c));
+        hi = glm::max(glm::max(hi, tri.a), glm::max(tri.b, tri.c));
+      }
+    else
+      for (std::uint32_t c = n.first; c < n.first + 2; ++c) {
+        lo = glm::min(lo, mesh->nodes_[c].lo);
+        hi = glm::max(hi, mesh->nodes_[c].hi);
+      }
+    n.lo = lo;
+    n.hi = hi;
+  }
   return std::shared_ptr<const ColliderMesh>(std::move(mesh));
 }
 

@@ -231,6 +231,8 @@ template <typename Real> void CpuSolver<Real>::Impl::prepare_colliders() {
       m.nodes = c.mesh->nodes().data();
       m.triangles = c.mesh->triangles().data();
       m.cache = mesh_cache_.data();
+      if (!c.mesh->triangle_velocities().empty())
+        m.velocities = c.mesh->triangle_velocities().data();
       cache = mesh_ordinal++ * std::uint32_t(pos_.size());
     }
     shapes.push_back(kernel::kernel_shape<Real>(c, 0, 0, cache));
@@ -281,9 +283,9 @@ void CpuSolver<Real>::Impl::contact_at(std::size_t p, Vec3 pos, Vec3& vel, Vec3&
   for (std::size_t k = 0; k < shapes.size(); ++k) {
     const kernel::ColliderShape<Real> s = friction ? shapes[k] : kernel::without_friction(shapes[k]);
     Real distance;
-    Vec3 normal;
-    kernel::collider_contact(mesh_of(k, p), s, pos, pos, band, distance, normal);
-    kernel::contact_response(vel, force, s, pos, normal, distance, band, both, h_over_m);
+    Vec3 normal, deform;
+    kernel::collider_contact(mesh_of(k, p), s, pos, pos, band, distance, normal, deform);
+    kernel::contact_response(vel, force, s, pos, normal, distance, band, both, h_over_m, deform);
   }
 }
 

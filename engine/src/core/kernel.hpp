@@ -74,6 +74,7 @@ struct MeshData {
   const ColliderMesh::Triangle* triangles = nullptr;
   void* cache = nullptr;
   std::uint32_t particle = 0;
+  const ColliderMesh::Triangle* velocities = nullptr; ///< a skinned mesh's corner velocities
 };
 template <typename V> void mesh_node(const MeshData& m, uint i, V& lo, uint& first, V& hi, uint& count) {
   const ColliderMesh::Node& n = m.nodes[i];
@@ -104,6 +105,12 @@ template <typename R> uint mesh_cache_uint(R w) {
 }
 template <typename R> R* mesh_cache_entry(const MeshData& m, uint slot) {
   return static_cast<R*>(m.cache) + 8 * (std::size_t(slot) + m.particle);
+}
+template <typename V> void mesh_velocity(const MeshData& m, uint i, V& va, V& vb, V& vc) {
+  const ColliderMesh::Triangle& t = m.velocities[i];
+  va = V(t.a);
+  vb = V(t.b);
+  vc = V(t.c);
 }
 template <typename V, typename R>
 void mesh_cache_load(const MeshData& m, uint slot, V& n, uint& tri, V& centre, R& radius) {
@@ -205,10 +212,12 @@ using ColliderShape = std::conditional_t<std::is_same_v<Real, float>, f32::Colli
 /// both backends use (CpuSolver; the GPU solver packs kernel_shape<float> into its Collider
 /// buffer), so the CPU float solver and the GPU see the same values. mesh_root / mesh_tri0: where
 /// the collider's mesh starts in the buffers the caller walks (0 when it walks the mesh in place);
-/// mesh_cache: where its particles' search entries start.
+/// mesh_cache: where its particles' search entries start; mesh_vel0: where a skinned mesh's corner
+/// velocities start (ignored for a rigid mesh, whose shape gets VKCLOTH_MESH_NONE).
 template <typename Real>
 kernel::ColliderShape<Real> kernel_shape(const Collider& c, std::uint32_t mesh_root = 0,
-                                         std::uint32_t mesh_tri0 = 0, std::uint32_t mesh_cache = 0) {
+                                         std::uint32_t mesh_tri0 = 0, std::uint32_t mesh_cache = 0,
+                                         std::uint32_t mesh_vel0 = 0) {
   using V = glm::vec<3, Real>;
   kernel::ColliderShape<Real> s{};
   s.type = std::uint32_t(c.type);
@@ -241,7 +250,9 @@ kernel::ColliderShape<Real> kernel_shape(const Collider& c, std::uint32_t mesh_r
   s.mesh_root = mesh_root;
   s.mesh_tri0 = mesh_tri0;
   s.mesh_cache = mesh_cache;
-  s.moving = c.moving();
+  const bool skinned = c.type == Collider::Type::mesh && c.mesh && !c.mesh->triangle_velocities().empty();
+  s.mesh_vel0 = skinned ? mesh_vel0 : VKCLOTH_MESH_NONE;
+  s.moving = c.moving() || skinned;
   s.velocity = V(c.linear_velocity);
   s.spin = V(c.angular_velocity);
   s.pivot = V(c.centre());

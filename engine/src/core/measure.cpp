@@ -61,13 +61,15 @@ Result<PenetrationStats> penetration(const ParticleSystem& system, std::span<con
     if (colliders[c].mesh) {
       mesh.nodes = colliders[c].mesh->nodes().data();
       mesh.triangles = colliders[c].mesh->triangles().data();
+      if (!colliders[c].mesh->triangle_velocities().empty())
+        mesh.velocities = colliders[c].mesh->triangle_velocities().data();
     }
     for (std::uint32_t p = 0; p < positions.size(); ++p) {
       if (system.particles[p].pinned)
         continue;
       double distance;
-      glm::dvec3 normal;
-      kernel::collider_contact(mesh, shape, positions[p], positions[p], 1.0, distance, normal);
+      glm::dvec3 normal, deform;
+      kernel::collider_contact(mesh, shape, positions[p], positions[p], 1.0, distance, normal, deform);
       if (-distance > stats.depth)
         stats = {-distance, p, c};
     }

@@ -405,6 +405,7 @@ VKCLOTH_AI typename ShapeOf<T>::type lane_shape(const vkcloth::detail::FinishSha
   s.pivot = u3(f.pivot);
   s.mu_k = f.mu_k;
   s.mu_s = f.mu_s;
+  s.mesh_vel0 = f.scalar->mesh_vel0;
   return s;
 }
 
@@ -448,9 +449,9 @@ std::int64_t simd_finish(const vkcloth::detail::FinishArgs<typename T::Real>& a,
     for (std::uint32_t k = 0; k < shape_count; ++k) { // contact_at
       const S& s = shapes[k];
       L distance;
-      L3 n;
-      collider_contact(lane_mesh<T>(a.shapes[k], std::uint32_t(q)), s, x0, x0, band, distance, n);
-      contact_response(v, f, s, x0, n, distance, band, both, h_over_m);
+      L3 n, deform;
+      collider_contact(lane_mesh<T>(a.shapes[k], std::uint32_t(q)), s, x0, x0, band, distance, n, deform);
+      contact_response(v, f, s, x0, n, distance, band, both, h_over_m, deform);
     }
     L3 x = x0;
     euler_update(semi, x, v, f, m, dt);
@@ -631,9 +632,9 @@ std::int64_t simd_vbd_finish(const vkcloth::detail::VbdFinishArgs<typename T::Re
     for (std::uint32_t c = 0; c < a.shape_count; ++c) { // contact_at without friction
       const S s = without_friction(shapes[c]);
       L distance;
-      L3 n;
-      collider_contact(lane_mesh<T>(a.shapes[c], std::uint32_t(q)), s, x, x, band, distance, n);
-      contact_response(v, no_force, s, x, n, distance, band, a.both, h_over_m);
+      L3 n, deform;
+      collider_contact(lane_mesh<T>(a.shapes[c], std::uint32_t(q)), s, x, x, band, distance, n, deform);
+      contact_response(v, no_force, s, x, n, distance, band, a.both, h_over_m, deform);
     }
     for (std::uint32_t c = 0; c < a.shape_count; ++c) // project_at
       project_out(lane_mesh<T>(a.shapes[c], std::uint32_t(q)), shapes[c], eps, x0, x, v);

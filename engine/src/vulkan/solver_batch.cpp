@@ -76,14 +76,30 @@ Result<void> SolverBatch::ensure_mesh_buffers() {
     return ensure_mesh_cache();
   std::vector<ColliderMesh::Node> nodes;
   std::vector<ColliderMesh::Triangle> tris;
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> starts;
+  std::vector<std::array<std::uint32_t, 3>> starts;
   for (const auto& m : wanted) {
-    starts.emplace_back(static_cast<std::uint32_t>(nodes.size()), static_cast<std::uint32_t>(tris.size()));
+    starts.push_back({static_cast<std::uint32_t>(nodes.size()), static_cast<std::uint32_t>(tris.size()),
+                      VKCLOTH_MESH_NONE});
     nodes.insert(nodes.end(), m->nodes().begin(), m->nodes().end());
     tris.insert(tris.end(), m->triangles().begin(), m->triangles().end());
   }
+  for (std::size_t k = 0; k < wanted.size(); ++k) // a skinned mesh's corner velocities, after them all
+    if (!wanted[k]->triangle_velocities().empty()) {
+      starts[k][2] = static_cast<std::uint32_t>(tris.size());
+      tris.insert(tris.end(), wanted[k]->triangle_velocities().begin(),
+                  wanted[k]->triangle_velocities().end());
+    }
   static_assert(sizeof(ColliderMesh::Node) == sizeof(sh::MeshNode) &&
                 sizeof(ColliderMesh::Triangle) == sizeof(sh::MeshTriangle));
+  if (mesh_nodes.buffer && nodes.size() == mesh_node_count && tris.size() == mesh_tri_count) {
+    // The same counts (a skinned mesh's next pose): recorded into the buffers, no wait.
+    mesh_nodes_pending = std::move(nodes);
+    mesh_tris_pending = std::move(tris);
+    meshes = std::move(wanted);
+    mesh_starts = std::move(starts);
+    params_dirty = true;
+    return ensure_mesh_cache();
+  }
   const StorageLimit limit = storage_limit(*ctx, knobs);
   VKCLOTH_TRY(check_buffer(*ctx, limit, "mesh collider hierarchy", nodes.size(), sizeof(sh::MeshNode)));
   VKCLOTH_TRY(check_buffer(*ctx, limit, "mesh collider triangles", tris.size(), sizeof(sh::MeshTriangle)));
@@ -120,6 +136,10 @@ Result<void> SolverBatch::ensure_mesh_buffers() {
       {&mesh_nodes, nodes.empty() ? nullptr : nodes.data(), nodes.size() * sizeof(sh::MeshNode)},
       {&mesh_tris, tris.empty() ? nullptr : tris.data(), tris.size() * sizeof(sh::MeshTriangle)}};
   VKCLOTH_TRY(upload(up));
+  mesh_node_count = nodes.size();
+  mesh_tri_count = tris.size();
+  mesh_nodes_pending.clear();
+  mesh_tris_pending.clear();
   meshes = std::move(wanted);
   mesh_starts = std::move(starts);
   VKCLOTH_TRY(create_buffer_views());
@@ -145,10 +165,14 @@ Result<void> SolverBatch::ensure_mesh_cache() {
     mesh_cache_key = std::move(key);
     return {};
   }
-  VKCLOTH_TRY(replace_state_buffer(mesh_cache, std::uint64_t(most) * size() * count, 2 * sizeof(sh::vec4),
-                                   "mesh collider search entries"));
+  const std::uint64_t entries = std::uint64_t(most) * size() * count;
+  if (entries != mesh_cache_entries) { // a new size: a new buffer (waits for recorded work)
+    VKCLOTH_TRY(
+        replace_state_buffer(mesh_cache, entries, 2 * sizeof(sh::vec4), "mesh collider search entries"));
+    mesh_cache_entries = entries;
+  }
   mesh_cache_key = std::move(key);
-  mesh_cache_clear = true;
+  mesh_cache_clear = true; // emptied by a fill at the next record(), no wait
   return {};
 }
 
@@ -158,13 +182,13 @@ std::vector<sh::Collider> SolverBatch::packed_colliders() const {
   for (const Slot& slot : slots) {
     std::uint32_t mesh_ordinal = 0;
     for (const Collider& c : slot.params.colliders) {
-      std::pair<std::uint32_t, std::uint32_t> start{0, 0};
+      std::array<std::uint32_t, 3> start{0, 0, 0};
       std::uint32_t cache = 0;
       if (c.mesh)
         start = mesh_starts[std::size_t(std::find(meshes.begin(), meshes.end(), c.mesh) - meshes.begin())];
       if (c.type == Collider::Type::mesh)
         cache = mesh_ordinal++ * size() * count;
-      const auto k = kernel::kernel_shape<float>(c, start.first, start.second, cache);
+      const auto k = kernel::kernel_shape<float>(c, start[0], start[1], cache, start[2]);
       const auto v4 = [](glm::vec3 v, float w) { return sh::vec4{v.x, v.y, v.z, w}; };
       sh::Collider g{};
       g.shape = v4(k.a, k.b);
@@ -172,7 +196,7 @@ std::vector<sh::Collider> SolverBatch::packed_colliders() const {
       g.moving = k.moving ? 1u : 0u;
       g.mesh_root = k.mesh_root;
       g.mesh_tri0 = k.mesh_tri0;
-      g.end_b = v4(k.c, 0.0f);
+      g.end_b = v4(k.c, std::bit_cast<float>(k.mesh_vel0));
       g.axis_x = v4(k.ax, 0.0f);
       g.axis_y = v4(k.ay, 0.0f);
       g.axis_z = v4(k.az, 0.0f);

@@ -30,6 +30,7 @@
 #include "passes/pass.hpp"
 #include "pipelines.hpp"
 #include "resources.hpp"
+#include "vkcloth/collider_mesh.hpp"
 #include "vkcloth/gpu/gpu_solver.hpp"
 #include "vkcloth/gpu/testing.hpp"
 #include "vkcloth/topology.hpp"
@@ -274,16 +275,24 @@ private:
   std::uint32_t collider_capacity = 0;
   // Mesh colliders: every distinct ColliderMesh of the batch's colliders, their hierarchies and
   // triangles one after the other (one zeroed element of each when there is none); `meshes` holds
-  // them alive, `mesh_starts` their first node and first triangle (Collider::mesh_root, mesh_tri0).
+  // them alive, `mesh_starts` their first node, first triangle and, for a skinned mesh, first corner
+  // velocities (after every mesh's triangles, in MESH_TRIS; VKCLOTH_MESH_NONE: rigid) (Collider::mesh_root,
+  // mesh_tri0, end_b.w).
   Buffer mesh_nodes, mesh_tris;
   std::vector<std::shared_ptr<const ColliderMesh>> meshes;
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> mesh_starts;
+  std::vector<std::array<std::uint32_t, 3>> mesh_starts;
+  // A skinned mesh's new pose (ColliderMesh::deformed: the same counts) is written into the same
+  // buffers by vkCmdUpdateBuffer at the next record(), no wait: these hold it until then.
+  std::vector<ColliderMesh::Node> mesh_nodes_pending;
+  std::vector<ColliderMesh::Triangle> mesh_tris_pending;
+  std::size_t mesh_node_count = 0, mesh_tri_count = 0;
   // VKCLOTH_BINDING_MESH_CACHE: each particle's search entry (2 vec4) per mesh collider of its
   // instance, the k-th mesh collider's entries for every particle of the batch at k x size() x count
   // (Collider::pivot.w); one element while no instance has a mesh collider. `mesh_cache_key`: each
   // instance's mesh colliders' meshes, for which the entries were found (other meshes: emptied, by
   // a fill record() records first while `mesh_cache_clear`).
   Buffer mesh_cache;
+  std::uint64_t mesh_cache_entries = 0;
   std::vector<std::vector<const ColliderMesh*>> mesh_cache_key;
   bool mesh_cache_clear = false;
   bool params_dirty = false; // set_params() since the last record(): record_params_update() due

@@ -107,6 +107,14 @@ void SolverBatch::record_params_update(VkCommandBuffer c) {
   record_buffer_update(c, instances, ip.data(), ip.size() * sizeof(sh::InstanceParams));
   const auto col = packed_colliders();
   record_buffer_update(c, colliders, col.data(), col.size() * sizeof(sh::Collider));
+  if (!mesh_tris_pending.empty()) { // a skinned mesh's new pose, into the buffers of its counts
+    record_buffer_update(c, mesh_nodes, mesh_nodes_pending.data(),
+                         mesh_nodes_pending.size() * sizeof(sh::MeshNode));
+    record_buffer_update(c, mesh_tris, mesh_tris_pending.data(),
+                         mesh_tris_pending.size() * sizeof(sh::MeshTriangle));
+    mesh_nodes_pending.clear();
+    mesh_tris_pending.clear();
+  }
   for (const auto& pass : passes) // the passes' own parameters (self-collision's)
     pass->write_params(*this, c);
   params_dirty = false; // before_steps() next makes the transfer writes visible to the dispatches
@@ -124,7 +132,8 @@ void SolverBatch::record(VkCommandBuffer c, std::uint32_t steps) {
   if (steps == 0)
     return;
   record_params_update(c);
-  if (mesh_cache_clear) { // a new buffer of search entries: every entry empty (radius 0)
+  if (mesh_cache_clear) {                // other meshes: every search entry empty (radius 0)
+    barriers::before_host_edit(vk(), c); // earlier steps' reads and writes of the entries finish first
     vk().vkCmdFillBuffer(c, mesh_cache.buffer, 0, VK_WHOLE_SIZE, 0);
     mesh_cache_clear = false;
   }
