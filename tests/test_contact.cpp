@@ -11,6 +11,7 @@
 #include <glm/geometric.hpp>
 
 #include "kernel.hpp"
+#include "grid_meshes.hpp"
 #include "sim_backends.hpp"
 
 using namespace vkcloth;
@@ -55,19 +56,8 @@ std::shared_ptr<const ColliderMesh> tetrahedron() {
 
 /// An open square sheet of 2 n^2 triangles at z = 0, side `size`, centred on the origin.
 std::shared_ptr<const ColliderMesh> sheet(int n, double size) {
-  std::vector<glm::dvec3> v;
-  std::vector<std::uint32_t> t;
-  for (int j = 0; j <= n; ++j)
-    for (int i = 0; i <= n; ++i)
-      v.push_back({size * (double(i) / n - 0.5), size * (double(j) / n - 0.5), 0.0});
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) {
-      const auto a = std::uint32_t(j * (n + 1) + i), b = a + 1, c = a + std::uint32_t(n + 1), d = c + 1;
-      t.insert(t.end(), {a, b, d, a, d, c});
-    }
-  auto m = ColliderMesh::create(v, t, "sheet");
-  REQUIRE(m.ok());
-  return *m;
+  return grid_collider(
+      n, size, [](double, double) { return 0.0; }, "sheet");
 }
 
 /// The signed distance of p to a collider (cloth_kernel.h in double; p_side = p).

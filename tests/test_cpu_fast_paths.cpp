@@ -12,6 +12,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "grid_meshes.hpp"
 #include "sim_backends.hpp"
 #include "vkcloth/vkcloth.hpp"
 
@@ -225,22 +226,8 @@ namespace {
 /// A bumpy height field of 2 x 16 x 16 triangles over [-0.6, 0.6]^2 (z = 0.03 sin(9x) cos(7y)): a mesh
 /// collider with convex and concave edges for the SIMD finish's mesh lanes.
 std::shared_ptr<const ColliderMesh> bumpy_mesh() {
-  constexpr int n = 16;
-  std::vector<glm::dvec3> v;
-  std::vector<std::uint32_t> t;
-  for (int j = 0; j <= n; ++j)
-    for (int i = 0; i <= n; ++i) {
-      const double x = 1.2 * (double(i) / n - 0.5), y = 1.2 * (double(j) / n - 0.5);
-      v.push_back({x, y, 0.03 * std::sin(9 * x) * std::cos(7 * y)});
-    }
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) {
-      const auto a = std::uint32_t(j * (n + 1) + i), b = a + 1, c = a + std::uint32_t(n + 1), d = c + 1;
-      t.insert(t.end(), {a, b, d, a, d, c});
-    }
-  auto m = ColliderMesh::create(v, t, "bumps");
-  REQUIRE(m.ok());
-  return *m;
+  return grid_collider(
+      16, 1.2, [](double x, double y) { return 0.03 * std::sin(9 * x) * std::cos(7 * y); }, "bumps");
 }
 
 } // namespace

@@ -11,6 +11,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "grid_meshes.hpp"
 #include "kernel.hpp"
 #include "vkcloth/collider_mesh.hpp"
 #include "vkcloth/params.hpp"
@@ -22,21 +23,8 @@ namespace {
 /// A bumpy height field over [-0.5, 0.5]^2 (z = 0.04 sin(7x) cos(5y)), n x n quads: convex and
 /// concave edges, near-coplanar neighbours.
 std::shared_ptr<const ColliderMesh> bumps(int n) {
-  std::vector<glm::dvec3> v;
-  std::vector<std::uint32_t> t;
-  for (int j = 0; j <= n; ++j)
-    for (int i = 0; i <= n; ++i) {
-      const double x = double(i) / n - 0.5, y = double(j) / n - 0.5;
-      v.push_back({x, y, 0.04 * std::sin(7 * x) * std::cos(5 * y)});
-    }
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) {
-      const auto a = std::uint32_t(j * (n + 1) + i), b = a + 1, c = a + std::uint32_t(n + 1), d = c + 1;
-      t.insert(t.end(), {a, b, d, a, d, c});
-    }
-  auto m = ColliderMesh::create(v, t, "bumps");
-  REQUIRE(m.ok());
-  return *m;
+  return test::grid_collider(
+      n, 1.0, [](double x, double y) { return 0.04 * std::sin(7 * x) * std::cos(5 * y); }, "bumps");
 }
 
 /// A closed box of 12 triangles (sharp 90-degree edges), faces outward.

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <vector>
 
+#include "grid_meshes.hpp"
 #include "sim_backends.hpp"
 #include "vkcloth/collider_mesh.hpp"
 
@@ -14,24 +15,6 @@ using namespace vkcloth;
 using namespace vkcloth::test;
 
 namespace {
-
-/// An n x n grid of vertices over [-size/2, size/2]^2 at height z, and its 2 (n-1)^2 triangles.
-struct SkinGrid {
-  std::vector<glm::dvec3> positions;
-  std::vector<std::uint32_t> triangles;
-};
-SkinGrid grid(int n, double size, double z) {
-  SkinGrid g;
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i)
-      g.positions.push_back({size * (double(i) / (n - 1) - 0.5), size * (double(j) / (n - 1) - 0.5), z});
-  for (int j = 0; j + 1 < n; ++j)
-    for (int i = 0; i + 1 < n; ++i) {
-      const auto a = std::uint32_t(j * n + i), b = a + 1, c = a + std::uint32_t(n), d = c + 1;
-      g.triangles.insert(g.triangles.end(), {a, b, d, a, d, c});
-    }
-  return g;
-}
 
 /// A single free particle (a 1 x 1 cloth) at `pos`.
 ParticleSystem particle(glm::dvec3 pos) {
@@ -47,7 +30,7 @@ ParticleSystem particle(glm::dvec3 pos) {
 } // namespace
 
 TEST_CASE("skinned mesh: deformed() refits the same hierarchy and gives each corner its velocity") {
-  SkinGrid g = grid(9, 2.0, 0.0);
+  GridMesh g = grid_mesh(8, 2.0, [](double, double) { return 0.0; });
   auto mesh = ColliderMesh::create(g.positions, g.triangles, "skin");
   REQUIRE(mesh.ok());
   CHECK((*mesh)->vertex_count() == 81);
@@ -100,7 +83,7 @@ TEST_CASE(
   // the collider itself never moves, so only the corners' velocities can carry the particle. With
   // mu = 1 it picks up the sheet's 0.3 m/s (static friction) and keeps it; frictionless, it stays.
   ValidationScope validation;
-  const SkinGrid g = grid(5, 4.0, 0.0);
+  const GridMesh g = grid_mesh(4, 4.0, [](double, double) { return 0.0; });
   auto rest = ColliderMesh::create(g.positions, g.triangles, "sliding sheet");
   REQUIRE(rest.ok());
   for (Backend b : backends())
@@ -137,7 +120,7 @@ TEST_CASE(
 
 TEST_CASE("skinned mesh: GPU = CPU for a cloth on a bending sheet, bit for bit on lavapipe") {
   ValidationScope validation;
-  const SkinGrid g = grid(12, 1.6, 0.0);
+  const GridMesh g = grid_mesh(11, 1.6, [](double, double) { return 0.0; });
   auto rest = ColliderMesh::create(g.positions, g.triangles, "bending sheet");
   REQUIRE(rest.ok());
   ClothDesc d;
