@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // ColliderMesh: the triangles of a mesh collider and a bounding-volume hierarchy over them
 // (median split along the longest axis of the triangles' centroids, at most leaf_size triangles per
-// leaf, children adjacent), walked by cloth_kernel.h mesh_closest on both backends.
+// leaf, children adjacent), walked by cloth_kernel.h mesh_nearest on both backends; deformed() refits it.
 #include "vkcloth/collider_mesh.hpp"
 
 #include <algorithm>

@@ -165,11 +165,12 @@ template <typename Real> struct CpuSolver<Real>::Impl {
   void vbd_begin(Real h);
   void vbd_solve_colour(std::uint32_t colour, Real h);
   /// The whole SIMD vectors of a colour's particles (row_kernel.hpp VbdArgs); returns how many it
-  /// stepped (0 without SIMD or with a mesh collider).
+  /// stepped (0 without SIMD or with more colliders than the lanes take).
   std::size_t vbd_colour_lanes(std::uint32_t colour, std::span<const std::uint32_t> particles, Real h);
   void pad_vbd_lists(std::size_t width);
   void pad_vbd_fans(std::size_t width);
-  /// The SIMD lanes' width in particles; 1 where they do not apply (no SIMD, or a mesh collider).
+  /// The SIMD lanes' width in particles; 1 where they do not apply (no SIMD, or more than
+  /// detail::finish_max_shapes colliders).
   std::size_t vbd_lane_width() const;
   std::size_t vbd_begin_lanes(std::size_t begin, std::size_t end, Real h);
   void vbd_finish(Real h);
@@ -230,7 +231,7 @@ template <typename Real> struct CpuSolver<Real>::Impl {
   std::unique_ptr<detail::ThreadPool> pool_;
   std::unique_ptr<detail::ImplicitWorkspace<Real>> implicit_; // created by the first implicit step
   std::unique_ptr<detail::ContactShapes<Real>> contacts_;     // this substep's colliders (prepare_colliders)
-  // Each particle's search entry per mesh collider (cloth_kernel.h MeshCacheEntry, 8 reals; collider
+  // Each particle's search entry per mesh collider (cloth_kernel.h mesh_contact, 8 reals; collider
   // ordinal-major), and the meshes they were found on (a different mesh empties them).
   std::vector<Real> mesh_cache_;
   std::vector<const ColliderMesh*> mesh_cache_meshes_;

@@ -180,8 +180,8 @@ void CpuSolver<Real>::Impl::vbd_solve_colour(const std::uint32_t colour, const R
     pool_->for_each(count, step);
 }
 
-// Whole vectors of a colour on SIMD lanes (the kernel's functions on lanes), when every collider is
-// one the lanes take (no mesh). The first call pads every colour's gather lists for the lanes.
+// Whole vectors of a colour on SIMD lanes (the kernel's functions on lanes), when the lanes take the
+// colliders (at most detail::finish_max_shapes). The first call pads every colour's gather lists.
 template <typename Real>
 std::size_t CpuSolver<Real>::Impl::vbd_colour_lanes(std::uint32_t colour,
                                                     std::span<const std::uint32_t> particles, const Real h) {
