@@ -34,7 +34,8 @@ KFN precise vec3 to_world_dir(ColliderShape s, vec3 d) {
 // - face (n != 0): triangle `tri` (unit normal n, turned towards q's side) holds the nearest point of
 //   the mesh inside its face for every q in front of it whose projection lies inside the face
 //   (face_margin > guard) and with |q - centre| < radius (no other triangle comes as near);
-// - empty (n = 0): no triangle nearer to q than radius - |q - centre| (radius <= 0: nothing).
+// - empty (n = 0): no triangle nearer to q than radius - |q - centre| (radius <= 0: nothing), the
+//   nearest at `centre` being `tri`.
 // The rounding of the distances in float at q's scale (guard) shrinks every bound.
 KFN precise real mesh_guard(vec3 q) {
   precise real g = real(0.000003814697265625) * (real(1) + max(max(abs(q.x), abs(q.y)), abs(q.z))); // 2^-18
@@ -273,7 +274,15 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
     return;
   }
   precise real guard = mesh_guard(q);
-  precise real best = mesh_nearest(MESH_DATA, s.mesh_root, s.mesh_tri0, q, real(1e18), VKCLOTH_MESH_NONE,
+  // The walk starts bounded by the entry's triangle, which is at least as far as the nearest: it
+  // finds the same triangle as an unbounded walk (the same order; no box holding the nearest is cut).
+  precise real start = real(1e18);
+  if (radius > real(0)) {
+    mesh_triangle(MESH_DATA, t, a, b, c);
+    precise vec3 d = q - closest_on_triangle(q, a, b, c);
+    start = sqrt(dot3(d, d)) * real(1.0009765625) + guard; // 1 + 2^-10: never below its own distance
+  }
+  precise real best = mesh_nearest(MESH_DATA, s.mesh_root, s.mesh_tri0, q, start, VKCLOTH_MESH_NONE,
                                    vec3(real(0)), real(0), real(-1), t);
   mesh_triangle(MESH_DATA, t, a, b, c);
   precise vec3 tn = unit_or_zero(cross3(b - a, c - a));
@@ -282,18 +291,18 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
     // The normal towards q's side (the face formula's bits do not depend on its sign). The ball: no
     // triangle reaching in front of the plane comes as near as the face (each moves at most as far as
     // q; one wholly behind it is never nearer than the plane while q is in front and its projection
-    // inside the face: a convex edge's neighbour), searched 4 reaches beyond d1.
+    // inside the face: a convex edge's neighbour), searched 8 reaches beyond d1.
     precise vec3 m = tn * select(dot3(q - a, tn) < real(0), real(-1), real(1));
     uint unused;
-    precise real next = mesh_nearest(MESH_DATA, s.mesh_root, s.mesh_tri0, q, d1 + real(4) * reach_total, t, m,
+    precise real next = mesh_nearest(MESH_DATA, s.mesh_root, s.mesh_tri0, q, d1 + real(8) * reach_total, t, m,
                                      dot3(a, m), guard, unused);
     mesh_cache_store(MESH_DATA, s.mesh_cache, m, t, q, (sqrt(next) - d1) * real(0.5) - guard);
     mesh_face_contact(s, m, a, q, p_side, reach, distance, normal);
     mesh_deformation(MESH_DATA, s, t, q - m * (dot3(q, m) - dot3(a, m)), a, b, c, deform);
     return;
   }
-  // Far, or on an edge or a corner: no triangle nearer than d1.
-  mesh_cache_store(MESH_DATA, s.mesh_cache, vec3(real(0)), 0u, q, d1 - guard);
+  // Far, or on an edge or a corner: no triangle nearer than d1 (t: the next walk's start).
+  mesh_cache_store(MESH_DATA, s.mesh_cache, vec3(real(0)), t, q, d1 - guard);
   if (best < reach_total * reach_total) {
     triangle_contact(s, a, b, c, q, p_side, distance, normal);
     mesh_deformation(MESH_DATA, s, t, closest_on_triangle(q, a, b, c), a, b, c, deform);
