@@ -4,8 +4,8 @@
 #include "solver_batch.hpp"
 
 #include <algorithm>
-#include <bit>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <limits>
