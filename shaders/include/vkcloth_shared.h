@@ -62,7 +62,7 @@ struct vec4 {
 #define VKCLOTH_BINDING_TARGETS 25    // Target per particle of each instance (its attachments' and host's)
 #define VKCLOTH_BINDING_FRAMES 26     // FrameMotion per instance: its frame's jump and carry this substep
 #define VKCLOTH_BINDING_MESH_CACHE                                                                           \
-  27 // MeshCacheEntry as 2 vec4 per particle and mesh collider (Collider::pivot.w)
+  27 // search entries (mesh_contact) as 2 vec4 per particle and mesh collider (Collider::pivot.w)
 #define VKCLOTH_BINDING_COUNT 28
 
 // Set 1 (force.comp, fused.comp, strain_*.comp): POS_IN again, as an RGBA32F uniform texel buffer view,

@@ -66,7 +66,7 @@ template <typename V> bool all_finite(V v) {
 }
 
 /// A mesh collider's hierarchy and triangles (ColliderMesh's arrays, read in place), the particles'
-/// search entries (cloth_kernel.h MeshCacheEntry: 8 reals each, in the solver's precision; null:
+/// search entries (cloth_kernel.h mesh_contact: 8 reals each, in the solver's precision; null:
 /// none, every query searches) and the particle a query is for; the accessors cloth_kernel.h
 /// mesh_contact reads them with (the mesh in float, converted to the solver's precision).
 struct MeshData {
