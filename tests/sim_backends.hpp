@@ -114,6 +114,13 @@ inline std::vector<Backend> float_backends() {
 }
 
 /// Creates a solver; the test fails (REQUIRE) when creation fails.
+/// make_cloth(d), failing the test case on an error.
+inline ParticleSystem grid_cloth(const ClothDesc& d) {
+  auto sys = make_cloth(d);
+  REQUIRE(sys.ok());
+  return *sys;
+}
+
 inline std::unique_ptr<Sim> make_sim(Backend b, const ParticleSystem& system, const SimParams& params) {
   switch (b) {
   case Backend::cpu_float: {

@@ -19,12 +19,6 @@ using namespace vkcloth::test;
 
 namespace {
 
-ParticleSystem cloth(ClothDesc d) {
-  auto sys = make_cloth(d);
-  REQUIRE(sys.ok());
-  return *sys;
-}
-
 SimParams no_forces() {
   SimParams p;
   p.gravity = {0, 0, 0};
@@ -37,7 +31,7 @@ ParticleSystem particle(glm::dvec3 pos, glm::dvec3 vel) {
   ClothDesc d;
   d.nx = d.ny = 1;
   d.pin_default_corners = false;
-  auto sys = cloth(d);
+  auto sys = grid_cloth(d);
   sys.particles[0].position = pos;
   sys.particles[0].velocity = vel;
   return sys;
@@ -56,7 +50,7 @@ TEST_CASE("a free cloth without gravity, damping or colliders keeps its total mo
   d.nx = 9;
   d.ny = 7;
   d.pin_default_corners = false;
-  auto sys = cloth(d);
+  auto sys = grid_cloth(d);
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-0.5, 0.5);
   for (Particle& p : sys.particles)
@@ -84,7 +78,7 @@ TEST_CASE("pinned points never move (bit-exact) while the hanging cloth falls") 
   ValidationScope validation;
   ClothDesc d;
   d.origin = {-0.5, 0.0, 0.5};
-  auto sys = cloth(d);
+  auto sys = grid_cloth(d);
   for (Backend b : backends()) {
     CAPTURE(to_string(b));
     auto s = make_sim(b, sys, SimParams{});
@@ -105,7 +99,7 @@ TEST_CASE("a cloth at rest in its rest shape with no gravity stays there") {
   d.nx = 12;
   d.ny = 8;
   d.size = {1.3, 0.7};
-  auto sys = cloth(d);
+  auto sys = grid_cloth(d);
   for (Backend b : backends()) {
     CAPTURE(to_string(b));
     auto s = make_sim(b, sys, no_forces());
@@ -123,7 +117,7 @@ TEST_CASE("the hanging cloth settles: kinetic energy decays, no NaN (report defa
   ValidationScope validation;
   ClothDesc d;
   d.origin = {-0.5, 0.0, 0.5};
-  auto sys = cloth(d);
+  auto sys = grid_cloth(d);
   const auto kinetic = [&](Sim& s) {
     double e = 0;
     for (const glm::dvec3& v : s.velocities())
@@ -149,7 +143,7 @@ TEST_CASE("structural springs alone diverge past K_struct ~ 50 at dt = 0.02 (rep
       ClothDesc d;
       d.origin = {-0.5, 0.0, 0.5};
       d.stiffness = {k, 0.0, 0.0};
-      auto s = make_sim(b, cloth(d), SimParams{});
+      auto s = make_sim(b, grid_cloth(d), SimParams{});
       auto r = s->run(3000);
       CHECK(r.ok() == (k < 50.0));
       if (!r.ok())
@@ -171,7 +165,7 @@ TEST_CASE("plane and sphere collisions: no particle ends inside a collider") {
   const glm::dvec3 centre{0.05, 0, 0.6};
   for (Backend b : backends()) {
     CAPTURE(to_string(b));
-    auto s = make_sim(b, cloth(d), p);
+    auto s = make_sim(b, grid_cloth(d), p);
     double min_plane = 1e9, min_sphere = 1e9;
     int sphere_contacts = 0;
     for (int block = 0; block < 120; ++block) {
@@ -281,13 +275,13 @@ TEST_CASE("wind F = Kw <n, u> n: zero when the wind lies in the cloth plane, alo
     const double tol = is_float(b) ? 1e-5 : 1e-12;
     SimParams p = no_forces();
     p.wind = {0.05, {1, 0, 1}};
-    auto in_plane = make_sim(b, cloth(d), p);
+    auto in_plane = make_sim(b, grid_cloth(d), p);
     REQUIRE(in_plane->step().ok());
     for (const glm::dvec3& f : in_plane->forces())
       CHECK(glm::length(f) < tol);
 
     p.wind = {0.05, {1, 1, 0}}; // normalised to (1, 1, 0)/sqrt 2: <n, u> = -+1/sqrt 2
-    auto across = make_sim(b, cloth(d), p);
+    auto across = make_sim(b, grid_cloth(d), p);
     REQUIRE(across->step().ok());
     const auto forces = across->forces(), normals = across->normals();
     for (std::size_t k = 0; k < forces.size(); ++k) {
@@ -306,7 +300,7 @@ TEST_CASE("a blow-up is reported with the step and time, and runs are bit-identi
   for (Backend b : backends()) {
     CAPTURE(to_string(b));
     d.stiffness.structural = 200.0;
-    auto s = make_sim(b, cloth(d), SimParams{});
+    auto s = make_sim(b, grid_cloth(d), SimParams{});
     auto r = s->run(1000);
     REQUIRE_FALSE(r.ok());
     CHECK(r.error().code == ErrorCode::diverged);
@@ -317,8 +311,8 @@ TEST_CASE("a blow-up is reported with the step and time, and runs are bit-identi
     SimParams p;
     p.wind = {0.05, {0, 1, 0}};
     p.integrator = Integrator::rk4;
-    auto first = make_sim(b, cloth(d), p);
-    auto second = make_sim(b, cloth(d), p);
+    auto first = make_sim(b, grid_cloth(d), p);
+    auto second = make_sim(b, grid_cloth(d), p);
     REQUIRE(first->run(300).ok());
     REQUIRE(second->run(300).ok());
     CHECK(first->positions() == second->positions());

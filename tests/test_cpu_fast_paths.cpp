@@ -21,12 +21,6 @@ using namespace vkcloth::test;
 
 namespace {
 
-ParticleSystem cloth(ClothDesc d) {
-  auto sys = make_cloth(d);
-  REQUIRE(sys.ok());
-  return *sys;
-}
-
 /// Moves every particle by up to `amplitude` along each axis and gives each free one a velocity of
 /// up to 10 x `amplitude` per axis, from a seeded generator (the same jitter on every run), so that
 /// no lane of a SIMD kernel sees a symmetric configuration.
@@ -53,8 +47,8 @@ TEST_CASE("the CPU solver gives bit-identical results for any thread count") {
   p.colliders = {Collider::sphere({0, 0.2, 0.2}, 0.3)};
   for (Integrator integ : {Integrator::semi_implicit_euler, Integrator::rk4}) {
     p.integrator = integ;
-    auto one = CpuSolver<float>::create(cloth(d), p, {1});
-    auto two = CpuSolver<float>::create(cloth(d), p, {2});
+    auto one = CpuSolver<float>::create(grid_cloth(d), p, {1});
+    auto two = CpuSolver<float>::create(grid_cloth(d), p, {2});
     REQUIRE(one.ok());
     REQUIRE(two.ok());
     CHECK(one->threads() == 1);
@@ -78,7 +72,7 @@ TEST_CASE("the CPU grid stencil gives the same results as the CSR gather lists")
   SimParams p;
   p.wind = {0.05, {0.2, 1, 0}};
   p.colliders = {Collider::sphere({0, 0.2, 0.2}, 0.3)};
-  ParticleSystem regular = cloth(d);
+  ParticleSystem regular = grid_cloth(d);
   ParticleSystem irregular = regular;
   irregular.springs.push_back(Spring{5 * d.nx + 5, 6 * d.nx + 7, 0.1, 0.0, SpringKind::plain});
   irregular.finalize();
@@ -120,7 +114,7 @@ TEST_CASE("the CPU row sweep: masked border rows and the per-particle border giv
   d.ny = 19;
   d.particle_mass = 0.3;
   d.origin = {-0.5, 0.0, 0.5};
-  ParticleSystem masked = cloth(d);
+  ParticleSystem masked = grid_cloth(d);
   masked.particles[std::size_t(1 * d.nx + 20)].pinned = true; // a pinned border particle
   jitter_state(masked, 0.004, 11);
   ParticleSystem border = masked;
@@ -189,7 +183,7 @@ TEST_CASE("the CPU row sweep's finite check catches a bad particle in any lane, 
   d.ny = 47; // 2115 particles: enough for 2 threads
   d.origin = {-0.5, 0.0, 0.5};
   d.pin_default_corners = false;
-  const ParticleSystem sys = cloth(d);
+  const ParticleSystem sys = grid_cloth(d);
   SimParams p;
   p.wind = {0.05, {0.2, 1, 0}};
   for (int colliders = 0; colliders < 2; ++colliders) {
@@ -273,7 +267,7 @@ TEST_CASE_TEMPLATE("the SIMD row kernels (AVX2, AVX-512) give the shared referen
   d.ny = 29;
   d.particle_mass = 0.3;
   d.origin = {-0.5, 0.0, 0.5};
-  ParticleSystem sys = cloth(d);
+  ParticleSystem sys = grid_cloth(d);
   sys.particles[std::size_t(10 * d.nx + 17)].pinned = true;
   jitter_state(sys, 0.004, 7);
   SimParams p;
