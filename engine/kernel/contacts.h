@@ -278,7 +278,8 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
   // finds the same triangle as an unbounded walk (the same order; no box holding the nearest is cut).
   precise real start = real(1e18);
   if (radius > real(0)) {
-    mesh_triangle(MESH_DATA, t, a, b, c);
+    if (!face) // a face entry's triangle is loaded already
+      mesh_triangle(MESH_DATA, t, a, b, c);
     precise vec3 d = q - closest_on_triangle(q, a, b, c);
     start = sqrt(dot3(d, d)) * real(1.0009765625) + guard; // 1 + 2^-10: never below its own distance
   }
