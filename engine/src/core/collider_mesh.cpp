@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <optional>
 
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
@@ -61,6 +62,14 @@ struct Builder {
   }
 };
 
+/// The first vertex with a coordinate that is not finite, if any.
+std::optional<std::size_t> first_non_finite(std::span<const glm::dvec3> positions) {
+  for (std::size_t v = 0; v < positions.size(); ++v)
+    if (!std::isfinite(positions[v].x) || !std::isfinite(positions[v].y) || !std::isfinite(positions[v].z))
+      return v;
+  return std::nullopt;
+}
+
 Error bad(const std::string& name, const std::string& what) {
   return Error{ErrorCode::invalid_argument, fmt::format("mesh collider {}: {}", name, what)};
 }
@@ -72,11 +81,9 @@ Result<std::shared_ptr<const ColliderMesh>> ColliderMesh::create(std::span<const
                                                                  std::string name) {
   if (triangles.size() % 3 != 0)
     return bad(name, fmt::format("{} triangle indices is not a multiple of 3", triangles.size()));
-  for (std::size_t v = 0; v < positions.size(); ++v)
-    for (int k = 0; k < 3; ++k)
-      if (!std::isfinite(positions[v][k]))
-        return bad(name, fmt::format("vertex {} is not finite ({}, {}, {})", v, positions[v].x,
-                                     positions[v].y, positions[v].z));
+  if (const auto v = first_non_finite(positions))
+    return bad(name, fmt::format("vertex {} is not finite ({}, {}, {})", *v, positions[*v].x, positions[*v].y,
+                                 positions[*v].z));
   Builder b;
   std::uint32_t dropped = 0;
   for (std::size_t t = 0; t + 2 < triangles.size(); t += 3) {
@@ -130,11 +137,9 @@ Result<std::shared_ptr<const ColliderMesh>> ColliderMesh::deformed(std::span<con
                                   positions_.size()));
   if (!std::isfinite(dt) || dt <= 0.0)
     return bad(name_, fmt::format("the skinned update's dt must be finite and > 0, got {}", dt));
-  for (std::size_t v = 0; v < positions.size(); ++v)
-    for (int k = 0; k < 3; ++k)
-      if (!std::isfinite(positions[v][k]))
-        return bad(name_, fmt::format("skinned vertex {} is not finite ({}, {}, {})", v, positions[v].x,
-                                      positions[v].y, positions[v].z));
+  if (const auto v = first_non_finite(positions))
+    return bad(name_, fmt::format("skinned vertex {} is not finite ({}, {}, {})", *v, positions[*v].x,
+                                  positions[*v].y, positions[*v].z));
   auto mesh = std::make_shared<ColliderMesh>(*this);
   for (std::size_t v = 0; v < positions.size(); ++v)
     mesh->positions_[v] = glm::vec3(positions[v]);
