@@ -5,6 +5,7 @@
 // time; and both are the nearest triangle's distance, against a brute-force scan of every triangle.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -45,6 +46,34 @@ double brute_force_distance(const ColliderMesh& mesh, glm::dvec3 q) {
     const glm::dvec3 cp =
         kernel::f64::closest_on_triangle(q, glm::dvec3(t.a), glm::dvec3(t.b), glm::dvec3(t.c));
     best = std::min(best, glm::length(q - cp));
+  }
+  return best;
+}
+
+/// The distance between segments p0-p1 and q0-q1 (Ericson 5.1.9, non-degenerate segments).
+double segment_distance(glm::dvec3 p0, glm::dvec3 p1, glm::dvec3 q0, glm::dvec3 q1) {
+  const glm::dvec3 d1 = p1 - p0, d2 = q1 - q0, r = p0 - q0;
+  const double a = glm::dot(d1, d1), e = glm::dot(d2, d2), f = glm::dot(d2, r), c = glm::dot(d1, r),
+               b = glm::dot(d1, d2), denom = a * e - b * b;
+  double s = denom > 0.0 ? std::clamp((b * f - c * e) / denom, 0.0, 1.0) : 0.0;
+  double t = (b * s + f) / e;
+  if (t < 0.0 || t > 1.0) {
+    t = std::clamp(t, 0.0, 1.0);
+    s = std::clamp((t * b - c) / a, 0.0, 1.0);
+  }
+  return glm::length((p0 + d1 * s) - (q0 + d2 * t));
+}
+
+/// The distance between two triangles that do not cross each other: the nearest of each one's
+/// corners to the other and of their edges to each other.
+double triangle_distance(const ColliderMesh::Triangle& x, const ColliderMesh::Triangle& y) {
+  const glm::dvec3 p[3] = {x.a, x.b, x.c}, q[3] = {y.a, y.b, y.c};
+  double best = 1e300;
+  for (int i = 0; i < 3; ++i) {
+    best = std::min(best, glm::length(p[i] - kernel::f64::closest_on_triangle(p[i], q[0], q[1], q[2])));
+    best = std::min(best, glm::length(q[i] - kernel::f64::closest_on_triangle(q[i], p[0], p[1], p[2])));
+    for (int j = 0; j < 3; ++j)
+      best = std::min(best, segment_distance(p[i], p[(i + 1) % 3], q[j], q[(j + 1) % 3]));
   }
   return best;
 }
@@ -122,4 +151,76 @@ TEST_CASE_TEMPLATE("mesh contact: a particle's search entry gives the search's b
     // Float: the search in float coordinates; the faces' plane formula agrees with the closest point.
     CHECK(w.worst_vs_brute_force < (sizeof(Real) == 4 ? 2e-6 : 1e-12));
   }
+}
+
+TEST_CASE("mesh contact: a triangle's clearances bound the distance to every triangle in front of it") {
+  // Checked against every pair, the distance measured between the triangles themselves.
+  for (const auto& mesh : {bumps(8), box_mesh()}) {
+    CAPTURE(mesh->name());
+    std::size_t bounded = 0;
+    const auto& tris = mesh->triangles();
+    for (std::size_t i = 0; i < tris.size(); ++i) {
+      const glm::dvec3 a(tris[i].a),
+          n = glm::normalize(glm::cross(glm::dvec3(tris[i].b) - a, glm::dvec3(tris[i].c) - a));
+      for (int side = 0; side < 2; ++side) {
+        const glm::dvec3 m = side == 0 ? n : -n;
+        const double clearance = side == 0 ? tris[i].clearance_front : tris[i].clearance_back;
+        CHECK(clearance >= 0.0);
+        bounded += clearance > 0.0;
+        for (std::size_t j = 0; j < tris.size(); ++j) {
+          const double ahead =
+              std::max({glm::dot(m, glm::dvec3(tris[j].a) - a), glm::dot(m, glm::dvec3(tris[j].b) - a),
+                        glm::dot(m, glm::dvec3(tris[j].c) - a)});
+          if (j != i && ahead > 1.0 / 262144.0)
+            CHECK(triangle_distance(tris[i], tris[j]) >= clearance);
+        }
+      }
+    }
+    CHECK(bounded > 0); // not vacuous
+  }
+  // The box from outside: nothing reaches in front of a face; inside, its neighbours touch it.
+  const auto box = box_mesh();
+  for (const ColliderMesh::Triangle& t : box->triangles()) {
+    CHECK(t.clearance_front > 1e30f);
+    CHECK(t.clearance_back == 0.0f);
+  }
+  // A deformed pose knows none (its search entries search instead).
+  const test::GridMesh g = test::grid_mesh(4, 1.0, [](double x, double) { return 0.1 * x * x; });
+  auto mesh = ColliderMesh::create(g.positions, g.triangles, "bent");
+  REQUIRE(mesh.ok());
+  auto moved = (*mesh)->deformed(g.positions, 0.01);
+  REQUIRE(moved.ok());
+  for (const ColliderMesh::Triangle& t : (*moved)->triangles())
+    CHECK((t.clearance_front == 0.0f && t.clearance_back == 0.0f));
+}
+
+TEST_CASE("mesh contact: a particle beyond a box's edge keeps its edge entry, with the search's bits") {
+  // The box's top front edge (y = -0.1, z = 0.15) seen from outside, along its middle: every position
+  // lies beyond the edge on both faces (the 90-degree wedge), 3 to 6 mm from it.
+  const auto mesh = box_mesh();
+  const Collider c =
+      Collider::triangle_mesh(mesh, {0.1, -0.2, 0.3}, Collider::rotation_from_degrees({10, 0, 30}), 0.005);
+  std::vector<float> entry(8, 0.0f);
+  kernel::MeshData cached{mesh->nodes().data(), mesh->triangles().data(), entry.data(), 0};
+  const kernel::MeshData searching{mesh->nodes().data(), mesh->triangles().data()};
+  const auto shape = kernel::kernel_shape<float>(c);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::size_t searches = 0, differences = 0;
+  for (int k = 0; k < 200; ++k) {
+    const double angle = 0.785398 + 0.6 * u(rng), r = 0.0045 + 0.0015 * u(rng);
+    const glm::dvec3 body(0.1 * u(rng), -0.1 - r * std::cos(angle), 0.15 + r * std::sin(angle));
+    const glm::vec3 world(c.center + c.rotation * body);
+    const std::vector<float> before = entry;
+    float d_cached, d_searched;
+    glm::vec3 n_cached, n_searched, deform;
+    kernel::collider_contact(cached, shape, world, world, 0.002f, d_cached, n_cached, deform);
+    kernel::collider_contact(searching, shape, world, world, 0.002f, d_searched, n_searched, deform);
+    searches += before != entry;
+    differences += d_cached != d_searched || n_cached != n_searched;
+    CHECK(entry[2] == 2.0f); // an edge entry
+    CHECK(std::abs(double(d_searched) - (r - c.thickness)) < 1e-6);
+  }
+  CHECK(differences == 0);
+  CHECK(searches == 1); // the first query's
 }

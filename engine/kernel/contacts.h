@@ -34,6 +34,9 @@ KFN precise vec3 to_world_dir(ColliderShape s, vec3 d) {
 // - face (n != 0): triangle `tri` (unit normal n, turned towards q's side) holds the nearest point of
 //   the mesh inside its face for every q in front of it whose projection lies inside the face
 //   (face_margin > guard) and with |q - centre| < radius (no other triangle comes as near);
+// - edge (n.z = 2): the nearest point of the mesh lies inside the edge that triangle `tri` shares with
+//   triangle n.x at an angle (the corners opposite it: n.y = k + 3 k2, corner_and_edge) for every q
+//   beyond the edge on both faces with |q - centre| < radius (mesh_edge_hit);
 // - empty (n = 0): no triangle nearer to q than radius - |q - centre| (radius <= 0: nothing), the
 //   nearest at `centre` being `tri`.
 // The rounding of the distances in float at q's scale (guard) shrinks every bound.
@@ -65,7 +68,8 @@ KFN VARYING(bool)
   VARYING(bool) within = r > real(0) && d2 < r * r;
   precise real guard = mesh_guard(q);
   VARYING(bool) on_face = dot3(q - a, n) > guard && face_margin(q, n, a, b, c) > guard;
-  return within && (!face || on_face);
+  VARYING(bool) edge = n.z > real(1.5); // mesh_contact's own (scalar) test
+  return within && (!face || on_face) && !edge;
 }
 
 // collider_contact for a mesh from a face entry (the nearest point of the mesh to q lies inside the
@@ -146,23 +150,48 @@ KFN precise vec3 closest_on_triangle(vec3 p, vec3 a, vec3 b, vec3 c) {
   return q;
 }
 
+// The squared distance from q to triangle (a, b, c): the search's measure, the entries' too.
+KFN precise real triangle_gap2(vec3 q, vec3 a, vec3 b, vec3 c) {
+  precise vec3 d = q - closest_on_triangle(q, a, b, c);
+  precise real d2 = dot3(d, d);
+  return d2;
+}
+
 // The triangle of a mesh collider nearest to q (body frame) within `reach` (its index in `nearest`,
 // VKCLOTH_MESH_NONE: none; its squared distance returned, reach^2: none), among those other than
-// `skip` that reach in front of the plane {x: m.x = offset} by more than `tol` (m = 0, tol < 0: all).
-// Walks the bounding-volume hierarchy depth first, the nearer child first, boxes no farther than the
-// nearest so far only, in a fixed order, so both backends find the same triangle (ties: the first
-// found). The including file provides mesh_node(MESH_DATA, i, lo, first, hi, count) and
-// mesh_triangle(MESH_DATA, i, a, b, c) (vkcloth::ColliderMesh's Node and Triangle); MESH_DATA_PARAM
-// declares MESH_DATA.
+// `skip` and `skip2` that reach in front of the plane {x: m.x = offset} or of {x: m2.x = offset2} by
+// more than `tol` (m = m2 = 0, tol < 0: all). `second`: the next nearest, where its squared distance
+// is within `slack` times the nearest's (an edge's other triangle; else VKCLOTH_MESH_NONE). Equally
+// near ones: the lowest index first, so the answer is a function of q alone (an entry reproduces
+// it). Walks the bounding-volume hierarchy depth first, the nearer child first, boxes no farther
+// than slack times the nearest so far only. The including file provides
+// mesh_node(MESH_DATA, i, lo, first, hi, count) and mesh_triangle(MESH_DATA, i, a, b, c)
+// (vkcloth::ColliderMesh's Node and Triangle); MESH_DATA_PARAM declares MESH_DATA.
 #define VKCLOTH_MESH_STACK 32
 KFN precise real box_gap2(vec3 lo, vec3 hi, vec3 q) {
   precise vec3 gap = max(max(lo - q, q - hi), vec3(real(0)));
   return dot3(gap, gap);
 }
-KFN_NOINLINE real mesh_nearest(MESH_DATA_PARAM, uint root, uint tri0, vec3 q, real reach, uint skip, vec3 m,
-                               real offset, real tol, OUT(uint) nearest) {
+KFN precise real box_ahead(vec3 lo, vec3 hi, vec3 m, real offset) {
+  precise real ahead = dot3(m, (lo + hi) * real(0.5)) + dot3(abs(m), (hi - lo) * real(0.5)) - offset;
+  return ahead;
+}
+KFN precise real triangle_ahead(vec3 a, vec3 b, vec3 c, vec3 m, real offset) {
+  precise real ahead = max(max(dot3(m, a), dot3(m, b)), dot3(m, c)) - offset;
+  return ahead;
+}
+// Whether (d2, i) comes before (best, at) (VKCLOTH_MESH_NONE: nothing yet, within best only).
+KFN bool nearer(real d2, uint i, real best, uint at) {
+  return d2 < best || (d2 == best && at != VKCLOTH_MESH_NONE && i < at);
+}
+KFN_NOINLINE real mesh_nearest(MESH_DATA_PARAM, uint root, uint tri0, vec3 q, real reach, uint skip,
+                               uint skip2, vec3 m, real offset, vec3 m2, real offset2, real tol, real slack,
+                               OUT(uint) nearest, OUT(uint) second) {
   nearest = VKCLOTH_MESH_NONE;
+  second = VKCLOTH_MESH_NONE;
   precise real best = reach * reach;
+  precise real best2 = best;
+  const bool planes = tol >= real(0);
   // The stack holds nodes with their boxes' squared gaps to q (measured with their parent's).
   uint stack[VKCLOTH_MESH_STACK];
   real stack_gap[VKCLOTH_MESH_STACK];
@@ -171,14 +200,13 @@ KFN_NOINLINE real mesh_nearest(MESH_DATA_PARAM, uint root, uint tri0, vec3 q, re
   stack_gap[0] = real(0);
   while (top > 0u) {
     top = top - 1u;
-    if (stack_gap[top] > best) // too far
+    if (stack_gap[top] > best * slack) // too far
       continue;
     vec3 lo, hi;
     uint first, count;
     mesh_node(MESH_DATA, root + stack[top], lo, first, hi, count);
-    precise real ahead = dot3(m, (lo + hi) * real(0.5)) + dot3(abs(m), (hi - lo) * real(0.5)) - offset;
-    if (ahead <= tol) // wholly behind the plane
-      continue;
+    if (planes && box_ahead(lo, hi, m, offset) <= tol && box_ahead(lo, hi, m2, offset2) <= tol)
+      continue;        // wholly behind both planes
     if (count == 0u) { // the nearer child is walked first (the first one on a tie)
       vec3 lo1, hi1;
       uint f1, c1;
@@ -195,17 +223,26 @@ KFN_NOINLINE real mesh_nearest(MESH_DATA_PARAM, uint root, uint tri0, vec3 q, re
     }
     for (uint t = first; t < first + count; ++t) {
       vec3 ta, tb, tc;
-      mesh_triangle(MESH_DATA, tri0 + t, ta, tb, tc);
-      if (tri0 + t == skip || max(max(dot3(m, ta), dot3(m, tb)), dot3(m, tc)) - offset <= tol)
+      const uint i = tri0 + t;
+      mesh_triangle(MESH_DATA, i, ta, tb, tc);
+      if (i == skip || i == skip2 ||
+          (planes && triangle_ahead(ta, tb, tc, m, offset) <= tol &&
+           triangle_ahead(ta, tb, tc, m2, offset2) <= tol))
         continue;
-      precise vec3 d = q - closest_on_triangle(q, ta, tb, tc);
-      precise real d2 = dot3(d, d);
-      if (d2 < best) {
+      precise real d2 = triangle_gap2(q, ta, tb, tc);
+      if (nearer(d2, i, best, nearest)) {
+        best2 = best;
+        second = nearest;
         best = d2;
-        nearest = tri0 + t;
+        nearest = i;
+      } else if (nearer(d2, i, best2, second)) {
+        best2 = d2;
+        second = i;
       }
     }
   }
+  if (best2 > best * slack)
+    second = VKCLOTH_MESH_NONE;
   return best;
 }
 
@@ -247,10 +284,106 @@ KFN void mesh_deformation(MESH_DATA_PARAM, ColliderShape s, uint t, vec3 p, vec3
   deform = triangle_velocity(s, p, a, b, c, va, vb, vc);
 }
 
+// The answer of the nearest triangle t (a, b, c) at squared distance gap2 by the general formula
+// (nothing beyond the thickness + reach).
+KFN void mesh_triangle_answer(MESH_DATA_PARAM, ColliderShape s, uint t, vec3 a, vec3 b, vec3 c, real gap2,
+                              vec3 q, vec3 p_side, real reach, OUT(real) distance, OUT(vec3) normal,
+                              OUT(vec3) deform) {
+  precise real reach_total = s.b + reach;
+  if (gap2 < reach_total * reach_total) {
+    triangle_contact(s, a, b, c, q, p_side, distance, normal);
+    mesh_deformation(MESH_DATA, s, t, closest_on_triangle(q, a, b, c), a, b, c, deform);
+  }
+}
+
+// The ball an entry at distance d1 may keep from its triangles' clearance (ColliderMesh::Triangle): a
+// triangle reaching in front of the plane is at least `clear` from the face (edge), hence from q at
+// distance d < clear / 2 farther than the face (edge) is. Capped, so that its square stays finite.
+KFN precise real mesh_clear_radius(real clear, real d1, real guard) {
+  precise real r = min(clear * real(0.5) - guard - d1, real(1e15));
+  return r;
+}
+
+// Triangle (a, b, c) seen from its corner k (0: a): that corner f and the edge e0 -> e1 opposite it,
+// in the triangle's counter-clockwise order.
+KFN void corner_and_edge(uint k, vec3 a, vec3 b, vec3 c, OUT(vec3) f, OUT(vec3) e0, OUT(vec3) e1) {
+  f = k == 0u ? a : (k == 1u ? b : c);
+  e0 = k == 0u ? b : (k == 1u ? c : a);
+  e1 = k == 0u ? c : (k == 1u ? a : b);
+}
+
+// Whether q lies beyond the edge e0 -> e1 of triangle (f, e0, e1) in its plane and its foot on the
+// edge inside it, each by more than guard: then the triangle's nearest point to q lies inside that edge.
+KFN bool beyond_edge(vec3 q, vec3 f, vec3 e0, vec3 e1, real guard) {
+  precise vec3 tn = unit_or_zero(cross3(e0 - f, e1 - f));
+  precise vec3 e = e1 - e0;
+  precise real len = sqrt(dot3(e, e));
+  precise real along = dot3(q - e0, e) / len;
+  return -edge_margin(q, tn, e0, e1) > guard && along > guard && len - along > guard;
+}
+
+// An edge entry: the edge e0 -> e1 of triangle (f1, e0, e1) is g0 -> g1 of the neighbour (f2, g0, g1).
+// It answers q within its ball, beyond the edge on both faces: there the nearest point of each
+// triangle, and of the wedge behind both their planes, is q's foot on the edge; the ball keeps every
+// triangle reaching in front of either plane farther than the edge.
+KFN bool mesh_edge_hit(vec3 centre, real radius, vec3 q, vec3 f1, vec3 e0, vec3 e1, vec3 f2, vec3 g0,
+                       vec3 g1) {
+  precise vec3 d = q - centre;
+  precise real guard = mesh_guard(q);
+  return radius > real(0) && dot3(d, d) < radius * radius && beyond_edge(q, f1, e0, e1, guard) &&
+         beyond_edge(q, f2, g0, g1, guard);
+}
+
+// The wedge of an edge entry where q's nearest point lies inside an edge of the nearest triangle t
+// (a, b, c) that triangle t2 (as near: the search's second) shares at an angle, q beyond it on both:
+// the planes m1, m2 (through the edge, each turned away from the other triangle's far corner), the
+// entry's corner code (k + 3 k2, corner_and_edge) and the triangles' clearance on the wedge's side.
+// False where there is no such edge.
+KFN bool mesh_edge_wedge(MESH_DATA_PARAM, uint t, vec3 a, vec3 b, vec3 c, uint t2, vec3 q, real guard,
+                         OUT(vec3) m1, OUT(vec3) m2, OUT(vec3) e0, OUT(uint) code, OUT(real) clear) {
+  if (t2 == VKCLOTH_MESH_NONE || t2 >= 16777216u) // the entry holds t2 as a real: exact below 2^24
+    return false;
+  uint k = 3u;
+  vec3 f1, e1;
+  for (uint i = 0u; i < 3u; ++i) {
+    corner_and_edge(i, a, b, c, f1, e0, e1);
+    if (beyond_edge(q, f1, e0, e1, guard))
+      k = i;
+  }
+  if (k == 3u)
+    return false;
+  corner_and_edge(k, a, b, c, f1, e0, e1);
+  vec3 a2, b2, c2, f2, g0, g1;
+  mesh_triangle(MESH_DATA, t2, a2, b2, c2);
+  uint k2 = 3u;
+  for (uint i = 0u; i < 3u; ++i) {
+    corner_and_edge(i, a2, b2, c2, f2, g0, g1);
+    if ((g0 == e0 && g1 == e1) || (g0 == e1 && g1 == e0))
+      k2 = i;
+  }
+  if (k2 == 3u)
+    return false;
+  corner_and_edge(k2, a2, b2, c2, f2, g0, g1);
+  if (!beyond_edge(q, f2, g0, g1, guard))
+    return false;
+  precise vec3 n1 = unit_or_zero(cross3(e0 - f1, e1 - f1)), n2 = unit_or_zero(cross3(g0 - f2, g1 - f2));
+  precise real h1 = dot3(n1, f2 - e0), h2 = dot3(n2, f1 - e0);
+  if (abs(h1) <= guard || abs(h2) <= guard) // flat: the face entries' case
+    return false;
+  m1 = n1 * select(h1 < real(0), real(1), real(-1));
+  m2 = n2 * select(h2 < real(0), real(1), real(-1));
+  code = k + 3u * k2;
+  real front1, back1, front2, back2;
+  mesh_clearance(MESH_DATA, t, front1, back1);
+  mesh_clearance(MESH_DATA, t2, front2, back2);
+  clear = min(select(h1 < real(0), front1, back1), select(h2 < real(0), front2, back2));
+  return true;
+}
+
 // collider_contact for a mesh collider, q = p in its body frame (to_body). The particle's entry
 // answers where it can; otherwise the search answers and leaves a new entry (slot:
-// ColliderShape::mesh_cache; the bridge adds the particle): a face entry where the nearest point
-// lies inside a face within twice the reach, else an empty one.
+// ColliderShape::mesh_cache; the bridge adds the particle): a face or an edge entry where the nearest
+// point lies inside a face or an edge within twice the reach, else an empty one.
 // A skinned mesh: `deform`, the surface's velocity at the nearest point from its corners' (zero otherwise).
 KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_side, real reach,
                                OUT(real) distance, OUT(vec3) normal, OUT(vec3) deform) {
@@ -264,11 +397,26 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
   uint t;
   real radius;
   mesh_cache_load(MESH_DATA, s.mesh_cache, n, t, centre, radius);
-  const bool face = dot3(n, n) > real(0);
+  const bool edge = n.z > real(1.5);
+  const bool face = !edge && dot3(n, n) > real(0);
   a = b = c = vec3(real(0));
-  if (face)
+  if (face || edge)
     mesh_triangle(MESH_DATA, t, a, b, c);
-  if (mesh_cache_hit(n, centre, radius, a, b, c, q, reach_total)) {
+  if (edge) { // the nearer of the edge's two triangles, as the search picks it
+    const uint t2 = uint(n.x), k = uint(n.y);
+    vec3 a2, b2, c2, f1, e0, e1, f2, g0, g1;
+    mesh_triangle(MESH_DATA, t2, a2, b2, c2);
+    corner_and_edge(k % 3u, a, b, c, f1, e0, e1);
+    corner_and_edge(k / 3u, a2, b2, c2, f2, g0, g1);
+    if (mesh_edge_hit(centre, radius, q, f1, e0, e1, f2, g0, g1)) {
+      precise real gap1 = triangle_gap2(q, a, b, c), gap2 = triangle_gap2(q, a2, b2, c2);
+      if (nearer(gap2, t2, gap1, t))
+        mesh_triangle_answer(MESH_DATA, s, t2, a2, b2, c2, gap2, q, p_side, reach, distance, normal, deform);
+      else
+        mesh_triangle_answer(MESH_DATA, s, t, a, b, c, gap1, q, p_side, reach, distance, normal, deform);
+      return;
+    }
+  } else if (mesh_cache_hit(n, centre, radius, a, b, c, q, reach_total)) {
     mesh_face_contact(s, n, a, q, p_side, reach, distance, normal);
     mesh_deformation(MESH_DATA, s, t, q - n * (dot3(q, n) - dot3(a, n)), a, b, c, deform);
     return;
@@ -278,36 +426,54 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
   // finds the same triangle as an unbounded walk (the same order; no box holding the nearest is cut).
   precise real start = real(1e18);
   if (radius > real(0)) {
-    if (!face) // a face entry's triangle is loaded already
+    if (!face && !edge) // a face's or an edge's triangle is loaded already
       mesh_triangle(MESH_DATA, t, a, b, c);
-    precise vec3 d = q - closest_on_triangle(q, a, b, c);
-    start = sqrt(dot3(d, d)) * real(1.0009765625) + guard; // 1 + 2^-10: never below its own distance
+    start = sqrt(triangle_gap2(q, a, b, c)) * real(1.0009765625) + guard; // 1 + 2^-10: never below its own
   }
+  uint t2;
   precise real best = mesh_nearest(MESH_DATA, s.mesh_root, s.mesh_tri0, q, start, VKCLOTH_MESH_NONE,
-                                   vec3(real(0)), real(0), real(-1), t);
+                                   VKCLOTH_MESH_NONE, vec3(real(0)), real(0), vec3(real(0)), real(0),
+                                   real(-1), real(1.001953125), t, t2); // 1 + 2^-9: an edge's other triangle
   mesh_triangle(MESH_DATA, t, a, b, c);
   precise vec3 tn = unit_or_zero(cross3(b - a, c - a));
   precise real d1 = sqrt(best);
-  if (d1 < real(2) * reach_total && face_margin(q, tn, a, b, c) > guard) { // near, inside the face
-    // The normal towards q's side (the face formula's bits do not depend on its sign). The ball: no
-    // triangle reaching in front of the plane comes as near as the face (each moves at most as far as
-    // q; one wholly behind it is never nearer than the plane while q is in front and its projection
-    // inside the face: a convex edge's neighbour), searched 8 reaches beyond d1.
-    precise vec3 m = tn * select(dot3(q - a, tn) < real(0), real(-1), real(1));
-    uint unused;
-    precise real next = mesh_nearest(MESH_DATA, s.mesh_root, s.mesh_tri0, q, d1 + real(8) * reach_total, t, m,
-                                     dot3(a, m), guard, unused);
-    mesh_cache_store(MESH_DATA, s.mesh_cache, m, t, q, (sqrt(next) - d1) * real(0.5) - guard);
-    mesh_face_contact(s, m, a, q, p_side, reach, distance, normal);
-    mesh_deformation(MESH_DATA, s, t, q - m * (dot3(q, m) - dot3(a, m)), a, b, c, deform);
+  const bool near = d1 < real(2) * reach_total;
+  // A face entry where the nearest point lies inside the face; an edge entry where it lies inside an
+  // edge of two faces at an angle; each within a ball where no triangle reaching in front of its
+  // plane(s) comes as near (its clearance, else a search 8 reaches beyond d1: each triangle moves at
+  // most as far as q; one wholly behind is never nearer than the face or the edge while q is in front
+  // of the face, inside it / beyond the edge on both faces, in the wedge).
+  const bool inside = face_margin(q, tn, a, b, c) > guard;
+  precise vec3 m1 = tn * select(dot3(q - a, tn) < real(0), real(-1), real(1)), m2 = m1, e0 = a;
+  uint code = 0u;
+  real clear = real(0), front, back;
+  mesh_clearance(MESH_DATA, t, front, back);
+  clear = select(dot3(m1, tn) < real(0), back, front);
+  const bool wedge =
+      near && !inside && mesh_edge_wedge(MESH_DATA, t, a, b, c, t2, q, guard, m1, m2, e0, code, clear);
+  precise real entry_radius = real(-1);
+  if (near && (inside || wedge)) {
+    entry_radius = mesh_clear_radius(clear, d1, guard);
+    if (entry_radius < real(2) * reach_total) {
+      uint unused, unused2;
+      precise real next = mesh_nearest(MESH_DATA, s.mesh_root, s.mesh_tri0, q, d1 + real(8) * reach_total, t,
+                                       select(wedge, t2, t), m1, dot3(m1, e0), m2, dot3(m2, e0), guard,
+                                       real(1), unused, unused2);
+      entry_radius = max(entry_radius, (sqrt(next) - d1) * real(0.5) - guard);
+    }
+  }
+  if (near && inside) {
+    mesh_cache_store(MESH_DATA, s.mesh_cache, m1, t, q, entry_radius);
+    mesh_face_contact(s, m1, a, q, p_side, reach, distance, normal);
+    mesh_deformation(MESH_DATA, s, t, q - m1 * (dot3(q, m1) - dot3(a, m1)), a, b, c, deform);
     return;
   }
-  // Far, or on an edge or a corner: no triangle nearer than d1 (t: the next walk's start).
-  mesh_cache_store(MESH_DATA, s.mesh_cache, vec3(real(0)), t, q, d1 - guard);
-  if (best < reach_total * reach_total) {
-    triangle_contact(s, a, b, c, q, p_side, distance, normal);
-    mesh_deformation(MESH_DATA, s, t, closest_on_triangle(q, a, b, c), a, b, c, deform);
-  }
+  // An edge entry; else (far, at a corner, ...) no triangle nearer than d1 (t: the next walk's start).
+  if (wedge && entry_radius > real(0))
+    mesh_cache_store(MESH_DATA, s.mesh_cache, vec3(real(t2), real(code), real(2)), t, q, entry_radius);
+  else
+    mesh_cache_store(MESH_DATA, s.mesh_cache, vec3(real(0)), t, q, d1 - guard);
+  mesh_triangle_answer(MESH_DATA, s, t, a, b, c, best, q, p_side, reach, distance, normal, deform);
 }
 #endif // VKCLOTH_KERNEL_NO_MESH
 

@@ -118,6 +118,11 @@ void mesh_triangle(uint particle, uint i, out vec3 a, out vec3 b, out vec3 c) {
   b = t.b.xyz;
   c = t.c.xyz;
 }
+void mesh_clearance(uint particle, uint i, out float front, out float back) {
+  const MeshTriangle t = read_mesh_triangle(i);
+  front = t.a.w;
+  back = t.b.w;
+}
 layout(std430, set = 0, binding = VKCLOTH_BINDING_MESH_CACHE) buffer MeshCacheBuf { vec4 mesh_entries[]; };
 void mesh_velocity(uint particle, uint i, out vec3 va, out vec3 vb, out vec3 vc) {
   const MeshTriangle t = read_mesh_triangle(i); // a skinned mesh's velocities follow the triangles

@@ -31,13 +31,17 @@ public:
     std::uint32_t count;
   };
   /// A triangle (48 bytes, the GPU's std430 MeshTriangle), counter-clockwise seen from its front.
+  /// Its clearances (create() computes them; 0: none known, as in a deformed() pose) bound from below
+  /// the distance from it to any other triangle that reaches in front of its plane on its front
+  /// (normal (b - a) x (c - a)) or back side: a contact entry near it then needs no search of its
+  /// own (cloth_kernel.h mesh_contact).
   struct Triangle {
     glm::vec3 a;
-    float pad_a;
+    float clearance_front;
     glm::vec3 b;
-    float pad_b;
+    float clearance_back;
     glm::vec3 c;
-    float pad_c;
+    float pad;
   };
   /// Triangles per leaf at most.
   static constexpr std::uint32_t leaf_size = 4;

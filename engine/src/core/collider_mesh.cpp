@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
 
+#include "kernel.hpp"
 #include "vkcloth/mesh.hpp"
 
 namespace vkcloth {
@@ -70,6 +71,36 @@ std::optional<std::size_t> first_non_finite(std::span<const glm::dvec3> position
   return std::nullopt;
 }
 
+/// Each triangle's clearances (ColliderMesh::Triangle) over the hierarchy: from its centroid, the
+/// nearest other triangle reaching in front of its plane by more than the smallest contact guard
+/// (cloth_kernel.h mesh_guard: 2^-18), less the centroid's distance to the triangle's farthest corner
+/// (every point of the triangle is that close to the centroid); rounded down to float.
+void compute_clearances(std::span<ColliderMesh::Triangle> tris, std::span<const ColliderMesh::Node> nodes) {
+  const kernel::MeshData md{nodes.data(), tris.data()};
+  constexpr double tol = 1.0 / 262144.0; // 2^-18
+  auto down = [](double x) {
+    const float f = float(x);
+    return double(f) > x ? std::nextafter(f, 0.0f) : f;
+  };
+  for (std::size_t i = 0; i < tris.size(); ++i) {
+    const glm::dvec3 a(tris[i].a), b(tris[i].b), c(tris[i].c);
+    const glm::dvec3 centroid = (a + b + c) / 3.0, n = glm::normalize(glm::cross(b - a, c - a));
+    const double corner =
+        std::max({glm::length(a - centroid), glm::length(b - centroid), glm::length(c - centroid)});
+    float clearance[2];
+    for (int side = 0; side < 2; ++side) {
+      const glm::dvec3 m = side == 0 ? n : -n;
+      std::uint32_t nearest, unused;
+      const double best =
+          kernel::f64::mesh_nearest(md, 0, 0, centroid, 1e18, std::uint32_t(i), std::uint32_t(i), m,
+                                    glm::dot(m, a), m, glm::dot(m, a), tol, 1.0, nearest, unused);
+      clearance[side] = nearest == VKCLOTH_MESH_NONE ? 3e38f : down(std::max(0.0, std::sqrt(best) - corner));
+    }
+    tris[i].clearance_front = clearance[0];
+    tris[i].clearance_back = clearance[1];
+  }
+}
+
 Error bad(const std::string& name, const std::string& what) {
   return Error{ErrorCode::invalid_argument, fmt::format("mesh collider {}: {}", name, what)};
 }
@@ -124,6 +155,7 @@ Result<std::shared_ptr<const ColliderMesh>> ColliderMesh::create(std::span<const
   for (const glm::dvec3& p : positions)
     mesh->positions_.emplace_back(p);
   mesh->nodes_ = std::move(b.nodes);
+  compute_clearances(mesh->triangles_, mesh->nodes_);
   mesh->name_ = std::move(name);
   mesh->depth_ = b.depth;
   mesh->dropped_ = dropped;

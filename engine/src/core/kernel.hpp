@@ -106,6 +106,10 @@ template <typename R> uint mesh_cache_uint(R w) {
 template <typename R> R* mesh_cache_entry(const MeshData& m, uint slot) {
   return static_cast<R*>(m.cache) + 8 * (std::size_t(slot) + m.particle);
 }
+template <typename R> void mesh_clearance(const MeshData& m, uint i, R& front, R& back) {
+  front = R(m.triangles[i].clearance_front);
+  back = R(m.triangles[i].clearance_back);
+}
 template <typename V> void mesh_velocity(const MeshData& m, uint i, V& va, V& vb, V& vc) {
   const ColliderMesh::Triangle& t = m.velocities[i];
   va = V(t.a);
