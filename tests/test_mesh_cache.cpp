@@ -94,7 +94,8 @@ Walked walk(const std::shared_ptr<const ColliderMesh>& mesh, glm::dvec3 centre, 
   const Collider c =
       Collider::triangle_mesh(mesh, {0.1, -0.2, 0.3}, Collider::rotation_from_degrees({10, 0, 30}), 0.005);
   std::vector<Real> entries(8 * particles, Real(0));
-  kernel::MeshData cached{mesh->nodes().data(), mesh->triangles().data(), entries.data(), 0};
+  kernel::MeshData cached{mesh->nodes().data(),     mesh->triangles().data(), entries.data(), 0, nullptr,
+                          mesh->neighbours().data()};
   const kernel::MeshData searching{mesh->nodes().data(), mesh->triangles().data()};
   const auto shape = kernel::kernel_shape<Real>(c);
   std::mt19937 rng(seed);
@@ -201,7 +202,8 @@ TEST_CASE("mesh contact: a particle beyond a box's edge keeps its edge entry, wi
   const Collider c =
       Collider::triangle_mesh(mesh, {0.1, -0.2, 0.3}, Collider::rotation_from_degrees({10, 0, 30}), 0.005);
   std::vector<float> entry(8, 0.0f);
-  kernel::MeshData cached{mesh->nodes().data(), mesh->triangles().data(), entry.data(), 0};
+  kernel::MeshData cached{mesh->nodes().data(),     mesh->triangles().data(), entry.data(), 0, nullptr,
+                          mesh->neighbours().data()};
   const kernel::MeshData searching{mesh->nodes().data(), mesh->triangles().data()};
   const auto shape = kernel::kernel_shape<float>(c);
   std::mt19937 rng(7);
@@ -223,4 +225,56 @@ TEST_CASE("mesh contact: a particle beyond a box's edge keeps its edge entry, wi
   }
   CHECK(differences == 0);
   CHECK(searches == 1); // the first query's
+}
+
+TEST_CASE("mesh contact: an entry moves across faces and edges to its neighbours without a search") {
+  // A particle slides 4 mm above the box's top face along y = 0 (across the diagonal shared by the
+  // face's two triangles), around the top's edge at x = 0.2 (its wedge) and down the side face
+  // (across its diagonal), 0.5 mm a query, off the regions' borders (where a search decides). Only
+  // the first query searches the hierarchy.
+  const auto mesh = box_mesh();
+  REQUIRE(mesh->neighbours().size() == 3 * mesh->triangles().size());
+  for (const std::uint32_t n : mesh->neighbours()) // a closed box: every edge has its neighbour
+    CHECK(n < mesh->triangles().size());
+  const Collider c =
+      Collider::triangle_mesh(mesh, {0.1, -0.2, 0.3}, Collider::rotation_from_degrees({10, 0, 30}), 0.005);
+  std::vector<float> entry(8, 0.0f);
+  std::uint64_t visits = 0;
+  kernel::MeshData cached{mesh->nodes().data(),
+                          mesh->triangles().data(),
+                          entry.data(),
+                          0,
+                          nullptr,
+                          mesh->neighbours().data(),
+                          &visits};
+  const kernel::MeshData searching{mesh->nodes().data(), mesh->triangles().data()};
+  const auto shape = kernel::kernel_shape<float>(c);
+  const double r = 0.004, top = 0.35, arc = top + 0.5 * 3.14159265358979 * r;
+  std::size_t queries = 0, differences = 0, edge_entries = 0;
+  std::uint64_t first_visits = 0;
+  for (double u = 0.00025; u < 0.55; u += 0.0005) { // arc length along the path
+    glm::dvec3 body;
+    if (u < top)
+      body = {-0.15 + u, 0.0, 0.15 + r};
+    else if (u < arc) {
+      const double angle = (u - top) / r; // 0 .. pi/2 around the edge
+      body = {0.2 + r * std::sin(angle), 0.0, 0.15 + r * std::cos(angle)};
+    } else
+      body = {0.2 + r, 0.0, 0.15 - (u - arc)};
+    const glm::vec3 world(c.center + c.rotation * body);
+    float d_cached, d_searched;
+    glm::vec3 n_cached, n_searched, deform;
+    kernel::collider_contact(cached, shape, world, world, 0.002f, d_cached, n_cached, deform);
+    kernel::collider_contact(searching, shape, world, world, 0.002f, d_searched, n_searched, deform);
+    if (queries++ == 0)
+      first_visits = visits;
+    differences += d_cached != d_searched || n_cached != n_searched;
+    edge_entries += entry[2] == 2.0f;
+    CHECK(std::abs(double(d_searched) - (r - c.thickness)) < 1e-6);
+  }
+  CHECK(queries > 1000);
+  CHECK(differences == 0);
+  CHECK(first_visits > 0);
+  CHECK(visits == first_visits); // no search after the first
+  CHECK(edge_entries > 5);       // the wedge was crossed with an edge entry
 }

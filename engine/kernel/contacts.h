@@ -289,6 +289,9 @@ KFN void mesh_deformation(MESH_DATA_PARAM, ColliderShape s, uint t, vec3 p, vec3
 KFN void mesh_triangle_answer(MESH_DATA_PARAM, ColliderShape s, uint t, vec3 a, vec3 b, vec3 c, real gap2,
                               vec3 q, vec3 p_side, real reach, OUT(real) distance, OUT(vec3) normal,
                               OUT(vec3) deform) {
+  distance = reach;
+  normal = vec3(real(0), real(0), real(1));
+  deform = vec3(real(0));
   precise real reach_total = s.b + reach;
   if (gap2 < reach_total * reach_total) {
     triangle_contact(s, a, b, c, q, p_side, distance, normal);
@@ -381,9 +384,13 @@ KFN bool mesh_edge_wedge(MESH_DATA_PARAM, uint t, vec3 a, vec3 b, vec3 c, uint t
 }
 
 // collider_contact for a mesh collider, q = p in its body frame (to_body). The particle's entry
-// answers where it can; otherwise the search answers and leaves a new entry (slot:
-// ColliderShape::mesh_cache; the bridge adds the particle): a face or an edge entry where the nearest
-// point lies inside a face or an edge within twice the reach, else an empty one.
+// answers where it can. Where it no longer does, a face or an edge entry first moves to the
+// triangles next to it without a search (the edge q went farthest beyond, as an edge and as a face,
+// then its own face; an edge entry: its two faces), where their clearance keeps a ball (a rigid
+// mesh): the entry the search would certify there (the same triangles, the same formulas).
+// Otherwise the search answers and leaves a new entry (slot: ColliderShape::mesh_cache; the bridge
+// adds the particle): a face or an edge entry where the nearest point lies inside a face or an edge
+// within twice the reach, else an empty one. Each formula has one call site (the GPU inlines them).
 // A skinned mesh: `deform`, the surface's velocity at the nearest point from its corners' (zero otherwise).
 KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_side, real reach,
                                OUT(real) distance, OUT(vec3) normal, OUT(vec3) deform) {
@@ -399,81 +406,154 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
   mesh_cache_load(MESH_DATA, s.mesh_cache, n, t, centre, radius);
   const bool edge = n.z > real(1.5);
   const bool face = !edge && dot3(n, n) > real(0);
+  const uint t2 = edge ? uint(n.x) : VKCLOTH_MESH_NONE;
   a = b = c = vec3(real(0));
-  if (face || edge)
+  if (face)
     mesh_triangle(MESH_DATA, t, a, b, c);
-  if (edge) { // the nearer of the edge's two triangles, as the search picks it
-    const uint t2 = uint(n.x), k = uint(n.y);
-    vec3 a2, b2, c2, f1, e0, e1, f2, g0, g1;
-    mesh_triangle(MESH_DATA, t2, a2, b2, c2);
-    corner_and_edge(k % 3u, a, b, c, f1, e0, e1);
-    corner_and_edge(k / 3u, a2, b2, c2, f2, g0, g1);
-    if (mesh_edge_hit(centre, radius, q, f1, e0, e1, f2, g0, g1)) {
-      precise real gap1 = triangle_gap2(q, a, b, c), gap2 = triangle_gap2(q, a2, b2, c2);
-      if (nearer(gap2, t2, gap1, t))
-        mesh_triangle_answer(MESH_DATA, s, t2, a2, b2, c2, gap2, q, p_side, reach, distance, normal, deform);
-      else
-        mesh_triangle_answer(MESH_DATA, s, t, a, b, c, gap1, q, p_side, reach, distance, normal, deform);
-      return;
-    }
-  } else if (mesh_cache_hit(n, centre, radius, a, b, c, q, reach_total)) {
-    mesh_face_contact(s, n, a, q, p_side, reach, distance, normal);
-    mesh_deformation(MESH_DATA, s, t, q - n * (dot3(q, n) - dot3(a, n)), a, b, c, deform);
-    return;
-  }
+  // The answer: 1: the face formula (plane m through a of triangle at: a, b, c); 2: the general
+  // formula (triangle at: a, b, c, at squared distance gap); 0: none yet.
+  uint answer = mesh_cache_hit(n, centre, radius, a, b, c, q, reach_total) ? 1u : 0u; // empty: m = 0, none
+  uint at = t;
+  vec3 m = n;
+  precise real gap = real(0);
   precise real guard = mesh_guard(q);
-  // The walk starts bounded by the entry's triangle, which is at least as far as the nearest: it
-  // finds the same triangle as an unbounded walk (the same order; no box holding the nearest is cut).
-  precise real start = real(1e18);
-  if (radius > real(0)) {
-    if (!face && !edge) // a face's or an edge's triangle is loaded already
-      mesh_triangle(MESH_DATA, t, a, b, c);
-    start = sqrt(triangle_gap2(q, a, b, c)) * real(1.0009765625) + guard; // 1 + 2^-10: never below its own
-  }
-  uint t2;
-  precise real best = mesh_nearest(MESH_DATA, s.mesh_root, s.mesh_tri0, q, start, VKCLOTH_MESH_NONE,
-                                   VKCLOTH_MESH_NONE, vec3(real(0)), real(0), vec3(real(0)), real(0),
-                                   real(-1), real(1.001953125), t, t2); // 1 + 2^-9: an edge's other triangle
-  mesh_triangle(MESH_DATA, t, a, b, c);
-  precise vec3 tn = unit_or_zero(cross3(b - a, c - a));
-  precise real d1 = sqrt(best);
-  const bool near = d1 < real(2) * reach_total;
-  // A face entry where the nearest point lies inside the face; an edge entry where it lies inside an
-  // edge of two faces at an angle; each within a ball where no triangle reaching in front of its
-  // plane(s) comes as near (its clearance, else a search 8 reaches beyond d1: each triangle moves at
-  // most as far as q; one wholly behind is never nearer than the face or the edge while q is in front
-  // of the face, inside it / beyond the edge on both faces, in the wedge).
-  const bool inside = face_margin(q, tn, a, b, c) > guard;
-  precise vec3 m1 = tn * select(dot3(q - a, tn) < real(0), real(-1), real(1)), m2 = m1, e0 = a;
-  uint code = 0u;
-  real clear = real(0), front, back;
-  mesh_clearance(MESH_DATA, t, front, back);
-  clear = select(dot3(m1, tn) < real(0), back, front);
-  const bool wedge =
-      near && !inside && mesh_edge_wedge(MESH_DATA, t, a, b, c, t2, q, guard, m1, m2, e0, code, clear);
-  precise real entry_radius = real(-1);
-  if (near && (inside || wedge)) {
-    entry_radius = mesh_clear_radius(clear, d1, guard);
-    if (entry_radius < real(2) * reach_total) {
-      uint unused, unused2;
-      precise real next = mesh_nearest(MESH_DATA, s.mesh_root, s.mesh_tri0, q, d1 + real(8) * reach_total, t,
-                                       select(wedge, t2, t), m1, dot3(m1, e0), m2, dot3(m2, e0), guard,
-                                       real(1), unused, unused2);
-      entry_radius = max(entry_radius, (sqrt(next) - d1) * real(0.5) - guard);
+  // Pass 0: an edge entry's own test. 1: the entry's neighbourhood, without a search. 2: the search.
+  // Each gives an edge (triangles base and cand, q beyond it on both) or a face (f0, else f1, q inside).
+  for (uint pass = edge ? 0u : (face ? 1u : 2u); pass < 3u && answer == 0u; ++pass) {
+    uint base = t, cand = VKCLOTH_MESH_NONE, f0 = VKCLOTH_MESH_NONE, f1 = VKCLOTH_MESH_NONE;
+    precise real d1 = real(0);
+    bool near = true;
+    vec3 ba, bb, bc;
+    if (pass == 0u) {
+      vec3 a2, b2, c2, x1, e0, e1, x2, g0, g1;
+      mesh_triangle(MESH_DATA, t, ba, bb, bc);
+      mesh_triangle(MESH_DATA, t2, a2, b2, c2);
+      corner_and_edge(uint(n.y) % 3u, ba, bb, bc, x1, e0, e1);
+      corner_and_edge(uint(n.y) / 3u, a2, b2, c2, x2, g0, g1);
+      if (!mesh_edge_hit(centre, radius, q, x1, e0, e1, x2, g0, g1))
+        continue;
+      cand = t2;
+    } else if (pass == 1u) {
+      if (face) {
+        precise vec3 tn = unit_or_zero(cross3(b - a, c - a));
+        precise real m0 = edge_margin(q, tn, b, c), m1 = edge_margin(q, tn, c, a),
+                     m2 = edge_margin(q, tn, a, b);
+        const uint k = m0 <= min(m1, m2) ? 0u : (m1 <= m2 ? 1u : 2u);
+        const uint local = mesh_neighbour(MESH_DATA, s.mesh_adj0, t - s.mesh_tri0, k);
+        cand = local >= 268435456u ? VKCLOTH_MESH_NONE : s.mesh_tri0 + local; // none (at most 2^28 triangles)
+        f0 = cand;
+        f1 = t;
+      } else {
+        f0 = t;
+        f1 = t2;
+      }
+      mesh_triangle(MESH_DATA, base, ba, bb, bc);
+    } else {
+      // The walk starts bounded by the entry's triangle, which is at least as far as the nearest:
+      // it finds the same triangle as an unbounded walk (the same order; no box holding it is cut).
+      precise real start = real(1e18);
+      if (radius > real(0)) {
+        mesh_triangle(MESH_DATA, t, a, b, c);
+        start =
+            sqrt(triangle_gap2(q, a, b, c)) * real(1.0009765625) + guard; // 1 + 2^-10: never below its own
+      }
+      gap = mesh_nearest(MESH_DATA, s.mesh_root, s.mesh_tri0, q, start, VKCLOTH_MESH_NONE, VKCLOTH_MESH_NONE,
+                         vec3(real(0)), real(0), vec3(real(0)), real(0), real(-1), real(1.001953125), base,
+                         cand); // 1 + 2^-9: an edge's other triangle
+      at = base;
+      d1 = sqrt(gap);
+      near = d1 < real(2) * reach_total;
+      f0 = base;
+      mesh_triangle(MESH_DATA, base, ba, bb, bc);
+    }
+    // An edge: the nearer of its two triangles by the search's measure (ties: the lower index).
+    precise vec3 m1, m2, e0;
+    uint code = 0u;
+    real clear = real(0);
+    bool is_edge = pass == 0u;
+    if (pass > 0u && near && cand != VKCLOTH_MESH_NONE)
+      is_edge = mesh_edge_wedge(MESH_DATA, base, ba, bb, bc, cand, q, guard, m1, m2, e0, code, clear);
+    bool is_face = false;
+    if (is_edge) {
+      at = base;
+      for (uint i = 0u; i < 2u; ++i) {
+        const uint ti = i == 0u ? base : cand;
+        vec3 ta, tb, tc;
+        mesh_triangle(MESH_DATA, ti, ta, tb, tc);
+        precise real gi = triangle_gap2(q, ta, tb, tc);
+        if (i == 0u || nearer(gi, ti, gap, at)) {
+          gap = gi;
+          at = ti;
+          a = ta;
+          b = tb;
+          c = tc;
+        }
+      }
+      d1 = sqrt(gap);
+      is_edge = pass != 1u || d1 < real(2) * reach_total;
+    } else {
+      // A face: q inside it (and, without a search, in front by more than guard, within twice the reach).
+      for (uint i = 0u; i < 2u && near && !is_face; ++i) {
+        const uint f = i == 0u ? f0 : f1;
+        if (f == VKCLOTH_MESH_NONE)
+          continue;
+        mesh_triangle(MESH_DATA, f, a, b, c);
+        precise vec3 tn = unit_or_zero(cross3(b - a, c - a));
+        precise real h = dot3(q - a, tn);
+        if (face_margin(q, tn, a, b, c) > guard &&
+            (pass == 2u || (abs(h) > guard && abs(h) < real(2) * reach_total))) {
+          is_face = true;
+          at = f;
+          m1 = tn * select(h < real(0), real(-1), real(1));
+          m2 = m1;
+          e0 = a;
+          real front, back;
+          mesh_clearance(MESH_DATA, f, front, back);
+          clear = select(h < real(0), back, front);
+          d1 = select(pass == 2u, d1, abs(h));
+        }
+      }
+    }
+    if (pass == 0u) {
+      answer = 2u;
+    } else if (is_edge || is_face) {
+      // The ball: no triangle reaching in front of the plane(s) comes as near as the face or the edge
+      // (its clearance; else, after a search, one 8 reaches beyond d1: each triangle moves at most as
+      // far as q; one wholly behind is never nearer than the face or the edge while q is in front of
+      // the face and inside it, or beyond the edge on both faces).
+      precise real ball = mesh_clear_radius(clear, d1, guard);
+      if (pass == 2u && ball < real(2) * reach_total) {
+        uint unused, unused2;
+        precise real next = mesh_nearest(MESH_DATA, s.mesh_root, s.mesh_tri0, q, d1 + real(8) * reach_total,
+                                         base, is_edge ? cand : base, m1, dot3(m1, e0), m2, dot3(m2, e0),
+                                         guard, real(1), unused, unused2);
+        ball = max(ball, (sqrt(next) - d1) * real(0.5) - guard);
+      }
+      if (is_face && (ball > real(0) || pass == 2u)) {
+        mesh_cache_store(MESH_DATA, s.mesh_cache, m1, at, q, ball);
+        m = m1;
+        answer = 1u;
+      } else if (is_edge && ball > real(0)) {
+        mesh_cache_store(MESH_DATA, s.mesh_cache, vec3(real(cand), real(code), real(2)), base, q, ball);
+        answer = 2u;
+      }
+    }
+    if (pass == 2u &&
+        answer == 0u) { // far, at a corner, ...: no triangle nearer than d1 (base: the next walk's start)
+      mesh_cache_store(MESH_DATA, s.mesh_cache, vec3(real(0)), base, q, d1 - guard);
+      at = base;
+      a = ba;
+      b = bb;
+      c = bc;
+      answer = 2u;
     }
   }
-  if (near && inside) {
-    mesh_cache_store(MESH_DATA, s.mesh_cache, m1, t, q, entry_radius);
-    mesh_face_contact(s, m1, a, q, p_side, reach, distance, normal);
-    mesh_deformation(MESH_DATA, s, t, q - m1 * (dot3(q, m1) - dot3(a, m1)), a, b, c, deform);
-    return;
+  if (answer == 1u) {
+    mesh_face_contact(s, m, a, q, p_side, reach, distance, normal);
+    mesh_deformation(MESH_DATA, s, at, q - m * (dot3(q, m) - dot3(a, m)), a, b, c, deform);
   }
-  // An edge entry; else (far, at a corner, ...) no triangle nearer than d1 (t: the next walk's start).
-  if (wedge && entry_radius > real(0))
-    mesh_cache_store(MESH_DATA, s.mesh_cache, vec3(real(t2), real(code), real(2)), t, q, entry_radius);
-  else
-    mesh_cache_store(MESH_DATA, s.mesh_cache, vec3(real(0)), t, q, d1 - guard);
-  mesh_triangle_answer(MESH_DATA, s, t, a, b, c, best, q, p_side, reach, distance, normal, deform);
+  if (answer == 2u)
+    mesh_triangle_answer(MESH_DATA, s, at, a, b, c, gap, q, p_side, reach, distance, normal, deform);
 }
 #endif // VKCLOTH_KERNEL_NO_MESH
 

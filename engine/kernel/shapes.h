@@ -21,6 +21,7 @@ struct ColliderShape {
   uint mesh_tri0;
   uint mesh_cache; // mesh: where its particles' search entries start (the bridge adds the particle)
   uint mesh_vel0;  // mesh: its first triangle's corner velocities (VKCLOTH_MESH_NONE: a rigid mesh)
+  uint mesh_adj0;  // mesh: its triangles' neighbours (mesh_neighbour)
   bool moving;     // the surface moves: velocity, spin and pivot apply
   vec3 velocity;   // linear velocity
   vec3 spin;       // angular velocity about pivot

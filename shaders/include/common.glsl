@@ -118,6 +118,14 @@ void mesh_triangle(uint particle, uint i, out vec3 a, out vec3 b, out vec3 c) {
   b = t.b.xyz;
   c = t.c.xyz;
 }
+// A mesh's neighbours (ColliderMesh::neighbours) follow every triangle and velocity in MESH_TRIS,
+// four triangles' (12 words) to a MeshTriangle, from adj0 on.
+uint mesh_neighbour(uint particle, uint adj0, uint i, uint k) {
+  const uint word = (i % 4u) * 3u + k;
+  const MeshTriangle t = read_mesh_triangle(adj0 + i / 4u);
+  const vec4 v = word < 4u ? t.a : (word < 8u ? t.b : t.c);
+  return floatBitsToUint(v[word % 4u]);
+}
 void mesh_clearance(uint particle, uint i, out float front, out float back) {
   const MeshTriangle t = read_mesh_triangle(i);
   front = t.a.w;
@@ -162,6 +170,7 @@ ColliderShape collider_shape(uint c) {
   s.mesh_tri0 = col.mesh_tri0;
   s.mesh_cache = floatBitsToUint(col.pivot.w);
   s.mesh_vel0 = floatBitsToUint(col.end_b.w);
+  s.mesh_adj0 = floatBitsToUint(col.axis_x.w);
   s.moving = col.moving != 0u;
   s.velocity = col.velocity.xyz;
   s.spin = col.spin.xyz;

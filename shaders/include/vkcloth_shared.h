@@ -251,7 +251,8 @@ struct Collider {
   uint mesh_tri0; // mesh: its first triangle in MESH_TRIS
   vec4 end_b;     // capsule: (b, 0); box: (half extents, 0); mesh: w: the bits of its first corner
                   // velocities in MESH_TRIS (VKCLOTH_MESH_NONE: rigid)
-  vec4 axis_x;    // box, mesh: the body's axes in the world (the rotation's columns)
+  vec4 axis_x;    // box, mesh: the body's axes in the world (the rotation's columns); x.w: a mesh:
+                  // the bits of where its neighbours start in MESH_TRIS
   vec4 axis_y;
   vec4 axis_z;
   vec4 velocity; // xyz: linear velocity; w: kinetic friction

@@ -82,13 +82,20 @@ public:
   /// Per triangle (leaf order), its corners' velocities in Triangle's layout (a, b, c); empty for a
   /// mesh that never moved (create(), from_mesh()).
   std::span<const Triangle> triangle_velocities() const { return velocities_; }
+  /// No triangle across an edge (neighbours()).
+  static constexpr std::uint32_t no_neighbour = 0xffffffffu;
+  /// Per triangle (leaf order), three: the triangle across its edge opposite corner a, b, c (the
+  /// only other one with both of the edge's corners at the same positions; no_neighbour for a border
+  /// or an edge of three or more). A contact entry moves across an edge to it without a search.
+  std::span<const std::uint32_t> neighbours() const { return neighbours_; }
 
 private:
   std::vector<Node> nodes_;
   std::vector<Triangle> triangles_;
   std::vector<Triangle> velocities_;
   std::vector<std::uint32_t> corners_; // per triangle (leaf order): its three vertices
-  std::vector<glm::vec3> positions_;   // the vertices, rounded to float
+  std::vector<std::uint32_t> neighbours_;
+  std::vector<glm::vec3> positions_; // the vertices, rounded to float
   std::string name_;
   std::uint32_t depth_ = 0;
   std::uint32_t dropped_ = 0;

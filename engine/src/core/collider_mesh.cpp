@@ -7,7 +7,9 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <map>
 #include <optional>
+#include <tuple>
 
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
@@ -101,6 +103,28 @@ void compute_clearances(std::span<ColliderMesh::Triangle> tris, std::span<const 
   }
 }
 
+/// Per triangle, the triangle across each edge (ColliderMesh::neighbours): edges keyed by their
+/// corners' positions, so that a seam's duplicated vertices still join.
+std::vector<std::uint32_t> find_neighbours(std::span<const ColliderMesh::Triangle> tris) {
+  using Point = std::tuple<float, float, float>;
+  auto point = [](glm::vec3 v) { return Point{v.x, v.y, v.z}; };
+  std::map<std::pair<Point, Point>, std::vector<std::uint32_t>> edges; // edge -> 3 t + k
+  for (std::size_t t = 0; t < tris.size(); ++t) {
+    const glm::vec3 v[3] = {tris[t].a, tris[t].b, tris[t].c};
+    for (std::uint32_t k = 0; k < 3; ++k) {
+      const Point p = point(v[(k + 1) % 3]), q = point(v[(k + 2) % 3]);
+      edges[std::minmax(p, q)].push_back(std::uint32_t(3 * t + k));
+    }
+  }
+  std::vector<std::uint32_t> out(3 * tris.size(), ColliderMesh::no_neighbour);
+  for (const auto& [edge, sides] : edges)
+    if (sides.size() == 2) {
+      out[sides[0]] = sides[1] / 3;
+      out[sides[1]] = sides[0] / 3;
+    }
+  return out;
+}
+
 Error bad(const std::string& name, const std::string& what) {
   return Error{ErrorCode::invalid_argument, fmt::format("mesh collider {}: {}", name, what)};
 }
@@ -156,6 +180,7 @@ Result<std::shared_ptr<const ColliderMesh>> ColliderMesh::create(std::span<const
     mesh->positions_.emplace_back(p);
   mesh->nodes_ = std::move(b.nodes);
   compute_clearances(mesh->triangles_, mesh->nodes_);
+  mesh->neighbours_ = find_neighbours(mesh->triangles_);
   mesh->name_ = std::move(name);
   mesh->depth_ = b.depth;
   mesh->dropped_ = dropped;

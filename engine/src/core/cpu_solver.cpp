@@ -231,6 +231,7 @@ template <typename Real> void CpuSolver<Real>::Impl::prepare_colliders() {
       m.nodes = c.mesh->nodes().data();
       m.triangles = c.mesh->triangles().data();
       m.cache = mesh_cache_.data();
+      m.neighbours = c.mesh->neighbours().data();
       if (!c.mesh->triangle_velocities().empty())
         m.velocities = c.mesh->triangle_velocities().data();
       cache = mesh_ordinal++ * std::uint32_t(pos_.size());

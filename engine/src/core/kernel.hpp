@@ -75,8 +75,12 @@ struct MeshData {
   void* cache = nullptr;
   std::uint32_t particle = 0;
   const ColliderMesh::Triangle* velocities = nullptr; ///< a skinned mesh's corner velocities
+  const std::uint32_t* neighbours = nullptr;          ///< ColliderMesh::neighbours (null: none)
+  std::uint64_t* node_visits = nullptr;               ///< counts the search's node reads (tests)
 };
 template <typename V> void mesh_node(const MeshData& m, uint i, V& lo, uint& first, V& hi, uint& count) {
+  if (m.node_visits)
+    ++*m.node_visits;
   const ColliderMesh::Node& n = m.nodes[i];
   lo = V(n.lo);
   hi = V(n.hi);
@@ -105,6 +109,10 @@ template <typename R> uint mesh_cache_uint(R w) {
 }
 template <typename R> R* mesh_cache_entry(const MeshData& m, uint slot) {
   return static_cast<R*>(m.cache) + 8 * (std::size_t(slot) + m.particle);
+}
+/// The triangle across edge k of triangle i (the mesh's own indices; VKCLOTH_MESH_NONE: none).
+inline uint mesh_neighbour(const MeshData& m, uint /*adj0*/, uint i, uint k) {
+  return m.neighbours ? m.neighbours[3 * std::size_t(i) + k] : VKCLOTH_MESH_NONE;
 }
 template <typename R> void mesh_clearance(const MeshData& m, uint i, R& front, R& back) {
   front = R(m.triangles[i].clearance_front);
@@ -217,11 +225,12 @@ using ColliderShape = std::conditional_t<std::is_same_v<Real, float>, f32::Colli
 /// buffer), so the CPU float solver and the GPU see the same values. mesh_root / mesh_tri0: where
 /// the collider's mesh starts in the buffers the caller walks (0 when it walks the mesh in place);
 /// mesh_cache: where its particles' search entries start; mesh_vel0: where a skinned mesh's corner
-/// velocities start (ignored for a rigid mesh, whose shape gets VKCLOTH_MESH_NONE).
+/// velocities start (ignored for a rigid mesh, whose shape gets VKCLOTH_MESH_NONE); mesh_adj0: where
+/// its neighbours start (the GPU's buffer; the CPU reads MeshData::neighbours).
 template <typename Real>
 kernel::ColliderShape<Real> kernel_shape(const Collider& c, std::uint32_t mesh_root = 0,
                                          std::uint32_t mesh_tri0 = 0, std::uint32_t mesh_cache = 0,
-                                         std::uint32_t mesh_vel0 = 0) {
+                                         std::uint32_t mesh_vel0 = 0, std::uint32_t mesh_adj0 = 0) {
   using V = glm::vec<3, Real>;
   kernel::ColliderShape<Real> s{};
   s.type = std::uint32_t(c.type);
@@ -254,6 +263,7 @@ kernel::ColliderShape<Real> kernel_shape(const Collider& c, std::uint32_t mesh_r
   s.mesh_root = mesh_root;
   s.mesh_tri0 = mesh_tri0;
   s.mesh_cache = mesh_cache;
+  s.mesh_adj0 = mesh_adj0;
   const bool skinned = c.type == Collider::Type::mesh && c.mesh && !c.mesh->triangle_velocities().empty();
   s.mesh_vel0 = skinned ? mesh_vel0 : VKCLOTH_MESH_NONE;
   s.moving = c.moving() || skinned;

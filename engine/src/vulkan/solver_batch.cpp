@@ -76,10 +76,10 @@ Result<void> SolverBatch::ensure_mesh_buffers() {
     return ensure_mesh_cache();
   std::vector<ColliderMesh::Node> nodes;
   std::vector<ColliderMesh::Triangle> tris;
-  std::vector<std::array<std::uint32_t, 3>> starts;
+  std::vector<std::array<std::uint32_t, 4>> starts;
   for (const auto& m : wanted) {
     starts.push_back({static_cast<std::uint32_t>(nodes.size()), static_cast<std::uint32_t>(tris.size()),
-                      VKCLOTH_MESH_NONE});
+                      VKCLOTH_MESH_NONE, 0});
     nodes.insert(nodes.end(), m->nodes().begin(), m->nodes().end());
     tris.insert(tris.end(), m->triangles().begin(), m->triangles().end());
   }
@@ -89,6 +89,20 @@ Result<void> SolverBatch::ensure_mesh_buffers() {
       tris.insert(tris.end(), wanted[k]->triangle_velocities().begin(),
                   wanted[k]->triangle_velocities().end());
     }
+  for (std::size_t k = 0; k < wanted.size(); ++k) { // their neighbours, four triangles' to a record
+    starts[k][3] = static_cast<std::uint32_t>(tris.size());
+    const std::span<const std::uint32_t> adj = wanted[k]->neighbours();
+    std::vector<float> words((adj.size() + 11) / 12 * 12, std::bit_cast<float>(VKCLOTH_MESH_NONE));
+    for (std::size_t w = 0; w < adj.size(); ++w)
+      words[w] = std::bit_cast<float>(adj[w]);
+    for (std::size_t r = 0; r < words.size(); r += 12)
+      tris.push_back({{words[r], words[r + 1], words[r + 2]},
+                      words[r + 3],
+                      {words[r + 4], words[r + 5], words[r + 6]},
+                      words[r + 7],
+                      {words[r + 8], words[r + 9], words[r + 10]},
+                      words[r + 11]});
+  }
   static_assert(sizeof(ColliderMesh::Node) == sizeof(sh::MeshNode) &&
                 sizeof(ColliderMesh::Triangle) == sizeof(sh::MeshTriangle));
   if (mesh_nodes.buffer && nodes.size() == mesh_node_count && tris.size() == mesh_tri_count) {
@@ -182,13 +196,13 @@ std::vector<sh::Collider> SolverBatch::packed_colliders() const {
   for (const Slot& slot : slots) {
     std::uint32_t mesh_ordinal = 0;
     for (const Collider& c : slot.params.colliders) {
-      std::array<std::uint32_t, 3> start{0, 0, 0};
+      std::array<std::uint32_t, 4> start{0, 0, 0, 0};
       std::uint32_t cache = 0;
       if (c.mesh)
         start = mesh_starts[std::size_t(std::find(meshes.begin(), meshes.end(), c.mesh) - meshes.begin())];
       if (c.type == Collider::Type::mesh)
         cache = mesh_ordinal++ * size() * count;
-      const auto k = kernel::kernel_shape<float>(c, start[0], start[1], cache, start[2]);
+      const auto k = kernel::kernel_shape<float>(c, start[0], start[1], cache, start[2], start[3]);
       const auto v4 = [](glm::vec3 v, float w) { return sh::vec4{v.x, v.y, v.z, w}; };
       sh::Collider g{};
       g.shape = v4(k.a, k.b);
@@ -197,7 +211,7 @@ std::vector<sh::Collider> SolverBatch::packed_colliders() const {
       g.mesh_root = k.mesh_root;
       g.mesh_tri0 = k.mesh_tri0;
       g.end_b = v4(k.c, std::bit_cast<float>(k.mesh_vel0));
-      g.axis_x = v4(k.ax, 0.0f);
+      g.axis_x = v4(k.ax, std::bit_cast<float>(k.mesh_adj0));
       g.axis_y = v4(k.ay, 0.0f);
       g.axis_z = v4(k.az, 0.0f);
       g.velocity = v4(k.velocity, k.mu_k);

@@ -275,12 +275,12 @@ private:
   std::uint32_t collider_capacity = 0;
   // Mesh colliders: every distinct ColliderMesh of the batch's colliders, their hierarchies and
   // triangles one after the other (one zeroed element of each when there is none); `meshes` holds
-  // them alive, `mesh_starts` their first node, first triangle and, for a skinned mesh, first corner
-  // velocities (after every mesh's triangles, in MESH_TRIS; VKCLOTH_MESH_NONE: rigid) (Collider::mesh_root,
-  // mesh_tri0, end_b.w).
+  // them alive, `mesh_starts` their first node, first triangle, for a skinned mesh first corner
+  // velocities (after every mesh's triangles, in MESH_TRIS; VKCLOTH_MESH_NONE: rigid) and first
+  // neighbours' record (after those) (Collider::mesh_root, mesh_tri0, end_b.w, axis_x.w).
   Buffer mesh_nodes, mesh_tris;
   std::vector<std::shared_ptr<const ColliderMesh>> meshes;
-  std::vector<std::array<std::uint32_t, 3>> mesh_starts;
+  std::vector<std::array<std::uint32_t, 4>> mesh_starts;
   // A skinned mesh's new pose (ColliderMesh::deformed: the same counts) is written into the same
   // buffers by vkCmdUpdateBuffer at the next record(), no wait: these hold it until then.
   std::vector<ColliderMesh::Node> mesh_nodes_pending;
