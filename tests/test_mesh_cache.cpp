@@ -278,3 +278,37 @@ TEST_CASE("mesh contact: an entry moves across faces and edges to its neighbours
   CHECK(visits == first_visits); // no search after the first
   CHECK(edge_entries > 5);       // the wedge was crossed with an edge entry
 }
+
+TEST_CASE("mesh contact: a face entry answers from the triangle's back as from its front") {
+  // Inside the box (its triangles face out), 3 to 5 mm under the top face's first triangle, within a
+  // 1 cm square (inside the ball its search leaves: the side faces are 7 cm away), and the same
+  // positions above it: one search each, the walk's bits.
+  const auto mesh = box_mesh();
+  const Collider c =
+      Collider::triangle_mesh(mesh, {0.1, -0.2, 0.3}, Collider::rotation_from_degrees({10, 0, 30}), 0.005);
+  const kernel::MeshData searching{mesh->nodes().data(), mesh->triangles().data()};
+  const auto shape = kernel::kernel_shape<float>(c);
+  for (const double side : {-1.0, 1.0}) {
+    CAPTURE(side);
+    std::vector<float> entry(8, 0.0f);
+    kernel::MeshData cached{mesh->nodes().data(),     mesh->triangles().data(), entry.data(), 0, nullptr,
+                            mesh->neighbours().data()};
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    std::size_t searches = 0, differences = 0;
+    for (int k = 0; k < 200; ++k) {
+      const glm::dvec3 body(0.05 + 0.005 * u(rng), -0.03 + 0.005 * u(rng),
+                            0.15 + side * (0.004 + 0.001 * u(rng)));
+      const glm::vec3 world(c.center + c.rotation * body);
+      const std::vector<float> before = entry;
+      float d_cached, d_searched;
+      glm::vec3 n_cached, n_searched, deform;
+      kernel::collider_contact(cached, shape, world, world, 0.002f, d_cached, n_cached, deform);
+      kernel::collider_contact(searching, shape, world, world, 0.002f, d_searched, n_searched, deform);
+      searches += before != entry;
+      differences += d_cached != d_searched || n_cached != n_searched;
+    }
+    CHECK(differences == 0);
+    CHECK(searches == 1);
+  }
+}

@@ -33,7 +33,7 @@ KFN precise vec3 to_world_dir(ColliderShape s, vec3 d) {
 // file's mesh_cache_load / mesh_cache_store(MESH_DATA, slot, n, tri, centre, radius):
 // - face (n != 0): triangle `tri` (unit normal n, turned towards q's side) holds the nearest point of
 //   the mesh inside its face for every q in front of it whose projection lies inside the face
-//   (face_margin > guard) and with |q - centre| < radius (no other triangle comes as near);
+//   (inside_face) and with |q - centre| < radius (no other triangle comes as near);
 // - edge (n.z = 2): the nearest point of the mesh lies inside the edge that triangle `tri` shares with
 //   triangle n.x at an angle (the corners opposite it: n.y = k + 3 k2, corner_and_edge) for every q
 //   beyond the edge on both faces with |q - centre| < radius (mesh_edge_hit);
@@ -45,16 +45,26 @@ KFN precise real mesh_guard(vec3 q) {
   return g;
 }
 
-// How far q's projection on the plane of triangle (a, b, c) (unit normal n, counter-clockwise) lies
-// inside it: its distance to the nearest edge's line, negative outside.
+// How far q's projection on the plane of a triangle (unit normal n, counter-clockwise) lies inside
+// its edge a -> b: its distance to the edge's line, negative beyond it.
 KFN precise real edge_margin(vec3 q, vec3 n, vec3 a, vec3 b) {
   precise vec3 e = b - a;
   precise real m = dot3(cross3(n, e), q - a) / sqrt(dot3(e, e));
   return m;
 }
-KFN precise real face_margin(vec3 q, vec3 n, vec3 a, vec3 b, vec3 c) {
-  precise real m = min(min(edge_margin(q, n, a, b), edge_margin(q, n, b, c)), edge_margin(q, n, c, a));
-  return m;
+// Whether q's projection on the plane of triangle (a, b, c) (unit normal n, either side) lies inside
+// it by more than guard from each edge's line: (n x e) . (q - a) > guard |e|, turned by the side n is
+// on and compared squared (no root, no division).
+KFN VARYING(bool) inside_edge(vec3 q, vec3 n, vec3 a, vec3 b, real turn, real guard) {
+  precise vec3 e = b - a;
+  precise real d = dot3(cross3(n, e), q - a) * turn;
+  precise real g2 = guard * guard * dot3(e, e);
+  return d > real(0) && d * d > g2;
+}
+KFN VARYING(bool) inside_face(vec3 q, vec3 n, vec3 a, vec3 b, vec3 c, real guard) {
+  precise real turn = select(dot3(n, cross3(b - a, c - a)) < real(0), real(-1), real(1));
+  return inside_edge(q, n, a, b, turn, guard) && inside_edge(q, n, b, c, turn, guard) &&
+         inside_edge(q, n, c, a, turn, guard);
 }
 
 // The entry (n, centre, radius; a face's triangle a, b, c) answers a query at q (body frame) that
@@ -67,7 +77,7 @@ KFN VARYING(bool)
   precise real r = select(face, radius, radius - reach_total);
   VARYING(bool) within = r > real(0) && d2 < r * r;
   precise real guard = mesh_guard(q);
-  VARYING(bool) on_face = dot3(q - a, n) > guard && face_margin(q, n, a, b, c) > guard;
+  VARYING(bool) on_face = dot3(q - a, n) > guard && inside_face(q, n, a, b, c, guard);
   VARYING(bool) edge = n.z > real(1.5); // mesh_contact's own (scalar) test
   return within && (!face || on_face) && !edge;
 }
@@ -500,7 +510,7 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
         mesh_triangle(MESH_DATA, f, a, b, c);
         precise vec3 tn = unit_or_zero(cross3(b - a, c - a));
         precise real h = dot3(q - a, tn);
-        if (face_margin(q, tn, a, b, c) > guard &&
+        if (inside_face(q, tn, a, b, c, guard) &&
             (pass == 2u || (abs(h) > guard && abs(h) < real(2) * reach_total))) {
           is_face = true;
           at = f;

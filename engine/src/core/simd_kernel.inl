@@ -67,9 +67,11 @@ inline void mesh_contact(const LaneMesh<Isa>& m, ColliderShape s, vec3 q, vec3 p
     put3(7, a);
     put3(10, b);
     put3(13, c);
-    put3(16, va);
-    put3(19, vb);
-    put3(22, vc);
+    if (skinned) {
+      put3(16, va);
+      put3(19, vb);
+      put3(22, vc);
+    }
   }
   auto lanes = [&](int k) {
     real r;
