@@ -63,8 +63,11 @@ KFN VARYING(bool) inside_edge(vec3 q, vec3 n, vec3 a, vec3 b, real turn, real gu
 }
 KFN VARYING(bool) inside_face(vec3 q, vec3 n, vec3 a, vec3 b, vec3 c, real guard) {
   precise real turn = select(dot3(n, cross3(b - a, c - a)) < real(0), real(-1), real(1));
-  return inside_edge(q, n, a, b, turn, guard) && inside_edge(q, n, b, c, turn, guard) &&
-         inside_edge(q, n, c, a, turn, guard);
+  // Each test first, then their && (GLSL branches around a call on the right of &&).
+  VARYING(bool) ab = inside_edge(q, n, a, b, turn, guard);
+  VARYING(bool) bc = inside_edge(q, n, b, c, turn, guard);
+  VARYING(bool) ca = inside_edge(q, n, c, a, turn, guard);
+  return ab && bc && ca;
 }
 
 // The entry (n, centre, radius; a face's triangle a, b, c) answers a query at q (body frame) that
@@ -77,7 +80,8 @@ KFN VARYING(bool)
   precise real r = select(face, radius, radius - reach_total);
   VARYING(bool) within = r > real(0) && d2 < r * r;
   precise real guard = mesh_guard(q);
-  VARYING(bool) on_face = dot3(q - a, n) > guard && inside_face(q, n, a, b, c, guard);
+  VARYING(bool) inside = inside_face(q, n, a, b, c, guard);
+  VARYING(bool) on_face = dot3(q - a, n) > guard && inside;
   VARYING(bool) edge = n.z > real(1.5); // mesh_contact's own (scalar) test
   return within && (!face || on_face) && !edge;
 }
