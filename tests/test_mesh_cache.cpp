@@ -78,6 +78,25 @@ double triangle_distance(const ColliderMesh::Triangle& x, const ColliderMesh::Tr
   return best;
 }
 
+/// One query at `world` (reach 2 mm) through the particle's entry (`cached`, whose entry is `entry`)
+/// and one by the search alone: whether the entry changed, whether the answers differ in any bit,
+/// and the search's distance.
+struct Compared {
+  bool searched = false, differs = false;
+  float distance = 0.0f;
+};
+Compared compare_query(const kernel::MeshData& cached, const kernel::ColliderShape<float>& shape,
+                       const std::shared_ptr<const ColliderMesh>& mesh, const std::vector<float>& entry,
+                       glm::vec3 world) {
+  const kernel::MeshData searching{mesh->nodes().data(), mesh->triangles().data()};
+  const std::vector<float> before = entry;
+  float d_cached, d_searched;
+  glm::vec3 n_cached, n_searched, deform;
+  kernel::collider_contact(cached, shape, world, world, 0.002f, d_cached, n_cached, deform);
+  kernel::collider_contact(searching, shape, world, world, 0.002f, d_searched, n_searched, deform);
+  return {before != entry, d_cached != d_searched || n_cached != n_searched, d_searched};
+}
+
 struct Walked {
   std::size_t queries = 0, searches = 0, differences = 0;
   double worst_vs_brute_force = 0.0;
@@ -204,7 +223,6 @@ TEST_CASE("mesh contact: a particle beyond a box's edge keeps its edge entry, wi
   std::vector<float> entry(8, 0.0f);
   kernel::MeshData cached{mesh->nodes().data(),     mesh->triangles().data(), entry.data(), 0, nullptr,
                           mesh->neighbours().data()};
-  const kernel::MeshData searching{mesh->nodes().data(), mesh->triangles().data()};
   const auto shape = kernel::kernel_shape<float>(c);
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -212,16 +230,11 @@ TEST_CASE("mesh contact: a particle beyond a box's edge keeps its edge entry, wi
   for (int k = 0; k < 200; ++k) {
     const double angle = 0.785398 + 0.6 * u(rng), r = 0.0045 + 0.0015 * u(rng);
     const glm::dvec3 body(0.1 * u(rng), -0.1 - r * std::cos(angle), 0.15 + r * std::sin(angle));
-    const glm::vec3 world(c.center + c.rotation * body);
-    const std::vector<float> before = entry;
-    float d_cached, d_searched;
-    glm::vec3 n_cached, n_searched, deform;
-    kernel::collider_contact(cached, shape, world, world, 0.002f, d_cached, n_cached, deform);
-    kernel::collider_contact(searching, shape, world, world, 0.002f, d_searched, n_searched, deform);
-    searches += before != entry;
-    differences += d_cached != d_searched || n_cached != n_searched;
+    const Compared q = compare_query(cached, shape, mesh, entry, glm::vec3(c.center + c.rotation * body));
+    searches += q.searched;
+    differences += q.differs;
     CHECK(entry[2] == 2.0f); // an edge entry
-    CHECK(std::abs(double(d_searched) - (r - c.thickness)) < 1e-6);
+    CHECK(std::abs(double(q.distance) - (r - c.thickness)) < 1e-6);
   }
   CHECK(differences == 0);
   CHECK(searches == 1); // the first query's
@@ -247,7 +260,6 @@ TEST_CASE("mesh contact: an entry moves across faces and edges to its neighbours
                           nullptr,
                           mesh->neighbours().data(),
                           &visits};
-  const kernel::MeshData searching{mesh->nodes().data(), mesh->triangles().data()};
   const auto shape = kernel::kernel_shape<float>(c);
   const double r = 0.004, top = 0.35, arc = top + 0.5 * 3.14159265358979 * r;
   std::size_t queries = 0, differences = 0, edge_entries = 0;
@@ -261,16 +273,12 @@ TEST_CASE("mesh contact: an entry moves across faces and edges to its neighbours
       body = {0.2 + r * std::sin(angle), 0.0, 0.15 + r * std::cos(angle)};
     } else
       body = {0.2 + r, 0.0, 0.15 - (u - arc)};
-    const glm::vec3 world(c.center + c.rotation * body);
-    float d_cached, d_searched;
-    glm::vec3 n_cached, n_searched, deform;
-    kernel::collider_contact(cached, shape, world, world, 0.002f, d_cached, n_cached, deform);
-    kernel::collider_contact(searching, shape, world, world, 0.002f, d_searched, n_searched, deform);
+    const Compared q = compare_query(cached, shape, mesh, entry, glm::vec3(c.center + c.rotation * body));
     if (queries++ == 0)
       first_visits = visits;
-    differences += d_cached != d_searched || n_cached != n_searched;
+    differences += q.differs;
     edge_entries += entry[2] == 2.0f;
-    CHECK(std::abs(double(d_searched) - (r - c.thickness)) < 1e-6);
+    CHECK(std::abs(double(q.distance) - (r - c.thickness)) < 1e-6);
   }
   CHECK(queries > 1000);
   CHECK(differences == 0);
@@ -286,7 +294,6 @@ TEST_CASE("mesh contact: a face entry answers from the triangle's back as from i
   const auto mesh = box_mesh();
   const Collider c =
       Collider::triangle_mesh(mesh, {0.1, -0.2, 0.3}, Collider::rotation_from_degrees({10, 0, 30}), 0.005);
-  const kernel::MeshData searching{mesh->nodes().data(), mesh->triangles().data()};
   const auto shape = kernel::kernel_shape<float>(c);
   for (const double side : {-1.0, 1.0}) {
     CAPTURE(side);
@@ -299,14 +306,9 @@ TEST_CASE("mesh contact: a face entry answers from the triangle's back as from i
     for (int k = 0; k < 200; ++k) {
       const glm::dvec3 body(0.05 + 0.005 * u(rng), -0.03 + 0.005 * u(rng),
                             0.15 + side * (0.004 + 0.001 * u(rng)));
-      const glm::vec3 world(c.center + c.rotation * body);
-      const std::vector<float> before = entry;
-      float d_cached, d_searched;
-      glm::vec3 n_cached, n_searched, deform;
-      kernel::collider_contact(cached, shape, world, world, 0.002f, d_cached, n_cached, deform);
-      kernel::collider_contact(searching, shape, world, world, 0.002f, d_searched, n_searched, deform);
-      searches += before != entry;
-      differences += d_cached != d_searched || n_cached != n_searched;
+      const Compared q = compare_query(cached, shape, mesh, entry, glm::vec3(c.center + c.rotation * body));
+      searches += q.searched;
+      differences += q.differs;
     }
     CHECK(differences == 0);
     CHECK(searches == 1);

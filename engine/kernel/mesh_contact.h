@@ -1,0 +1,554 @@
+// SPDX-License-Identifier: MIT
+// vkcloth kernel: a mesh collider's contact (docs/model.md "Mesh contact"): the per-particle search
+// entries, the search of the triangles' hierarchy, and mesh_contact, which collider_contact calls.
+// Part of the kernel that cloth_kernel.h gathers (the rules it states hold here: fixed order,
+// `precise` results, real(...) literals); contacts.h includes it after to_body / to_world_dir. No
+// include guard: the C++ bridge includes it once per precision.
+
+// ---- Mesh colliders (docs/model.md "Mesh contact") ------------------------------------------
+// A particle's contact with a mesh collider comes from the nearest triangle. A search of the
+// triangles' hierarchy finds it; each particle keeps what its last search found (an entry per
+// particle and mesh collider, on both backends), which answers the queries that follow while the
+// particle stays within the entry's bounds: the same triangle as the search, by the same formula.
+
+// A particle's entry for one mesh collider (body frame), read and written through the including
+// file's mesh_cache_load / mesh_cache_store(MESH_DATA, slot, n, tri, centre, radius):
+// - face (n != 0): triangle `tri` (unit normal n, turned towards q's side) holds the nearest point of
+//   the mesh inside its face for every q in front of it whose projection lies inside the face
+//   (inside_face) and with |q - centre| < radius (no other triangle comes as near);
+// - edge (n.z = 2): the nearest point of the mesh lies inside the edge that triangle `tri` shares with
+//   triangle n.x at an angle (the corners opposite it: n.y = k + 3 k2, corner_and_edge) for every q
+//   beyond the edge on both faces with |q - centre| < radius (mesh_edge_hit);
+// - empty (n = 0): no triangle nearer to q than radius - |q - centre| (radius <= 0: nothing), the
+//   nearest at `centre` being `tri`.
+// The rounding of the distances in float at q's scale (guard) shrinks every bound.
+KFN precise real mesh_guard(vec3 q) {
+  precise real g = real(0.000003814697265625) * (real(1) + max(max(abs(q.x), abs(q.y)), abs(q.z))); // 2^-18
+  return g;
+}
+
+// How far q's projection on the plane of a triangle (unit normal n, counter-clockwise) lies inside
+// its edge a -> b: its distance to the edge's line, negative beyond it.
+KFN precise real edge_margin(vec3 q, vec3 n, vec3 a, vec3 b) {
+  precise vec3 e = b - a;
+  precise real m = dot3(cross3(n, e), q - a) / sqrt(dot3(e, e));
+  return m;
+}
+// Whether q's projection on the plane of triangle (a, b, c) (unit normal n, either side) lies inside
+// it by more than guard from each edge's line: (n x e) . (q - a) > guard |e|, turned by the side n is
+// on and compared squared (no root, no division).
+KFN VARYING(bool) inside_edge(vec3 q, vec3 n, vec3 a, vec3 b, real turn, real guard) {
+  precise vec3 e = b - a;
+  precise real d = dot3(cross3(n, e), q - a) * turn;
+  precise real g2 = guard * guard * dot3(e, e);
+  return d > real(0) && d * d > g2;
+}
+KFN VARYING(bool) inside_face(vec3 q, vec3 n, vec3 a, vec3 b, vec3 c, real guard) {
+  precise real turn = select(dot3(n, cross3(b - a, c - a)) < real(0), real(-1), real(1));
+  // Each test first, then their && (GLSL branches around a call on the right of &&).
+  VARYING(bool) ab = inside_edge(q, n, a, b, turn, guard);
+  VARYING(bool) bc = inside_edge(q, n, b, c, turn, guard);
+  VARYING(bool) ca = inside_edge(q, n, c, a, turn, guard);
+  return ab && bc && ca;
+}
+
+// The entry (n, centre, radius; a face's triangle a, b, c) answers a query at q (body frame) that
+// reaches reach_total (the thickness + reach).
+KFN VARYING(bool)
+    mesh_cache_hit(vec3 n, vec3 centre, real radius, vec3 a, vec3 b, vec3 c, vec3 q, real reach_total) {
+  precise vec3 d = q - centre;
+  precise real d2 = dot3(d, d);
+  VARYING(bool) face = dot3(n, n) > real(0);
+  precise real r = select(face, radius, radius - reach_total);
+  VARYING(bool) within = r > real(0) && d2 < r * r;
+  precise real guard = mesh_guard(q);
+  VARYING(bool) inside = inside_face(q, n, a, b, c, guard);
+  VARYING(bool) on_face = dot3(q - a, n) > guard && inside;
+  VARYING(bool) edge = n.z > real(1.5); // mesh_contact's own (scalar) test
+  return within && (!face || on_face) && !edge;
+}
+
+// collider_contact for a mesh from a face entry (the nearest point of the mesh to q lies inside the
+// face of unit normal n through corner a) or an empty one (nothing within reach): the particle's
+// height over the plane on the side p_side is on, less the thickness; the face's normal towards that
+// side. Farther than the thickness + reach: distance = reach (no contact).
+KFN void mesh_face_contact(ColliderShape s, vec3 n, vec3 a, vec3 q, vec3 p_side, real reach,
+                           OUT(real) distance, OUT(vec3) normal) {
+  precise real offset = dot3(a, n);
+  precise real h = dot3(q, n) - offset;
+  precise real h_side = dot3(to_body(s, p_side), n) - offset;
+  precise real side = select(h_side < real(0), real(-1), real(1));
+  precise real reach_total = s.b + reach;
+  VARYING(bool) found = dot3(n, n) > real(0) && h * h < reach_total * reach_total;
+  precise real d = h * side - s.b;
+  distance = select(found, d, reach);
+  normal = select(found, to_world_dir(s, n * side), vec3(real(0), real(0), real(1)));
+}
+
+// A skinned mesh's surface velocity at point p of triangle (a, b, c) whose corners move at va, vb, vc
+// (barycentric interpolation, Ericson 3.4; a degenerate triangle: their mean), in the world.
+KFN precise vec3 triangle_velocity(ColliderShape s, vec3 p, vec3 a, vec3 b, vec3 c, vec3 va, vec3 vb,
+                                   vec3 vc) {
+  precise vec3 e0 = b - a, e1 = c - a, e2 = p - a;
+  precise real d00 = dot3(e0, e0), d01 = dot3(e0, e1), d11 = dot3(e1, e1);
+  precise real d20 = dot3(e2, e0), d21 = dot3(e2, e1);
+  precise real denom = d00 * d11 - d01 * d01;
+  VARYING(bool) proper = denom > real(0);
+  precise real safe = select(proper, denom, real(1));
+  precise real v = select(proper, (d11 * d20 - d01 * d21) / safe, real(1) / real(3));
+  precise real w = select(proper, (d00 * d21 - d01 * d20) / safe, real(1) / real(3));
+  precise vec3 vel = va * (real(1) - v - w) + vb * v;
+  vel = vel + vc * w;
+  return to_world_dir(s, vel);
+}
+
+// The search of the hierarchy and the entry it leaves. A bridge that cannot run it (the CPU's SIMD
+// lanes, which call the scalar mesh_contact lane by lane where their entries miss) defines
+// VKCLOTH_KERNEL_NO_MESH.
+#ifndef VKCLOTH_KERNEL_NO_MESH
+// The closest point of triangle (a, b, c) to p (Ericson, Real-Time Collision Detection, 5.1.5).
+KFN precise vec3 closest_on_triangle(vec3 p, vec3 a, vec3 b, vec3 c) {
+  precise vec3 ab = b - a, ac = c - a, ap = p - a;
+  precise real d1 = dot3(ab, ap), d2 = dot3(ac, ap);
+  if (d1 <= real(0) && d2 <= real(0))
+    return a;
+  precise vec3 bp = p - b;
+  precise real d3 = dot3(ab, bp), d4 = dot3(ac, bp);
+  if (d3 >= real(0) && d4 <= d3)
+    return b;
+  precise real vc = d1 * d4 - d3 * d2;
+  if (vc <= real(0) && d1 >= real(0) && d3 <= real(0)) {
+    precise real v = d1 / (d1 - d3);
+    precise vec3 q = a + ab * v;
+    return q;
+  }
+  precise vec3 cp = p - c;
+  precise real d5 = dot3(ab, cp), d6 = dot3(ac, cp);
+  if (d6 >= real(0) && d5 <= d6)
+    return c;
+  precise real vb = d5 * d2 - d1 * d6;
+  if (vb <= real(0) && d2 >= real(0) && d6 <= real(0)) {
+    precise real w = d2 / (d2 - d6);
+    precise vec3 q = a + ac * w;
+    return q;
+  }
+  precise real va = d3 * d6 - d5 * d4;
+  precise real e43 = d4 - d3, e56 = d5 - d6;
+  if (va <= real(0) && e43 >= real(0) && e56 >= real(0)) {
+    precise real w = e43 / (e43 + e56);
+    precise vec3 q = b + (c - b) * w;
+    return q;
+  }
+  precise real denom = real(1) / ((va + vb) + vc);
+  precise real v = vb * denom, w = vc * denom;
+  precise vec3 q = a + ab * v;
+  q = q + ac * w;
+  return q;
+}
+
+// The squared distance from q to triangle (a, b, c): the search's measure, the entries' too.
+KFN precise real triangle_gap2(vec3 q, vec3 a, vec3 b, vec3 c) {
+  precise vec3 d = q - closest_on_triangle(q, a, b, c);
+  precise real d2 = dot3(d, d);
+  return d2;
+}
+
+// The triangle of a mesh collider nearest to q (body frame) within `reach` (its index in `nearest`,
+// VKCLOTH_MESH_NONE: none; its squared distance returned, reach^2: none), among those other than
+// `skip` and `skip2` that reach in front of the plane {x: m.x = offset} or of {x: m2.x = offset2} by
+// more than `tol` (m = m2 = 0, tol < 0: all). `second`: the next nearest, where its squared distance
+// is within `slack` times the nearest's (an edge's other triangle; else VKCLOTH_MESH_NONE). Equally
+// near ones: the lowest index first, so the answer is a function of q alone (an entry reproduces
+// it). Walks the bounding-volume hierarchy depth first, the nearer child first, boxes no farther
+// than slack times the nearest so far only. The including file provides
+// mesh_node(MESH_DATA, i, lo, first, hi, count) and mesh_triangle(MESH_DATA, i, a, b, c)
+// (vkcloth::ColliderMesh's Node and Triangle); MESH_DATA_PARAM declares MESH_DATA.
+#define VKCLOTH_MESH_STACK 32
+KFN precise real box_gap2(vec3 lo, vec3 hi, vec3 q) {
+  precise vec3 gap = max(max(lo - q, q - hi), vec3(real(0)));
+  return dot3(gap, gap);
+}
+KFN precise real box_ahead(vec3 lo, vec3 hi, vec3 m, real offset) {
+  precise real ahead = dot3(m, (lo + hi) * real(0.5)) + dot3(abs(m), (hi - lo) * real(0.5)) - offset;
+  return ahead;
+}
+KFN precise real triangle_ahead(vec3 a, vec3 b, vec3 c, vec3 m, real offset) {
+  precise real ahead = max(max(dot3(m, a), dot3(m, b)), dot3(m, c)) - offset;
+  return ahead;
+}
+// Whether (d2, i) comes before (best, at) (VKCLOTH_MESH_NONE: nothing yet, within best only).
+KFN bool nearer(real d2, uint i, real best, uint at) {
+  return d2 < best || (d2 == best && at != VKCLOTH_MESH_NONE && i < at);
+}
+KFN_NOINLINE real mesh_nearest(MESH_DATA_PARAM, uint root, uint tri0, vec3 q, real reach, uint skip,
+                               uint skip2, vec3 m, real offset, vec3 m2, real offset2, real tol, real slack,
+                               OUT(uint) nearest, OUT(uint) second) {
+  nearest = VKCLOTH_MESH_NONE;
+  second = VKCLOTH_MESH_NONE;
+  precise real best = reach * reach;
+  precise real best2 = best;
+  const bool planes = tol >= real(0);
+  // The stack holds nodes with their boxes' squared gaps to q (measured with their parent's).
+  uint stack[VKCLOTH_MESH_STACK];
+  real stack_gap[VKCLOTH_MESH_STACK];
+  uint top = 1u;
+  stack[0] = 0u;
+  stack_gap[0] = real(0);
+  while (top > 0u) {
+    top = top - 1u;
+    if (stack_gap[top] > best * slack) // too far
+      continue;
+    vec3 lo, hi;
+    uint first, count;
+    mesh_node(MESH_DATA, root + stack[top], lo, first, hi, count);
+    if (planes && box_ahead(lo, hi, m, offset) <= tol && box_ahead(lo, hi, m2, offset2) <= tol)
+      continue;        // wholly behind both planes
+    if (count == 0u) { // the nearer child is walked first (the first one on a tie)
+      vec3 lo1, hi1;
+      uint f1, c1;
+      mesh_node(MESH_DATA, root + first, lo, f1, hi, c1);
+      mesh_node(MESH_DATA, root + first + 1u, lo1, f1, hi1, c1);
+      precise real g0 = box_gap2(lo, hi, q), g1 = box_gap2(lo1, hi1, q);
+      const bool swap = g1 < g0;
+      stack[top] = swap ? first : first + 1u;
+      stack_gap[top] = swap ? g0 : g1;
+      stack[top + 1u] = swap ? first + 1u : first;
+      stack_gap[top + 1u] = swap ? g1 : g0;
+      top = top + 2u;
+      continue;
+    }
+    for (uint t = first; t < first + count; ++t) {
+      vec3 ta, tb, tc;
+      const uint i = tri0 + t;
+      mesh_triangle(MESH_DATA, i, ta, tb, tc);
+      if (i == skip || i == skip2 ||
+          (planes && triangle_ahead(ta, tb, tc, m, offset) <= tol &&
+           triangle_ahead(ta, tb, tc, m2, offset2) <= tol))
+        continue;
+      precise real d2 = triangle_gap2(q, ta, tb, tc);
+      if (nearer(d2, i, best, nearest)) {
+        best2 = best;
+        second = nearest;
+        best = d2;
+        nearest = i;
+      } else if (nearer(d2, i, best2, second)) {
+        best2 = d2;
+        second = i;
+      }
+    }
+  }
+  if (best2 > best * slack)
+    second = VKCLOTH_MESH_NONE;
+  return best;
+}
+
+// The contact with triangle (a, b, c), the nearest to q: the general case (an edge, a corner, or a particle
+// that crossed through the triangle).
+KFN void triangle_contact(ColliderShape s, vec3 a, vec3 b, vec3 c, vec3 q, vec3 p_side, OUT(real) distance,
+                          OUT(vec3) normal) {
+  precise vec3 tn = unit_or_zero(cross3(b - a, c - a));
+  precise vec3 cp = closest_on_triangle(q, a, b, c);
+  precise vec3 r = q - cp;
+  precise real len = sqrt(dot3(r, r));
+  precise real side = select(dot3(to_body(s, p_side) - cp, tn) < real(0), real(-1), real(1));
+  precise vec3 side_n = tn * side;
+  precise real along = dot3(r, side_n);
+  precise vec3 across = r - side_n * along; // beyond an edge: its offset in the triangle's plane
+  if (along < real(0) && dot3(across, across) <= s.b * s.b) {
+    // Crossed to the other side through the triangle (or within the shell of its edge): back out
+    // on the side it came from.
+    precise real d = along - s.b;
+    distance = d;
+    normal = to_world_dir(s, side_n);
+    return;
+  }
+  precise vec3 nb = select(len > real(0), r / len, side_n);
+  precise real d = len - s.b;
+  distance = d;
+  normal = to_world_dir(s, nb);
+}
+
+// A skinned mesh's surface velocity at point p of its triangle t (a, b, c); zero for a rigid mesh. The
+// including file provides mesh_velocity(MESH_DATA, i, va, vb, vc) (ColliderMesh::triangle_velocities).
+KFN void mesh_deformation(MESH_DATA_PARAM, ColliderShape s, uint t, vec3 p, vec3 a, vec3 b, vec3 c,
+                          OUT(vec3) deform) {
+  deform = vec3(real(0));
+  if (!deforming(s))
+    return;
+  vec3 va, vb, vc;
+  mesh_velocity(MESH_DATA, s.mesh_vel0 + (t - s.mesh_tri0), va, vb, vc);
+  deform = triangle_velocity(s, p, a, b, c, va, vb, vc);
+}
+
+// The answer of the nearest triangle t (a, b, c) at squared distance gap2 by the general formula
+// (nothing beyond the thickness + reach).
+KFN void mesh_triangle_answer(MESH_DATA_PARAM, ColliderShape s, uint t, vec3 a, vec3 b, vec3 c, real gap2,
+                              vec3 q, vec3 p_side, real reach, OUT(real) distance, OUT(vec3) normal,
+                              OUT(vec3) deform) {
+  distance = reach;
+  normal = vec3(real(0), real(0), real(1));
+  deform = vec3(real(0));
+  precise real reach_total = s.b + reach;
+  if (gap2 < reach_total * reach_total) {
+    triangle_contact(s, a, b, c, q, p_side, distance, normal);
+    mesh_deformation(MESH_DATA, s, t, closest_on_triangle(q, a, b, c), a, b, c, deform);
+  }
+}
+
+// The ball an entry at distance d1 may keep from its triangles' clearance (ColliderMesh::Triangle): a
+// triangle reaching in front of the plane is at least `clear` from the face (edge), hence from q at
+// distance d < clear / 2 farther than the face (edge) is. Capped, so that its square stays finite.
+KFN precise real mesh_clear_radius(real clear, real d1, real guard) {
+  precise real r = min(clear * real(0.5) - guard - d1, real(1e15));
+  return r;
+}
+
+// Triangle (a, b, c) seen from its corner k (0: a): that corner f and the edge e0 -> e1 opposite it,
+// in the triangle's counter-clockwise order.
+KFN void corner_and_edge(uint k, vec3 a, vec3 b, vec3 c, OUT(vec3) f, OUT(vec3) e0, OUT(vec3) e1) {
+  f = k == 0u ? a : (k == 1u ? b : c);
+  e0 = k == 0u ? b : (k == 1u ? c : a);
+  e1 = k == 0u ? c : (k == 1u ? a : b);
+}
+
+// Whether q lies beyond the edge e0 -> e1 of triangle (f, e0, e1) in its plane and its foot on the
+// edge inside it, each by more than guard: then the triangle's nearest point to q lies inside that edge.
+KFN bool beyond_edge(vec3 q, vec3 f, vec3 e0, vec3 e1, real guard) {
+  precise vec3 tn = unit_or_zero(cross3(e0 - f, e1 - f));
+  precise vec3 e = e1 - e0;
+  precise real len = sqrt(dot3(e, e));
+  precise real along = dot3(q - e0, e) / len;
+  return -edge_margin(q, tn, e0, e1) > guard && along > guard && len - along > guard;
+}
+
+// An edge entry: the edge e0 -> e1 of triangle (f1, e0, e1) is g0 -> g1 of the neighbour (f2, g0, g1).
+// It answers q within its ball, beyond the edge on both faces: there the nearest point of each
+// triangle, and of the wedge behind both their planes, is q's foot on the edge; the ball keeps every
+// triangle reaching in front of either plane farther than the edge.
+KFN bool mesh_edge_hit(vec3 centre, real radius, vec3 q, vec3 f1, vec3 e0, vec3 e1, vec3 f2, vec3 g0,
+                       vec3 g1) {
+  precise vec3 d = q - centre;
+  precise real guard = mesh_guard(q);
+  return radius > real(0) && dot3(d, d) < radius * radius && beyond_edge(q, f1, e0, e1, guard) &&
+         beyond_edge(q, f2, g0, g1, guard);
+}
+
+// The wedge of an edge entry where q's nearest point lies inside an edge of the nearest triangle t
+// (a, b, c) that triangle t2 (as near: the search's second) shares at an angle, q beyond it on both:
+// the planes m1, m2 (through the edge, each turned away from the other triangle's far corner), the
+// entry's corner code (k + 3 k2, corner_and_edge) and the triangles' clearance on the wedge's side.
+// False where there is no such edge.
+KFN bool mesh_edge_wedge(MESH_DATA_PARAM, uint t, vec3 a, vec3 b, vec3 c, uint t2, vec3 q, real guard,
+                         OUT(vec3) m1, OUT(vec3) m2, OUT(vec3) e0, OUT(uint) code, OUT(real) clear) {
+  if (t2 == VKCLOTH_MESH_NONE || t2 >= 16777216u) // the entry holds t2 as a real: exact below 2^24
+    return false;
+  uint k = 3u;
+  vec3 f1, e1;
+  for (uint i = 0u; i < 3u; ++i) {
+    corner_and_edge(i, a, b, c, f1, e0, e1);
+    if (beyond_edge(q, f1, e0, e1, guard))
+      k = i;
+  }
+  if (k == 3u)
+    return false;
+  corner_and_edge(k, a, b, c, f1, e0, e1);
+  vec3 a2, b2, c2, f2, g0, g1;
+  mesh_triangle(MESH_DATA, t2, a2, b2, c2);
+  uint k2 = 3u;
+  for (uint i = 0u; i < 3u; ++i) {
+    corner_and_edge(i, a2, b2, c2, f2, g0, g1);
+    if ((g0 == e0 && g1 == e1) || (g0 == e1 && g1 == e0))
+      k2 = i;
+  }
+  if (k2 == 3u)
+    return false;
+  corner_and_edge(k2, a2, b2, c2, f2, g0, g1);
+  if (!beyond_edge(q, f2, g0, g1, guard))
+    return false;
+  precise vec3 n1 = unit_or_zero(cross3(e0 - f1, e1 - f1)), n2 = unit_or_zero(cross3(g0 - f2, g1 - f2));
+  precise real h1 = dot3(n1, f2 - e0), h2 = dot3(n2, f1 - e0);
+  if (abs(h1) <= guard || abs(h2) <= guard) // flat: the face entries' case
+    return false;
+  m1 = n1 * select(h1 < real(0), real(1), real(-1));
+  m2 = n2 * select(h2 < real(0), real(1), real(-1));
+  code = k + 3u * k2;
+  real front1, back1, front2, back2;
+  mesh_clearance(MESH_DATA, t, front1, back1);
+  mesh_clearance(MESH_DATA, t2, front2, back2);
+  clear = min(select(h1 < real(0), front1, back1), select(h2 < real(0), front2, back2));
+  return true;
+}
+
+// collider_contact for a mesh collider, q = p in its body frame (to_body). The particle's entry
+// answers where it can. Where it no longer does, a face or an edge entry first moves to the
+// triangles next to it without a search (the edge q went farthest beyond, as an edge and as a face,
+// then its own face; an edge entry: its two faces), where their clearance keeps a ball (a rigid
+// mesh): the entry the search would certify there (the same triangles, the same formulas).
+// Otherwise the search answers and leaves a new entry (slot: ColliderShape::mesh_cache; the bridge
+// adds the particle): a face or an edge entry where the nearest point lies inside a face or an edge
+// within twice the reach, else an empty one. Each formula has one call site (the GPU inlines them).
+// A skinned mesh: `deform`, the surface's velocity at the nearest point from its corners' (zero otherwise).
+KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_side, real reach,
+                               OUT(real) distance, OUT(vec3) normal, OUT(vec3) deform) {
+  distance = reach;
+  normal = vec3(real(0), real(0), real(1));
+  deform = vec3(real(0));
+  if (!VKCLOTH_COLLIDER_PRESENT(VKCLOTH_COLLIDER_MESH))
+    return;
+  precise real reach_total = s.b + reach;
+  vec3 n, centre, a, b, c;
+  uint t;
+  real radius;
+  mesh_cache_load(MESH_DATA, s.mesh_cache, n, t, centre, radius);
+  const bool edge = n.z > real(1.5);
+  const bool face = !edge && dot3(n, n) > real(0);
+  const uint t2 = edge ? uint(n.x) : VKCLOTH_MESH_NONE;
+  a = b = c = vec3(real(0));
+  if (face)
+    mesh_triangle(MESH_DATA, t, a, b, c);
+  // The answer: 1: the face formula (plane m through a of triangle at: a, b, c); 2: the general
+  // formula (triangle at: a, b, c, at squared distance gap); 0: none yet.
+  uint answer = mesh_cache_hit(n, centre, radius, a, b, c, q, reach_total) ? 1u : 0u; // empty: m = 0, none
+  uint at = t;
+  vec3 m = n;
+  precise real gap = real(0);
+  precise real guard = mesh_guard(q);
+  // Pass 0: an edge entry's own test. 1: the entry's neighbourhood, without a search. 2: the search.
+  // Each gives an edge (triangles base and cand, q beyond it on both) or a face (f0, else f1, q inside).
+  for (uint pass = edge ? 0u : (face ? 1u : 2u); pass < 3u && answer == 0u; ++pass) {
+    uint base = t, cand = VKCLOTH_MESH_NONE, f0 = VKCLOTH_MESH_NONE, f1 = VKCLOTH_MESH_NONE;
+    precise real d1 = real(0);
+    bool near = true;
+    vec3 ba, bb, bc;
+    if (pass == 0u) {
+      vec3 a2, b2, c2, x1, e0, e1, x2, g0, g1;
+      mesh_triangle(MESH_DATA, t, ba, bb, bc);
+      mesh_triangle(MESH_DATA, t2, a2, b2, c2);
+      corner_and_edge(uint(n.y) % 3u, ba, bb, bc, x1, e0, e1);
+      corner_and_edge(uint(n.y) / 3u, a2, b2, c2, x2, g0, g1);
+      if (!mesh_edge_hit(centre, radius, q, x1, e0, e1, x2, g0, g1))
+        continue;
+      cand = t2;
+    } else if (pass == 1u) {
+      if (face) {
+        precise vec3 tn = unit_or_zero(cross3(b - a, c - a));
+        precise real m0 = edge_margin(q, tn, b, c), m1 = edge_margin(q, tn, c, a),
+                     m2 = edge_margin(q, tn, a, b);
+        const uint k = m0 <= min(m1, m2) ? 0u : (m1 <= m2 ? 1u : 2u);
+        const uint local = mesh_neighbour(MESH_DATA, s.mesh_adj0, t - s.mesh_tri0, k);
+        cand = local >= 268435456u ? VKCLOTH_MESH_NONE : s.mesh_tri0 + local; // none (at most 2^28 triangles)
+        f0 = cand;
+        f1 = t;
+      } else {
+        f0 = t;
+        f1 = t2;
+      }
+      mesh_triangle(MESH_DATA, base, ba, bb, bc);
+    } else {
+      // The walk starts bounded by the entry's triangle, which is at least as far as the nearest:
+      // it finds the same triangle as an unbounded walk (the same order; no box holding it is cut).
+      precise real start = real(1e18);
+      if (radius > real(0)) {
+        mesh_triangle(MESH_DATA, t, a, b, c);
+        start =
+            sqrt(triangle_gap2(q, a, b, c)) * real(1.0009765625) + guard; // 1 + 2^-10: never below its own
+      }
+      gap = mesh_nearest(MESH_DATA, s.mesh_root, s.mesh_tri0, q, start, VKCLOTH_MESH_NONE, VKCLOTH_MESH_NONE,
+                         vec3(real(0)), real(0), vec3(real(0)), real(0), real(-1), real(1.001953125), base,
+                         cand); // 1 + 2^-9: an edge's other triangle
+      at = base;
+      d1 = sqrt(gap);
+      near = d1 < real(2) * reach_total;
+      f0 = base;
+      mesh_triangle(MESH_DATA, base, ba, bb, bc);
+    }
+    // An edge: the nearer of its two triangles by the search's measure (ties: the lower index).
+    precise vec3 m1, m2, e0;
+    uint code = 0u;
+    real clear = real(0);
+    bool is_edge = pass == 0u;
+    if (pass > 0u && near && cand != VKCLOTH_MESH_NONE)
+      is_edge = mesh_edge_wedge(MESH_DATA, base, ba, bb, bc, cand, q, guard, m1, m2, e0, code, clear);
+    bool is_face = false;
+    if (is_edge) {
+      at = base;
+      for (uint i = 0u; i < 2u; ++i) {
+        const uint ti = i == 0u ? base : cand;
+        vec3 ta, tb, tc;
+        mesh_triangle(MESH_DATA, ti, ta, tb, tc);
+        precise real gi = triangle_gap2(q, ta, tb, tc);
+        if (i == 0u || nearer(gi, ti, gap, at)) {
+          gap = gi;
+          at = ti;
+          a = ta;
+          b = tb;
+          c = tc;
+        }
+      }
+      d1 = sqrt(gap);
+      is_edge = pass != 1u || d1 < real(2) * reach_total;
+    } else {
+      // A face: q inside it (and, without a search, in front by more than guard, within twice the reach).
+      for (uint i = 0u; i < 2u && near && !is_face; ++i) {
+        const uint f = i == 0u ? f0 : f1;
+        if (f == VKCLOTH_MESH_NONE)
+          continue;
+        mesh_triangle(MESH_DATA, f, a, b, c);
+        precise vec3 tn = unit_or_zero(cross3(b - a, c - a));
+        precise real h = dot3(q - a, tn);
+        if (inside_face(q, tn, a, b, c, guard) &&
+            (pass == 2u || (abs(h) > guard && abs(h) < real(2) * reach_total))) {
+          is_face = true;
+          at = f;
+          m1 = tn * select(h < real(0), real(-1), real(1));
+          m2 = m1;
+          e0 = a;
+          real front, back;
+          mesh_clearance(MESH_DATA, f, front, back);
+          clear = select(h < real(0), back, front);
+          d1 = select(pass == 2u, d1, abs(h));
+        }
+      }
+    }
+    if (pass == 0u) {
+      answer = 2u;
+    } else if (is_edge || is_face) {
+      // The ball: no triangle reaching in front of the plane(s) comes as near as the face or the edge
+      // (its clearance; else, after a search, one 8 reaches beyond d1: each triangle moves at most as
+      // far as q; one wholly behind is never nearer than the face or the edge while q is in front of
+      // the face and inside it, or beyond the edge on both faces).
+      precise real ball = mesh_clear_radius(clear, d1, guard);
+      if (pass == 2u && ball < real(2) * reach_total) {
+        uint unused, unused2;
+        precise real next = mesh_nearest(MESH_DATA, s.mesh_root, s.mesh_tri0, q, d1 + real(8) * reach_total,
+                                         base, is_edge ? cand : base, m1, dot3(m1, e0), m2, dot3(m2, e0),
+                                         guard, real(1), unused, unused2);
+        ball = max(ball, (sqrt(next) - d1) * real(0.5) - guard);
+      }
+      if (is_face && (ball > real(0) || pass == 2u)) {
+        mesh_cache_store(MESH_DATA, s.mesh_cache, m1, at, q, ball);
+        m = m1;
+        answer = 1u;
+      } else if (is_edge && ball > real(0)) {
+        mesh_cache_store(MESH_DATA, s.mesh_cache, vec3(real(cand), real(code), real(2)), base, q, ball);
+        answer = 2u;
+      }
+    }
+    if (pass == 2u &&
+        answer == 0u) { // far, at a corner, ...: no triangle nearer than d1 (base: the next walk's start)
+      mesh_cache_store(MESH_DATA, s.mesh_cache, vec3(real(0)), base, q, d1 - guard);
+      at = base;
+      a = ba;
+      b = bb;
+      c = bc;
+      answer = 2u;
+    }
+  }
+  if (answer == 1u) {
+    mesh_face_contact(s, m, a, q, p_side, reach, distance, normal);
+    mesh_deformation(MESH_DATA, s, at, q - m * (dot3(q, m) - dot3(a, m)), a, b, c, deform);
+  }
+  if (answer == 2u)
+    mesh_triangle_answer(MESH_DATA, s, at, a, b, c, gap, q, p_side, reach, distance, normal, deform);
+}
+#endif // VKCLOTH_KERNEL_NO_MESH
