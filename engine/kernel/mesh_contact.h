@@ -22,16 +22,25 @@
 // - empty (n = 0): no triangle nearer to q than radius - |q - centre| (radius <= 0: nothing), the
 //   nearest at `centre` being `tri`.
 // The rounding of the distances in float at q's scale (guard) shrinks every bound.
+// An edge entry's mark: n.z = 2 (a unit normal's z is at most 1).
+KFN VARYING(bool) mesh_edge_entry(vec3 n) {
+  return n.z > real(1.5);
+}
 KFN precise real mesh_guard(vec3 q) {
   precise real g = real(0.000003814697265625) * (real(1) + max(max(abs(q.x), abs(q.y)), abs(q.z))); // 2^-18
   return g;
 }
 
-// How far q's projection on the plane of a triangle (unit normal n, counter-clockwise) lies inside
-// its edge a -> b: its distance to the edge's line, negative beyond it.
+// Which side of the edge a -> b of a triangle (unit normal n, counter-clockwise) q's projection on
+// its plane lies: |b - a| times its distance to the edge's line, positive inside, negative beyond.
+KFN precise real edge_side(vec3 q, vec3 n, vec3 a, vec3 b) {
+  precise real d = dot3(cross3(n, b - a), q - a);
+  return d;
+}
+// The distance itself (edge_side / |b - a|).
 KFN precise real edge_margin(vec3 q, vec3 n, vec3 a, vec3 b) {
   precise vec3 e = b - a;
-  precise real m = dot3(cross3(n, e), q - a) / sqrt(dot3(e, e));
+  precise real m = edge_side(q, n, a, b) / sqrt(dot3(e, e));
   return m;
 }
 // Whether q's projection on the plane of triangle (a, b, c) (unit normal n, either side) lies inside
@@ -39,7 +48,7 @@ KFN precise real edge_margin(vec3 q, vec3 n, vec3 a, vec3 b) {
 // on and compared squared (no root, no division).
 KFN VARYING(bool) inside_edge(vec3 q, vec3 n, vec3 a, vec3 b, real turn, real guard) {
   precise vec3 e = b - a;
-  precise real d = dot3(cross3(n, e), q - a) * turn;
+  precise real d = edge_side(q, n, a, b) * turn;
   precise real g2 = guard * guard * dot3(e, e);
   return d > real(0) && d * d > g2;
 }
@@ -64,7 +73,7 @@ KFN VARYING(bool)
   precise real guard = mesh_guard(q);
   VARYING(bool) inside = inside_face(q, n, a, b, c, guard);
   VARYING(bool) on_face = dot3(q - a, n) > guard && inside;
-  VARYING(bool) edge = n.z > real(1.5); // mesh_contact's own (scalar) test
+  VARYING(bool) edge = mesh_edge_entry(n); // mesh_contact's own (scalar) test
   return within && (!face || on_face) && !edge;
 }
 
@@ -400,7 +409,7 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
   uint t;
   real radius;
   mesh_cache_load(MESH_DATA, s.mesh_cache, n, t, centre, radius);
-  const bool edge = n.z > real(1.5);
+  const bool edge = mesh_edge_entry(n);
   const bool face = !edge && dot3(n, n) > real(0);
   const uint t2 = edge ? uint(n.x) : VKCLOTH_MESH_NONE;
   a = b = c = vec3(real(0));
