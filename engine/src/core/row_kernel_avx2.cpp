@@ -79,7 +79,15 @@ struct IsaF : IsaGeneric<float, vf8, vi8, 8> {
   // z and the next particle's x, unused), then a 4 x 4 transpose in each 128-bit lane, as the
   // AVX-512 file; reads one float past the particle: never called on a vector that names the last one.
   static void gather3(const float* pos, const std::uint32_t* index, V& x, V& y, V& z) {
-    auto at = [&](int l) { return _mm_loadu_ps(pos + 3 * std::size_t(index[l])); };
+    V w;
+    transpose4([&](int l) { return _mm_loadu_ps(pos + 3 * std::size_t(index[l])); }, x, y, z, w);
+  }
+  // The four floats at base + offset[l] of each lane l, the same way.
+  static void gather4(const float* base, const std::uint32_t* offset, V& x, V& y, V& z, V& w) {
+    transpose4([&](int l) { return _mm_loadu_ps(base + offset[l]); }, x, y, z, w);
+  }
+  // Lane l's four floats at(l) as four vectors x, y, z, w.
+  template <typename At> static void transpose4(At at, V& x, V& y, V& z, V& w) {
     const __m256 a = _mm256_set_m128(at(4), at(0)), b = _mm256_set_m128(at(5), at(1));
     const __m256 c = _mm256_set_m128(at(6), at(2)), d = _mm256_set_m128(at(7), at(3));
     const __m256 ab_lo = _mm256_unpacklo_ps(a, b), cd_lo = _mm256_unpacklo_ps(c, d);
@@ -87,6 +95,7 @@ struct IsaF : IsaGeneric<float, vf8, vi8, 8> {
     x = (V)_mm256_shuffle_ps(ab_lo, cd_lo, _MM_SHUFFLE(1, 0, 1, 0));
     y = (V)_mm256_shuffle_ps(ab_lo, cd_lo, _MM_SHUFFLE(3, 2, 3, 2));
     z = (V)_mm256_shuffle_ps(ab_hi, cd_hi, _MM_SHUFFLE(1, 0, 1, 0));
+    w = (V)_mm256_shuffle_ps(ab_hi, cd_hi, _MM_SHUFFLE(3, 2, 3, 2));
   }
   static M loadmask(const std::uint16_t* p) {
     return (vi8)_mm256_cvtepu16_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)));

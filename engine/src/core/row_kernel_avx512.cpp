@@ -73,10 +73,18 @@ struct IsaF : IsaGeneric<float, vf16, vi16, 16> {
   // y, z and the next particle's x, unused), then a 4 x 4 transpose in each 128-bit lane. Faster
   // than 48 lane inserts, a hardware gather or masked loads (all measured, docs/performance.md);
   // reads one float past the particle: never called on a vector that names the last one.
-  // (Masked forms, all lanes: the plain ones read _mm512_undefined, a GCC 12 -Wmaybe-uninitialized.)
   static void gather3(const float* pos, const std::uint32_t* index, V& x, V& y, V& z) {
+    V w;
+    transpose4([&](int l) { return _mm_loadu_ps(pos + 3 * std::size_t(index[l])); }, x, y, z, w);
+  }
+  // The four floats at base + offset[l] of each lane l, the same way.
+  static void gather4(const float* base, const std::uint32_t* offset, V& x, V& y, V& z, V& w) {
+    transpose4([&](int l) { return _mm_loadu_ps(base + offset[l]); }, x, y, z, w);
+  }
+  // Lane l's four floats at(l) as four vectors x, y, z, w. (Masked forms, all lanes: the plain ones
+  // read _mm512_undefined, a GCC 12 -Wmaybe-uninitialized.)
+  template <typename At> static void transpose4(At at, V& x, V& y, V& z, V& w) {
     constexpr __mmask16 all = 0xFFFF;
-    auto at = [&](int l) { return _mm_loadu_ps(pos + 3 * std::size_t(index[l])); };
     auto row = [&](int r) { // lanes r, r + 4, r + 8, r + 12, one per 128-bit lane
       const __m512d lo = _mm512_castpd256_pd512(_mm256_castps_pd(_mm256_set_m128(at(r + 4), at(r))));
       const __m256d hi = _mm256_castps_pd(_mm256_set_m128(at(r + 12), at(r + 8)));
@@ -88,6 +96,7 @@ struct IsaF : IsaGeneric<float, vf16, vi16, 16> {
     x = (V)_mm512_mask_shuffle_ps(ab_lo, all, ab_lo, cd_lo, _MM_SHUFFLE(1, 0, 1, 0));
     y = (V)_mm512_mask_shuffle_ps(ab_lo, all, ab_lo, cd_lo, _MM_SHUFFLE(3, 2, 3, 2));
     z = (V)_mm512_mask_shuffle_ps(ab_hi, all, ab_hi, cd_hi, _MM_SHUFFLE(1, 0, 1, 0));
+    w = (V)_mm512_mask_shuffle_ps(ab_hi, all, ab_hi, cd_hi, _MM_SHUFFLE(3, 2, 3, 2));
   }
   static M loadmask(const std::uint16_t* p) {
     return (vi16)_mm512_maskz_cvtepu16_epi32(__mmask16(0xFFFF),

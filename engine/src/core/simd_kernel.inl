@@ -39,62 +39,68 @@ inline void mesh_contact(const LaneMesh<Isa>& m, ColliderShape s, vec3 q, vec3 p
 inline void mesh_contact(const LaneMesh<Isa>& m, ColliderShape s, vec3 q, vec3 p_side, real reach,
                          real& distance, vec3& normal, vec3& deform) {
   using R = typename Isa::Real;
-  using V = glm::vec<3, R>;
+  using V = typename Isa::V;
+  using Triangle = vkcloth::ColliderMesh::Triangle;
   constexpr int W = Isa::W;
   const bool skinned = deforming(s);
-  // Per lane: n, centre, radius, the face's corners a, b, c and their velocities (zero for other entries).
-  R v[25][W];
-  for (int l = 0; l < W; ++l) {
-    vkcloth::kernel::MeshData md = *m.mesh;
-    md.particle = m.particle(l);
-    V n, centre, a(0), b(0), c(0), va(0), vb(0), vc(0);
-    std::uint32_t tri;
-    R radius;
-    vkcloth::kernel::mesh_cache_load(md, m.scalar->mesh_cache, n, tri, centre, radius);
-    if (n != V(0)) {
-      vkcloth::kernel::mesh_triangle(md, tri, a, b, c);
-      if (skinned)
-        vkcloth::kernel::mesh_velocity(md, m.scalar->mesh_vel0 + (tri - m.scalar->mesh_tri0), va, vb, vc);
-    }
-    // Rows 0-2 n, 3-5 centre, 6 radius, 7-15 a, b, c, 16-24 va, vb, vc.
-    auto put3 = [&](int k, V x) {
-      for (int d = 0; d < 3; ++d)
-        v[k + d][l] = x[d];
-    };
-    put3(0, n);
-    put3(3, centre);
-    v[6][l] = radius;
-    put3(7, a);
-    put3(10, b);
-    put3(13, c);
-    if (skinned) {
-      put3(16, va);
-      put3(19, vb);
-      put3(22, vc);
-    }
+  const vkcloth::kernel::MeshData& md = *m.mesh;
+  // Each lane's entry (kernel.hpp mesh_cache_load: n, the triangle's index, centre, radius; all zero
+  // without entries), gathered as two rows of four.
+  V e[8];
+  if (!md.cache)
+    std::fill(e, e + 8, V{});
+  else {
+    std::uint32_t at[W];
+    for (int l = 0; l < W; ++l)
+      at[l] = 8 * (m.scalar->mesh_cache + m.particle(l));
+    Isa::gather4(static_cast<const R*>(md.cache), at, e[0], e[1], e[2], e[3]);
+    Isa::gather4(static_cast<const R*>(md.cache) + 4, at, e[4], e[5], e[6], e[7]);
   }
-  auto lanes = [&](int k) {
-    real r;
-    __builtin_memcpy(&r.v, v[k], sizeof r.v);
-    return r;
+  auto lanes = [](V x) { return real(x); };
+  const vec3 n(lanes(e[0]), lanes(e[1]), lanes(e[2]));
+  // A face or edge entry names a triangle; the others read the first and take zeros.
+  const varying<bool> named = n.x != real(0) || n.y != real(0) || n.z != real(0);
+  std::uint32_t tri[W], vel[W];
+  for (int l = 0; l < W; ++l) {
+    tri[l] = named.m[l] ? vkcloth::kernel::mesh_cache_uint(e[3][l]) : m.scalar->mesh_tri0;
+    vel[l] = m.scalar->mesh_vel0 + (tri[l] - m.scalar->mesh_tri0);
+  }
+  // Three corners of the triangles index[0..W) names (float rows of four: a corner and a clearance).
+  auto corners = [&](const Triangle* rows, const std::uint32_t* index, vec3& a, vec3& b, vec3& c) {
+    static_assert(sizeof(Triangle) == 12 * sizeof(float) && offsetof(Triangle, b) == 16 &&
+                  offsetof(Triangle, c) == 32);
+    std::uint32_t at[W];
+    for (int l = 0; l < W; ++l)
+      at[l] = 12 * index[l];
+    const float* f = reinterpret_cast<const float*>(rows);
+    V t[12];
+    for (int k = 0; k < 3; ++k)
+      Isa::gather4(f + 4 * k, at, t[4 * k], t[4 * k + 1], t[4 * k + 2], t[4 * k + 3]);
+    const vec3 zero(real(0));
+    a = select(named, vec3(lanes(t[0]), lanes(t[1]), lanes(t[2])), zero);
+    b = select(named, vec3(lanes(t[4]), lanes(t[5]), lanes(t[6])), zero);
+    c = select(named, vec3(lanes(t[8]), lanes(t[9]), lanes(t[10])), zero);
   };
-  auto lanes3 = [&](int k) { return vec3(lanes(k), lanes(k + 1), lanes(k + 2)); };
-  const vec3 n = lanes3(0), a = lanes3(7), b = lanes3(10), c = lanes3(13);
-  const varying<bool> hit = mesh_cache_hit(n, lanes3(3), lanes(6), a, b, c, q, s.b + reach);
+  vec3 a, b, c;
+  corners(md.triangles, tri, a, b, c);
+  const vec3 centre(lanes(e[4]), lanes(e[5]), lanes(e[6]));
+  const varying<bool> hit = mesh_cache_hit(n, centre, lanes(e[7]), a, b, c, q, s.b + reach);
   mesh_face_contact(s, n, a, q, p_side, reach, distance, normal);
   deform = vec3(real(0));
-  if (skinned) // at q's foot on the face, as contacts.h mesh_contact's entry hit
-    deform =
-        triangle_velocity(s, q - n * (dot3(q, n) - dot3(a, n)), a, b, c, lanes3(16), lanes3(19), lanes3(22));
+  if (skinned) { // at q's foot on the face, as contacts.h mesh_contact's entry hit
+    vec3 va, vb, vc;
+    corners(md.velocities, vel, va, vb, vc);
+    deform = triangle_velocity(s, q - n * (dot3(q, n) - dot3(a, n)), a, b, c, va, vb, vc);
+  }
   for (int l = 0; l < W; ++l) {
     if (hit.m[l])
       continue;
-    vkcloth::kernel::MeshData md = *m.mesh;
-    md.particle = m.particle(l);
-    const V ql(q.x.v[l], q.y.v[l], q.z.v[l]), sl(p_side.x.v[l], p_side.y.v[l], p_side.z.v[l]);
+    vkcloth::kernel::MeshData ml = md;
+    ml.particle = m.particle(l);
+    const glm::vec<3, R> ql(q.x.v[l], q.y.v[l], q.z.v[l]), sl(p_side.x.v[l], p_side.y.v[l], p_side.z.v[l]);
     R d;
-    V nl, dl;
-    vkcloth::kernel::mesh_contact(md, *m.scalar, ql, sl, reach.v[l], d, nl, dl);
+    glm::vec<3, R> nl, dl;
+    vkcloth::kernel::mesh_contact(ml, *m.scalar, ql, sl, reach.v[l], d, nl, dl);
     distance.v[l] = d;
     normal.x.v[l] = nl.x;
     normal.y.v[l] = nl.y;

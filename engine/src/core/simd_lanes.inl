@@ -147,6 +147,17 @@ template <typename Real, typename V, typename M, int W> struct IsaGeneric {
       z[l] = p[2];
     }
   }
+  // The four values at base + offset[l] of each lane l (a record's row of four), as Reals.
+  template <typename S>
+  static void gather4(const S* base, const std::uint32_t* offset, V& x, V& y, V& z, V& w) {
+    for (int l = 0; l < W; ++l) {
+      const S* p = base + offset[l];
+      x[l] = Real(p[0]);
+      y[l] = Real(p[1]);
+      z[l] = Real(p[2]);
+      w[l] = Real(p[3]);
+    }
+  }
   // The same where index may name the last particle (the ISA files' gather3 reads past it).
   static void gather3_last(const Real* pos, const std::uint32_t* index, V& x, V& y, V& z) {
     IsaGeneric::gather3(pos, index, x, y, z);
