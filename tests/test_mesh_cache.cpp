@@ -314,3 +314,31 @@ TEST_CASE("mesh contact: a face entry answers from the triangle's back as from i
     CHECK(searches == 1);
   }
 }
+
+TEST_CASE("mesh contact: a particle beyond a box's corner keeps its corner entry, with the search's bits") {
+  // The box's corner (0.2, -0.1, 0.15) seen from outside: every position lies in its region (beyond
+  // each of the three faces' edges through it), 3 to 6 mm from it. The fan around the corner holds
+  // triangles of three faces, two of them coplanar on some faces.
+  const auto mesh = box_mesh();
+  const Collider c =
+      Collider::triangle_mesh(mesh, {0.1, -0.2, 0.3}, Collider::rotation_from_degrees({10, 0, 30}), 0.005);
+  std::vector<float> entry(8, 0.0f);
+  kernel::MeshData cached{mesh->nodes().data(),     mesh->triangles().data(), entry.data(), 0, nullptr,
+                          mesh->neighbours().data()};
+  const auto shape = kernel::kernel_shape<float>(c);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0.15, 1.0);
+  std::size_t searches = 0, differences = 0;
+  for (int k = 0; k < 200; ++k) {
+    const glm::dvec3 dir = glm::normalize(glm::dvec3(u(rng), -u(rng), u(rng)));
+    const double r = 0.003 + 0.003 * (u(rng) - 0.15) / 0.85;
+    const glm::dvec3 body = glm::dvec3(0.2, -0.1, 0.15) + r * dir;
+    const Compared q = compare_query(cached, shape, mesh, entry, glm::vec3(c.center + c.rotation * body));
+    searches += q.searched;
+    differences += q.differs;
+    CHECK(entry[2] == 3.0f); // a corner entry
+    CHECK(std::abs(double(q.distance) - (r - c.thickness)) < 1e-6);
+  }
+  CHECK(differences == 0);
+  CHECK(searches == 1); // the first query's
+}

@@ -19,10 +19,13 @@
 // - edge (n.z = 2): the nearest point of the mesh lies inside the edge that triangle `tri` shares with
 //   triangle n.x at an angle (the corners opposite it: n.y = k + 3 k2, corner_and_edge) for every q
 //   beyond the edge on both faces with |q - centre| < radius (mesh_edge_hit);
+// - corner (n.z = 3): the nearest point of the mesh is corner k = n.x of triangle `tri`, a vertex whose
+//   fan of triangles closes around it, convex, for every q in its region with |q - centre| < radius
+//   (mesh_corner);
 // - empty (n = 0): no triangle nearer to q than radius - |q - centre| (radius <= 0: nothing), the
 //   nearest at `centre` being `tri`.
 // The rounding of the distances in float at q's scale (guard) shrinks every bound.
-// An edge entry's mark: n.z = 2 (a unit normal's z is at most 1).
+// An edge or a corner entry's mark: n.z = 2 or 3 (a unit normal's z is at most 1).
 KFN VARYING(bool) mesh_edge_entry(vec3 n) {
   return n.z > real(1.5);
 }
@@ -388,6 +391,78 @@ KFN bool mesh_edge_wedge(MESH_DATA_PARAM, uint t, vec3 a, vec3 b, vec3 c, uint t
   return true;
 }
 
+// ---- Corner entries: q nearest to a vertex v of the mesh --------------------------------------
+// Whether q lies in the region of corner v of a triangle with the edge v -> w: (q - v).(w - v) <
+// -guard |w - v| (compared squared: no root).
+KFN bool corner_region(vec3 q, vec3 v, vec3 w, real guard) {
+  precise vec3 e = w - v;
+  precise real d = dot3(q - v, e);
+  precise real g2 = guard * guard * dot3(e, e);
+  return d < real(0) && d * d > g2;
+}
+// One step around vertex v: triangle `cur` (entered from `prev`), its corners next to v (w1, w2) and
+// the triangle across its other edge at v (VKCLOTH_MESH_NONE at the mesh's border, or where cur has no
+// corner at v). Edge j of a triangle lies opposite its corner j (ColliderMesh::neighbours).
+KFN uint mesh_fan_next(MESH_DATA_PARAM, ColliderShape s, vec3 v, uint prev, uint cur, OUT(vec3) w1,
+                       OUT(vec3) w2) {
+  vec3 a, b, c, f;
+  mesh_triangle(MESH_DATA, cur, a, b, c);
+  const uint k = a == v ? 0u : (b == v ? 1u : (c == v ? 2u : 3u));
+  corner_and_edge(k % 3u, a, b, c, f, w1, w2);
+  const uint local = cur - s.mesh_tri0;
+  uint n1 = mesh_neighbour(MESH_DATA, s.mesh_adj0, local, (k + 2u) % 3u); // across v -> w1
+  uint n2 = mesh_neighbour(MESH_DATA, s.mesh_adj0, local, (k + 1u) % 3u); // across w2 -> v
+  n1 = n1 >= 268435456u ? VKCLOTH_MESH_NONE : s.mesh_tri0 + n1;           // none (at most 2^28 triangles)
+  n2 = n2 >= 268435456u ? VKCLOTH_MESH_NONE : s.mesh_tri0 + n2;
+  return k == 3u ? VKCLOTH_MESH_NONE : (n1 != prev ? n1 : n2);
+}
+// A corner entry (corner k of triangle t, the mesh's vertex v): whether the fan of triangles around v
+// closes (at most VKCLOTH_MESH_FAN) and q lies in v's region of each (corner_region): then each one is
+// nearest to q at v, all at |q - v|, and the search takes the lowest index (`lowest`). With `shape`
+// (the entry's making): also whether each triangle's plane has the whole fan behind it or on it
+// (within guard: a convex vertex), where the cone behind all the planes is nearest at v too (q lies
+// in its polar cone), and `clear`, the least clearance of the fan's triangles on q's side, which
+// keeps every triangle reaching in front of a plane farther than v within the entry's ball.
+#define VKCLOTH_MESH_FAN 16u
+KFN bool mesh_corner(MESH_DATA_PARAM, ColliderShape s, uint t, uint k, vec3 q, real guard, bool shape,
+                     OUT(uint) lowest, OUT(real) clear) {
+  vec3 a, b, c, v, w1, w2;
+  mesh_triangle(MESH_DATA, t, a, b, c);
+  corner_and_edge(k, a, b, c, v, w1, w2);
+  lowest = t;
+  clear = real(1e15);
+  uint prev = VKCLOTH_MESH_NONE, cur = t;
+  bool inside = true;
+  for (uint i = 0u; i < VKCLOTH_MESH_FAN && inside; ++i) {
+    const uint next = mesh_fan_next(MESH_DATA, s, v, prev, cur, w1, w2);
+    inside = next != VKCLOTH_MESH_NONE && corner_region(q, v, w1, guard) && corner_region(q, v, w2, guard);
+    lowest = min(lowest, cur);
+    if (shape && inside) { // cur's plane against every corner of the fan
+      precise vec3 n = unit_or_zero(cross3(w1 - v, w2 - v));
+      precise real ahead = real(0), behind = real(0);
+      uint prev2 = VKCLOTH_MESH_NONE, cur2 = t;
+      for (uint j = 0u; j < VKCLOTH_MESH_FAN && cur2 != VKCLOTH_MESH_NONE; ++j) {
+        vec3 x1, x2;
+        const uint next2 = mesh_fan_next(MESH_DATA, s, v, prev2, cur2, x1, x2);
+        precise real h1 = dot3(n, x1 - v), h2 = dot3(n, x2 - v);
+        ahead = max(ahead, max(h1, h2));
+        behind = min(behind, min(h1, h2));
+        prev2 = cur2;
+        cur2 = next2 == t ? VKCLOTH_MESH_NONE : next2;
+      }
+      inside = ahead <= guard || behind >= -guard;
+      real front, back;
+      mesh_clearance(MESH_DATA, cur, front, back);
+      clear = min(clear, ahead <= guard ? front : back);
+    }
+    prev = cur;
+    cur = next;
+    if (cur == t)
+      return inside;
+  }
+  return false;
+}
+
 // collider_contact for a mesh collider, q = p in its body frame (to_body). The particle's entry
 // answers where it can. Where it no longer does, a face or an edge entry first moves to the
 // triangles next to it without a search (the edge q went farthest beyond, as an edge and as a face,
@@ -409,8 +484,9 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
   uint t;
   real radius;
   mesh_cache_load(MESH_DATA, s.mesh_cache, n, t, centre, radius);
-  const bool edge = mesh_edge_entry(n);
-  const bool face = !edge && dot3(n, n) > real(0);
+  const bool corner = n.z > real(2.5);
+  const bool edge = mesh_edge_entry(n) && !corner;
+  const bool face = !edge && !corner && dot3(n, n) > real(0);
   const uint t2 = edge ? uint(n.x) : VKCLOTH_MESH_NONE;
   a = b = c = vec3(real(0));
   if (face)
@@ -422,14 +498,22 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
   vec3 m = n;
   precise real gap = real(0);
   precise real guard = mesh_guard(q);
-  // Pass 0: an edge entry's own test. 1: the entry's neighbourhood, without a search. 2: the search.
-  // Each gives an edge (triangles base and cand, q beyond it on both) or a face (f0, else f1, q inside).
-  for (uint pass = edge ? 0u : (face ? 1u : 2u); pass < 3u && answer == 0u; ++pass) {
+  // Pass 0: an edge or a corner entry's own test. 1: the entry's neighbourhood, without a search. 2:
+  // the search. Each gives an edge (triangles base and cand, q beyond it on both; a corner: base =
+  // cand, its fan's lowest) or a face (f0, else f1, q inside).
+  for (uint pass = edge || corner ? 0u : (face ? 1u : 2u); pass < 3u && answer == 0u; ++pass) {
     uint base = t, cand = VKCLOTH_MESH_NONE, f0 = VKCLOTH_MESH_NONE, f1 = VKCLOTH_MESH_NONE;
     precise real d1 = real(0);
     bool near = true;
     vec3 ba, bb, bc;
-    if (pass == 0u) {
+    if (pass == 0u && corner) {
+      precise vec3 d = q - centre;
+      real unused;
+      if (!(dot3(d, d) < radius * radius) ||
+          !mesh_corner(MESH_DATA, s, t, uint(n.x), q, guard, false, base, unused))
+        continue;
+      cand = base;
+    } else if (pass == 0u) {
       vec3 a2, b2, c2, x1, e0, e1, x2, g0, g1;
       mesh_triangle(MESH_DATA, t, ba, bb, bc);
       mesh_triangle(MESH_DATA, t2, a2, b2, c2);
@@ -543,9 +627,21 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
         answer = 2u;
       }
     }
-    if (pass == 2u &&
-        answer == 0u) { // far, at a corner, ...: no triangle nearer than d1 (base: the next walk's start)
-      mesh_cache_store(MESH_DATA, s.mesh_cache, vec3(real(0)), base, q, d1 - guard);
+    if (pass == 2u && answer == 0u) {
+      // At a convex corner, near: a corner entry (its fan's clearance). Else (far, ...) an empty one: no
+      // triangle nearer than d1 (base: the next walk's start).
+      precise vec3 cp = closest_on_triangle(q, ba, bb, bc);
+      const uint k = cp == ba ? 0u : (cp == bb ? 1u : (cp == bc ? 2u : 3u));
+      vec3 entry = vec3(real(0));
+      precise real ball = d1 - guard;
+      uint lowest;
+      real fan_clear;
+      if (near && k < 3u && mesh_corner(MESH_DATA, s, base, k, q, guard, true, lowest, fan_clear) &&
+          lowest == base && mesh_clear_radius(fan_clear, d1, guard) > real(0)) {
+        entry = vec3(real(k), real(0), real(3));
+        ball = mesh_clear_radius(fan_clear, d1, guard);
+      }
+      mesh_cache_store(MESH_DATA, s.mesh_cache, entry, base, q, ball);
       at = base;
       a = ba;
       b = bb;
