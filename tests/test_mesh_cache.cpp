@@ -342,3 +342,31 @@ TEST_CASE("mesh contact: a particle beyond a box's corner keeps its corner entry
   CHECK(differences == 0);
   CHECK(searches == 1); // the first query's
 }
+
+TEST_CASE("mesh contact: a particle resting on the border between a face and its edge keeps an edge entry") {
+  // Particles that rest on a curved mesh settle where their contact normal turns, on the border
+  // between a face's region and its edge's (within the guard of it, where neither a face entry nor
+  // the edge's wedge answers): the box's top face's edge at x = 0.2, 1.5 um either side of it, 3 to 6
+  // mm above. The edge's hinge answers there (mesh_hinge): one search, the walk's bits.
+  const auto mesh = box_mesh();
+  const Collider c =
+      Collider::triangle_mesh(mesh, {0.1, -0.2, 0.3}, Collider::rotation_from_degrees({10, 0, 30}), 0.005);
+  std::vector<float> entry(8, 0.0f);
+  kernel::MeshData cached{mesh->nodes().data(),     mesh->triangles().data(), entry.data(), 0, nullptr,
+                          mesh->neighbours().data()};
+  const auto shape = kernel::kernel_shape<float>(c);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::size_t searches = 0, differences = 0;
+  for (int k = 0; k < 200; ++k) {
+    const double h = 0.0045 + 0.0015 * u(rng);
+    const glm::dvec3 body(0.2 + 1.5e-6 * u(rng), 0.05 * u(rng), 0.15 + h);
+    const Compared q = compare_query(cached, shape, mesh, entry, glm::vec3(c.center + c.rotation * body));
+    searches += q.searched;
+    differences += q.differs;
+    CHECK(entry[2] == 2.0f); // an edge entry
+    CHECK(std::abs(double(q.distance) - (h - c.thickness)) < 1e-6);
+  }
+  CHECK(differences == 0);
+  CHECK(searches == 1); // the first query's
+}

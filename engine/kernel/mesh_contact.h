@@ -323,71 +323,73 @@ KFN void corner_and_edge(uint k, vec3 a, vec3 b, vec3 c, OUT(vec3) f, OUT(vec3) 
   e1 = k == 0u ? c : (k == 1u ? a : b);
 }
 
-// Whether q lies beyond the edge e0 -> e1 of triangle (f, e0, e1) in its plane and its foot on the
-// edge inside it, each by more than guard: then the triangle's nearest point to q lies inside that edge.
-KFN bool beyond_edge(vec3 q, vec3 f, vec3 e0, vec3 e1, real guard) {
-  precise vec3 tn = unit_or_zero(cross3(e0 - f, e1 - f));
+// An edge's two triangles (f1, e0, e1) and (f2, g0, g1) (the same edge e0 -> e1, the other way
+// round in the second), each plane turned by s1, s2 (+1: its winding's front) to face away from the
+// other triangle: the wedge W behind both planes holds both triangles. Whether q lies near their edge
+// (within guard of it inside a face, or beyond it on both: the band that face entries leave) where
+// the nearest point of W lies in one of the triangles: q's foot on the first's plane inside it, q in
+// front; else the same on the second; else q beyond the edge on both, in front of both, its foot on
+// the edge inside it. Only the outer borders keep a guard (on each side of an inner one the nearest
+// point lies in a triangle).
+KFN bool mesh_hinge(vec3 q, vec3 f1, vec3 e0, vec3 e1, real s1, vec3 f2, vec3 g0, vec3 g1, real s2,
+                    real guard) {
+  precise vec3 n1 = unit_or_zero(cross3(e0 - f1, e1 - f1)), n2 = unit_or_zero(cross3(g0 - f2, g1 - f2));
+  precise real h1 = dot3(q - e0, n1) * s1, h2 = dot3(q - g0, n2) * s2;
+  precise real inside1 = edge_margin(q, n1, e0, e1), inside2 = edge_margin(q, n2, g0, g1);
+  if (inside1 >= real(0))
+    return inside1 <= guard && h1 > guard && edge_margin(q, n1, e1, f1) > guard &&
+           edge_margin(q, n1, f1, e0) > guard;
+  if (inside2 >= real(0))
+    return inside2 <= guard && h2 > guard && edge_margin(q, n2, g1, f2) > guard &&
+           edge_margin(q, n2, f2, g0) > guard;
   precise vec3 e = e1 - e0;
   precise real len = sqrt(dot3(e, e));
   precise real along = dot3(q - e0, e) / len;
-  return -edge_margin(q, tn, e0, e1) > guard && along > guard && len - along > guard;
+  return along > guard && len - along > guard && h1 > real(0) && h2 > real(0);
 }
 
-// An edge entry: the edge e0 -> e1 of triangle (f1, e0, e1) is g0 -> g1 of the neighbour (f2, g0, g1).
-// It answers q within its ball, beyond the edge on both faces: there the nearest point of each
-// triangle, and of the wedge behind both their planes, is q's foot on the edge; the ball keeps every
-// triangle reaching in front of either plane farther than the edge.
-KFN bool mesh_edge_hit(vec3 centre, real radius, vec3 q, vec3 f1, vec3 e0, vec3 e1, vec3 f2, vec3 g0,
-                       vec3 g1) {
-  precise vec3 d = q - centre;
-  precise real guard = mesh_guard(q);
-  return radius > real(0) && dot3(d, d) < radius * radius && beyond_edge(q, f1, e0, e1, guard) &&
-         beyond_edge(q, f2, g0, g1, guard);
-}
-
-// The wedge of an edge entry where q's nearest point lies inside an edge of the nearest triangle t
-// (a, b, c) that triangle t2 (as near: the search's second) shares at an angle, q beyond it on both:
-// the planes m1, m2 (through the edge, each turned away from the other triangle's far corner), the
-// entry's corner code (k + 3 k2, corner_and_edge) and the triangles' clearance on the wedge's side.
-// False where there is no such edge.
+// An edge entry's hinge, where the search's nearest triangle t (a, b, c) shares an edge with t2 (its
+// second, as near): the planes' turns (each away from the other triangle's far corner; flat: towards
+// q), the entry's code (k + 3 k2 + 9 [s1 < 0] + 18 [s2 < 0], corner_and_edge), m1, m2 (the turned
+// normals) and e0 (on both planes), and the triangles' clearance on the wedge's side. False where
+// there is no such edge or the nearest point of the wedge to q lies in neither triangle (mesh_hinge).
 KFN bool mesh_edge_wedge(MESH_DATA_PARAM, uint t, vec3 a, vec3 b, vec3 c, uint t2, vec3 q, real guard,
                          OUT(vec3) m1, OUT(vec3) m2, OUT(vec3) e0, OUT(uint) code, OUT(real) clear) {
   if (t2 == VKCLOTH_MESH_NONE || t2 >= 16777216u) // the entry holds t2 as a real: exact below 2^24
     return false;
-  uint k = 3u;
-  vec3 f1, e1;
+  vec3 a2, b2, c2, f1, e1, f2, g0, g1;
+  mesh_triangle(MESH_DATA, t2, a2, b2, c2);
+  // t's corner opposite the shared edge (its other two are corners of t2), then t2's.
+  uint k = 3u, k2 = 3u;
   for (uint i = 0u; i < 3u; ++i) {
     corner_and_edge(i, a, b, c, f1, e0, e1);
-    if (beyond_edge(q, f1, e0, e1, guard))
+    if ((e0 == a2 || e0 == b2 || e0 == c2) && (e1 == a2 || e1 == b2 || e1 == c2))
       k = i;
   }
   if (k == 3u)
     return false;
   corner_and_edge(k, a, b, c, f1, e0, e1);
-  vec3 a2, b2, c2, f2, g0, g1;
-  mesh_triangle(MESH_DATA, t2, a2, b2, c2);
-  uint k2 = 3u;
   for (uint i = 0u; i < 3u; ++i) {
     corner_and_edge(i, a2, b2, c2, f2, g0, g1);
-    if ((g0 == e0 && g1 == e1) || (g0 == e1 && g1 == e0))
+    if (f2 != e0 && f2 != e1)
       k2 = i;
   }
-  if (k2 == 3u)
-    return false;
   corner_and_edge(k2, a2, b2, c2, f2, g0, g1);
-  if (!beyond_edge(q, f2, g0, g1, guard))
-    return false;
   precise vec3 n1 = unit_or_zero(cross3(e0 - f1, e1 - f1)), n2 = unit_or_zero(cross3(g0 - f2, g1 - f2));
   precise real h1 = dot3(n1, f2 - e0), h2 = dot3(n2, f1 - e0);
-  if (abs(h1) <= guard || abs(h2) <= guard) // flat: the face entries' case
+  precise real s1 = abs(h1) <= guard ? select(dot3(n1, q - e0) < real(0), real(-1), real(1))
+                                     : select(h1 < real(0), real(1), real(-1));
+  precise real s2 = abs(h2) <= guard ? select(dot3(n2, q - e0) < real(0), real(-1), real(1))
+                                     : select(h2 < real(0), real(1), real(-1));
+  if (!mesh_hinge(q, f1, e0, e1, s1, f2, g0, g1, s2, guard))
     return false;
-  m1 = n1 * select(h1 < real(0), real(1), real(-1));
-  m2 = n2 * select(h2 < real(0), real(1), real(-1));
-  code = k + 3u * k2;
+  m1 = n1 * s1;
+  m2 = n2 * s2;
+  code = k + 3u * k2 + (s1 < real(0) ? 9u : 0u) + (s2 < real(0) ? 18u : 0u);
   real front1, back1, front2, back2;
   mesh_clearance(MESH_DATA, t, front1, back1);
   mesh_clearance(MESH_DATA, t2, front2, back2);
-  clear = min(select(h1 < real(0), front1, back1), select(h2 < real(0), front2, back2));
+  clear = min(select(s1 > real(0), front1, back1), select(s2 > real(0), front2, back2));
   return true;
 }
 
@@ -517,26 +519,38 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
       vec3 a2, b2, c2, x1, e0, e1, x2, g0, g1;
       mesh_triangle(MESH_DATA, t, ba, bb, bc);
       mesh_triangle(MESH_DATA, t2, a2, b2, c2);
-      corner_and_edge(uint(n.y) % 3u, ba, bb, bc, x1, e0, e1);
-      corner_and_edge(uint(n.y) / 3u, a2, b2, c2, x2, g0, g1);
-      if (!mesh_edge_hit(centre, radius, q, x1, e0, e1, x2, g0, g1))
+      const uint code = uint(n.y);
+      corner_and_edge(code % 3u, ba, bb, bc, x1, e0, e1);
+      corner_and_edge((code / 3u) % 3u, a2, b2, c2, x2, g0, g1);
+      precise vec3 d = q - centre;
+      if (!(radius > real(0) && dot3(d, d) < radius * radius) ||
+          !mesh_hinge(q, x1, e0, e1, (code / 9u) % 2u == 1u ? real(-1) : real(1), x2, g0, g1,
+                      code >= 18u ? real(-1) : real(1), guard))
         continue;
       cand = t2;
     } else if (pass == 1u) {
-      if (face) {
-        precise vec3 tn = unit_or_zero(cross3(b - a, c - a));
-        precise real m0 = edge_margin(q, tn, b, c), m1 = edge_margin(q, tn, c, a),
-                     m2 = edge_margin(q, tn, a, b);
-        const uint k = m0 <= min(m1, m2) ? 0u : (m1 <= m2 ? 1u : 2u);
-        const uint local = mesh_neighbour(MESH_DATA, s.mesh_adj0, t - s.mesh_tri0, k);
-        cand = local >= 268435456u ? VKCLOTH_MESH_NONE : s.mesh_tri0 + local; // none (at most 2^28 triangles)
-        f0 = cand;
-        f1 = t;
-      } else {
-        f0 = t;
-        f1 = t2;
+      // The entry's face (an edge entry's: its triangle on q's side of their edge) and the triangle
+      // across the edge of it that q went farthest beyond.
+      ba = a;
+      bb = b;
+      bc = c;
+      if (edge) {
+        vec3 x1, e0, e1;
+        mesh_triangle(MESH_DATA, t, ba, bb, bc);
+        corner_and_edge(uint(n.y) % 3u, ba, bb, bc, x1, e0, e1);
+        if (edge_margin(q, unit_or_zero(cross3(e0 - x1, e1 - x1)), e0, e1) < real(0)) {
+          base = t2;
+          mesh_triangle(MESH_DATA, base, ba, bb, bc);
+        }
       }
-      mesh_triangle(MESH_DATA, base, ba, bb, bc);
+      precise vec3 tn = unit_or_zero(cross3(bb - ba, bc - ba));
+      precise real m0 = edge_margin(q, tn, bb, bc), m1 = edge_margin(q, tn, bc, ba),
+                   m2 = edge_margin(q, tn, ba, bb);
+      const uint k = m0 <= min(m1, m2) ? 0u : (m1 <= m2 ? 1u : 2u);
+      const uint local = mesh_neighbour(MESH_DATA, s.mesh_adj0, base - s.mesh_tri0, k);
+      cand = local >= 268435456u ? VKCLOTH_MESH_NONE : s.mesh_tri0 + local; // none (at most 2^28 triangles)
+      f0 = cand;
+      f1 = base;
     } else {
       // The walk starts bounded by the entry's triangle, which is at least as far as the nearest:
       // it finds the same triangle as an unbounded walk (the same order; no box holding it is cut).
@@ -555,14 +569,37 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
       f0 = base;
       mesh_triangle(MESH_DATA, base, ba, bb, bc);
     }
-    // An edge: the nearer of its two triangles by the search's measure (ties: the lower index).
     precise vec3 m1, m2, e0;
     uint code = 0u;
     real clear = real(0);
-    bool is_edge = pass == 0u;
-    if (pass > 0u && near && cand != VKCLOTH_MESH_NONE)
-      is_edge = mesh_edge_wedge(MESH_DATA, base, ba, bb, bc, cand, q, guard, m1, m2, e0, code, clear);
+    // A face: q inside it (and, without a search, in front by more than guard, within twice the reach).
     bool is_face = false;
+    for (uint i = 0u; i < 2u && pass > 0u && near && !is_face; ++i) {
+      const uint f = i == 0u ? f0 : f1;
+      if (f == VKCLOTH_MESH_NONE)
+        continue;
+      mesh_triangle(MESH_DATA, f, a, b, c);
+      precise vec3 tn = unit_or_zero(cross3(b - a, c - a));
+      precise real h = dot3(q - a, tn);
+      if (inside_face(q, tn, a, b, c, guard) &&
+          (pass == 2u || (abs(h) > guard && abs(h) < real(2) * reach_total))) {
+        is_face = true;
+        at = f;
+        m1 = tn * select(h < real(0), real(-1), real(1));
+        m2 = m1;
+        e0 = a;
+        real front, back;
+        mesh_clearance(MESH_DATA, f, front, back);
+        clear = select(h < real(0), back, front);
+        d1 = select(pass == 2u, d1, abs(h));
+      }
+    }
+    // Else an edge (its hinge: mesh_edge_wedge; a corner entry's fan): the nearer of its two triangles
+    // by the search's measure (ties: the lower index); the face formula where q lies inside its face
+    // (the rule after the passes).
+    bool is_edge = pass == 0u;
+    if (!is_face && pass > 0u && near && cand != VKCLOTH_MESH_NONE)
+      is_edge = mesh_edge_wedge(MESH_DATA, base, ba, bb, bc, cand, q, guard, m1, m2, e0, code, clear);
     if (is_edge) {
       at = base;
       for (uint i = 0u; i < 2u; ++i) {
@@ -580,28 +617,6 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
       }
       d1 = sqrt(gap);
       is_edge = pass != 1u || d1 < real(2) * reach_total;
-    } else {
-      // A face: q inside it (and, without a search, in front by more than guard, within twice the reach).
-      for (uint i = 0u; i < 2u && near && !is_face; ++i) {
-        const uint f = i == 0u ? f0 : f1;
-        if (f == VKCLOTH_MESH_NONE)
-          continue;
-        mesh_triangle(MESH_DATA, f, a, b, c);
-        precise vec3 tn = unit_or_zero(cross3(b - a, c - a));
-        precise real h = dot3(q - a, tn);
-        if (inside_face(q, tn, a, b, c, guard) &&
-            (pass == 2u || (abs(h) > guard && abs(h) < real(2) * reach_total))) {
-          is_face = true;
-          at = f;
-          m1 = tn * select(h < real(0), real(-1), real(1));
-          m2 = m1;
-          e0 = a;
-          real front, back;
-          mesh_clearance(MESH_DATA, f, front, back);
-          clear = select(h < real(0), back, front);
-          d1 = select(pass == 2u, d1, abs(h));
-        }
-      }
     }
     if (pass == 0u) {
       answer = 2u;
@@ -609,7 +624,7 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
       // The ball: no triangle reaching in front of the plane(s) comes as near as the face or the edge
       // (its clearance; else, after a search, one 8 reaches beyond d1: each triangle moves at most as
       // far as q; one wholly behind is never nearer than the face or the edge while q is in front of
-      // the face and inside it, or beyond the edge on both faces).
+      // the face and inside it, or in the edge's hinge: mesh_hinge).
       precise real ball = mesh_clear_radius(clear, d1, guard);
       if (pass == 2u && ball < real(2) * reach_total) {
         uint unused, unused2;
@@ -647,6 +662,14 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
       b = bb;
       c = bc;
       answer = 2u;
+    }
+  }
+  // The search's rule for every answer: a nearest point inside the face (near) takes the face formula.
+  if (answer == 2u && sqrt(gap) < real(2) * reach_total) {
+    precise vec3 tn = unit_or_zero(cross3(b - a, c - a));
+    if (inside_face(q, tn, a, b, c, guard)) {
+      m = tn * select(dot3(q - a, tn) < real(0), real(-1), real(1));
+      answer = 1u;
     }
   }
   if (answer == 1u) {
