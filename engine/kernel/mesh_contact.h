@@ -501,33 +501,20 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
   precise real gap = real(0);
   precise real guard = mesh_guard(q);
   // Pass 0: an edge or a corner entry's own test. 1: the entry's neighbourhood, without a search. 2:
-  // the search. Each gives an edge (triangles base and cand, q beyond it on both; a corner: base =
-  // cand, its fan's lowest) or a face (f0, else f1, q inside).
+  // the search. Each tries a corner (triangle base's corner k, its fan), a face (f0, else f1, q inside)
+  // and an edge (triangles base and cand: its hinge), in that order; each formula has one call site.
   for (uint pass = edge || corner ? 0u : (face ? 1u : 2u); pass < 3u && answer == 0u; ++pass) {
-    uint base = t, cand = VKCLOTH_MESH_NONE, f0 = VKCLOTH_MESH_NONE, f1 = VKCLOTH_MESH_NONE;
+    uint base = t, cand = VKCLOTH_MESH_NONE, f0 = VKCLOTH_MESH_NONE, f1 = VKCLOTH_MESH_NONE, k = 3u;
     precise real d1 = real(0);
     bool near = true;
     vec3 ba, bb, bc;
-    if (pass == 0u && corner) {
+    if (pass == 0u) {
       precise vec3 d = q - centre;
-      real unused;
-      if (!(dot3(d, d) < radius * radius) ||
-          !mesh_corner(MESH_DATA, s, t, uint(n.x), q, guard, false, base, unused))
+      if (!(radius > real(0) && dot3(d, d) < radius * radius))
         continue;
-      cand = base;
-    } else if (pass == 0u) {
-      vec3 a2, b2, c2, x1, e0, e1, x2, g0, g1;
       mesh_triangle(MESH_DATA, t, ba, bb, bc);
-      mesh_triangle(MESH_DATA, t2, a2, b2, c2);
-      const uint code = uint(n.y);
-      corner_and_edge(code % 3u, ba, bb, bc, x1, e0, e1);
-      corner_and_edge((code / 3u) % 3u, a2, b2, c2, x2, g0, g1);
-      precise vec3 d = q - centre;
-      if (!(radius > real(0) && dot3(d, d) < radius * radius) ||
-          !mesh_hinge(q, x1, e0, e1, (code / 9u) % 2u == 1u ? real(-1) : real(1), x2, g0, g1,
-                      code >= 18u ? real(-1) : real(1), guard))
-        continue;
       cand = t2;
+      k = corner ? uint(n.x) : 3u;
     } else if (pass == 1u) {
       // The entry's face (an edge entry's: its triangle on q's side of their edge) and the triangle
       // across the edge of it that q went farthest beyond.
@@ -546,8 +533,8 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
       precise vec3 tn = unit_or_zero(cross3(bb - ba, bc - ba));
       precise real m0 = edge_margin(q, tn, bb, bc), m1 = edge_margin(q, tn, bc, ba),
                    m2 = edge_margin(q, tn, ba, bb);
-      const uint k = m0 <= min(m1, m2) ? 0u : (m1 <= m2 ? 1u : 2u);
-      const uint local = mesh_neighbour(MESH_DATA, s.mesh_adj0, base - s.mesh_tri0, k);
+      const uint e = m0 <= min(m1, m2) ? 0u : (m1 <= m2 ? 1u : 2u);
+      const uint local = mesh_neighbour(MESH_DATA, s.mesh_adj0, base - s.mesh_tri0, e);
       cand = local >= 268435456u ? VKCLOTH_MESH_NONE : s.mesh_tri0 + local; // none (at most 2^28 triangles)
       f0 = cand;
       f1 = base;
@@ -568,13 +555,25 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
       near = d1 < real(2) * reach_total;
       f0 = base;
       mesh_triangle(MESH_DATA, base, ba, bb, bc);
+      if (near) { // the nearest point at a corner of base: its fan
+        precise vec3 cp = closest_on_triangle(q, ba, bb, bc);
+        k = cp == ba ? 0u : (cp == bb ? 1u : (cp == bc ? 2u : 3u));
+      }
     }
     precise vec3 m1, m2, e0;
     uint code = 0u;
     real clear = real(0);
+    // A corner: its fan closes, convex, q in its region (the search's: also its clearance's ball).
+    bool is_corner = false;
+    if (k < 3u) {
+      uint lowest;
+      is_corner = mesh_corner(MESH_DATA, s, base, k, q, guard, pass == 2u, lowest, clear) &&
+                  (pass == 0u || lowest == base);
+      cand = is_corner ? lowest : cand;
+    }
     // A face: q inside it (and, without a search, in front by more than guard, within twice the reach).
     bool is_face = false;
-    for (uint i = 0u; i < 2u && pass > 0u && near && !is_face; ++i) {
+    for (uint i = 0u; i < 2u && pass > 0u && near && !is_corner && !is_face; ++i) {
       const uint f = i == 0u ? f0 : f1;
       if (f == VKCLOTH_MESH_NONE)
         continue;
@@ -594,13 +593,17 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
         d1 = select(pass == 2u, d1, abs(h));
       }
     }
-    // Else an edge (its hinge: mesh_edge_wedge; a corner entry's fan): the nearer of its two triangles
-    // by the search's measure (ties: the lower index); the face formula where q lies inside its face
-    // (the rule after the passes).
-    bool is_edge = pass == 0u;
-    if (!is_face && pass > 0u && near && cand != VKCLOTH_MESH_NONE)
-      is_edge = mesh_edge_wedge(MESH_DATA, base, ba, bb, bc, cand, q, guard, m1, m2, e0, code, clear);
-    if (is_edge) {
+    // An edge: its hinge (mesh_edge_wedge; an edge entry's own: the same edge, planes and code).
+    bool is_edge = false;
+    if (!is_corner && !is_face && near && cand != VKCLOTH_MESH_NONE)
+      is_edge = mesh_edge_wedge(MESH_DATA, base, ba, bb, bc, cand, q, guard, m1, m2, e0, code, clear) &&
+                (pass != 0u || code == uint(n.y));
+    if (pass == 0u && !is_corner && !is_edge)
+      continue;
+    // A corner or an edge answers with the nearer of its two triangles (a corner: base = cand, its
+    // fan's lowest) by the search's measure (ties: the lower index); the face formula where q lies
+    // inside its face (the rule after the passes).
+    if (is_corner || is_edge) {
       at = base;
       for (uint i = 0u; i < 2u; ++i) {
         const uint ti = i == 0u ? base : cand;
@@ -616,17 +619,17 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
         }
       }
       d1 = sqrt(gap);
-      is_edge = pass != 1u || d1 < real(2) * reach_total;
+      is_edge = is_edge && (pass != 1u || d1 < real(2) * reach_total);
     }
     if (pass == 0u) {
       answer = 2u;
-    } else if (is_edge || is_face) {
-      // The ball: no triangle reaching in front of the plane(s) comes as near as the face or the edge
-      // (its clearance; else, after a search, one 8 reaches beyond d1: each triangle moves at most as
-      // far as q; one wholly behind is never nearer than the face or the edge while q is in front of
-      // the face and inside it, or in the edge's hinge: mesh_hinge).
+    } else if (is_corner || is_edge || is_face) {
+      // The ball: no triangle reaching in front of the plane(s) comes as near as the face, the edge or
+      // the corner (their clearance; else, after a search, one 8 reaches beyond d1: each triangle
+      // moves at most as far as q; one wholly behind is never nearer than the face or the edge while q
+      // is in front of the face and inside it, or in the edge's hinge: mesh_hinge).
       precise real ball = mesh_clear_radius(clear, d1, guard);
-      if (pass == 2u && ball < real(2) * reach_total) {
+      if (pass == 2u && !is_corner && ball < real(2) * reach_total) {
         uint unused, unused2;
         precise real next = mesh_nearest(MESH_DATA, s.mesh_root, s.mesh_tri0, q, d1 + real(8) * reach_total,
                                          base, is_edge ? cand : base, m1, dot3(m1, e0), m2, dot3(m2, e0),
@@ -637,26 +640,15 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
         mesh_cache_store(MESH_DATA, s.mesh_cache, m1, at, q, ball);
         m = m1;
         answer = 1u;
-      } else if (is_edge && ball > real(0)) {
-        mesh_cache_store(MESH_DATA, s.mesh_cache, vec3(real(cand), real(code), real(2)), base, q, ball);
+      } else if ((is_edge || is_corner) && ball > real(0)) {
+        const vec3 entry = is_edge ? vec3(real(cand), real(code), real(2)) : vec3(real(k), real(0), real(3));
+        mesh_cache_store(MESH_DATA, s.mesh_cache, entry, base, q, ball);
         answer = 2u;
       }
     }
-    if (pass == 2u && answer == 0u) {
-      // At a convex corner, near: a corner entry (its fan's clearance). Else (far, ...) an empty one: no
-      // triangle nearer than d1 (base: the next walk's start).
-      precise vec3 cp = closest_on_triangle(q, ba, bb, bc);
-      const uint k = cp == ba ? 0u : (cp == bb ? 1u : (cp == bc ? 2u : 3u));
-      vec3 entry = vec3(real(0));
-      precise real ball = d1 - guard;
-      uint lowest;
-      real fan_clear;
-      if (near && k < 3u && mesh_corner(MESH_DATA, s, base, k, q, guard, true, lowest, fan_clear) &&
-          lowest == base && mesh_clear_radius(fan_clear, d1, guard) > real(0)) {
-        entry = vec3(real(k), real(0), real(3));
-        ball = mesh_clear_radius(fan_clear, d1, guard);
-      }
-      mesh_cache_store(MESH_DATA, s.mesh_cache, entry, base, q, ball);
+    if (pass == 2u &&
+        answer == 0u) { // far, ...: an empty entry, no triangle nearer than d1 (base: the next walk's start)
+      mesh_cache_store(MESH_DATA, s.mesh_cache, vec3(real(0)), base, q, d1 - guard);
       at = base;
       a = ba;
       b = bb;
