@@ -16,9 +16,9 @@
 // - face (n != 0): triangle `tri` (unit normal n, turned towards q's side) holds the nearest point of
 //   the mesh inside its face for every q in front of it whose projection lies inside the face
 //   (inside_face) and with |q - centre| < radius (no other triangle comes as near);
-// - edge (n.z = 2): the nearest point of the mesh lies inside the edge that triangle `tri` shares with
-//   triangle n.x at an angle (the corners opposite it: n.y = k + 3 k2, corner_and_edge) for every q
-//   beyond the edge on both faces with |q - centre| < radius (mesh_edge_hit);
+// - edge (n.z = 2): the nearest point of the mesh lies in triangle `tri` or triangle n.x, which share
+//   an edge (their corners opposite it and their planes' turns: n.y, mesh_edge_wedge's code), for
+//   every q near that edge in its hinge (mesh_hinge) with |q - centre| < radius;
 // - corner (n.z = 3): the nearest point of the mesh is corner k = n.x of triangle `tri`, a vertex whose
 //   fan of triangles closes around it, convex, for every q in its region with |q - centre| < radius
 //   (mesh_corner);
@@ -468,11 +468,12 @@ KFN bool mesh_corner(MESH_DATA_PARAM, ColliderShape s, uint t, uint k, vec3 q, r
 // collider_contact for a mesh collider, q = p in its body frame (to_body). The particle's entry
 // answers where it can. Where it no longer does, a face or an edge entry first moves to the
 // triangles next to it without a search (the edge q went farthest beyond, as an edge and as a face,
-// then its own face; an edge entry: its two faces), where their clearance keeps a ball (a rigid
-// mesh): the entry the search would certify there (the same triangles, the same formulas).
-// Otherwise the search answers and leaves a new entry (slot: ColliderShape::mesh_cache; the bridge
-// adds the particle): a face or an edge entry where the nearest point lies inside a face or an edge
-// within twice the reach, else an empty one. Each formula has one call site (the GPU inlines them).
+// then its own face; an edge entry: the same from its triangle on q's side), where their clearance
+// keeps a ball (a rigid mesh): the entry the search would certify there (the same triangles, the
+// same formulas). Otherwise the search answers and leaves a new entry (slot:
+// ColliderShape::mesh_cache; the bridge adds the particle): a corner, face or edge entry where the
+// nearest point lies at a convex corner, inside a face or by an edge within twice the reach, else an
+// empty one. Each formula has one call site (the GPU inlines them).
 // A skinned mesh: `deform`, the surface's velocity at the nearest point from its corners' (zero otherwise).
 KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_side, real reach,
                                OUT(real) distance, OUT(vec3) normal, OUT(vec3) deform) {
