@@ -465,6 +465,104 @@ KFN bool mesh_corner(MESH_DATA_PARAM, ColliderShape s, uint t, uint k, vec3 q, r
   return false;
 }
 
+// mesh_contact's passes, each called once. Pass 1's triangles: the entry's face (an edge entry's:
+// its triangle on q's side of their edge; ba, bb, bc on entry: a face entry's corners) as base, and
+// the triangle across the edge of it that q went farthest beyond as cand.
+KFN void mesh_neighbourhood(MESH_DATA_PARAM, ColliderShape s, uint t, uint t2, uint code, bool edge, vec3 q,
+                            OUT(uint) base, INOUT(vec3) ba, INOUT(vec3) bb, INOUT(vec3) bc, OUT(uint) cand) {
+  base = t;
+  if (edge) {
+    vec3 x1, e0, e1;
+    mesh_triangle(MESH_DATA, t, ba, bb, bc);
+    corner_and_edge(code % 3u, ba, bb, bc, x1, e0, e1);
+    if (edge_margin(q, unit_or_zero(cross3(e0 - x1, e1 - x1)), e0, e1) < real(0)) {
+      base = t2;
+      mesh_triangle(MESH_DATA, base, ba, bb, bc);
+    }
+  }
+  precise vec3 tn = unit_or_zero(cross3(bb - ba, bc - ba));
+  precise real m0 = edge_margin(q, tn, bb, bc), m1 = edge_margin(q, tn, bc, ba),
+               m2 = edge_margin(q, tn, ba, bb);
+  const uint e = m0 <= min(m1, m2) ? 0u : (m1 <= m2 ? 1u : 2u);
+  const uint local = mesh_neighbour(MESH_DATA, s.mesh_adj0, base - s.mesh_tri0, e);
+  cand = local >= 268435456u ? VKCLOTH_MESH_NONE : s.mesh_tri0 + local; // none (at most 2^28 triangles)
+}
+
+// Pass 2, the search: the nearest triangle base (ba, bb, bc) at squared distance gap (returned) and
+// the edge's other one, cand (the search's second); k: the corner of base that is q's nearest point
+// where it is one and q is near (3: none). The walk starts bounded by the entry's triangle t (radius >
+// 0), which is at least as far as the nearest: it finds the same triangle as an unbounded walk (the
+// same order; no box holding it is cut).
+KFN real mesh_search(MESH_DATA_PARAM, ColliderShape s, uint t, real radius, vec3 q, real guard, real near_gap,
+                     OUT(uint) base, OUT(vec3) ba, OUT(vec3) bb, OUT(vec3) bc, OUT(uint) cand, OUT(uint) k) {
+  precise real start = real(1e18);
+  if (radius > real(0)) {
+    vec3 a, b, c;
+    mesh_triangle(MESH_DATA, t, a, b, c);
+    start = sqrt(triangle_gap2(q, a, b, c)) * real(1.0009765625) + guard; // 1 + 2^-10: never below its own
+  }
+  precise real gap = mesh_nearest(MESH_DATA, s.mesh_root, s.mesh_tri0, q, start, VKCLOTH_MESH_NONE,
+                                  VKCLOTH_MESH_NONE, vec3(real(0)), real(0), vec3(real(0)), real(0), real(-1),
+                                  real(1.001953125), base, cand); // 1 + 2^-9: an edge's other triangle
+  mesh_triangle(MESH_DATA, base, ba, bb, bc);
+  k = 3u;
+  if (sqrt(gap) < near_gap) {
+    precise vec3 cp = closest_on_triangle(q, ba, bb, bc);
+    k = cp == ba ? 0u : (cp == bb ? 1u : (cp == bc ? 2u : 3u));
+  }
+  return gap;
+}
+
+// A face entry's test: q inside triangle f0's face, else f1's (VKCLOTH_MESH_NONE: none), and, without
+// a search, in front by more than guard and within twice the reach: its corners a, b, c, the normal
+// m turned to q's side, its clearance on that side and q's height d1 (after a search: kept).
+KFN bool mesh_face(MESH_DATA_PARAM, bool searched, uint f0, uint f1, vec3 q, real guard, real reach_total,
+                   OUT(uint) at, OUT(vec3) a, OUT(vec3) b, OUT(vec3) c, OUT(vec3) m, OUT(real) clear,
+                   INOUT(real) d1) {
+  bool is_face = false;
+  for (uint i = 0u; i < 2u && !is_face; ++i) {
+    const uint f = i == 0u ? f0 : f1;
+    if (f == VKCLOTH_MESH_NONE)
+      continue;
+    mesh_triangle(MESH_DATA, f, a, b, c);
+    precise vec3 tn = unit_or_zero(cross3(b - a, c - a));
+    precise real h = dot3(q - a, tn);
+    if (inside_face(q, tn, a, b, c, guard) &&
+        (searched || (abs(h) > guard && abs(h) < real(2) * reach_total))) {
+      is_face = true;
+      at = f;
+      m = tn * select(h < real(0), real(-1), real(1));
+      real front, back;
+      mesh_clearance(MESH_DATA, f, front, back);
+      clear = select(h < real(0), back, front);
+      d1 = select(searched, d1, abs(h));
+    }
+  }
+  return is_face;
+}
+
+// The nearer of triangles base and cand by the search's measure (ties: the lower index): at, its
+// corners a, b, c and its squared distance, returned.
+KFN real mesh_nearer_of(MESH_DATA_PARAM, uint base, uint cand, vec3 q, OUT(uint) at, OUT(vec3) a, OUT(vec3) b,
+                        OUT(vec3) c) {
+  precise real gap = real(0);
+  at = base;
+  for (uint i = 0u; i < 2u; ++i) {
+    const uint ti = i == 0u ? base : cand;
+    vec3 ta, tb, tc;
+    mesh_triangle(MESH_DATA, ti, ta, tb, tc);
+    precise real gi = triangle_gap2(q, ta, tb, tc);
+    if (i == 0u || nearer(gi, ti, gap, at)) {
+      gap = gi;
+      at = ti;
+      a = ta;
+      b = tb;
+      c = tc;
+    }
+  }
+  return gap;
+}
+
 // collider_contact for a mesh collider, q = p in its body frame (to_body). The particle's entry
 // answers where it can. Where it no longer does, a face or an edge entry first moves to the
 // triangles next to it without a search (the edge q went farthest beyond, as an edge and as a face,
@@ -517,49 +615,18 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
       cand = t2;
       k = corner ? uint(n.x) : 3u;
     } else if (pass == 1u) {
-      // The entry's face (an edge entry's: its triangle on q's side of their edge) and the triangle
-      // across the edge of it that q went farthest beyond.
       ba = a;
       bb = b;
       bc = c;
-      if (edge) {
-        vec3 x1, e0, e1;
-        mesh_triangle(MESH_DATA, t, ba, bb, bc);
-        corner_and_edge(uint(n.y) % 3u, ba, bb, bc, x1, e0, e1);
-        if (edge_margin(q, unit_or_zero(cross3(e0 - x1, e1 - x1)), e0, e1) < real(0)) {
-          base = t2;
-          mesh_triangle(MESH_DATA, base, ba, bb, bc);
-        }
-      }
-      precise vec3 tn = unit_or_zero(cross3(bb - ba, bc - ba));
-      precise real m0 = edge_margin(q, tn, bb, bc), m1 = edge_margin(q, tn, bc, ba),
-                   m2 = edge_margin(q, tn, ba, bb);
-      const uint e = m0 <= min(m1, m2) ? 0u : (m1 <= m2 ? 1u : 2u);
-      const uint local = mesh_neighbour(MESH_DATA, s.mesh_adj0, base - s.mesh_tri0, e);
-      cand = local >= 268435456u ? VKCLOTH_MESH_NONE : s.mesh_tri0 + local; // none (at most 2^28 triangles)
+      mesh_neighbourhood(MESH_DATA, s, t, t2, edge ? uint(n.y) : 0u, edge, q, base, ba, bb, bc, cand);
       f0 = cand;
       f1 = base;
     } else {
-      // The walk starts bounded by the entry's triangle, which is at least as far as the nearest:
-      // it finds the same triangle as an unbounded walk (the same order; no box holding it is cut).
-      precise real start = real(1e18);
-      if (radius > real(0)) {
-        mesh_triangle(MESH_DATA, t, a, b, c);
-        start =
-            sqrt(triangle_gap2(q, a, b, c)) * real(1.0009765625) + guard; // 1 + 2^-10: never below its own
-      }
-      gap = mesh_nearest(MESH_DATA, s.mesh_root, s.mesh_tri0, q, start, VKCLOTH_MESH_NONE, VKCLOTH_MESH_NONE,
-                         vec3(real(0)), real(0), vec3(real(0)), real(0), real(-1), real(1.001953125), base,
-                         cand); // 1 + 2^-9: an edge's other triangle
+      gap = mesh_search(MESH_DATA, s, t, radius, q, guard, real(2) * reach_total, base, ba, bb, bc, cand, k);
       at = base;
       d1 = sqrt(gap);
       near = d1 < real(2) * reach_total;
       f0 = base;
-      mesh_triangle(MESH_DATA, base, ba, bb, bc);
-      if (near) { // the nearest point at a corner of base: its fan
-        precise vec3 cp = closest_on_triangle(q, ba, bb, bc);
-        k = cp == ba ? 0u : (cp == bb ? 1u : (cp == bc ? 2u : 3u));
-      }
     }
     precise vec3 m1, m2, e0;
     uint code = 0u;
@@ -572,27 +639,12 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
                   (pass == 0u || lowest == base);
       cand = is_corner ? lowest : cand;
     }
-    // A face: q inside it (and, without a search, in front by more than guard, within twice the reach).
+    // A face: q inside it (mesh_face).
     bool is_face = false;
-    for (uint i = 0u; i < 2u && pass > 0u && near && !is_corner && !is_face; ++i) {
-      const uint f = i == 0u ? f0 : f1;
-      if (f == VKCLOTH_MESH_NONE)
-        continue;
-      mesh_triangle(MESH_DATA, f, a, b, c);
-      precise vec3 tn = unit_or_zero(cross3(b - a, c - a));
-      precise real h = dot3(q - a, tn);
-      if (inside_face(q, tn, a, b, c, guard) &&
-          (pass == 2u || (abs(h) > guard && abs(h) < real(2) * reach_total))) {
-        is_face = true;
-        at = f;
-        m1 = tn * select(h < real(0), real(-1), real(1));
-        m2 = m1;
-        e0 = a;
-        real front, back;
-        mesh_clearance(MESH_DATA, f, front, back);
-        clear = select(h < real(0), back, front);
-        d1 = select(pass == 2u, d1, abs(h));
-      }
+    if (pass > 0u && near && !is_corner) {
+      is_face = mesh_face(MESH_DATA, pass == 2u, f0, f1, q, guard, reach_total, at, a, b, c, m1, clear, d1);
+      m2 = m1;
+      e0 = a;
     }
     // An edge: its hinge (mesh_edge_wedge; an edge entry's own: the same edge, planes and code).
     bool is_edge = false;
@@ -605,20 +657,7 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
     // fan's lowest) by the search's measure (ties: the lower index); the face formula where q lies
     // inside its face (the rule after the passes).
     if (is_corner || is_edge) {
-      at = base;
-      for (uint i = 0u; i < 2u; ++i) {
-        const uint ti = i == 0u ? base : cand;
-        vec3 ta, tb, tc;
-        mesh_triangle(MESH_DATA, ti, ta, tb, tc);
-        precise real gi = triangle_gap2(q, ta, tb, tc);
-        if (i == 0u || nearer(gi, ti, gap, at)) {
-          gap = gi;
-          at = ti;
-          a = ta;
-          b = tb;
-          c = tc;
-        }
-      }
+      gap = mesh_nearer_of(MESH_DATA, base, cand, q, at, a, b, c);
       d1 = sqrt(gap);
       is_edge = is_edge && (pass != 1u || d1 < real(2) * reach_total);
     }
