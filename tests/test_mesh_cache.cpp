@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -146,6 +147,34 @@ Walked walk(const std::shared_ptr<const ColliderMesh>& mesh, glm::dvec3 centre, 
   return w;
 }
 
+/// 200 queries of one particle on the box (in the frame of compare_query's collider, seed `seed`),
+/// at the positions place(rng, u) gives with their distance to the box: whether each leaves an entry
+/// of kind `kind` (the entry's n.z: 2 an edge, 3 a corner) and answers the expected distance; the
+/// searches (entries renewed) and the answers that differ from the search in any bit.
+struct Kept {
+  std::size_t searches = 0, differences = 0;
+};
+template <typename Place> Kept keep_entry_on_box(std::uint32_t seed, float kind, Place place) {
+  const auto mesh = box_mesh();
+  const Collider c =
+      Collider::triangle_mesh(mesh, {0.1, -0.2, 0.3}, Collider::rotation_from_degrees({10, 0, 30}), 0.005);
+  std::vector<float> entry(8, 0.0f);
+  kernel::MeshData cached{mesh->nodes().data(),     mesh->triangles().data(), entry.data(), 0, nullptr,
+                          mesh->neighbours().data()};
+  const auto shape = kernel::kernel_shape<float>(c);
+  std::mt19937 rng(seed);
+  Kept k;
+  for (int i = 0; i < 200; ++i) {
+    const auto [body, distance] = place(rng);
+    const Compared q = compare_query(cached, shape, mesh, entry, glm::vec3(c.center + c.rotation * body));
+    k.searches += q.searched;
+    k.differences += q.differs;
+    CHECK(entry[2] == kind);
+    CHECK(std::abs(double(q.distance) - (distance - c.thickness)) < 1e-6);
+  }
+  return k;
+}
+
 } // namespace
 
 TEST_CASE_TEMPLATE("mesh contact: a particle's search entry gives the search's bits, the nearest triangle's "
@@ -217,27 +246,13 @@ TEST_CASE("mesh contact: a triangle's clearances bound the distance to every tri
 TEST_CASE("mesh contact: a particle beyond a box's edge keeps its edge entry, with the search's bits") {
   // The box's top front edge (y = -0.1, z = 0.15) seen from outside, along its middle: every position
   // lies beyond the edge on both faces (the 90-degree wedge), 3 to 6 mm from it.
-  const auto mesh = box_mesh();
-  const Collider c =
-      Collider::triangle_mesh(mesh, {0.1, -0.2, 0.3}, Collider::rotation_from_degrees({10, 0, 30}), 0.005);
-  std::vector<float> entry(8, 0.0f);
-  kernel::MeshData cached{mesh->nodes().data(),     mesh->triangles().data(), entry.data(), 0, nullptr,
-                          mesh->neighbours().data()};
-  const auto shape = kernel::kernel_shape<float>(c);
-  std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  std::size_t searches = 0, differences = 0;
-  for (int k = 0; k < 200; ++k) {
+  const Kept k = keep_entry_on_box(7, 2.0f, [&](std::mt19937& rng) {
     const double angle = 0.785398 + 0.6 * u(rng), r = 0.0045 + 0.0015 * u(rng);
-    const glm::dvec3 body(0.1 * u(rng), -0.1 - r * std::cos(angle), 0.15 + r * std::sin(angle));
-    const Compared q = compare_query(cached, shape, mesh, entry, glm::vec3(c.center + c.rotation * body));
-    searches += q.searched;
-    differences += q.differs;
-    CHECK(entry[2] == 2.0f); // an edge entry
-    CHECK(std::abs(double(q.distance) - (r - c.thickness)) < 1e-6);
-  }
-  CHECK(differences == 0);
-  CHECK(searches == 1); // the first query's
+    return std::pair{glm::dvec3(0.1 * u(rng), -0.1 - r * std::cos(angle), 0.15 + r * std::sin(angle)), r};
+  });
+  CHECK(k.differences == 0);
+  CHECK(k.searches == 1); // the first query's
 }
 
 TEST_CASE("mesh contact: an entry moves across faces and edges to its neighbours without a search") {
@@ -319,28 +334,14 @@ TEST_CASE("mesh contact: a particle beyond a box's corner keeps its corner entry
   // The box's corner (0.2, -0.1, 0.15) seen from outside: every position lies in its region (beyond
   // each of the three faces' edges through it), 3 to 6 mm from it. The fan around the corner holds
   // triangles of three faces, two of them coplanar on some faces.
-  const auto mesh = box_mesh();
-  const Collider c =
-      Collider::triangle_mesh(mesh, {0.1, -0.2, 0.3}, Collider::rotation_from_degrees({10, 0, 30}), 0.005);
-  std::vector<float> entry(8, 0.0f);
-  kernel::MeshData cached{mesh->nodes().data(),     mesh->triangles().data(), entry.data(), 0, nullptr,
-                          mesh->neighbours().data()};
-  const auto shape = kernel::kernel_shape<float>(c);
-  std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(0.15, 1.0);
-  std::size_t searches = 0, differences = 0;
-  for (int k = 0; k < 200; ++k) {
+  const Kept k = keep_entry_on_box(5, 3.0f, [&](std::mt19937& rng) {
     const glm::dvec3 dir = glm::normalize(glm::dvec3(u(rng), -u(rng), u(rng)));
     const double r = 0.003 + 0.003 * (u(rng) - 0.15) / 0.85;
-    const glm::dvec3 body = glm::dvec3(0.2, -0.1, 0.15) + r * dir;
-    const Compared q = compare_query(cached, shape, mesh, entry, glm::vec3(c.center + c.rotation * body));
-    searches += q.searched;
-    differences += q.differs;
-    CHECK(entry[2] == 3.0f); // a corner entry
-    CHECK(std::abs(double(q.distance) - (r - c.thickness)) < 1e-6);
-  }
-  CHECK(differences == 0);
-  CHECK(searches == 1); // the first query's
+    return std::pair{glm::dvec3(0.2, -0.1, 0.15) + r * dir, r};
+  });
+  CHECK(k.differences == 0);
+  CHECK(k.searches == 1); // the first query's
 }
 
 TEST_CASE("mesh contact: a particle resting on the border between a face and its edge keeps an edge entry") {
@@ -348,25 +349,11 @@ TEST_CASE("mesh contact: a particle resting on the border between a face and its
   // between a face's region and its edge's (within the guard of it, where neither a face entry nor
   // the edge's wedge answers): the box's top face's edge at x = 0.2, 1.5 um either side of it, 3 to 6
   // mm above. The edge's hinge answers there (mesh_hinge): one search, the walk's bits.
-  const auto mesh = box_mesh();
-  const Collider c =
-      Collider::triangle_mesh(mesh, {0.1, -0.2, 0.3}, Collider::rotation_from_degrees({10, 0, 30}), 0.005);
-  std::vector<float> entry(8, 0.0f);
-  kernel::MeshData cached{mesh->nodes().data(),     mesh->triangles().data(), entry.data(), 0, nullptr,
-                          mesh->neighbours().data()};
-  const auto shape = kernel::kernel_shape<float>(c);
-  std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  std::size_t searches = 0, differences = 0;
-  for (int k = 0; k < 200; ++k) {
+  const Kept k = keep_entry_on_box(3, 2.0f, [&](std::mt19937& rng) {
     const double h = 0.0045 + 0.0015 * u(rng);
-    const glm::dvec3 body(0.2 + 1.5e-6 * u(rng), 0.05 * u(rng), 0.15 + h);
-    const Compared q = compare_query(cached, shape, mesh, entry, glm::vec3(c.center + c.rotation * body));
-    searches += q.searched;
-    differences += q.differs;
-    CHECK(entry[2] == 2.0f); // an edge entry
-    CHECK(std::abs(double(q.distance) - (h - c.thickness)) < 1e-6);
-  }
-  CHECK(differences == 0);
-  CHECK(searches == 1); // the first query's
+    return std::pair{glm::dvec3(0.2 + 1.5e-6 * u(rng), 0.05 * u(rng), 0.15 + h), h};
+  });
+  CHECK(k.differences == 0);
+  CHECK(k.searches == 1); // the first query's
 }
