@@ -250,7 +250,8 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
     mesh_triangle(MESH_DATA, t, a, b, c);
   // The answer: 1: the face formula (plane m through a of triangle at: a, b, c); 2: the general
   // formula (triangle at: a, b, c, at squared distance gap); 0: none yet.
-  uint answer = mesh_cache_hit(n, centre, radius, a, b, c, q, reach_total) ? 1u : 0u; // empty: m = 0, none
+  uint answer = // an edge or corner entry: its own test (pass 0); empty: m = 0, none
+      !edge && !corner && mesh_cache_hit(n, centre, radius, a, b, c, q, reach_total) ? 1u : 0u;
   uint at = t;
   vec3 m = n;
   precise real gap = real(0);

@@ -29,22 +29,22 @@ KFN void corner_and_edge(uint k, vec3 a, vec3 b, vec3 c, OUT(vec3) f, OUT(vec3) 
 // the nearest point of W lies in one of the triangles: q's foot on the first's plane inside it, q in
 // front; else the same on the second; else q beyond the edge on both, in front of both, its foot on
 // the edge inside it. Only the outer borders keep a guard (on each side of an inner one the nearest
-// point lies in a triangle).
-KFN bool mesh_hinge(vec3 q, vec3 f1, vec3 e0, vec3 e1, real s1, vec3 f2, vec3 g0, vec3 g1, real s2,
-                    real guard) {
-  precise vec3 n1 = unit_or_zero(cross3(e0 - f1, e1 - f1)), n2 = unit_or_zero(cross3(g0 - f2, g1 - f2));
+// point lies in a triangle). n1, n2: the triangles' unit normals (their winding's); the tests
+// compared squared (inside_edge: no root, no division).
+KFN bool mesh_hinge(vec3 q, vec3 f1, vec3 e0, vec3 e1, vec3 n1, real s1, vec3 f2, vec3 g0, vec3 g1, vec3 n2,
+                    real s2, real guard) {
   precise real h1 = dot3(q - e0, n1) * s1, h2 = dot3(q - g0, n2) * s2;
-  precise real inside1 = edge_margin(q, n1, e0, e1), inside2 = edge_margin(q, n2, g0, g1);
-  if (inside1 >= real(0))
-    return inside1 <= guard && h1 > guard && edge_margin(q, n1, e1, f1) > guard &&
-           edge_margin(q, n1, f1, e0) > guard;
-  if (inside2 >= real(0))
-    return inside2 <= guard && h2 > guard && edge_margin(q, n2, g1, f2) > guard &&
-           edge_margin(q, n2, f2, g0) > guard;
+  if (edge_side(q, n1, e0, e1) >= real(0))
+    return !inside_edge(q, n1, e0, e1, real(1), guard) && h1 > guard &&
+           inside_edge(q, n1, e1, f1, real(1), guard) && inside_edge(q, n1, f1, e0, real(1), guard);
+  if (edge_side(q, n2, g0, g1) >= real(0))
+    return !inside_edge(q, n2, g0, g1, real(1), guard) && h2 > guard &&
+           inside_edge(q, n2, g1, f2, real(1), guard) && inside_edge(q, n2, f2, g0, real(1), guard);
   precise vec3 e = e1 - e0;
-  precise real len = sqrt(dot3(e, e));
-  precise real along = dot3(q - e0, e) / len;
-  return along > guard && len - along > guard && h1 > real(0) && h2 > real(0);
+  precise real g2 = guard * guard * dot3(e, e);
+  precise real from0 = dot3(q - e0, e), from1 = dot3(e1 - q, e);
+  return from0 > real(0) && from0 * from0 > g2 && from1 > real(0) && from1 * from1 > g2 && h1 > real(0) &&
+         h2 > real(0);
 }
 
 // An edge entry's hinge, where the search's nearest triangle t (a, b, c) shares an edge with t2 (its
@@ -80,7 +80,7 @@ KFN bool mesh_edge_wedge(MESH_DATA_PARAM, uint t, vec3 a, vec3 b, vec3 c, uint t
                                      : select(h1 < real(0), real(1), real(-1));
   precise real s2 = abs(h2) <= guard ? select(dot3(n2, q - e0) < real(0), real(-1), real(1))
                                      : select(h2 < real(0), real(1), real(-1));
-  if (!mesh_hinge(q, f1, e0, e1, s1, f2, g0, g1, s2, guard))
+  if (!mesh_hinge(q, f1, e0, e1, n1, s1, f2, g0, g1, n2, s2, guard))
     return false;
   m1 = n1 * s1;
   m2 = n2 * s2;
