@@ -60,18 +60,19 @@ inline void mesh_contact(const LaneMesh<Isa>& m, ColliderShape s, vec3 q, vec3 p
   const vec3 n(lanes(e[0]), lanes(e[1]), lanes(e[2]));
   // A face or edge entry names a triangle; the others read the first and take zeros.
   const varying<bool> named = n.x != real(0) || n.y != real(0) || n.z != real(0);
-  std::uint32_t tri[W], vel[W];
+  // Each lane's rows: its triangle's (row_tri) and, skinned, its corner velocities' (row_vel), in
+  // floats (ColliderMesh::Triangle: 12 of them, a corner and a clearance a row); scalar stores that
+  // gather4 reads back one at a time (a vector load of them would wait for each store).
+  static_assert(sizeof(Triangle) == 12 * sizeof(float) && offsetof(Triangle, b) == 16 &&
+                offsetof(Triangle, c) == 32);
+  std::uint32_t row_tri[W], row_vel[W];
   for (int l = 0; l < W; ++l) {
-    tri[l] = named.m[l] ? vkcloth::kernel::mesh_cache_uint(e[3][l]) : m.scalar->mesh_tri0;
-    vel[l] = m.scalar->mesh_vel0 + (tri[l] - m.scalar->mesh_tri0);
+    const std::uint32_t tri = named.m[l] ? vkcloth::kernel::mesh_cache_uint(e[3][l]) : m.scalar->mesh_tri0;
+    row_tri[l] = 12 * tri;
+    row_vel[l] = 12 * (m.scalar->mesh_vel0 + (tri - m.scalar->mesh_tri0));
   }
-  // Three corners of the triangles index[0..W) names (float rows of four: a corner and a clearance).
-  auto corners = [&](const Triangle* rows, const std::uint32_t* index, vec3& a, vec3& b, vec3& c) {
-    static_assert(sizeof(Triangle) == 12 * sizeof(float) && offsetof(Triangle, b) == 16 &&
-                  offsetof(Triangle, c) == 32);
-    std::uint32_t at[W];
-    for (int l = 0; l < W; ++l)
-      at[l] = 12 * index[l];
+  // The three corners in the rows `at` names (zeros for a lane without a triangle).
+  auto corners = [&](const Triangle* rows, const std::uint32_t* at, vec3& a, vec3& b, vec3& c) {
     const float* f = reinterpret_cast<const float*>(rows);
     V t[12];
     for (int k = 0; k < 3; ++k)
@@ -82,18 +83,21 @@ inline void mesh_contact(const LaneMesh<Isa>& m, ColliderShape s, vec3 q, vec3 p
     c = select(named, vec3(lanes(t[8]), lanes(t[9]), lanes(t[10])), zero);
   };
   vec3 a, b, c;
-  corners(md.triangles, tri, a, b, c);
+  corners(md.triangles, row_tri, a, b, c);
   const vec3 centre(lanes(e[4]), lanes(e[5]), lanes(e[6]));
   const varying<bool> hit = mesh_cache_hit(n, centre, lanes(e[7]), a, b, c, q, s.b + reach);
   mesh_face_contact(s, n, a, q, p_side, reach, distance, normal);
   deform = vec3(real(0));
   if (skinned) { // at q's foot on the face, as contacts.h mesh_contact's entry hit
     vec3 va, vb, vc;
-    corners(md.velocities, vel, va, vb, vc);
+    corners(md.velocities, row_vel, va, vb, vc);
     deform = triangle_velocity(s, q - n * (dot3(q, n) - dot3(a, n)), a, b, c, va, vb, vc);
   }
+  const varying<bool> miss = !hit;
+  if (!any_particle(miss))
+    return;
   for (int l = 0; l < W; ++l) {
-    if (hit.m[l])
+    if (!miss.m[l])
       continue;
     vkcloth::kernel::MeshData ml = md;
     ml.particle = m.particle(l);
