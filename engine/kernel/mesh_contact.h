@@ -300,8 +300,10 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
     bool is_face = false;
     if (pass > 0u && near && !is_corner) {
       is_face = mesh_face(MESH_DATA, pass == 2u, f0, f1, q, guard, reach_total, at, a, b, c, m1, clear, d1);
-      m2 = m1;
-      e0 = a;
+      if (is_face) {
+        m2 = m1;
+        e0 = a;
+      }
     }
     // An edge: its hinge (mesh_edge_wedge; an edge entry's own: the same edge, planes and code).
     bool is_edge = false;
