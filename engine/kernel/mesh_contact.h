@@ -285,7 +285,7 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
       near = d1 < real(2) * reach_total;
       f0 = base;
     }
-    precise vec3 m1, m2, e0;
+    precise vec3 m1 = vec3(real(0)), m2 = m1, e0 = m1; // set by the face or the edge that answers
     uint code = 0u;
     real clear = real(0);
     // A corner: its fan closes, convex, q in its region (the search's: also its clearance's ball).

@@ -528,9 +528,9 @@ TEST_CASE("cloth.attach: a region pins the particles it selects, max_distance le
 }
 
 TEST_CASE("inertia and keyframes' teleport: bad entries name the key and the value (issue 39 point 8)") {
-  const std::string sphere = R"({"type": "sphere", "center": [0, 0, 2], "radius": 0.1})";
+  const std::string sphere_json = R"({"type": "sphere", "center": [0, 0, 2], "radius": 0.1})";
   const auto scene = [&](const std::string& inertia) {
-    return R"({"system": "cloth", "colliders": [)" + sphere + R"(, {"type": "plane"}], "inertia": )" +
+    return R"({"system": "cloth", "colliders": [)" + sphere_json + R"(, {"type": "plane"}], "inertia": )" +
            inertia + "}";
   };
   expect_error(scene(R"({"collider": 3})"), {"inertia.collider is 3, but there are 2 colliders"});

@@ -141,10 +141,10 @@ Result<void> stiff_figures(Gallery& G) {
     labels.push_back(
         fmt::format("{}: {:.0f} %", solver.brief, 100.0 * tl->metrics["max_strain"].get<double>()));
     if (d.ctx) {
-      auto g = display_solver(*d.ctx, tl->run);
-      if (!g)
-        return g.error();
-      tl->run.gpu.emplace(std::move(*g));
+      auto gpu = display_solver(*d.ctx, tl->run);
+      if (!gpu)
+        return gpu.error();
+      tl->run.gpu.emplace(std::move(*gpu));
     }
     runs.push_back(std::move(tl->run));
   }
