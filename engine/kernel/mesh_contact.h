@@ -26,7 +26,7 @@
 //   nearest at `centre` being `tri`.
 // The rounding of the distances in float at q's scale (guard) shrinks every bound.
 // An edge or a corner entry's mark: n.z = 2 or 3 (a unit normal's z is at most 1).
-KFN VARYING(bool) mesh_edge_entry(vec3 n) {
+KFN VARYING(bool) mesh_edge_or_corner_entry(vec3 n) {
   return n.z > real(1.5);
 }
 KFN precise real mesh_guard(vec3 q) {
@@ -76,8 +76,8 @@ KFN VARYING(bool)
   precise real guard = mesh_guard(q);
   VARYING(bool) inside = inside_face(q, n, a, b, c, guard);
   VARYING(bool) on_face = dot3(q - a, n) > guard && inside;
-  VARYING(bool) edge = mesh_edge_entry(n); // mesh_contact's own (scalar) test
-  return within && (!face || on_face) && !edge;
+  VARYING(bool) own_test = mesh_edge_or_corner_entry(n); // mesh_contact's own (scalar) test
+  return within && (!face || on_face) && !own_test;
 }
 
 // collider_contact for a mesh from a face entry (the nearest point of the mesh to q lies inside the
@@ -145,12 +145,11 @@ KFN void mesh_neighbourhood(MESH_DATA_PARAM, ColliderShape s, uint t, uint t2, u
 }
 
 // Pass 2, the search: the nearest triangle base (ba, bb, bc) at squared distance gap (returned) and
-// the edge's other one, cand (the search's second); k: the corner of base that is q's nearest point
-// where it is one and q is near (3: none). The walk starts bounded by the entry's triangle t (radius >
-// 0), which is at least as far as the nearest: it finds the same triangle as an unbounded walk (the
-// same order; no box holding it is cut).
-KFN real mesh_search(MESH_DATA_PARAM, ColliderShape s, uint t, real radius, vec3 q, real guard, real near_gap,
-                     OUT(uint) base, OUT(vec3) ba, OUT(vec3) bb, OUT(vec3) bc, OUT(uint) cand, OUT(uint) k) {
+// the edge's other one, cand (the search's second). The walk starts bounded by the entry's triangle t (radius
+// > 0), which is at least as far as the nearest: it finds the same triangle as an unbounded walk (the same
+// order; no box holding it is cut).
+KFN real mesh_search(MESH_DATA_PARAM, ColliderShape s, uint t, real radius, vec3 q, real guard,
+                     OUT(uint) base, OUT(vec3) ba, OUT(vec3) bb, OUT(vec3) bc, OUT(uint) cand) {
   precise real start = real(1e18);
   if (radius > real(0)) {
     vec3 a, b, c;
@@ -161,11 +160,6 @@ KFN real mesh_search(MESH_DATA_PARAM, ColliderShape s, uint t, real radius, vec3
                                   VKCLOTH_MESH_NONE, vec3(real(0)), real(0), vec3(real(0)), real(0), real(-1),
                                   real(1.001953125), base, cand); // 1 + 2^-9: an edge's other triangle
   mesh_triangle(MESH_DATA, base, ba, bb, bc);
-  k = 3u;
-  if (sqrt(gap) < near_gap) {
-    precise vec3 cp = closest_on_triangle(q, ba, bb, bc);
-    k = cp == ba ? 0u : (cp == bb ? 1u : (cp == bc ? 2u : 3u));
-  }
   return gap;
 }
 
@@ -242,7 +236,7 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
   real radius;
   mesh_cache_load(MESH_DATA, s.mesh_cache, n, t, centre, radius);
   const bool corner = n.z > real(2.5);
-  const bool edge = mesh_edge_entry(n) && !corner;
+  const bool edge = mesh_edge_or_corner_entry(n) && !corner;
   const bool face = !edge && !corner && dot3(n, n) > real(0);
   const uint t2 = edge ? uint(n.x) : VKCLOTH_MESH_NONE;
   a = b = c = vec3(real(0));
@@ -279,11 +273,15 @@ KFN_NOINLINE void mesh_contact(MESH_DATA_PARAM, ColliderShape s, vec3 q, vec3 p_
       f0 = cand;
       f1 = base;
     } else {
-      gap = mesh_search(MESH_DATA, s, t, radius, q, guard, real(2) * reach_total, base, ba, bb, bc, cand, k);
+      gap = mesh_search(MESH_DATA, s, t, radius, q, guard, base, ba, bb, bc, cand);
       at = base;
       d1 = sqrt(gap);
       near = d1 < real(2) * reach_total;
       f0 = base;
+      if (near) { // the nearest point at a corner of base: its fan
+        precise vec3 cp = closest_on_triangle(q, ba, bb, bc);
+        k = cp == ba ? 0u : (cp == bb ? 1u : (cp == bc ? 2u : 3u));
+      }
     }
     precise vec3 m1 = vec3(real(0)), m2 = m1, e0 = m1; // set by the face or the edge that answers
     uint code = 0u;
