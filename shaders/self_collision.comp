@@ -19,6 +19,8 @@
 void self_range(uint unused, uint b, out uint first, out uint stop);
 void self_entry(uint unused, uint i, out uint q, out uint key);
 void self_particle(uint unused, uint q, out vec3 x, out vec3 v, out float w, out vec3 rest);
+void self_list_put(uint unused, uint p, uint slot, uint q);
+uint self_list_get(uint unused, uint p, uint i);
 #define VKCLOTH_PUSH_STRUCT SelfPush
 #include "common.glsl"
 
@@ -32,6 +34,10 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_BLOCKS) buffer BlockBuf {
 layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_KEYS) buffer KeyBuf { uint key_of[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_SORTED) buffer SortedBuf { uvec2 sorted[]; }; // particle, key
 layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_DELTA) buffer DeltaBuf { vec4 delta[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_BUILT) buffer BuiltBuf { vec4 built[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_LISTED) buffer ListedBuf { uint listed[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_LIST) buffer ListBuf { uint list[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_STALE) buffer StaleBuf { uint stale[]; };
 
 shared uint partial[VKCLOTH_WORKGROUP_SIZE];
 
@@ -66,6 +72,13 @@ void self_particle(uint unused, uint q, out vec3 x, out vec3 v, out float w, out
   rest = r.xyz;
 }
 
+void self_list_put(uint unused, uint p, uint slot, uint q) { list[(base + p) * VKCLOTH_SELF_LIST_CAPACITY + slot] = q; }
+uint self_list_get(uint unused, uint p, uint i) { return list[(base + p) * VKCLOTH_SELF_LIST_CAPACITY + i]; }
+
+// Whether this pass builds the hash (and the lists): without a skin before a substep's first
+// pass, with one when CHECK found a particle that moved more than half the skin. Uniform per instance.
+bool building(SelfParams sp) { return sp.half_skin2 > 0.0 ? stale[2u * inst] != 0u : pc.iteration == 0u; }
+
 // Workgroup exclusive prefix sum of one value per invocation (integers: the same sums in any
 // order); the workgroup's total is left in scan_total. Called in uniform control flow.
 shared uint scan_total;
@@ -95,6 +108,14 @@ void main() {
     return;
   const uint stage = pass_stage();
   const uint mask = pc.table_size - 1u;
+  if (pc.iteration >= sp.iterations) // past this instance's passes (another asks for more)
+    return;
+  const bool lists = sp.half_skin2 > 0.0;
+  if ((stage == VKCLOTH_SELF_CHECK || stage == VKCLOTH_SELF_LIST) && !lists)
+    return;
+  if (stage != VKCLOTH_SELF_CHECK && stage != VKCLOTH_SELF_COLLIDE && stage != VKCLOTH_SELF_APPLY &&
+      !building(sp))
+    return;
   if (stage == VKCLOTH_SELF_SCAN_BLOCKS) {
     // Workgroup = one block of VKCLOTH_SELF_SCAN_BLOCK buckets; 8 consecutive buckets per invocation.
     const uint block = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
@@ -164,14 +185,36 @@ void main() {
     const uint b = self_bucket(key, mask);
     const uint left = atomicAdd(counts[table_base() + b], 0xffffffffu); // minus one
     sorted[base + bucket_start(b) + left - 1u] = uvec2(p, key);
-  } else if (pc.iteration < sp.iterations && particle[p].pinned == 0u) {
+  } else if (stage == VKCLOTH_SELF_CHECK) { // also stale when built for another reach or thickness
+    const vec4 b = built[base + p];
+    if (self_moved(pos_out[base + p].xyz, b.xyz, sp.half_skin2) || b.w != sp.reach2 ||
+        stale[2u * inst + 1u] != floatBitsToUint(sp.thickness))
+      atomicOr(stale[2u * inst], 1u);
+  } else if (stage == VKCLOTH_SELF_LIST) {
+    const vec3 x = pos_out[base + p].xyz;
+    vec3 unused_x = vec3(0.0);
+    vec3 unused_v = vec3(0.0);
+    listed[base + p] = self_walk(0u, p, key_of[base + p], true, x, vec3(0.0), 0.0, rest_pos[p].xyz, sp.thickness,
+                                 sp.reach2, mask, sp.friction, unused_x, unused_v);
+    built[base + p] = vec4(x, sp.reach2);
+    if (p == 0u)
+      stale[2u * inst + 1u] = floatBitsToUint(sp.thickness);
+  } else {
+    if (stage == VKCLOTH_SELF_COLLIDE && p == 0u)
+      stale[2u * inst] = 0u; // CHECK and the build have read it (barriers since)
+    if (particle[p].pinned != 0u)
+      return;
     if (stage == VKCLOTH_SELF_COLLIDE) {
       const vec3 x = read_pos_out(p);
       const vec3 v = read_velocity(p);
       const vec4 r = read_self_rest(p);
       vec3 dx;
       vec3 dv;
-      self_collide(0u, p, x, v, r.w, r.xyz, sp.thickness, sp.inv_cell, mask, sp.friction, dx, dv);
+      if (lists)
+        self_collide_listed(0u, p, listed[base + p], key_of[base + p], x, v, r.w, r.xyz, sp.thickness, mask,
+                            sp.friction, dx, dv);
+      else
+        self_collide(0u, p, x, v, r.w, r.xyz, sp.thickness, sp.inv_cell, mask, sp.friction, dx, dv);
       delta[2u * (base + p)] = vec4(dx, 0.0);
       delta[2u * (base + p) + 1u] = vec4(dv, 0.0);
     } else { // VKCLOTH_SELF_APPLY

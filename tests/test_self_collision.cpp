@@ -163,7 +163,8 @@ TEST_CASE("self-collision samples: no triangle passes through another after the 
   // tests/gpu/test_gpu_self_collision.cpp.
   for (const char* name : {"cloth_drop_self_collision", "cloth_slide_self_collision"}) {
     for (const bool on : {true, false}) {
-      INFO(std::string(name) << (on ? " with" : " without") << " self-collision");
+      const std::string what = std::string(name) + (on ? " with" : " without") + " self-collision";
+      INFO(what);
       const std::string o = std::string("self_collision.enabled=") + (on ? "true" : "false");
       auto scene = load_scene_file(std::string(VKCLOTH_SCENES_DIR) + "/" + name + ".json",
                                    std::span<const std::string>(&o, 1));
@@ -175,8 +176,7 @@ TEST_CASE("self-collision samples: no triangle passes through another after the 
       CHECK(s->time() == doctest::Approx(3.0));
       auto hits = intersecting_triangle_pairs(scene->system, s->positions());
       REQUIRE(hits.ok());
-      MESSAGE(std::string(name) << (on ? " with" : " without") << " self-collision: " << hits->pairs
-                                << " intersecting triangle pairs of " << hits->triangles);
+      MESSAGE(what << ": " << hits->pairs << " intersecting triangle pairs of " << hits->triangles);
       if (on)
         CHECK(hits->pairs == 0);
       else

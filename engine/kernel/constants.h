@@ -54,5 +54,8 @@
 // Self-collision's buckets per workgroup of the GPU's SCAN_BLOCKS pass (64 invocations x 8): the
 // hash table's size is a multiple of it on both backends (kernel.hpp self_table_size).
 #define VKCLOTH_SELF_SCAN_BLOCK 512u
+// The most entries of a particle's self-collision neighbour list (self_collide_listed: past it, the
+// particle walks the build's cells instead).
+#define VKCLOTH_SELF_LIST_CAPACITY 32u
 
 #endif // VKCLOTH_KERNEL_CONSTANTS_H

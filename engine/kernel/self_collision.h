@@ -79,22 +79,51 @@ KFN void self_contact(INOUT(vec3) dx, INOUT(vec3) dv, vec3 x, vec3 v, real w, ve
   dv = mv;
 }
 
+// Whether xq (rest rxq) may become p's pair before the neighbour list is built again: closer than
+// `reach` (the thickness plus the skin) now and not closer than the thickness at rest (those never
+// pair). Unlike self_pair, it keeps a particle at p's own point: it has no direction now, but may
+// have one by the time the pair is tested.
+KFN bool self_candidate(vec3 x, vec3 xq, vec3 rx, vec3 rxq, real reach2, real thickness2) {
+  precise vec3 u = x - xq;
+  precise real d2 = dot3(u, u);
+  precise vec3 r = rx - rxq;
+  precise real r2 = dot3(r, r);
+  return d2 < reach2 && !(r2 < thickness2);
+}
+
+// Whether x has moved more than half the skin (half_skin2: its square) from xb, where the neighbour
+// list was built (NaN: never built). While no particle has, a pair closer than the thickness was
+// closer than the thickness plus the skin at the build, so it is in the list.
+KFN bool self_moved(vec3 x, vec3 xb, real half_skin2) {
+  precise vec3 u = x - xb;
+  precise real d2 = dot3(u, u);
+  return !(d2 <= half_skin2);
+}
+
+// The mean of a particle's pair responses (Jacobi: a particle pressed from many sides does not overshoot).
+KFN void self_mean(vec3 sum_x, vec3 sum_v, uint pairs, OUT(vec3) dx, OUT(vec3) dv) {
+  precise real k = pairs > 0u ? real(1) / real(pairs) : real(0);
+  precise vec3 mx = sum_x * k;
+  precise vec3 mv = sum_v * k;
+  dx = mx;
+  dv = mv;
+}
+
 #ifdef SELF_DATA_PARAM // the includer provides the table (C++: kernel.hpp; GLSL: self_collision.comp)
-// Particle p's response (Jacobi: the mean of its pairs' responses, so that a particle pressed from
-// many sides does not overshoot): every particle q of the 27 cells around p's, cell by cell in a
-// fixed order, each cell's particles in increasing index (a bucket holds the particles of every
-// cell hashed to it, in increasing index: those of other cells are skipped by their key).
+// The 27 cells around the cell of key `own`, cell by cell in a fixed order, each cell's particles in
+// increasing index (a bucket holds the particles of every cell hashed to it, in increasing index:
+// those of other cells are skipped by their key). With `gather`, it writes p's neighbour list
+// (self_list_put; self_candidate with `reach2`) and returns its length (past the capacity: it stops
+// writing, and the count says the list overflowed); without, it adds p's response to every pair
+// (self_pair, self_contact) to sum_x, sum_v and returns the number of pairs.
 // Provided by the including file: self_range(SELF_DATA, bucket, first, stop) (the bucket's entries
 // of the sorted table), self_entry(SELF_DATA, i, q, key) (an entry's particle and the key of the
-// cell it was sorted in), self_particle(SELF_DATA, q, x, v, w, rest). Both backends build the
-// same table, so they sum the same pairs in the same order.
-KFN void self_collide(SELF_DATA_PARAM, uint p, vec3 x, vec3 v, real w, vec3 rx, real thickness, real inv_cell,
-                      uint mask, real mu, OUT(vec3) dx, OUT(vec3) dv) {
+// cell it was sorted in), self_particle(SELF_DATA, q, x, v, w, rest), self_list_put(SELF_DATA, p,
+// slot, q). Both backends build the same table, so they visit the same particles in the same order.
+KFN uint self_walk(SELF_DATA_PARAM, uint p, uint own, bool gather, vec3 x, vec3 v, real w, vec3 rx,
+                   real thickness, real reach2, uint mask, real mu, INOUT(vec3) sum_x, INOUT(vec3) sum_v) {
   precise real t2 = thickness * thickness;
-  const uint own = self_key(x, inv_cell);
-  precise vec3 sum_x = vec3(real(0));
-  precise vec3 sum_v = vec3(real(0));
-  uint pairs = 0u;
+  uint found = 0u;
   for (int dk = -1; dk <= 1; ++dk)
     for (int dj = -1; dj <= 1; ++dj)
       for (int di = -1; di <= 1; ++di) {
@@ -113,17 +142,58 @@ KFN void self_collide(SELF_DATA_PARAM, uint p, vec3 x, vec3 v, real w, vec3 rx, 
           vec3 rq;
           real wq;
           self_particle(SELF_DATA, q, xq, vq, wq, rq);
-          if (self_pair(x, xq, rx, rq, t2)) {
+          if (gather) {
+            if (self_candidate(x, xq, rx, rq, reach2, t2)) {
+              if (found < uint(VKCLOTH_SELF_LIST_CAPACITY))
+                self_list_put(SELF_DATA, p, found, q);
+              found += 1u;
+            }
+          } else if (self_pair(x, xq, rx, rq, t2)) {
             self_contact(sum_x, sum_v, x, v, w, xq, vq, wq, thickness, mu);
-            pairs += 1u;
+            found += 1u;
           }
         }
       }
-  precise real k = pairs > 0u ? real(1) / real(pairs) : real(0);
-  precise vec3 mx = sum_x * k;
-  precise vec3 mv = sum_v * k;
-  dx = mx;
-  dv = mv;
+  return found;
+}
+
+// Particle p's response, every pair found by the walk around its cell now (no neighbour list).
+KFN void self_collide(SELF_DATA_PARAM, uint p, vec3 x, vec3 v, real w, vec3 rx, real thickness, real inv_cell,
+                      uint mask, real mu, OUT(vec3) dx, OUT(vec3) dv) {
+  precise vec3 sum_x = vec3(real(0));
+  precise vec3 sum_v = vec3(real(0));
+  const uint pairs = self_walk(SELF_DATA, p, self_key(x, inv_cell), false, x, v, w, rx, thickness, real(0),
+                               mask, mu, sum_x, sum_v);
+  self_mean(sum_x, sum_v, pairs, dx, dv);
+}
+
+// Particle p's response from its neighbour list (`listed` entries, self_list_get(SELF_DATA, p, i)),
+// in the list's order; a list that overflowed (listed > capacity) walks the cells of the build
+// instead (own: p's key then), which holds every particle the list would have: the same pairs in
+// the same order.
+KFN void self_collide_listed(SELF_DATA_PARAM, uint p, uint listed, uint own, vec3 x, vec3 v, real w, vec3 rx,
+                             real thickness, uint mask, real mu, OUT(vec3) dx, OUT(vec3) dv) {
+  precise vec3 sum_x = vec3(real(0));
+  precise vec3 sum_v = vec3(real(0));
+  uint pairs = 0u;
+  if (listed > uint(VKCLOTH_SELF_LIST_CAPACITY)) {
+    pairs = self_walk(SELF_DATA, p, own, false, x, v, w, rx, thickness, real(0), mask, mu, sum_x, sum_v);
+  } else {
+    precise real t2 = thickness * thickness;
+    for (uint i = 0u; i < listed; ++i) {
+      const uint q = self_list_get(SELF_DATA, p, i);
+      vec3 xq;
+      vec3 vq;
+      vec3 rq;
+      real wq;
+      self_particle(SELF_DATA, q, xq, vq, wq, rq);
+      if (self_pair(x, xq, rx, rq, t2)) {
+        self_contact(sum_x, sum_v, x, v, w, xq, vq, wq, thickness, mu);
+        pairs += 1u;
+      }
+    }
+  }
+  self_mean(sum_x, sum_v, pairs, dx, dv);
 }
 #endif
 

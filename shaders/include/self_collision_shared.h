@@ -22,6 +22,13 @@ namespace vkcloth::gpu::shared {
 #define VKCLOTH_BINDING_SELF_KEYS 44   // each particle's cell key when sorted (uint, per particle)
 #define VKCLOTH_BINDING_SELF_SORTED 45 // the particles by bucket, then by index, with their keys (uvec2)
 #define VKCLOTH_BINDING_SELF_DELTA 46  // this Jacobi pass's move and velocity change (2 vec4 per particle)
+// The neighbour lists (SelfParams::half_skin2 > 0; CpuSolver's SelfCollisionGrid built, listed, list).
+#define VKCLOTH_BINDING_SELF_BUILT                                                                           \
+  47 // where each particle was when the lists were built, w: reach^2 (vec4; NaN: never)
+#define VKCLOTH_BINDING_SELF_LISTED 48 // each list's length (uint per particle; > capacity: overflowed)
+#define VKCLOTH_BINDING_SELF_LIST 49   // VKCLOTH_SELF_LIST_CAPACITY particles per particle (uint)
+#define VKCLOTH_BINDING_SELF_STALE                                                                           \
+  50 // 2 uint per instance: nonzero when the lists must be built again; the build's thickness (bits)
 
 // Set 1 of the self_collision_texel build: what COLLIDE's walk reads, through uniform texel buffer
 // views (llvmpipe turns a storage-buffer load into a per-lane loop, a texel fetch into one
@@ -37,22 +44,30 @@ namespace vkcloth::gpu::shared {
 #define VKCLOTH_SELF_SCAN_PER_INVOCATION 8u
 
 // self_collision.comp passes (PushConstants::stage), in recording order; one barrier between each.
+// With a skin, every Jacobi pass starts with CHECK, and COUNT .. LIST do nothing unless it found a
+// particle that moved more than half the skin (SELF_STALE).
 #define VKCLOTH_SELF_COUNT 0u       // per particle: its bucket; counts[bucket] += 1 (integer atomics)
 #define VKCLOTH_SELF_SCAN_BLOCKS 1u // per scan block: exclusive prefix sums of its counts, its total
 #define VKCLOTH_SELF_SCAN_TOP 2u    // one workgroup per instance: exclusive prefix sums of the block totals
 #define VKCLOTH_SELF_SCAN_ADD 3u    // per bucket: its block's start added (starts: absolute), the end
 #define VKCLOTH_SELF_SCATTER 4u     // per particle: a slot in its bucket (counts[bucket] -= 1: zero again)
 #define VKCLOTH_SELF_SORT 5u        // per bucket: its particles in increasing index (the CPU's order)
-#define VKCLOTH_SELF_COLLIDE 6u     // per particle: cloth_kernel.h self_collide -> DELTA
+#define VKCLOTH_SELF_COLLIDE 6u     // per particle: cloth_kernel.h self_collide(_listed) -> DELTA
 #define VKCLOTH_SELF_APPLY 7u       // per particle: x += dx, v += dv (cloth_kernel.h self_apply)
+#define VKCLOTH_SELF_CHECK 8u       // per particle: SELF_STALE |= self_moved (COLLIDE's first clears it)
+#define VKCLOTH_SELF_LIST 9u        // per particle: its neighbour list (self_walk), BUILT = its position
 
-/// Self-collision parameters of one instance (std430: 16 bytes), converted from the double
+/// Self-collision parameters of one instance (std430: 32 bytes), converted from the double
 /// SimParams::self_collision as CpuSolver<float>::self_collide converts them.
 struct SelfParams {
   uint iterations; // 0: self-collision off for this instance
   float thickness;
-  float inv_cell; // float(1.0 / thickness): the hash's cell size is the thickness
+  float inv_cell; // 1 / the reach (thickness + skin): the hash's cell size
   float friction;
+  float reach2;     // the reach squared (the lists' candidates)
+  float half_skin2; // (skin / 2)^2; 0: no skin, no lists (COLLIDE walks the cells)
+  uint unused0;
+  uint unused1;
 };
 
 /// self_collision.comp's push constants (PushConstants' five fields, then its own).
@@ -70,7 +85,7 @@ struct SelfPush {
 #ifdef __cplusplus
 static_assert(sizeof(SelfPush) == sizeof(PushConstants));
 static_assert(VKCLOTH_BINDING_SELF_PARAMS == VKCLOTH_BINDING_IMPL_ARGS + 1);
-static_assert(sizeof(SelfParams) == 16);
+static_assert(sizeof(SelfParams) == 32);
 /// Self-collision's storage bindings (set 0) and its texel build's views (set 1), in
 /// descriptor-write order: its one binding table (engine/src/vulkan/passes/self_collision.cpp).
 inline constexpr uint self_collision_bindings[] = {
@@ -78,7 +93,8 @@ inline constexpr uint self_collision_bindings[] = {
     VKCLOTH_BINDING_FLAGS,       VKCLOTH_BINDING_INSTANCES,   VKCLOTH_BINDING_SELF_PARAMS,
     VKCLOTH_BINDING_SELF_REST,   VKCLOTH_BINDING_SELF_COUNTS, VKCLOTH_BINDING_SELF_STARTS,
     VKCLOTH_BINDING_SELF_BLOCKS, VKCLOTH_BINDING_SELF_KEYS,   VKCLOTH_BINDING_SELF_SORTED,
-    VKCLOTH_BINDING_SELF_DELTA};
+    VKCLOTH_BINDING_SELF_DELTA,  VKCLOTH_BINDING_SELF_BUILT,  VKCLOTH_BINDING_SELF_LISTED,
+    VKCLOTH_BINDING_SELF_LIST,   VKCLOTH_BINDING_SELF_STALE};
 inline constexpr uint self_collision_texel_bindings[] = {VKCLOTH_SELF_TEXEL_POS, VKCLOTH_SELF_TEXEL_VEL,
                                                          VKCLOTH_SELF_TEXEL_REST, VKCLOTH_SELF_TEXEL_STARTS,
                                                          VKCLOTH_SELF_TEXEL_SORTED};

@@ -13,11 +13,11 @@ namespace vkcloth::gpu::shared {
 #endif
 
 #define VKCLOTH_BINDING_PROJ_INCIDENCE                                                                       \
-  47 // uint: the topology's strain_incidence_offsets, then its strain_incidence
-#define VKCLOTH_BINDING_PROJ_LINKS 48  // 2 vec4 per link per instance: (g, 1 / A_ll), (lambda, r, d, q)
-#define VKCLOTH_BINDING_PROJ_GATHER 49 // vec4 per particle per instance: grad C^T of d or lambda
-#define VKCLOTH_BINDING_PROJ_STATE 50  // ProjState per instance
-#define VKCLOTH_BINDING_PROJ_ARGS 51   // ProjArgsHead, then a uint per instance: reset every substep
+  51 // uint: the topology's strain_incidence_offsets, then its strain_incidence
+#define VKCLOTH_BINDING_PROJ_LINKS 52  // 2 vec4 per link per instance: (g, 1 / A_ll), (lambda, r, d, q)
+#define VKCLOTH_BINDING_PROJ_GATHER 53 // vec4 per particle per instance: grad C^T of d or lambda
+#define VKCLOTH_BINDING_PROJ_STATE 54  // ProjState per instance
+#define VKCLOTH_BINDING_PROJ_ARGS 55   // ProjArgsHead, then a uint per instance: reset every substep
 
 // The phases of one Newton iteration (ProjState::phase), as CpuSolver::project_strain runs them.
 #define VKCLOTH_PROJ_LINKS 0u     // per link: C, g, in the solve, r = d = rhs; sums r.z, r.r; max C
@@ -64,7 +64,7 @@ struct ProjectionPush {
 
 #ifdef __cplusplus
 static_assert(sizeof(ProjectionPush) == sizeof(PushConstants));
-static_assert(VKCLOTH_BINDING_PROJ_INCIDENCE == VKCLOTH_BINDING_SELF_DELTA + 1);
+static_assert(VKCLOTH_BINDING_PROJ_INCIDENCE == VKCLOTH_BINDING_SELF_STALE + 1);
 static_assert(sizeof(ProjState) == 48);
 static_assert(sizeof(ProjArgsHead) == 16);
 /// The projection's storage bindings, in descriptor-write order: its one binding table

@@ -24,43 +24,48 @@ Result<Scene> sample(const char* name, std::span<const std::string> overrides = 
 
 // Both builds of self_collision.comp (its COLLIDE pass reading through texel views, or storage
 // buffers): the same bits, and the CPU's within 1e-5 m.
+// The samples keep neighbour lists (a skin); with skin 0 every pass walks the cells.
 TEST_CASE("GPU matches CPU on the self-collision samples: 100 steps within 1e-5 m") {
   VKCLOTH_GPU_TEST_BEGIN(ctx);
-  for (const char* name : {"cloth_drop_self_collision", "cloth_slide_self_collision"}) {
-    INFO(std::string(name));
-    auto scene = sample(name);
-    REQUIRE_MESSAGE(scene.ok(), (scene.ok() ? "" : scene.error().message));
-    REQUIRE(scene->params.self_collision.enabled);
-    auto cpu = CpuSolver<float>::create(scene->system, scene->params);
-    REQUIRE(cpu.ok());
-    REQUIRE(cpu->run(100).ok());
-    std::vector<glm::vec3> builds[2];
-    for (int k = 0; k < 2; ++k) {
-      gpu::GpuSolverOptions o;
-      o.buffer_access = k == 0 ? gpu::BufferAccess::texel_views : gpu::BufferAccess::storage_buffers;
-      auto gpu = gpu::GpuSolver::create(ctx, scene->system, scene->params, o);
-      REQUIRE(gpu.ok());
-      REQUIRE(gpu->simulate(100).ok());
-      auto gp = gpu->positions();
-      REQUIRE(gp.ok());
-      builds[k] = std::move(*gp);
+  const std::string walk = "self_collision.skin=0";
+  for (const char* name : {"cloth_drop_self_collision", "cloth_slide_self_collision"})
+    for (const bool lists : {true, false}) {
+      const std::string what = std::string(name) + (lists ? " (lists)" : " (walk)");
+      INFO(what);
+      auto scene =
+          sample(name, lists ? std::span<const std::string>{} : std::span<const std::string>(&walk, 1));
+      REQUIRE_MESSAGE(scene.ok(), (scene.ok() ? "" : scene.error().message));
+      REQUIRE((scene->params.self_collision.skin > 0.0) == lists);
+      REQUIRE(scene->params.self_collision.enabled);
+      auto cpu = CpuSolver<float>::create(scene->system, scene->params);
+      REQUIRE(cpu.ok());
+      REQUIRE(cpu->run(100).ok());
+      std::vector<glm::vec3> builds[2];
+      for (int k = 0; k < 2; ++k) {
+        gpu::GpuSolverOptions o;
+        o.buffer_access = k == 0 ? gpu::BufferAccess::texel_views : gpu::BufferAccess::storage_buffers;
+        auto gpu = gpu::GpuSolver::create(ctx, scene->system, scene->params, o);
+        REQUIRE(gpu.ok());
+        REQUIRE(gpu->simulate(100).ok());
+        auto gp = gpu->positions();
+        REQUIRE(gp.ok());
+        builds[k] = std::move(*gp);
+      }
+      CHECK_MESSAGE(gpu::test::diff(builds[0], builds[1]).bitwise, "texel views and storage buffers differ");
+      const std::vector<glm::vec3>* gp = &builds[0];
+      const auto d = gpu::test::diff(cpu->positions(), *gp);
+      // Self-collision acted within those 100 steps: the same run without it ends elsewhere.
+      SimParams off = scene->params;
+      off.self_collision.enabled = false;
+      auto bare = CpuSolver<float>::create(scene->system, off);
+      REQUIRE(bare.ok());
+      REQUIRE(bare->run(100).ok());
+      const auto moved = gpu::test::diff(bare->positions(), cpu->positions());
+      MESSAGE(what << ": max |p_cpu - p_gpu| after 100 steps = " << d.max_abs << " m (bitwise: " << d.bitwise
+                   << "); self-collision moved the cloth by up to " << moved.max_abs << " m");
+      CHECK(d.max_abs <= 1e-5);
+      CHECK(moved.max_abs > 1e-3);
     }
-    CHECK_MESSAGE(gpu::test::diff(builds[0], builds[1]).bitwise, "texel views and storage buffers differ");
-    const std::vector<glm::vec3>* gp = &builds[0];
-    const auto d = gpu::test::diff(cpu->positions(), *gp);
-    // Self-collision acted within those 100 steps: the same run without it ends elsewhere.
-    SimParams off = scene->params;
-    off.self_collision.enabled = false;
-    auto bare = CpuSolver<float>::create(scene->system, off);
-    REQUIRE(bare.ok());
-    REQUIRE(bare->run(100).ok());
-    const auto moved = gpu::test::diff(bare->positions(), cpu->positions());
-    MESSAGE(std::string(name) << ": max |p_cpu - p_gpu| after 100 steps = " << d.max_abs
-                              << " m (bitwise: " << d.bitwise << "); self-collision moved the cloth by up to "
-                              << moved.max_abs << " m");
-    CHECK(d.max_abs <= 1e-5);
-    CHECK(moved.max_abs > 1e-3);
-  }
 }
 
 TEST_CASE("GPU self-collision: no intersecting triangle pairs after the drop settles (3 s)") {
@@ -81,15 +86,19 @@ TEST_CASE("GPU self-collision: no intersecting triangle pairs after the drop set
 
 TEST_CASE("ClothWorld: self-collision per instance in one batch, each as its own CPU solver") {
   VKCLOTH_GPU_TEST_BEGIN(ctx);
-  // Two instances of one topology: self-collision on (thickness 1 cm, friction 0.2) and on with
-  // other settings (1.2 cm, frictionless, one pass), plus a third with it off.
+  // Instances of one topology: self-collision on (thickness 1 cm, friction 0.2, neighbour lists with
+  // a 5 mm skin), on with other settings (1.2 cm, frictionless, no lists: the walk), off, and on with
+  // lists of another skin and three passes (the batch runs three; the others stop after theirs).
   auto scene = sample("cloth_drop_self_collision");
   REQUIRE_MESSAGE(scene.ok(), (scene.ok() ? "" : scene.error().message));
-  std::vector<SimParams> params(3, scene->params);
+  std::vector<SimParams> params(4, scene->params);
   params[1].self_collision.thickness = 0.012;
   params[1].self_collision.friction = 0.0;
   params[1].self_collision.iterations = 1;
+  params[1].self_collision.skin = 0.0;
   params[2].self_collision.enabled = false;
+  params[3].self_collision.skin = 0.008;
+  params[3].self_collision.iterations = 3;
   auto topology = ClothTopology::create(scene->system);
   REQUIRE(topology.ok());
   auto world = gpu::ClothWorld::create(ctx);

@@ -405,6 +405,9 @@ TEST_CASE("self_collision: bad input names the key and the value (issue 16 item 
          {"self_collision.iterations", "1..16", "got 17"});
   expect(R"({"friction": -0.1})", ErrorCode::invalid_argument,
          {"self_collision.friction", ">= 0", "got -0.1"});
+  expect(R"({"skin": -0.001})", ErrorCode::invalid_argument, {"self_collision.skin", ">= 0", "got -0.001"});
+  expect(R"({"thickness": 0.01, "skin": 0.2})", ErrorCode::invalid_argument,
+         {"self_collision.skin", "10 x the thickness", "got 0.2"});
   // Off, the values are still checked (a later --set self_collision.enabled=true must not meet them).
   expect(R"({"enabled": false, "thickness": -1})", ErrorCode::invalid_argument,
          {"self_collision.thickness", "got -1"});

@@ -419,6 +419,7 @@ TEST_CASE("self_collision: absent is off with the defaults; present is read into
     CHECK(off.params.self_collision.thickness == def.thickness);
     CHECK(off.params.self_collision.friction == def.friction);
     CHECK(off.params.self_collision.iterations == def.iterations);
+    CHECK(off.params.self_collision.skin == 0.0); // no neighbour lists unless asked for
     CHECK(off.warnings.empty());
   }
   CHECK_FALSE(def.enabled);
@@ -427,11 +428,12 @@ TEST_CASE("self_collision: absent is off with the defaults; present is read into
   CHECK(def.iterations == 1);
 
   const Scene on = load_ok(
-      R"({"system": "cloth", "self_collision": {"enabled": true, "thickness": 0.08, "friction": 0.35, "iterations": 5}})");
+      R"({"system": "cloth", "self_collision": {"enabled": true, "thickness": 0.08, "friction": 0.35, "iterations": 5, "skin": 0.02}})");
   CHECK(on.params.self_collision.enabled);
   CHECK(on.params.self_collision.thickness == 0.08);
   CHECK(on.params.self_collision.friction == 0.35);
   CHECK(on.params.self_collision.iterations == 5);
+  CHECK(on.params.self_collision.skin == 0.02);
   CHECK(on.warnings.empty()); // 0.08 m is above half the 1/9 m spacing
 
   // Present without "enabled": on, the other keys at their defaults.

@@ -28,6 +28,9 @@ public:
 
   std::uint64_t step_index() const override { return solver_.step_index(); }
   SolveStats last_solve() const override { return solver_.last_solve(); }
+  std::optional<SelfCollisionStats> self_collision_stats() const override {
+    return solver_.self_collision_stats();
+  }
   double time() const override { return solver_.time(); }
   std::vector<Collider> colliders() const override { return solver_.params().colliders; }
 

@@ -41,6 +41,8 @@ public:
   virtual std::vector<Collider> colliders() const = 0;
   /// implicit_euler: the last substep's CG iterations and relative residual.
   virtual SolveStats last_solve() const { return {}; }
+  /// Self-collision's passes and neighbour-list builds (the CPU solver counts them; Vulkan: none).
+  virtual std::optional<SelfCollisionStats> self_collision_stats() const { return std::nullopt; }
 };
 
 /// "cpu" or "vulkan". Unknown name: ErrorCode::invalid_argument; no Vulkan device: ErrorCode::no_device.

@@ -242,11 +242,12 @@ Result<Outputs> open_outputs(const RunOptions& opt) {
 
 /// What the run measured, for the summary lines and --json.
 struct RunSummary {
-  double wall = 0.0;                     ///< seconds of wall time in the step loop
-  double max_displacement = 0.0;         ///< m, the largest move of a particle from its start
-  SolveStats cg;                         ///< implicit_euler's last solve
-  std::optional<StrainStats> end_strain; ///< cloths: the strain of the final state
-  StrainTrack strain;                    ///< ... and the largest over the run
+  double wall = 0.0;                      ///< seconds of wall time in the step loop
+  double max_displacement = 0.0;          ///< m, the largest move of a particle from its start
+  SolveStats cg;                          ///< implicit_euler's last solve
+  std::optional<SelfCollisionStats> self; ///< self-collision's passes and list builds (CPU)
+  std::optional<StrainStats> end_strain;  ///< cloths: the strain of the final state
+  StrainTrack strain;                     ///< ... and the largest over the run
   std::uint64_t strain_every = 1;
   std::optional<ContactTrack> contact; ///< scenes with colliders
   std::uint64_t contact_every = 1;
@@ -268,6 +269,10 @@ void print_summary(const Scene& scene, const RunOptions& opt, const SimBackend& 
         "{:.1f} CG iterations per solve over the run ({} solves)\n",
         r.cg.iterations, r.cg.residual, scene.params.cg_tolerance, scene.params.cg_max_iterations,
         r.cg.mean_iterations(), r.cg.solves);
+  if (r.self && r.self->builds > 0)
+    fmt::print("self-collision: {} passes, {} of them built the neighbour lists first ({} entries, {} "
+               "overflowed, at the last build)\n",
+               r.self->passes, r.self->builds, r.self->candidates, r.self->overflowed);
   if (r.end_strain) {
     const Spring& sp = system.springs[r.end_strain->spring];
     fmt::print(
@@ -317,6 +322,11 @@ nlohmann::json summary_json(const Scene& scene, const RunOptions& opt, const Sim
                                                {"cg_iterations_mean", r.cg.mean_iterations()},
                                                {"cg_solves", r.cg.solves}}
                               : nlohmann::json(nullptr);
+  if (r.self)
+    doc["self_collision"] = {{"passes", r.self->passes},
+                             {"list_builds", r.self->builds},
+                             {"list_entries", r.self->candidates},
+                             {"lists_overflowed", r.self->overflowed}};
   if (r.end_strain) {
     const auto ends = [&](std::uint32_t k) {
       const Spring& sp = system.springs[k];
@@ -474,6 +484,8 @@ int run_command(const RunOptions& opt) {
   for (std::size_t k = 0; k < pos.size(); ++k)
     sum.max_displacement = std::max(sum.max_displacement, glm::length(pos[k] - initial[k]));
   sum.cg = backend.last_solve();
+  if (scene->params.self_collision.enabled)
+    sum.self = backend.self_collision_stats();
   if (track_strain) {
     auto s = strain_of_pos();
     if (!s)

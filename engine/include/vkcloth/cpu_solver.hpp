@@ -81,6 +81,8 @@ public:
 
   /// implicit_euler: CG iterations and relative residual of the last substep's solve.
   const SolveStats& last_solve() const;
+  /// Self-collision's passes and neighbour-list builds so far (all 0 before its first substep).
+  SelfCollisionStats self_collision_stats() const;
 
   std::uint64_t step_index() const;
   /// Simulated time: the sum of the steps' dt (dt may change between steps, StepParams).

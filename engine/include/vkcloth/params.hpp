@@ -41,6 +41,14 @@ struct SolveStats {
   double mean_iterations() const { return solves ? double(total_iterations) / double(solves) : 0.0; }
 };
 
+/// Self-collision's neighbour lists (SelfCollision::skin > 0; CpuSolver::self_collision_stats).
+struct SelfCollisionStats {
+  std::uint64_t passes = 0;     ///< Jacobi passes since the solver was made
+  std::uint64_t builds = 0;     ///< of those, the passes that built the lists first
+  std::uint64_t candidates = 0; ///< list entries at the last build (each pair within thickness + skin twice)
+  std::uint64_t overflowed = 0; ///< particles whose list overflowed at the last build (they walk the cells)
+};
+
 const char* to_string(Integrator integrator);
 std::optional<Integrator> parse_integrator(std::string_view name);
 
@@ -224,6 +232,10 @@ struct SelfCollision {
   double thickness = 0.01;      ///< m, > 0: the distance kept between particles not that close at rest
   double friction = 0.2;        ///< >= 0: Coulomb coefficient between touching layers
   std::uint32_t iterations = 1; ///< 1..16 Jacobi passes per substep
+  /// m, >= 0: 0 walks the hash's cells in every pass; > 0 keeps a neighbour list of the pairs within
+  /// thickness + skin, rebuilt only when some particle has moved more than skin / 2 since
+  /// (docs/model.md "Self-collision"; the same pairs, found less often).
+  double skin = 0.0;
 };
 
 /// Particles that follow a collider (docs/model.md "Attachments"): particle particles[i]'s target

@@ -618,6 +618,10 @@ template <typename Real> auto CpuSolver<Real>::forces() const -> std::span<const
 template <typename Real> auto CpuSolver<Real>::normals() const -> std::span<const Vec3> {
   return impl_->normal_;
 }
+template <typename Real> SelfCollisionStats CpuSolver<Real>::self_collision_stats() const {
+  return impl_->self_ ? impl_->self_->stats : SelfCollisionStats{};
+}
+
 template <typename Real> const SolveStats& CpuSolver<Real>::last_solve() const {
   return impl_->solve_;
 }

@@ -23,6 +23,7 @@ namespace detail {
 class ThreadPool;
 template <typename Real> struct ImplicitWorkspace;
 template <typename Real> struct SelfCollisionGrid;
+template <typename Real> struct SelfConstants;
 template <typename Real> struct StrainProjection;
 /// The colliders as the kernel takes them at this substep's pose, and their meshes; the same values
 /// for the SIMD finish of the grid rows (row_kernel.hpp FinishShape), empty when there are more
@@ -178,6 +179,10 @@ template <typename Real> struct CpuSolver<Real>::Impl {
   void limit_stretch(Real h);
   // Self-collision after that (self_collision.cpp; docs/model.md "Self-collision").
   void self_collide();
+  kernel::SelfDataT<Real> self_data();
+  void self_hash(Real inv_cell);
+  bool self_list_stale(const detail::SelfConstants<Real>& k);
+  void self_build_lists(const detail::SelfConstants<Real>& k, std::uint32_t mask);
   void project_strain(Real h);
 
   using Edge = detail::SolverEdge<Real>;

@@ -158,6 +158,7 @@ template <typename Real> struct SelfDataT {
   const glm::vec<3, Real>* vel = nullptr;
   const Real* inv_mass = nullptr;
   const glm::vec<3, Real>* rest = nullptr;
+  std::uint32_t* list = nullptr; // the neighbour lists: VKCLOTH_SELF_LIST_CAPACITY entries per particle
 };
 template <typename Real> void self_range(const SelfDataT<Real>& d, uint b, uint& first, uint& stop) {
   first = d.start[b];
@@ -166,6 +167,12 @@ template <typename Real> void self_range(const SelfDataT<Real>& d, uint b, uint&
 template <typename Real> void self_entry(const SelfDataT<Real>& d, uint i, uint& q, uint& key) {
   q = d.sorted[i];
   key = d.key[q];
+}
+template <typename Real> void self_list_put(const SelfDataT<Real>& d, uint p, uint slot, uint q) {
+  d.list[std::size_t(p) * VKCLOTH_SELF_LIST_CAPACITY + slot] = q;
+}
+template <typename Real> uint self_list_get(const SelfDataT<Real>& d, uint p, uint i) {
+  return d.list[std::size_t(p) * VKCLOTH_SELF_LIST_CAPACITY + i];
 }
 template <typename Real, typename V>
 void self_particle(const SelfDataT<Real>& d, uint q, V& x, V& v, Real& w, V& rest) {

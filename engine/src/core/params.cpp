@@ -543,6 +543,12 @@ Result<void> SimParams::validate() {
   if (!std::isfinite(self_collision.friction) || self_collision.friction < 0.0)
     return bad_argument(
         fmt::format("self_collision.friction must be finite and >= 0, got {}", self_collision.friction));
+  // A skin of many thicknesses puts most of the cloth in each particle's list (quadratic).
+  if (!std::isfinite(self_collision.skin) || self_collision.skin < 0.0 ||
+      self_collision.skin > 10.0 * self_collision.thickness)
+    return bad_argument(fmt::format("self_collision.skin must be finite, >= 0 and at most 10 x the thickness "
+                                    "({} m), got {}",
+                                    10.0 * self_collision.thickness, self_collision.skin));
   if (self_collision.iterations < 1 || self_collision.iterations > 16)
     return bad_argument(
         fmt::format("self_collision.iterations must be in 1..16, got {}", self_collision.iterations));

@@ -4,6 +4,8 @@
 // come in increasing index, the order the GPU's sort pass gives), then Jacobi passes of
 // cloth_kernel.h self_collide, the walk the GPU's COLLIDE pass runs too (self_collision.comp).
 #include <algorithm>
+#include <atomic>
+#include <limits>
 
 #include "kernel.hpp"
 #include "self_collision.hpp"
@@ -23,38 +25,36 @@ template <typename Real> void CpuSolver<Real>::Impl::self_collide() {
       self_->rest.push_back(Vec3(system.particles[p].position));
       self_->inv_mass.push_back(kernel::inverse_mass(mass_[p], pinned_[p] != 0));
     }
+    self_->built.assign(n, Vec3(std::numeric_limits<Real>::quiet_NaN()));
+    self_->listed.assign(n, 0);
+    self_->list.assign(n * VKCLOTH_SELF_LIST_CAPACITY, 0);
   }
   auto& g = *self_;
-  const std::uint32_t table = kernel::self_table_size(static_cast<std::uint32_t>(n)), mask = table - 1;
-  // The same conversions as the GPU's host side (SelfCollisionGpu::packed).
-  const Real thickness = Real(sc.thickness), inv_cell = Real(1.0 / sc.thickness), mu = Real(sc.friction);
-
-  // The table: count per bucket, exclusive prefix sums, then the particles in index order.
-  g.start.assign(std::size_t(table) + 1, 0);
-  g.key.resize(n);
-  g.sorted.resize(n);
+  const std::uint32_t mask = kernel::self_table_size(static_cast<std::uint32_t>(n)) - 1;
+  const detail::SelfConstants<Real> k = detail::self_constants<Real>(sc);
   g.dx.resize(n);
   g.dv.resize(n);
-  for (std::size_t p = 0; p < n; ++p) {
-    g.key[p] = kernel::self_key(pos_[p], inv_cell); // self_bucket takes no real: either precision
-    ++g.start[std::size_t(kernel::f32::self_bucket(g.key[p], mask)) + 1];
-  }
-  for (std::size_t b = 0; b < table; ++b)
-    g.start[b + 1] += g.start[b];
-  g.fill.assign(g.start.begin(), g.start.end() - 1);
-  for (std::size_t p = 0; p < n; ++p)
-    g.sorted[g.fill[kernel::f32::self_bucket(g.key[p], mask)]++] = static_cast<std::uint32_t>(p);
+  const bool lists = k.half_skin2 > Real(0); // the GPU's test (a skin so small it is 0 keeps none)
+  kernel::SelfDataT<Real> data{};            // the table's arrays, once built
+  auto collide = [&](std::size_t p) {
+    if (pinned_[p])
+      g.dx[p] = g.dv[p] = Vec3(0);
+    else if (lists)
+      kernel::self_collide_listed(data, std::uint32_t(p), g.listed[p], g.key[p], pos_[p], vel_[p],
+                                  g.inv_mass[p], g.rest[p], k.thickness, mask, k.friction, g.dx[p], g.dv[p]);
+    else
+      kernel::self_collide(data, std::uint32_t(p), pos_[p], vel_[p], g.inv_mass[p], g.rest[p], k.thickness,
+                           k.inv_cell, mask, k.friction, g.dx[p], g.dv[p]);
+  };
 
+  if (!lists)
+    self_hash(k.inv_cell);
   for (std::uint32_t it = 0; it < sc.iterations; ++it) {
-    const kernel::SelfDataT<Real> data{g.start.data(), g.sorted.data(),   g.key.data(), pos_.data(),
-                                       vel_.data(),    g.inv_mass.data(), g.rest.data()};
-    pool_->for_each(n, [&](std::size_t p) {
-      if (pinned_[p])
-        g.dx[p] = g.dv[p] = Vec3(0);
-      else
-        kernel::self_collide(data, static_cast<std::uint32_t>(p), pos_[p], vel_[p], g.inv_mass[p], g.rest[p],
-                             thickness, inv_cell, mask, mu, g.dx[p], g.dv[p]);
-    });
+    if (lists && self_list_stale(k))
+      self_build_lists(k, mask);
+    data = self_data();
+    ++g.stats.passes;
+    pool_->for_each(n, collide);
     pool_->for_each(n, [&](std::size_t p) {
       if (!pinned_[p])
         kernel::self_apply(pos_[p], vel_[p], g.dx[p], g.dv[p]);
@@ -69,7 +69,83 @@ template <typename Real> void CpuSolver<Real>::Impl::self_collide() {
   swept_finite_ = false; // checked with the rest of the state (check_finite)
 }
 
+// What the kernel's walks read: the table, the lists and the particles' state, in place.
+template <typename Real> kernel::SelfDataT<Real> CpuSolver<Real>::Impl::self_data() {
+  auto& g = *self_;
+  return {g.start.data(), g.sorted.data(),   g.key.data(),  pos_.data(),
+          vel_.data(),    g.inv_mass.data(), g.rest.data(), g.list.data()};
+}
+
+// The hash table of the positions now, cells of 1 / inv_cell: count per bucket, exclusive prefix
+// sums, then the particles in index order (the order the GPU's SORT pass gives each bucket).
+template <typename Real> void CpuSolver<Real>::Impl::self_hash(const Real inv_cell) {
+  auto& g = *self_;
+  const std::size_t n = pos_.size();
+  const std::uint32_t table = kernel::self_table_size(static_cast<std::uint32_t>(n)), mask = table - 1;
+  g.start.assign(std::size_t(table) + 1, 0);
+  g.key.resize(n);
+  g.sorted.resize(n);
+  for (std::size_t p = 0; p < n; ++p) {
+    g.key[p] = kernel::self_key(pos_[p], inv_cell); // self_bucket takes no real: either precision
+    ++g.start[std::size_t(kernel::f32::self_bucket(g.key[p], mask)) + 1];
+  }
+  for (std::size_t b = 0; b < table; ++b)
+    g.start[b + 1] += g.start[b];
+  g.fill.assign(g.start.begin(), g.start.end() - 1);
+  for (std::size_t p = 0; p < n; ++p)
+    g.sorted[g.fill[kernel::f32::self_bucket(g.key[p], mask)]++] = static_cast<std::uint32_t>(p);
+}
+
+// Whether some particle has moved more than half the skin since the lists were built (or they
+// never were, or were built for another reach or thickness): the GPU's CHECK pass.
+template <typename Real> bool CpuSolver<Real>::Impl::self_list_stale(const detail::SelfConstants<Real>& k) {
+  const auto& g = *self_;
+  if (!(g.built_reach2 == k.reach2 && g.built_thickness == k.thickness))
+    return true;
+  const Real half_skin2 = k.half_skin2;
+  std::atomic<bool> stale{false};
+  pool_->parallel_for(pos_.size(), [&](std::size_t begin, std::size_t end) {
+    for (std::size_t p = begin; p < end; ++p)
+      if (kernel::self_moved(pos_[p], g.built[p], half_skin2)) {
+        stale.store(true, std::memory_order_relaxed);
+        return;
+      }
+  });
+  return stale.load();
+}
+
+// The hash of cells of the reach (thickness + skin), then each particle's list of the candidates
+// within the reach (its 27 cells' walk), and where each particle is now: the GPU's COUNT .. LIST.
+template <typename Real>
+void CpuSolver<Real>::Impl::self_build_lists(const detail::SelfConstants<Real>& k, const std::uint32_t mask) {
+  auto& g = *self_;
+  self_hash(k.inv_cell);
+  const kernel::SelfDataT<Real> data = self_data();
+  pool_->for_each(pos_.size(), [&](std::size_t p) {
+    Vec3 unused_x(0), unused_v(0);
+    g.listed[p] = kernel::self_walk(data, std::uint32_t(p), g.key[p], true, pos_[p], vel_[p], g.inv_mass[p],
+                                    g.rest[p], k.thickness, k.reach2, mask, k.friction, unused_x, unused_v);
+    g.built[p] = pos_[p];
+  });
+  g.built_reach2 = k.reach2;
+  g.built_thickness = k.thickness;
+  ++g.stats.builds;
+  g.stats.candidates = g.stats.overflowed = 0;
+  for (const std::uint32_t listed : g.listed) {
+    g.stats.candidates += listed;
+    g.stats.overflowed += listed > VKCLOTH_SELF_LIST_CAPACITY ? 1 : 0;
+  }
+}
+
 template void CpuSolver<float>::Impl::self_collide();
 template void CpuSolver<double>::Impl::self_collide();
+template kernel::SelfDataT<float> CpuSolver<float>::Impl::self_data();
+template kernel::SelfDataT<double> CpuSolver<double>::Impl::self_data();
+template void CpuSolver<float>::Impl::self_hash(float);
+template void CpuSolver<double>::Impl::self_hash(double);
+template bool CpuSolver<float>::Impl::self_list_stale(const detail::SelfConstants<float>&);
+template bool CpuSolver<double>::Impl::self_list_stale(const detail::SelfConstants<double>&);
+template void CpuSolver<float>::Impl::self_build_lists(const detail::SelfConstants<float>&, std::uint32_t);
+template void CpuSolver<double>::Impl::self_build_lists(const detail::SelfConstants<double>&, std::uint32_t);
 
 } // namespace vkcloth

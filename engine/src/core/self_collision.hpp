@@ -7,11 +7,14 @@
 
 #include <glm/vec3.hpp>
 
+#include "vkcloth/params.hpp"
+
 namespace vkcloth {
 
 namespace detail {
-/// The hash table and the per-particle constants of self-collision, made by the first substep with
-/// it on (rest positions and inverse masses as the GPU computes them: cast to Real, then the kernel).
+/// The hash table, the neighbour lists and the per-particle constants of self-collision, made by
+/// the first substep with it on (rest positions and inverse masses as the GPU computes them: cast
+/// to Real, then the kernel).
 template <typename Real> struct SelfCollisionGrid {
   using Vec3 = glm::vec<3, Real>;
   std::vector<Vec3> rest;
@@ -22,7 +25,22 @@ template <typename Real> struct SelfCollisionGrid {
   std::vector<std::uint32_t> key;  // each particle's cell key (its bucket: kernel::self_bucket)
   std::vector<std::uint32_t> sorted;
   std::vector<Vec3> dx, dv; // this pass's moves and velocity changes
+  // The neighbour lists (SelfCollision::skin > 0): where each particle was when they were built
+  // (NaN before the first build), each list's length (past the capacity: overflowed) and entries.
+  std::vector<Vec3> built;
+  std::vector<std::uint32_t> listed, list;
+  Real built_reach2 = 0, built_thickness = 0; // what they were built for
+  SelfCollisionStats stats;
 };
+/// SelfCollision's numbers as the kernel takes them, each computed in double and cast once (the GPU's
+/// SelfCollisionGpu::packed casts the same to float): the hash's cells are the reach, thickness +
+/// skin (the thickness alone without a skin).
+template <typename Real> struct SelfConstants { Real thickness, friction, inv_cell, reach2, half_skin2; };
+template <typename Real> SelfConstants<Real> self_constants(const SelfCollision& sc) {
+  const double reach = sc.thickness + sc.skin;
+  return {Real(sc.thickness), Real(sc.friction), Real(1.0 / reach), Real(reach * reach),
+          Real(0.25 * sc.skin * sc.skin)};
+}
 } // namespace detail
 
 } // namespace vkcloth

@@ -2,7 +2,9 @@
 // Self-collision after a substep's update and stretch control: SelfCollisionGpu (the spatial
 // hash and the Jacobi passes of self_collision.comp, its own buffers, sets and parameters), made
 // when an instance first turns it on.
+#include <algorithm>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -41,9 +43,13 @@ public:
       rest[p] = {float(q.position.x), float(q.position.y), float(q.position.z),
                  kernel::inverse_mass(float(q.mass), q.pinned)};
     }
+    const float nan = std::numeric_limits<float>::quiet_NaN(); // no list built yet
+    const std::vector<shared::vec4> never(std::size_t(count) * b.size(), shared::vec4{nan, nan, nan, nan});
     const SolverBatch::Upload up[] = {
         {&(*r)->rest_positions(), rest.data(), rest.size() * sizeof(shared::vec4)},
-        {&(*r)->counts(), nullptr, 0}};
+        {&(*r)->counts(), nullptr, 0},
+        {&(*r)->built(), never.data(), never.size() * sizeof(shared::vec4)},
+        {&(*r)->stale(), nullptr, 0}};
     VKCLOTH_TRY(b.upload(up));
     gpu_ = std::move(*r);
     write_params(b, VK_NULL_HANDLE);
@@ -62,6 +68,9 @@ public:
     for (const SolverBatch::Slot& s : b.instance_slots())
       params.push_back(&s.params);
     const auto packed = SelfCollisionGpu::packed(params);
+    gpu_->set_lists(std::any_of(packed.begin(), packed.end(), [](const shared::SelfParams& p) {
+      return p.iterations > 0 && p.half_skin2 > 0.0f;
+    }));
     const std::size_t bytes = packed.size() * sizeof(shared::SelfParams);
     if (cmd)
       b.record_buffer_update(cmd, gpu_->params(), packed.data(), bytes);

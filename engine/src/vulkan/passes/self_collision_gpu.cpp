@@ -7,6 +7,7 @@
 #include <tuple>
 
 #include "../../core/kernel.hpp"
+#include "../../core/self_collision.hpp"
 #include "../barriers.hpp"
 #include "../pipelines.hpp"
 #include "vkcloth/shaders/self_collision_storage_comp_spv.hpp"
@@ -51,7 +52,11 @@ Result<void> SelfCollisionGpu::create_buffers(bool allow_map) {
       {&blocks_, buckets / VKCLOTH_SELF_SCAN_BLOCK * 4, "self-collision: scan blocks"},
       {&keys_, per_particle * 4, "self-collision: cell keys"},
       {&sorted_, per_particle * 8, "self-collision: sorted particles"},
-      {&delta_, per_particle * 32, "self-collision: moves and velocity changes"}};
+      {&delta_, per_particle * 32, "self-collision: moves and velocity changes"},
+      {&built_, per_particle * 16, "self-collision: positions at the lists' build"},
+      {&listed_, per_particle * 4, "self-collision: list lengths"},
+      {&list_, per_particle * 4 * VKCLOTH_SELF_LIST_CAPACITY, "self-collision: neighbour lists"},
+      {&stale_, VkDeviceSize(instances_) * 8, "self-collision: lists stale"}};
   for (auto [b, bytes, what] : device_buffers) {
     auto r = create_buffer(ctx, std::max<VkDeviceSize>(bytes, 16), usage, MemoryUse::device, allow_map, what);
     if (!r)
@@ -146,6 +151,14 @@ Result<void> SelfCollisionGpu::write_sets(const OneSetInputs& in) {
                         return sorted_.buffer;
                       case VKCLOTH_BINDING_SELF_DELTA:
                         return delta_.buffer;
+                      case VKCLOTH_BINDING_SELF_BUILT:
+                        return built_.buffer;
+                      case VKCLOTH_BINDING_SELF_LISTED:
+                        return listed_.buffer;
+                      case VKCLOTH_BINDING_SELF_LIST:
+                        return list_.buffer;
+                      case VKCLOTH_BINDING_SELF_STALE:
+                        return stale_.buffer;
                       default:
                         return in.main_binding(read, binding);
                       }
@@ -157,9 +170,9 @@ std::vector<sh::SelfParams> SelfCollisionGpu::packed(std::span<const SimParams* 
   std::vector<sh::SelfParams> out;
   for (const SimParams* p : params) {
     const SelfCollision& sc = p->self_collision;
-    // As CpuSolver<float>::self_collide: each double cast to float once.
-    out.push_back({sc.enabled ? sc.iterations : 0u, float(sc.thickness), float(1.0 / sc.thickness),
-                   float(sc.friction)});
+    const auto k = vkcloth::detail::self_constants<float>(sc); // as CpuSolver<float>::self_collide
+    out.push_back({sc.enabled ? sc.iterations : 0u, k.thickness, k.inv_cell, k.friction, k.reach2,
+                   k.half_skin2, 0u, 0u});
   }
   return out;
 }
@@ -185,14 +198,21 @@ std::uint32_t SelfCollisionGpu::record_substep(VkCommandBuffer c, std::uint32_t 
     v.vkCmdDispatch(c, std::uint32_t(gx), std::uint32_t((groups + gx - 1) / gx), instances_);
     ++dispatches;
   };
-  pass(VKCLOTH_SELF_COUNT, count_);
-  pass(VKCLOTH_SELF_SCAN_BLOCKS, std::uint64_t(table_ / VKCLOTH_SELF_SCAN_BLOCK) * VKCLOTH_WORKGROUP_SIZE);
-  pass(VKCLOTH_SELF_SCAN_TOP, 1);
-  pass(VKCLOTH_SELF_SCAN_ADD, std::uint64_t(table_) + 1);
-  pass(VKCLOTH_SELF_SCATTER, count_);
-  pass(VKCLOTH_SELF_SORT, table_);
   for (std::uint32_t it = 0; it < iterations; ++it) {
     pc.iteration = it;
+    if (it == 0 || lists_) { // the hash (and the lists): each pass's stages decide whether to build
+      if (lists_)
+        pass(VKCLOTH_SELF_CHECK, count_);
+      pass(VKCLOTH_SELF_COUNT, count_);
+      pass(VKCLOTH_SELF_SCAN_BLOCKS,
+           std::uint64_t(table_ / VKCLOTH_SELF_SCAN_BLOCK) * VKCLOTH_WORKGROUP_SIZE);
+      pass(VKCLOTH_SELF_SCAN_TOP, 1);
+      pass(VKCLOTH_SELF_SCAN_ADD, std::uint64_t(table_) + 1);
+      pass(VKCLOTH_SELF_SCATTER, count_);
+      pass(VKCLOTH_SELF_SORT, table_);
+      if (lists_)
+        pass(VKCLOTH_SELF_LIST, count_);
+    }
     pass(VKCLOTH_SELF_COLLIDE, count_);
     pass(VKCLOTH_SELF_APPLY, count_);
   }

@@ -4,6 +4,11 @@
 //
 //   COUNT -> SCAN_BLOCKS -> SCAN_TOP -> SCAN_ADD -> SCATTER -> SORT -> iterations x [ COLLIDE -> APPLY ]
 //
+// or, when an instance keeps neighbour lists (a skin), before every pass:
+//
+//   iterations x [ CHECK -> COUNT -> ... -> SORT -> LIST -> COLLIDE -> APPLY ]
+//
+// where COUNT .. LIST do nothing unless CHECK found a particle that moved more than half the skin.
 // one barrier between consecutive passes (barriers::dispatch_to_dispatch). The spatial hash (one
 // table per instance, kernel.hpp self_table_size buckets) is rebuilt every substep; the counts
 // go back to zero as SCATTER hands out the slots, so no clearing pass is needed. In a batch whose
@@ -42,6 +47,12 @@ public:
   Result<void> write_sets(const OneSetInputs& in);
   Buffer& rest_positions() { return rest_; }
   Buffer& counts() { return counts_; }
+  /// Where each particle was when its list was built: the caller fills it with NaN (never built),
+  /// and zeroes stale().
+  Buffer& built() { return built_; }
+  Buffer& stale() { return stale_; }
+  /// Whether some instance keeps neighbour lists (record_substep's pass sequence).
+  void set_lists(bool lists) { lists_ = lists; }
   /// The per-instance parameters (host-visible; written by the caller at creation, then by
   /// vkCmdUpdateBuffer with the instance parameters).
   const Buffer& params() const { return params_; }
@@ -57,7 +68,8 @@ private:
   std::shared_ptr<Context::Impl> ctx_;
   std::uint32_t count_ = 0, instances_ = 0, table_ = 0, groups_max_x_ = 1;
   BufferAccess access_ = BufferAccess::storage_buffers; // the build that runs (never automatic)
-  Buffer params_, rest_, counts_, starts_, blocks_, keys_, sorted_, delta_;
+  bool lists_ = false;
+  Buffer params_, rest_, counts_, starts_, blocks_, keys_, sorted_, delta_, built_, listed_, list_, stale_;
   DescriptorPool pool_, texel_pool_;
   VkDescriptorSet sets_[2] = {}, texel_sets_[2] = {}; // [read]: set 0 and the texel build's set 1
   // The texel build's views: positions[0], positions[1] (the parity's POS_OUT), then velocities,
@@ -65,7 +77,7 @@ private:
   BufferView pos_views_[2], vel_view_, rest_view_, starts_view_, sorted_view_;
   // The Context's (PipelineRegistry), shared by every batch.
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
-  static constexpr std::uint32_t kPasses = VKCLOTH_SELF_APPLY + 1;
+  static constexpr std::uint32_t kPasses = VKCLOTH_SELF_LIST + 1;
   VkPipeline passes_[kPasses] = {}; // [stage]: self_collision.comp specialised with its stage (SC_STAGE)
 
   Result<void> create_buffers(bool allow_map);

@@ -1,0 +1,221 @@
+// SPDX-License-Identifier: MIT
+// Self-collision's neighbour lists (SelfCollision::skin; docs/model.md "Self-collision"): the
+// invariant that makes them exact (after moves of at most half the skin every pair closer than the
+// thickness is in both particles' lists, and a larger move can lose one), a listed and an
+// overflowed particle's response against the brute-force sum over all pairs, and the solver's
+// rebuild rule, counts and thread independence.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <glm/geometric.hpp>
+
+#include "kernel.hpp"
+#include "sim_backends.hpp"
+
+using namespace vkcloth;
+
+namespace {
+
+constexpr float thickness = 0.01f, skin = 0.01f;
+constexpr float reach = thickness + skin;
+constexpr std::uint32_t capacity = VKCLOTH_SELF_LIST_CAPACITY;
+
+/// Particles with the hash of their cells (the CPU solver's counting sort: each bucket's particles
+/// in increasing index) and their neighbour lists, built with the kernel's walk.
+struct Cloud {
+  std::vector<glm::vec3> x, v, rest;
+  std::vector<float> w;
+  std::vector<std::uint32_t> start, sorted, key, list, listed;
+  std::uint32_t mask = 0;
+
+  kernel::SelfDataT<float> data() {
+    return {start.data(), sorted.data(), key.data(), x.data(), v.data(), w.data(), rest.data(), list.data()};
+  }
+  void build() {
+    const auto n = std::uint32_t(x.size());
+    mask = kernel::self_table_size(n) - 1;
+    start.assign(mask + 2, 0);
+    key.resize(n);
+    sorted.resize(n);
+    for (std::uint32_t p = 0; p < n; ++p) {
+      key[p] = kernel::self_key(x[p], 1.0f / reach);
+      ++start[kernel::f32::self_bucket(key[p], mask) + 1];
+    }
+    for (std::uint32_t b = 0; b <= mask; ++b)
+      start[b + 1] += start[b];
+    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+    for (std::uint32_t p = 0; p < n; ++p)
+      sorted[fill[kernel::f32::self_bucket(key[p], mask)]++] = p;
+    list.assign(std::size_t(n) * capacity, 0);
+    listed.resize(n);
+    const auto d = data();
+    for (std::uint32_t p = 0; p < n; ++p) {
+      glm::vec3 unused_x(0), unused_v(0);
+      listed[p] = kernel::self_walk(d, p, key[p], true, x[p], v[p], w[p], rest[p], thickness, reach * reach, mask,
+                                    0.2f, unused_x, unused_v);
+    }
+  }
+  bool lists(std::uint32_t p, std::uint32_t q) const {
+    const auto first = list.begin() + std::ptrdiff_t(p) * capacity;
+    return std::find(first, first + std::min(listed[p], capacity), q) != first + std::min(listed[p], capacity);
+  }
+};
+
+/// n particles in a cube of side `side` at random, with random velocities; rest positions far apart
+/// (no pair is close at rest).
+Cloud random_cloud(std::uint32_t n, float side, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(0.0f, side), s(-1.0f, 1.0f);
+  Cloud c;
+  for (std::uint32_t p = 0; p < n; ++p) {
+    c.x.push_back({u(rng), u(rng), u(rng)});
+    c.v.push_back({s(rng), s(rng), s(rng)});
+    c.rest.push_back({float(p), 0.0f, 0.0f});
+    c.w.push_back(100.0f);
+  }
+  return c;
+}
+
+/// Every particle moved by `distance` in a random direction.
+void move_all(Cloud& c, float distance, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> g;
+  for (glm::vec3& x : c.x) {
+    const glm::vec3 d = glm::normalize(glm::vec3(g(rng), g(rng), g(rng)));
+    x += d * distance;
+  }
+}
+
+/// The pairs closer than the thickness now that some particle's list lacks (overflowed lists walk
+/// the cells, which hold them: not counted), and how many pairs there are.
+std::pair<int, int> unlisted_pairs(const Cloud& c) {
+  int missing = 0, pairs = 0;
+  for (std::uint32_t p = 0; p < c.x.size(); ++p)
+    for (std::uint32_t q = p + 1; q < c.x.size(); ++q)
+      if (kernel::self_pair(c.x[p], c.x[q], c.rest[p], c.rest[q], thickness * thickness)) {
+        ++pairs;
+        const bool in_p = c.listed[p] > capacity || c.lists(p, q);
+        const bool in_q = c.listed[q] > capacity || c.lists(q, p);
+        missing += in_p && in_q ? 0 : 1;
+      }
+  return {missing, pairs};
+}
+
+/// p's response summed over every other particle in index order (no table): the reference.
+void brute_force(const Cloud& c, std::uint32_t p, glm::vec3& dx, glm::vec3& dv) {
+  glm::vec3 sx(0), sv(0);
+  std::uint32_t pairs = 0;
+  for (std::uint32_t q = 0; q < c.x.size(); ++q)
+    if (q != p && kernel::self_pair(c.x[p], c.x[q], c.rest[p], c.rest[q], thickness * thickness)) {
+      kernel::self_contact(sx, sv, c.x[p], c.v[p], c.w[p], c.x[q], c.v[q], c.w[q], thickness, 0.2f);
+      ++pairs;
+    }
+  kernel::self_mean(sx, sv, pairs, dx, dv);
+}
+
+} // namespace
+
+TEST_CASE("self-collision lists: after moves of at most half the skin, every pair is listed") {
+  for (unsigned seed : {1u, 2u, 3u}) {
+    INFO("seed " << seed);
+    Cloud c = random_cloud(400, 0.1f, seed);
+    c.build();
+    move_all(c, 0.499f * skin, seed + 100);
+    const auto [missing, pairs] = unlisted_pairs(c);
+    CHECK(pairs > 100); // the test has pairs to lose
+    CHECK(missing == 0);
+
+    // The bound is needed: moves of 1.5 skins lose pairs.
+    Cloud far = random_cloud(400, 0.1f, seed);
+    far.build();
+    move_all(far, 1.5f * skin, seed + 100);
+    CHECK(unlisted_pairs(far).first > 0);
+  }
+}
+
+TEST_CASE("self-collision lists: a listed and an overflowed particle respond as the sum over all pairs") {
+  // A dense clump (60 particles within 2 cm: every list overflows) and a sparse cloud.
+  Cloud dense = random_cloud(60, 0.012f, 7);
+  Cloud sparse = random_cloud(400, 0.1f, 8);
+  for (Cloud* c : {&dense, &sparse}) {
+    c->build();
+    move_all(*c, 0.4f * skin, 9);
+    const auto d = c->data();
+    int overflowed = 0, compared = 0;
+    for (std::uint32_t p = 0; p < c->x.size(); ++p) {
+      glm::vec3 dx, dv, rx, rv;
+      kernel::self_collide_listed(d, p, c->listed[p], c->key[p], c->x[p], c->v[p], c->w[p], c->rest[p], thickness,
+                                  c->mask, 0.2f, dx, dv);
+      brute_force(*c, p, rx, rv);
+      overflowed += c->listed[p] > capacity ? 1 : 0;
+      compared += glm::length(rx) > 0.0f ? 1 : 0;
+      CHECK(glm::length(dx - rx) <= 1e-6f * thickness); // the same pairs, summed in another order
+      CHECK(glm::length(dv - rv) <= 1e-6f * (1.0f + glm::length(rv)));
+    }
+    CHECK(compared > 20);
+    if (c == &dense)
+      CHECK(overflowed == int(c->x.size()));
+    else
+      CHECK(overflowed == 0);
+  }
+}
+
+TEST_CASE("self-collision lists: built once while nothing moves, again when a particle moves half the skin") {
+  // A flat 16 x 16 cloth, no gravity: it never moves, so the first pass builds and no other does.
+  ClothDesc desc;
+  desc.nx = desc.ny = 16;
+  desc.size = {0.3, 0.3};
+  desc.pin_default_corners = false;
+  auto system = make_cloth(desc);
+  REQUIRE(system.ok());
+  SimParams params;
+  params.gravity = {0.0, 0.0, 0.0};
+  params.dt = 1e-3;
+  params.self_collision.enabled = true;
+  params.self_collision.iterations = 2;
+  params.self_collision.skin = 0.01;
+  auto s = CpuSolver<float>::create(*system, params);
+  REQUIRE(s.ok());
+  REQUIRE(s->run(20).ok());
+  SelfCollisionStats st = s->self_collision_stats();
+  CHECK(st.passes == 40);
+  CHECK(st.builds == 1);
+  CHECK(st.candidates > 0);
+  CHECK(st.overflowed == 0);
+  // One particle moved by 0.6 skin: the next pass builds again, and only that one.
+  REQUIRE(s->set_particle(100, s->positions()[100] + glm::vec3(0.0f, 0.0f, 0.006f), glm::vec3(0)).ok());
+  REQUIRE(s->run(5).ok());
+  st = s->self_collision_stats();
+  CHECK(st.passes == 50);
+  CHECK(st.builds == 2);
+  // Another skin is another reach: built again at once.
+  params.self_collision.skin = 0.02;
+  REQUIRE(s->set_params(params).ok());
+  REQUIRE(s->run(1).ok());
+  CHECK(s->self_collision_stats().builds == 3);
+}
+
+TEST_CASE("self-collision lists: the drop sample builds them in fewer than half its passes, on any thread count") {
+  const std::string path = std::string(VKCLOTH_SCENES_DIR) + "/cloth_drop_self_collision.json";
+  auto scene = load_scene_file(path);
+  REQUIRE_MESSAGE(scene.ok(), (scene.ok() ? "" : scene.error().message));
+  REQUIRE(scene->params.self_collision.skin > 0.0);
+  std::vector<std::vector<glm::vec3>> runs;
+  for (unsigned threads : {1u, 2u, 4u}) {
+    auto s = CpuSolver<float>::create(scene->system, scene->params, {threads});
+    REQUIRE(s.ok());
+    REQUIRE(s->run(150).ok()); // into the fold: self-contacts from step ~70
+    runs.emplace_back(s->positions().begin(), s->positions().end());
+    const SelfCollisionStats st = s->self_collision_stats();
+    MESSAGE(threads << " threads: " << st.passes << " passes, " << st.builds << " list builds");
+    CHECK(st.passes == 150 * scene->params.substeps * scene->params.self_collision.iterations);
+    CHECK(st.builds * 2 < st.passes); // it falls ~1 mm a substep: half the skin is 2.5 mm
+  }
+  CHECK(runs[0] == runs[1]);
+  CHECK(runs[0] == runs[2]);
+}
