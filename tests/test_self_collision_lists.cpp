@@ -56,13 +56,14 @@ struct Cloud {
     const auto d = data();
     for (std::uint32_t p = 0; p < n; ++p) {
       glm::vec3 unused_x(0), unused_v(0);
-      listed[p] = kernel::self_walk(d, p, key[p], true, x[p], v[p], w[p], rest[p], thickness, reach * reach, mask,
-                                    0.2f, unused_x, unused_v);
+      listed[p] = kernel::self_walk(d, p, key[p], true, x[p], v[p], w[p], rest[p], thickness, reach * reach,
+                                    mask, 0.2f, unused_x, unused_v);
     }
   }
   bool lists(std::uint32_t p, std::uint32_t q) const {
     const auto first = list.begin() + std::ptrdiff_t(p) * capacity;
-    return std::find(first, first + std::min(listed[p], capacity), q) != first + std::min(listed[p], capacity);
+    return std::find(first, first + std::min(listed[p], capacity), q) !=
+           first + std::min(listed[p], capacity);
   }
 };
 
@@ -149,8 +150,8 @@ TEST_CASE("self-collision lists: a listed and an overflowed particle respond as 
     int overflowed = 0, compared = 0;
     for (std::uint32_t p = 0; p < c->x.size(); ++p) {
       glm::vec3 dx, dv, rx, rv;
-      kernel::self_collide_listed(d, p, c->listed[p], c->key[p], c->x[p], c->v[p], c->w[p], c->rest[p], thickness,
-                                  c->mask, 0.2f, dx, dv);
+      kernel::self_collide_listed(d, p, c->listed[p], c->key[p], c->x[p], c->v[p], c->w[p], c->rest[p],
+                                  thickness, c->mask, 0.2f, dx, dv);
       brute_force(*c, p, rx, rv);
       overflowed += c->listed[p] > capacity ? 1 : 0;
       compared += glm::length(rx) > 0.0f ? 1 : 0;
@@ -200,7 +201,8 @@ TEST_CASE("self-collision lists: built once while nothing moves, again when a pa
   CHECK(s->self_collision_stats().builds == 3);
 }
 
-TEST_CASE("self-collision lists: the drop sample builds them in fewer than half its passes, on any thread count") {
+TEST_CASE(
+    "self-collision lists: the drop sample builds them in fewer than half its passes, on any thread count") {
   const std::string path = std::string(VKCLOTH_SCENES_DIR) + "/cloth_drop_self_collision.json";
   auto scene = load_scene_file(path);
   REQUIRE_MESSAGE(scene.ok(), (scene.ok() ? "" : scene.error().message));

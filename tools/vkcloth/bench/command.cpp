@@ -358,7 +358,10 @@ int self_collision_rows(BenchRun& run) {
             [&](bool fused, gpu::BufferAccess access) {
               return bench_vulkan_self(*run.ctx, *sc, fused, access, o);
             },
-            [&](Row& r) { r.self_thickness = sc->params.self_collision.thickness; }))
+            [&](Row& r) {
+              r.self_thickness = sc->params.self_collision.thickness;
+              r.self_skin = sc->params.self_collision.skin;
+            }))
       return e;
   }
   return exit_ok;
@@ -453,6 +456,11 @@ void add_bench_command(CLI::App& app, int* exit) {
       "Also time each size's cloth folded into 4 layers on the floor with self-collision on (issue 16; "
       "thickness 1.5 x the grid spacing, friction 0.2, 1 iteration) against the same cloth with it off, "
       "alternated (n >= 16)");
+  cmd->add_option("--self-skin", opt->self_skin,
+                  "With --self-collision: keep neighbour lists with a skin of this many thicknesses, rebuilt "
+                  "when a particle has moved half the skin (self_collision.skin; default 0: every pass walks "
+                  "the cells)")
+      ->check(CLI::Range(0.0, 10.0));
   cmd->add_option(
       "--stiffness", opt->stiffness,
       "Structural, shear and bend stiffness of the grid in N/m, e.g. 10000,2000,2000 (default 40,8,8)");

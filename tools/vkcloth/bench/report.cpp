@@ -111,12 +111,13 @@ void print_preamble(const BenchRun& run) {
         "{:g}; no wind; n free: the same cloth without colliders (n column)\n",
         20 * sphere_frequency * sphere_frequency, contact_friction);
   if (o.self_collision)
-    fmt::print("self-collision rows: n+self: the n x n cloth folded into {} layers on the floor plane "
-               "(friction {:g}), "
-               "self_collision {{thickness: {:g} x the spacing, friction: {:g}, iterations: {}}}; no wind; "
-               "n-self: the "
-               "same cloth with self-collision off (n column)\n",
-               self_layers, contact_friction, self_thickness_over_spacing, self_friction, self_iterations);
+    fmt::print(
+        "self-collision rows: n+self: the n x n cloth folded into {} layers on the floor plane "
+        "(friction {:g}), "
+        "self_collision {{thickness: {:g} x the spacing, friction: {:g}, iterations: {}, skin: {:g} x the "
+        "thickness}}; no wind; n-self: the same cloth with self-collision off (n column)\n",
+        self_layers, contact_friction, self_thickness_over_spacing, self_friction, self_iterations,
+        o.self_skin);
 }
 
 /// What a row's median wall time comes to: ms per step, particle-steps per second, GB/s and GFLOP/s
@@ -196,6 +197,7 @@ void add_scene_keys(nlohmann::json& j, const std::vector<Row>& rows, const Row& 
     j["self_collision_thickness"] = r.self_thickness;
     j["self_collision_friction"] = self_friction;
     j["self_collision_iterations"] = self_iterations;
+    j["self_collision_skin"] = r.self_skin;
     if (r.scene == "self_collision") {
       j["particles_in_self_contact_start"] = r.in_contact_start;
       j["particles_in_self_contact_end"] = r.in_contact_end;
