@@ -20,6 +20,7 @@ void self_range(uint unused, uint b, out uint first, out uint stop);
 void self_entry(uint unused, uint i, out uint q, out uint key);
 void self_particle(uint unused, uint q, out vec3 x, out vec3 v, out float w, out vec3 rest);
 void self_list_put(uint unused, uint p, uint slot, uint q);
+void self_entry_particle(uint unused, uint i, uint q, out vec3 x, out vec3 rest);
 uint self_list_get(uint unused, uint p, uint i);
 #define VKCLOTH_PUSH_STRUCT SelfPush
 #include "common.glsl"
@@ -38,6 +39,10 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_BUILT) buffer BuiltBuf { 
 layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_LISTED) buffer ListedBuf { uint listed[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_LIST) buffer ListBuf { uint list[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_STALE) buffer StaleBuf { uint stale[]; };
+// vbd's scratch that the explicit integrators' RK4 stages use: self-contact's force and stiffness block.
+layout(std430, set = 0, binding = VKCLOTH_BINDING_ACC_POS) writeonly buffer ContactF { vec4 contact_f[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_ACC_VEL) writeonly buffer ContactDiag { vec4 contact_diag[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_STAGE_VEL) writeonly buffer ContactOff { vec4 contact_off[]; };
 
 shared uint partial[VKCLOTH_WORKGROUP_SIZE];
 
@@ -72,6 +77,10 @@ void self_particle(uint unused, uint q, out vec3 x, out vec3 v, out float w, out
   rest = r.xyz;
 }
 
+void self_entry_particle(uint unused, uint i, uint q, out vec3 x, out vec3 rest) {
+  x = read_pos_out(q);
+  rest = read_self_rest(q).xyz;
+}
 void self_list_put(uint unused, uint p, uint slot, uint q) { list[(base + p) * VKCLOTH_SELF_LIST_CAPACITY + slot] = q; }
 uint self_list_get(uint unused, uint p, uint i) { return list[(base + p) * VKCLOTH_SELF_LIST_CAPACITY + i]; }
 
@@ -110,11 +119,17 @@ void main() {
   const uint mask = pc.table_size - 1u;
   if (pc.iteration >= sp.iterations) // past this instance's passes (another asks for more)
     return;
+  // vbd's sweeps record the lists and CONTACT of the instances that take self-contact as an energy;
+  // the passes after the step are the others'.
+  const bool energy = sp.stiffness > 0.0 && sp.half_skin2 > 0.0;
+  if (energy != (pc.in_sweeps != 0u))
+    return;
   const bool lists = sp.half_skin2 > 0.0;
   if ((stage == VKCLOTH_SELF_CHECK || stage == VKCLOTH_SELF_LIST) && !lists)
     return;
-  if (stage != VKCLOTH_SELF_CHECK && stage != VKCLOTH_SELF_COLLIDE && stage != VKCLOTH_SELF_APPLY &&
-      !building(sp))
+  const bool every_pass = stage == VKCLOTH_SELF_CHECK || stage == VKCLOTH_SELF_COLLIDE ||
+                          stage == VKCLOTH_SELF_APPLY || stage == VKCLOTH_SELF_CONTACT;
+  if (!every_pass && !building(sp)) // the hash and the lists: only when built
     return;
   if (stage == VKCLOTH_SELF_SCAN_BLOCKS) {
     // Workgroup = one block of VKCLOTH_SELF_SCAN_BLOCK buckets; 8 consecutive buckets per invocation.
@@ -190,12 +205,22 @@ void main() {
     if (self_moved(pos_out[base + p].xyz, b.xyz, sp.half_skin2) || b.w != sp.reach2 ||
         stale[2u * inst + 1u] != floatBitsToUint(sp.thickness))
       atomicOr(stale[2u * inst], 1u);
+  } else if (stage == VKCLOTH_SELF_CONTACT) {
+    if (p == 0u)
+      stale[2u * inst] = 0u; // CHECK and the build have read it (barriers since)
+    vec3 f = vec3(0.0);
+    SpringBlock hc;
+    hc.diag = vec3(0.0);
+    hc.off = vec3(0.0);
+    if (particle[p].pinned == 0u)
+      self_energy_listed(0u, p, listed[base + p], key_of[base + p], pos_out[base + p].xyz, rest_pos[p].xyz,
+                         sp.thickness, mask, sp.stiffness, f, hc);
+    contact_f[base + p] = vec4(f, 0.0);
+    contact_diag[base + p] = vec4(hc.diag, 0.0);
+    contact_off[base + p] = vec4(hc.off, 0.0);
   } else if (stage == VKCLOTH_SELF_LIST) {
     const vec3 x = pos_out[base + p].xyz;
-    vec3 unused_x = vec3(0.0);
-    vec3 unused_v = vec3(0.0);
-    listed[base + p] = self_walk(0u, p, key_of[base + p], true, x, vec3(0.0), 0.0, rest_pos[p].xyz, sp.thickness,
-                                 sp.reach2, mask, sp.friction, unused_x, unused_v);
+    listed[base + p] = self_gather(0u, p, key_of[base + p], x, rest_pos[p].xyz, sp.thickness, sp.reach2, mask);
     built[base + p] = vec4(x, sp.reach2);
     if (p == 0u)
       stale[2u * inst + 1u] = floatBitsToUint(sp.thickness);

@@ -8,7 +8,7 @@
 //           CPU's normal_at), the inertia target y -> VEL_FILT, the first guess x0 + h v0
 //           projected out of the colliders -> POS_OUT, no push yet -> STAGE_POS;
 //   SOLVE:  one invocation per particle of one colour (VBD_ORDER[colour_first ..]): one Newton step
-//           (springs, inertia, friction) from the neighbours' latest positions in
+//           (springs, self-contact when VbdPush::contact, inertia, friction) from the neighbours' latest positions in
 //           POS_OUT, projected; writes its own POS_OUT entry and its push. No two particles of a
 //           colour share a spring, so no invocation reads what another writes;
 //   FINISH: one invocation per particle: the last sweep's x; v = (x - x0) / h before the last
@@ -27,6 +27,10 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_VEL) buffer VelBuf { vec4 vel[
 layout(std430, set = 0, binding = VKCLOTH_BINDING_VEL_FILT) buffer TargetBuf { vec4 target[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_STAGE_POS) buffer PushBuf { vec4 push_of[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_VBD_ORDER) readonly buffer OrderBuf { uint vbd_order[]; };
+// Self-contact's force and stiffness block from the sweep's start (self_collision.comp CONTACT).
+layout(std430, set = 0, binding = VKCLOTH_BINDING_ACC_POS) readonly buffer ContactF { vec4 contact_f[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_ACC_VEL) readonly buffer ContactDiag { vec4 contact_diag[]; };
+layout(std430, set = 0, binding = VKCLOTH_BINDING_STAGE_VEL) readonly buffer ContactOff { vec4 contact_off[]; };
 
 #include "finish.glsl"
 
@@ -63,6 +67,12 @@ void solve(uint p, uint g) {
   for (uint e = range.x; e < range.z; ++e) {
     const Edge s = read_edge(e);
     vbd_add_spring(f, hessian, pos_out[base + s.other].xyz - x, s.rest_length, s.stiffness);
+  }
+  if (pc.contact != 0u) {
+    SpringBlock hc;
+    hc.diag = contact_diag[g].xyz;
+    hc.off = contact_off[g].xyz;
+    vbd_add_contact(f, hessian, contact_f[g].xyz, hc);
   }
   const vec3 x0 = read_pos_in(p);
   const float m = read_particle(p).mass;

@@ -48,8 +48,9 @@
 #include "friction.h"
 #include "strain.h"
 #include "attach.h"
-#include "self_collision.h"
 #include "integrators.h"
 #include "blocks.h"
 #include "implicit.h"
 #include "vbd.h"
+// self_collision.h after vbd.h: its contact energy is a vbd spring.
+#include "self_collision.h"

@@ -100,6 +100,14 @@ KFN bool self_moved(vec3 x, vec3 xb, real half_skin2) {
   return !(d2 <= half_skin2);
 }
 
+// One pair's contact energy in p's vertex step (vbd with a self-contact stiffness; docs/model.md
+// "Self-collision"): (k / 2) (t - d)^2 for d = |x - xq| < t, a spring of rest length t and stiffness
+// k that only pushes: its force k (t - d) away from xq and its stiffness block k n n^T (vbd_add_spring
+// of a compressed spring keeps only the part along it).
+KFN void self_energy(INOUT(vec3) f, INOUT(SpringBlock) hessian, vec3 x, vec3 xq, real thickness, real k) {
+  vbd_add_spring(f, hessian, xq - x, thickness, k);
+}
+
 // The mean of a particle's pair responses (Jacobi: a particle pressed from many sides does not overshoot).
 KFN void self_mean(vec3 sum_x, vec3 sum_v, uint pairs, OUT(vec3) dx, OUT(vec3) dv) {
   precise real k = pairs > 0u ? real(1) / real(pairs) : real(0);
@@ -110,18 +118,27 @@ KFN void self_mean(vec3 sum_x, vec3 sum_v, uint pairs, OUT(vec3) dx, OUT(vec3) d
 }
 
 #ifdef SELF_DATA_PARAM // the includer provides the table (C++: kernel.hpp; GLSL: self_collision.comp)
+// What self_walk does with the particles it visits.
+#define VKCLOTH_SELF_WALK_COLLIDE 0u // sums p's response to every pair (self_pair, self_contact)
+#define VKCLOTH_SELF_WALK_GATHER 1u  // writes p's neighbour list (self_candidate, self_list_put)
+#define VKCLOTH_SELF_WALK_ENERGY 2u  // adds every pair's contact energy to p's vertex step (self_energy)
+
 // The 27 cells around the cell of key `own`, cell by cell in a fixed order, each cell's particles in
 // increasing index (a bucket holds the particles of every cell hashed to it, in increasing index:
-// those of other cells are skipped by their key). With `gather`, it writes p's neighbour list
-// (self_list_put; self_candidate with `reach2`) and returns its length (past the capacity: it stops
-// writing, and the count says the list overflowed); without, it adds p's response to every pair
-// (self_pair, self_contact) to sum_x, sum_v and returns the number of pairs.
+// those of other cells are skipped by their key), for `mode` (VKCLOTH_SELF_WALK_*): COLLIDE adds p's
+// response to every pair to sum_x, sum_v and returns the number of pairs; GATHER writes p's
+// neighbour list (candidates within `reach2`) and returns its length (past the capacity it stops
+// writing, and the count says the list overflowed); ENERGY adds the pairs' contact energy (stiffness
+// `k`) to f and hessian and returns the number of pairs.
 // Provided by the including file: self_range(SELF_DATA, bucket, first, stop) (the bucket's entries
 // of the sorted table), self_entry(SELF_DATA, i, q, key) (an entry's particle and the key of the
-// cell it was sorted in), self_particle(SELF_DATA, q, x, v, w, rest), self_list_put(SELF_DATA, p,
-// slot, q). Both backends build the same table, so they visit the same particles in the same order.
-KFN uint self_walk(SELF_DATA_PARAM, uint p, uint own, bool gather, vec3 x, vec3 v, real w, vec3 rx,
-                   real thickness, real reach2, uint mask, real mu, INOUT(vec3) sum_x, INOUT(vec3) sum_v) {
+// cell it was sorted in), self_particle(SELF_DATA, q, x, v, w, rest), self_entry_particle(SELF_DATA,
+// i, q, x, rest) (entry i's particle q, as the table was built: a backend may keep them in table
+// order), self_list_put(SELF_DATA, p, slot, q). Both backends build the same table, so they visit
+// the same particles in the same order.
+KFN uint self_walk(SELF_DATA_PARAM, uint p, uint own, uint mode, vec3 x, vec3 v, real w, vec3 rx,
+                   real thickness, real reach2, uint mask, real mu, real k, INOUT(vec3) sum_x,
+                   INOUT(vec3) sum_v, INOUT(SpringBlock) hessian) {
   precise real t2 = thickness * thickness;
   uint found = 0u;
   for (int dk = -1; dk <= 1; ++dk)
@@ -141,15 +158,21 @@ KFN uint self_walk(SELF_DATA_PARAM, uint p, uint own, bool gather, vec3 x, vec3 
           vec3 vq;
           vec3 rq;
           real wq;
-          self_particle(SELF_DATA, q, xq, vq, wq, rq);
-          if (gather) {
+          if (mode == VKCLOTH_SELF_WALK_GATHER) {
+            self_entry_particle(SELF_DATA, i, q, xq, rq); // right after the build: by entry
             if (self_candidate(x, xq, rx, rq, reach2, t2)) {
               if (found < uint(VKCLOTH_SELF_LIST_CAPACITY))
                 self_list_put(SELF_DATA, p, found, q);
               found += 1u;
             }
-          } else if (self_pair(x, xq, rx, rq, t2)) {
-            self_contact(sum_x, sum_v, x, v, w, xq, vq, wq, thickness, mu);
+            continue;
+          }
+          self_particle(SELF_DATA, q, xq, vq, wq, rq);
+          if (self_pair(x, xq, rx, rq, t2)) {
+            if (mode == VKCLOTH_SELF_WALK_ENERGY)
+              self_energy(sum_x, hessian, x, xq, thickness, k);
+            else
+              self_contact(sum_x, sum_v, x, v, w, xq, vq, wq, thickness, mu);
             found += 1u;
           }
         }
@@ -157,13 +180,29 @@ KFN uint self_walk(SELF_DATA_PARAM, uint p, uint own, bool gather, vec3 x, vec3 
   return found;
 }
 
+// Particle p's neighbour list (positions now, p at x; own: p's cell key in the table of cells of the
+// reach): its length (past the capacity: overflowed).
+KFN uint self_gather(SELF_DATA_PARAM, uint p, uint own, vec3 x, vec3 rx, real thickness, real reach2,
+                     uint mask) {
+  vec3 unused_x = vec3(real(0));
+  vec3 unused_v = vec3(real(0));
+  SpringBlock unused;
+  unused.diag = vec3(real(0));
+  unused.off = vec3(real(0));
+  return self_walk(SELF_DATA, p, own, VKCLOTH_SELF_WALK_GATHER, x, vec3(real(0)), real(0), rx, thickness,
+                   reach2, mask, real(0), real(0), unused_x, unused_v, unused);
+}
+
 // Particle p's response, every pair found by the walk around its cell now (no neighbour list).
 KFN void self_collide(SELF_DATA_PARAM, uint p, vec3 x, vec3 v, real w, vec3 rx, real thickness, real inv_cell,
                       uint mask, real mu, OUT(vec3) dx, OUT(vec3) dv) {
   precise vec3 sum_x = vec3(real(0));
   precise vec3 sum_v = vec3(real(0));
-  const uint pairs = self_walk(SELF_DATA, p, self_key(x, inv_cell), false, x, v, w, rx, thickness, real(0),
-                               mask, mu, sum_x, sum_v);
+  SpringBlock unused;
+  unused.diag = vec3(real(0));
+  unused.off = vec3(real(0));
+  const uint pairs = self_walk(SELF_DATA, p, self_key(x, inv_cell), VKCLOTH_SELF_WALK_COLLIDE, x, v, w, rx,
+                               thickness, real(0), mask, mu, real(0), sum_x, sum_v, unused);
   self_mean(sum_x, sum_v, pairs, dx, dv);
 }
 
@@ -177,7 +216,11 @@ KFN void self_collide_listed(SELF_DATA_PARAM, uint p, uint listed, uint own, vec
   precise vec3 sum_v = vec3(real(0));
   uint pairs = 0u;
   if (listed > uint(VKCLOTH_SELF_LIST_CAPACITY)) {
-    pairs = self_walk(SELF_DATA, p, own, false, x, v, w, rx, thickness, real(0), mask, mu, sum_x, sum_v);
+    SpringBlock unused;
+    unused.diag = vec3(real(0));
+    unused.off = vec3(real(0));
+    pairs = self_walk(SELF_DATA, p, own, VKCLOTH_SELF_WALK_COLLIDE, x, v, w, rx, thickness, real(0), mask, mu,
+                      real(0), sum_x, sum_v, unused);
   } else {
     precise real t2 = thickness * thickness;
     for (uint i = 0u; i < listed; ++i) {
@@ -194,6 +237,37 @@ KFN void self_collide_listed(SELF_DATA_PARAM, uint p, uint listed, uint own, vec
     }
   }
   self_mean(sum_x, sum_v, pairs, dx, dv);
+}
+
+// Particle p's self-contact energy in its vertex step (vbd with a self-contact stiffness k > 0):
+// its listed pairs at the positions the sweep starts from (x: p's, self_particle: the others'), in
+// the list's order (an overflowed list walks the build's cells, as self_collide_listed), as f (the
+// force) and hessian (the stiffness), which the step adds to its springs'.
+KFN void self_energy_listed(SELF_DATA_PARAM, uint p, uint listed, uint own, vec3 x, vec3 rx, real thickness,
+                            uint mask, real k, OUT(vec3) f, OUT(SpringBlock) hessian) {
+  precise vec3 sum_f = vec3(real(0));
+  vec3 unused_v = vec3(real(0));
+  SpringBlock block;
+  block.diag = vec3(real(0));
+  block.off = vec3(real(0));
+  if (listed > uint(VKCLOTH_SELF_LIST_CAPACITY)) {
+    self_walk(SELF_DATA, p, own, VKCLOTH_SELF_WALK_ENERGY, x, vec3(real(0)), real(0), rx, thickness, real(0),
+              mask, real(0), k, sum_f, unused_v, block);
+  } else {
+    precise real t2 = thickness * thickness;
+    for (uint i = 0u; i < listed; ++i) {
+      const uint q = self_list_get(SELF_DATA, p, i);
+      vec3 xq;
+      vec3 vq;
+      vec3 rq;
+      real wq;
+      self_particle(SELF_DATA, q, xq, vq, wq, rq);
+      if (self_pair(x, xq, rx, rq, t2))
+        self_energy(sum_f, block, x, xq, thickness, k);
+    }
+  }
+  f = sum_f;
+  hessian = block;
 }
 #endif
 

@@ -37,6 +37,17 @@ KFN void vbd_add_spring(INOUT(vec3) f, INOUT(SpringBlock) hessian, vec3 u, real 
   hessian.off = select(has_length, o, hessian.off);
 }
 
+// Self-contact's part in a vertex's step (self_energy_listed's force fc and stiffness hc, from the
+// sweep's start), added after its springs'.
+KFN void vbd_add_contact(INOUT(vec3) f, INOUT(SpringBlock) hessian, vec3 fc, SpringBlock hc) {
+  precise vec3 t = f + fc;
+  precise vec3 d = hessian.diag + hc.diag;
+  precise vec3 o = hessian.off + hc.off;
+  f = t;
+  hessian.diag = d;
+  hessian.off = o;
+}
+
 // The inertia's (and damping's) stiffness in a vertex's Hessian, (1 + h mu) m / h^2 as vbd_step adds it.
 KFN precise real vbd_inertia_weight(real m, real h, real mu) {
   precise real m_h2 = m / (h * h);

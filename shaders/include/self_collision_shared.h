@@ -55,7 +55,9 @@ namespace vkcloth::gpu::shared {
 #define VKCLOTH_SELF_COLLIDE 6u     // per particle: cloth_kernel.h self_collide(_listed) -> DELTA
 #define VKCLOTH_SELF_APPLY 7u       // per particle: x += dx, v += dv (cloth_kernel.h self_apply)
 #define VKCLOTH_SELF_CHECK 8u       // per particle: SELF_STALE |= self_moved (COLLIDE's first clears it)
-#define VKCLOTH_SELF_LIST 9u        // per particle: its neighbour list (self_walk), BUILT = its position
+#define VKCLOTH_SELF_LIST 9u        // per particle: its neighbour list (self_gather), BUILT = its position
+#define VKCLOTH_SELF_CONTACT                                                                                 \
+  10u // per particle, each vbd sweep: self_energy_listed -> ACC_POS, ACC_VEL, STAGE_VEL
 
 /// Self-collision parameters of one instance (std430: 32 bytes), converted from the double
 /// SimParams::self_collision as CpuSolver<float>::self_collide converts them.
@@ -66,8 +68,8 @@ struct SelfParams {
   float friction;
   float reach2;     // the reach squared (the lists' candidates)
   float half_skin2; // (skin / 2)^2; 0: no skin, no lists (COLLIDE walks the cells)
-  uint unused0;
-  uint unused1;
+  float stiffness;  // > 0: vbd takes self-contact as an energy in its sweeps (no passes after the step)
+  uint unused;
 };
 
 /// self_collision.comp's push constants (PushConstants' five fields, then its own).
@@ -79,7 +81,8 @@ struct SelfPush {
   uint step;
   uint table_size; // buckets of each instance's hash table (kernel.hpp self_table_size)
   uint iteration;  // the Jacobi iteration (COLLIDE, APPLY)
-  uint unused;
+  uint in_sweeps; // 1: recorded by vbd's sweeps (the lists and CONTACT of the energy instances), 0: after the
+                  // step
 };
 
 #ifdef __cplusplus
@@ -94,7 +97,8 @@ inline constexpr uint self_collision_bindings[] = {
     VKCLOTH_BINDING_SELF_REST,   VKCLOTH_BINDING_SELF_COUNTS, VKCLOTH_BINDING_SELF_STARTS,
     VKCLOTH_BINDING_SELF_BLOCKS, VKCLOTH_BINDING_SELF_KEYS,   VKCLOTH_BINDING_SELF_SORTED,
     VKCLOTH_BINDING_SELF_DELTA,  VKCLOTH_BINDING_SELF_BUILT,  VKCLOTH_BINDING_SELF_LISTED,
-    VKCLOTH_BINDING_SELF_LIST,   VKCLOTH_BINDING_SELF_STALE};
+    VKCLOTH_BINDING_SELF_LIST,   VKCLOTH_BINDING_SELF_STALE,  VKCLOTH_BINDING_ACC_POS,
+    VKCLOTH_BINDING_ACC_VEL,     VKCLOTH_BINDING_STAGE_VEL};
 inline constexpr uint self_collision_texel_bindings[] = {VKCLOTH_SELF_TEXEL_POS, VKCLOTH_SELF_TEXEL_VEL,
                                                          VKCLOTH_SELF_TEXEL_REST, VKCLOTH_SELF_TEXEL_STARTS,
                                                          VKCLOTH_SELF_TEXEL_SORTED};

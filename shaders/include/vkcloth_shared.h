@@ -152,7 +152,7 @@ struct VbdPush {
   uint step;
   uint colour_first; // the colour's first entry of VBD_ORDER
   uint colour_count; // its particles
-  uint unused;
+  uint contact;      // 1: add self-contact's force and stiffness (ACC_POS, ACC_VEL, STAGE_VEL) to the step
 };
 
 /// Per-instance parameters (80 bytes; InstanceParams[instance] at VKCLOTH_BINDING_INSTANCES).

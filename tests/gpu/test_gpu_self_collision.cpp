@@ -24,18 +24,23 @@ Result<Scene> sample(const char* name, std::span<const std::string> overrides = 
 
 // Both builds of self_collision.comp (its COLLIDE pass reading through texel views, or storage
 // buffers): the same bits, and the CPU's within 1e-5 m.
-// The samples keep neighbour lists (a skin); with skin 0 every pass walks the cells.
+// The samples keep neighbour lists (a skin); with skin 0 every pass walks the cells; with vbd and a
+// self-contact stiffness the lists feed an energy in the vertex steps (its CONTACT pass per sweep).
 TEST_CASE("GPU matches CPU on the self-collision samples: 100 steps within 1e-5 m") {
   VKCLOTH_GPU_TEST_BEGIN(ctx);
-  const std::string walk = "self_collision.skin=0";
+  struct Variant {
+    const char* what;
+    std::vector<std::string> overrides;
+  };
+  const Variant variants[] = {{"lists", {}},
+                              {"walk", {"self_collision.skin=0"}},
+                              {"vbd energy", {"integrator.method=vbd", "self_collision.stiffness=100"}}};
   for (const char* name : {"cloth_drop_self_collision", "cloth_slide_self_collision"})
-    for (const bool lists : {true, false}) {
-      const std::string what = std::string(name) + (lists ? " (lists)" : " (walk)");
+    for (const Variant& variant : variants) {
+      const std::string what = std::string(name) + " (" + variant.what + ")";
       INFO(what);
-      auto scene =
-          sample(name, lists ? std::span<const std::string>{} : std::span<const std::string>(&walk, 1));
+      auto scene = sample(name, variant.overrides);
       REQUIRE_MESSAGE(scene.ok(), (scene.ok() ? "" : scene.error().message));
-      REQUIRE((scene->params.self_collision.skin > 0.0) == lists);
       REQUIRE(scene->params.self_collision.enabled);
       auto cpu = CpuSolver<float>::create(scene->system, scene->params);
       REQUIRE(cpu.ok());
@@ -88,10 +93,12 @@ TEST_CASE("ClothWorld: self-collision per instance in one batch, each as its own
   VKCLOTH_GPU_TEST_BEGIN(ctx);
   // Instances of one topology: self-collision on (thickness 1 cm, friction 0.2, neighbour lists with
   // a 5 mm skin), on with other settings (1.2 cm, frictionless, no lists: the walk), off, and on with
-  // lists of another skin and three passes (the batch runs three; the others stop after theirs).
+  // lists of another skin and three passes (the batch runs three; the others stop after theirs);
+  // and a vbd batch of two: one taking self-contact as an energy in its sweeps, one with the passes
+  // after its steps.
   auto scene = sample("cloth_drop_self_collision");
   REQUIRE_MESSAGE(scene.ok(), (scene.ok() ? "" : scene.error().message));
-  std::vector<SimParams> params(4, scene->params);
+  std::vector<SimParams> params(6, scene->params);
   params[1].self_collision.thickness = 0.012;
   params[1].self_collision.friction = 0.0;
   params[1].self_collision.iterations = 1;
@@ -99,6 +106,8 @@ TEST_CASE("ClothWorld: self-collision per instance in one batch, each as its own
   params[2].self_collision.enabled = false;
   params[3].self_collision.skin = 0.008;
   params[3].self_collision.iterations = 3;
+  params[4].integrator = params[5].integrator = Integrator::vbd;
+  params[4].self_collision.stiffness = 100.0;
   auto topology = ClothTopology::create(scene->system);
   REQUIRE(topology.ok());
   auto world = gpu::ClothWorld::create(ctx);

@@ -408,6 +408,9 @@ TEST_CASE("self_collision: bad input names the key and the value (issue 16 item 
   expect(R"({"skin": -0.001})", ErrorCode::invalid_argument, {"self_collision.skin", ">= 0", "got -0.001"});
   expect(R"({"thickness": 0.01, "skin": 0.2})", ErrorCode::invalid_argument,
          {"self_collision.skin", "10 x the thickness", "got 0.2"});
+  expect(R"({"stiffness": -1})", ErrorCode::invalid_argument, {"self_collision.stiffness", ">= 0", "got -1"});
+  expect(R"({"stiffness": 100})", ErrorCode::invalid_argument,
+         {"self_collision.stiffness 100", "self_collision.skin > 0", "got skin 0"});
   // Off, the values are still checked (a later --set self_collision.enabled=true must not meet them).
   expect(R"({"enabled": false, "thickness": -1})", ErrorCode::invalid_argument,
          {"self_collision.thickness", "got -1"});

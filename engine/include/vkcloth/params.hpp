@@ -236,6 +236,10 @@ struct SelfCollision {
   /// thickness + skin, rebuilt only when some particle has moved more than skin / 2 since
   /// (docs/model.md "Self-collision"; the same pairs, found less often).
   double skin = 0.0;
+  /// N/m, >= 0: with integrator vbd, > 0 makes each pair a contact energy (k / 2) (t - d)^2 in the
+  /// vertex steps of every sweep (it needs a skin: the steps read the neighbour lists) instead of the
+  /// passes after the step; the other integrators keep the passes (docs/model.md "Self-collision").
+  double stiffness = 0.0;
 };
 
 /// Particles that follow a collider (docs/model.md "Attachments"): particle particles[i]'s target

@@ -410,7 +410,7 @@ template <typename Real> void CpuSolver<Real>::Impl::substep(const Real h) {
   }
   if (params_.stretch_limit.enabled())
     limit_stretch(h);
-  if (params_.self_collision.enabled)
+  if (params_.self_collision.enabled && !self_energy()) // vbd's energy acted in its sweeps
     self_collide();
 }
 

@@ -77,6 +77,8 @@ template <typename Real> struct VbdWorkspace {
   std::vector<Vec3> x0;   ///< positions at the substep's start
   std::vector<Vec3> y;    ///< inertia targets
   std::vector<Vec3> push; ///< the colliders' projection move of the last iteration
+  /// Self-contact's force and stiffness block per particle, from the sweep's start (self_energy_sweep).
+  std::vector<Vec3> contact_f, contact_diag, contact_off;
   /// The SIMD lanes' gather lists, padded per vector of each colour's whole vectors (pad_vector),
   /// and each colour's first vector in them; built by the first substep on lanes.
   std::unique_ptr<PaddedLists<Real>> lists;
@@ -164,10 +166,11 @@ template <typename Real> struct CpuSolver<Real>::Impl {
   // Vertex block descent (vbd.cpp): the targets, the coloured sweeps, then velocities and friction.
   void vbd_substep(Real h);
   void vbd_begin(Real h);
-  void vbd_solve_colour(std::uint32_t colour, Real h);
+  void vbd_solve_colour(std::uint32_t colour, Real h, bool contact);
   /// The whole SIMD vectors of a colour's particles (row_kernel.hpp VbdArgs); returns how many it
   /// stepped (0 without SIMD or with more colliders than the lanes take).
-  std::size_t vbd_colour_lanes(std::uint32_t colour, std::span<const std::uint32_t> particles, Real h);
+  std::size_t vbd_colour_lanes(std::uint32_t colour, std::span<const std::uint32_t> particles, Real h,
+                               bool contact);
   void pad_vbd_lists(std::size_t width);
   void pad_vbd_fans(std::size_t width);
   /// The SIMD lanes' width in particles; 1 where they do not apply (no SIMD, or more than
@@ -179,6 +182,11 @@ template <typename Real> struct CpuSolver<Real>::Impl {
   void limit_stretch(Real h);
   // Self-collision after that (self_collision.cpp; docs/model.md "Self-collision").
   void self_collide();
+  void self_init();
+  /// Whether vbd takes self-contact as an energy in its vertex steps (SelfCollision::stiffness).
+  bool self_energy() const;
+  void self_energy_lists();
+  void self_energy_sweep();
   kernel::SelfDataT<Real> self_data();
   void self_hash(Real inv_cell);
   bool self_list_stale(const detail::SelfConstants<Real>& k);

@@ -159,6 +159,12 @@ template <typename Real> struct SelfDataT {
   const Real* inv_mass = nullptr;
   const glm::vec<3, Real>* rest = nullptr;
   std::uint32_t* list = nullptr; // the neighbour lists: VKCLOTH_SELF_LIST_CAPACITY entries per particle
+  // In table order (optional: null reads through the particle): each entry's key, and its
+  // particle's position and rest position as the table was built (self_entry_particle: the list
+  // build walks them as contiguous memory).
+  const std::uint32_t* sorted_key = nullptr;
+  const glm::vec<3, Real>* entry_pos = nullptr;
+  const glm::vec<3, Real>* entry_rest = nullptr;
 };
 template <typename Real> void self_range(const SelfDataT<Real>& d, uint b, uint& first, uint& stop) {
   first = d.start[b];
@@ -166,7 +172,12 @@ template <typename Real> void self_range(const SelfDataT<Real>& d, uint b, uint&
 }
 template <typename Real> void self_entry(const SelfDataT<Real>& d, uint i, uint& q, uint& key) {
   q = d.sorted[i];
-  key = d.key[q];
+  key = d.sorted_key ? d.sorted_key[i] : d.key[q];
+}
+template <typename Real, typename V>
+void self_entry_particle(const SelfDataT<Real>& d, uint i, uint q, V& x, V& rest) {
+  x = d.entry_pos ? d.entry_pos[i] : d.pos[q];
+  rest = d.entry_rest ? d.entry_rest[i] : d.rest[q];
 }
 template <typename Real> void self_list_put(const SelfDataT<Real>& d, uint p, uint slot, uint q) {
   d.list[std::size_t(p) * VKCLOTH_SELF_LIST_CAPACITY + slot] = q;

@@ -549,6 +549,13 @@ Result<void> SimParams::validate() {
     return bad_argument(fmt::format("self_collision.skin must be finite, >= 0 and at most 10 x the thickness "
                                     "({} m), got {}",
                                     10.0 * self_collision.thickness, self_collision.skin));
+  if (!std::isfinite(self_collision.stiffness) || self_collision.stiffness < 0.0)
+    return bad_argument(fmt::format("self_collision.stiffness must be finite and >= 0 (N/m), got {}",
+                                    self_collision.stiffness));
+  if (self_collision.stiffness > 0.0 && !(self_collision.skin > 0.0))
+    return bad_argument(fmt::format("self_collision.stiffness {} needs a self_collision.skin > 0 (the vertex "
+                                    "steps read the neighbour lists), got skin {}",
+                                    self_collision.stiffness, self_collision.skin));
   if (self_collision.iterations < 1 || self_collision.iterations > 16)
     return bad_argument(
         fmt::format("self_collision.iterations must be in 1..16, got {}", self_collision.iterations));

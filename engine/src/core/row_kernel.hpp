@@ -130,6 +130,10 @@ template <typename Real> struct VbdArgs {
   const FinishShape<Real>* shapes; // every collider at most finish_max_shapes
   std::uint32_t shape_count;
   Real eps, h, mu; // contact_epsilon, the substep, the damping
+  // Self-contact's force and stiffness block per particle (AoS), added after the springs; null: none.
+  const Real* contact_f = nullptr;
+  const Real* contact_diag = nullptr;
+  const Real* contact_off = nullptr;
 };
 
 /// The start of a vbd substep (CpuSolver::vbd_begin), W consecutive particles per vector: the normal

@@ -18,17 +18,7 @@ namespace vkcloth {
 template <typename Real> void CpuSolver<Real>::Impl::self_collide() {
   const SelfCollision& sc = params_.self_collision;
   const std::size_t n = pos_.size();
-  if (!self_) {
-    self_ = std::make_unique<detail::SelfCollisionGrid<Real>>();
-    const ParticleSystem& system = topology_->system();
-    for (std::size_t p = 0; p < n; ++p) {
-      self_->rest.push_back(Vec3(system.particles[p].position));
-      self_->inv_mass.push_back(kernel::inverse_mass(mass_[p], pinned_[p] != 0));
-    }
-    self_->built.assign(n, Vec3(std::numeric_limits<Real>::quiet_NaN()));
-    self_->listed.assign(n, 0);
-    self_->list.assign(n * VKCLOTH_SELF_LIST_CAPACITY, 0);
-  }
+  self_init();
   auto& g = *self_;
   const std::uint32_t mask = kernel::self_table_size(static_cast<std::uint32_t>(n)) - 1;
   const detail::SelfConstants<Real> k = detail::self_constants<Real>(sc);
@@ -69,11 +59,67 @@ template <typename Real> void CpuSolver<Real>::Impl::self_collide() {
   swept_finite_ = false; // checked with the rest of the state (check_finite)
 }
 
+// The workspace, made by the first substep with self-collision on.
+template <typename Real> void CpuSolver<Real>::Impl::self_init() {
+  if (self_)
+    return;
+  const std::size_t n = pos_.size();
+  self_ = std::make_unique<detail::SelfCollisionGrid<Real>>();
+  const ParticleSystem& system = topology_->system();
+  for (std::size_t p = 0; p < n; ++p) {
+    self_->rest.push_back(Vec3(system.particles[p].position));
+    self_->inv_mass.push_back(kernel::inverse_mass(mass_[p], pinned_[p] != 0));
+  }
+  self_->built.assign(n, Vec3(std::numeric_limits<Real>::quiet_NaN()));
+  self_->listed.assign(n, 0);
+  self_->list.assign(n * VKCLOTH_SELF_LIST_CAPACITY, 0);
+}
+
+template <typename Real> bool CpuSolver<Real>::Impl::self_energy() const {
+  return detail::self_contact_energy<Real>(params_);
+}
+
+// vbd's self-contact energy: the lists at the first guesses (built again when stale), before the sweeps.
+template <typename Real> void CpuSolver<Real>::Impl::self_energy_lists() {
+  self_init();
+  const auto k = detail::self_constants<Real>(params_.self_collision);
+  if (self_list_stale(k))
+    self_build_lists(k, kernel::self_table_size(std::uint32_t(pos_.size())) - 1);
+}
+
+// Each particle's self-contact force and stiffness from the positions the sweep starts from (a
+// snapshot: a colour's steps do not see each other's moves through a contact, as through a spring),
+// the GPU's CONTACT pass.
+template <typename Real> void CpuSolver<Real>::Impl::self_energy_sweep() {
+  auto& g = *self_;
+  auto& w = *vbd_;
+  const std::size_t n = pos_.size();
+  const auto k = detail::self_constants<Real>(params_.self_collision);
+  const std::uint32_t mask = kernel::self_table_size(std::uint32_t(n)) - 1;
+  w.contact_f.resize(n);
+  w.contact_diag.resize(n);
+  w.contact_off.resize(n);
+  const kernel::SelfDataT<Real> data = self_data();
+  pool_->for_each(n, [&](std::size_t p) {
+    kernel::SpringBlock<Real> hc{Vec3(0), Vec3(0)};
+    Vec3 fc(0);
+    if (!pinned_[p])
+      kernel::self_energy_listed(data, std::uint32_t(p), g.listed[p], g.key[p], pos_[p], g.rest[p],
+                                 k.thickness, mask, k.stiffness, fc, hc);
+    w.contact_f[p] = fc;
+    w.contact_diag[p] = hc.diag;
+    w.contact_off[p] = hc.off;
+  });
+  ++g.stats.passes;
+}
+
 // What the kernel's walks read: the table, the lists and the particles' state, in place.
 template <typename Real> kernel::SelfDataT<Real> CpuSolver<Real>::Impl::self_data() {
   auto& g = *self_;
-  return {g.start.data(), g.sorted.data(),   g.key.data(),  pos_.data(),
-          vel_.data(),    g.inv_mass.data(), g.rest.data(), g.list.data()};
+  kernel::SelfDataT<Real> d{g.start.data(), g.sorted.data(),   g.key.data(),  pos_.data(),
+                            vel_.data(),    g.inv_mass.data(), g.rest.data(), g.list.data()};
+  d.sorted_key = g.sorted_key.data();
+  return d;
 }
 
 // The hash table of the positions now, cells of 1 / inv_cell: count per bucket, exclusive prefix
@@ -94,6 +140,9 @@ template <typename Real> void CpuSolver<Real>::Impl::self_hash(const Real inv_ce
   g.fill.assign(g.start.begin(), g.start.end() - 1);
   for (std::size_t p = 0; p < n; ++p)
     g.sorted[g.fill[kernel::f32::self_bucket(g.key[p], mask)]++] = static_cast<std::uint32_t>(p);
+  g.sorted_key.resize(n);
+  for (std::size_t i = 0; i < n; ++i)
+    g.sorted_key[i] = g.key[g.sorted[i]];
 }
 
 // Whether some particle has moved more than half the skin since the lists were built (or they
@@ -120,11 +169,19 @@ template <typename Real>
 void CpuSolver<Real>::Impl::self_build_lists(const detail::SelfConstants<Real>& k, const std::uint32_t mask) {
   auto& g = *self_;
   self_hash(k.inv_cell);
-  const kernel::SelfDataT<Real> data = self_data();
+  const std::size_t n = pos_.size();
+  g.entry_pos.resize(n);
+  g.entry_rest.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    g.entry_pos[i] = pos_[g.sorted[i]];
+    g.entry_rest[i] = g.rest[g.sorted[i]];
+  }
+  kernel::SelfDataT<Real> data = self_data();
+  data.entry_pos = g.entry_pos.data(); // the positions the table was built from: these
+  data.entry_rest = g.entry_rest.data();
   pool_->for_each(pos_.size(), [&](std::size_t p) {
-    Vec3 unused_x(0), unused_v(0);
-    g.listed[p] = kernel::self_walk(data, std::uint32_t(p), g.key[p], true, pos_[p], vel_[p], g.inv_mass[p],
-                                    g.rest[p], k.thickness, k.reach2, mask, k.friction, unused_x, unused_v);
+    g.listed[p] = kernel::self_gather(data, std::uint32_t(p), g.key[p], pos_[p], g.rest[p], k.thickness,
+                                      k.reach2, mask);
     g.built[p] = pos_[p];
   });
   g.built_reach2 = k.reach2;
@@ -139,6 +196,14 @@ void CpuSolver<Real>::Impl::self_build_lists(const detail::SelfConstants<Real>& 
 
 template void CpuSolver<float>::Impl::self_collide();
 template void CpuSolver<double>::Impl::self_collide();
+template void CpuSolver<float>::Impl::self_init();
+template void CpuSolver<double>::Impl::self_init();
+template bool CpuSolver<float>::Impl::self_energy() const;
+template bool CpuSolver<double>::Impl::self_energy() const;
+template void CpuSolver<float>::Impl::self_energy_lists();
+template void CpuSolver<double>::Impl::self_energy_lists();
+template void CpuSolver<float>::Impl::self_energy_sweep();
+template void CpuSolver<double>::Impl::self_energy_sweep();
 template kernel::SelfDataT<float> CpuSolver<float>::Impl::self_data();
 template kernel::SelfDataT<double> CpuSolver<double>::Impl::self_data();
 template void CpuSolver<float>::Impl::self_hash(float);

@@ -24,6 +24,10 @@ template <typename Real> struct SelfCollisionGrid {
   std::vector<std::uint32_t> fill; // the counting sort's next slot per bucket
   std::vector<std::uint32_t> key;  // each particle's cell key (its bucket: kernel::self_bucket)
   std::vector<std::uint32_t> sorted;
+  // In table order: each entry's key, and (after a list build's hash) its particle's position and
+  // rest position, which the build's walks read as contiguous memory.
+  std::vector<std::uint32_t> sorted_key;
+  std::vector<Vec3> entry_pos, entry_rest;
   std::vector<Vec3> dx, dv; // this pass's moves and velocity changes
   // The neighbour lists (SelfCollision::skin > 0): where each particle was when they were built
   // (NaN before the first build), each list's length (past the capacity: overflowed) and entries.
@@ -35,11 +39,25 @@ template <typename Real> struct SelfCollisionGrid {
 /// SelfCollision's numbers as the kernel takes them, each computed in double and cast once (the GPU's
 /// SelfCollisionGpu::packed casts the same to float): the hash's cells are the reach, thickness +
 /// skin (the thickness alone without a skin).
-template <typename Real> struct SelfConstants { Real thickness, friction, inv_cell, reach2, half_skin2; };
+template <typename Real> struct SelfConstants {
+  Real thickness, friction, inv_cell, reach2, half_skin2, stiffness;
+};
 template <typename Real> SelfConstants<Real> self_constants(const SelfCollision& sc) {
   const double reach = sc.thickness + sc.skin;
-  return {Real(sc.thickness), Real(sc.friction), Real(1.0 / reach), Real(reach * reach),
-          Real(0.25 * sc.skin * sc.skin)};
+  return {Real(sc.thickness),
+          Real(sc.friction),
+          Real(1.0 / reach),
+          Real(reach * reach),
+          Real(0.25 * sc.skin * sc.skin),
+          Real(sc.stiffness)};
+}
+/// Whether vbd takes self-contact as an energy in its vertex steps rather than passes after the step
+/// (SelfCollision::stiffness with a skin, in the solver's precision): CpuSolver and the GPU batch decide
+/// alike.
+template <typename Real> bool self_contact_energy(const SimParams& p) {
+  const SelfConstants<Real> k = self_constants<Real>(p.self_collision);
+  return p.self_collision.enabled && p.integrator == Integrator::vbd && k.stiffness > Real(0) &&
+         k.half_skin2 > Real(0);
 }
 } // namespace detail
 

@@ -65,6 +65,9 @@ std::int64_t simd_vbd_colour(const vkcloth::detail::VbdArgs<typename T::Real>& a
         T::gather3(a.pos, a.other + s, ox, oy, oz);
       vbd_add_spring(f, hessian, L3(L(ox), L(oy), L(oz)) - x, load<T>(a.rest + s), load<T>(a.stiff + s));
     }
+    if (a.contact_f)
+      vbd_add_contact(f, hessian, gather(a.contact_f, idx),
+                      B{gather(a.contact_diag, idx), gather(a.contact_off, idx)});
     L3 stepped = vbd_step(x, y, x0, f, hessian, m, h, mu);
     const L inertia = vbd_inertia_weight(m, h, mu);
     for (std::uint32_t c = 0; c < a.shape_count; ++c)

@@ -18,10 +18,16 @@ namespace vkcloth {
 
 template <typename Real> void CpuSolver<Real>::Impl::vbd_substep(const Real h) {
   vbd_begin(h);
+  const bool contact = self_energy(); // self-contact as an energy in the steps (self_collision.cpp)
+  if (contact)
+    self_energy_lists();
   const std::uint32_t colours = std::uint32_t(topology_->vertex_colour_offsets().size()) - 1;
-  for (std::uint32_t it = 0; it < params_.vbd_iterations; ++it)
+  for (std::uint32_t it = 0; it < params_.vbd_iterations; ++it) {
+    if (contact)
+      self_energy_sweep();
     for (std::uint32_t c = 0; c < colours; ++c)
-      vbd_solve_colour(c, h);
+      vbd_solve_colour(c, h, contact);
+  }
   vbd_finish(h);
   solve_.iterations = params_.vbd_iterations;
   solve_.residual = 0.0;
@@ -145,7 +151,7 @@ template <typename Real> void CpuSolver<Real>::Impl::pad_vbd_fans(const std::siz
 }
 
 template <typename Real>
-void CpuSolver<Real>::Impl::vbd_solve_colour(const std::uint32_t colour, const Real h) {
+void CpuSolver<Real>::Impl::vbd_solve_colour(const std::uint32_t colour, const Real h, const bool contact) {
   auto& w = *vbd_;
   const auto order = topology_->vertex_order();
   const std::uint32_t first = topology_->vertex_colour_offsets()[colour];
@@ -162,6 +168,8 @@ void CpuSolver<Real>::Impl::vbd_solve_colour(const std::uint32_t colour, const R
       const Edge& s = edges_[e];
       kernel::vbd_add_spring(f, hessian, pos_[s.other] - x, s.rest_length, s.stiffness);
     }
+    if (contact)
+      kernel::vbd_add_contact(f, hessian, w.contact_f[p], {w.contact_diag[p], w.contact_off[p]});
     Vec3 stepped = kernel::vbd_step(x, w.y[p], w.x0[p], f, hessian, mass_[p], h, mu);
     const Real inertia = kernel::vbd_inertia_weight(mass_[p], h, mu);
     for (std::size_t c = 0; c < contacts_->shapes.size(); ++c)
@@ -172,7 +180,7 @@ void CpuSolver<Real>::Impl::vbd_solve_colour(const std::uint32_t colour, const R
     w.push[p] = projected - stepped;
     pos_[p] = projected;
   };
-  const std::size_t simd_end = vbd_colour_lanes(colour, order.subspan(first, count), h);
+  const std::size_t simd_end = vbd_colour_lanes(colour, order.subspan(first, count), h, contact);
   if (simd_end > 0) // fewer than one vector left: here, not another fork-join
     for (std::size_t k = simd_end; k < count; ++k)
       step(k);
@@ -184,7 +192,8 @@ void CpuSolver<Real>::Impl::vbd_solve_colour(const std::uint32_t colour, const R
 // colliders (at most detail::finish_max_shapes). The first call pads every colour's gather lists.
 template <typename Real>
 std::size_t CpuSolver<Real>::Impl::vbd_colour_lanes(std::uint32_t colour,
-                                                    std::span<const std::uint32_t> particles, const Real h) {
+                                                    std::span<const std::uint32_t> particles, const Real h,
+                                                    const bool contact) {
 #if VKCLOTH_ROW_SIMD
   const std::size_t width = vbd_lane_width();
   if (width == 1)
@@ -194,25 +203,30 @@ std::size_t CpuSolver<Real>::Impl::vbd_colour_lanes(std::uint32_t colour,
     pad_vbd_lists(width);
   const detail::PaddedLists<Real>& l = *w.lists;
   const std::size_t end = particles.size() - particles.size() % width;
-  const detail::VbdArgs<Real> a{particles.data(),
-                                std::uint32_t(pos_.size()),
-                                &pos_[0].x,
-                                &w.push[0].x,
-                                &w.y[0].x,
-                                &w.x0[0].x,
-                                mass_.data(),
-                                pinned_.data(),
-                                w.colour_vector[colour],
-                                l.spring_begin.data(),
-                                l.other.data(),
-                                l.rest.data(),
-                                l.stiff.data(),
-                                l.reads_last.data(),
-                                contacts_->finish.data(),
-                                std::uint32_t(contacts_->finish.size()),
-                                Real(params_.contact_epsilon),
-                                h,
-                                Real(params_.damping)};
+  detail::VbdArgs<Real> a{particles.data(),
+                          std::uint32_t(pos_.size()),
+                          &pos_[0].x,
+                          &w.push[0].x,
+                          &w.y[0].x,
+                          &w.x0[0].x,
+                          mass_.data(),
+                          pinned_.data(),
+                          w.colour_vector[colour],
+                          l.spring_begin.data(),
+                          l.other.data(),
+                          l.rest.data(),
+                          l.stiff.data(),
+                          l.reads_last.data(),
+                          contacts_->finish.data(),
+                          std::uint32_t(contacts_->finish.size()),
+                          Real(params_.contact_epsilon),
+                          h,
+                          Real(params_.damping)};
+  if (contact) {
+    a.contact_f = &w.contact_f[0].x;
+    a.contact_diag = &w.contact_diag[0].x;
+    a.contact_off = &w.contact_off[0].x;
+  }
   pool_->for_each(end / width, [&](std::size_t b) {
     const std::int64_t k0 = std::int64_t(b * width), k1 = k0 + std::int64_t(width);
 #if VKCLOTH_ROW_AVX512
@@ -228,6 +242,7 @@ std::size_t CpuSolver<Real>::Impl::vbd_colour_lanes(std::uint32_t colour,
   (void)colour;
   (void)particles;
   (void)h;
+  (void)contact;
   return 0;
 #endif
 }

@@ -112,13 +112,15 @@ Result<void> read_self_collision(const json& doc, SimParams& params) {
   if (!obj)
     return {};
   const char* path = "self_collision";
-  VKCLOTH_TRY(sd::check_keys(*obj, path, {"enabled", "thickness", "friction", "iterations", "skin"}));
+  VKCLOTH_TRY(
+      sd::check_keys(*obj, path, {"enabled", "thickness", "friction", "iterations", "skin", "stiffness"}));
   SelfCollision& sc = params.self_collision;
   sc.enabled = true;
   VKCLOTH_TRY(sd::read(*obj, path, "enabled", sc.enabled));
   VKCLOTH_TRY(sd::read(*obj, path, "thickness", sc.thickness));
   VKCLOTH_TRY(sd::read(*obj, path, "friction", sc.friction));
   VKCLOTH_TRY(sd::read(*obj, path, "skin", sc.skin));
+  VKCLOTH_TRY(sd::read(*obj, path, "stiffness", sc.stiffness));
   if (obj->contains("iterations")) {
     SCENE_TRY_ASSIGN(it, sd::as_integer((*obj)["iterations"], "self_collision.iterations", 1000000));
     sc.iterations = static_cast<std::uint32_t>(it); // the range (1..16) is validate()'s

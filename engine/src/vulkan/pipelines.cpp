@@ -173,6 +173,12 @@ VkBuffer OneSetInputs::main_binding(std::uint32_t read, std::uint32_t binding) c
     return instances;
   case VKCLOTH_BINDING_STRAIN_LINKS:
     return strain_links;
+  case VKCLOTH_BINDING_ACC_POS:
+    return acc_pos;
+  case VKCLOTH_BINDING_ACC_VEL:
+    return acc_vel;
+  case VKCLOTH_BINDING_STAGE_VEL:
+    return stage_vel;
   default:
     return VK_NULL_HANDLE;
   }

@@ -115,6 +115,8 @@ private:
 /// main layout, at the same binding numbers.
 struct OneSetInputs {
   VkBuffer pos[2], vel, particle, flags, instances, strain_links;
+  VkBuffer acc_pos, acc_vel,
+      stage_vel; // vbd's self-contact force and stiffness (self_collision.comp CONTACT)
   /// The buffer of main-layout `binding` in the set of position parity `read` (POS_OUT: the
   /// positions that substep writes); VK_NULL_HANDLE for a binding of the pass's own.
   VkBuffer main_binding(std::uint32_t read, std::uint32_t binding) const;

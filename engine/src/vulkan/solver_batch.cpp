@@ -16,6 +16,7 @@
 #include <fmt/format.h>
 
 #include "../core/kernel.hpp"
+#include "../core/self_collision.hpp"
 #include "barriers.hpp"
 #include "batch_limits.hpp"
 #include "passes/implicit_update.hpp"
@@ -243,7 +244,9 @@ std::vector<sh::InstanceParams> SolverBatch::packed_instance_params() const {
     ip.flags = normal_flag(normals) | (float(params.wind.strength) != 0.0f ? VKCLOTH_FLAG_WIND : 0u) |
                (params.contact_inward_only ? 0u : VKCLOTH_FLAG_CONTACT_BOTH) |
                (options.flip_normals ? VKCLOTH_FLAG_FLIP_NORMALS : 0u) |
-               (params.self_collision.enabled ? VKCLOTH_FLAG_SELF_COLLISION : 0u);
+               (params.self_collision.enabled && !vkcloth::detail::self_contact_energy<float>(params)
+                    ? VKCLOTH_FLAG_SELF_COLLISION // the passes after the step (and the projection after them)
+                    : 0u);
     ip.integrator = static_cast<std::uint32_t>(params.integrator);
     ip.collider_first = first_collider;
     ip.collider_count = static_cast<std::uint32_t>(params.colliders.size());
@@ -571,9 +574,14 @@ std::uint32_t SolverBatch::projection_iterations() const {
 std::uint32_t SolverBatch::self_iterations() const {
   std::uint32_t most = 0;
   for (const Slot& s : slots)
-    if (s.params.self_collision.enabled)
+    if (s.params.self_collision.enabled && !vkcloth::detail::self_contact_energy<float>(s.params))
       most = std::max(most, s.params.self_collision.iterations);
   return most;
+}
+
+bool SolverBatch::any_self_energy() const {
+  return std::any_of(slots.begin(), slots.end(),
+                     [](const Slot& s) { return vkcloth::detail::self_contact_energy<float>(s.params); });
 }
 
 std::uint32_t SolverBatch::collider_types() const {

@@ -38,6 +38,8 @@
 
 namespace vkcloth::gpu {
 
+class SelfCollisionGpu;
+
 /// Optional initial state of one instance (empty vectors: the topology's).
 struct SlotState {
   const std::vector<glm::dvec3>* positions = nullptr;
@@ -174,7 +176,15 @@ public:
   /// The most Newton iterations of the fast projection an instance asks for (0: none uses it).
   std::uint32_t projection_iterations() const;
   /// The most self-collision passes an instance asks for (0: none has it on).
+  /// The most self-collision passes after the step any instance asks for (0: none does; an
+  /// instance whose vbd takes self-contact as an energy has none).
   std::uint32_t self_iterations() const;
+  /// Whether some instance's vbd takes self-contact as an energy in its sweeps (SelfCollision::stiffness).
+  bool any_self_energy() const;
+  /// The self-collision pass's hash and lists (null before that pass makes them): vbd's sweeps
+  /// record its list build and contact passes when an instance takes self-contact as an energy.
+  SelfCollisionGpu* self_collision() const { return self_collision_; }
+  void set_self_collision(SelfCollisionGpu* s) { self_collision_ = s; }
   /// Bit t (VKCLOTH_COLLIDER_*) for each collider type some instance has; 0 without colliders.
   std::uint32_t collider_types() const;
   /// The batch's shader build and workgroup size, the pass fixed to `stage` (VKCLOTH_ANY_STAGE:
@@ -214,7 +224,10 @@ public:
             particle.buffer,
             flags.buffer,
             instances.buffer,
-            strain_links.buffer};
+            strain_links.buffer,
+            acc_pos.buffer,
+            acc_vel.buffer,
+            stage_vel.buffer};
   }
   /// The state buffers the implicit passes bind.
   ImplicitInputs implicit_inputs() const;
@@ -321,9 +334,10 @@ private:
   shared::PushConstants pc{}; // per dispatch (count, grid, stage, step)
   std::uint64_t recorded = 0; // recorded steps since the flag epoch: flag step numbers
   std::uint32_t parity = 0;   // positions[parity] is current; flipped by every recorded substep
-  std::vector<std::unique_ptr<Pass>> passes; // make_solver_passes(): in the order they record
-  std::vector<glm::vec2> uvs_;               // per particle of one instance (as uploaded)
-  std::uint64_t dispatches_ = 0;             // recorded so far (ClothWorld::dispatches_recorded)
+  std::vector<std::unique_ptr<Pass>> passes;   // make_solver_passes(): in the order they record
+  SelfCollisionGpu* self_collision_ = nullptr; // self_collision()
+  std::vector<glm::vec2> uvs_;                 // per particle of one instance (as uploaded)
+  std::uint64_t dispatches_ = 0;               // recorded so far (ClothWorld::dispatches_recorded)
 
   VkDeviceSize slot_offset(std::uint32_t slot) const {
     return VkDeviceSize(slot) * count * GpuSolver::stride;

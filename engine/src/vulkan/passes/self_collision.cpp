@@ -21,7 +21,7 @@ namespace {
 class SelfCollisionPass final : public Pass {
 public:
   const char* name() const override { return "self-collision"; }
-  bool active(const SolverBatch& b) const override { return b.self_iterations() > 0; }
+  bool active(const SolverBatch& b) const override { return b.self_iterations() > 0 || b.any_self_energy(); }
 
   // Its buffers (the rest positions uploaded, the counts zeroed) and descriptor sets, which nothing
   // recorded so far uses; its parameters straight into the mapped buffer (no recorded work reads it).
@@ -52,6 +52,7 @@ public:
         {&(*r)->stale(), nullptr, 0}};
     VKCLOTH_TRY(b.upload(up));
     gpu_ = std::move(*r);
+    b.set_self_collision(gpu_.get());
     write_params(b, VK_NULL_HANDLE);
     // Only its own new sets: the state sets may be in use by recorded work (set_params).
     return gpu_->write_sets(b.one_set_inputs());
@@ -69,7 +70,7 @@ public:
       params.push_back(&s.params);
     const auto packed = SelfCollisionGpu::packed(params);
     gpu_->set_lists(std::any_of(packed.begin(), packed.end(), [](const shared::SelfParams& p) {
-      return p.iterations > 0 && p.half_skin2 > 0.0f;
+      return p.iterations > 0 && p.half_skin2 > 0.0f && !(p.stiffness > 0.0f); // after the step
     }));
     const std::size_t bytes = packed.size() * sizeof(shared::SelfParams);
     if (cmd)
@@ -79,7 +80,8 @@ public:
   }
 
   std::uint32_t record(const SolverBatch& b, PassFrame& f) override {
-    return gpu_->record_substep(f.cmd, f.read, *f.pc, b.self_iterations());
+    const std::uint32_t iterations = b.self_iterations(); // 0: every instance's acted in vbd's sweeps
+    return iterations ? gpu_->record_substep(f.cmd, f.read, *f.pc, iterations) : 0;
   }
 
 private:

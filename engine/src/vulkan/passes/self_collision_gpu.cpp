@@ -171,52 +171,93 @@ std::vector<sh::SelfParams> SelfCollisionGpu::packed(std::span<const SimParams* 
   for (const SimParams* p : params) {
     const SelfCollision& sc = p->self_collision;
     const auto k = vkcloth::detail::self_constants<float>(sc); // as CpuSolver<float>::self_collide
+    const float energy = vkcloth::detail::self_contact_energy<float>(*p) ? k.stiffness : 0.0f; // vbd's sweeps
     out.push_back({sc.enabled ? sc.iterations : 0u, k.thickness, k.inv_cell, k.friction, k.reach2,
-                   k.half_skin2, 0u, 0u});
+                   k.half_skin2, energy, 0u});
   }
   return out;
 }
 
-std::uint32_t SelfCollisionGpu::record_substep(VkCommandBuffer c, std::uint32_t read,
-                                               const sh::PushConstants& main_pc, std::uint32_t iterations) {
-  const auto& v = ctx_->vk;
+void SelfCollisionGpu::bind(VkCommandBuffer c, std::uint32_t read) const {
   const VkDescriptorSet bound[2] = {sets_[read], texel_sets_[read]};
-  v.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0,
-                            access_ == BufferAccess::texel_views ? 2 : 1, bound, 0, nullptr);
-  auto pc = sh::push_from<sh::SelfPush>(main_pc);
-  pc.table_size = table_;
+  ctx_->vk.vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0,
+                                   access_ == BufferAccess::texel_views ? 2 : 1, bound, 0, nullptr);
+}
+
+// `items` invocations of `pc.stage` (64 per workgroup, rows of at most groups_max_x_ workgroups),
+// every instance.
+void SelfCollisionGpu::dispatch(VkCommandBuffer c, const sh::SelfPush& pc, std::uint64_t items) const {
+  const auto& v = ctx_->vk;
+  barriers::dispatch_to_dispatch(v, c); // the previous pass (or the substep's update) -> this one
+  v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, passes_[pc.stage]);
+  v.vkCmdPushConstants(c, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
+  const std::uint64_t groups =
+      std::max<std::uint64_t>((items + VKCLOTH_WORKGROUP_SIZE - 1) / VKCLOTH_WORKGROUP_SIZE, 1);
+  const std::uint64_t gx = std::min<std::uint64_t>(groups, groups_max_x_);
+  v.vkCmdDispatch(c, std::uint32_t(gx), std::uint32_t((groups + gx - 1) / gx), instances_);
+}
+
+// The hash (COUNT .. SORT), with CHECK before it and LIST after it when `lists`.
+std::uint32_t SelfCollisionGpu::record_build(VkCommandBuffer c, sh::SelfPush& pc, bool lists) const {
   std::uint32_t dispatches = 0;
-  // `items` invocations (64 per workgroup, rows of at most groups_max_x_ workgroups), every instance.
   auto pass = [&](std::uint32_t stage, std::uint64_t items) {
-    barriers::dispatch_to_dispatch(v, c); // the previous pass (or the substep's update) -> this one
-    v.vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, passes_[stage]);
     pc.stage = stage;
-    v.vkCmdPushConstants(c, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
-    const std::uint64_t groups =
-        std::max<std::uint64_t>((items + VKCLOTH_WORKGROUP_SIZE - 1) / VKCLOTH_WORKGROUP_SIZE, 1);
-    const std::uint64_t gx = std::min<std::uint64_t>(groups, groups_max_x_);
-    v.vkCmdDispatch(c, std::uint32_t(gx), std::uint32_t((groups + gx - 1) / gx), instances_);
+    dispatch(c, pc, items);
     ++dispatches;
   };
+  if (lists)
+    pass(VKCLOTH_SELF_CHECK, count_);
+  pass(VKCLOTH_SELF_COUNT, count_);
+  pass(VKCLOTH_SELF_SCAN_BLOCKS, std::uint64_t(table_ / VKCLOTH_SELF_SCAN_BLOCK) * VKCLOTH_WORKGROUP_SIZE);
+  pass(VKCLOTH_SELF_SCAN_TOP, 1);
+  pass(VKCLOTH_SELF_SCAN_ADD, std::uint64_t(table_) + 1);
+  pass(VKCLOTH_SELF_SCATTER, count_);
+  pass(VKCLOTH_SELF_SORT, table_);
+  if (lists)
+    pass(VKCLOTH_SELF_LIST, count_);
+  return dispatches;
+}
+
+std::uint32_t SelfCollisionGpu::record_substep(VkCommandBuffer c, std::uint32_t read,
+                                               const sh::PushConstants& main_pc, std::uint32_t iterations) {
+  bind(c, read);
+  auto pc = sh::push_from<sh::SelfPush>(main_pc);
+  pc.table_size = table_;
+  pc.in_sweeps = 0;
+  std::uint32_t dispatches = 0;
   for (std::uint32_t it = 0; it < iterations; ++it) {
     pc.iteration = it;
-    if (it == 0 || lists_) { // the hash (and the lists): each pass's stages decide whether to build
-      if (lists_)
-        pass(VKCLOTH_SELF_CHECK, count_);
-      pass(VKCLOTH_SELF_COUNT, count_);
-      pass(VKCLOTH_SELF_SCAN_BLOCKS,
-           std::uint64_t(table_ / VKCLOTH_SELF_SCAN_BLOCK) * VKCLOTH_WORKGROUP_SIZE);
-      pass(VKCLOTH_SELF_SCAN_TOP, 1);
-      pass(VKCLOTH_SELF_SCAN_ADD, std::uint64_t(table_) + 1);
-      pass(VKCLOTH_SELF_SCATTER, count_);
-      pass(VKCLOTH_SELF_SORT, table_);
-      if (lists_)
-        pass(VKCLOTH_SELF_LIST, count_);
+    if (it == 0 || lists_) // the hash (and the lists): each pass's stages decide whether to build
+      dispatches += record_build(c, pc, lists_);
+    for (std::uint32_t stage : {VKCLOTH_SELF_COLLIDE, VKCLOTH_SELF_APPLY}) {
+      pc.stage = stage;
+      dispatch(c, pc, count_);
+      ++dispatches;
     }
-    pass(VKCLOTH_SELF_COLLIDE, count_);
-    pass(VKCLOTH_SELF_APPLY, count_);
   }
   return dispatches;
+}
+
+std::uint32_t SelfCollisionGpu::record_sweep_lists(VkCommandBuffer c, std::uint32_t read,
+                                                   const sh::PushConstants& main_pc) const {
+  bind(c, read);
+  auto pc = sh::push_from<sh::SelfPush>(main_pc);
+  pc.table_size = table_;
+  pc.iteration = 0;
+  pc.in_sweeps = 1;
+  return record_build(c, pc, true);
+}
+
+std::uint32_t SelfCollisionGpu::record_sweep_contact(VkCommandBuffer c, std::uint32_t read,
+                                                     const sh::PushConstants& main_pc) const {
+  bind(c, read);
+  auto pc = sh::push_from<sh::SelfPush>(main_pc);
+  pc.table_size = table_;
+  pc.iteration = 0;
+  pc.in_sweeps = 1;
+  pc.stage = VKCLOTH_SELF_CONTACT;
+  dispatch(c, pc, count_);
+  return 1;
 }
 
 } // namespace vkcloth::gpu

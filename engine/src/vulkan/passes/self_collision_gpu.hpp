@@ -9,6 +9,8 @@
 //   iterations x [ CHECK -> COUNT -> ... -> SORT -> LIST -> COLLIDE -> APPLY ]
 //
 // where COUNT .. LIST do nothing unless CHECK found a particle that moved more than half the skin.
+// An instance whose vbd takes self-contact as an energy has no passes after the step: vbd's sweeps
+// record CHECK .. LIST after their first guesses and CONTACT before each sweep (record_sweep_*).
 // one barrier between consecutive passes (barriers::dispatch_to_dispatch). The spatial hash (one
 // table per instance, kernel.hpp self_table_size buckets) is rebuilt every substep; the counts
 // go back to zero as SCATTER hands out the slots, so no clearing pass is needed. In a batch whose
@@ -62,6 +64,14 @@ public:
   /// `iterations`, the most any instance asks for. Returns the number of dispatches recorded.
   std::uint32_t record_substep(VkCommandBuffer cmd, std::uint32_t read, const shared::PushConstants& pc,
                                std::uint32_t iterations);
+  /// vbd's sweeps, for the instances that take self-contact as an energy: the lists of the first
+  /// guesses (CHECK .. LIST: built again when stale) before the sweeps, and each sweep's CONTACT
+  /// (each particle's contact force and stiffness into ACC_POS, ACC_VEL, STAGE_VEL). They bind this
+  /// pass's layout: the caller binds its own again. Return the number of dispatches recorded.
+  std::uint32_t record_sweep_lists(VkCommandBuffer cmd, std::uint32_t read,
+                                   const shared::PushConstants& pc) const;
+  std::uint32_t record_sweep_contact(VkCommandBuffer cmd, std::uint32_t read,
+                                     const shared::PushConstants& pc) const;
 
 private:
   SelfCollisionGpu() = default;
@@ -77,10 +87,13 @@ private:
   BufferView pos_views_[2], vel_view_, rest_view_, starts_view_, sorted_view_;
   // The Context's (PipelineRegistry), shared by every batch.
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
-  static constexpr std::uint32_t kPasses = VKCLOTH_SELF_LIST + 1;
+  static constexpr std::uint32_t kPasses = VKCLOTH_SELF_CONTACT + 1;
   VkPipeline passes_[kPasses] = {}; // [stage]: self_collision.comp specialised with its stage (SC_STAGE)
 
   Result<void> create_buffers(bool allow_map);
+  void bind(VkCommandBuffer cmd, std::uint32_t read) const;
+  void dispatch(VkCommandBuffer cmd, const shared::SelfPush& pc, std::uint64_t items) const;
+  std::uint32_t record_build(VkCommandBuffer cmd, shared::SelfPush& pc, bool lists) const;
   Result<void> create_sets();
   Result<void> write_texel_sets(const OneSetInputs& in);
 };

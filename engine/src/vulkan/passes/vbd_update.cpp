@@ -9,6 +9,7 @@
 #include "../barriers.hpp"
 #include "../solver_batch.hpp"
 #include "pass.hpp"
+#include "self_collision_gpu.hpp"
 #include "state_set.hpp"
 #include "vkcloth/shaders/vbd_comp_spv.hpp"
 
@@ -48,10 +49,21 @@ public:
       barriers::dispatch_to_dispatch(v, f.cmd); // the previous substep's passes -> this one
     b.dispatch_particles(f.cmd);
     std::uint32_t dispatches = 1;
+    // Self-contact as an energy (an instance's SelfCollision::stiffness): the lists of the first
+    // guesses, then each sweep's contact forces, in the self-collision pass's layout.
+    SelfCollisionGpu* const self = b.any_self_energy() ? b.self_collision() : nullptr;
+    pc.contact = self ? 1u : 0u;
+    if (self)
+      dispatches += self->record_sweep_lists(f.cmd, f.read, *f.pc);
     const auto colours = b.topology().vertex_colour_offsets();
-    run(VKCLOTH_VBD_SOLVE);
     // Instances of a batch share their sweeps: the world batches vbd instances by their iterations.
-    for (std::uint32_t it = 0; it < b.family().vbd_iterations; ++it)
+    for (std::uint32_t it = 0; it < b.family().vbd_iterations; ++it) {
+      if (self) {
+        dispatches += self->record_sweep_contact(f.cmd, f.read, *f.pc);
+        b.bind_state(f.cmd, f.read, false, SolverBatch::no_texel_set);
+      }
+      if (it == 0 || self)
+        run(VKCLOTH_VBD_SOLVE);
       for (std::size_t c = 0; c + 1 < colours.size(); ++c) {
         pc.colour_first = colours[c];
         pc.colour_count = colours[c + 1] - colours[c];
@@ -60,6 +72,7 @@ public:
         b.dispatch_items(f.cmd, pc.colour_count);
         ++dispatches;
       }
+    }
     run(VKCLOTH_VBD_FINISH);
     barriers::dispatch_to_dispatch(v, f.cmd); // the last colour -> the velocities
     b.dispatch_particles(f.cmd);
