@@ -48,7 +48,8 @@ struct BenchOptions {
   std::string cg_dispatch = "auto"; // implicit on Vulkan: auto | one_workgroup | per_iteration | both
   std::string contact;              // also time the contact scenes (issue 15): table | mesh (+ sphere) | both
   bool self_collision = false;      // also time each size folded, self-collision on vs off (issue 16)
-  double self_skin = 0.0; // its neighbour lists' skin, in thicknesses (0: every pass walks the cells)
+  double self_skin = 0.0;      // its neighbour lists' skin, in thicknesses (0: every pass walks the cells)
+  double self_stiffness = 0.0; // with vbd: self-contact as an energy of this stiffness (N/m; 0: the passes)
 };
 
 /// The benchmark scene at n x n: a 1 m x 1 m vertical cloth hanging from its two top corners, in
@@ -155,6 +156,7 @@ struct Row {
   std::uint32_t collider_triangles = 0;                 // scene "contact": a mesh collider's
   double self_thickness = 0; // self-collision rows: the thickness (m) of the "on" row's parameters
   double self_skin = 0;      // and its neighbour lists' skin (m; 0: none)
+  double self_stiffness = 0; // and vbd's self-contact stiffness (N/m; 0: the passes after the step)
   // Mesh rows: the grid the row is quoted against, timed in alternation with it (each repetition
   // runs `steps` of the grid, then of the mesh): its side and median wall time (-1: not paired).
   std::uint32_t partner_size = 0;

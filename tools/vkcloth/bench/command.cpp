@@ -361,6 +361,7 @@ int self_collision_rows(BenchRun& run) {
             [&](Row& r) {
               r.self_thickness = sc->params.self_collision.thickness;
               r.self_skin = sc->params.self_collision.skin;
+              r.self_stiffness = sc->params.self_collision.stiffness;
             }))
       return e;
   }
@@ -461,6 +462,12 @@ void add_bench_command(CLI::App& app, int* exit) {
                   "when a particle has moved half the skin (self_collision.skin; default 0: every pass walks "
                   "the cells)")
       ->check(CLI::Range(0.0, 10.0));
+  cmd->add_option(
+         "--self-stiffness", opt->self_stiffness,
+         "With --self-collision, --integrator vbd and --self-skin: self-contact as an energy of this "
+         "stiffness in the vertex steps (self_collision.stiffness, N/m; default 0: the passes after the "
+         "step)")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option(
       "--stiffness", opt->stiffness,
       "Structural, shear and bend stiffness of the grid in N/m, e.g. 10000,2000,2000 (default 40,8,8)");

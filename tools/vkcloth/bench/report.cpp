@@ -115,9 +115,10 @@ void print_preamble(const BenchRun& run) {
         "self-collision rows: n+self: the n x n cloth folded into {} layers on the floor plane "
         "(friction {:g}), "
         "self_collision {{thickness: {:g} x the spacing, friction: {:g}, iterations: {}, skin: {:g} x the "
-        "thickness}}; no wind; n-self: the same cloth with self-collision off (n column)\n",
+        "thickness, stiffness: {:g} N/m}}; no wind; n-self: the same cloth with self-collision off (n "
+        "column)\n",
         self_layers, contact_friction, self_thickness_over_spacing, self_friction, self_iterations,
-        o.self_skin);
+        o.self_skin, o.self_stiffness);
 }
 
 /// What a row's median wall time comes to: ms per step, particle-steps per second, GB/s and GFLOP/s
@@ -198,6 +199,7 @@ void add_scene_keys(nlohmann::json& j, const std::vector<Row>& rows, const Row& 
     j["self_collision_friction"] = self_friction;
     j["self_collision_iterations"] = self_iterations;
     j["self_collision_skin"] = r.self_skin;
+    j["self_collision_stiffness"] = r.self_stiffness;
     if (r.scene == "self_collision") {
       j["particles_in_self_contact_start"] = r.in_contact_start;
       j["particles_in_self_contact_end"] = r.in_contact_end;

@@ -313,6 +313,7 @@ Result<SelfScene> folded_scene(std::uint32_t n, Integrator integrator, double dt
   p.self_collision.friction = self_friction;
   p.self_collision.iterations = self_iterations;
   p.self_collision.skin = o.self_skin * p.self_collision.thickness;
+  p.self_collision.stiffness = o.self_stiffness;
   p.colliders = {with_contact_friction(Collider::plane({0.0, 0.0, 1.0}, 0.0))};
   VKCLOTH_TRY(p.validate());
   auto warnings = check_self_collision(p.self_collision, cloth->system); // none at 1.5 spacings
