@@ -117,12 +117,22 @@ KFN void self_mean(vec3 sum_x, vec3 sum_v, uint pairs, OUT(vec3) dx, OUT(vec3) d
   dv = mv;
 }
 
-#ifdef SELF_DATA_PARAM // the includer provides the table (C++: kernel.hpp; GLSL: self_collision.comp)
-// What self_walk does with the particles it visits.
+// What self_walk (and self_pairs) do with the particles they visit.
 #define VKCLOTH_SELF_WALK_COLLIDE 0u // sums p's response to every pair (self_pair, self_contact)
 #define VKCLOTH_SELF_WALK_GATHER 1u  // writes p's neighbour list (self_candidate, self_list_put)
 #define VKCLOTH_SELF_WALK_ENERGY 2u  // adds every pair's contact energy to p's vertex step (self_energy)
 
+// One pair's part for `mode` (VKCLOTH_SELF_WALK_COLLIDE: p's response into sum_x, sum_v; ENERGY: the
+// contact energy into sum_x, the force, and hessian).
+KFN void self_add_pair(uint mode, INOUT(vec3) sum_x, INOUT(vec3) sum_v, INOUT(SpringBlock) hessian, vec3 x,
+                       vec3 v, real w, vec3 xq, vec3 vq, real wq, real thickness, real mu, real k) {
+  if (mode == VKCLOTH_SELF_WALK_ENERGY)
+    self_energy(sum_x, hessian, x, xq, thickness, k);
+  else
+    self_contact(sum_x, sum_v, x, v, w, xq, vq, wq, thickness, mu);
+}
+
+#ifdef SELF_DATA_PARAM // the includer provides the table (C++: kernel.hpp; GLSL: self_collision.comp)
 // The 27 cells around the cell of key `own`, cell by cell in a fixed order, each cell's particles in
 // increasing index (a bucket holds the particles of every cell hashed to it, in increasing index:
 // those of other cells are skipped by their key), for `mode` (VKCLOTH_SELF_WALK_*): COLLIDE adds p's
@@ -169,10 +179,7 @@ KFN uint self_walk(SELF_DATA_PARAM, uint p, uint own, uint mode, vec3 x, vec3 v,
           }
           self_particle(SELF_DATA, q, xq, vq, wq, rq);
           if (self_pair(x, xq, rx, rq, t2)) {
-            if (mode == VKCLOTH_SELF_WALK_ENERGY)
-              self_energy(sum_x, hessian, x, xq, thickness, k);
-            else
-              self_contact(sum_x, sum_v, x, v, w, xq, vq, wq, thickness, mu);
+            self_add_pair(mode, sum_x, sum_v, hessian, x, v, w, xq, vq, wq, thickness, mu, k);
             found += 1u;
           }
         }
@@ -206,43 +213,49 @@ KFN void self_collide(SELF_DATA_PARAM, uint p, vec3 x, vec3 v, real w, vec3 rx, 
   self_mean(sum_x, sum_v, pairs, dx, dv);
 }
 
-// Particle p's response from its neighbour list (`listed` entries, self_list_get(SELF_DATA, p, i)),
-// in the list's order; a list that overflowed (listed > capacity) walks the cells of the build
-// instead (own: p's key then), which holds every particle the list would have: the same pairs in
-// the same order.
+// Every pair of p for `mode` (COLLIDE or ENERGY, as self_walk): from its neighbour list (`listed`
+// entries, self_list_get(SELF_DATA, p, i)) in the list's order; a list that overflowed (listed >
+// capacity) walks the cells of the build instead (own: p's key then), which holds every particle
+// the list would have: the same pairs in the same order. Returns the number of pairs.
+KFN uint self_pairs(SELF_DATA_PARAM, uint p, uint listed, uint own, uint mode, vec3 x, vec3 v, real w,
+                    vec3 rx, real thickness, uint mask, real mu, real k, INOUT(vec3) sum_x, INOUT(vec3) sum_v,
+                    INOUT(SpringBlock) hessian) {
+  if (listed > uint(VKCLOTH_SELF_LIST_CAPACITY))
+    return self_walk(SELF_DATA, p, own, mode, x, v, w, rx, thickness, real(0), mask, mu, k, sum_x, sum_v,
+                     hessian);
+  precise real t2 = thickness * thickness;
+  uint pairs = 0u;
+  for (uint i = 0u; i < listed; ++i) {
+    const uint q = self_list_get(SELF_DATA, p, i);
+    vec3 xq;
+    vec3 vq;
+    vec3 rq;
+    real wq;
+    self_particle(SELF_DATA, q, xq, vq, wq, rq);
+    if (self_pair(x, xq, rx, rq, t2)) {
+      self_add_pair(mode, sum_x, sum_v, hessian, x, v, w, xq, vq, wq, thickness, mu, k);
+      pairs += 1u;
+    }
+  }
+  return pairs;
+}
+
+// Particle p's response from its neighbour list (self_pairs).
 KFN void self_collide_listed(SELF_DATA_PARAM, uint p, uint listed, uint own, vec3 x, vec3 v, real w, vec3 rx,
                              real thickness, uint mask, real mu, OUT(vec3) dx, OUT(vec3) dv) {
   precise vec3 sum_x = vec3(real(0));
   precise vec3 sum_v = vec3(real(0));
-  uint pairs = 0u;
-  if (listed > uint(VKCLOTH_SELF_LIST_CAPACITY)) {
-    SpringBlock unused;
-    unused.diag = vec3(real(0));
-    unused.off = vec3(real(0));
-    pairs = self_walk(SELF_DATA, p, own, VKCLOTH_SELF_WALK_COLLIDE, x, v, w, rx, thickness, real(0), mask, mu,
-                      real(0), sum_x, sum_v, unused);
-  } else {
-    precise real t2 = thickness * thickness;
-    for (uint i = 0u; i < listed; ++i) {
-      const uint q = self_list_get(SELF_DATA, p, i);
-      vec3 xq;
-      vec3 vq;
-      vec3 rq;
-      real wq;
-      self_particle(SELF_DATA, q, xq, vq, wq, rq);
-      if (self_pair(x, xq, rx, rq, t2)) {
-        self_contact(sum_x, sum_v, x, v, w, xq, vq, wq, thickness, mu);
-        pairs += 1u;
-      }
-    }
-  }
+  SpringBlock unused;
+  unused.diag = vec3(real(0));
+  unused.off = vec3(real(0));
+  const uint pairs = self_pairs(SELF_DATA, p, listed, own, VKCLOTH_SELF_WALK_COLLIDE, x, v, w, rx, thickness,
+                                mask, mu, real(0), sum_x, sum_v, unused);
   self_mean(sum_x, sum_v, pairs, dx, dv);
 }
 
 // Particle p's self-contact energy in its vertex step (vbd with a self-contact stiffness k > 0):
-// its listed pairs at the positions the sweep starts from (x: p's, self_particle: the others'), in
-// the list's order (an overflowed list walks the build's cells, as self_collide_listed), as f (the
-// force) and hessian (the stiffness), which the step adds to its springs'.
+// its pairs (self_pairs) at the positions the sweep starts from (x: p's, self_particle: the
+// others'), as f (the force) and hessian (the stiffness), which the step adds to its springs'.
 KFN void self_energy_listed(SELF_DATA_PARAM, uint p, uint listed, uint own, vec3 x, vec3 rx, real thickness,
                             uint mask, real k, OUT(vec3) f, OUT(SpringBlock) hessian) {
   precise vec3 sum_f = vec3(real(0));
@@ -250,22 +263,8 @@ KFN void self_energy_listed(SELF_DATA_PARAM, uint p, uint listed, uint own, vec3
   SpringBlock block;
   block.diag = vec3(real(0));
   block.off = vec3(real(0));
-  if (listed > uint(VKCLOTH_SELF_LIST_CAPACITY)) {
-    self_walk(SELF_DATA, p, own, VKCLOTH_SELF_WALK_ENERGY, x, vec3(real(0)), real(0), rx, thickness, real(0),
-              mask, real(0), k, sum_f, unused_v, block);
-  } else {
-    precise real t2 = thickness * thickness;
-    for (uint i = 0u; i < listed; ++i) {
-      const uint q = self_list_get(SELF_DATA, p, i);
-      vec3 xq;
-      vec3 vq;
-      vec3 rq;
-      real wq;
-      self_particle(SELF_DATA, q, xq, vq, wq, rq);
-      if (self_pair(x, xq, rx, rq, t2))
-        self_energy(sum_f, block, x, xq, thickness, k);
-    }
-  }
+  self_pairs(SELF_DATA, p, listed, own, VKCLOTH_SELF_WALK_ENERGY, x, vec3(real(0)), real(0), rx, thickness,
+             mask, real(0), k, sum_f, unused_v, block);
   f = sum_f;
   hessian = block;
 }

@@ -238,23 +238,26 @@ std::uint32_t SelfCollisionGpu::record_substep(VkCommandBuffer c, std::uint32_t 
   return dispatches;
 }
 
-std::uint32_t SelfCollisionGpu::record_sweep_lists(VkCommandBuffer c, std::uint32_t read,
-                                                   const sh::PushConstants& main_pc) const {
+// Binds this pass's sets for vbd's sweeps and gives their push constants (the energy instances').
+sh::SelfPush SelfCollisionGpu::begin_sweep_pass(VkCommandBuffer c, std::uint32_t read,
+                                                const sh::PushConstants& main_pc) const {
   bind(c, read);
   auto pc = sh::push_from<sh::SelfPush>(main_pc);
   pc.table_size = table_;
   pc.iteration = 0;
   pc.in_sweeps = 1;
+  return pc;
+}
+
+std::uint32_t SelfCollisionGpu::record_sweep_lists(VkCommandBuffer c, std::uint32_t read,
+                                                   const sh::PushConstants& main_pc) const {
+  auto pc = begin_sweep_pass(c, read, main_pc);
   return record_build(c, pc, true);
 }
 
 std::uint32_t SelfCollisionGpu::record_sweep_contact(VkCommandBuffer c, std::uint32_t read,
                                                      const sh::PushConstants& main_pc) const {
-  bind(c, read);
-  auto pc = sh::push_from<sh::SelfPush>(main_pc);
-  pc.table_size = table_;
-  pc.iteration = 0;
-  pc.in_sweeps = 1;
+  auto pc = begin_sweep_pass(c, read, main_pc);
   pc.stage = VKCLOTH_SELF_CONTACT;
   dispatch(c, pc, count_);
   return 1;

@@ -94,6 +94,8 @@ private:
   void bind(VkCommandBuffer cmd, std::uint32_t read) const;
   void dispatch(VkCommandBuffer cmd, const shared::SelfPush& pc, std::uint64_t items) const;
   std::uint32_t record_build(VkCommandBuffer cmd, shared::SelfPush& pc, bool lists) const;
+  shared::SelfPush begin_sweep_pass(VkCommandBuffer cmd, std::uint32_t read,
+                                    const shared::PushConstants& pc) const;
   Result<void> create_sets();
   Result<void> write_texel_sets(const OneSetInputs& in);
 };
