@@ -2,7 +2,9 @@
 // Self-collision on the CPU (CpuSolver::self_collide; docs/model.md "Self-collision"): the spatial
 // hash as a counting sort of the particles by bucket (in index order, so each bucket's particles
 // come in increasing index, the order the GPU's sort pass gives), then Jacobi passes of
-// cloth_kernel.h self_collide, the walk the GPU's COLLIDE pass runs too (self_collision.comp).
+// cloth_kernel.h self_collide, the walk the GPU's COLLIDE pass runs too (self_collision.comp); with
+// a skin, the neighbour lists (self_build_lists, when stale) and self_collide_listed; with vbd's
+// energy, the lists before the sweeps and each sweep's contact forces (self_energy_*).
 #include <algorithm>
 #include <atomic>
 #include <limits>
@@ -177,7 +179,7 @@ void CpuSolver<Real>::Impl::self_build_lists(const detail::SelfConstants<Real>& 
     g.entry_rest[i] = g.rest[g.sorted[i]];
   }
   kernel::SelfDataT<Real> data = self_data();
-  data.entry_pos = g.entry_pos.data(); // the positions the table was built from: these
+  data.entry_pos = g.entry_pos.data(); // the table's particles in its order, as it was built
   data.entry_rest = g.entry_rest.data();
   pool_->for_each(pos_.size(), [&](std::size_t p) {
     g.listed[p] = kernel::self_gather(data, std::uint32_t(p), g.key[p], pos_[p], g.rest[p], k.thickness,

@@ -3,7 +3,9 @@
 // vbd.comp, one pipeline per phase: BEGIN over every particle, then for each iteration one dispatch
 // per colour of the topology (ClothTopology::vertex_order, uploaded as VBD_ORDER), then FINISH.
 // The state set of the substep's parity: POS_IN = positions[read] (the start), POS_OUT the iterate.
-// VEL_FILT and STAGE_POS, the explicit integrators' scratch, hold the targets and the pushes.
+// VEL_FILT and STAGE_POS, the explicit integrators' scratch, hold the targets and the pushes; with
+// self-contact as an energy, ACC_POS, ACC_VEL and STAGE_VEL each sweep's contact forces and
+// stiffness, which SelfCollisionGpu's CONTACT pass writes before the sweep's colours.
 #include <memory>
 
 #include "../barriers.hpp"
