@@ -220,7 +220,8 @@ void main() {
     contact_off[base + p] = vec4(hc.off, 0.0);
   } else if (stage == VKCLOTH_SELF_LIST) {
     const vec3 x = pos_out[base + p].xyz;
-    listed[base + p] = self_gather(0u, p, key_of[base + p], x, rest_pos[p].xyz, sp.thickness, sp.reach2, mask);
+    listed[base + p] =
+        self_gather(0u, p, key_of[base + p], x, rest_pos[p].xyz, sp.thickness, sp.reach2, sp.inv_cell, mask);
     built[base + p] = vec4(x, sp.reach2);
     if (p == 0u)
       stale[2u * inst + 1u] = floatBitsToUint(sp.thickness);

@@ -44,7 +44,7 @@ struct Cloud {
     key.resize(n);
     sorted.resize(n);
     for (std::uint32_t p = 0; p < n; ++p) {
-      key[p] = kernel::self_key(x[p], 1.0f / reach);
+      key[p] = kernel::self_key(x[p], 1.0f / (2.0f * reach));
       ++start[kernel::f32::self_bucket(key[p], mask) + 1];
     }
     for (std::uint32_t b = 0; b <= mask; ++b)
@@ -56,7 +56,8 @@ struct Cloud {
     listed.resize(n);
     const auto d = data();
     for (std::uint32_t p = 0; p < n; ++p) {
-      listed[p] = kernel::self_gather(d, p, key[p], x[p], rest[p], thickness, reach * reach, mask);
+      listed[p] = kernel::self_gather(d, p, key[p], x[p], rest[p], thickness, reach * reach,
+                                      1.0f / (2.0f * reach), mask);
     }
   }
   bool lists(std::uint32_t p, std::uint32_t q) const {

@@ -117,6 +117,16 @@ KFN void self_mean(vec3 sum_x, vec3 sum_v, uint pairs, OUT(vec3) dx, OUT(vec3) d
   dv = mv;
 }
 
+// The neighbouring cells (offsets lo..hi along one axis) that can hold a point within half a cell
+// of coordinate c (cells 1 / inv_cell wide): the side of c's cell that c is on (its half nearest
+// the point's cell boundary), both sides within 1 % of the middle, where rounding could decide.
+KFN void self_cell_span(real c, real inv_cell, OUT(int) lo, OUT(int) hi) {
+  precise real u = c * inv_cell;
+  precise real f = u - floor(u);
+  lo = f <= real(0.51) ? -1 : 0;
+  hi = f >= real(0.49) ? 1 : 0;
+}
+
 // What self_walk (and self_pairs) do with the particles they visit.
 #define VKCLOTH_SELF_WALK_COLLIDE 0u // sums p's response to every pair (self_pair, self_contact)
 #define VKCLOTH_SELF_WALK_GATHER 1u  // writes p's neighbour list (self_candidate, self_list_put)
@@ -147,13 +157,22 @@ KFN void self_add_pair(uint mode, INOUT(vec3) sum_x, INOUT(vec3) sum_v, INOUT(Sp
 // order), self_list_put(SELF_DATA, p, slot, q). Both backends build the same table, so they visit
 // the same particles in the same order.
 KFN uint self_walk(SELF_DATA_PARAM, uint p, uint own, uint mode, vec3 x, vec3 v, real w, vec3 rx,
-                   real thickness, real reach2, uint mask, real mu, real k, INOUT(vec3) sum_x,
+                   real thickness, real reach2, real inv_cell, uint mask, real mu, real k, INOUT(vec3) sum_x,
                    INOUT(vec3) sum_v, INOUT(SpringBlock) hessian) {
   precise real t2 = thickness * thickness;
   uint found = 0u;
-  for (int dk = -1; dk <= 1; ++dk)
-    for (int dj = -1; dj <= 1; ++dj)
-      for (int di = -1; di <= 1; ++di) {
+  // GATHER's cells are twice the reach: the 2 x 2 x 2 on x's side of its cell's middle hold every
+  // candidate (self_cell_span); the other modes walk all 27.
+  const bool octant = mode == VKCLOTH_SELF_WALK_GATHER;
+  int i0 = -1, i1 = 1, j0 = -1, j1 = 1, k0 = -1, k1 = 1;
+  if (octant) {
+    self_cell_span(x.x, inv_cell, i0, i1);
+    self_cell_span(x.y, inv_cell, j0, j1);
+    self_cell_span(x.z, inv_cell, k0, k1);
+  }
+  for (int dk = k0; dk <= k1; ++dk)
+    for (int dj = j0; dj <= j1; ++dj)
+      for (int di = i0; di <= i1; ++di) {
         const uint key = self_key_step(own, di, dj, dk);
         uint first;
         uint stop;
@@ -187,17 +206,17 @@ KFN uint self_walk(SELF_DATA_PARAM, uint p, uint own, uint mode, vec3 x, vec3 v,
   return found;
 }
 
-// Particle p's neighbour list (positions now, p at x; own: p's cell key in the table of cells of the
-// reach): its length (past the capacity: overflowed).
+// Particle p's neighbour list (positions now, p at x; own: p's cell key in the table of cells
+// 1 / inv_cell = twice the reach wide): its length (past the capacity: overflowed).
 KFN uint self_gather(SELF_DATA_PARAM, uint p, uint own, vec3 x, vec3 rx, real thickness, real reach2,
-                     uint mask) {
+                     real inv_cell, uint mask) {
   vec3 unused_x = vec3(real(0));
   vec3 unused_v = vec3(real(0));
   SpringBlock unused;
   unused.diag = vec3(real(0));
   unused.off = vec3(real(0));
   return self_walk(SELF_DATA, p, own, VKCLOTH_SELF_WALK_GATHER, x, vec3(real(0)), real(0), rx, thickness,
-                   reach2, mask, real(0), real(0), unused_x, unused_v, unused);
+                   reach2, inv_cell, mask, real(0), real(0), unused_x, unused_v, unused);
 }
 
 // Particle p's response, every pair found by the walk around its cell now (no neighbour list).
@@ -209,20 +228,20 @@ KFN void self_collide(SELF_DATA_PARAM, uint p, vec3 x, vec3 v, real w, vec3 rx, 
   unused.diag = vec3(real(0));
   unused.off = vec3(real(0));
   const uint pairs = self_walk(SELF_DATA, p, self_key(x, inv_cell), VKCLOTH_SELF_WALK_COLLIDE, x, v, w, rx,
-                               thickness, real(0), mask, mu, real(0), sum_x, sum_v, unused);
+                               thickness, real(0), inv_cell, mask, mu, real(0), sum_x, sum_v, unused);
   self_mean(sum_x, sum_v, pairs, dx, dv);
 }
 
 // Every pair of p for `mode` (COLLIDE or ENERGY, as self_walk): from its neighbour list (`listed`
 // entries, self_list_get(SELF_DATA, p, i)) in the list's order; a list that overflowed (listed >
-// capacity) walks the cells of the build instead (own: p's key then), which holds every particle
-// the list would have: the same pairs in the same order. Returns the number of pairs.
+// capacity) walks all 27 cells around its cell of the build instead (own: p's key then), which hold
+// every particle the list would have (in the walk's order). Returns the number of pairs.
 KFN uint self_pairs(SELF_DATA_PARAM, uint p, uint listed, uint own, uint mode, vec3 x, vec3 v, real w,
                     vec3 rx, real thickness, uint mask, real mu, real k, INOUT(vec3) sum_x, INOUT(vec3) sum_v,
                     INOUT(SpringBlock) hessian) {
   if (listed > uint(VKCLOTH_SELF_LIST_CAPACITY))
-    return self_walk(SELF_DATA, p, own, mode, x, v, w, rx, thickness, real(0), mask, mu, k, sum_x, sum_v,
-                     hessian);
+    return self_walk(SELF_DATA, p, own, mode, x, v, w, rx, thickness, real(0), real(0), mask, mu, k, sum_x,
+                     sum_v, hessian);
   precise real t2 = thickness * thickness;
   uint pairs = 0u;
   for (uint i = 0u; i < listed; ++i) {

@@ -64,7 +64,8 @@ namespace vkcloth::gpu::shared {
 struct SelfParams {
   uint iterations; // 0: self-collision off for this instance
   float thickness;
-  float inv_cell; // 1 / the reach (thickness + skin): the hash's cell size
+  float inv_cell; // 1 / the hash's cell size: twice the reach (thickness + skin), or the thickness without a
+                  // skin
   float friction;
   float reach2;     // the reach squared (the lists' candidates)
   float half_skin2; // (skin / 2)^2; 0: no skin, no lists (COLLIDE walks the cells)

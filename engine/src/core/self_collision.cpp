@@ -183,7 +183,7 @@ void CpuSolver<Real>::Impl::self_build_lists(const detail::SelfConstants<Real>& 
   data.entry_rest = g.entry_rest.data();
   pool_->for_each(pos_.size(), [&](std::size_t p) {
     g.listed[p] = kernel::self_gather(data, std::uint32_t(p), g.key[p], pos_[p], g.rest[p], k.thickness,
-                                      k.reach2, mask);
+                                      k.reach2, k.inv_cell, mask);
     g.built[p] = pos_[p];
   });
   g.built_reach2 = k.reach2;

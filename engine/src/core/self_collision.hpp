@@ -37,16 +37,18 @@ template <typename Real> struct SelfCollisionGrid {
   SelfCollisionStats stats;
 };
 /// SelfCollision's numbers as the kernel takes them, each computed in double and cast once (the GPU's
-/// SelfCollisionGpu::packed casts the same to float): the hash's cells are the reach, thickness +
-/// skin (the thickness alone without a skin).
+/// SelfCollisionGpu::packed casts the same to float): the hash's cells are twice the reach,
+/// thickness + skin, with a skin (self_walk's GATHER visits the 2 x 2 x 2 on a particle's side), and
+/// the thickness without one (the walk's 27).
 template <typename Real> struct SelfConstants {
   Real thickness, friction, inv_cell, reach2, half_skin2, stiffness;
 };
 template <typename Real> SelfConstants<Real> self_constants(const SelfCollision& sc) {
   const double reach = sc.thickness + sc.skin;
+  const double cell = sc.skin > 0.0 ? 2.0 * reach : sc.thickness; // the lists' build walks 2 x 2 x 2 cells
   return {Real(sc.thickness),
           Real(sc.friction),
-          Real(1.0 / reach),
+          Real(1.0 / cell),
           Real(reach * reach),
           Real(0.25 * sc.skin * sc.skin),
           Real(sc.stiffness)};
