@@ -117,9 +117,10 @@ KFN void self_mean(vec3 sum_x, vec3 sum_v, uint pairs, OUT(vec3) dx, OUT(vec3) d
   dv = mv;
 }
 
-// The neighbouring cells (offsets lo..hi along one axis) that can hold a point within half a cell
-// of coordinate c (cells 1 / inv_cell wide): the side of c's cell that c is on (its half nearest
-// the point's cell boundary), both sides within 1 % of the middle, where rounding could decide.
+// The cells along one axis (offsets lo..hi from c's own, cells 1 / inv_cell wide) that can hold a
+// point within half a cell of coordinate c: c's own and its neighbour on the side of the middle
+// that c is on; both neighbours within 1 % of the middle, where rounding could decide (the margin
+// holds for coordinates up to ~10^4 cells from the origin; the key repeats every 1024 anyway).
 KFN void self_cell_span(real c, real inv_cell, OUT(int) lo, OUT(int) hi) {
   precise real u = c * inv_cell;
   precise real f = u - floor(u);
