@@ -191,6 +191,8 @@ void main() {
   const uint p = particle_index();
   if (p >= pc.count)
     return;
+  if ((stage == VKCLOTH_SELF_COLLIDE || stage == VKCLOTH_SELF_CONTACT) && p == 0u)
+    stale[2u * inst] = 0u; // the first pass after CHECK and the build, which have read it (barriers since)
   if (stage == VKCLOTH_SELF_COUNT) {
     const uint key = self_key(pos_out[base + p].xyz, sp.inv_cell);
     key_of[base + p] = key;
@@ -206,8 +208,6 @@ void main() {
         stale[2u * inst + 1u] != floatBitsToUint(sp.thickness))
       atomicOr(stale[2u * inst], 1u);
   } else if (stage == VKCLOTH_SELF_CONTACT) {
-    if (p == 0u)
-      stale[2u * inst] = 0u; // CHECK and the build have read it (barriers since)
     vec3 f = vec3(0.0);
     SpringBlock hc;
     hc.diag = vec3(0.0);
@@ -226,8 +226,6 @@ void main() {
     if (p == 0u)
       stale[2u * inst + 1u] = floatBitsToUint(sp.thickness);
   } else {
-    if (stage == VKCLOTH_SELF_COLLIDE && p == 0u)
-      stale[2u * inst] = 0u; // CHECK and the build have read it (barriers since)
     if (particle[p].pinned != 0u)
       return;
     if (stage == VKCLOTH_SELF_COLLIDE) {

@@ -190,7 +190,7 @@ template <typename Real> struct CpuSolver<Real>::Impl {
   kernel::SelfDataT<Real> self_data();
   void self_hash(Real inv_cell);
   bool self_list_stale(const detail::SelfConstants<Real>& k);
-  void self_build_lists(const detail::SelfConstants<Real>& k, std::uint32_t mask);
+  void self_build_lists(const detail::SelfConstants<Real>& k);
   void project_strain(Real h);
 
   using Edge = detail::SolverEdge<Real>;

@@ -22,7 +22,7 @@ template <typename Real> void CpuSolver<Real>::Impl::self_collide() {
   const std::size_t n = pos_.size();
   self_init();
   auto& g = *self_;
-  const std::uint32_t mask = kernel::self_table_size(static_cast<std::uint32_t>(n)) - 1;
+  const std::uint32_t mask = g.mask;
   const detail::SelfConstants<Real> k = detail::self_constants<Real>(sc);
   g.dx.resize(n);
   g.dv.resize(n);
@@ -43,7 +43,7 @@ template <typename Real> void CpuSolver<Real>::Impl::self_collide() {
     self_hash(k.inv_cell);
   for (std::uint32_t it = 0; it < sc.iterations; ++it) {
     if (lists && self_list_stale(k))
-      self_build_lists(k, mask);
+      self_build_lists(k);
     data = self_data();
     ++g.stats.passes;
     pool_->for_each(n, collide);
@@ -75,6 +75,7 @@ template <typename Real> void CpuSolver<Real>::Impl::self_init() {
   self_->built.assign(n, Vec3(std::numeric_limits<Real>::quiet_NaN()));
   self_->listed.assign(n, 0);
   self_->list.assign(n * VKCLOTH_SELF_LIST_CAPACITY, 0);
+  self_->mask = kernel::self_table_size(static_cast<std::uint32_t>(n)) - 1;
 }
 
 template <typename Real> bool CpuSolver<Real>::Impl::self_energy() const {
@@ -86,7 +87,7 @@ template <typename Real> void CpuSolver<Real>::Impl::self_energy_lists() {
   self_init();
   const auto k = detail::self_constants<Real>(params_.self_collision);
   if (self_list_stale(k))
-    self_build_lists(k, kernel::self_table_size(std::uint32_t(pos_.size())) - 1);
+    self_build_lists(k);
 }
 
 // Each particle's self-contact force and stiffness from the positions the sweep starts from (a
@@ -97,7 +98,6 @@ template <typename Real> void CpuSolver<Real>::Impl::self_energy_sweep() {
   auto& w = *vbd_;
   const std::size_t n = pos_.size();
   const auto k = detail::self_constants<Real>(params_.self_collision);
-  const std::uint32_t mask = kernel::self_table_size(std::uint32_t(n)) - 1;
   w.contact_f.resize(n);
   w.contact_diag.resize(n);
   w.contact_off.resize(n);
@@ -107,7 +107,7 @@ template <typename Real> void CpuSolver<Real>::Impl::self_energy_sweep() {
     Vec3 fc(0);
     if (!pinned_[p])
       kernel::self_energy_listed(data, std::uint32_t(p), g.listed[p], g.key[p], pos_[p], g.rest[p],
-                                 k.thickness, mask, k.stiffness, fc, hc);
+                                 k.thickness, g.mask, k.stiffness, fc, hc);
     w.contact_f[p] = fc;
     w.contact_diag[p] = hc.diag;
     w.contact_off[p] = hc.off;
@@ -129,7 +129,7 @@ template <typename Real> kernel::SelfDataT<Real> CpuSolver<Real>::Impl::self_dat
 template <typename Real> void CpuSolver<Real>::Impl::self_hash(const Real inv_cell) {
   auto& g = *self_;
   const std::size_t n = pos_.size();
-  const std::uint32_t table = kernel::self_table_size(static_cast<std::uint32_t>(n)), mask = table - 1;
+  const std::uint32_t mask = g.mask, table = mask + 1;
   g.start.assign(std::size_t(table) + 1, 0);
   g.key.resize(n);
   g.sorted.resize(n);
@@ -167,8 +167,7 @@ template <typename Real> bool CpuSolver<Real>::Impl::self_list_stale(const detai
 
 // The hash of cells of the reach (thickness + skin), then each particle's list of the candidates
 // within the reach (its 27 cells' walk), and where each particle is now: the GPU's COUNT .. LIST.
-template <typename Real>
-void CpuSolver<Real>::Impl::self_build_lists(const detail::SelfConstants<Real>& k, const std::uint32_t mask) {
+template <typename Real> void CpuSolver<Real>::Impl::self_build_lists(const detail::SelfConstants<Real>& k) {
   auto& g = *self_;
   self_hash(k.inv_cell);
   const std::size_t n = pos_.size();
@@ -183,7 +182,7 @@ void CpuSolver<Real>::Impl::self_build_lists(const detail::SelfConstants<Real>& 
   data.entry_rest = g.entry_rest.data();
   pool_->for_each(pos_.size(), [&](std::size_t p) {
     g.listed[p] = kernel::self_gather(data, std::uint32_t(p), g.key[p], pos_[p], g.rest[p], k.thickness,
-                                      k.reach2, k.inv_cell, mask);
+                                      k.reach2, k.inv_cell, g.mask);
     g.built[p] = pos_[p];
   });
   g.built_reach2 = k.reach2;
@@ -212,7 +211,7 @@ template void CpuSolver<float>::Impl::self_hash(float);
 template void CpuSolver<double>::Impl::self_hash(double);
 template bool CpuSolver<float>::Impl::self_list_stale(const detail::SelfConstants<float>&);
 template bool CpuSolver<double>::Impl::self_list_stale(const detail::SelfConstants<double>&);
-template void CpuSolver<float>::Impl::self_build_lists(const detail::SelfConstants<float>&, std::uint32_t);
-template void CpuSolver<double>::Impl::self_build_lists(const detail::SelfConstants<double>&, std::uint32_t);
+template void CpuSolver<float>::Impl::self_build_lists(const detail::SelfConstants<float>&);
+template void CpuSolver<double>::Impl::self_build_lists(const detail::SelfConstants<double>&);
 
 } // namespace vkcloth

@@ -19,6 +19,7 @@ template <typename Real> struct SelfCollisionGrid {
   using Vec3 = glm::vec<3, Real>;
   std::vector<Vec3> rest;
   std::vector<Real> inv_mass;
+  std::uint32_t mask = 0; // the hash table's size - 1 (kernel.hpp self_table_size of the particle count)
   std::vector<std::uint32_t>
       start; // table size + 1: bucket b's particles are sorted[start[b] .. start[b + 1])
   std::vector<std::uint32_t> fill; // the counting sort's next slot per bucket
