@@ -460,7 +460,12 @@ template <typename Real> void CpuSolver<Real>::Impl::limit_stretch(const Real h)
     });
   }
   const std::span<const std::uint32_t> colours = topology_->strain_colour_offsets();
-  for (std::uint32_t it = 0; sl.provot() && it < sl.iterations; ++it)
+  // A sweep that moves no link leaves every link within its bound, so the sweeps after it would
+  // move none either: stopping there gives the same bits as running them all (as the GPU does).
+  std::atomic<bool> corrected{true};
+  for (std::uint32_t it = 0; sl.provot() && it < sl.iterations && corrected.load(std::memory_order_relaxed);
+       ++it) {
+    corrected.store(false, std::memory_order_relaxed);
     for (std::size_t c = 0; c + 1 < colours.size(); ++c)
       pool_->for_each(colours[c + 1] - colours[c], [&](std::size_t k) {
         const Link& l = strain_links_[colours[c] + k];
@@ -472,7 +477,9 @@ template <typename Real> void CpuSolver<Real>::Impl::limit_stretch(const Real h)
         kernel::apply_correction(pos_[l.b], vel_[l.b], db, h);
         moved(l.a);
         moved(l.b);
+        corrected.store(true, std::memory_order_relaxed);
       });
+  }
   if (sl.projection()) {
     project_strain(h);
     soa_valid_ = false; // the next row sweep transposes the moved positions
