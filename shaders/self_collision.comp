@@ -43,6 +43,10 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_SELF_STALE) buffer StaleBuf { 
 layout(std430, set = 0, binding = VKCLOTH_BINDING_ACC_POS) writeonly buffer ContactF { vec4 contact_f[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_ACC_VEL) writeonly buffer ContactDiag { vec4 contact_diag[]; };
 layout(std430, set = 0, binding = VKCLOTH_BINDING_STAGE_VEL) writeonly buffer ContactOff { vec4 contact_off[]; };
+// vbd's positions at the step's start (CONTACT: the friction's slips).
+layout(std430, set = 0, binding = VKCLOTH_BINDING_POS_IN) readonly buffer StepStart { vec4 step_start[]; };
+// CONTACT: self_particle gives each particle's move since the step's start in place of its velocity.
+bool contact_pass = false;
 
 shared uint partial[VKCLOTH_WORKGROUP_SIZE];
 
@@ -71,7 +75,7 @@ void self_entry(uint unused, uint i, out uint q, out uint key) {
 }
 void self_particle(uint unused, uint q, out vec3 x, out vec3 v, out float w, out vec3 rest) {
   x = read_pos_out(q);
-  v = read_velocity(q);
+  v = contact_pass ? x - step_start[base + q].xyz : read_velocity(q);
   const vec4 r = read_self_rest(q);
   w = r.w; // the host's kernel inverse_mass, as the CPU's
   rest = r.xyz;
@@ -212,9 +216,11 @@ void main() {
     SpringBlock hc;
     hc.diag = vec3(0.0);
     hc.off = vec3(0.0);
+    contact_pass = true;
+    const vec3 x = pos_out[base + p].xyz;
     if (particle[p].pinned == 0u)
-      self_energy_listed(0u, p, listed[base + p], key_of[base + p], pos_out[base + p].xyz, rest_pos[p].xyz,
-                         sp.thickness, mask, sp.stiffness, f, hc);
+      self_energy_listed(0u, p, listed[base + p], key_of[base + p], x, x - step_start[base + p].xyz,
+                         rest_pos[p].xyz, sp.thickness, mask, sp.stiffness, sp.friction, ip.dt, f, hc);
     contact_f[base + p] = vec4(f, 0.0);
     contact_diag[base + p] = vec4(hc.diag, 0.0);
     contact_off[base + p] = vec4(hc.off, 0.0);

@@ -285,6 +285,90 @@ TEST_CASE_TEMPLATE(
   CHECK(s->self_collision_stats().passes == 120 * 5); // one contact evaluation per sweep
 }
 
+namespace {
+/// A pinned row of particles 2 mm apart along x (a smooth rail), and one free particle (the last)
+/// resting on it at height `t` with velocity (vx, 0, 0); 10 g each.
+ParticleSystem rail_and_slider(double t, double vx) {
+  ParticleSystem s;
+  for (int i = 0; i < 160; ++i) {
+    Particle q;
+    q.position = {-0.05 + 0.002 * i, 0.0, 0.0};
+    q.mass = 0.01;
+    q.pinned = true;
+    s.particles.push_back(q);
+  }
+  Particle slider;
+  slider.position = {0.0, 0.0, t};
+  slider.velocity = {vx, 0.0, 0.0};
+  slider.mass = 0.01;
+  s.particles.push_back(slider);
+  s.finalize();
+  return s;
+}
+} // namespace
+
+TEST_CASE("vbd self-contact energy: Coulomb friction takes mu g per second off a slide on a pinned rail") {
+  // A pinned row of particles 2 mm apart along x (a smooth rail), and one free particle resting on it
+  // at the thickness, sliding along it at 0.5 m/s under gravity. The contact energy carries its
+  // weight, lambda = m g summed over its pairs (nearly vertical: it sinks m g / k = 0.1 mm), so
+  // friction takes mu g per second off the slide: 0.294 m/s over 0.1 s at mu 0.3.
+  vkcloth::test::ValidationScope validation;
+  const double t = 0.01, v0 = 0.5, k = 1000.0;
+  const ParticleSystem rail = rail_and_slider(t, v0);
+  const std::size_t free_p = rail.particles.size() - 1;
+  for (double mu : {0.0, 0.3}) {
+    for (vkcloth::test::Backend b : vkcloth::test::backends()) {
+      INFO(std::string(to_string(b)) << ", mu " << mu);
+      SimParams p = vbd_contact(k);
+      p.gravity = {0.0, 0.0, -9.81};
+      p.self_collision.friction = mu;
+      auto sim = vkcloth::test::make_sim(b, rail, p);
+      REQUIRE(sim->run(20).ok()); // settles onto the rail (its contact takes a few steps)
+      const double vx0 = sim->velocity(free_p).x;
+      REQUIRE(sim->run(100).ok());
+      const glm::dvec3 xp = sim->position(free_p), vp = sim->velocity(free_p);
+      CHECK(xp.z > 0.98 * t); // resting on the rail, at most its sag below the thickness
+      CHECK(xp.z < 1.001 * t);
+      CHECK(std::abs(vp.z) < 0.01);
+      if (mu == 0.0) {
+        CHECK(vp.x == doctest::Approx(vx0).epsilon(0.02)); // frictionless: it keeps sliding
+      } else {
+        CHECK(vx0 == doctest::Approx(v0 - mu * 9.81 * 0.02).epsilon(0.03));
+        CHECK(vp.x == doctest::Approx(vx0 - mu * 9.81 * 0.1).epsilon(0.03));
+      }
+    }
+  }
+}
+
+TEST_CASE(
+    "vbd self-contact energy: static friction holds a particle on a rail tilted below its friction angle") {
+  // Gravity tilted by tan(theta) = 0.2 along the rail: with mu = 0.3 the particle is held (the
+  // smoothed static friction lets it creep below the slip speed: at 1 mm/s x tan(theta) / mu = 0.67
+  // mm/s, 0.13 mm over the 0.2 s); with mu = 0.1 it slides with g (sin theta - mu cos theta).
+  vkcloth::test::ValidationScope validation;
+  const double t = 0.01, tan_theta = 0.2;
+  const double cos_t = 1.0 / std::sqrt(1.0 + tan_theta * tan_theta), sin_t = tan_theta * cos_t;
+  const ParticleSystem rail = rail_and_slider(t, 0.0);
+  const std::size_t free_p = rail.particles.size() - 1;
+  for (double mu : {0.3, 0.1}) {
+    for (vkcloth::test::Backend b : vkcloth::test::backends()) {
+      INFO(std::string(to_string(b)) << ", mu " << mu);
+      SimParams p = vbd_contact(1000.0);
+      p.gravity = {9.81 * sin_t, 0.0, -9.81 * cos_t};
+      p.self_collision.friction = mu;
+      auto sim = vkcloth::test::make_sim(b, rail, p);
+      REQUIRE(sim->run(200).ok()); // 0.2 s
+      const double vx = sim->velocity(free_p).x, x = sim->position(free_p).x;
+      if (mu == 0.3) {
+        CHECK(std::abs(vx) < VKCLOTH_SELF_FRICTION_SLIP_SPEED);
+        CHECK(std::abs(x) < VKCLOTH_SELF_FRICTION_SLIP_SPEED * 0.2);
+      } else {
+        CHECK(vx == doctest::Approx(9.81 * (sin_t - mu * cos_t) * 0.2).epsilon(0.05));
+      }
+    }
+  }
+}
+
 TEST_CASE("vbd self-contact energy: the SIMD lanes give the scalar reference's bits, on any thread count") {
   const std::string path = std::string(VKCLOTH_SCENES_DIR) + "/cloth_drop_self_collision.json";
   const std::string overrides[] = {"integrator.method=vbd", "self_collision.stiffness=100"};

@@ -27,6 +27,17 @@ KFN SpringBlock spring_block_n(vec3 n, real r, real k) {
   return s;
 }
 
+// c (I - n n^T) for a unit n: a stiffness c across n and none along it (self_energy's friction).
+KFN SpringBlock tangent_block(vec3 n, real c) {
+  SpringBlock s;
+  precise real xx = c - c * n.x * n.x, yy = c - c * n.y * n.y, zz = c - c * n.z * n.z;
+  precise real nc = real(0) - c;
+  precise real xy = nc * n.x * n.y, xz = nc * n.x * n.z, yz = nc * n.y * n.z;
+  s.diag = vec3(xx, yy, zz);
+  s.off = vec3(xy, xz, yz);
+  return s;
+}
+
 // K w for a symmetric block.
 KFN precise vec3 apply_block(SpringBlock s, vec3 w) {
   precise real x = s.diag.x * w.x + s.off.x * w.y;

@@ -57,5 +57,9 @@
 // The most entries of a particle's self-collision neighbour list (self_collide_listed: past it, the
 // particle walks the build's cells instead).
 #define VKCLOTH_SELF_LIST_CAPACITY 32u
+// Self-contact friction in vbd's sweeps (self_energy): a relative slip over the step slower than
+// this (m/s) is held as static friction, a stiff spring of force mu lambda at slip speed * h; the
+// tolerance of IPC's smoothed friction (Li et al. 2020), which vbd's Gaia takes over.
+#define VKCLOTH_SELF_FRICTION_SLIP_SPEED 1e-3
 
 #endif // VKCLOTH_KERNEL_CONSTANTS_H

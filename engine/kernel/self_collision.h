@@ -103,9 +103,30 @@ KFN bool self_moved(vec3 x, vec3 xb, real half_skin2) {
 // One pair's contact energy in p's vertex step (vbd with a self-contact stiffness; docs/model.md
 // "Self-collision"): (k / 2) (t - d)^2 for d = |x - xq| < t, a spring of rest length t and stiffness
 // k that only pushes: its force k (t - d) away from xq and its stiffness block k n n^T (vbd_add_spring
-// of a compressed spring keeps only the part along it).
-KFN void self_energy(INOUT(vec3) f, INOUT(SpringBlock) hessian, vec3 x, vec3 xq, real thickness, real k) {
+// of a compressed spring keeps only the part along it). With friction mu > 0, Coulomb's law on the
+// pair's slip over the step so far, s = the part of u - uq across n (u, uq: each particle's move
+// from the step's start), with the normal force lambda = k (t - d): the force -c s and the stiffness
+// c (I - n n^T), c = mu lambda / max(|s|, slip): a spring that holds a slip below `slip` (static)
+// and a force mu lambda against a longer one (kinetic); IPC's lagged friction, as vbd's Gaia.
+KFN void self_energy(INOUT(vec3) f, INOUT(SpringBlock) hessian, vec3 x, vec3 u, vec3 xq, vec3 uq,
+                     real thickness, real k, real mu, real slip) {
   vbd_add_spring(f, hessian, xq - x, thickness, k);
+  if (!(mu > real(0)))
+    return;
+  precise vec3 e = x - xq;
+  precise real d = sqrt(dot3(e, e)); // > 0: self_pair
+  precise vec3 n = e / d;
+  precise real lambda = k * (thickness - d);
+  precise vec3 r = u - uq;
+  precise vec3 s = r - n * dot3(n, r);
+  precise real c = mu * lambda / max(sqrt(dot3(s, s)), slip);
+  precise vec3 t = f - s * c;
+  SpringBlock b = tangent_block(n, c);
+  precise vec3 bd = hessian.diag + b.diag;
+  precise vec3 bo = hessian.off + b.off;
+  f = t;
+  hessian.diag = bd;
+  hessian.off = bo;
 }
 
 // The mean of a particle's pair responses (Jacobi: a particle pressed from many sides does not overshoot).
@@ -134,11 +155,13 @@ KFN void self_cell_span(real c, real inv_cell, OUT(int) lo, OUT(int) hi) {
 #define VKCLOTH_SELF_WALK_ENERGY 2u  // adds every pair's contact energy to p's vertex step (self_energy)
 
 // One pair's part for `mode` (VKCLOTH_SELF_WALK_COLLIDE: p's response into sum_x, sum_v; ENERGY: the
-// contact energy into sum_x, the force, and hessian).
+// contact energy into sum_x, the force, and hessian, where v and vq are the particles' moves since
+// the step's start).
 KFN void self_add_pair(uint mode, INOUT(vec3) sum_x, INOUT(vec3) sum_v, INOUT(SpringBlock) hessian, vec3 x,
-                       vec3 v, real w, vec3 xq, vec3 vq, real wq, real thickness, real mu, real k) {
+                       vec3 v, real w, vec3 xq, vec3 vq, real wq, real thickness, real mu, real k,
+                       real slip) {
   if (mode == VKCLOTH_SELF_WALK_ENERGY)
-    self_energy(sum_x, hessian, x, xq, thickness, k);
+    self_energy(sum_x, hessian, x, v, xq, vq, thickness, k, mu, slip);
   else
     self_contact(sum_x, sum_v, x, v, w, xq, vq, wq, thickness, mu);
 }
@@ -150,7 +173,8 @@ KFN void self_add_pair(uint mode, INOUT(vec3) sum_x, INOUT(vec3) sum_v, INOUT(Sp
 // response to every pair to sum_x, sum_v and returns the number of pairs; GATHER writes p's
 // neighbour list (candidates within `reach2`) and returns its length (past the capacity it stops
 // writing, and the count says the list overflowed); ENERGY adds the pairs' contact energy (stiffness
-// `k`) to f and hessian and returns the number of pairs.
+// `k`, friction `mu` with static slip `slip`) to f and hessian and returns the number of pairs (v and
+// self_particle's velocities are then the particles' moves since the step's start).
 // Provided by the including file: self_range(SELF_DATA, bucket, first, stop) (the bucket's entries
 // of the sorted table), self_entry(SELF_DATA, i, q, key) (an entry's particle and the key of the
 // cell it was sorted in), self_particle(SELF_DATA, q, x, v, w, rest), self_entry_particle(SELF_DATA,
@@ -158,8 +182,8 @@ KFN void self_add_pair(uint mode, INOUT(vec3) sum_x, INOUT(vec3) sum_v, INOUT(Sp
 // order), self_list_put(SELF_DATA, p, slot, q). Both backends build the same table, so they visit
 // the same particles in the same order.
 KFN uint self_walk(SELF_DATA_PARAM, uint p, uint own, uint mode, vec3 x, vec3 v, real w, vec3 rx,
-                   real thickness, real reach2, real inv_cell, uint mask, real mu, real k, INOUT(vec3) sum_x,
-                   INOUT(vec3) sum_v, INOUT(SpringBlock) hessian) {
+                   real thickness, real reach2, real inv_cell, uint mask, real mu, real k, real slip,
+                   INOUT(vec3) sum_x, INOUT(vec3) sum_v, INOUT(SpringBlock) hessian) {
   precise real t2 = thickness * thickness;
   uint found = 0u;
   // GATHER's cells are twice the reach: the 2 x 2 x 2 on x's side of its cell's middle hold every
@@ -199,7 +223,7 @@ KFN uint self_walk(SELF_DATA_PARAM, uint p, uint own, uint mode, vec3 x, vec3 v,
           }
           self_particle(SELF_DATA, q, xq, vq, wq, rq);
           if (self_pair(x, xq, rx, rq, t2)) {
-            self_add_pair(mode, sum_x, sum_v, hessian, x, v, w, xq, vq, wq, thickness, mu, k);
+            self_add_pair(mode, sum_x, sum_v, hessian, x, v, w, xq, vq, wq, thickness, mu, k, slip);
             found += 1u;
           }
         }
@@ -217,7 +241,7 @@ KFN uint self_gather(SELF_DATA_PARAM, uint p, uint own, vec3 x, vec3 rx, real th
   unused.diag = vec3(real(0));
   unused.off = vec3(real(0));
   return self_walk(SELF_DATA, p, own, VKCLOTH_SELF_WALK_GATHER, x, vec3(real(0)), real(0), rx, thickness,
-                   reach2, inv_cell, mask, real(0), real(0), unused_x, unused_v, unused);
+                   reach2, inv_cell, mask, real(0), real(0), real(0), unused_x, unused_v, unused);
 }
 
 // Particle p's response, every pair found by the walk around its cell now (no neighbour list).
@@ -228,8 +252,9 @@ KFN void self_collide(SELF_DATA_PARAM, uint p, vec3 x, vec3 v, real w, vec3 rx, 
   SpringBlock unused;
   unused.diag = vec3(real(0));
   unused.off = vec3(real(0));
-  const uint pairs = self_walk(SELF_DATA, p, self_key(x, inv_cell), VKCLOTH_SELF_WALK_COLLIDE, x, v, w, rx,
-                               thickness, real(0), inv_cell, mask, mu, real(0), sum_x, sum_v, unused);
+  const uint pairs =
+      self_walk(SELF_DATA, p, self_key(x, inv_cell), VKCLOTH_SELF_WALK_COLLIDE, x, v, w, rx, thickness,
+                real(0), inv_cell, mask, mu, real(0), real(0), sum_x, sum_v, unused);
   self_mean(sum_x, sum_v, pairs, dx, dv);
 }
 
@@ -238,11 +263,11 @@ KFN void self_collide(SELF_DATA_PARAM, uint p, vec3 x, vec3 v, real w, vec3 rx, 
 // capacity) walks all 27 cells around its cell of the build instead (own: p's key then), which hold
 // every particle the list would have (in the walk's order). Returns the number of pairs.
 KFN uint self_pairs(SELF_DATA_PARAM, uint p, uint listed, uint own, uint mode, vec3 x, vec3 v, real w,
-                    vec3 rx, real thickness, uint mask, real mu, real k, INOUT(vec3) sum_x, INOUT(vec3) sum_v,
-                    INOUT(SpringBlock) hessian) {
+                    vec3 rx, real thickness, uint mask, real mu, real k, real slip, INOUT(vec3) sum_x,
+                    INOUT(vec3) sum_v, INOUT(SpringBlock) hessian) {
   if (listed > uint(VKCLOTH_SELF_LIST_CAPACITY))
-    return self_walk(SELF_DATA, p, own, mode, x, v, w, rx, thickness, real(0), real(0), mask, mu, k, sum_x,
-                     sum_v, hessian);
+    return self_walk(SELF_DATA, p, own, mode, x, v, w, rx, thickness, real(0), real(0), mask, mu, k, slip,
+                     sum_x, sum_v, hessian);
   precise real t2 = thickness * thickness;
   uint pairs = 0u;
   for (uint i = 0u; i < listed; ++i) {
@@ -253,7 +278,7 @@ KFN uint self_pairs(SELF_DATA_PARAM, uint p, uint listed, uint own, uint mode, v
     real wq;
     self_particle(SELF_DATA, q, xq, vq, wq, rq);
     if (self_pair(x, xq, rx, rq, t2)) {
-      self_add_pair(mode, sum_x, sum_v, hessian, x, v, w, xq, vq, wq, thickness, mu, k);
+      self_add_pair(mode, sum_x, sum_v, hessian, x, v, w, xq, vq, wq, thickness, mu, k, slip);
       pairs += 1u;
     }
   }
@@ -269,22 +294,25 @@ KFN void self_collide_listed(SELF_DATA_PARAM, uint p, uint listed, uint own, vec
   unused.diag = vec3(real(0));
   unused.off = vec3(real(0));
   const uint pairs = self_pairs(SELF_DATA, p, listed, own, VKCLOTH_SELF_WALK_COLLIDE, x, v, w, rx, thickness,
-                                mask, mu, real(0), sum_x, sum_v, unused);
+                                mask, mu, real(0), real(0), sum_x, sum_v, unused);
   self_mean(sum_x, sum_v, pairs, dx, dv);
 }
 
 // Particle p's self-contact energy in its vertex step (vbd with a self-contact stiffness k > 0):
 // its pairs (self_pairs) at the positions the sweep starts from (x: p's, self_particle: the
-// others'), as f (the force) and hessian (the stiffness), which the step adds to its springs'.
-KFN void self_energy_listed(SELF_DATA_PARAM, uint p, uint listed, uint own, vec3 x, vec3 rx, real thickness,
-                            uint mask, real k, OUT(vec3) f, OUT(SpringBlock) hessian) {
+// others'; u and self_particle's velocities: the moves since the step's start, for the friction mu
+// over a step of h), as f (the force) and hessian (the stiffness), which the step adds to its springs'.
+KFN void self_energy_listed(SELF_DATA_PARAM, uint p, uint listed, uint own, vec3 x, vec3 u, vec3 rx,
+                            real thickness, uint mask, real k, real mu, real h, OUT(vec3) f,
+                            OUT(SpringBlock) hessian) {
   precise vec3 sum_f = vec3(real(0));
   vec3 unused_v = vec3(real(0));
   SpringBlock block;
   block.diag = vec3(real(0));
   block.off = vec3(real(0));
-  self_pairs(SELF_DATA, p, listed, own, VKCLOTH_SELF_WALK_ENERGY, x, vec3(real(0)), real(0), rx, thickness,
-             mask, real(0), k, sum_f, unused_v, block);
+  precise real slip = real(VKCLOTH_SELF_FRICTION_SLIP_SPEED) * h;
+  self_pairs(SELF_DATA, p, listed, own, VKCLOTH_SELF_WALK_ENERGY, x, u, real(0), rx, thickness, mask, mu, k,
+             slip, sum_f, unused_v, block);
   f = sum_f;
   hessian = block;
 }

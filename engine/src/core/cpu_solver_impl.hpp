@@ -186,7 +186,7 @@ template <typename Real> struct CpuSolver<Real>::Impl {
   /// Whether vbd takes self-contact as an energy in its vertex steps (SelfCollision::stiffness).
   bool self_energy() const;
   void self_energy_lists();
-  void self_energy_sweep();
+  void self_energy_sweep(Real h);
   kernel::SelfDataT<Real> self_data();
   void self_hash(Real inv_cell);
   bool self_list_stale(const detail::SelfConstants<Real>& k);

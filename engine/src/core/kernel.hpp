@@ -165,6 +165,9 @@ template <typename Real> struct SelfDataT {
   const std::uint32_t* sorted_key = nullptr;
   const glm::vec<3, Real>* entry_pos = nullptr;
   const glm::vec<3, Real>* entry_rest = nullptr;
+  // vbd's contact energy (optional): the positions at the step's start; self_particle then gives each
+  // particle's move since then in place of its velocity (self_energy's friction).
+  const glm::vec<3, Real>* step_start = nullptr;
 };
 template <typename Real> void self_range(const SelfDataT<Real>& d, uint b, uint& first, uint& stop) {
   first = d.start[b];
@@ -188,7 +191,7 @@ template <typename Real> uint self_list_get(const SelfDataT<Real>& d, uint p, ui
 template <typename Real, typename V>
 void self_particle(const SelfDataT<Real>& d, uint q, V& x, V& v, Real& w, V& rest) {
   x = d.pos[q];
-  v = d.vel[q];
+  v = d.step_start ? V(d.pos[q] - d.step_start[q]) : d.vel[q];
   w = d.inv_mass[q];
   rest = d.rest[q];
 }

@@ -93,7 +93,7 @@ template <typename Real> void CpuSolver<Real>::Impl::self_energy_lists() {
 // Each particle's self-contact force and stiffness from the positions the sweep starts from (a
 // snapshot: a colour's steps do not see each other's moves through a contact, as through a spring),
 // the GPU's CONTACT pass.
-template <typename Real> void CpuSolver<Real>::Impl::self_energy_sweep() {
+template <typename Real> void CpuSolver<Real>::Impl::self_energy_sweep(const Real h) {
   auto& g = *self_;
   auto& w = *vbd_;
   const std::size_t n = pos_.size();
@@ -101,13 +101,14 @@ template <typename Real> void CpuSolver<Real>::Impl::self_energy_sweep() {
   w.contact_f.resize(n);
   w.contact_diag.resize(n);
   w.contact_off.resize(n);
-  const kernel::SelfDataT<Real> data = self_data();
+  kernel::SelfDataT<Real> data = self_data();
+  data.step_start = w.x0.data(); // the friction's slips
   pool_->for_each(n, [&](std::size_t p) {
     kernel::SpringBlock<Real> hc{Vec3(0), Vec3(0)};
     Vec3 fc(0);
     if (!pinned_[p])
-      kernel::self_energy_listed(data, std::uint32_t(p), g.listed[p], g.key[p], pos_[p], g.rest[p],
-                                 k.thickness, g.mask, k.stiffness, fc, hc);
+      kernel::self_energy_listed(data, std::uint32_t(p), g.listed[p], g.key[p], pos_[p], pos_[p] - w.x0[p],
+                                 g.rest[p], k.thickness, g.mask, k.stiffness, k.friction, h, fc, hc);
     w.contact_f[p] = fc;
     w.contact_diag[p] = hc.diag;
     w.contact_off[p] = hc.off;
@@ -203,8 +204,8 @@ template bool CpuSolver<float>::Impl::self_energy() const;
 template bool CpuSolver<double>::Impl::self_energy() const;
 template void CpuSolver<float>::Impl::self_energy_lists();
 template void CpuSolver<double>::Impl::self_energy_lists();
-template void CpuSolver<float>::Impl::self_energy_sweep();
-template void CpuSolver<double>::Impl::self_energy_sweep();
+template void CpuSolver<float>::Impl::self_energy_sweep(float);
+template void CpuSolver<double>::Impl::self_energy_sweep(double);
 template kernel::SelfDataT<float> CpuSolver<float>::Impl::self_data();
 template kernel::SelfDataT<double> CpuSolver<double>::Impl::self_data();
 template void CpuSolver<float>::Impl::self_hash(float);

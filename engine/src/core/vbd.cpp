@@ -24,7 +24,7 @@ template <typename Real> void CpuSolver<Real>::Impl::vbd_substep(const Real h) {
   const std::uint32_t colours = std::uint32_t(topology_->vertex_colour_offsets().size()) - 1;
   for (std::uint32_t it = 0; it < params_.vbd_iterations; ++it) {
     if (contact)
-      self_energy_sweep();
+      self_energy_sweep(h);
     for (std::uint32_t c = 0; c < colours; ++c)
       vbd_solve_colour(c, h, contact);
   }

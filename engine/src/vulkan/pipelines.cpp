@@ -161,6 +161,8 @@ Result<VkPipeline> PipelineRegistry::pipeline(const ShaderSource& shader,
 
 VkBuffer OneSetInputs::main_binding(std::uint32_t read, std::uint32_t binding) const {
   switch (binding) {
+  case VKCLOTH_BINDING_POS_IN:
+    return pos[read]; // the positions at the substep's start
   case VKCLOTH_BINDING_POS_OUT:
     return pos[read ^ 1u]; // the positions this substep writes
   case VKCLOTH_BINDING_VEL:

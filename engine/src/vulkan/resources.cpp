@@ -242,21 +242,27 @@ Result<void> create_parity_sets(Context::Impl& ctx, VkDescriptorSetLayout layout
   return {};
 }
 
-void write_parity_sets(Context::Impl& ctx, const VkDescriptorSet (&sets)[2],
-                       std::span<const std::uint32_t> bindings,
-                       const std::function<VkBuffer(std::uint32_t read, std::uint32_t binding)>& buffer_of) {
+Result<void>
+write_parity_sets(Context::Impl& ctx, const VkDescriptorSet (&sets)[2],
+                  std::span<const std::uint32_t> bindings,
+                  const std::function<VkBuffer(std::uint32_t read, std::uint32_t binding)>& buffer_of) {
   std::vector<VkDescriptorBufferInfo> infos(2 * bindings.size());
   std::vector<VkWriteDescriptorSet> writes(2 * bindings.size());
   std::size_t k = 0;
   for (std::uint32_t read = 0; read < 2; ++read)
     for (std::uint32_t binding : bindings) {
       infos[k] = {buffer_of(read, binding), 0, VK_WHOLE_SIZE};
+      if (infos[k].buffer == VK_NULL_HANDLE)
+        return make_error(
+            ErrorCode::unsupported,
+            fmt::format("internal: descriptor binding {} has no buffer (parity {})", binding, read));
       writes[k] =
           VkWriteDescriptorSet{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, nullptr, sets[read], binding, 0, 1,
                                VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,      nullptr, &infos[k],  nullptr};
       ++k;
     }
   ctx.vk.vkUpdateDescriptorSets(ctx.device, static_cast<std::uint32_t>(k), writes.data(), 0, nullptr);
+  return {};
 }
 
 Result<BufferView> create_buffer_view(Context::Impl& ctx, VkBuffer buffer, VkFormat format,

@@ -174,10 +174,13 @@ Result<void> create_parity_sets(Context::Impl& ctx, VkDescriptorSetLayout layout
                                 VkDescriptorType type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
 
 /// Writes every binding of both parity sets as a whole storage buffer: buffer_of(read, binding)
-/// (`read`: the set's position parity, 0 or 1). Creation and buffer replacement only.
-void write_parity_sets(Context::Impl& ctx, const VkDescriptorSet (&sets)[2],
-                       std::span<const std::uint32_t> bindings,
-                       const std::function<VkBuffer(std::uint32_t read, std::uint32_t binding)>& buffer_of);
+/// (`read`: the set's position parity, 0 or 1). Creation and buffer replacement only. A binding
+/// that buffer_of maps to no buffer is an error naming it (a layout's binding left unwritten would
+/// read whatever the set held).
+Result<void>
+write_parity_sets(Context::Impl& ctx, const VkDescriptorSet (&sets)[2],
+                  std::span<const std::uint32_t> bindings,
+                  const std::function<VkBuffer(std::uint32_t read, std::uint32_t binding)>& buffer_of);
 
 /// A whole-buffer texel view of `buffer` in `format`.
 Result<BufferView> create_buffer_view(Context::Impl& ctx, VkBuffer buffer, VkFormat format, const char* name);

@@ -129,63 +129,63 @@ Result<void> ImplicitGpu::ensure_collider_passes(std::uint32_t types,
 // Long (~60 lines) but flat: one switch that maps each binding of the implicit layout
 // (implicit_shared.h) to its buffer, a table to scan rather than logic to follow.
 Result<void> ImplicitGpu::write_sets(const ImplicitInputs& in) {
-  write_parity_sets(*ctx_, sets_, sh::implicit_bindings,
-                    [&](std::uint32_t read, std::uint32_t binding) -> VkBuffer {
-                      switch (binding) {
-                      case VKCLOTH_BINDING_POS_IN:
-                        return in.pos[read];
-                      case VKCLOTH_BINDING_POS_OUT:
-                        return in.pos[read ^ 1u];
-                      case VKCLOTH_BINDING_FORCE_OUT:
-                        return in.force;
-                      case VKCLOTH_BINDING_NORMAL:
-                        return in.normal;
-                      case VKCLOTH_BINDING_VEL:
-                        return in.vel;
-                      case VKCLOTH_BINDING_PARTICLE:
-                        return in.particle;
-                      case VKCLOTH_BINDING_OFFSETS:
-                        return in.offsets;
-                      case VKCLOTH_BINDING_EDGES:
-                        return in.edges;
-                      case VKCLOTH_BINDING_COLLIDERS:
-                        return in.colliders;
-                      case VKCLOTH_BINDING_FLAGS:
-                        return in.flags;
-                      case VKCLOTH_BINDING_INSTANCES:
-                        return in.instances;
-                      case VKCLOTH_BINDING_MESH_NODES:
-                        return in.mesh_nodes;
-                      case VKCLOTH_BINDING_MESH_TRIS:
-                        return in.mesh_tris;
-                      case VKCLOTH_BINDING_MESH_CACHE:
-                        return in.mesh_cache;
-                      case VKCLOTH_BINDING_IMPL_VF:
-                        return vf_.buffer;
-                      case VKCLOTH_BINDING_IMPL_KS:
-                        return ks_.buffer;
-                      case VKCLOTH_BINDING_IMPL_BLOCK_INV:
-                        return block_inv_.buffer;
-                      case VKCLOTH_BINDING_IMPL_X:
-                        return x_.buffer;
-                      case VKCLOTH_BINDING_IMPL_R:
-                        return r_.buffer;
-                      case VKCLOTH_BINDING_IMPL_Z:
-                        return z_.buffer;
-                      case VKCLOTH_BINDING_IMPL_D:
-                        return d_.buffer;
-                      case VKCLOTH_BINDING_IMPL_Q:
-                        return q_.buffer;
-                      case VKCLOTH_BINDING_IMPL_PARTIALS:
-                        return partials_.buffer;
-                      case VKCLOTH_BINDING_IMPL_STATE:
-                        return state_.buffer;
-                      case VKCLOTH_BINDING_IMPL_ARGS:
-                        return args_.buffer;
-                      default:
-                        return VK_NULL_HANDLE;
-                      }
-                    });
+  VKCLOTH_TRY(write_parity_sets(*ctx_, sets_, sh::implicit_bindings,
+                                [&](std::uint32_t read, std::uint32_t binding) -> VkBuffer {
+                                  switch (binding) {
+                                  case VKCLOTH_BINDING_POS_IN:
+                                    return in.pos[read];
+                                  case VKCLOTH_BINDING_POS_OUT:
+                                    return in.pos[read ^ 1u];
+                                  case VKCLOTH_BINDING_FORCE_OUT:
+                                    return in.force;
+                                  case VKCLOTH_BINDING_NORMAL:
+                                    return in.normal;
+                                  case VKCLOTH_BINDING_VEL:
+                                    return in.vel;
+                                  case VKCLOTH_BINDING_PARTICLE:
+                                    return in.particle;
+                                  case VKCLOTH_BINDING_OFFSETS:
+                                    return in.offsets;
+                                  case VKCLOTH_BINDING_EDGES:
+                                    return in.edges;
+                                  case VKCLOTH_BINDING_COLLIDERS:
+                                    return in.colliders;
+                                  case VKCLOTH_BINDING_FLAGS:
+                                    return in.flags;
+                                  case VKCLOTH_BINDING_INSTANCES:
+                                    return in.instances;
+                                  case VKCLOTH_BINDING_MESH_NODES:
+                                    return in.mesh_nodes;
+                                  case VKCLOTH_BINDING_MESH_TRIS:
+                                    return in.mesh_tris;
+                                  case VKCLOTH_BINDING_MESH_CACHE:
+                                    return in.mesh_cache;
+                                  case VKCLOTH_BINDING_IMPL_VF:
+                                    return vf_.buffer;
+                                  case VKCLOTH_BINDING_IMPL_KS:
+                                    return ks_.buffer;
+                                  case VKCLOTH_BINDING_IMPL_BLOCK_INV:
+                                    return block_inv_.buffer;
+                                  case VKCLOTH_BINDING_IMPL_X:
+                                    return x_.buffer;
+                                  case VKCLOTH_BINDING_IMPL_R:
+                                    return r_.buffer;
+                                  case VKCLOTH_BINDING_IMPL_Z:
+                                    return z_.buffer;
+                                  case VKCLOTH_BINDING_IMPL_D:
+                                    return d_.buffer;
+                                  case VKCLOTH_BINDING_IMPL_Q:
+                                    return q_.buffer;
+                                  case VKCLOTH_BINDING_IMPL_PARTIALS:
+                                    return partials_.buffer;
+                                  case VKCLOTH_BINDING_IMPL_STATE:
+                                    return state_.buffer;
+                                  case VKCLOTH_BINDING_IMPL_ARGS:
+                                    return args_.buffer;
+                                  default:
+                                    return VK_NULL_HANDLE;
+                                  }
+                                }));
   return {};
 }
 

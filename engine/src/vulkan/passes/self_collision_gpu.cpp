@@ -132,37 +132,37 @@ Result<void> SelfCollisionGpu::write_texel_sets(const OneSetInputs& in) {
 }
 
 Result<void> SelfCollisionGpu::write_sets(const OneSetInputs& in) {
-  write_parity_sets(*ctx_, sets_, sh::self_collision_bindings,
-                    [&](std::uint32_t read, std::uint32_t binding) -> VkBuffer {
-                      switch (binding) {
-                      case VKCLOTH_BINDING_SELF_PARAMS:
-                        return params_.buffer;
-                      case VKCLOTH_BINDING_SELF_REST:
-                        return rest_.buffer;
-                      case VKCLOTH_BINDING_SELF_COUNTS:
-                        return counts_.buffer;
-                      case VKCLOTH_BINDING_SELF_STARTS:
-                        return starts_.buffer;
-                      case VKCLOTH_BINDING_SELF_BLOCKS:
-                        return blocks_.buffer;
-                      case VKCLOTH_BINDING_SELF_KEYS:
-                        return keys_.buffer;
-                      case VKCLOTH_BINDING_SELF_SORTED:
-                        return sorted_.buffer;
-                      case VKCLOTH_BINDING_SELF_DELTA:
-                        return delta_.buffer;
-                      case VKCLOTH_BINDING_SELF_BUILT:
-                        return built_.buffer;
-                      case VKCLOTH_BINDING_SELF_LISTED:
-                        return listed_.buffer;
-                      case VKCLOTH_BINDING_SELF_LIST:
-                        return list_.buffer;
-                      case VKCLOTH_BINDING_SELF_STALE:
-                        return stale_.buffer;
-                      default:
-                        return in.main_binding(read, binding);
-                      }
-                    });
+  VKCLOTH_TRY(write_parity_sets(*ctx_, sets_, sh::self_collision_bindings,
+                                [&](std::uint32_t read, std::uint32_t binding) -> VkBuffer {
+                                  switch (binding) {
+                                  case VKCLOTH_BINDING_SELF_PARAMS:
+                                    return params_.buffer;
+                                  case VKCLOTH_BINDING_SELF_REST:
+                                    return rest_.buffer;
+                                  case VKCLOTH_BINDING_SELF_COUNTS:
+                                    return counts_.buffer;
+                                  case VKCLOTH_BINDING_SELF_STARTS:
+                                    return starts_.buffer;
+                                  case VKCLOTH_BINDING_SELF_BLOCKS:
+                                    return blocks_.buffer;
+                                  case VKCLOTH_BINDING_SELF_KEYS:
+                                    return keys_.buffer;
+                                  case VKCLOTH_BINDING_SELF_SORTED:
+                                    return sorted_.buffer;
+                                  case VKCLOTH_BINDING_SELF_DELTA:
+                                    return delta_.buffer;
+                                  case VKCLOTH_BINDING_SELF_BUILT:
+                                    return built_.buffer;
+                                  case VKCLOTH_BINDING_SELF_LISTED:
+                                    return listed_.buffer;
+                                  case VKCLOTH_BINDING_SELF_LIST:
+                                    return list_.buffer;
+                                  case VKCLOTH_BINDING_SELF_STALE:
+                                    return stale_.buffer;
+                                  default:
+                                    return in.main_binding(read, binding);
+                                  }
+                                }));
   return access_ == BufferAccess::texel_views ? write_texel_sets(in) : Result<void>{};
 }
 

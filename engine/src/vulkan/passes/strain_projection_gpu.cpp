@@ -108,23 +108,23 @@ Result<void> StrainProjectionGpu::create_sets() {
 }
 
 Result<void> StrainProjectionGpu::write_sets(const OneSetInputs& in) {
-  write_parity_sets(*ctx_, sets_, sh::strain_project_bindings,
-                    [&](std::uint32_t read, std::uint32_t binding) -> VkBuffer {
-                      switch (binding) {
-                      case VKCLOTH_BINDING_PROJ_INCIDENCE:
-                        return incidence_.buffer;
-                      case VKCLOTH_BINDING_PROJ_LINKS:
-                        return link_state_.buffer;
-                      case VKCLOTH_BINDING_PROJ_GATHER:
-                        return gathered_.buffer;
-                      case VKCLOTH_BINDING_PROJ_STATE:
-                        return state_.buffer;
-                      case VKCLOTH_BINDING_PROJ_ARGS:
-                        return args_.buffer;
-                      default:
-                        return in.main_binding(read, binding);
-                      }
-                    });
+  VKCLOTH_TRY(write_parity_sets(*ctx_, sets_, sh::strain_project_bindings,
+                                [&](std::uint32_t read, std::uint32_t binding) -> VkBuffer {
+                                  switch (binding) {
+                                  case VKCLOTH_BINDING_PROJ_INCIDENCE:
+                                    return incidence_.buffer;
+                                  case VKCLOTH_BINDING_PROJ_LINKS:
+                                    return link_state_.buffer;
+                                  case VKCLOTH_BINDING_PROJ_GATHER:
+                                    return gathered_.buffer;
+                                  case VKCLOTH_BINDING_PROJ_STATE:
+                                    return state_.buffer;
+                                  case VKCLOTH_BINDING_PROJ_ARGS:
+                                    return args_.buffer;
+                                  default:
+                                    return in.main_binding(read, binding);
+                                  }
+                                }));
   return {};
 }
 
