@@ -2,7 +2,6 @@
 #include "vkcloth/cpu_solver.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -412,86 +411,6 @@ template <typename Real> void CpuSolver<Real>::Impl::substep(const Real h) {
     limit_stretch(h);
   if (params_.self_collision.enabled && !self_energy()) // vbd's energy acted in its sweeps
     self_collide();
-}
-
-// The tethers first (anchors are pinned: every particle's tethers are independent of the
-// others'), then Provot's sweeps (one colour at a time: its links share no particle, so they are
-// projected in parallel with the same result as in order), so that the structural springs get
-// the last word; or, for method projection, the fast projection after the tethers
-// (strain_projection.cpp);
-// then the colliders' projection, since a correction may have pulled a particle into one. Each
-// formula: cloth_kernel.h; the GPU: strain_finish.comp, strain_links.comp, strain_project.comp.
-template <typename Real> void CpuSolver<Real>::Impl::limit_stretch(const Real h) {
-  const StretchLimit& sl = params_.stretch_limit;
-  const Real max_strain = Real(sl.max_strain);
-  // The row sweep's SoA copy of the positions (when valid) follows every move, so the next sweep
-  // need not transpose the whole state again.
-  const std::size_t stride = pos_.size() + 2 * soa_pad_;
-  Real* const soa = soa_valid_ ? soa_.data() + soa_pad_ : nullptr;
-  auto moved = [&](std::size_t q) {
-    if (!soa)
-      return;
-    soa[q] = pos_[q].x;
-    soa[stride + q] = pos_[q].y;
-    soa[2 * stride + q] = pos_[q].z;
-  };
-  if (strain_links_.empty() && !topology_->strain_links().empty())
-    for (const StrainLink& l : topology_->strain_links())
-      strain_links_.push_back(Link{l.a, l.b, Real(l.rest_length)});
-  if (sl.tethers()) {
-    if (tethers_.empty() || tether_kind_ != sl.tether_distance) {
-      tethers_.clear();
-      for (const Tether& t : topology_->tethers(sl.tether_distance))
-        tethers_.push_back(TetherSlot{t.anchor, Real(t.rest_length)});
-      tether_kind_ = sl.tether_distance;
-    }
-    pool_->for_each(pos_.size(), [&](std::size_t p) {
-      for (std::uint32_t k = 0; !pinned_[p] && k < tethers_per_particle; ++k) {
-        const TetherSlot& t = tethers_[p * tethers_per_particle + k];
-        if (t.anchor == no_tether)
-          break;
-        Vec3 d;
-        if (kernel::tether_move(pos_[p], pos_[t.anchor], kernel::stretch_bound(t.rest_length, max_strain),
-                                d)) {
-          kernel::apply_correction(pos_[p], vel_[p], d, h);
-          moved(p);
-        }
-      }
-    });
-  }
-  const std::span<const std::uint32_t> colours = topology_->strain_colour_offsets();
-  // A sweep that moves no link leaves every link within its bound, so the sweeps after it would
-  // move none either: stopping there gives the same bits as running them all (as the GPU does).
-  std::atomic<bool> corrected{true};
-  for (std::uint32_t it = 0; sl.provot() && it < sl.iterations && corrected.load(std::memory_order_relaxed);
-       ++it) {
-    corrected.store(false, std::memory_order_relaxed);
-    for (std::size_t c = 0; c + 1 < colours.size(); ++c)
-      pool_->for_each(colours[c + 1] - colours[c], [&](std::size_t k) {
-        const Link& l = strain_links_[colours[c] + k];
-        Vec3 da, db;
-        if (!kernel::provot_link(pos_[l.a], pos_[l.b], pinned_[l.a] != 0, pinned_[l.b] != 0,
-                                 kernel::stretch_bound(l.rest_length, max_strain), da, db))
-          return;
-        kernel::apply_correction(pos_[l.a], vel_[l.a], da, h);
-        kernel::apply_correction(pos_[l.b], vel_[l.b], db, h);
-        moved(l.a);
-        moved(l.b);
-        corrected.store(true, std::memory_order_relaxed);
-      });
-  }
-  if (sl.projection()) {
-    project_strain(h);
-    soa_valid_ = false; // the next row sweep transposes the moved positions
-  }
-  if (!params_.colliders.empty())
-    pool_->for_each(pos_.size(), [&](std::size_t p) {
-      if (!pinned_[p]) {
-        project_at(p, pos_[p], pos_[p], vel_[p]);
-        moved(p);
-      }
-    });
-  swept_finite_ = false; // the moves are checked with the rest of the state (check_finite)
 }
 
 template <typename Real>
