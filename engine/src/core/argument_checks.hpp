@@ -12,6 +12,10 @@
 
 #include "vkcloth/result.hpp"
 
+namespace vkcloth {
+struct Collider;
+}
+
 namespace vkcloth::detail {
 
 inline Error bad_argument(std::string message) {
@@ -24,5 +28,9 @@ inline bool finite(glm::dvec3 v) {
 inline std::string str(glm::dvec3 v) {
   return fmt::format("[{}, {}, {}]", v.x, v.y, v.z);
 }
+
+/// One collider's fields (the message names `at`.field and the value); normalises a plane's
+/// normal (collider.cpp; SimParams::validate checks each of its colliders with it).
+Result<void> validate_collider(Collider& c, const std::string& at);
 
 } // namespace vkcloth::detail
