@@ -21,7 +21,6 @@ using detail::finite;
 using detail::str;
 namespace {
 
-
 bool positive(double x) {
   return std::isfinite(x) && x > 0.0;
 }
@@ -140,7 +139,6 @@ Result<void> validate_collider(Collider& c, const std::string& at) {
 }
 
 } // namespace detail
-
 
 Collider Collider::plane(glm::dvec3 normal, double offset) {
   Collider c;
