@@ -228,9 +228,14 @@ foreach(i RANGE ${last})
   string(JSON skin GET "${doc}" results ${i} self_collision_skin)
   string(JSON stiffness GET "${doc}" results ${i} self_collision_stiffness)
   string(JSON ratio GET "${doc}" results ${i} self_collision_ratio)
-  if(NOT skin GREATER 0 OR NOT stiffness EQUAL 200 OR NOT ratio GREATER 0)
+  # vbd's per-sweep figures, as for the grid rows (a number: an unset sweep count wrote null)
+  string(JSON sweeps GET "${doc}" results ${i} vbd_sweeps_per_step)
+  string(JSON per_sweep GET "${doc}" results ${i} ns_per_particle_sweep)
+  if(NOT skin GREATER 0 OR NOT stiffness EQUAL 200 OR NOT ratio GREATER 0 OR NOT sweeps GREATER 0
+     OR NOT per_sweep GREATER 0)
     message(FATAL_ERROR "bench JSON (self-collision energy): results[${i}] has skin ${skin}, stiffness "
-                        "${stiffness}, ratio ${ratio}")
+                        "${stiffness}, ratio ${ratio}, vbd_sweeps_per_step ${sweeps}, ns_per_particle_sweep "
+                        "${per_sweep}")
   endif()
   math(EXPR energy_rows "${energy_rows} + 1")
 endforeach()

@@ -362,6 +362,8 @@ int self_collision_rows(BenchRun& run) {
               r.self_thickness = sc->params.self_collision.thickness;
               r.self_skin = sc->params.self_collision.skin;
               r.self_stiffness = sc->params.self_collision.stiffness;
+              if (sc->params.integrator == Integrator::vbd) // the per-sweep figures (print_ratios, JSON)
+                r.vbd_sweeps = sc->params.vbd_iterations * sc->params.substeps;
             }))
       return e;
   }
