@@ -18,7 +18,8 @@
 #define SELF_DATA self_data
 void self_range(uint unused, uint b, out uint first, out uint stop);
 void self_entry(uint unused, uint i, out uint q, out uint key);
-void self_particle(uint unused, uint q, out vec3 x, out vec3 v, out float w, out vec3 rest);
+void self_particle(uint unused, uint q, out vec3 x, out float w, out vec3 rest);
+vec3 self_velocity(uint unused, uint q);
 void self_list_put(uint unused, uint p, uint slot, uint q);
 void self_entry_particle(uint unused, uint i, uint q, out vec3 x, out vec3 rest);
 uint self_list_get(uint unused, uint p, uint i);
@@ -45,7 +46,7 @@ layout(std430, set = 0, binding = VKCLOTH_BINDING_ACC_VEL) writeonly buffer Cont
 layout(std430, set = 0, binding = VKCLOTH_BINDING_STAGE_VEL) writeonly buffer ContactOff { vec4 contact_off[]; };
 // vbd's positions at the step's start (CONTACT: the friction's slips).
 layout(std430, set = 0, binding = VKCLOTH_BINDING_POS_IN) readonly buffer StepStart { vec4 step_start[]; };
-// CONTACT: self_particle gives each particle's move since the step's start in place of its velocity.
+// CONTACT: self_velocity gives each particle's move since the step's start in place of its velocity.
 bool contact_pass = false;
 
 shared uint partial[VKCLOTH_WORKGROUP_SIZE];
@@ -73,12 +74,14 @@ void self_entry(uint unused, uint i, out uint q, out uint key) {
   q = e.x;
   key = e.y;
 }
-void self_particle(uint unused, uint q, out vec3 x, out vec3 v, out float w, out vec3 rest) {
+void self_particle(uint unused, uint q, out vec3 x, out float w, out vec3 rest) {
   x = read_pos_out(q);
-  v = contact_pass ? x - step_start[base + q].xyz : read_velocity(q);
   const vec4 r = read_self_rest(q);
   w = r.w; // the host's kernel inverse_mass, as the CPU's
   rest = r.xyz;
+}
+vec3 self_velocity(uint unused, uint q) {
+  return contact_pass ? read_pos_out(q) - step_start[base + q].xyz : read_velocity(q);
 }
 
 void self_entry_particle(uint unused, uint i, uint q, out vec3 x, out vec3 rest) {

@@ -32,7 +32,7 @@
 // all_finite(vec3) (no component is NaN or inf); for mesh colliders MESH_DATA_PARAM / MESH_DATA
 // (the mesh buffers: a dummy uint in GLSL, whose buffers are global), mesh_node and mesh_triangle;
 // floor; for self_collide (only where SELF_DATA_PARAM is defined) SELF_DATA_PARAM / SELF_DATA,
-// self_range, self_entry and self_particle;
+// self_range, self_entry, self_particle and self_velocity;
 // VKCLOTH_COLLIDER_PRESENT(type): false only when no collider of that type can reach the caller
 // (C++: always true; GLSL: a specialisation constant, so that the absent shapes' code is compiled
 // out, since llvmpipe runs every branch of a non-uniform `if`). It changes no result.

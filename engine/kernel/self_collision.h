@@ -174,10 +174,11 @@ KFN void self_add_pair(uint mode, INOUT(vec3) sum_x, INOUT(vec3) sum_v, INOUT(Sp
 // neighbour list (candidates within `reach2`) and returns its length (past the capacity it stops
 // writing, and the count says the list overflowed); ENERGY adds the pairs' contact energy (stiffness
 // `k`, friction `mu` with static slip `slip`) to f and hessian and returns the number of pairs (v and
-// self_particle's velocities are then the particles' moves since the step's start).
+// self_velocity's are then the particles' moves since the step's start).
 // Provided by the including file: self_range(SELF_DATA, bucket, first, stop) (the bucket's entries
 // of the sorted table), self_entry(SELF_DATA, i, q, key) (an entry's particle and the key of the
-// cell it was sorted in), self_particle(SELF_DATA, q, x, v, w, rest), self_entry_particle(SELF_DATA,
+// cell it was sorted in), self_particle(SELF_DATA, q, x, w, rest), self_velocity(SELF_DATA, q) (read
+// only for a pair, where the response needs it), self_entry_particle(SELF_DATA,
 // i, q, x, rest) (entry i's particle q, as the table was built: a backend may keep them in table
 // order), self_list_put(SELF_DATA, p, slot, q). Both backends build the same table, so they visit
 // the same particles in the same order.
@@ -221,8 +222,9 @@ KFN uint self_walk(SELF_DATA_PARAM, uint p, uint own, uint mode, vec3 x, vec3 v,
             }
             continue;
           }
-          self_particle(SELF_DATA, q, xq, vq, wq, rq);
+          self_particle(SELF_DATA, q, xq, wq, rq);
           if (self_pair(x, xq, rx, rq, t2)) {
+            vq = self_velocity(SELF_DATA, q);
             self_add_pair(mode, sum_x, sum_v, hessian, x, v, w, xq, vq, wq, thickness, mu, k, slip);
             found += 1u;
           }
@@ -276,8 +278,9 @@ KFN uint self_pairs(SELF_DATA_PARAM, uint p, uint listed, uint own, uint mode, v
     vec3 vq;
     vec3 rq;
     real wq;
-    self_particle(SELF_DATA, q, xq, vq, wq, rq);
+    self_particle(SELF_DATA, q, xq, wq, rq);
     if (self_pair(x, xq, rx, rq, t2)) {
+      vq = self_velocity(SELF_DATA, q);
       self_add_pair(mode, sum_x, sum_v, hessian, x, v, w, xq, vq, wq, thickness, mu, k, slip);
       pairs += 1u;
     }
@@ -300,7 +303,7 @@ KFN void self_collide_listed(SELF_DATA_PARAM, uint p, uint listed, uint own, vec
 
 // Particle p's self-contact energy in its vertex step (vbd with a self-contact stiffness k > 0):
 // its pairs (self_pairs) at the positions the sweep starts from (x: p's, self_particle: the
-// others'; u and self_particle's velocities: the moves since the step's start, for the friction mu
+// others'; u and self_velocity's: the moves since the step's start, for the friction mu
 // over a step of h), as f (the force) and hessian (the stiffness), which the step adds to its springs'.
 KFN void self_energy_listed(SELF_DATA_PARAM, uint p, uint listed, uint own, vec3 x, vec3 u, vec3 rx,
                             real thickness, uint mask, real k, real mu, real h, OUT(vec3) f,

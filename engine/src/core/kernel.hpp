@@ -165,7 +165,7 @@ template <typename Real> struct SelfDataT {
   const std::uint32_t* sorted_key = nullptr;
   const glm::vec<3, Real>* entry_pos = nullptr;
   const glm::vec<3, Real>* entry_rest = nullptr;
-  // vbd's contact energy (optional): the positions at the step's start; self_particle then gives each
+  // vbd's contact energy (optional): the positions at the step's start; self_velocity then gives each
   // particle's move since then in place of its velocity (self_energy's friction).
   const glm::vec<3, Real>* step_start = nullptr;
 };
@@ -189,11 +189,13 @@ template <typename Real> uint self_list_get(const SelfDataT<Real>& d, uint p, ui
   return d.list[std::size_t(p) * VKCLOTH_SELF_LIST_CAPACITY + i];
 }
 template <typename Real, typename V>
-void self_particle(const SelfDataT<Real>& d, uint q, V& x, V& v, Real& w, V& rest) {
+void self_particle(const SelfDataT<Real>& d, uint q, V& x, Real& w, V& rest) {
   x = d.pos[q];
-  v = d.step_start ? V(d.pos[q] - d.step_start[q]) : d.vel[q];
   w = d.inv_mass[q];
   rest = d.rest[q];
+}
+template <typename Real> glm::vec<3, Real> self_velocity(const SelfDataT<Real>& d, uint q) {
+  return d.step_start ? glm::vec<3, Real>(d.pos[q] - d.step_start[q]) : d.vel[q];
 }
 
 namespace f32 {
