@@ -61,28 +61,29 @@ inline void expect_obj_error(const std::string& text, std::initializer_list<std:
 
 // A quad and a triangle sharing an edge, with texture coordinates. Values are exact in float, so the
 // glTF version of it reads back the same doubles.
-inline const std::vector<glm::dvec3> ref_positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {2, 0, 0.5}};
+inline const std::vector<glm::dvec3> ref_positions = {
+    {0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {2, 0, 0.5}};
 inline const std::vector<glm::dvec2> ref_uvs = {{0, 0}, {0.5, 0}, {0.5, 1}, {0, 1}, {1, 0.25}};
 
 inline const char* const ref_obj = "# a quad and a triangle\n"
-                            "mtllib cloth.mtl\n"
-                            "o cloth\n"
-                            "v 0 0 0\n"
-                            "v 1 0 0\r\n"
-                            "v 1 1 0 # a comment after the values\n"
-                            "v 0 1 0\n"
-                            "v 2 0 0.5 1\n"
-                            "vt 0 1\n" // OBJ's v goes up: these are ref_uvs with v -> 1 - v
-                            "vt 0.5 1\n"
-                            "vt 0.5 0\n"
-                            "vt 0 0\n"
-                            "vt 1 0.75 0\n"
-                            "vn 0 0 1\n"
-                            "g front\n"
-                            "usemtl cotton\n"
-                            "s off\n"
-                            "f 1/1/1 2/2/1 3/3/1 4/4/1\n"
-                            "\tf  -4/-4   -1/-1 -3/-3  \n"; // relative indices: 2 5 3
+                                   "mtllib cloth.mtl\n"
+                                   "o cloth\n"
+                                   "v 0 0 0\n"
+                                   "v 1 0 0\r\n"
+                                   "v 1 1 0 # a comment after the values\n"
+                                   "v 0 1 0\n"
+                                   "v 2 0 0.5 1\n"
+                                   "vt 0 1\n" // OBJ's v goes up: these are ref_uvs with v -> 1 - v
+                                   "vt 0.5 1\n"
+                                   "vt 0.5 0\n"
+                                   "vt 0 0\n"
+                                   "vt 1 0.75 0\n"
+                                   "vn 0 0 1\n"
+                                   "g front\n"
+                                   "usemtl cotton\n"
+                                   "s off\n"
+                                   "f 1/1/1 2/2/1 3/3/1 4/4/1\n"
+                                   "\tf  -4/-4   -1/-1 -3/-3  \n"; // relative indices: 2 5 3
 
 } // namespace mesh_io_test
 using namespace mesh_io_test;

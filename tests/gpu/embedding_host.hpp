@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: MIT
-// What the embedding tests share (test_embedding.cpp, test_embedding_frames.cpp): a small cloth's
-// topology, the test host (HostVulkan, skipped off CI when it cannot make its device) and its
-// handles for Context::adopt.
+// What the embedding tests share (test_embedding.cpp, test_embedding_frames.cpp): the test host
+// (HostVulkan, skipped off CI when it cannot make its device) and its handles for Context::adopt.
 #pragma once
 
 #include <memory>
@@ -13,23 +12,6 @@
 #include "host_vulkan.hpp"
 
 namespace vkcloth::gpu::test {
-
-inline std::shared_ptr<const ClothTopology> make_topology(std::uint32_t nx, std::uint32_t ny,
-                                                          bool horizontal = false) {
-  ClothDesc d;
-  d.nx = nx;
-  d.ny = ny;
-  if (horizontal) {
-    d.orientation = ClothOrientation::horizontal;
-    d.origin = {-0.5, -0.5, 0.3};
-    d.pin_default_corners = false;
-  }
-  auto s = make_cloth(d);
-  REQUIRE(s.ok());
-  auto t = ClothTopology::create(*s);
-  REQUIRE(t.ok());
-  return *t;
-}
 
 inline std::unique_ptr<HostVulkan> host_or_skip(std::string& error) {
   auto h = HostVulkan::create(error);

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -106,6 +107,24 @@ inline CpuGpuRun run_cpu_and_gpu(Context& ctx, const std::filesystem::path& file
   REQUIRE(r.cpu->run(steps).ok());
   REQUIRE(r.gpu->simulate(steps).ok());
   return r;
+}
+
+/// A small nx x ny cloth's topology: vertical with its default pinned corners, or horizontal and free.
+inline std::shared_ptr<const ClothTopology> make_topology(std::uint32_t nx, std::uint32_t ny,
+                                                          bool horizontal = false) {
+  ClothDesc d;
+  d.nx = nx;
+  d.ny = ny;
+  if (horizontal) {
+    d.orientation = ClothOrientation::horizontal;
+    d.origin = {-0.5, -0.5, 0.3};
+    d.pin_default_corners = false;
+  }
+  auto s = make_cloth(d);
+  REQUIRE(s.ok());
+  auto t = ClothTopology::create(*s);
+  REQUIRE(t.ok());
+  return *t;
 }
 
 } // namespace vkcloth::gpu::test
