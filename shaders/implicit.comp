@@ -254,9 +254,7 @@ void main() {
       if (!warm) cx[p] = vec4(0.0); // neighbours read cx only when warm: no race
       precise vec3 lv = vec3(0.0);
       precise vec3 lx = vec3(0.0);
-      SpringBlock ksum;
-      ksum.diag = vec3(0.0);
-      ksum.off = vec3(0.0);
+      SpringBlock ksum = zero_block();
       const uint end = offsets[p + 1];
       for (uint e = offsets[p]; e < end; ++e) {
         const Edge s = edges[e];
@@ -268,10 +266,7 @@ void main() {
         add_block(ksum, k);
       }
       if (pinned) {
-        SpringBlock zero;
-        zero.diag = vec3(0.0);
-        zero.off = vec3(0.0);
-        store_precond(p, zero);
+        store_precond(p, zero_block());
         cr[p] = cz[p] = cd[p] = vec4(0.0);
       } else {
         const float m = particle[p].mass;

@@ -216,9 +216,7 @@ void main() {
       atomicOr(stale[2u * inst], 1u);
   } else if (stage == VKCLOTH_SELF_CONTACT) {
     vec3 f = vec3(0.0);
-    SpringBlock hc;
-    hc.diag = vec3(0.0);
-    hc.off = vec3(0.0);
+    SpringBlock hc = zero_block();
     contact_pass = true;
     const vec3 x = pos_out[base + p].xyz;
     if (particle[p].pinned == 0u)

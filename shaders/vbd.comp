@@ -60,9 +60,7 @@ void begin(uint p, uint g, bool pinned) {
 void solve(uint p, uint g) {
   const vec3 x = pos_out[g].xyz;
   vec3 f = vec3(0.0);
-  SpringBlock hessian;
-  hessian.diag = vec3(0.0);
-  hessian.off = vec3(0.0);
+  SpringBlock hessian = zero_block();
   const uvec3 range = read_list_range(p);
   for (uint e = range.x; e < range.z; ++e) {
     const Edge s = read_edge(e);

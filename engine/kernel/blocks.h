@@ -27,6 +27,14 @@ KFN SpringBlock spring_block_n(vec3 n, real r, real k) {
   return s;
 }
 
+// The zero block (a sum's start).
+KFN SpringBlock zero_block() {
+  SpringBlock s;
+  s.diag = vec3(real(0));
+  s.off = vec3(real(0));
+  return s;
+}
+
 // c (I - n n^T) for a unit n: a stiffness c across n and none along it (self_energy's friction).
 KFN SpringBlock tangent_block(vec3 n, real c) {
   SpringBlock s;

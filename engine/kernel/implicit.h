@@ -7,9 +7,7 @@
 // ---- Implicit Euler (docs/model.md "Implicit Euler") ------------------------------------------
 
 KFN SpringBlock spring_block(vec3 u, real rest, real k) {
-  SpringBlock s;
-  s.diag = vec3(real(0));
-  s.off = vec3(real(0));
+  SpringBlock s = zero_block();
   precise real len = sqrt(dot3(u, u));
   if (len > real(0)) {
     precise vec3 n = u / len;

@@ -110,11 +110,12 @@ KFN bool self_moved(vec3 x, vec3 xb, real half_skin2) {
 // and a force mu lambda against a longer one (kinetic); IPC's lagged friction, as vbd's Gaia.
 KFN void self_energy(INOUT(vec3) f, INOUT(SpringBlock) hessian, vec3 x, vec3 u, vec3 xq, vec3 uq,
                      real thickness, real k, real mu, real slip) {
-  vbd_add_spring(f, hessian, xq - x, thickness, k);
+  precise vec3 u_q = xq - x;
+  precise real d = sqrt(dot3(u_q, u_q)); // > 0: self_pair
+  vbd_add_spring_len(f, hessian, u_q, d, thickness, k);
   if (!(mu > real(0)))
     return;
   precise vec3 e = x - xq;
-  precise real d = sqrt(dot3(e, e)); // > 0: self_pair
   precise vec3 n = e / d;
   precise real lambda = k * (thickness - d);
   precise vec3 r = u - uq;
@@ -154,19 +155,28 @@ KFN void self_cell_span(real c, real inv_cell, OUT(int) lo, OUT(int) hi) {
 #define VKCLOTH_SELF_WALK_GATHER 1u  // writes p's neighbour list (self_candidate, self_list_put)
 #define VKCLOTH_SELF_WALK_ENERGY 2u  // adds every pair's contact energy to p's vertex step (self_energy)
 
-// One pair's part for `mode` (VKCLOTH_SELF_WALK_COLLIDE: p's response into sum_x, sum_v; ENERGY: the
-// contact energy into sum_x, the force, and hessian, where v and vq are the particles' moves since
-// the step's start).
-KFN void self_add_pair(uint mode, INOUT(vec3) sum_x, INOUT(vec3) sum_v, INOUT(SpringBlock) hessian, vec3 x,
-                       vec3 v, real w, vec3 xq, vec3 vq, real wq, real thickness, real mu, real k,
-                       real slip) {
+#ifdef SELF_DATA_PARAM // the includer provides the table (C++: kernel.hpp; GLSL: self_collision.comp)
+// Candidate q of p for `mode` (COLLIDE or ENERGY): when the two are a pair (self_pair; t2 the
+// thickness squared), its part goes into sum_x, sum_v (COLLIDE: p's response) or sum_x, the force,
+// and hessian (ENERGY: the contact energy, where v and q's self_velocity are the particles' moves
+// since the step's start); returns 1 for a pair, else 0.
+KFN uint self_visit(SELF_DATA_PARAM, uint q, uint mode, vec3 x, vec3 v, real w, vec3 rx, real t2,
+                    real thickness, real mu, real k, real slip, INOUT(vec3) sum_x, INOUT(vec3) sum_v,
+                    INOUT(SpringBlock) hessian) {
+  vec3 xq;
+  vec3 rq;
+  real wq;
+  self_particle(SELF_DATA, q, xq, wq, rq);
+  if (!self_pair(x, xq, rx, rq, t2))
+    return 0u;
+  const vec3 vq = self_velocity(SELF_DATA, q); // read for a pair only
   if (mode == VKCLOTH_SELF_WALK_ENERGY)
     self_energy(sum_x, hessian, x, v, xq, vq, thickness, k, mu, slip);
   else
     self_contact(sum_x, sum_v, x, v, w, xq, vq, wq, thickness, mu);
+  return 1u;
 }
 
-#ifdef SELF_DATA_PARAM // the includer provides the table (C++: kernel.hpp; GLSL: self_collision.comp)
 // The 27 cells around the cell of key `own`, cell by cell in a fixed order, each cell's particles in
 // increasing index (a bucket holds the particles of every cell hashed to it, in increasing index:
 // those of other cells are skipped by their key), for `mode` (VKCLOTH_SELF_WALK_*): COLLIDE adds p's
@@ -209,23 +219,17 @@ KFN uint self_walk(SELF_DATA_PARAM, uint p, uint own, uint mode, vec3 x, vec3 v,
           self_entry(SELF_DATA, i, q, qkey);
           if (qkey != key || q == p)
             continue;
-          vec3 xq;
-          vec3 vq;
-          vec3 rq;
-          real wq;
-          if (mode == VKCLOTH_SELF_WALK_GATHER) {
-            self_entry_particle(SELF_DATA, i, q, xq, rq); // right after the build: by entry
-            if (self_candidate(x, xq, rx, rq, reach2, t2)) {
-              if (found < uint(VKCLOTH_SELF_LIST_CAPACITY))
-                self_list_put(SELF_DATA, p, found, q);
-              found += 1u;
-            }
+          if (mode != VKCLOTH_SELF_WALK_GATHER) {
+            found += self_visit(SELF_DATA, q, mode, x, v, w, rx, t2, thickness, mu, k, slip, sum_x, sum_v,
+                                hessian);
             continue;
           }
-          self_particle(SELF_DATA, q, xq, wq, rq);
-          if (self_pair(x, xq, rx, rq, t2)) {
-            vq = self_velocity(SELF_DATA, q);
-            self_add_pair(mode, sum_x, sum_v, hessian, x, v, w, xq, vq, wq, thickness, mu, k, slip);
+          vec3 xq;
+          vec3 rq;
+          self_entry_particle(SELF_DATA, i, q, xq, rq); // right after the build: by entry
+          if (self_candidate(x, xq, rx, rq, reach2, t2)) {
+            if (found < uint(VKCLOTH_SELF_LIST_CAPACITY))
+              self_list_put(SELF_DATA, p, found, q);
             found += 1u;
           }
         }
@@ -239,9 +243,7 @@ KFN uint self_gather(SELF_DATA_PARAM, uint p, uint own, vec3 x, vec3 rx, real th
                      real inv_cell, uint mask) {
   vec3 unused_x = vec3(real(0));
   vec3 unused_v = vec3(real(0));
-  SpringBlock unused;
-  unused.diag = vec3(real(0));
-  unused.off = vec3(real(0));
+  SpringBlock unused = zero_block();
   return self_walk(SELF_DATA, p, own, VKCLOTH_SELF_WALK_GATHER, x, vec3(real(0)), real(0), rx, thickness,
                    reach2, inv_cell, mask, real(0), real(0), real(0), unused_x, unused_v, unused);
 }
@@ -251,9 +253,7 @@ KFN void self_collide(SELF_DATA_PARAM, uint p, vec3 x, vec3 v, real w, vec3 rx, 
                       uint mask, real mu, OUT(vec3) dx, OUT(vec3) dv) {
   precise vec3 sum_x = vec3(real(0));
   precise vec3 sum_v = vec3(real(0));
-  SpringBlock unused;
-  unused.diag = vec3(real(0));
-  unused.off = vec3(real(0));
+  SpringBlock unused = zero_block();
   const uint pairs =
       self_walk(SELF_DATA, p, self_key(x, inv_cell), VKCLOTH_SELF_WALK_COLLIDE, x, v, w, rx, thickness,
                 real(0), inv_cell, mask, mu, real(0), real(0), sum_x, sum_v, unused);
@@ -272,19 +272,9 @@ KFN uint self_pairs(SELF_DATA_PARAM, uint p, uint listed, uint own, uint mode, v
                      sum_x, sum_v, hessian);
   precise real t2 = thickness * thickness;
   uint pairs = 0u;
-  for (uint i = 0u; i < listed; ++i) {
-    const uint q = self_list_get(SELF_DATA, p, i);
-    vec3 xq;
-    vec3 vq;
-    vec3 rq;
-    real wq;
-    self_particle(SELF_DATA, q, xq, wq, rq);
-    if (self_pair(x, xq, rx, rq, t2)) {
-      vq = self_velocity(SELF_DATA, q);
-      self_add_pair(mode, sum_x, sum_v, hessian, x, v, w, xq, vq, wq, thickness, mu, k, slip);
-      pairs += 1u;
-    }
-  }
+  for (uint i = 0u; i < listed; ++i)
+    pairs += self_visit(SELF_DATA, self_list_get(SELF_DATA, p, i), mode, x, v, w, rx, t2, thickness, mu, k,
+                        slip, sum_x, sum_v, hessian);
   return pairs;
 }
 
@@ -293,9 +283,7 @@ KFN void self_collide_listed(SELF_DATA_PARAM, uint p, uint listed, uint own, vec
                              real thickness, uint mask, real mu, OUT(vec3) dx, OUT(vec3) dv) {
   precise vec3 sum_x = vec3(real(0));
   precise vec3 sum_v = vec3(real(0));
-  SpringBlock unused;
-  unused.diag = vec3(real(0));
-  unused.off = vec3(real(0));
+  SpringBlock unused = zero_block();
   const uint pairs = self_pairs(SELF_DATA, p, listed, own, VKCLOTH_SELF_WALK_COLLIDE, x, v, w, rx, thickness,
                                 mask, mu, real(0), real(0), sum_x, sum_v, unused);
   self_mean(sum_x, sum_v, pairs, dx, dv);
@@ -310,9 +298,7 @@ KFN void self_energy_listed(SELF_DATA_PARAM, uint p, uint listed, uint own, vec3
                             OUT(SpringBlock) hessian) {
   precise vec3 sum_f = vec3(real(0));
   vec3 unused_v = vec3(real(0));
-  SpringBlock block;
-  block.diag = vec3(real(0));
-  block.off = vec3(real(0));
+  SpringBlock block = zero_block();
   precise real slip = real(VKCLOTH_SELF_FRICTION_SLIP_SPEED) * h;
   self_pairs(SELF_DATA, p, listed, own, VKCLOTH_SELF_WALK_ENERGY, x, u, real(0), rx, thickness, mask, mu, k,
              slip, sum_f, unused_v, block);

@@ -19,9 +19,9 @@ KFN precise vec3 vbd_inertia_target(vec3 x0, vec3 v0, vec3 f_ext, real m, real h
 // One spring's part in a vertex's step, u = x_q - x: its force, eq. 2 as K (|u| - L0) n with the
 // unit direction n (add_spring_edge keeps the explicit step's rounding, u K (|u| - L0) / |u|), and
 // its stiffness block (spring_block_n: the positive semi-definite part of the Hessian), from one
-// length and one reciprocal. A zero-length spring adds nothing.
-KFN void vbd_add_spring(INOUT(vec3) f, INOUT(SpringBlock) hessian, vec3 u, real rest, real k) {
-  precise real len = sqrt(dot3(u, u));
+// length and one reciprocal. A zero-length spring adds nothing. len: |u|, as the caller computed it
+// (vbd_add_spring computes it; self_energy shares it with its friction).
+KFN void vbd_add_spring_len(INOUT(vec3) f, INOUT(SpringBlock) hessian, vec3 u, real len, real rest, real k) {
   VARYING(bool) has_length = len > real(0);
   if (!maybe_any_particle(has_length))
     return;
@@ -35,6 +35,12 @@ KFN void vbd_add_spring(INOUT(vec3) f, INOUT(SpringBlock) hessian, vec3 u, real 
   f = select(has_length, t, f);
   hessian.diag = select(has_length, d, hessian.diag);
   hessian.off = select(has_length, o, hessian.off);
+}
+
+// The same, |u| computed here.
+KFN void vbd_add_spring(INOUT(vec3) f, INOUT(SpringBlock) hessian, vec3 u, real rest, real k) {
+  precise real len = sqrt(dot3(u, u));
+  vbd_add_spring_len(f, hessian, u, len, rest, k);
 }
 
 // Self-contact's part in a vertex's step (self_energy_listed's force fc and stiffness hc, from the
