@@ -409,7 +409,7 @@ template <typename Real> void CpuSolver<Real>::Impl::substep(const Real h) {
   }
   if (params_.stretch_limit.enabled())
     limit_stretch(h);
-  if (params_.self_collision.enabled && !self_energy()) // vbd's energy acted in its sweeps
+  if (detail::self_collision_passes<Real>(params_)) // vbd's energy acts in its sweeps instead
     self_collide();
 }
 

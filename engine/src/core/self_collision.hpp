@@ -62,6 +62,10 @@ template <typename Real> bool self_contact_energy(const SimParams& p) {
   return p.self_collision.enabled && p.integrator == Integrator::vbd && k.stiffness > Real(0) &&
          k.half_skin2 > Real(0);
 }
+/// Whether self-collision runs as passes after each substep (on, and not vbd's energy).
+template <typename Real> bool self_collision_passes(const SimParams& p) {
+  return p.self_collision.enabled && !self_contact_energy<Real>(p);
+}
 } // namespace detail
 
 } // namespace vkcloth

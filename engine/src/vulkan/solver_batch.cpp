@@ -244,7 +244,7 @@ std::vector<sh::InstanceParams> SolverBatch::packed_instance_params() const {
     ip.flags = normal_flag(normals) | (float(params.wind.strength) != 0.0f ? VKCLOTH_FLAG_WIND : 0u) |
                (params.contact_inward_only ? 0u : VKCLOTH_FLAG_CONTACT_BOTH) |
                (options.flip_normals ? VKCLOTH_FLAG_FLIP_NORMALS : 0u) |
-               (params.self_collision.enabled && !vkcloth::detail::self_contact_energy<float>(params)
+               (vkcloth::detail::self_collision_passes<float>(params)
                     ? VKCLOTH_FLAG_SELF_COLLISION // the passes after the step (and the projection after them)
                     : 0u);
     ip.integrator = static_cast<std::uint32_t>(params.integrator);
@@ -574,7 +574,7 @@ std::uint32_t SolverBatch::projection_iterations() const {
 std::uint32_t SolverBatch::self_iterations() const {
   std::uint32_t most = 0;
   for (const Slot& s : slots)
-    if (s.params.self_collision.enabled && !vkcloth::detail::self_contact_energy<float>(s.params))
+    if (vkcloth::detail::self_collision_passes<float>(s.params))
       most = std::max(most, s.params.self_collision.iterations);
   return most;
 }
