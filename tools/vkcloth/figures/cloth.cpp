@@ -19,6 +19,7 @@
 #include <glm/trigonometric.hpp>
 
 #include "cloth_drawing.hpp"
+#include "report_cloth.hpp"
 #include "figures.hpp"
 #include "image_grid.hpp"
 #include "vkcloth/cpu_solver.hpp"
@@ -31,7 +32,7 @@
 
 namespace vkcloth::figures {
 
-namespace {
+// The report cloth's scenes and numbers the material figures share (report_cloth.hpp).
 
 Scene cloth_scene(const ClothDesc& d, SimParams p, std::string name) {
   Scene s;
@@ -42,15 +43,13 @@ Scene cloth_scene(const ClothDesc& d, SimParams p, std::string name) {
   return s;
 }
 
-/// The report's cloth: 10 x 10 points over 1 x 1, 0.05 kg per point, hanging (vertical) from its
-/// two top corners, or horizontal at height z with nothing pinned.
 ClothDesc hanging(double ks, double ksh, double kb) {
   ClothDesc d;
   d.origin = {-0.5, 0.0, 0.5};
   d.stiffness = {ks, ksh, kb};
   return d;
 }
-ClothDesc horizontal(double z, double ks = 40, double ksh = 8, double kb = 8) {
+ClothDesc horizontal(double z, double ks, double ksh, double kb) {
   ClothDesc d;
   d.orientation = ClothOrientation::horizontal;
   d.origin = {-0.5, -0.5, z};
@@ -59,25 +58,30 @@ ClothDesc horizontal(double z, double ks = 40, double ksh = 8, double kb = 8) {
   return d;
 }
 
-SimParams params(double dt = 0.02) {
+SimParams report_params(double dt) {
   SimParams p;
   p.dt = dt;
   p.damping = 0.5;
   return p;
 }
 
-// --- the numbers behind the pictures ------------------------------------------------------------
-
-std::size_t at(const Grid& g, std::uint32_t i, std::uint32_t j) {
-  return std::size_t(j) * g.nx + i;
-}
-
-/// Largest downward displacement of a particle since the start (m).
 double sag(const Run& r) {
   double s = 0.0;
   for (std::size_t i = 0; i < r.pos.size(); ++i)
     s = std::max(s, r.initial[i].z - r.pos[i].z);
   return s;
+}
+
+std::string key(double v) {
+  return fmt::format("{:g}", v);
+}
+
+namespace {
+
+// --- the numbers behind the pictures ------------------------------------------------------------
+
+std::size_t at(const Grid& g, std::uint32_t i, std::uint32_t j) {
+  return std::size_t(j) * g.nx + i;
 }
 
 /// Mean over the grid's quads of |d1 - d2| / mean(d1, d2), d1 and d2 its two diagonals: zero for a
@@ -162,10 +166,6 @@ nlohmann::json contact_metrics(const Run& r, const Collider& sphere, double eps)
           {"diverged", !r.diverged.empty()}};
 }
 
-std::string key(double v) {
-  return fmt::format("{:g}", v);
-}
-
 const char* const sec_springs = "Cloth springs (report §3, Figures 5-9)";
 const char* const sec_collisions = "Collisions and wind (report §4, Figures 11-13)";
 
@@ -184,7 +184,7 @@ Result<void> stiffness_sweep(Gallery& G, Drawing& d, nlohmann::json& M, const St
   std::vector<Run> runs;
   std::vector<std::string> labels;
   for (double k : s.values) {
-    auto r = simulate_cloth(d, cloth_scene(s.cloth(k), params(), s.name), 500, G.backend);
+    auto r = simulate_cloth(d, cloth_scene(s.cloth(k), report_params(), s.name), 500, G.backend);
     if (!r)
       return r.error();
     nlohmann::json m = s.metrics(*r);
@@ -260,7 +260,7 @@ Result<void> holes_figure(Gallery& G, Drawing& d, nlohmann::json& M, const std::
   std::vector<Run> runs;
   std::vector<std::string> labels;
   for (double ks : {0.0, 40.0}) {
-    SimParams p = params();
+    SimParams p = report_params();
     p.colliders = {Collider::sphere({0, 0, 0.15}, 0.15), Collider::plane({0, 0, 1}, 0.0)};
     ClothDesc desc = horizontal(2.0, ks, 4, 4);
     desc.particle_mass = 0.5;
@@ -288,7 +288,7 @@ Result<void> collisions_figure(Gallery& G, Drawing& d, nlohmann::json& M, const 
   std::vector<Run> runs;
   std::vector<std::string> labels;
   for (int with_sphere = 0; with_sphere < 2; ++with_sphere) {
-    SimParams p = params();
+    SimParams p = report_params();
     p.colliders = {Collider::plane({0, 0, 1}, 0.0)};
     if (with_sphere)
       p.colliders.insert(p.colliders.begin(), Collider::sphere({0, 0, 0.3}, 0.3));
@@ -320,7 +320,7 @@ Result<void> inward_only_figure(Gallery& G, Drawing& d, nlohmann::json& M, const
   std::vector<std::string> labels;
   const Collider sphere = Collider::sphere({0, 0, 3.4}, 3.0);
   for (bool inward : {true, false}) {
-    SimParams p = params();
+    SimParams p = report_params();
     p.colliders = {sphere};
     p.contact_inward_only = inward;
     auto r = simulate_cloth(d, cloth_scene(horizontal(0.5), p, "contact"), 20, G.backend);
@@ -346,7 +346,7 @@ Result<void> wind_figure(Gallery& G, Drawing& d, nlohmann::json& M, const std::s
   std::vector<Run> runs;
   std::vector<std::string> labels;
   for (double kw : {0.01, 0.02, 0.05}) {
-    SimParams p = params();
+    SimParams p = report_params();
     p.wind = {kw, {0, 1, 0}};
     auto r = simulate_cloth(d, cloth_scene(hanging(40, 8, 8), p, "wind"), 250, G.backend);
     if (!r)
@@ -366,7 +366,7 @@ Result<void> wind_figure(Gallery& G, Drawing& d, nlohmann::json& M, const std::s
 
 /// Figure 14: the GPU solver, three spring kinds and wind, at three instants (drawn: needs d.ctx).
 Result<void> gpu_figure(Gallery& G, Drawing& d, nlohmann::json& M, const std::string& note) {
-  SimParams p = params();
+  SimParams p = report_params();
   p.wind = {0.05, {0, 1, 0}};
   ClothDesc desc = hanging(40, 8, 8);
   Scene scene = cloth_scene(desc, p, "gpu_wind");
@@ -447,126 +447,6 @@ Result<void> mesh_figure(Gallery& G, Drawing& d, nlohmann::json& M) {
       {0.9f, -1.6f, 1.0f});
 }
 
-const char* const sec_materials = "Stretch control and materials";
-
-/// The report's Figure 7 cloth with all three spring kinds (K_struct = 5 / 20 / 50, shear and bend 8),
-/// without (top row) and with (bottom row) the strain limit (tethers + Provot, 10 %, 4 sweeps).
-Result<void> strain_limit_figure(Gallery& G, Drawing& d, nlohmann::json& M, const std::string& note) {
-  std::vector<Run> runs;
-  std::vector<std::string> labels;
-  for (bool limit : {false, true})
-    for (double k : {5.0, 20.0, 50.0}) {
-      SimParams p = params();
-      if (limit)
-        p.stretch_limit = {StretchLimit::Method::both, 0.1, 4};
-      auto r = simulate_cloth(d, cloth_scene(hanging(k, 8, 8), p, "strain_limit"), 500, G.backend);
-      if (!r)
-        return r.error();
-      M["strain_limit"][limit ? "on" : "off"][key(k)] = {{"max_strain", max_strain(*r)},
-                                                         {"min_z", min_z(*r)},
-                                                         {"sag", sag(*r)},
-                                                         {"diverged", !r->diverged.empty()}};
-      runs.push_back(std::move(*r));
-      labels.push_back(fmt::format("K = {:g}, {}", k, limit ? "limit 0.1" : "no limit"));
-    }
-  return grid_figure(
-      G, d, runs, labels, "cloth_strain_limit.png", sec_materials,
-      "Figure 7 with and without the strain limit",
-      note +
-          "K_struct = 5 / 20 / 50 with shear and bend springs 8, after 10 s. Top row: the springs alone "
-          "(the softer, the longer the cloth). Bottom row: stretch_limit = {method: both, max_strain: 0.1, "
-          "iterations: 4} (tethers to the pinned corners, then Provot's sweeps over the structural "
-          "springs): the cloth keeps its size whatever K_struct. Largest structural strain and lowest "
-          "point of each panel: cloth.strain_limit.{off,on}.<K>.",
-      {0.9f, -1.6f, 1.0f}, true, 3);
-}
-
-/// Cotton hanging from its two top corners at 16 x 16, 32 x 32 and 64 x 64: a material (not spring
-/// constants) gives the same drape at every resolution.
-Result<void> resolution_figure(Gallery& G, Drawing& d, nlohmann::json& M) {
-  const Material cotton = *material_preset("cotton");
-  std::vector<Run> runs;
-  std::vector<std::string> labels;
-  double lo = 1e30, hi = -1e30;
-  for (std::uint32_t n : {16u, 32u, 64u}) {
-    ClothDesc desc;
-    desc.nx = desc.ny = n;
-    desc.origin = {-0.5, 0.0, 0.5};
-    desc.material = cotton;
-    SimParams p = params();
-    p.integrator = Integrator::implicit_euler;
-    p.cg_tolerance = 1e-4;
-    p.cg_max_iterations = 1000;
-    p.damping = cotton.damping;
-    // Always the CPU solver: the Vulkan implicit step records every allowed CG iteration, which on
-    // lavapipe takes minutes at 64 x 64 (docs/performance.md).
-    auto r = simulate_cloth(d, cloth_scene(desc, p, "resolution"), 50, "cpu");
-    if (!r)
-      return r.error();
-    const double z = min_z(*r);
-    lo = std::min(lo, z), hi = std::max(hi, z);
-    M["resolution"][std::to_string(n)] = {
-        {"min_z", z}, {"sag", sag(*r)}, {"max_strain", max_strain(*r)}, {"diverged", !r->diverged.empty()}};
-    runs.push_back(std::move(*r));
-    labels.push_back(fmt::format("{} x {}", n, n));
-  }
-  M["resolution"]["min_z_spread_percent"] = 100.0 * (hi - lo) / 1.0; // of the 1 m cloth
-  return grid_figure(
-      G, d, runs, labels, "cloth_resolution.png", sec_materials, "One material at three resolutions",
-      "Cotton (density 0.15 kg/m^2, stretch 500 N/m, shear 50 N/m, bend 1e-5 N m, mu = 0.5; "
-      "docs/model.md, Materials), 1 x 1 m hanging from its two top corners, at 16 x 16, 32 x 32 and "
-      "64 x 64 points, implicit Euler at dt = 0.02 s (CG to a relative residual of 1e-4), after 1 s "
-      "(settled: at 16 x 16 and 32 x 32 the lowest point moves by 2e-6 m more by 3 s). The masses "
-      "and spring constants follow from the material for each spacing, so the drape is the same: lowest "
-      "point of each and their spread in % of the cloth's size in cloth.resolution. Simulated by the CPU "
-      "solver whatever --backend says (the Vulkan implicit step is slow on lavapipe).");
-}
-
-/// Every material preset dropped flat onto the sphere of samples/scenes/cloth_on_sphere.json.
-Result<void> presets_figure(Gallery& G, Drawing& d, nlohmann::json& M) {
-  const Collider sphere = Collider::sphere({0, 0, 0.3}, 0.3);
-  std::vector<Run> runs;
-  std::vector<std::string> labels;
-  for (std::string_view name : material_preset_names()) {
-    if (name == "report") // fitted to the report's 10 x 10 grid: needs a spacing of at least 0.09 m
-      continue;
-    const Material m = *material_preset(name);
-    ClothDesc desc = horizontal(0.8);
-    desc.nx = desc.ny = 20;
-    desc.material = m;
-    SimParams p = params(0.01);
-    p.integrator = Integrator::implicit_euler;
-    p.cg_max_iterations = 1000;
-    p.damping = m.damping;
-    p.colliders = {sphere, Collider::plane({0, 0, 1}, 0.0)};
-    auto r = simulate_cloth(d, cloth_scene(desc, p, "presets"), 100, "cpu"); // as the resolution figure
-    if (!r)
-      return r.error();
-    const double z = min_z(*r);
-    M["presets"][std::string(name)] = {{"min_z", z},
-                                       {"below_equator", sphere.center.z - z},
-                                       {"sag", sag(*r)},
-                                       {"max_strain", max_strain(*r)},
-                                       {"diverged", !r->diverged.empty()}};
-    runs.push_back(std::move(*r));
-    labels.push_back(std::string(name));
-  }
-  return grid_figure(
-      G, d, runs, labels, "cloth_presets.png", sec_materials, "The material presets over the sphere",
-      "Each preset but report (cotton, silk, denim, leather, rubber; docs/scene-format.md, Materials) "
-      "as a 1 x 1 m cloth of 20 x 20 points dropped flat from z = 0.8 m onto the sphere of "
-      "samples/scenes/cloth_on_sphere.json (r = 0.3 m, centre z = 0.3 m, and its floor), implicit Euler "
-      "at dt = 0.01 s, after 1 s: draped, before the frictionless sphere lets the cloth slide off. The "
-      "stiffer in bending, the higher the cloth stays: the lowest points come in the order of the "
-      "bending stiffness (silk 3e-6, cotton 1e-5, denim 1e-4, rubber 1.7e-4, leather 1e-3 N m). "
-      "Lowest point and how far it hangs below the sphere's equator (z = 0.3 m) in cloth.presets. "
-      "The impact is violent for the stiff presets: their largest structural strain is still 0.25 "
-      "(denim) and 0.13 (leather) at 1 s (cloth.presets.*.max_strain; contact projection against "
-      "stiff springs). (The report preset is fitted to the report's 10 x 10 grid: 20 x 20 is finer "
-      "than its bending stiffness allows.) Simulated by the CPU solver whatever --backend says.",
-      {0.9f, -1.6f, 1.0f});
-}
-
 } // namespace
 
 Result<void> cloth_figures(Gallery& G) {
@@ -598,12 +478,7 @@ Result<void> cloth_figures(Gallery& G) {
     VKCLOTH_TRY(gpu_figure(G, d, M, note));
   }
   VKCLOTH_TRY(mesh_figure(G, d, M));
-  progress("Figure 7 with and without the strain limit");
-  VKCLOTH_TRY(strain_limit_figure(G, d, M, note));
-  progress("one material at three resolutions");
-  VKCLOTH_TRY(resolution_figure(G, d, M));
-  progress("the material presets over the sphere");
-  VKCLOTH_TRY(presets_figure(G, d, M));
+  VKCLOTH_TRY(material_figures(G, d, M, note, progress));
   progress("done");
   return {};
 }
