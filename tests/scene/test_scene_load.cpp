@@ -434,7 +434,7 @@ TEST_CASE("self_collision: absent is off with the defaults; present is read into
   CHECK(on.params.self_collision.friction == 0.35);
   CHECK(on.params.self_collision.iterations == 5);
   CHECK(on.params.self_collision.skin == 0.02);
-  CHECK(on.warnings.empty()); // 0.08 m is above half the 1/9 m spacing
+  CHECK(on.warnings.empty()); // 0.08 m is above the triangles' circumradius (half the 1/9 m cells' diagonal)
 
   // Present without "enabled": on, the other keys at their defaults.
   const Scene bare = load_ok(R"({"system": "cloth", "self_collision": {"thickness": 0.1}})");
@@ -475,7 +475,9 @@ TEST_CASE("self_collision: overrides reach every key and turn it on") {
   CHECK(off.params.self_collision.thickness == 0.06);
 }
 
-TEST_CASE("self_collision: a thickness below half the smallest rest length is a warning in scene.warnings") {
+TEST_CASE("self_collision: a thickness below half the smallest rest length, or below a triangle's "
+          "circumradius, is a "
+          "warning in scene.warnings") {
   // The default 10 x 10 grid over 1 m: structural springs of 1/9 m; half of that is 0.0556 m.
   const Scene thin = load_ok(R"({"system": "cloth", "self_collision": {"thickness": 0.01}})");
   REQUIRE(thin.warnings.size() == 1);
@@ -484,7 +486,20 @@ TEST_CASE("self_collision: a thickness below half the smallest rest length is a 
   CHECK(thin.warnings[0].find("a triangle can pass between two particles") != std::string::npos);
   // The default thickness (0.01 m) warns as well once turned on.
   CHECK(load_ok(R"({"system": "cloth"})", {"self_collision.enabled=true"}).warnings.size() == 1);
-  CHECK(load_ok(R"({"system": "cloth", "self_collision": {"thickness": 0.06}})").warnings.empty());
+  // Above half the spacing but below a triangle's circumradius (half the cell's diagonal, 0.07857 m):
+  // a particle can cross the middle of another layer's triangle unseen.
+  const Scene mid = load_ok(R"({"system": "cloth", "self_collision": {"thickness": 0.06}})");
+  REQUIRE(mid.warnings.size() == 1);
+  CHECK(mid.warnings[0].find("self_collision.thickness 0.06 m is below the largest circumradius of the "
+                             "cloth's triangles (0.07857 m)") == 0);
+  CHECK(load_ok(R"({"system": "cloth", "self_collision": {"thickness": 0.08}})").warnings.empty());
+  // A 2 x 1 m cloth of 3 x 11 particles: cells of 1 x 0.1 m, triangles of circumradius 0.5025 m.
+  const std::string wide = R"({"system": "cloth", "cloth": {"size": [2, 1], "resolution": [3, 11]},
+                               "self_collision": {"thickness": )";
+  const Scene long_cells = load_ok(wide + "0.3}}");
+  REQUIRE(long_cells.warnings.size() == 1);
+  CHECK(long_cells.warnings[0].find("(0.5025 m)") != std::string::npos);
+  CHECK(load_ok(wide + "0.51}}").warnings.empty());
 
   // A mesh cloth: a 3 x 1 strip of unit quads (structural springs of 1 m).
   const std::filesystem::path d = std::filesystem::path(VKCLOTH_TEST_TMP) / "self_collision_mesh";
@@ -496,7 +511,10 @@ TEST_CASE("self_collision: a thickness below half the smallest rest length is a 
   REQUIRE(mesh_thin.warnings.size() == 1);
   CHECK(mesh_thin.warnings[0].find(
             "self_collision.thickness 0.2 m is below half the smallest rest length (1 m)") == 0);
-  CHECK(load_in_tmp("self_collision_mesh", mesh + R"({"thickness": 0.6}})").warnings.empty());
+  const Scene mesh_mid = load_in_tmp("self_collision_mesh", mesh + R"({"thickness": 0.6}})");
+  REQUIRE(mesh_mid.warnings.size() == 1);
+  CHECK(mesh_mid.warnings[0].find("circumradius of the cloth's triangles (0.7071 m)") != std::string::npos);
+  CHECK(load_in_tmp("self_collision_mesh", mesh + R"({"thickness": 0.75}})").warnings.empty());
 }
 
 TEST_CASE("up: \"y\" turns the grid's plane and the defaults of gravity and a plane, \"z\" is the default") {

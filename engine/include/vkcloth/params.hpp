@@ -328,8 +328,9 @@ struct SimParams {
 /// A self-collision thickness against a cloth's spring lengths (structural springs; all springs
 /// when it has none): an error (ErrorCode::invalid_argument naming self_collision.thickness) when it
 /// is more than 10 x their mean rest length, since every particle would then touch most of the
-/// cloth; otherwise the warnings, e.g. a thickness below half the smallest rest length (a triangle
-/// can then pass between two particles). Nothing to check when self-collision is off.
+/// cloth; otherwise the warnings: a thickness below half the smallest rest length (a triangle can
+/// then pass between two particles), else below the largest circumradius of the cloth's triangles (a
+/// particle can then cross a triangle's middle unseen). Nothing to check when self-collision is off.
 Result<std::vector<std::string>> check_self_collision(const SelfCollision& self,
                                                       const ParticleSystem& system);
 

@@ -15,6 +15,8 @@
 
 #include "vkcloth/measure.hpp"
 
+#include "system_triangles.hpp"
+
 namespace vkcloth {
 namespace {
 
@@ -365,33 +367,13 @@ Result<IntersectionStats> pairs_impl(std::span<const std::uint32_t> indices, std
   return stats;
 }
 
-/// The triangles ClothTopology::triangles() lists: a grid's (a, b, d), (a, d, c) per cell, a mesh's
-/// Surface::triangles, none for a chain.
-std::vector<std::uint32_t> system_triangles(const ParticleSystem& system) {
-  std::vector<std::uint32_t> tris;
-  if (system.grid) {
-    const std::uint32_t nx = system.grid->nx, ny = system.grid->ny;
-    if (nx >= 2 && ny >= 2) {
-      tris.reserve(std::size_t(nx - 1) * (ny - 1) * 6);
-      for (std::uint32_t j = 0; j + 1 < ny; ++j)
-        for (std::uint32_t i = 0; i + 1 < nx; ++i) {
-          const std::uint32_t a = j * nx + i, b = a + 1, c = a + nx, d = c + 1;
-          tris.insert(tris.end(), {a, b, d, a, d, c});
-        }
-    }
-  } else if (system.surface) {
-    tris = system.surface->triangles;
-  }
-  return tris;
-}
-
 template <typename Vec>
 Result<IntersectionStats> system_pairs(const ParticleSystem& system, std::span<const Vec> positions) {
   if (positions.size() != system.size())
     return make_error(ErrorCode::invalid_argument,
                       fmt::format("intersecting_triangle_pairs: {} positions for {} particles",
                                   positions.size(), system.size()));
-  const std::vector<std::uint32_t> tris = system_triangles(system);
+  const std::vector<std::uint32_t> tris = detail::system_triangles(system);
   return intersecting_triangle_pairs(std::span<const std::uint32_t>(tris), positions);
 }
 
@@ -425,5 +407,43 @@ Result<IntersectionStats> intersecting_triangle_pairs(const ParticleSystem& syst
                                                       std::span<const glm::vec3> positions) {
   return system_pairs(system, positions);
 }
+
+namespace detail {
+
+std::vector<std::uint32_t> system_triangles(const ParticleSystem& system) {
+  std::vector<std::uint32_t> tris;
+  if (system.grid) {
+    const std::uint32_t nx = system.grid->nx, ny = system.grid->ny;
+    if (nx >= 2 && ny >= 2) {
+      tris.reserve(std::size_t(nx - 1) * (ny - 1) * 6);
+      for (std::uint32_t j = 0; j + 1 < ny; ++j)
+        for (std::uint32_t i = 0; i + 1 < nx; ++i) {
+          const std::uint32_t a = j * nx + i, b = a + 1, c = a + nx, d = c + 1;
+          tris.insert(tris.end(), {a, b, d, a, d, c});
+        }
+    }
+  } else if (system.surface) {
+    tris = system.surface->triangles;
+  }
+  return tris;
+}
+
+double largest_circumradius(const ParticleSystem& system) {
+  const std::vector<std::uint32_t> tris = system_triangles(system);
+  double largest = 0.0;
+  for (std::size_t t = 0; t + 2 < tris.size(); t += 3) {
+    if (std::max({tris[t], tris[t + 1], tris[t + 2]}) >= system.size())
+      continue; // an unchecked system's bad index: ParticleSystem::validate names it
+    const glm::dvec3 a = system.particles[tris[t]].position, b = system.particles[tris[t + 1]].position,
+                     c = system.particles[tris[t + 2]].position;
+    const double twice_area = glm::length(glm::cross(b - a, c - a));
+    if (twice_area > 0.0) // R = |ab| |bc| |ca| / (4 area)
+      largest = std::max(largest,
+                         glm::length(b - a) * glm::length(c - b) * glm::length(a - c) / (2.0 * twice_area));
+  }
+  return largest;
+}
+
+} // namespace detail
 
 } // namespace vkcloth

@@ -12,6 +12,7 @@
 #include <glm/matrix.hpp>
 
 #include "argument_checks.hpp"
+#include "system_triangles.hpp"
 
 namespace vkcloth {
 using detail::bad_argument;
@@ -245,11 +246,18 @@ Result<std::vector<std::string>> check_self_collision(const SelfCollision& self,
                     "system's {} ({:.4g} m): every particle would touch most of the cloth; "
                     "use a thickness near the particle spacing",
                     self.thickness, structural ? "structural springs" : "springs", mean));
+  const double circumradius = detail::largest_circumradius(system);
   if (self.thickness < 0.5 * smallest)
     warnings.push_back(fmt::format("self_collision.thickness {} m is below half the smallest rest length "
                                    "({:.4g} m): a triangle can pass between two particles; a thickness "
                                    "of at least {:.4g} m closes the gaps",
                                    self.thickness, smallest, 1.42 * mean));
+  else if (self.thickness < circumradius) // particles only: a point crossing a triangle's middle is unseen
+    warnings.push_back(fmt::format("self_collision.thickness {} m is below the largest circumradius of the "
+                                   "cloth's triangles ({:.4g} m): a particle can cross another layer's "
+                                   "triangle farther than the thickness from its corners; keep it above "
+                                   "{:.4g} m (more where a contact stiffness lets pairs overlap)",
+                                   self.thickness, circumradius, circumradius));
   return warnings;
 }
 
