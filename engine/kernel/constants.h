@@ -19,12 +19,14 @@
 #define VKCLOTH_RING_CLOSE 4u // then add the triangle (this entry, the chain's first entry)
 
 // InstanceParams::stretch bits (SimParams::stretch_limit).
-#define VKCLOTH_STRETCH_PROVOT 1u       // Provot sweeps over the strain links (strain_links.comp)
-#define VKCLOTH_STRETCH_TETHERS 2u      // tethers (strain_finish.comp)
-#define VKCLOTH_STRETCH_GEODESIC 4u     // tethers with geodesic rest lengths (the second half of TETHERS)
-#define VKCLOTH_STRETCH_PROJECTION 8u   // the fast projection (strain_project.comp)
-#define VKCLOTH_TETHERS_PER_PARTICLE 4u // vkcloth::tethers_per_particle
-#define VKCLOTH_NO_TETHER 0xffffffffu   // an unused tether slot (vkcloth::no_tether)
+#define VKCLOTH_STRETCH_PROVOT 1u     // Provot sweeps over the strain links (strain_links.comp)
+#define VKCLOTH_STRETCH_TETHERS 2u    // tethers (strain_finish.comp)
+#define VKCLOTH_STRETCH_GEODESIC 4u   // tethers with geodesic rest lengths (the second half of TETHERS)
+#define VKCLOTH_STRETCH_PROJECTION 8u // the fast projection (strain_project.comp)
+#define VKCLOTH_STRETCH_CHAINS 16u    // Provot's sweeps along a grid's rows and columns (strain_links.comp)
+#define VKCLOTH_CHAIN_BACKWARD 0x80000000u // StrainLinksPush::chain_links: the chains' pass back
+#define VKCLOTH_TETHERS_PER_PARTICLE 4u    // vkcloth::tethers_per_particle
+#define VKCLOTH_NO_TETHER 0xffffffffu      // an unused tether slot (vkcloth::no_tether)
 // The fast projection (cloth_kernel.h projection_*, docs/model.md "Stretch control"): links whose
 // C = |u|^2 / B^2 - 1 is above -BAND take part in a Newton iteration's solve (those within the band
 // keep their length, so the solve cannot stretch them past the bound); the projection stops once

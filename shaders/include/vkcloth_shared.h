@@ -115,16 +115,16 @@ struct PushConstants {
   uint unused2;
 };
 
-/// strain_links.comp: one colour of one sweep (`stage`: the sweep).
+/// strain_links.comp: one colour of one sweep (`stage`: the sweep), or one family of chains.
 struct StrainLinksPush {
   uint count;
   uint nx;
   uint ny;
   uint stage;
   uint step;
-  uint link_first; // the colour's first link
-  uint link_count; // the colour's links
-  uint unused;
+  uint link_first;  // the colour's first link (chains: the family's first)
+  uint link_count;  // the colour's links (chains: the family's chains)
+  uint chain_links; // 0: a colour; else the links of each chain of the family (| VKCLOTH_CHAIN_BACKWARD)
 };
 
 /// targets.comp (`stage`: VKCLOTH_TARGETS_DRIVE or _HOLD): the entries of each instance's targets

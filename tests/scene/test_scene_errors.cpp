@@ -168,6 +168,9 @@ TEST_CASE("stretch_limit: bad input names the key and the value (issue 17 point 
   expect_error(base + R"({"method": "both", "tether_distance": "manhattan"}})",
                {"stretch_limit.tether_distance", "\"manhattan\""});
   expect_error(base + R"({"method": "both", "sweeps": 4}})", {"unknown key stretch_limit.sweeps"});
+  expect_error(base + R"({"method": "provot", "order": "chain"}})",
+               {"stretch_limit.order", "\"colours\" or \"chains\"", "\"chain\""});
+  expect_error(base + R"({"method": "provot", "order": 1}})", {"stretch_limit.order"});
   // --set reaches every key, and turns the limit on in a scene without one.
   expect_error(R"({"system": "cloth"})", {"stretch_limit.max_strain", "got 0"},
                {"stretch_limit.method=both", "stretch_limit.max_strain=0"});
@@ -176,6 +179,10 @@ TEST_CASE("stretch_limit: bad input names the key and the value (issue 17 point 
   REQUIRE(on.ok());
   CHECK(on->params.stretch_limit.method == StretchLimit::Method::provot);
   CHECK(on->params.stretch_limit.iterations == 4);
+  CHECK(on->params.stretch_limit.order == StretchLimit::SweepOrder::colours); // the default
+  auto chains = parse_scene(base + R"({"method": "both", "order": "chains"}})", "ok.json");
+  REQUIRE(chains.ok());
+  CHECK(chains->params.stretch_limit.chains());
   auto projection = parse_scene(R"({"system": "cloth"})", "ok.json",
                                 std::vector<std::string>{"stretch_limit.method=projection"});
   REQUIRE(projection.ok());

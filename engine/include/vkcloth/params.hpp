@@ -200,13 +200,19 @@ struct StretchLimit {
   enum class Method : std::uint32_t { off = 0, tethers = 1, provot = 2, both = 3, projection = 4 };
   /// How a tether's rest length is measured in the rest state: straight, or along the cloth.
   enum class TetherDistance : std::uint32_t { euclidean = 0, geodesic = 1 };
+  /// The order of Provot's sweeps (docs/model.md "Stretch control"): colour by colour (each link of a
+  /// colour at once), or along chains, a grid's rows then its columns, each link after the one before
+  /// it and back, so that one sweep carries a correction along a whole row (grids only).
+  enum class SweepOrder : std::uint32_t { colours = 0, chains = 1 };
   Method method = Method::off;
   double max_strain = 0.1; ///< > 0: the largest allowed (|u| - L0) / L0
   /// 1..100 per substep: Provot sweeps, or (projection) the most Newton iterations.
   std::uint32_t iterations = 4;
   TetherDistance tether_distance = TetherDistance::euclidean;
+  SweepOrder order = SweepOrder::colours; ///< Provot's sweeps (provot, both)
 
   bool provot() const { return method == Method::provot || method == Method::both; }
+  bool chains() const { return provot() && order == SweepOrder::chains; }
   bool tethers() const {
     return method == Method::tethers || method == Method::both || method == Method::projection;
   }
@@ -218,6 +224,8 @@ const char* to_string(StretchLimit::Method method);
 std::optional<StretchLimit::Method> parse_stretch_method(std::string_view name);
 const char* to_string(StretchLimit::TetherDistance distance);
 std::optional<StretchLimit::TetherDistance> parse_tether_distance(std::string_view name);
+const char* to_string(StretchLimit::SweepOrder order);
+std::optional<StretchLimit::SweepOrder> parse_sweep_order(std::string_view name);
 
 /// Self-collision (docs/model.md "Self-collision"): off by default (the report's model). After each
 /// substep's update (and stretch control), particles closer than `thickness` to each other are

@@ -79,6 +79,17 @@ struct StrainLink {
   double rest_length = 0.0;
 };
 
+/// A grid's chains of strain links (StretchLimit::SweepOrder::chains): `rows` chains of `row_links`
+/// links each (row j: particles (0, j) -> (1, j) -> ...), then `columns` chains of `column_links`.
+/// A link that has no structural spring is (p, p, 0), which never moves. All zero without a grid.
+struct StrainChainShape {
+  std::uint32_t rows = 0;
+  std::uint32_t row_links = 0;
+  std::uint32_t columns = 0;
+  std::uint32_t column_links = 0;
+  bool empty() const { return rows == 0 && columns == 0; }
+};
+
 /// Slots per particle in ClothTopology::tethers(); a slot without a tether has anchor no_tether.
 inline constexpr std::uint32_t tethers_per_particle = 4;
 inline constexpr std::uint32_t no_tether = 0xffffffffu;
@@ -148,6 +159,12 @@ public:
   /// backend. Within a colour, links keep their spring order.
   std::span<const StrainLink> strain_links() const { return strain_links_; }
   std::span<const std::uint32_t> strain_colour_offsets() const { return strain_colour_offsets_; }
+  /// The same links along a grid's rows, then its columns, each chain's links in order
+  /// (StrainChainShape; empty without a grid): Provot's sweeps in chain order run each chain's links
+  /// one after the other, forward then back, the chains of a family (the rows, the columns) in
+  /// parallel, since no two share a particle.
+  std::span<const StrainLink> strain_chains() const { return strain_chains_; }
+  StrainChainShape strain_chain_shape() const { return strain_chain_shape_; }
   /// Each particle's strain links (the fast projection's gather, StretchLimit::Method::projection):
   /// particle p's are strain_incidence()[strain_incidence_offsets()[p] .. [p + 1]), each entry
   /// 2 l + e for link l = strain_links()[l], e = 1 when p is its end b (0: end a), in link order.
@@ -182,6 +199,8 @@ private:
   std::vector<glm::vec2> uvs_;
   std::vector<StrainLink> strain_links_;
   std::vector<std::uint32_t> strain_colour_offsets_;
+  std::vector<StrainLink> strain_chains_;
+  StrainChainShape strain_chain_shape_;
   std::vector<std::uint32_t> strain_incidence_offsets_, strain_incidence_;
   std::vector<std::uint32_t> vertex_order_, vertex_colour_offsets_;
   // Tethers, computed on first use (tethers()): [0] euclidean, [1] geodesic.

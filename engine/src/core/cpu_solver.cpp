@@ -11,6 +11,7 @@
 #include <glm/geometric.hpp>
 
 #include "cpu_solver_impl.hpp"
+#include "stretch_topology.hpp"
 #include "implicit_euler.hpp"
 #include "kernel.hpp"
 #include "row_kernel.hpp"
@@ -78,6 +79,7 @@ Result<CpuSolver<Real>> CpuSolver<Real>::create(std::shared_ptr<const ClothTopol
   const std::size_t n = system.size();
 
   VKCLOTH_TRY(detail::PinTargets::check(params, {}, n));
+  VKCLOTH_TRY(detail::check_sweep_order(params.stretch_limit, *topology));
 
   auto impl = std::make_unique<Impl>();
   Impl& s = *impl;
@@ -120,6 +122,7 @@ Result<CpuSolver<Real>> CpuSolver<Real>::create(std::shared_ptr<const ClothTopol
 template <typename Real> Result<void> CpuSolver<Real>::Impl::set_params(SimParams params) {
   VKCLOTH_TRY(params.validate());
   VKCLOTH_TRY(targets_.check_params(params, pos_.size()));
+  VKCLOTH_TRY(detail::check_sweep_order(params.stretch_limit, *topology_));
   if (!detail::same_frame(params.inertia, params_.inertia))
     frame_last_.reset();
   params_ = params;

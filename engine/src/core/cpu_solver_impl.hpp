@@ -237,6 +237,7 @@ template <typename Real> struct CpuSolver<Real>::Impl {
     Real rest_length;
   };
   std::vector<Link> strain_links_;
+  std::vector<Link> strain_chains_; // ClothTopology::strain_chains()
   std::vector<TetherSlot> tethers_;
   StretchLimit::TetherDistance tether_kind_ = StretchLimit::TetherDistance::euclidean;
   std::uint64_t step_ = 0;

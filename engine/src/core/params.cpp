@@ -104,6 +104,18 @@ std::optional<StretchLimit::TetherDistance> parse_tether_distance(std::string_vi
   return std::nullopt;
 }
 
+const char* to_string(StretchLimit::SweepOrder order) {
+  return order == StretchLimit::SweepOrder::colours ? "colours" : "chains";
+}
+
+std::optional<StretchLimit::SweepOrder> parse_sweep_order(std::string_view name) {
+  using O = StretchLimit::SweepOrder;
+  for (O o : {O::colours, O::chains})
+    if (name == to_string(o))
+      return o;
+  return std::nullopt;
+}
+
 Result<void> SimParams::validate() {
   if (static_cast<std::uint32_t>(integrator) > static_cast<std::uint32_t>(Integrator::vbd))
     return bad_argument(
@@ -146,6 +158,9 @@ Result<void> SimParams::validate() {
   if (!std::isfinite(stretch_limit.max_strain) || stretch_limit.max_strain <= 0.0)
     return bad_argument(
         fmt::format("stretch_limit.max_strain must be finite and > 0, got {}", stretch_limit.max_strain));
+  if (std::uint32_t(stretch_limit.order) > std::uint32_t(StretchLimit::SweepOrder::chains))
+    return bad_argument(
+        fmt::format("stretch_limit.order: unknown sweep order {}", std::uint32_t(stretch_limit.order)));
   if (stretch_limit.iterations < 1 || stretch_limit.iterations > 100)
     return bad_argument(
         fmt::format("stretch_limit.iterations must be in 1..100, got {}", stretch_limit.iterations));

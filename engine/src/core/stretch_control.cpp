@@ -2,6 +2,7 @@
 // CpuSolver's stretch control after each substep (docs/model.md "Stretch control"): the tethers,
 // Provot's sweeps or the fast projection (strain_projection.cpp), then the colliders' projection.
 #include <atomic>
+#include <utility>
 
 #include "cpu_solver_impl.hpp"
 #include "kernel.hpp"
@@ -55,25 +56,51 @@ template <typename Real> void CpuSolver<Real>::Impl::limit_stretch(const Real h)
       }
     });
   }
-  const std::span<const std::uint32_t> colours = topology_->strain_colour_offsets();
   // A sweep that moves no link leaves every link within its bound, so the sweeps after it would
   // move none either: stopping there gives the same bits as running them all (as the GPU does).
   std::atomic<bool> corrected{true};
+  auto project = [&](const Link& l) { // Provot's correction of one link (strain_links.comp's)
+    Vec3 da, db;
+    if (!kernel::provot_link(pos_[l.a], pos_[l.b], pinned_[l.a] != 0, pinned_[l.b] != 0,
+                             kernel::stretch_bound(l.rest_length, max_strain), da, db))
+      return false;
+    kernel::apply_correction(pos_[l.a], vel_[l.a], da, h);
+    kernel::apply_correction(pos_[l.b], vel_[l.b], db, h);
+    moved(l.a);
+    moved(l.b);
+    return true;
+  };
+  if (sl.chains() && strain_chains_.empty())
+    for (const StrainLink& l : topology_->strain_chains())
+      strain_chains_.push_back(Link{l.a, l.b, Real(l.rest_length)});
+  const std::span<const std::uint32_t> colours = topology_->strain_colour_offsets();
+  const StrainChainShape chains = topology_->strain_chain_shape();
   for (std::uint32_t it = 0; sl.provot() && it < sl.iterations && corrected.load(std::memory_order_relaxed);
        ++it) {
     corrected.store(false, std::memory_order_relaxed);
+    if (sl.chains()) { // the rows, then the columns: each chain forward and back, in parallel
+      const std::pair<std::uint32_t, std::uint32_t> families[] = {{chains.rows, chains.row_links},
+                                                                  {chains.columns, chains.column_links}};
+      std::size_t first = 0;
+      for (const auto& [count, length] : families) {
+        pool_->for_each(count, [&](std::size_t k) {
+          const Link* chain = strain_chains_.data() + first + k * length;
+          bool any = false;
+          for (std::uint32_t i = 0; i < length; ++i)
+            any = project(chain[i]) || any;
+          for (std::uint32_t i = length; i-- > 0;)
+            any = project(chain[i]) || any;
+          if (any)
+            corrected.store(true, std::memory_order_relaxed);
+        });
+        first += std::size_t(count) * length;
+      }
+      continue;
+    }
     for (std::size_t c = 0; c + 1 < colours.size(); ++c)
       pool_->for_each(colours[c + 1] - colours[c], [&](std::size_t k) {
-        const Link& l = strain_links_[colours[c] + k];
-        Vec3 da, db;
-        if (!kernel::provot_link(pos_[l.a], pos_[l.b], pinned_[l.a] != 0, pinned_[l.b] != 0,
-                                 kernel::stretch_bound(l.rest_length, max_strain), da, db))
-          return;
-        kernel::apply_correction(pos_[l.a], vel_[l.a], da, h);
-        kernel::apply_correction(pos_[l.b], vel_[l.b], db, h);
-        moved(l.a);
-        moved(l.b);
-        corrected.store(true, std::memory_order_relaxed);
+        if (project(strain_links_[colours[c] + k]))
+          corrected.store(true, std::memory_order_relaxed);
       });
   }
   if (sl.projection()) {

@@ -8,6 +8,7 @@
 #include <limits>
 #include <queue>
 #include <tuple>
+#include <unordered_map>
 
 #include <glm/geometric.hpp>
 
@@ -46,6 +47,47 @@ void colour_strain_links(const ParticleSystem& system, std::vector<StrainLink>& 
   links.clear();
   for (const std::uint32_t s : group_by_colour(colour, no_tether, offsets)) // spring order within a colour
     links.push_back(StrainLink{springs[s].a, springs[s].b, springs[s].rest_length});
+}
+
+void chain_strain_links(const ParticleSystem& system, const std::vector<StrainLink>& links,
+                        std::vector<StrainLink>& chains, StrainChainShape& shape) {
+  chains.clear();
+  shape = {};
+  if (!system.grid)
+    return;
+  const std::uint32_t nx = system.grid->nx, ny = system.grid->ny;
+  std::unordered_map<std::uint64_t, double> rest; // each link's rest length by its ends
+  auto key = [](std::uint32_t a, std::uint32_t b) {
+    return (std::uint64_t(std::min(a, b)) << 32) | std::max(a, b);
+  };
+  for (const StrainLink& l : links)
+    rest.emplace(key(l.a, l.b), l.rest_length);
+  auto add = [&](std::uint32_t a, std::uint32_t b) {
+    const auto found = rest.find(key(a, b));
+    chains.push_back(found == rest.end() ? StrainLink{a, a, 0.0} : StrainLink{a, b, found->second});
+  };
+  if (nx >= 2) {
+    shape.rows = ny;
+    shape.row_links = nx - 1;
+    for (std::uint32_t j = 0; j < ny; ++j)
+      for (std::uint32_t i = 0; i + 1 < nx; ++i)
+        add(j * nx + i, j * nx + i + 1);
+  }
+  if (ny >= 2) {
+    shape.columns = nx;
+    shape.column_links = ny - 1;
+    for (std::uint32_t i = 0; i < nx; ++i)
+      for (std::uint32_t j = 0; j + 1 < ny; ++j)
+        add(j * nx + i, (j + 1) * nx + i);
+  }
+}
+
+Result<void> check_sweep_order(const StretchLimit& sl, const ClothTopology& topology) {
+  if (sl.chains() && topology.strain_chain_shape().empty())
+    return make_error(ErrorCode::invalid_argument,
+                      "stretch_limit.order \"chains\" needs a grid cloth (its rows and columns are the "
+                      "chains), and this cloth has no grid: use \"colours\"");
+  return {};
 }
 
 void link_incidence(std::size_t particles, const std::vector<StrainLink>& links,

@@ -331,6 +331,7 @@ Result<std::shared_ptr<const ClothTopology>> ClothTopology::create(const Particl
     t->fan_ends_[p] = e;
   }
   detail::colour_strain_links(s, t->strain_links_, t->strain_colour_offsets_);
+  detail::chain_strain_links(s, t->strain_links_, t->strain_chains_, t->strain_chain_shape_);
   detail::link_incidence(n, t->strain_links_, t->strain_incidence_offsets_, t->strain_incidence_);
   detail::colour_vertices(s, t->edge_offsets_, t->edges_, t->vertex_order_, t->vertex_colour_offsets_);
   return std::shared_ptr<const ClothTopology>(std::move(t));

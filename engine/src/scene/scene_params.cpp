@@ -89,7 +89,7 @@ Result<void> read_stretch_limit(const json& doc, SimParams& params) {
   if (!obj)
     return {};
   const char* path = "stretch_limit";
-  VKCLOTH_TRY(sd::check_keys(*obj, path, {"method", "max_strain", "iterations", "tether_distance"}));
+  VKCLOTH_TRY(sd::check_keys(*obj, path, {"method", "max_strain", "iterations", "tether_distance", "order"}));
   StretchLimit& sl = params.stretch_limit;
   const char* methods = "\"tethers\", \"provot\", \"both\", \"projection\" or \"off\"";
   if (!obj->contains("method"))
@@ -100,8 +100,9 @@ Result<void> read_stretch_limit(const json& doc, SimParams& params) {
     SCENE_TRY_ASSIGN(it, sd::as_integer((*obj)["iterations"], "stretch_limit.iterations", 1000000));
     sl.iterations = static_cast<std::uint32_t>(it); // the range (1..100) is validate()'s
   }
-  return read_choice(*obj, path, "tether_distance", parse_tether_distance, "\"euclidean\" or \"geodesic\"",
-                     sl.tether_distance);
+  VKCLOTH_TRY(read_choice(*obj, path, "tether_distance", parse_tether_distance,
+                          "\"euclidean\" or \"geodesic\"", sl.tether_distance));
+  return read_choice(*obj, path, "order", parse_sweep_order, "\"colours\" or \"chains\"", sl.order);
 }
 
 // Absent: off (the report's model). Present: on unless "enabled" is false; every other key has the

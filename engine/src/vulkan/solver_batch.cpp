@@ -264,6 +264,7 @@ std::vector<sh::InstanceParams> SolverBatch::packed_instance_params() const {
     ip.max_strain = float(sl.max_strain);
     ip.stretch = (sl.provot() ? VKCLOTH_STRETCH_PROVOT : 0u) | (sl.tethers() ? VKCLOTH_STRETCH_TETHERS : 0u) |
                  (sl.projection() ? VKCLOTH_STRETCH_PROJECTION : 0u) |
+                 (sl.chains() ? VKCLOTH_STRETCH_CHAINS : 0u) |
                  (sl.tethers() && sl.tether_distance == StretchLimit::TetherDistance::geodesic
                       ? VKCLOTH_STRETCH_GEODESIC
                       : 0u);
@@ -409,6 +410,7 @@ Result<void> SolverBatch::set_params(std::uint32_t slot, SimParams params) {
     VKCLOTH_TRY(ensure_targets());
     VKCLOTH_TRY(ensure_frames());
     VKCLOTH_TRY(prepare_passes());
+    VKCLOTH_TRY(ensure_strain_chains());
     return ensure_tethers();
   }();
   if (!done) { // e.g. no room for the tethers: the instance keeps stepping with its old parameters
@@ -525,6 +527,42 @@ Result<void> SolverBatch::ensure_tethers() {
   const Upload up[] = {{&tethers, data.data(), bytes}};
   VKCLOTH_TRY(upload(up));
   tethers_uploaded = true;
+  VKCLOTH_TRY(create_buffer_views());
+  return write_sets();
+}
+
+// The strain links in chain order (ClothTopology::strain_chains()) after the coloured ones, in one
+// buffer (VKCLOTH_BINDING_STRAIN_LINKS), uploaded when an instance first asks for Provot's sweeps
+// in chain order (passes/stretch.cpp); the buffer replaces the one of the coloured links alone.
+Result<void> SolverBatch::ensure_strain_chains() {
+  if (strain_chains_uploaded ||
+      std::none_of(slots.begin(), slots.end(), [](const Slot& s) { return s.params.stretch_limit.chains(); }))
+    return {};
+  const auto coloured = batch_topology->strain_links();
+  const auto chains = batch_topology->strain_chains();
+  const std::uint64_t items = coloured.size() + chains.size();
+  VKCLOTH_TRY(check_buffer(*ctx, storage_limit(*ctx, knobs), "strain links", items, sizeof(sh::StrainLink)));
+  if (access == BufferAccess::texel_views) // three R32UI texels a link
+    VKCLOTH_TRY(check_texels(*ctx, "strain links", 3 * items,
+                             "use fewer particles or stretch_limit.order \"colours\""));
+  VKCLOTH_TRY(commands->wait_for_earlier_work()); // write_sets() below: no recorded work may use the sets
+  std::vector<sh::StrainLink> data;
+  data.reserve(items);
+  for (const auto links : {coloured, chains})
+    for (const StrainLink& l : links)
+      data.push_back({l.a, l.b, float(l.rest_length)});
+  const VkDeviceSize bytes = std::max<VkDeviceSize>(data.size() * sizeof(sh::StrainLink), 16);
+  auto b = create_buffer(*ctx, bytes,
+                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                             VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT,
+                         MemoryUse::device, !knobs.force_staging, "strain links");
+  if (!b)
+    return b.error();
+  strain_links_view.reset(); // before the buffer it views
+  strain_links = std::move(*b);
+  const Upload up[] = {{&strain_links, data.data(), data.size() * sizeof(sh::StrainLink)}};
+  VKCLOTH_TRY(upload(up));
+  strain_chains_uploaded = true;
   VKCLOTH_TRY(create_buffer_views());
   return write_sets();
 }

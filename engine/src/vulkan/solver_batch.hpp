@@ -278,6 +278,7 @@ private:
   bool frames_allocated = false;
   bool frame_jump_now = false, frame_carry_now = false;
   bool tethers_uploaded = false;
+  bool strain_chains_uploaded = false; // ensure_strain_chains()
   // The batch's topology, for what is uploaded when first needed (the tethers): alive as long as
   // the batch, since every instance of the batch holds it (ClothWorld::Impl::Instance).
   const ClothTopology* batch_topology = nullptr;
@@ -360,6 +361,7 @@ private:
   /// Every pass's prepare() (creation, set_params).
   Result<void> prepare_passes();
   Result<void> ensure_tethers();
+  Result<void> ensure_strain_chains();
   Result<void> ensure_collider_capacity();
   Result<void> ensure_mesh_buffers();
   Result<void> ensure_targets();

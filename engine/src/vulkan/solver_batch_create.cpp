@@ -383,6 +383,7 @@ SolverBatch::create(const std::shared_ptr<Context::Impl>& ctx, CommandContext& c
   s.write_params_now();
   VKCLOTH_TRY(s.upload_initial_state(topology, states));
   VKCLOTH_TRY(s.ensure_tethers());
+  VKCLOTH_TRY(s.ensure_strain_chains());
   VKCLOTH_TRY(s.ensure_targets());
   VKCLOTH_TRY(s.ensure_frames());
   VKCLOTH_TRY(s.prepare_passes());

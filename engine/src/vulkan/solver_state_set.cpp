@@ -157,22 +157,22 @@ Result<void> SolverBatch::create_texel_views() {
       {flags.buffer, VK_FORMAT_R32_UINT, &flags_view, "flags"},
       {instances.buffer, VK_FORMAT_R32G32B32A32_UINT, &instances_view, "instance parameters"},
       {ranges.buffer, VK_FORMAT_R32G32B32A32_UINT, &ranges_view, "adjacency ranges"},
-      {edges.buffer, VK_FORMAT_R32G32B32A32_UINT, &edges_view, "adjacency"},
-      {strain_links.buffer, VK_FORMAT_R32_UINT, &strain_links_view, "strain links"}};
-  static_assert(sizeof(sh::StrainLink) == 12, "three R32UI texels per StrainLink");
+      {edges.buffer, VK_FORMAT_R32G32B32A32_UINT, &edges_view, "adjacency"}};
   VKCLOTH_TRY(vkcloth::gpu::create_texel_views(*ctx, views));
   return create_buffer_views();
 }
 
 // The views of the buffers that are replaced while the batch lives (again whenever one is:
-// ensure_tethers, ensure_collider_capacity, ensure_mesh_buffers): the tethers, the colliders and
-// the mesh colliders' nodes and triangles; then every texel set.
+// ensure_strain_chains, ensure_tethers, ensure_collider_capacity, ensure_mesh_buffers): the strain
+// links, the tethers, the colliders and the mesh colliders' nodes and triangles; then every texel set.
 Result<void> SolverBatch::create_buffer_views() {
   static_assert(sizeof(sh::TetherSlot) == 8, "one RG32UI texel per TetherSlot");
   static_assert(sizeof(sh::MeshNode) == 2 * 16 && sizeof(sh::MeshTriangle) == 3 * 16);
   if (access != BufferAccess::texel_views || !texel_sets[0])
     return {}; // no views (init_pipelines), or not yet (create_buffers: create_texel_views makes them)
+  static_assert(sizeof(sh::StrainLink) == 12, "three R32UI texels per StrainLink");
   const TexelViewSpec views[] = {
+      {strain_links.buffer, VK_FORMAT_R32_UINT, &strain_links_view, "strain links"},
       {tethers.buffer, VK_FORMAT_R32G32_UINT, &tethers_view, "tethers"},
       {colliders.buffer, VK_FORMAT_R32G32B32A32_UINT, &colliders_view, "colliders"},
       {mesh_nodes.buffer, VK_FORMAT_R32G32B32A32_UINT, &mesh_nodes_view, "mesh collider nodes"},

@@ -11,6 +11,7 @@
 
 #include "barriers.hpp"
 #include "world_impl.hpp"
+#include "../core/stretch_topology.hpp"
 
 namespace vkcloth::gpu {
 
@@ -239,6 +240,7 @@ Result<InstanceId> ClothWorld::add(std::shared_ptr<const ClothTopology> topology
                     initial.velocities.size(), n));
   VKCLOTH_TRY(params.validate());
   VKCLOTH_TRY(vkcloth::detail::PinTargets::check(params, {}, n));
+  VKCLOTH_TRY(vkcloth::detail::check_sweep_order(params.stretch_limit, *topology));
   Impl& s = *impl_;
   const InstanceId id = s.next;
   s.instances.emplace(id, Impl::Instance{std::move(topology), std::move(params)});
@@ -276,6 +278,7 @@ Result<void> ClothWorld::set_params(InstanceId id, SimParams params) {
   Impl& s = *impl_;
   Impl::Instance& inst = **found;
   VKCLOTH_TRY(inst.batch->slot(inst.slot).targets.check_params(params, inst.batch->particle_count()));
+  VKCLOTH_TRY(vkcloth::detail::check_sweep_order(params.stretch_limit, *inst.topology));
   const Impl::BatchKey old_key = Impl::key_of(inst, id);
   SimParams previous = std::move(inst.params);
   inst.params = std::move(params);

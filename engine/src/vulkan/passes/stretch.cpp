@@ -5,6 +5,7 @@
 // (strain_project.comp, its own buffers and sets), made when an instance first asks for it.
 #include <algorithm>
 #include <memory>
+#include <tuple>
 
 #include "../barriers.hpp"
 #include "../batch_limits.hpp"
@@ -31,6 +32,14 @@ std::uint32_t provot_sweeps(const SolverBatch& b) {
   return sweeps;
 }
 
+/// Whether an instance sweeps in `chains` order (else: in colours).
+bool any_order(const SolverBatch& b, bool chains) {
+  const auto& slots = b.instance_slots();
+  return std::any_of(slots.begin(), slots.end(), [&](const SolverBatch::Slot& s) {
+    return s.params.stretch_limit.provot() && s.params.stretch_limit.chains() == chains;
+  });
+}
+
 class StrainLinks final : public Pass {
 public:
   const char* name() const override { return "Provot's sweeps"; }
@@ -51,16 +60,33 @@ public:
     const auto colours = b.strain_colour_offsets();
     const std::uint32_t sweeps = provot_sweeps(b);
     std::uint32_t dispatches = 0;
-    for (std::uint32_t sweep = 0; sweep < sweeps; ++sweep)
-      for (std::size_t k = 0; k + 1 < colours.size(); ++k) {
-        pc.stage = sweep;
-        pc.link_first = colours[k];
-        pc.link_count = colours[k + 1] - colours[k];
-        b.push_state(f.cmd, &pc);
-        barriers::dispatch_to_dispatch(v, f.cmd); // the previous pass or colour -> this colour
-        b.dispatch_items(f.cmd, pc.link_count);
-        ++dispatches;
-      }
+    auto dispatch = [&](std::uint32_t first, std::uint32_t count, std::uint32_t chain_links) {
+      pc.link_first = first;
+      pc.link_count = count;
+      pc.chain_links = chain_links;
+      b.push_state(f.cmd, &pc);
+      barriers::dispatch_to_dispatch(v, f.cmd); // the previous pass, colour or chains' pass -> this one
+      b.dispatch_items(f.cmd, count);
+      ++dispatches;
+    };
+    // Chain order: the rows, then the columns (SolverBatch::ensure_strain_chains put their links
+    // after the coloured ones), each forward, then back in a dispatch of its own: the pass back
+    // reads through the texel views what the pass forward wrote.
+    const StrainChainShape chains = b.topology().strain_chain_shape();
+    const bool by_colour = any_order(b, false), by_chain = any_order(b, true);
+    for (std::uint32_t sweep = 0; sweep < sweeps; ++sweep) {
+      pc.stage = sweep;
+      for (std::size_t k = 0; by_colour && k + 1 < colours.size(); ++k)
+        dispatch(colours[k], colours[k + 1] - colours[k], 0u);
+      const std::uint32_t row_first = std::uint32_t(b.strain_link_count());
+      const std::uint32_t column_first = row_first + chains.rows * chains.row_links;
+      for (const auto& [first, count, links] :
+           {std::tuple{row_first, chains.rows, chains.row_links},
+            std::tuple{column_first, chains.columns, chains.column_links}})
+        for (const std::uint32_t direction : {0u, VKCLOTH_CHAIN_BACKWARD})
+          if (by_chain && count > 0)
+            dispatch(first, count, links | direction);
+    }
     return dispatches;
   }
 
