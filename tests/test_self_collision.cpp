@@ -192,6 +192,44 @@ TEST_CASE("self-collision samples: no triangle passes through another after the 
   }
 }
 
+TEST_CASE(
+    "self-collision: the cotton drop at 128 x 128 ends with no intersecting pair, its strain within 10 % "
+    "at every step") {
+  // Issue 38's drop at 128 x 128 (samples/bench/cotton_drop_self_collision_128.json: vbd's contact
+  // energy, 20 of Provot's sweeps in chain order to 6 %): no intersecting triangle pair after 3 s,
+  // and the largest structural strain of every step at most 10 % (measured 9.4 %). The same 20
+  // sweeps colour by colour leave 15.9 %, so the check can fail. The Vulkan run:
+  // tests/gpu/test_gpu_self_collision.cpp.
+  for (const bool chains : {true, false}) {
+    const std::string o = chains ? "stretch_limit.order=chains" : "stretch_limit.order=colours";
+    INFO(o);
+    auto scene =
+        load_scene_file(std::string(VKCLOTH_SCENES_DIR) + "/../bench/cotton_drop_self_collision_128.json",
+                        std::span<const std::string>(&o, 1));
+    REQUIRE_MESSAGE(scene.ok(), (scene.ok() ? "" : scene.error().message));
+    CHECK(scene->params.self_collision.thickness == 0.01);
+    auto s = CpuSolver<float>::create(scene->system, scene->params);
+    REQUIRE(s.ok());
+    double largest = 0.0;
+    for (std::uint64_t k = 0; k < scene->steps; ++k) {
+      REQUIRE(s->step().ok());
+      auto strain = structural_strain(scene->system, s->positions());
+      REQUIRE(strain.ok());
+      largest = std::max(largest, strain->max);
+    }
+    auto hits = intersecting_triangle_pairs(scene->system, s->positions());
+    REQUIRE(hits.ok());
+    MESSAGE(o << ": largest structural strain " << largest << ", " << hits->pairs
+              << " intersecting triangle pairs after 3 s");
+    if (chains) {
+      CHECK(largest <= 0.10);
+      CHECK(hits->pairs == 0);
+    } else {
+      CHECK(largest > 0.12);
+    }
+  }
+}
+
 TEST_CASE("self-collision: the cotton drop keeps its structural strain within 10 % at every step") {
   // Issue 38's drop at 64 x 64 (cotton_drop_self_collision: vbd with the contact energy, 4 Provot
   // sweeps to 9.5 %): the largest structural strain of every step stays at most 10 %; without the

@@ -102,6 +102,29 @@ TEST_CASE("GPU self-collision: no intersecting triangle pairs after the drop set
   }
 }
 
+TEST_CASE("GPU self-collision: the cotton drop at 128 x 128 ends with no intersecting pair (3 s)") {
+  VKCLOTH_GPU_TEST_BEGIN(ctx);
+  // Issue 38's drop at 128 x 128 (samples/bench/: Provot's sweeps in chain order); the CPU run and
+  // its strain at every step: tests/test_self_collision.cpp.
+  auto scene = load_scene_file(std::filesystem::path(VKCLOTH_SAMPLES_SCENES_DIR) / ".." / "bench" /
+                               "cotton_drop_self_collision_128.json");
+  REQUIRE_MESSAGE(scene.ok(), (scene.ok() ? "" : scene.error().message));
+  REQUIRE(scene->params.stretch_limit.chains());
+  auto gpu = gpu::GpuSolver::create(ctx, scene->system, scene->params);
+  REQUIRE(gpu.ok());
+  REQUIRE(gpu->simulate(scene->steps).ok());
+  auto gp = gpu->positions();
+  REQUIRE(gp.ok());
+  auto hits = intersecting_triangle_pairs(scene->system, *gp);
+  REQUIRE(hits.ok());
+  const auto strain = structural_strain(scene->system, *gp);
+  REQUIRE(strain.ok());
+  MESSAGE("on the GPU after 3 s: " << hits->pairs << " intersecting triangle pairs of " << hits->triangles
+                                   << ", structural strain " << strain->max);
+  CHECK(hits->pairs == 0);
+  CHECK(strain->max < 0.10);
+}
+
 TEST_CASE("ClothWorld: self-collision per instance in one batch, each as its own CPU solver") {
   VKCLOTH_GPU_TEST_BEGIN(ctx);
   // Instances of one topology: self-collision on (thickness 1 cm, friction 0.2, neighbour lists with
