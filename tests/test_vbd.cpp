@@ -280,6 +280,44 @@ TEST_CASE("vbd: the scene's integrator.iterations, with its range") {
   CHECK(SimParams{}.vbd_iterations == 5);
 }
 
+TEST_CASE(
+    "issue 37's cotton drop at 64 x 64 and 128 x 128 (samples/bench): strain within 10 % at every step") {
+  // The drop the peer comparison times (docs/performance.md "Vertex block descent"): 64 x 64 with
+  // vbd's 5 sweeps and no limit (measured 9.7 %); 128 x 128 with one sweep and 6 of Provot's sweeps
+  // in chain order to 3 % (9.1 %). The same 128 x 128 run with its sweeps colour by colour stretches
+  // 26 %, and with vbd's 5 sweeps and no limit 43 %: the check can fail.
+  struct Run {
+    const char* file;
+    const char* override_;
+    bool within;
+  };
+  const Run runs[] = {{"cotton_drop.json", "integrator.iterations=5", true},
+                      {"cotton_drop_128.json", "stretch_limit.order=chains", true},
+                      {"cotton_drop_128.json", "stretch_limit.order=colours", false}};
+  for (const Run& r : runs) {
+    const std::string o = r.override_;
+    CAPTURE(r.file);
+    CAPTURE(o);
+    auto scene = load_scene_file(std::string(VKCLOTH_SCENES_DIR) + "/../bench/" + r.file,
+                                 std::span<const std::string>(&o, 1));
+    REQUIRE_MESSAGE(scene.ok(), (scene.ok() ? "" : scene.error().message));
+    auto s = CpuSolver<float>::create(scene->system, scene->params);
+    REQUIRE(s.ok());
+    double largest = 0.0;
+    for (std::uint64_t k = 0; k < scene->steps; ++k) {
+      REQUIRE(s->step().ok());
+      auto strain = structural_strain(scene->system, s->positions());
+      REQUIRE(strain.ok());
+      largest = std::max(largest, strain->max);
+    }
+    MESSAGE(std::string(r.file) << " (" << o << "): largest structural strain over the run " << largest);
+    if (r.within)
+      CHECK(largest <= 0.10);
+    else
+      CHECK(largest > 0.15);
+  }
+}
+
 TEST_CASE("implicit solvers on the cotton drop onto a sphere: strain within 10 % without friction (vbd "
           "also with it), no particle flung") {
   // Issue 37's drop at 32 x 32 and dt 1/300 for 2 s, for both implicit solvers (CG, vbd). CG used to
