@@ -142,6 +142,19 @@ inline std::unique_ptr<Sim> make_sim(Backend b, const ParticleSystem& system, co
   return nullptr;
 }
 
+/// Steps `solver` through `scene`'s steps (the test fails on an error) and returns the largest
+/// structural strain of every step (the strain targets of issues 37 and 38).
+inline double largest_strain_over_steps(const Scene& scene, CpuSolver<float>& solver) {
+  double largest = 0.0;
+  for (std::uint64_t k = 0; k < scene.steps; ++k) {
+    REQUIRE(solver.step().ok());
+    auto strain = structural_strain(scene.system, solver.positions());
+    REQUIRE(strain.ok());
+    largest = std::max(largest, strain->max);
+  }
+  return largest;
+}
+
 /// The largest distance between the first run's positions and each other run's (the float
 /// backends' ends: GPU = CPU checks).
 inline double largest_gap(const std::vector<std::vector<glm::dvec3>>& ends) {

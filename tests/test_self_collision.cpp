@@ -210,13 +210,7 @@ TEST_CASE(
     CHECK(scene->params.self_collision.thickness == 0.01);
     auto s = CpuSolver<float>::create(scene->system, scene->params);
     REQUIRE(s.ok());
-    double largest = 0.0;
-    for (std::uint64_t k = 0; k < scene->steps; ++k) {
-      REQUIRE(s->step().ok());
-      auto strain = structural_strain(scene->system, s->positions());
-      REQUIRE(strain.ok());
-      largest = std::max(largest, strain->max);
-    }
+    const double largest = largest_strain_over_steps(*scene, *s);
     auto hits = intersecting_triangle_pairs(scene->system, s->positions());
     REQUIRE(hits.ok());
     MESSAGE(o << ": largest structural strain " << largest << ", " << hits->pairs
@@ -241,13 +235,7 @@ TEST_CASE("self-collision: the cotton drop keeps its structural strain within 10
     REQUIRE_MESSAGE(scene.ok(), (scene.ok() ? "" : scene.error().message));
     auto s = CpuSolver<float>::create(scene->system, scene->params);
     REQUIRE(s.ok());
-    double largest = 0.0;
-    for (std::uint64_t k = 0; k < scene->steps; ++k) {
-      REQUIRE(s->step().ok());
-      auto strain = structural_strain(scene->system, s->positions());
-      REQUIRE(strain.ok());
-      largest = std::max(largest, strain->max);
-    }
+    const double largest = largest_strain_over_steps(*scene, *s);
     MESSAGE(std::string(limited ? "with" : "without")
             << " Provot's sweeps: largest structural strain " << largest);
     if (limited)
