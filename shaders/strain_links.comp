@@ -24,20 +24,27 @@
 #define VKCLOTH_ACCESS_STRAIN_LINKS
 #include "buffer_access.glsl"
 
-// Provot's correction of link l (the CPU's `project`): nothing when it is within its bound. Along
-// a chain, the particle the previous link shared with this one comes from `carried` (its id, position
-// and velocity): what this invocation wrote is not visible through the texel views before the next
-// dispatch. It leaves in `carried` the particle this link shares with the next (forward: b, back: a).
+// Provot's correction of link l (the CPU's `project`): nothing when it is within its bound (its
+// velocities are then not read). Along a chain, the particle the previous link shared with this one
+// comes from `carried` (its id, position and, when that link moved it, velocity): what this
+// invocation wrote is not visible through the texel views before the next dispatch. A link that
+// does not move leaves as `carried` a particle this pass has not yet written (the chain's next one),
+// so its velocity can then come from memory. It leaves in `carried` the particle this link shares
+// with the next (forward: b, back: a).
 uint carried = 0xffffffffu;
 vec3 carried_x, carried_v;
+bool carried_moved = false;
+vec3 velocity_of(uint q) { return q == carried && carried_moved ? carried_v : read_velocity(q); }
 void project_link(uint l, bool backward) {
   const StrainLink link = read_strain_link(l);
   const uint a = link.a, b = link.b;
   vec3 xa = a == carried ? carried_x : read_pos_out(a), xb = b == carried ? carried_x : read_pos_out(b);
-  vec3 va = a == carried ? carried_v : read_velocity(a), vb = b == carried ? carried_v : read_velocity(b);
-  vec3 da, db;
-  if (provot_link(xa, xb, read_particle(a).pinned != 0u, read_particle(b).pinned != 0u,
-                  stretch_bound(link.rest_length, ip.max_strain), da, db)) {
+  vec3 da, db, va, vb;
+  const bool moves = provot_link(xa, xb, read_particle(a).pinned != 0u, read_particle(b).pinned != 0u,
+                                 stretch_bound(link.rest_length, ip.max_strain), da, db);
+  if (moves) {
+    va = velocity_of(a);
+    vb = velocity_of(b);
     apply_correction(xa, va, da, ip.dt);
     apply_correction(xb, vb, db, ip.dt);
     pos_out[base + a] = vec4(xa, 1.0);
@@ -48,6 +55,7 @@ void project_link(uint l, bool backward) {
   carried = backward ? a : b;
   carried_x = backward ? xa : xb;
   carried_v = backward ? va : vb;
+  carried_moved = moves;
 }
 
 void main() {
