@@ -241,13 +241,20 @@ TEST_CASE(
   CHECK(world->step_index(*late) == 10);
 }
 
-TEST_CASE("ClothWorld batches: instances with and without the fast projection, each bitwise == alone") {
-  // One batch of a topology: the fast projection (two Newton budgets), the sweeps, nothing. The
-  // projection's dispatches serve every instance of the batch (one workgroup each) and end when
-  // the last projecting instance is done; the others skip them.
+TEST_CASE("ClothWorld batches: instances with and without the fast projection, Provot's sweeps in colours or "
+          "in chains, each bitwise == alone") {
+  // One batch of a topology: the fast projection (two Newton budgets), the sweeps, nothing, the
+  // sweeps in chain order (two budgets). The projection's dispatches serve every instance of the
+  // batch (one workgroup each) and end when the last projecting instance is done; the others skip
+  // them. The colours' and the chains' dispatches each skip the instances of the other order.
   VKCLOTH_GPU_TEST_BEGIN(ctx);
   auto topo = make_topology(12, 9);
-  std::vector<SimParams> params(4);
+  std::vector<SimParams> params(6);
+  params[4].stretch_limit.method = StretchLimit::Method::provot;
+  params[4].stretch_limit.order = StretchLimit::SweepOrder::chains;
+  params[4].stretch_limit.max_strain = 0.002;
+  params[5] = params[4];
+  params[5].stretch_limit.iterations = 9;
   params[0].stretch_limit.method = StretchLimit::Method::projection;
   params[0].stretch_limit.max_strain = 0.002;
   params[1] = params[0];
@@ -288,6 +295,10 @@ TEST_CASE("ClothWorld batches: instances with and without the fast projection, e
   };
   CHECK(strain(0) < 0.002 + 2e-4);
   CHECK(strain(3) > 0.004);
+  MESSAGE("largest strain: colours " << strain(2) << ", none " << strain(3) << ", chains x 4 " << strain(4)
+                                     << ", chains x 9 " << strain(5));
+  CHECK(strain(4) < strain(3)); // the chains acted
+  CHECK(strain(5) < strain(4)); // and 9 sweeps more than 4
 }
 
 TEST_CASE("ClothWorld batches: a diverging instance is frozen and named, the others go on") {
