@@ -200,13 +200,17 @@ foreach(i RANGE ${last})
                       self_collision_iterations wall_ms ms_per_step)
   if(scene STREQUAL "self_collision")
     require_result_keys(" (self-collision)" ${i} self_collision_ratio self_collision_us_per_particle
-                        particles_in_self_contact_start particles_in_self_contact_end)
+                        particles_in_self_contact_start particles_in_self_contact_end self_contact_pairs_end)
     string(JSON ratio GET "${doc}" results ${i} self_collision_ratio)
     string(JSON start GET "${doc}" results ${i} particles_in_self_contact_start)
     string(JSON end GET "${doc}" results ${i} particles_in_self_contact_end)
-    if(NOT ratio GREATER 0 OR start LESS 1 OR end LESS 1)
-      message(FATAL_ERROR "bench JSON (self-collision): results[${i}] (${backend}) has ratio ${ratio} and "
-                          "${start} then ${end} particles in self-contact")
+    string(JSON pairs GET "${doc}" results ${i} self_contact_pairs_end)
+    # Each particle in self-contact has a pair, and a pair holds two of them.
+    math(EXPR most "${end} * (${end} - 1) / 2")
+    math(EXPR least "(${end} + 1) / 2")
+    if(NOT ratio GREATER 0 OR start LESS 1 OR end LESS 1 OR pairs LESS least OR pairs GREATER most)
+      message(FATAL_ERROR "bench JSON (self-collision): results[${i}] (${backend}) has ratio ${ratio}, "
+                          "${start} then ${end} particles in self-contact and ${pairs} pairs")
     endif()
   endif()
   list(APPEND self_rows "${backend}:${scene}")

@@ -114,7 +114,12 @@ struct SelfScene {
 };
 
 Result<SelfScene> folded_scene(std::uint32_t n, Integrator integrator, double dt, const BenchOptions& o);
-std::size_t particles_in_self_contact(const SelfScene& sc, std::span<const glm::vec3> positions);
+/// What is in self-contact: the particles, and the pairs (each once).
+struct SelfContact {
+  std::size_t particles = 0;
+  std::size_t pairs = 0;
+};
+SelfContact self_contact(const SelfScene& sc, std::span<const glm::vec3> positions);
 
 // ---- Cost model (cost.cpp) --------------------------------------------------------------------
 
@@ -152,6 +157,7 @@ struct Row {
   std::string contact; // contact rows: "table" | "mesh" | "sphere" (scene "contact" or "contact_free")
   std::size_t in_contact_start = 0, in_contact_end = 0; // scene "contact": particles within 2 eps;
                                                         // "self_collision": in self-contact
+  std::size_t self_pairs_end = 0;                       // "self_collision": pairs in self-contact
   std::vector<std::string> colliders;                   // scene "contact": their types
   std::uint32_t collider_triangles = 0;                 // scene "contact": a mesh collider's
   double self_thickness = 0; // self-collision rows: the thickness (m) of the "on" row's parameters

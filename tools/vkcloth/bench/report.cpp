@@ -203,6 +203,7 @@ void add_scene_keys(nlohmann::json& j, const std::vector<Row>& rows, const Row& 
     if (r.scene == "self_collision") {
       j["particles_in_self_contact_start"] = r.in_contact_start;
       j["particles_in_self_contact_end"] = r.in_contact_end;
+      j["self_contact_pairs_end"] = r.self_pairs_end;
       if (const Row* f = self_free_of(rows, r)) {
         j["self_collision_ratio"] = r.wall_ms / f->wall_ms;
         j["self_collision_us_per_particle"] =
@@ -322,16 +323,18 @@ void print_self_table(const std::vector<Row>& rows) {
     if (const Row* f = r.scene == "self_collision" ? self_free_of(rows, r) : nullptr) {
       if (!self_header) {
         fmt::print("self-collision on vs off, alternated (ms per step, wall; us/particle: (on - off) per "
-                   "step / particles; in self-contact: after the warm-up / after the timed steps)\n");
-        fmt::print("{:<7} {:<9} {:<11} {:>5} {:>9} {:>10} {:>10} {:>8} {:>11} {:>17}\n", "backend", "variant",
-                   "layout", "n", "particles", "off ms", "on ms", "on/off", "us/particle", "in self-contact");
+                   "step / particles; in self-contact: particles after the warm-up / after the timed steps; "
+                   "pairs: in self-contact after the timed steps)\n");
+        fmt::print("{:<7} {:<9} {:<11} {:>5} {:>9} {:>10} {:>10} {:>8} {:>11} {:>17} {:>8}\n", "backend",
+                   "variant", "layout", "n", "particles", "off ms", "on ms", "on/off", "us/particle",
+                   "in self-contact", "pairs");
         self_header = true;
       }
       const double on = r.wall_ms / double(r.steps), off = f->wall_ms / double(f->steps);
-      fmt::print("{:<7} {:<9} {:<11} {:>5} {:>9} {:>10.4f} {:>10.4f} {:>7.2f}x {:>11.4f} {:>17}\n", r.backend,
-                 r.variant, r.layout.empty() ? "-" : fmt::format("{}/{}", r.layout, r.workgroup), r.size,
-                 r.particles, off, on, r.wall_ms / f->wall_ms, 1e3 * (on - off) / double(r.particles),
-                 fmt::format("{} / {}", r.in_contact_start, r.in_contact_end));
+      fmt::print("{:<7} {:<9} {:<11} {:>5} {:>9} {:>10.4f} {:>10.4f} {:>7.2f}x {:>11.4f} {:>17} {:>8}\n",
+                 r.backend, r.variant, r.layout.empty() ? "-" : fmt::format("{}/{}", r.layout, r.workgroup),
+                 r.size, r.particles, off, on, r.wall_ms / f->wall_ms, 1e3 * (on - off) / double(r.particles),
+                 fmt::format("{} / {}", r.in_contact_start, r.in_contact_end), r.self_pairs_end);
     }
 }
 

@@ -341,14 +341,14 @@ Result<SelfScene> folded_scene(std::uint32_t n, Integrator integrator, double dt
   return SelfScene{n, std::move(cloth->system), std::move(p), std::move(rest)};
 }
 
-/// Particles in self-contact: within 1.05 x the thickness of a particle that was not closer than the
-/// thickness at rest (the solvers' rest-position filter, cloth_kernel.h self_pair), in double from
-/// the float positions and rest positions; a spatial hash of cells 1.05 thickness wide, the 27 cells
-/// around each particle. A band, not the solvers' "closer than the thickness", because a step ends
-/// with its self-collision passes, which leave a resolved pair exactly the thickness apart, and the
-/// resting layers hover 1-5 % of the thickness apart between the substeps that push them together;
-/// the grid's next particles but one, 2 spacings = 1.33 thicknesses apart, stay outside it.
-std::size_t particles_in_self_contact(const SelfScene& sc, std::span<const glm::vec3> positions) {
+/// Particles in self-contact, and pairs: within 1.05 x the thickness of a particle that was not closer than
+/// the thickness at rest (the solvers' rest-position filter, cloth_kernel.h self_pair), in double from the
+/// float positions and rest positions; a spatial hash of cells 1.05 thickness wide, the 27 cells around each
+/// particle. A band, not the solvers' "closer than the thickness", because a step ends with its
+/// self-collision passes, which leave a resolved pair exactly the thickness apart, and the resting layers
+/// hover 1-5 % of the thickness apart between the substeps that push them together; the grid's next particles
+/// but one, 2 spacings = 1.33 thicknesses apart, stay outside it.
+SelfContact self_contact(const SelfScene& sc, std::span<const glm::vec3> positions) {
   const double thickness = sc.params.self_collision.thickness, rest2 = thickness * thickness;
   const double t = self_contact_band * thickness, t2 = t * t;
   using Cell = std::array<std::int64_t, 3>;
@@ -367,13 +367,13 @@ std::size_t particles_in_self_contact(const SelfScene& sc, std::span<const glm::
   std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> cells;
   for (std::size_t k = 0; k < x.size(); ++k)
     cells[key(cell(x[k]), 0, 0, 0)].push_back(std::uint32_t(k));
-  std::size_t count = 0;
+  SelfContact count;
   for (std::size_t k = 0; k < x.size(); ++k) {
     const Cell c = cell(x[k]);
     bool touching = false;
-    for (int dz = -1; dz <= 1 && !touching; ++dz)
-      for (int dy = -1; dy <= 1 && !touching; ++dy)
-        for (int dx = -1; dx <= 1 && !touching; ++dx) {
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
           const auto at = cells.find(key(c, dx, dy, dz));
           if (at == cells.end())
             continue;
@@ -382,11 +382,11 @@ std::size_t particles_in_self_contact(const SelfScene& sc, std::span<const glm::
             const double d2 = glm::dot(u, u);
             if (q != k && d2 < t2 && d2 > 0.0 && !(glm::dot(v, v) < rest2)) {
               touching = true;
-              break;
+              count.pairs += q > k; // each pair once
             }
           }
         }
-    count += touching;
+    count.particles += touching;
   }
   return count;
 }

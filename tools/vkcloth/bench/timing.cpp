@@ -341,18 +341,31 @@ Result<std::array<Row, 2>> bench_vulkan_contact(gpu::Context& ctx, const Contact
 Result<std::array<Row, 2>> bench_cpu_self(const SelfScene& sc, const BenchOptions& o) {
   SimParams off = sc.params;
   off.self_collision.enabled = false;
-  return bench_cpu_pair(
-      sc.system, off, sc.params, o, {"self_collision_free", "self_collision"},
-      [&](std::span<const glm::vec3> x) -> Result<std::size_t> { return particles_in_self_contact(sc, x); });
+  SelfContact last; // the count after the timed steps, the last one taken
+  auto rows = bench_cpu_pair(sc.system, off, sc.params, o, {"self_collision_free", "self_collision"},
+                             [&](std::span<const glm::vec3> x) -> Result<std::size_t> {
+                               last = self_contact(sc, x);
+                               return last.particles;
+                             });
+  if (rows)
+    (*rows)[1].self_pairs_end = last.pairs;
+  return rows;
 }
 
 Result<std::array<Row, 2>> bench_vulkan_self(gpu::Context& ctx, const SelfScene& sc, bool fused,
                                              gpu::BufferAccess access, const BenchOptions& o) {
   SimParams off = sc.params;
   off.self_collision.enabled = false;
-  return bench_vulkan_pair(
-      ctx, sc.system, off, sc.params, fused, access, o, {"self_collision_free", "self_collision"},
-      [&](std::span<const glm::vec3> x) -> Result<std::size_t> { return particles_in_self_contact(sc, x); });
+  SelfContact last; // the count after the timed steps, the last one taken
+  auto rows = bench_vulkan_pair(ctx, sc.system, off, sc.params, fused, access, o,
+                                {"self_collision_free", "self_collision"},
+                                [&](std::span<const glm::vec3> x) -> Result<std::size_t> {
+                                  last = self_contact(sc, x);
+                                  return last.particles;
+                                });
+  if (rows)
+    (*rows)[1].self_pairs_end = last.pairs;
+  return rows;
 }
 
 } // namespace vkcloth::cli::bench
