@@ -367,13 +367,24 @@ Result<IntersectionStats> pairs_impl(std::span<const std::uint32_t> indices, std
   return stats;
 }
 
+/// The triangles ClothTopology::triangles() lists (detail::for_each_system_triangle).
+std::vector<std::uint32_t> system_triangles(const ParticleSystem& system) {
+  std::vector<std::uint32_t> tris;
+  if (system.grid && system.grid->nx >= 2 && system.grid->ny >= 2)
+    tris.reserve(std::size_t(system.grid->nx - 1) * (system.grid->ny - 1) * 6);
+  detail::for_each_system_triangle(system, [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
+    tris.insert(tris.end(), {a, b, c});
+  });
+  return tris;
+}
+
 template <typename Vec>
 Result<IntersectionStats> system_pairs(const ParticleSystem& system, std::span<const Vec> positions) {
   if (positions.size() != system.size())
     return make_error(ErrorCode::invalid_argument,
                       fmt::format("intersecting_triangle_pairs: {} positions for {} particles",
                                   positions.size(), system.size()));
-  const std::vector<std::uint32_t> tris = detail::system_triangles(system);
+  const std::vector<std::uint32_t> tris = system_triangles(system);
   return intersecting_triangle_pairs(std::span<const std::uint32_t>(tris), positions);
 }
 
@@ -410,37 +421,18 @@ Result<IntersectionStats> intersecting_triangle_pairs(const ParticleSystem& syst
 
 namespace detail {
 
-std::vector<std::uint32_t> system_triangles(const ParticleSystem& system) {
-  std::vector<std::uint32_t> tris;
-  if (system.grid) {
-    const std::uint32_t nx = system.grid->nx, ny = system.grid->ny;
-    if (nx >= 2 && ny >= 2) {
-      tris.reserve(std::size_t(nx - 1) * (ny - 1) * 6);
-      for (std::uint32_t j = 0; j + 1 < ny; ++j)
-        for (std::uint32_t i = 0; i + 1 < nx; ++i) {
-          const std::uint32_t a = j * nx + i, b = a + 1, c = a + nx, d = c + 1;
-          tris.insert(tris.end(), {a, b, d, a, d, c});
-        }
-    }
-  } else if (system.surface) {
-    tris = system.surface->triangles;
-  }
-  return tris;
-}
-
 double largest_circumradius(const ParticleSystem& system) {
-  const std::vector<std::uint32_t> tris = system_triangles(system);
   double largest = 0.0;
-  for (std::size_t t = 0; t + 2 < tris.size(); t += 3) {
-    if (std::max({tris[t], tris[t + 1], tris[t + 2]}) >= system.size())
-      continue; // an unchecked system's bad index: ParticleSystem::validate names it
-    const glm::dvec3 a = system.particles[tris[t]].position, b = system.particles[tris[t + 1]].position,
-                     c = system.particles[tris[t + 2]].position;
+  for_each_system_triangle(system, [&](std::uint32_t i, std::uint32_t j, std::uint32_t k) {
+    if (std::max({i, j, k}) >= system.size())
+      return; // an unchecked system's bad index: ParticleSystem::validate names it
+    const glm::dvec3 a = system.particles[i].position, b = system.particles[j].position,
+                     c = system.particles[k].position;
     const double twice_area = glm::length(glm::cross(b - a, c - a));
     if (twice_area > 0.0) // R = |ab| |bc| |ca| / (4 area)
       largest = std::max(largest,
                          glm::length(b - a) * glm::length(c - b) * glm::length(a - c) / (2.0 * twice_area));
-  }
+  });
   return largest;
 }
 
