@@ -342,10 +342,21 @@ TEST_CASE(
   SimParams p = limited(StretchLimit::Method::provot, 4, 0.001);
   p.stretch_limit.order = StretchLimit::SweepOrder::chains;
   const ParticleSystem chain = make_chain(ChainDesc{}).value();
-  auto cpu = CpuSolver<float>::create(chain, p);
-  REQUIRE_FALSE(cpu.ok());
-  CHECK(cpu.error().code == ErrorCode::invalid_argument);
-  CHECK(cpu.error().message.find("stretch_limit.order \"chains\" needs a grid cloth") != std::string::npos);
+  // A mesh cloth of two triangles (a unit quad).
+  Mesh quad;
+  quad.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  quad.indices = {0, 1, 2, 0, 2, 3};
+  quad.face_offsets = {0, 3, 6};
+  auto mesh = make_mesh_cloth(quad, MeshClothDesc{});
+  REQUIRE(mesh.ok());
+  const std::vector<const ParticleSystem*> gridless = {&chain, &mesh->system};
+  for (const ParticleSystem* s : gridless) {
+    auto refused_early = CpuSolver<float>::create(*s, p);
+    REQUIRE_FALSE(refused_early.ok());
+    CHECK(refused_early.error().code == ErrorCode::invalid_argument);
+    CHECK(refused_early.error().message.find("stretch_limit.order \"chains\" needs a grid cloth") !=
+          std::string::npos);
+  }
   // Turned on later: the solver keeps its parameters.
   auto colours = CpuSolver<float>::create(chain, limited(StretchLimit::Method::provot, 4, 0.001));
   REQUIRE(colours.ok());
@@ -357,9 +368,12 @@ TEST_CASE(
     if (b != Backend::vulkan)
       continue;
     ValidationScope validation;
-    auto gpu = gpu::GpuSolver::create(*gpu::test::shared_context().context, chain, p);
-    REQUIRE_FALSE(gpu.ok());
-    CHECK(gpu.error().message.find("stretch_limit.order \"chains\" needs a grid cloth") != std::string::npos);
+    for (const ParticleSystem* s : gridless) {
+      auto gpu = gpu::GpuSolver::create(*gpu::test::shared_context().context, *s, p);
+      REQUIRE_FALSE(gpu.ok());
+      CHECK(gpu.error().message.find("stretch_limit.order \"chains\" needs a grid cloth") !=
+            std::string::npos);
+    }
     auto sim = make_sim(b, chain, limited(StretchLimit::Method::provot, 4, 0.001));
     CHECK(sim->set_params(p).error().message.find("needs a grid cloth") != std::string::npos);
   }
