@@ -336,36 +336,39 @@ Result<std::array<Row, 2>> bench_vulkan_contact(gpu::Context& ctx, const Contact
       [&](std::span<const glm::vec3> x) { return particles_in_contact(sc, to_double(x)); });
 }
 
+namespace {
+
 /// The folded cloth with self-collision off (row 0, scene "self_collision_free") and on (row 1,
-/// "self_collision"), alternated; the particles in self-contact counted on the second.
-Result<std::array<Row, 2>> bench_cpu_self(const SelfScene& sc, const BenchOptions& o) {
+/// "self_collision"), alternated by `time_pair(off, on, count)` (bench_cpu_pair or
+/// bench_vulkan_pair); the particles in self-contact counted on the second, and its pairs after the
+/// timed steps (the last count taken).
+template <typename TimePair> Result<std::array<Row, 2>> self_rows(const SelfScene& sc, TimePair&& time_pair) {
   SimParams off = sc.params;
   off.self_collision.enabled = false;
-  SelfContact last; // the count after the timed steps, the last one taken
-  auto rows = bench_cpu_pair(sc.system, off, sc.params, o, {"self_collision_free", "self_collision"},
-                             [&](std::span<const glm::vec3> x) -> Result<std::size_t> {
-                               last = self_contact(sc, x);
-                               return last.particles;
-                             });
+  SelfContact last;
+  auto rows = time_pair(off, [&](std::span<const glm::vec3> x) -> Result<std::size_t> {
+    last = self_contact(sc, x);
+    return last.particles;
+  });
   if (rows)
     (*rows)[1].self_pairs_end = last.pairs;
   return rows;
 }
 
+} // namespace
+
+Result<std::array<Row, 2>> bench_cpu_self(const SelfScene& sc, const BenchOptions& o) {
+  return self_rows(sc, [&](const SimParams& off, const auto& count) {
+    return bench_cpu_pair(sc.system, off, sc.params, o, {"self_collision_free", "self_collision"}, count);
+  });
+}
+
 Result<std::array<Row, 2>> bench_vulkan_self(gpu::Context& ctx, const SelfScene& sc, bool fused,
                                              gpu::BufferAccess access, const BenchOptions& o) {
-  SimParams off = sc.params;
-  off.self_collision.enabled = false;
-  SelfContact last; // the count after the timed steps, the last one taken
-  auto rows = bench_vulkan_pair(ctx, sc.system, off, sc.params, fused, access, o,
-                                {"self_collision_free", "self_collision"},
-                                [&](std::span<const glm::vec3> x) -> Result<std::size_t> {
-                                  last = self_contact(sc, x);
-                                  return last.particles;
-                                });
-  if (rows)
-    (*rows)[1].self_pairs_end = last.pairs;
-  return rows;
+  return self_rows(sc, [&](const SimParams& off, const auto& count) {
+    return bench_vulkan_pair(ctx, sc.system, off, sc.params, fused, access, o,
+                             {"self_collision_free", "self_collision"}, count);
+  });
 }
 
 } // namespace vkcloth::cli::bench
