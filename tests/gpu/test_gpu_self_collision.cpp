@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "gpu_test_util.hpp"
 #include "vkcloth/gpu/testing.hpp"
@@ -18,6 +19,16 @@ namespace {
 Result<Scene> sample(const char* name, std::span<const std::string> overrides = {}) {
   return load_scene_file(std::filesystem::path(VKCLOTH_SAMPLES_SCENES_DIR) / (std::string(name) + ".json"),
                          overrides);
+}
+
+/// The scene's whole run on the GPU: its positions at the end (the test fails on an error).
+std::vector<glm::vec3> gpu_end(gpu::Context& ctx, const Scene& scene) {
+  auto gpu = gpu::GpuSolver::create(ctx, scene.system, scene.params);
+  REQUIRE(gpu.ok());
+  REQUIRE(gpu->simulate(scene.steps).ok());
+  auto gp = gpu->positions();
+  REQUIRE(gp.ok());
+  return *gp;
 }
 
 } // namespace
@@ -89,12 +100,7 @@ TEST_CASE("GPU self-collision: no intersecting triangle pairs after the drop set
     INFO(name);
     auto scene = sample(name);
     REQUIRE_MESSAGE(scene.ok(), (scene.ok() ? "" : scene.error().message));
-    auto gpu = gpu::GpuSolver::create(ctx, scene->system, scene->params);
-    REQUIRE(gpu.ok());
-    REQUIRE(gpu->simulate(scene->steps).ok());
-    auto gp = gpu->positions();
-    REQUIRE(gp.ok());
-    auto hits = intersecting_triangle_pairs(scene->system, *gp);
+    auto hits = intersecting_triangle_pairs(scene->system, gpu_end(ctx, *scene));
     REQUIRE(hits.ok());
     MESSAGE(name << " on the GPU after 3 s: " << hits->pairs << " intersecting triangle pairs of "
                  << hits->triangles);
@@ -110,14 +116,10 @@ TEST_CASE("GPU self-collision: the cotton drop at 128 x 128 ends with no interse
                                "cotton_drop_self_collision_128.json");
   REQUIRE_MESSAGE(scene.ok(), (scene.ok() ? "" : scene.error().message));
   REQUIRE(scene->params.stretch_limit.chains());
-  auto gpu = gpu::GpuSolver::create(ctx, scene->system, scene->params);
-  REQUIRE(gpu.ok());
-  REQUIRE(gpu->simulate(scene->steps).ok());
-  auto gp = gpu->positions();
-  REQUIRE(gp.ok());
-  auto hits = intersecting_triangle_pairs(scene->system, *gp);
+  const std::vector<glm::vec3> end = gpu_end(ctx, *scene);
+  auto hits = intersecting_triangle_pairs(scene->system, end);
   REQUIRE(hits.ok());
-  const auto strain = structural_strain(scene->system, *gp);
+  const auto strain = structural_strain(scene->system, end);
   REQUIRE(strain.ok());
   MESSAGE("on the GPU after 3 s: " << hits->pairs << " intersecting triangle pairs of " << hits->triangles
                                    << ", structural strain " << strain->max);
