@@ -74,12 +74,12 @@ public:
     // reads through the texel views what the pass forward wrote.
     const StrainChainShape chains = b.topology().strain_chain_shape();
     const bool by_colour = any_order(b, false), by_chain = any_order(b, true);
+    const std::uint32_t row_first = std::uint32_t(b.strain_link_count());
+    const std::uint32_t column_first = row_first + chains.rows * chains.row_links;
     for (std::uint32_t sweep = 0; sweep < sweeps; ++sweep) {
       pc.stage = sweep;
       for (std::size_t k = 0; by_colour && k + 1 < colours.size(); ++k)
         dispatch(colours[k], colours[k + 1] - colours[k], 0u);
-      const std::uint32_t row_first = std::uint32_t(b.strain_link_count());
-      const std::uint32_t column_first = row_first + chains.rows * chains.row_links;
       for (const auto& [first, count, links] :
            {std::tuple{row_first, chains.rows, chains.row_links},
             std::tuple{column_first, chains.columns, chains.column_links}})
