@@ -362,6 +362,8 @@ private:
   Result<void> prepare_passes();
   Result<void> ensure_tethers();
   Result<void> ensure_strain_chains();
+  Result<void> replace_topology_buffer(Buffer& dst, BufferView& view, const void* data, VkDeviceSize bytes,
+                                       const char* what);
   Result<void> ensure_collider_capacity();
   Result<void> ensure_mesh_buffers();
   Result<void> ensure_targets();
