@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <limits>
+#include <optional>
 #include <fmt/format.h>
 
 #include <glm/geometric.hpp>
@@ -42,6 +44,15 @@ Result<void> validate_attachment(const Attachment& a, const std::vector<Collider
   return {};
 }
 
+/// The value among `values` whose to_string is `name` (a scene key's string); nullopt for none.
+template <typename Enum>
+std::optional<Enum> parse_named(std::string_view name, std::initializer_list<Enum> values) {
+  for (Enum v : values)
+    if (name == to_string(v))
+      return v;
+  return std::nullopt;
+}
+
 } // namespace
 
 const char* to_string(Integrator integrator) {
@@ -61,11 +72,8 @@ const char* to_string(Integrator integrator) {
 }
 
 std::optional<Integrator> parse_integrator(std::string_view name) {
-  for (Integrator i : {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::rk4,
-                       Integrator::implicit_euler, Integrator::vbd})
-    if (name == to_string(i))
-      return i;
-  return std::nullopt;
+  return parse_named(name, {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::rk4,
+                            Integrator::implicit_euler, Integrator::vbd});
 }
 
 const char* to_string(StretchLimit::Method method) {
@@ -86,10 +94,7 @@ const char* to_string(StretchLimit::Method method) {
 
 std::optional<StretchLimit::Method> parse_stretch_method(std::string_view name) {
   using M = StretchLimit::Method;
-  for (M m : {M::off, M::tethers, M::provot, M::both, M::projection})
-    if (name == to_string(m))
-      return m;
-  return std::nullopt;
+  return parse_named(name, {M::off, M::tethers, M::provot, M::both, M::projection});
 }
 
 const char* to_string(StretchLimit::TetherDistance distance) {
@@ -98,10 +103,7 @@ const char* to_string(StretchLimit::TetherDistance distance) {
 
 std::optional<StretchLimit::TetherDistance> parse_tether_distance(std::string_view name) {
   using D = StretchLimit::TetherDistance;
-  for (D d : {D::euclidean, D::geodesic})
-    if (name == to_string(d))
-      return d;
-  return std::nullopt;
+  return parse_named(name, {D::euclidean, D::geodesic});
 }
 
 const char* to_string(StretchLimit::SweepOrder order) {
@@ -110,10 +112,7 @@ const char* to_string(StretchLimit::SweepOrder order) {
 
 std::optional<StretchLimit::SweepOrder> parse_sweep_order(std::string_view name) {
   using O = StretchLimit::SweepOrder;
-  for (O o : {O::colours, O::chains})
-    if (name == to_string(o))
-      return o;
-  return std::nullopt;
+  return parse_named(name, {O::colours, O::chains});
 }
 
 Result<void> SimParams::validate() {
