@@ -104,6 +104,13 @@ inline std::vector<Backend> backends() {
   return {Backend::cpu_float, Backend::cpu_double};
 }
 
+/// The Vulkan backend runs on lavapipe (llvmpipe): the same expressions in the same order as the
+/// CPU float solver, so the CPU's bits.
+inline bool vulkan_gives_cpu_bits() {
+  const auto& shared = gpu::test::shared_context();
+  return shared.context && shared.context->device_name().find("llvmpipe") != std::string::npos;
+}
+
 /// Float-only backends (CPU float and Vulkan), for checks stated at float precision.
 inline std::vector<Backend> float_backends() {
   std::vector<Backend> r;

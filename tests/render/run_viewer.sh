@@ -17,7 +17,7 @@ VKCLOTH_VALIDATION=1 timeout 120 xvfb-run -a "$bin" view "$scene" --frames 30 --
   --screenshot "$out/view_shot.png" "$@" >"$out/view.stdout" 2>"$out/view.stderr"
 rc=$?
 cat "$out/view.stdout"; cat "$out/view.stderr" >&2
-if [[ $rc -eq 4 && "${CI:-}" != "true" ]]; then echo "skipped: no Vulkan device / display"; exit 77; fi
+if [[ $rc -eq 4 && "${CI:-}" != "true" && "${CI:-}" != "1" ]]; then echo "skipped: no Vulkan device / display"; exit 77; fi
 [[ $rc -eq 0 ]] || { echo "FAIL: vkcloth view exited $rc" >&2; exit 1; }
 if grep -qi "validation" "$out/view.stderr"; then echo "FAIL: validation messages on stderr" >&2; exit 1; fi
 [[ -s "$out/view_shot.png" ]] || { echo "FAIL: no screenshot" >&2; exit 1; }

@@ -178,7 +178,7 @@ void check_contact_physics(const nlohmann::json& m) {
 }
 
 /// The self-collision figures' numbers (issue 16), run for `steps` steps (--self-collision-steps):
-/// with self-collision no two triangles of either sample intersect; without, no fewer.
+/// with self-collision no two triangles of either sample intersect; without, the slide's do.
 void check_self_collision(const nlohmann::json& m, std::uint64_t steps) {
   for (const char* name : {"cloth_drop_self_collision", "cloth_slide_self_collision"}) {
     CAPTURE(name);
@@ -192,8 +192,10 @@ void check_self_collision(const nlohmann::json& m, std::uint64_t steps) {
     CHECK_FALSE(off["self_collision"].get<bool>());
     CHECK(on["self_collision"].get<bool>());
     CHECK(on["intersecting_pairs"].get<std::size_t>() == 0);
-    CHECK(off["intersecting_pairs"].get<std::size_t>() >= on["intersecting_pairs"].get<std::size_t>());
   }
+  // Without self-collision the slide's layers pass through each other within the suite's 100 steps
+  // (1816 pairs); the drop folds onto itself only later in its full run.
+  CHECK(m["self_collision"]["cloth_slide_self_collision"]["off"]["intersecting_pairs"].get<std::size_t>() > 100);
 }
 
 /// The stiff-cloth figure's numbers (issue 37; always the CPU solver): cotton dropped onto a sphere
