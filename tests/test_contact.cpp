@@ -99,6 +99,33 @@ TEST_CASE("kernel: box, capsule and mesh distances and normals, edges and corner
   CHECK(distance_to(tet, {0, 0, 1 - 0.1}) == doctest::Approx(0.09));       // below the base
   CHECK(distance_to(tet, {0, 0, 1 + 0.5 + 0.2}) == doctest::Approx(0.19)); // above the apex
   CHECK(distance_to(tet, {5, 5, 5}) == doctest::Approx(1.0));              // beyond reach: "no contact"
+  // 1e18 m and more away, past the search's first bound: no contact (its walk used to find no
+  // triangle and read past the list).
+  for (double far : {1e18, 1e30}) {
+    CAPTURE(far);
+    const Collider away = Collider::triangle_mesh(tetrahedron(), {far, 0, 0}, glm::dmat3(1.0), 0.01);
+    CHECK(distance_to(away, {0, 0, 1}) == 1.0);
+  }
+}
+
+TEST_CASE("a mesh collider 1e18 m away or more leaves a falling particle alone, every backend") {
+  const ParticleSystem s = particle({0, 0, 1}, {0, 0, 0});
+  SimParams p = gravity_only();
+  std::vector<std::vector<glm::dvec3>> ends;
+  for (Backend b : backends()) {
+    CAPTURE(to_string(b));
+    ValidationScope validation;
+    auto alone = make_sim(b, s, p);
+    REQUIRE(alone->run(20).ok());
+    for (double far : {1e18, 1e25}) {
+      CAPTURE(far);
+      SimParams q = p;
+      q.colliders = {Collider::triangle_mesh(tetrahedron(), {far, 0, 0}, glm::dmat3(1.0), 0.01)};
+      auto sim = make_sim(b, s, q);
+      REQUIRE(sim->run(20).ok());
+      CHECK(sim->position(0) == alone->position(0));
+    }
+  }
 }
 
 TEST_CASE("kernel: a mesh remembers the side a particle came from (a thin sheet is not crossed)") {

@@ -159,6 +159,12 @@ KFN real mesh_search(MESH_DATA_PARAM, ColliderShape s, uint t, real radius, vec3
   precise real gap = mesh_nearest(MESH_DATA, s.mesh_root, s.mesh_tri0, q, start, VKCLOTH_MESH_NONE,
                                   VKCLOTH_MESH_NONE, vec3(real(0)), real(0), vec3(real(0)), real(0), real(-1),
                                   real(1.001953125), base, cand); // 1 + 2^-9: an edge's other triangle
+  if (base == VKCLOTH_MESH_NONE) { // q 1e18 m or more away (or not finite): the first triangle, far
+    base = s.mesh_tri0;
+    mesh_triangle(MESH_DATA, base, ba, bb, bc);
+    gap = triangle_gap2(q, ba, bb, bc);
+    return gap;
+  }
   mesh_triangle(MESH_DATA, base, ba, bb, bc);
   return gap;
 }
