@@ -73,3 +73,27 @@ TEST_CASE("cli: run reports the deepest penetration and the last second's larges
   CHECK(h.out.find("contact:") == std::string::npos);
   CHECK(nlohmann::json::parse(slurp(none))["contact"].is_null());
 }
+
+TEST_CASE("cli: run with colliders says when there is nothing to measure (no step, no free particle)") {
+  // Before: "deepest penetration -inf m (particle 0, collider 0, step 18446744073709551615 ...)".
+  const std::string scene = sample("cloth_on_sphere.json");
+  const fs::path json = tmp_dir() / "contact_unmeasured.json";
+  const Outcome none =
+      run_cli("contact_no_step", "run " + scene + " --steps 0 --json '" + json.string() + "'");
+  REQUIRE(none.code == 0);
+  CHECK(none.out.find("contact: nothing to measure (no step ran)") != std::string::npos);
+  CHECK(none.out.find("inf") == std::string::npos);
+  const auto c = nlohmann::json::parse(slurp(json))["contact"];
+  REQUIRE(c.is_object()); // the same keys, null where nothing was measured
+  for (const char* key :
+       {"max_penetration", "penetration_particle", "penetration_collider", "penetration_step"})
+    CHECK_MESSAGE(c[key].is_null(), key);
+  CHECK(c["contact_epsilon"].is_number());
+  // Every particle attached to the sphere: none free to measure.
+  const Outcome held = run_cli(
+      "contact_all_held",
+      "run " + scene +
+          R"( --steps 3 --set 'cloth.attach=[{"collider":0,"region":{"min":[-9,-9,-9],"max":[9,9,9]}}]')");
+  REQUIRE_MESSAGE(held.code == 0, held.err);
+  CHECK(held.out.find("contact: nothing to measure (no free particle)") != std::string::npos);
+}

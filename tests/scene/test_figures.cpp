@@ -195,7 +195,8 @@ void check_self_collision(const nlohmann::json& m, std::uint64_t steps) {
   }
   // Without self-collision the slide's layers pass through each other within the suite's 100 steps
   // (1816 pairs); the drop folds onto itself only later in its full run.
-  CHECK(m["self_collision"]["cloth_slide_self_collision"]["off"]["intersecting_pairs"].get<std::size_t>() > 100);
+  CHECK(m["self_collision"]["cloth_slide_self_collision"]["off"]["intersecting_pairs"].get<std::size_t>() >
+        100);
 }
 
 /// The stiff-cloth figure's numbers (issue 37; always the CPU solver): cotton dropped onto a sphere

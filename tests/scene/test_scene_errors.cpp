@@ -350,6 +350,30 @@ TEST_CASE("colliders: velocities must be finite; a plane takes linear_velocity o
                {"colliders[0].angular_velocity", "plane", "linear_velocity only", "[0, 0, 1]"});
 }
 
+TEST_CASE("colliders and wind: vectors and lengths beyond +-1e30 (float's range) name the key and value") {
+  // Each finite in double but inf (or NaN) once the solvers take it in float: the collider would
+  // silently do nothing, or the wind's direction normalise to zero.
+  const Error e =
+      expect_error(colliders(R"({"type": "capsule", "a": [0,0,0], "b": [1e39,0,0], "radius": 0.1})"),
+                   {"colliders[0].b", "within +-1e30", "[1e+39, 0, 0]"});
+  CHECK(e.code == ErrorCode::invalid_argument);
+  expect_error(colliders(R"({"type": "sphere", "center": [1e308, 0, 0], "radius": 1})"),
+               {"colliders[0].center", "within +-1e30", "1e+308"});
+  expect_error(colliders(R"({"type": "plane", "normal": [1e308, 1e308, 0]})"),
+               {"colliders[0].normal", "within +-1e30", "[1e+308, 1e+308, 0]"});
+  expect_error(colliders(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1e31})"),
+               {"colliders[0].radius", "at most 1e30", "1e+31"});
+  expect_error(colliders(sphere + R"(, "linear_velocity": [1e308, 0, 0]})"),
+               {"colliders[0].linear_velocity", "within +-1e30"});
+  expect_error(colliders(sphere + R"(, "angular_velocity": [0, 0, -1e31]})"),
+               {"colliders[0].angular_velocity", "within +-1e30"});
+  expect_error(R"({"system": "chain", "wind": {"strength": 1, "direction": [0, 1e308, 1e308]}})",
+               {"wind.direction", "within +-1e30", "[0, 1e+308, 1e+308]"});
+  // At the limit: accepted.
+  CHECK(parse_scene(colliders(R"({"type": "sphere", "center": [1e30, 0, 0], "radius": 1e30})"), "ok.json")
+            .ok());
+}
+
 TEST_CASE("colliders: a mesh collider's thickness, scale and file") {
   const auto dir = mesh_dir("mesh", "tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
   const std::string ok_path = R"("path": "tri.obj")";

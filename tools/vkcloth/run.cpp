@@ -110,6 +110,13 @@ struct ContactTrack {
       calm_speed = std::max(calm_speed, max_free_speed(system, vel));
     return {};
   }
+  /// Why there is no deepest penetration to report (no step ran, or every particle is pinned or
+  /// attached), or null when there is one.
+  const char* unmeasured() const {
+    if (step == no_step)
+      return "no step ran";
+    return std::isfinite(deepest.depth) ? nullptr : "no free particle";
+  }
 };
 
 struct RunOptions {
@@ -282,7 +289,9 @@ void print_summary(const Scene& scene, const RunOptions& opt, const SimBackend& 
         r.strain.run.max, r.strain.run_step,
         r.strain_every > 1 ? fmt::format(", sampled every {} steps", r.strain_every) : "");
   }
-  if (r.contact)
+  if (r.contact && r.contact->unmeasured())
+    fmt::print("contact: nothing to measure ({})\n", r.contact->unmeasured());
+  else if (r.contact)
     fmt::print(
         "contact: deepest penetration {:.3g} m (particle {}, collider {}, step {}; contact_epsilon {:g}{}), "
         "largest speed over the last second {:.3g} m/s\n",
@@ -354,6 +363,10 @@ nlohmann::json summary_json(const Scene& scene, const RunOptions& opt, const Sim
                                  {"last_second_from_step", r.contact->calm_from},
                                  {"every", r.contact_every}}
                 : nlohmann::json(nullptr);
+  if (r.contact && r.contact->unmeasured()) // the same keys, null where nothing was measured
+    for (const char* key :
+         {"max_penetration", "penetration_particle", "penetration_collider", "penetration_step"})
+      doc["contact"][key] = nullptr;
   if (r.intersections)
     doc["intersections"] = {{"pairs", r.intersections->pairs}, {"triangles", r.intersections->triangles}};
   return doc;

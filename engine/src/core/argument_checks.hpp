@@ -24,6 +24,15 @@ inline Error bad_argument(std::string message) {
 inline bool finite(glm::dvec3 v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
+/// The largest magnitude a collider's or the wind's vector or length may have, the mesh readers'
+/// coordinate limit: beyond it the solvers' float turns it into inf and the contact into NaN.
+inline constexpr double max_magnitude = 1e30;
+inline bool in_range(double x) {
+  return std::isfinite(x) && std::abs(x) <= max_magnitude;
+}
+inline bool in_range(glm::dvec3 v) {
+  return in_range(v.x) && in_range(v.y) && in_range(v.z);
+}
 /// A vector as the messages write it: [x, y, z].
 inline std::string str(glm::dvec3 v) {
   return fmt::format("[{}, {}, {}]", v.x, v.y, v.z);

@@ -22,7 +22,7 @@ using detail::str;
 namespace {
 
 bool positive(double x) {
-  return std::isfinite(x) && x > 0.0;
+  return detail::in_range(x) && x > 0.0;
 }
 
 // How far R is from an orthonormal right-handed frame (its columns; 0 for a rotation matrix).
@@ -69,8 +69,8 @@ namespace detail {
 // One collider's fields (the message names `at`.field and the value); normalises a plane's normal.
 Result<void> validate_collider(Collider& c, const std::string& at) {
   const auto vec = [&](const char* key, glm::dvec3 v) -> Result<void> {
-    if (!finite(v))
-      return bad_argument(fmt::format("{}.{} must be finite, got {}", at, key, str(v)));
+    if (!detail::in_range(v))
+      return bad_argument(fmt::format("{}.{} must be finite and within +-1e30, got {}", at, key, str(v)));
     return {};
   };
   switch (c.type) {
@@ -80,8 +80,8 @@ Result<void> validate_collider(Collider& c, const std::string& at) {
     if (!(len > 0.0))
       return bad_argument(fmt::format("{}.normal must be non-zero, got {}", at, str(c.normal)));
     c.normal /= len;
-    if (!std::isfinite(c.offset))
-      return bad_argument(fmt::format("{}.offset must be finite, got {}", at, c.offset));
+    if (!detail::in_range(c.offset))
+      return bad_argument(fmt::format("{}.offset must be finite and within +-1e30, got {}", at, c.offset));
     if (c.angular_velocity != glm::dvec3(0.0))
       return bad_argument(
           fmt::format("{}.angular_velocity: a plane cannot turn (it takes linear_velocity only), got {}", at,
@@ -91,26 +91,29 @@ Result<void> validate_collider(Collider& c, const std::string& at) {
   case Collider::Type::sphere:
     VKCLOTH_TRY(vec("center", c.center));
     if (!positive(c.radius))
-      return bad_argument(fmt::format("{}.radius must be finite and > 0, got {}", at, c.radius));
+      return bad_argument(
+          fmt::format("{}.radius must be finite, > 0 and at most 1e30, got {}", at, c.radius));
     break;
   case Collider::Type::capsule:
     VKCLOTH_TRY(vec("a", c.a));
     VKCLOTH_TRY(vec("b", c.b));
     if (!positive(c.radius))
-      return bad_argument(fmt::format("{}.radius must be finite and > 0, got {}", at, c.radius));
+      return bad_argument(
+          fmt::format("{}.radius must be finite, > 0 and at most 1e30, got {}", at, c.radius));
     break;
   case Collider::Type::box:
     VKCLOTH_TRY(vec("center", c.center));
     if (!positive(c.half_extents.x) || !positive(c.half_extents.y) || !positive(c.half_extents.z))
-      return bad_argument(
-          fmt::format("{}.half_extents must be finite and > 0, got {}", at, str(c.half_extents)));
+      return bad_argument(fmt::format("{}.half_extents must be finite, > 0 and at most 1e30, got {}", at,
+                                      str(c.half_extents)));
     break;
   case Collider::Type::mesh:
     VKCLOTH_TRY(vec("center", c.center));
     if (!c.mesh)
       return bad_argument(fmt::format("{}: a mesh collider needs its mesh (ColliderMesh::create)", at));
     if (!positive(c.thickness))
-      return bad_argument(fmt::format("{}.thickness must be finite and > 0, got {}", at, c.thickness));
+      return bad_argument(
+          fmt::format("{}.thickness must be finite, > 0 and at most 1e30, got {}", at, c.thickness));
     break;
   default:
     return bad_argument(fmt::format("{}.type is unknown ({})", at, std::uint32_t(c.type)));

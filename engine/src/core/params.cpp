@@ -138,8 +138,8 @@ Result<void> SimParams::validate() {
     return bad_argument(fmt::format("physics.damping must be finite and >= 0, got {}", damping));
   if (!std::isfinite(wind.strength))
     return bad_argument(fmt::format("wind.strength must be finite, got {}", wind.strength));
-  if (!finite(wind.direction))
-    return bad_argument("wind.direction must be finite, got " + str(wind.direction));
+  if (!detail::in_range(wind.direction))
+    return bad_argument("wind.direction must be finite and within +-1e30, got " + str(wind.direction));
   if (wind.strength != 0.0) {
     const double len = glm::length(wind.direction);
     if (!(len > 0.0))
