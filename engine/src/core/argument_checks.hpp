@@ -14,7 +14,8 @@
 
 namespace vkcloth {
 struct Collider;
-}
+struct ParticleSystem;
+} // namespace vkcloth
 
 namespace vkcloth::detail {
 
@@ -37,6 +38,11 @@ inline bool in_range(glm::dvec3 v) {
 inline std::string str(glm::dvec3 v) {
   return fmt::format("[{}, {}, {}]", v.x, v.y, v.z);
 }
+
+/// Every free particle's mass is a normal float (>= 1.2e-38 kg): what the float solvers (CPU float,
+/// Vulkan) need, where a smaller mass rounds to zero or loses its precision and the first step
+/// divides by it (system.cpp; their create / add check it).
+Result<void> check_float_masses(const ParticleSystem& system);
 
 /// One collider's fields (the message names `at`.field and the value); normalises a plane's
 /// normal (collider.cpp; SimParams::validate checks each of its colliders with it).

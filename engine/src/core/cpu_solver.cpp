@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
 
+#include "argument_checks.hpp"
 #include "cpu_solver_impl.hpp"
 #include "stretch_topology.hpp"
 #include "implicit_euler.hpp"
@@ -80,6 +81,8 @@ Result<CpuSolver<Real>> CpuSolver<Real>::create(std::shared_ptr<const ClothTopol
 
   VKCLOTH_TRY(detail::PinTargets::check(params, {}, n));
   VKCLOTH_TRY(detail::check_sweep_order(params.stretch_limit, *topology));
+  if constexpr (std::is_same_v<Real, float>)
+    VKCLOTH_TRY(detail::check_float_masses(system));
 
   auto impl = std::make_unique<Impl>();
   Impl& s = *impl;

@@ -1,7 +1,11 @@
 // SPDX-License-Identifier: MIT
 #include "vkcloth/system.hpp"
 
+#include <limits>
+
 #include <fmt/format.h>
+
+#include "argument_checks.hpp"
 
 namespace vkcloth {
 
@@ -96,4 +100,18 @@ Result<void> ParticleSystem::validate() const {
   return {};
 }
 
+namespace detail {
+
+Result<void> check_float_masses(const ParticleSystem& system) {
+  constexpr double smallest = std::numeric_limits<float>::min();
+  for (std::size_t p = 0; p < system.size(); ++p)
+    if (!system.particles[p].pinned && system.particles[p].mass < smallest)
+      return bad_argument(fmt::format("particle {} has mass {} kg, below float's smallest normal number ({:g}): "
+                                      "the float solvers would divide by zero; use a larger mass or the "
+                                      "double CPU solver (--precision double)",
+                                      p, system.particles[p].mass, smallest));
+  return {};
+}
+
+} // namespace detail
 } // namespace vkcloth

@@ -11,6 +11,7 @@
 
 #include "barriers.hpp"
 #include "world_impl.hpp"
+#include "../core/argument_checks.hpp"
 #include "../core/stretch_topology.hpp"
 
 namespace vkcloth::gpu {
@@ -241,6 +242,7 @@ Result<InstanceId> ClothWorld::add(std::shared_ptr<const ClothTopology> topology
   VKCLOTH_TRY(params.validate());
   VKCLOTH_TRY(vkcloth::detail::PinTargets::check(params, {}, n));
   VKCLOTH_TRY(vkcloth::detail::check_sweep_order(params.stretch_limit, *topology));
+  VKCLOTH_TRY(vkcloth::detail::check_float_masses(topology->system()));
   Impl& s = *impl_;
   const InstanceId id = s.next;
   s.instances.emplace(id, Impl::Instance{std::move(topology), std::move(params)});
