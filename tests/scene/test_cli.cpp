@@ -348,6 +348,12 @@ TEST_CASE("cli: soak runs a short soak and reports drift and RSS") {
   const Outcome div =
       run_cli("soak_div", "soak " + sample("spring.json") + " --set integrator.dt=0.45 --steps 1000");
   CHECK(div.code == 3);
+  // A run no longer than the warm-up is checked too (it reported max speed 0 m/s, checking nothing).
+  const Outcome brief = run_cli("soak_brief", "soak " + sample("cloth_hanging.json") + " --steps 5");
+  CHECK(brief.code == 0);
+  CHECK(brief.out.find("max speed 0 m/s") == std::string::npos);
+  CHECK(run_cli("soak_brief_div", "soak " + sample("spring.json") + " --set integrator.dt=1e30 --steps 3").code ==
+        3);
 }
 
 TEST_CASE("cli: --validate runs under the validation layer and passes on a clean run") {

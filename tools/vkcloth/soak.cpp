@@ -49,31 +49,35 @@ int soak_command(const SoakOptions& opt) {
   if (auto r = backend.read_state(pos, vel); !r)
     return report(r.error());
   const std::vector<glm::dvec3> initial = pos;
-  // Warm-up (first allocations of the solver and the readback), then the baseline RSS.
-  if (auto r = backend.step(std::min<std::uint64_t>(opt.steps, 10)); !r)
-    return report(r.error());
-  if (auto r = backend.read_state(pos, vel); !r)
-    return report(r.error());
-  const std::uint64_t rss0 = rss_kib();
-
-  const std::uint64_t chunk = std::max<std::uint64_t>(1, opt.steps / std::max<std::uint64_t>(1, opt.checks));
   double max_pin_drift = 0.0, max_speed = 0.0;
-  while (backend.step_index() < opt.steps) {
-    const std::uint64_t n = std::min(chunk, opt.steps - backend.step_index());
-    if (auto r = backend.step(n); !r)
-      return report(r.error());
-    if (auto r = backend.read_state(pos, vel); !r)
-      return report(r.error());
+  // One state check: after the warm-up (every step of a run of 10 or fewer) and after each chunk.
+  const auto check_state = [&]() -> Result<void> {
+    VKCLOTH_TRY(backend.read_state(pos, vel));
     for (std::size_t k = 0; k < pos.size(); ++k) {
       for (int c = 0; c < 3; ++c)
         if (!std::isfinite(pos[k][c]) || !std::isfinite(vel[k][c]))
-          return report(
-              make_error(ErrorCode::diverged,
-                         fmt::format("soak: particle {} is not finite at step {}", k, backend.step_index())));
+          return make_error(ErrorCode::diverged,
+                            fmt::format("soak: particle {} is not finite at step {}", k, backend.step_index()));
       if (scene->system.particles[k].pinned)
         max_pin_drift = std::max(max_pin_drift, glm::length(pos[k] - initial[k]));
       max_speed = std::max(max_speed, glm::length(vel[k]));
     }
+    return {};
+  };
+  // Warm-up (first allocations of the solver and the readback), then the baseline RSS.
+  if (auto r = backend.step(std::min<std::uint64_t>(opt.steps, 10)); !r)
+    return report(r.error());
+  if (auto r = check_state(); !r)
+    return report(r.error());
+  const std::uint64_t rss0 = rss_kib();
+
+  const std::uint64_t chunk = std::max<std::uint64_t>(1, opt.steps / std::max<std::uint64_t>(1, opt.checks));
+  while (backend.step_index() < opt.steps) {
+    const std::uint64_t n = std::min(chunk, opt.steps - backend.step_index());
+    if (auto r = backend.step(n); !r)
+      return report(r.error());
+    if (auto r = check_state(); !r)
+      return report(r.error());
   }
   const std::uint64_t rss1 = rss_kib();
   const long long growth = static_cast<long long>(rss1) - static_cast<long long>(rss0);
