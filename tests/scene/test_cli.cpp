@@ -319,6 +319,7 @@ TEST_CASE("cli: hostile command-line values exit 2 and name the option or key") 
   CHECK(big.err.find("integrator.steps") != std::string::npos);
   const Outcome neg = run_cli("host_steps_neg", "run " + sample("spring.json") + " --steps -5");
   CHECK(neg.code == 2);
+  CHECK(neg.err.find("integrator.steps must be an integer in 0..1000000000, got -5") != std::string::npos);
   for (const char* dt : {"0", "-1", "nan", "inf", "1e999"}) {
     CAPTURE(dt);
     const Outcome o = run_cli("host_dt", "run " + sample("spring.json") + " --dt " + dt);
@@ -337,6 +338,13 @@ TEST_CASE("cli: hostile command-line values exit 2 and name the option or key") 
       run_cli("host_out", "run " + sample("spring.json") + " --steps 1 --positions /nonexistent/dir/p.csv");
   CHECK(out.code == 2);
   CHECK(out.err.find("/nonexistent/dir/p.csv") != std::string::npos);
+  // Two outputs in one file (each overwrote the other's lines), however the path is spelt.
+  const std::string same = (tmp_dir() / "same.csv").string();
+  const Outcome twice =
+      run_cli("host_same_out", "run " + sample("spring.json") + " --steps 1 --trace '" + same +
+                                   "' --positions '" + (tmp_dir() / "." / "same.csv").string() + "'");
+  CHECK(twice.code == 2);
+  CHECK(twice.err.find("--trace and --positions name the same file") != std::string::npos);
 }
 
 TEST_CASE("cli: soak runs a short soak and reports drift and RSS") {
@@ -352,8 +360,8 @@ TEST_CASE("cli: soak runs a short soak and reports drift and RSS") {
   const Outcome brief = run_cli("soak_brief", "soak " + sample("cloth_hanging.json") + " --steps 5");
   CHECK(brief.code == 0);
   CHECK(brief.out.find("max speed 0 m/s") == std::string::npos);
-  CHECK(run_cli("soak_brief_div", "soak " + sample("spring.json") + " --set integrator.dt=1e30 --steps 3").code ==
-        3);
+  CHECK(run_cli("soak_brief_div", "soak " + sample("spring.json") + " --set integrator.dt=1e30 --steps 3")
+            .code == 3);
 }
 
 TEST_CASE("cli: --validate runs under the validation layer and passes on a clean run") {

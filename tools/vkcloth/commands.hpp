@@ -33,7 +33,7 @@ int report(const Error& e);
 struct SceneArgs {
   std::string scene;
   std::vector<std::string> sets;
-  std::optional<std::uint64_t> steps;
+  std::optional<std::string> steps; // as typed: the scene key's check names a bad count as it was given
   std::optional<double> dt;
   std::optional<std::string> integrator;
   /// --set values followed by the sugar flags, as key.path=value strings.

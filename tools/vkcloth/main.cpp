@@ -73,7 +73,8 @@ void add_scene_options(CLI::App& cmd, SceneArgs& args, bool sugar) {
       ->allow_extra_args(false);
   if (!sugar)
     return;
-  cmd.add_option("--steps", args.steps, "Number of steps (sugar for --set integrator.steps=N)");
+  cmd.add_option("--steps", args.steps, "Number of steps (sugar for --set integrator.steps=N)")
+      ->type_name("N");
   cmd.add_option("--dt", args.dt, "Time step in seconds (sugar for --set integrator.dt=X)");
   cmd.add_option("--integrator", args.integrator,
                  "explicit_euler | semi_implicit_euler | rk4 | implicit_euler | vbd (sugar for --set "

@@ -224,6 +224,29 @@ private:
   std::uint64_t frames_ = 0;
 };
 
+/// No two of the run's output files are one file (each would overwrite the other's lines).
+Result<void> check_distinct_outputs(const RunOptions& opt) {
+  namespace fs = std::filesystem;
+  const std::pair<const char*, const std::string*> outputs[] = {{"--trace", &opt.trace},
+                                                                {"--positions", &opt.positions},
+                                                                {"--json", &opt.json},
+                                                                {"--export", &opt.export_path}};
+  const auto same_file = [](const std::string& a, const std::string& b) {
+    std::error_code ea, eb;
+    const fs::path pa = fs::weakly_canonical(fs::absolute(a), ea),
+                   pb = fs::weakly_canonical(fs::absolute(b), eb);
+    return !ea && !eb ? pa == pb : a == b;
+  };
+  for (std::size_t i = 0; i < std::size(outputs); ++i)
+    for (std::size_t j = i + 1; j < std::size(outputs); ++j)
+      if (!outputs[i].second->empty() && !outputs[j].second->empty() &&
+          same_file(*outputs[i].second, *outputs[j].second))
+        return make_error(ErrorCode::invalid_argument,
+                          fmt::format("{} and {} name the same file ({}): give each output its own",
+                                      outputs[i].first, outputs[j].first, *outputs[j].second));
+  return {};
+}
+
 /// The output files, opened before the run: a typo in a path should not cost a whole run.
 struct Outputs {
   File trace, positions, json;
@@ -432,6 +455,8 @@ int run_command(const RunOptions& opt) {
   const auto precision = parse_precision(opt.precision);
   if (!precision)
     return report(make_error(ErrorCode::invalid_argument, "--precision must be float or double"));
+  if (auto distinct = check_distinct_outputs(opt); !distinct)
+    return report(distinct.error());
   auto scene = opt.args.load();
   if (!scene)
     return report(scene.error());

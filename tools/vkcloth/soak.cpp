@@ -56,8 +56,8 @@ int soak_command(const SoakOptions& opt) {
     for (std::size_t k = 0; k < pos.size(); ++k) {
       for (int c = 0; c < 3; ++c)
         if (!std::isfinite(pos[k][c]) || !std::isfinite(vel[k][c]))
-          return make_error(ErrorCode::diverged,
-                            fmt::format("soak: particle {} is not finite at step {}", k, backend.step_index()));
+          return make_error(ErrorCode::diverged, fmt::format("soak: particle {} is not finite at step {}", k,
+                                                             backend.step_index()));
       if (scene->system.particles[k].pinned)
         max_pin_drift = std::max(max_pin_drift, glm::length(pos[k] - initial[k]));
       max_speed = std::max(max_speed, glm::length(vel[k]));

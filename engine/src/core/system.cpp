@@ -106,10 +106,11 @@ Result<void> check_float_masses(const ParticleSystem& system) {
   constexpr double smallest = std::numeric_limits<float>::min();
   for (std::size_t p = 0; p < system.size(); ++p)
     if (!system.particles[p].pinned && system.particles[p].mass < smallest)
-      return bad_argument(fmt::format("particle {} has mass {} kg, below float's smallest normal number ({:g}): "
-                                      "the float solvers would divide by zero; use a larger mass or the "
-                                      "double CPU solver (--precision double)",
-                                      p, system.particles[p].mass, smallest));
+      return bad_argument(
+          fmt::format("particle {} has mass {} kg, below float's smallest normal number ({:g}): "
+                      "the float solvers would divide by zero; use a larger mass or the "
+                      "double CPU solver (--precision double)",
+                      p, system.particles[p].mass, smallest));
   return {};
 }
 
