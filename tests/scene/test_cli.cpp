@@ -338,6 +338,17 @@ TEST_CASE("cli: hostile command-line values exit 2 and name the option or key") 
       run_cli("host_out", "run " + sample("spring.json") + " --steps 1 --positions /nonexistent/dir/p.csv");
   CHECK(out.code == 2);
   CHECK(out.err.find("/nonexistent/dir/p.csv") != std::string::npos);
+  // Counts and numbers name the bound and the value as typed (CLI11's wrote "Value 0 not in range
+  // 0.000000 to 1797...").
+  const Outcome every = run_cli("host_every", "run " + sample("spring.json") + " --strain-every 0");
+  CHECK(every.code == 2);
+  CHECK(every.err.find("--strain-every: must be a whole number >= 1, got 0") != std::string::npos);
+  const Outcome wind = run_cli("host_bench_wind", "bench --wind -1");
+  CHECK(wind.code == 2);
+  CHECK(wind.err.find("--wind: must be a finite number >= 0, got -1") != std::string::npos);
+  const Outcome integ = run_cli("host_bench_integrator", "bench --integrator euler");
+  CHECK(integ.code == 2);
+  CHECK(integ.err.find("implicit_euler or vbd, got 'euler'") != std::string::npos);
   // Two outputs in one file (each overwrote the other's lines), however the path is spelt.
   const std::string same = (tmp_dir() / "same.csv").string();
   const Outcome twice =

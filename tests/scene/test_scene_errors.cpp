@@ -128,7 +128,15 @@ TEST_CASE("unknown integrator names the key and the value") {
 }
 
 TEST_CASE("substeps and the CG keys are range-checked") {
-  expect_error(R"({"system": "chain", "integrator": {"substeps": 0}})", {"integrator.substeps", "0"});
+  // The range a message quotes is the one the key takes (it said 0..1000000 and then refused 0).
+  for (const char* n : {"0", "1e7"}) {
+    CAPTURE(n);
+    expect_error(R"({"system": "chain", "integrator": {"substeps": )" + std::string(n) + "}}",
+                 {"integrator.substeps must be an integer in 1..1000000, got"});
+  }
+  expect_error(R"({"system": "chain", "integrator": {"iterations": 1001}})",
+               {"integrator.iterations must be an integer in 1..1000, got 1001"});
+
   expect_error(R"({"system": "chain", "integrator": {"cg_tolerance": 2}})", {"integrator.cg_tolerance", "2"});
   expect_error(R"({"system": "chain", "integrator": {"cg_max_iterations": 0}})",
                {"integrator.cg_max_iterations", "0"});

@@ -23,6 +23,13 @@ enum Exit : int {
   exit_mismatch = 5,  ///< `compare`: the backends differ by more than the tolerance
 };
 
+/// Option checks whose messages name the bound and the value as typed (CLI11's PositiveNumber
+/// wrote "Value 0 not in range 0.000000 to 1797...(300 digits)"): a whole number >= 1 (a K of
+/// --trace-every and friends), a finite number > 0 and a finite number >= 0.
+extern const CLI::Validator whole_number_at_least_one;
+extern const CLI::Validator positive_number;
+extern const CLI::Validator non_negative_number;
+
 /// Maps an error to the exit code documented in --help and docs/scene-format.md.
 int exit_code(const Error& e);
 /// Prints "vkcloth: <message>" on stderr and returns exit_code(e).

@@ -94,7 +94,7 @@ void add_compare_command(CLI::App& app, int* exit) {
   cmd->footer(exit_codes_footer);
   add_scene_options(*cmd, opt->args);
   cmd->add_option("--window", opt->window, "Steps per report row (default: a tenth of the run)")
-      ->check(CLI::PositiveNumber);
+      ->check(whole_number_at_least_one);
   cmd->add_option("--tolerance", opt->tolerance,
                   "Largest max position difference that passes, in scene units (default 1e-5)");
   cmd->callback([opt, exit] { *exit = compare_command(*opt); });

@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: MIT
 // vkcloth: command-line front end to the scene loader and the solvers.
+#include <charconv>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 
@@ -11,6 +13,43 @@
 #include "vkcloth/gpu/context.hpp"
 
 namespace vkcloth::cli {
+
+namespace {
+/// A check of an option's text: an empty string when it holds, else what is wrong.
+CLI::Validator text_check(std::string description, std::string (*check)(const std::string&)) {
+  return CLI::Validator([check](std::string& text) { return check(text); }, std::move(description));
+}
+std::string parse_whole(const std::string& text, std::uint64_t& value) {
+  const char* end = text.data() + text.size();
+  const auto [at, ec] = std::from_chars(text.data(), end, value);
+  return ec == std::errc{} && at == end ? std::string{} : "must be a whole number, got " + text;
+}
+std::string parse_finite(const std::string& text, double& value) {
+  const char* end = text.data() + text.size();
+  const auto [at, ec] = std::from_chars(text.data(), end, value);
+  return ec == std::errc{} && at == end && std::isfinite(value) ? std::string{}
+                                                                : "must be a finite number, got " + text;
+}
+} // namespace
+
+const CLI::Validator whole_number_at_least_one = text_check("N>=1", [](const std::string& text) {
+  std::uint64_t n = 0;
+  if (std::string e = parse_whole(text, n); !e.empty() || n == 0)
+    return "must be a whole number >= 1, got " + text;
+  return std::string{};
+});
+const CLI::Validator positive_number = text_check("X>0", [](const std::string& text) {
+  double x = 0.0;
+  if (std::string e = parse_finite(text, x); !e.empty() || !(x > 0.0))
+    return "must be a finite number > 0, got " + text;
+  return std::string{};
+});
+const CLI::Validator non_negative_number = text_check("X>=0", [](const std::string& text) {
+  double x = 0.0;
+  if (std::string e = parse_finite(text, x); !e.empty() || !(x >= 0.0))
+    return "must be a finite number >= 0, got " + text;
+  return std::string{};
+});
 
 int exit_code(const Error& e) {
   switch (e.code) {

@@ -265,7 +265,8 @@ void add_render_command(CLI::App& app, int* exit) {
       "Cloth texture (PNG or JPEG; default: a glTF mesh's own texture, else the built-in fabric)");
   cmd->add_option("--frames", opt->frames_dir,
                   "Write a numbered PNG sequence DIR/frame_00000.png, one every K steps");
-  cmd->add_option("--every", opt->every, "K for --frames / --video (default 10)")->check(CLI::PositiveNumber);
+  cmd->add_option("--every", opt->every, "K for --frames / --video (default 10)")
+      ->check(whole_number_at_least_one);
   cmd->add_option("--video", opt->video,
                   "Assemble the frames into FILE.mp4 or FILE.gif with ffmpeg (must be installed)");
   add_draw_backend_option(*cmd, opt->backend);

@@ -559,14 +559,14 @@ void add_run_command(CLI::App& app, int* exit) {
                       "Write every particle's state to a CSV file: step,time,particle,x,y,z,vx,vy,vz "
                       "(step 0 then every K steps; for a mesh cloth, particle is the file's vertex index)");
   cmd->add_option("--trace-every", opt->trace_every, "K for --trace (default 1)")
-      ->check(CLI::PositiveNumber)
+      ->check(whole_number_at_least_one)
       ->needs(trace);
   cmd->add_option(
       "--export", opt->export_path,
       "Write the animated cloth as glTF 2.0: FILE.glb (binary) or FILE.gltf (JSON, buffer embedded); "
       "frames at step 0 then every K steps (--export-every), in the mesh file's vertex order");
   cmd->add_option("--export-every", opt->export_every, "K for --export and --obj-frames (default 1)")
-      ->check(CLI::PositiveNumber);
+      ->check(whole_number_at_least_one);
   cmd->add_option(
          "--obj-frames", opt->obj_frames,
          "Write one OBJ per exported frame into DIR (created): frame_00000.obj, frame_00001.obj, ...")
@@ -576,11 +576,11 @@ void add_run_command(CLI::App& app, int* exit) {
          "--contact-every", opt->contact_every,
          "Scenes with colliders: measure the penetration (and, over the last second, the largest "
          "particle speed) every K-th and the last step (default 1; on Vulkan each reads the state back)")
-      ->check(CLI::PositiveNumber);
+      ->check(whole_number_at_least_one);
   cmd->add_option("--strain-every", opt->strain_every,
                   "Cloths: take the largest structural strain over the run from step 0, every K-th and the "
                   "last step (default 1: every step; on Vulkan each one reads the positions back)")
-      ->check(CLI::PositiveNumber);
+      ->check(whole_number_at_least_one);
   cmd->add_flag(
       "--check-intersections", opt->check_intersections,
       "After the run, count the pairs of the cloth's triangles that intersect each other and share "

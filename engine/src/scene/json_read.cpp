@@ -90,13 +90,13 @@ Result<double> as_number(const json& v, std::string_view path) {
   return d;
 }
 
-Result<std::uint64_t> as_integer(const json& v, std::string_view path, std::uint64_t max) {
+Result<std::uint64_t> as_integer(const json& v, std::string_view path, std::uint64_t max, std::uint64_t min) {
   const auto range = [&] {
-    return shape_error(fmt::format("{} must be an integer in 0..{}, got {}", path, max, show(v)));
+    return shape_error(fmt::format("{} must be an integer in {}..{}, got {}", path, min, max, show(v)));
   };
   if (v.is_number_unsigned()) {
     const auto u = v.get<std::uint64_t>();
-    if (u > max)
+    if (u < min || u > max)
       return range();
     return u;
   }
@@ -105,7 +105,8 @@ Result<std::uint64_t> as_integer(const json& v, std::string_view path, std::uint
   if (v.is_number_float()) {
     const double d = v.get<double>();
     // 1e3 is a JSON float; accept it when it is a whole number.
-    if (!std::isfinite(d) || d < 0.0 || d != std::floor(d) || d > static_cast<double>(max))
+    if (!std::isfinite(d) || d < static_cast<double>(min) || d != std::floor(d) ||
+        d > static_cast<double>(max))
       return range();
     return static_cast<std::uint64_t>(d);
   }

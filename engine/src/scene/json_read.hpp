@@ -53,7 +53,9 @@ Result<void> read(const json& obj, std::string_view path, const char* key, std::
 
 /// Value readers (the value itself, at `path`).
 Result<double> as_number(const json& v, std::string_view path);
-Result<std::uint64_t> as_integer(const json& v, std::string_view path, std::uint64_t max);
+/// A whole number in min..max (a JSON float too when it is whole); the message names that range.
+Result<std::uint64_t> as_integer(const json& v, std::string_view path, std::uint64_t max,
+                                 std::uint64_t min = 0);
 Result<glm::dvec3> as_vec3(const json& v, std::string_view path);
 
 } // namespace vkcloth::scene_detail

@@ -26,16 +26,16 @@ Result<void> read_integrator(const json& doc, SimParams& params, std::uint64_t& 
   params.integrator = *integ;
   VKCLOTH_TRY(sd::read(*obj, "integrator", "dt", params.dt));
   if (auto it = obj->find("substeps"); it != obj->end()) {
-    SCENE_TRY_ASSIGN(n, sd::as_integer(*it, "integrator.substeps", 1000000));
+    SCENE_TRY_ASSIGN(n, sd::as_integer(*it, "integrator.substeps", 1000000, 1));
     params.substeps = static_cast<std::uint32_t>(n);
   }
   VKCLOTH_TRY(sd::read(*obj, "integrator", "cg_tolerance", params.cg_tolerance));
   if (auto it = obj->find("cg_max_iterations"); it != obj->end()) {
-    SCENE_TRY_ASSIGN(n, sd::as_integer(*it, "integrator.cg_max_iterations", 100000));
+    SCENE_TRY_ASSIGN(n, sd::as_integer(*it, "integrator.cg_max_iterations", 100000, 1));
     params.cg_max_iterations = static_cast<std::uint32_t>(n);
   }
   if (auto it = obj->find("iterations"); it != obj->end()) {
-    SCENE_TRY_ASSIGN(n, sd::as_integer(*it, "integrator.iterations", 1000000));
+    SCENE_TRY_ASSIGN(n, sd::as_integer(*it, "integrator.iterations", 1000, 1));
     params.vbd_iterations = static_cast<std::uint32_t>(n); // the range (1..1000) is validate()'s
   }
   if (auto it = obj->find("steps"); it != obj->end()) {

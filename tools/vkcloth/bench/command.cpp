@@ -57,7 +57,7 @@ int check_options(BenchRun& run) {
     return report(make_error(
         ErrorCode::invalid_argument,
         fmt::format(
-            "--integrator must be explicit_euler, semi_implicit_euler, rk4 or implicit_euler, got '{}'",
+            "--integrator must be explicit_euler, semi_implicit_euler, rk4, implicit_euler or vbd, got '{}'",
             o.integrator)));
   run.integrator = *integrator;
   auto sizes = parse_sizes(o.sizes);
@@ -473,17 +473,17 @@ void add_bench_command(CLI::App& app, int* exit) {
          "With --self-collision, --integrator vbd and --self-skin: self-contact as an energy of this "
          "stiffness in the vertex steps (self_collision.stiffness, N/m; default 0: the passes after the "
          "step)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_number);
   cmd->add_option(
       "--stiffness", opt->stiffness,
       "Structural, shear and bend stiffness of the grid in N/m, e.g. 10000,2000,2000 (default 40,8,8)");
   cmd->add_option("--wind", opt->wind,
                   "Grid rows: the wind's acceleration of a particle facing it, in m/s^2 (0: no wind)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_number);
   cmd->add_option("--cloth-mass", opt->cloth_mass,
                   "Mass of the whole grid in kg (default: 0.05 kg per particle of a 64 x 64 grid, 204.8 kg)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number);
   cmd->add_option(
          "--cg-dispatch", opt->cg_dispatch,
          "implicit_euler on Vulkan: where the CG iterations run (auto: GpuSolverOptions' default; both: "
