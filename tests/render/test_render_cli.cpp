@@ -218,3 +218,24 @@ TEST_CASE("render: an unknown --backend is exit 2 naming the accepted values") {
   CHECK(o.code == 2);
   CHECK_MESSAGE(o.err.find("auto,cpu,vulkan") != std::string::npos, o.err);
 }
+
+TEST_CASE("render: --out must end in .png and --camera names the number that is not finite (exit 2)") {
+  // Both before any device work: they hold without a Vulkan device too.
+  const Outcome jpg = run_vkcloth("out_jpg", "render " + scenes + "/cloth_on_sphere.json --steps 1 --out " +
+                                                 (tmp_dir() / "never.jpg").string());
+  CHECK(jpg.code == 2);
+  CHECK_MESSAGE(jpg.err.find("the file must end in .png") != std::string::npos, jpg.err);
+  CHECK_FALSE(fs::exists(tmp_dir() / "never.jpg"));
+  const Outcome cam = run_vkcloth("camera_huge", "render " + scenes +
+                                                     "/cloth_on_sphere.json --steps 1 --camera "
+                                                     "1,1e308,0,0,0,0 --out " +
+                                                     (tmp_dir() / "never.png").string());
+  CHECK(cam.code == 2);
+  CHECK_MESSAGE(cam.err.find("number 2 is not a finite float") != std::string::npos, cam.err);
+  const Outcome five = run_vkcloth(
+      "camera_five", "render " + scenes + "/cloth_on_sphere.json --steps 1 --camera 1,2,3,4,5 --out " +
+                         (tmp_dir() / "never.png").string());
+  CHECK(five.code == 2);
+  CHECK_MESSAGE(five.err.find("expected six numbers") != std::string::npos, five.err);
+  CHECK_MESSAGE(five.err.find("got 5") != std::string::npos, five.err);
+}

@@ -3,6 +3,7 @@
 // sequence), optionally assembled into a video with ffmpeg. No display needed. The simulation runs
 // where --backend says (auto: the GPU solver on a GPU, the CPU solver on lavapipe; DrawnCloth).
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -59,6 +60,14 @@ Result<CheckedOptions> check_options(const RenderOptions& opt) {
   if (opt.out.empty() && opt.frames_dir.empty() && opt.video.empty())
     return make_error(ErrorCode::invalid_argument,
                       "render: give --out FILE.png, --frames DIR or --video FILE");
+  if (!opt.out.empty()) {
+    std::string ext = std::filesystem::path(opt.out).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return char(std::tolower(c)); });
+    if (ext != ".png")
+      return make_error(ErrorCode::invalid_argument,
+                        fmt::format("--out {}: the picture is a PNG, so the file must end in .png", opt.out));
+  }
   auto size = parse_size(opt.size);
   if (!size)
     return size.error();

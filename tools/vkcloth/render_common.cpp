@@ -40,10 +40,17 @@ Result<render::Camera> make_camera(const std::string& spec, float fov, const Sce
       v.push_back(NAN);
     }
   }
-  if (v.size() != 6 || std::any_of(v.begin(), v.end(), [](float f) { return !std::isfinite(f); }))
+  if (v.size() != 6)
     return make_error(
         ErrorCode::invalid_argument,
-        fmt::format("--camera {}: expected six numbers eye_x,eye_y,eye_z,target_x,target_y,target_z", spec));
+        fmt::format("--camera {}: expected six numbers eye_x,eye_y,eye_z,target_x,target_y,target_z, got {}",
+                    spec, v.size()));
+  for (std::size_t k = 0; k < v.size(); ++k)
+    if (!std::isfinite(v[k]))
+      return make_error(ErrorCode::invalid_argument,
+                        fmt::format("--camera {}: number {} is not a finite float (of the six "
+                                    "eye_x,eye_y,eye_z,target_x,target_y,target_z)",
+                                    spec, k + 1));
   cam.eye = {v[0], v[1], v[2]};
   cam.target = {v[3], v[4], v[5]};
   const float dist = glm::length(cam.eye - cam.target);
