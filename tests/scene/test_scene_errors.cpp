@@ -517,6 +517,8 @@ TEST_CASE("cloth.attach and cloth.max_distance: bad entries name the key and the
                {"cloth.attach[0]", "collider 1 is a plane"});
   expect_error(attached(R"("attach": [{"collider": 0, "region": {"min": [5, 5, 5], "max": [6, 6, 6]}}])"),
                {"cloth.attach[0].region", "selects no particle"});
+  expect_error(attached(R"("attach": [{"collider": 0, "vertices": []}])"),
+               {"cloth.attach[0].vertices is empty", "no particle"});
   expect_error(attached(R"("attach": [{"collider": 0, "vertices": [[4, 0]]}])"),
                {"cloth.attach[0].vertices[0] = [4, 0]", "outside the 4 x 4 grid"});
   expect_error(attached(R"("attach": [{"collider": 0, "vertices": [3]}])"),

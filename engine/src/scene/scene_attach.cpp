@@ -27,6 +27,8 @@ Result<std::vector<std::uint32_t>> read_vertices(const json& list, const std::st
                                                  const ParticleSystem& system) {
   if (!list.is_array())
     return shape_error(fmt::format("{} must be an array, got {}", at, show(list)));
+  if (list.empty()) // as a region that selects nothing
+    return bad(fmt::format("{} is empty: it attaches no particle", at));
   std::vector<std::uint32_t> particles;
   std::unordered_map<std::uint32_t, std::uint32_t> particle_of; // a mesh's file vertex -> particle
   if (system.surface && !system.surface->source_vertex.empty())
