@@ -32,6 +32,25 @@ std::string cloth(const std::string& body) {
 
 } // namespace
 
+TEST_CASE("a key twice in one object, or a NUL byte, is an error naming where (not the last key winning)") {
+  // nlohmann lets the last of two keys win and stops reading at a NUL byte: both silently dropped
+  // part of the scene.
+  const Error twice = expect_error(R"({"system": "chain", "colliders": [{"type": "sphere", "radius": 1, )"
+                                   R"("center": [0, 0, 0], "radius": 2}]})",
+                                   {"invalid JSON at colliders[0]", "the key \"radius\" appears twice"});
+  CHECK(twice.code == ErrorCode::parse);
+  expect_error(R"({"system": "cloth", "system": "chain"})", {"the key \"system\" appears twice"});
+  // The same key in two objects is fine.
+  CHECK(parse_scene(
+            R"({"system": "chain", "colliders": [{"type": "sphere", "center": [0, 0, 0], "radius": 1}, )"
+            R"({"type": "sphere", "center": [1, 0, 0], "radius": 1}]})",
+            "ok.json")
+            .ok());
+  const Error nul =
+      expect_error(std::string("{\"system\": \"chain\"}\0{\"more\": 1}", 31), {"bad.json:1:20", "NUL byte"});
+  CHECK(nul.code == ErrorCode::parse);
+}
+
 TEST_CASE("malformed JSON: parse error with line and column") {
   const Error e = expect_error("{\"system\": \"chain\",\n  \"physics\": {\"damping\": 0.5,}\n}",
                                {"bad.json:2:", "invalid JSON"});

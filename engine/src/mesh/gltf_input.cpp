@@ -89,12 +89,8 @@ Result<GlbLayout> check_glb(std::span<const std::uint8_t> bytes, std::string_vie
 
 Result<json> parse_json_text(std::string_view text, std::string_view where) {
   json doc;
-  if (scene_detail::JsonParseFailure f; !scene_detail::parse_json(text, doc, f)) {
-    const auto [line, col] = scene_detail::line_col(text, f.byte);
-    const std::string at = f.path.empty() ? "" : fmt::format(" at {}", f.path);
-    return make_error(ErrorCode::parse, fmt::format("{}:{}:{}: invalid JSON{} (byte {}): {}", where, line,
-                                                    col, at, f.byte, f.message));
-  }
+  if (scene_detail::JsonParseFailure f; !scene_detail::parse_json(text, doc, f))
+    return make_error(ErrorCode::parse, scene_detail::describe(f, text, where));
   if (!doc.is_object())
     return make_error(ErrorCode::parse,
                       fmt::format("{}: the glTF JSON must be an object, got {}", where, doc.type_name()));

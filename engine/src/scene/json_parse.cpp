@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "json_parse.hpp"
 
+#include <string>
+#include <unordered_set>
 #include <vector>
 
 #include <fmt/format.h>
@@ -13,7 +15,8 @@ using json = nlohmann::json;
 /// nlohmann's DOM builder plus a key-path stack, so a failure can say where it happened.
 class PathTrackingSax {
 public:
-  explicit PathTrackingSax(json& root) : dom_(root, /*allow_exceptions=*/false) {}
+  PathTrackingSax(json& root, bool unique_keys)
+      : unique_keys_(unique_keys), dom_(root, /*allow_exceptions=*/false) {}
 
   bool null() { return value(), dom_.null(); }
   bool boolean(bool v) { return value(), dom_.boolean(v); }
@@ -25,11 +28,23 @@ public:
   bool string(json::string_t& v) { return value(), dom_.string(v); }
   bool binary(json::binary_t& v) { return value(), dom_.binary(v); }
   bool start_object(std::size_t n) {
-    return value(), frames_.push_back({false, 0, {}}), dom_.start_object(n);
+    return value(), frames_.push_back({false, 0, {}, {}}), dom_.start_object(n);
   }
-  bool key(json::string_t& k) { return frames_.back().key = k, dom_.key(k); }
+  bool key(json::string_t& k) {
+    Frame& f = frames_.back();
+    if (unique_keys_ && !f.keys.insert(k).second) { // nlohmann gives no position here
+      failure.byte = std::string::npos;
+      failure.path = path();
+      failure.message =
+          fmt::format("the key \"{}\" appears twice in this object (each key may appear once)", k);
+      return false;
+    }
+    return f.key = k, dom_.key(k);
+  }
   bool end_object() { return frames_.pop_back(), dom_.end_object(); }
-  bool start_array(std::size_t n) { return value(), frames_.push_back({true, 0, {}}), dom_.start_array(n); }
+  bool start_array(std::size_t n) {
+    return value(), frames_.push_back({true, 0, {}, {}}), dom_.start_array(n);
+  }
   bool end_array() { return frames_.pop_back(), dom_.end_array(); }
 
   bool parse_error(std::size_t position, const std::string& /*last_token*/,
@@ -44,6 +59,7 @@ public:
       if (auto at = failure.message.find(": ", col); at != std::string::npos)
         failure.message.erase(0, at + 2);
     // The failing value was not started: the innermost array's index is its element count.
+    failure.path.clear();
     for (std::size_t k = 0; k < frames_.size(); ++k) {
       const Frame& f = frames_[k];
       if (f.array)
@@ -61,7 +77,17 @@ private:
     bool array;
     std::size_t count;
     std::string key;
+    std::unordered_set<std::string> keys; // with unique_keys: the object's keys so far
   };
+  // The key path of the object being read (its enclosing arrays' current elements).
+  std::string path() const {
+    std::string p;
+    for (std::size_t k = 0; k + 1 < frames_.size(); ++k)
+      p += frames_[k].array ? fmt::format("[{}]", frames_[k].count - 1)
+                            : (p.empty() ? "" : ".") + frames_[k].key;
+    return p;
+  }
+  bool unique_keys_;
   void value() {
     if (!frames_.empty() && frames_.back().array)
       ++frames_.back().count;
@@ -99,7 +125,17 @@ std::size_t too_deep_at(std::string_view text, std::size_t max_depth) {
   return std::string_view::npos;
 }
 
-bool parse_json(std::string_view text, json& out, JsonParseFailure& failure) {
+bool parse_json(std::string_view text, json& out, JsonParseFailure& failure, bool unique_keys) {
+  if (const std::size_t at = text.find('\0'); at != std::string_view::npos) {
+    if (text.find_first_not_of('\0', at) != std::string_view::npos) {
+      failure = JsonParseFailure{};
+      failure.byte = at;
+      failure.message = "a NUL byte before more text (JSON is text; nothing after it would be read)";
+      out = json();
+      return false;
+    }
+    text = text.substr(0, at); // trailing NULs: a C string's terminator
+  }
   if (const std::size_t at = too_deep_at(text, max_json_depth); at != std::string_view::npos) {
     failure = JsonParseFailure{};
     failure.byte = at;
@@ -107,12 +143,20 @@ bool parse_json(std::string_view text, json& out, JsonParseFailure& failure) {
     out = json();
     return false;
   }
-  PathTrackingSax sax(out);
+  PathTrackingSax sax(out, unique_keys);
   if (json::sax_parse(text, &sax))
     return true;
   failure = std::move(sax.failure);
   out = json();
   return false;
+}
+
+std::string describe(const JsonParseFailure& f, std::string_view text, std::string_view where) {
+  const std::string at = f.path.empty() ? "" : fmt::format(" at {}", f.path);
+  if (f.byte == std::string::npos)
+    return fmt::format("{}: invalid JSON{}: {}", where, at, f.message);
+  const auto [line, col] = line_col(text, f.byte);
+  return fmt::format("{}:{}:{}: invalid JSON{} (byte {}): {}", where, line, col, at, f.byte, f.message);
 }
 
 std::pair<std::size_t, std::size_t> line_col(std::string_view text, std::size_t byte) {

@@ -118,12 +118,8 @@ Result<Scene> parse_scene(std::string_view json_text, std::string_view source_na
                         fmt::format("{}: the scene is {} bytes, more than the limit {} ({} MiB)", source_name,
                                     json_text.size(), max_scene_bytes, max_scene_bytes >> 20));
     json doc;
-    if (sd::JsonParseFailure f; !sd::parse_json(json_text, doc, f)) {
-      const auto [line, col] = sd::line_col(json_text, f.byte);
-      const std::string where = f.path.empty() ? "" : fmt::format(" at {}", f.path);
-      return make_error(ErrorCode::parse, fmt::format("{}:{}:{}: invalid JSON{} (byte {}): {}", source_name,
-                                                      line, col, where, f.byte, f.message));
-    }
+    if (sd::JsonParseFailure f; !sd::parse_json(json_text, doc, f, /*unique_keys=*/true))
+      return make_error(ErrorCode::parse, sd::describe(f, json_text, source_name));
     if (!doc.is_object())
       return with_source(
           sd::shape_error(fmt::format("the scene must be a JSON object, got {}", doc.type_name())),
