@@ -319,6 +319,25 @@ TEST_CASE("a blow-up is reported with the step and time, and runs are bit-identi
   }
 }
 
+TEST_CASE("a blow-up at a step under a microsecond advises a longer step, not a shorter one") {
+  // vbd's m / h^2 overflows float at dt = 1e-12: NaN at the first step, on every float backend.
+  ClothDesc d;
+  d.nx = d.ny = 4;
+  SimParams p;
+  p.integrator = Integrator::vbd;
+  p.dt = 1e-12;
+  for (Backend b : float_backends()) {
+    CAPTURE(to_string(b));
+    ValidationScope validation;
+    auto s = make_sim(b, grid_cloth(d), p);
+    auto r = s->run(2);
+    REQUIRE_FALSE(r.ok());
+    CHECK(r.error().code == ErrorCode::diverged);
+    CHECK(r.error().message.find("integrator.dt = 1e-12 s is under a microsecond") != std::string::npos);
+    CHECK(r.error().message.find("smaller integrator.dt") == std::string::npos);
+  }
+}
+
 TEST_CASE("a free particle's mass below float's smallest normal: the float solvers refuse it, naming it") {
   // It rounds to zero (or a denormal) in float and the first step divided by it: a NaN reported as
   // a divergence, with the advice to shorten dt. The double solver takes it.

@@ -44,6 +44,11 @@ inline std::string str(glm::dvec3 v) {
 /// divides by it (system.cpp; their create / add check it).
 Result<void> check_float_masses(const ParticleSystem& system);
 
+/// What a divergence message advises: a shorter step, lower stiffness or more damping; but where
+/// the step is already under a microsecond, a longer one (vbd's m / h^2 and implicit Euler's
+/// system overflow float there: a NaN at the first step).
+std::string divergence_advice(double dt);
+
 /// One collider's fields (the message names `at`.field and the value); normalises a plane's
 /// normal (collider.cpp; SimParams::validate checks each of its colliders with it).
 Result<void> validate_collider(Collider& c, const std::string& at);

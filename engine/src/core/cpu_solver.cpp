@@ -314,10 +314,9 @@ template <typename Real> Result<void> CpuSolver<Real>::Impl::check_finite() cons
       return make_error(
           ErrorCode::diverged,
           fmt::format("simulation diverged at step {} (t = {:.4g} s): particle {} is at ({:.4g}, {:.4g}, "
-                      "{:.4g}) with velocity ({:.4g}, {:.4g}, {:.4g}) (limit {:g}); try a smaller "
-                      "integrator.dt, lower stiffness or more damping",
+                      "{:.4g}) with velocity ({:.4g}, {:.4g}, {:.4g}) (limit {:g}); {}",
                       step_, time(), p, double(x.x), double(x.y), double(x.z), double(v.x), double(v.y),
-                      double(v.z), params_.divergence_limit));
+                      double(v.z), params_.divergence_limit, detail::divergence_advice(params_.dt)));
   }
   return {};
 }

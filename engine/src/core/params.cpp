@@ -115,6 +115,16 @@ std::optional<StretchLimit::SweepOrder> parse_sweep_order(std::string_view name)
   return parse_named(name, {O::colours, O::chains});
 }
 
+namespace detail {
+std::string divergence_advice(double dt) {
+  if (dt < 1e-6)
+    return fmt::format("integrator.dt = {:g} s is under a microsecond, where terms in 1 / dt^2 overflow "
+                       "float: use a longer step (or the double CPU solver)",
+                       dt);
+  return "try a smaller integrator.dt, lower stiffness or more damping";
+}
+} // namespace detail
+
 Result<void> SimParams::validate() {
   if (static_cast<std::uint32_t>(integrator) > static_cast<std::uint32_t>(Integrator::vbd))
     return bad_argument(

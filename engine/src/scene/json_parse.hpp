@@ -23,8 +23,8 @@ struct JsonParseFailure {
 inline constexpr std::size_t max_json_depth = 64;
 
 /// Parses `text` (refusing nesting deeper than max_json_depth and a NUL byte before more text, where
-/// nlohmann would stop reading; with `unique_keys`, a key that an object repeats, which nlohmann lets the last one
-/// win); on failure fills `failure` and returns false. Never throws (except bad_alloc).
+/// nlohmann would stop reading; with `unique_keys`, a key that an object repeats, which nlohmann lets the
+/// last one win); on failure fills `failure` and returns false. Never throws (except bad_alloc).
 bool parse_json(std::string_view text, nlohmann::json& out, JsonParseFailure& failure,
                 bool unique_keys = false);
 

@@ -16,6 +16,7 @@
 
 #include <fmt/format.h>
 
+#include "../core/argument_checks.hpp"
 #include "../core/kernel.hpp"
 #include "../core/self_collision.hpp"
 #include "barriers.hpp"
@@ -162,9 +163,9 @@ void SolverBatch::refresh_flags() {
     slot.diverged = make_error(
         ErrorCode::diverged,
         fmt::format("simulation diverged at step {} (t = {:.4g} s) on the GPU{} (limit {:g}); the "
-                    "state is left as after that step; try a smaller integrator.dt, lower "
-                    "stiffness or more damping",
-                    slot.step, double(slot.step) * slot.params.dt, where, slot.params.divergence_limit));
+                    "state is left as after that step; {}",
+                    slot.step, double(slot.step) * slot.params.dt, where, slot.params.divergence_limit,
+                    vkcloth::detail::divergence_advice(slot.params.dt)));
   }
 }
 
