@@ -90,7 +90,16 @@ TEST_CASE("GPU matches CPU with capsule, box and mesh colliders, friction and mo
         // (measured 1.9e-3 m on the turning box); before it, 1e-4 m held.
         const bool implicit = integrator == Integrator::implicit_euler;
         const std::uint32_t steps = implicit ? 50 : 100;
-        REQUIRE(cpu->run(steps).ok());
+        // Halfway, the cloth lies on the shape itself (the floor alone would do for a lowest point;
+        // the moving capsule has left it by the end): some particle within the contact band of the
+        // shape where the steps have moved it.
+        REQUIRE(cpu->run(steps / 2).ok());
+        const std::vector<glm::dvec3> halfway(cpu->positions().begin(), cpu->positions().end());
+        const auto met =
+            penetration(sys, std::span<const Collider>(cpu->params().colliders.data(), 1), halfway);
+        REQUIRE(met.ok());
+        CHECK(met->depth > -2.0 * p.contact_epsilon);
+        REQUIRE(cpu->run(steps - steps / 2).ok());
         REQUIRE(gpu->simulate(steps, 32).ok()); // several recordings of several steps each
         auto gp = gpu->positions();
         REQUIRE(gp.ok());
@@ -101,7 +110,6 @@ TEST_CASE("GPU matches CPU with capsule, box and mesh colliders, friction and mo
         MESSAGE(fmt::format(
             "{:<18} {:<20} substeps {} max|dp| = {:.3g}{} after {} steps (lowest point {:.3f} m)", name,
             to_string(integrator), substeps, d.max_abs, d.bitwise ? " (bitwise)" : "", steps, lowest));
-        CHECK(lowest < 0.44); // it fell and met the collider
         CHECK(d.max_abs <= (implicit ? 9.81 * p.dt * p.dt : gpu_cpu_tolerance));
         if (implicit) {
           REQUIRE(cpu->run(50).ok());
