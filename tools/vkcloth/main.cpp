@@ -19,36 +19,27 @@ namespace {
 CLI::Validator text_check(std::string description, std::string (*check)(const std::string&)) {
   return CLI::Validator([check](std::string& text) { return check(text); }, std::move(description));
 }
-std::string parse_whole(const std::string& text, std::uint64_t& value) {
+/// The whole of `text` as a number of type T (std::from_chars: no sign for unsigned, no spaces).
+template <typename T> bool parse_all(const std::string& text, T& value) {
   const char* end = text.data() + text.size();
   const auto [at, ec] = std::from_chars(text.data(), end, value);
-  return ec == std::errc{} && at == end ? std::string{} : "must be a whole number, got " + text;
-}
-std::string parse_finite(const std::string& text, double& value) {
-  const char* end = text.data() + text.size();
-  const auto [at, ec] = std::from_chars(text.data(), end, value);
-  return ec == std::errc{} && at == end && std::isfinite(value) ? std::string{}
-                                                                : "must be a finite number, got " + text;
+  return ec == std::errc{} && at == end;
 }
 } // namespace
 
 const CLI::Validator whole_number_at_least_one = text_check("N>=1", [](const std::string& text) {
   std::uint64_t n = 0;
-  if (std::string e = parse_whole(text, n); !e.empty() || n == 0)
-    return "must be a whole number >= 1, got " + text;
-  return std::string{};
+  return parse_all(text, n) && n >= 1 ? std::string{} : "must be a whole number >= 1, got " + text;
 });
 const CLI::Validator positive_number = text_check("X>0", [](const std::string& text) {
   double x = 0.0;
-  if (std::string e = parse_finite(text, x); !e.empty() || !(x > 0.0))
-    return "must be a finite number > 0, got " + text;
-  return std::string{};
+  return parse_all(text, x) && std::isfinite(x) && x > 0.0 ? std::string{}
+                                                           : "must be a finite number > 0, got " + text;
 });
 const CLI::Validator non_negative_number = text_check("X>=0", [](const std::string& text) {
   double x = 0.0;
-  if (std::string e = parse_finite(text, x); !e.empty() || !(x >= 0.0))
-    return "must be a finite number >= 0, got " + text;
-  return std::string{};
+  return parse_all(text, x) && std::isfinite(x) && x >= 0.0 ? std::string{}
+                                                            : "must be a finite number >= 0, got " + text;
 });
 
 int exit_code(const Error& e) {

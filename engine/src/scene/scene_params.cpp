@@ -36,7 +36,7 @@ Result<void> read_integrator(const json& doc, SimParams& params, std::uint64_t& 
   }
   if (auto it = obj->find("iterations"); it != obj->end()) {
     SCENE_TRY_ASSIGN(n, sd::as_integer(*it, "integrator.iterations", 1000, 1));
-    params.vbd_iterations = static_cast<std::uint32_t>(n); // the range (1..1000) is validate()'s
+    params.vbd_iterations = static_cast<std::uint32_t>(n); // validate() holds the same range
   }
   if (auto it = obj->find("steps"); it != obj->end()) {
     SCENE_TRY_ASSIGN(n, sd::as_integer(*it, "integrator.steps", max_scene_steps));
