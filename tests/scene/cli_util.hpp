@@ -48,6 +48,14 @@ inline Outcome run_cli(const std::string& tag, const std::string& args, const st
   return o;
 }
 
+/// run_cli for input that must be refused: exit 2 with `needle` in stderr.
+inline Outcome run_cli_refused(const std::string& tag, const std::string& args, const std::string& needle) {
+  Outcome o = run_cli(tag, args);
+  CHECK_MESSAGE(o.code == 2, "vkcloth " << args << ": exit " << o.code);
+  CHECK_MESSAGE(o.err.find(needle) != std::string::npos, "'" << needle << "' not in: " << o.err);
+  return o;
+}
+
 /// Single-quoted for the shell. (Appending avoids a g++ 12 -Wrestrict false positive on "'" + s.)
 inline std::string quote(const std::string& s) {
   std::string q;

@@ -310,52 +310,32 @@ TEST_CASE("vkcloth on Vulkan: divergence exits 3, no device exits 4, bad compare
 }
 
 TEST_CASE("cli: hostile command-line values exit 2 and name the option or key") {
-  const Outcome huge =
-      run_cli("host_steps_huge", "run " + sample("spring.json") + " --steps 99999999999999999999999");
-  CHECK(huge.code == 2);
-  CHECK(huge.err.find("steps") != std::string::npos);
-  const Outcome big = run_cli("host_steps_big", "run " + sample("spring.json") + " --steps 1000000000000");
-  CHECK(big.code == 2);
-  CHECK(big.err.find("integrator.steps") != std::string::npos);
-  const Outcome neg = run_cli("host_steps_neg", "run " + sample("spring.json") + " --steps -5");
-  CHECK(neg.code == 2);
-  CHECK(neg.err.find("integrator.steps must be an integer in 0..1000000000, got -5") != std::string::npos);
+  const std::string spring = "run " + sample("spring.json");
+  run_cli_refused("host_steps_huge", spring + " --steps 99999999999999999999999", "steps");
+  run_cli_refused("host_steps_big", spring + " --steps 1000000000000", "integrator.steps");
+  run_cli_refused("host_steps_neg", spring + " --steps -5",
+                  "integrator.steps must be an integer in 0..1000000000, got -5");
   for (const char* dt : {"0", "-1", "nan", "inf", "1e999"}) {
     CAPTURE(dt);
-    const Outcome o = run_cli("host_dt", "run " + sample("spring.json") + " --dt " + dt);
-    CHECK(o.code == 2);
-    CHECK((o.err.find("dt") != std::string::npos));
+    run_cli_refused("host_dt", spring + " --dt " + dt, "dt");
   }
-  const Outcome setbad = run_cli("host_set", "run " + sample("spring.json") + " --set colliders.0.radius");
-  CHECK(setbad.code == 2);
-  CHECK(setbad.err.find("key.path=value") != std::string::npos);
-  const Outcome dev = run_cli("host_devzero", "run /dev/zero");
-  CHECK(dev.code == 2);
-  CHECK(dev.err.find("scene size limit") != std::string::npos);
-  const Outcome dir = run_cli("host_dir", "run /");
-  CHECK(dir.code == 2);
-  const Outcome out =
-      run_cli("host_out", "run " + sample("spring.json") + " --steps 1 --positions /nonexistent/dir/p.csv");
-  CHECK(out.code == 2);
-  CHECK(out.err.find("/nonexistent/dir/p.csv") != std::string::npos);
+  run_cli_refused("host_set", spring + " --set colliders.0.radius", "key.path=value");
+  run_cli_refused("host_devzero", "run /dev/zero", "scene size limit");
+  CHECK(run_cli("host_dir", "run /").code == 2);
+  run_cli_refused("host_out", spring + " --steps 1 --positions /nonexistent/dir/p.csv",
+                  "/nonexistent/dir/p.csv");
   // Counts and numbers name the bound and the value as typed (CLI11's wrote "Value 0 not in range
   // 0.000000 to 1797...").
-  const Outcome every = run_cli("host_every", "run " + sample("spring.json") + " --strain-every 0");
-  CHECK(every.code == 2);
-  CHECK(every.err.find("--strain-every: must be a whole number >= 1, got 0") != std::string::npos);
-  const Outcome wind = run_cli("host_bench_wind", "bench --wind -1");
-  CHECK(wind.code == 2);
-  CHECK(wind.err.find("--wind: must be a finite number >= 0, got -1") != std::string::npos);
-  const Outcome integ = run_cli("host_bench_integrator", "bench --integrator euler");
-  CHECK(integ.code == 2);
-  CHECK(integ.err.find("implicit_euler or vbd, got 'euler'") != std::string::npos);
+  run_cli_refused("host_every", spring + " --strain-every 0",
+                  "--strain-every: must be a whole number >= 1, got 0");
+  run_cli_refused("host_bench_wind", "bench --wind -1", "--wind: must be a finite number >= 0, got -1");
+  run_cli_refused("host_bench_integrator", "bench --integrator euler", "implicit_euler or vbd, got 'euler'");
   // Two outputs in one file (each overwrote the other's lines), however the path is spelt.
   const std::string same = (tmp_dir() / "same.csv").string();
-  const Outcome twice =
-      run_cli("host_same_out", "run " + sample("spring.json") + " --steps 1 --trace '" + same +
-                                   "' --positions '" + (tmp_dir() / "." / "same.csv").string() + "'");
-  CHECK(twice.code == 2);
-  CHECK(twice.err.find("--trace and --positions name the same file") != std::string::npos);
+  run_cli_refused("host_same_out",
+                  spring + " --steps 1 --trace '" + same + "' --positions '" +
+                      (tmp_dir() / "." / "same.csv").string() + "'",
+                  "--trace and --positions name the same file");
 }
 
 TEST_CASE("cli: soak runs a short soak and reports drift and RSS") {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "vkcloth/cpu_solver.hpp"
+#include "scene_errors_util.hpp"
 #include "vkcloth/scene.hpp"
 
 using namespace vkcloth;
@@ -20,13 +21,9 @@ namespace {
 
 Error refused(const std::string& text, std::initializer_list<std::string> needles,
               std::vector<std::string> overrides = {}) {
-  auto s = parse_scene(text, "hostile.json", overrides);
-  REQUIRE_MESSAGE(!s.ok(), "expected an error for: " << text.substr(0, 200));
-  const std::string& msg = s.error().message;
-  for (const std::string& n : needles)
-    CHECK_MESSAGE(msg.find(n) != std::string::npos, "'" << n << "' not in: " << msg);
-  CHECK(msg.size() < 2000); // a message a person can read, not the input echoed back
-  return s.error();
+  Error e = vkcloth::test::expect_error_as("hostile.json", text, needles, std::move(overrides));
+  CHECK(e.message.size() < 2000); // a message a person can read, not the input echoed back
+  return e;
 }
 
 std::string cloth(const std::string& body) {
