@@ -18,7 +18,8 @@ namespace vkcloth::test {
 
 /// Parses `text` as the file `source`, expects an error whose message contains every one of `needles`.
 inline Error expect_error_as(const std::string& source, const std::string& text,
-                             std::initializer_list<std::string> needles, std::vector<std::string> overrides = {}) {
+                             std::initializer_list<std::string> needles,
+                             std::vector<std::string> overrides = {}) {
   auto s = parse_scene(text, source, overrides);
   REQUIRE_MESSAGE(!s.ok(), "expected an error for: " << text.substr(0, 200));
   const std::string& msg = s.error().message;
@@ -50,10 +51,12 @@ inline std::string colliders(const std::string& body) {
   return R"({"system": "chain", "colliders": [)" + body + "]}";
 }
 
-inline const std::string sphere = R"({"type": "sphere", "center": [0, 0, 0], "radius": 1)"; // no closing brace
+inline const std::string sphere =
+    R"({"type": "sphere", "center": [0, 0, 0], "radius": 1)"; // no closing brace
 
 /// tmp/errors_<tag>/ with `name` holding `text`; returns the directory (scenes parsed "in" it).
-inline std::filesystem::path mesh_dir(const std::string& tag, const std::string& name, const std::string& text) {
+inline std::filesystem::path mesh_dir(const std::string& tag, const std::string& name,
+                                      const std::string& text) {
   const std::filesystem::path d = std::filesystem::path(VKCLOTH_TEST_TMP) / ("errors_" + tag);
   std::filesystem::create_directories(d);
   std::ofstream(d / name) << text;
