@@ -376,20 +376,22 @@ nlohmann::json summary_json(const Scene& scene, const RunOptions& opt, const Sim
   } else {
     doc["max_structural_strain"] = nullptr;
   }
-  doc["contact"] =
-      r.contact ? nlohmann::json{{"max_penetration", r.contact->deepest.depth},
-                                 {"penetration_particle", file_vertex(system, r.contact->deepest.particle)},
-                                 {"penetration_collider", r.contact->deepest.collider},
-                                 {"penetration_step", r.contact->step},
-                                 {"contact_epsilon", scene.params.contact_epsilon},
-                                 {"max_speed_last_second", r.contact->calm_speed},
-                                 {"last_second_from_step", r.contact->calm_from},
-                                 {"every", r.contact_every}}
-                : nlohmann::json(nullptr);
-  if (r.contact && r.contact->unmeasured()) // the same keys, null where nothing was measured
-    for (const char* key :
-         {"max_penetration", "penetration_particle", "penetration_collider", "penetration_step"})
-      doc["contact"][key] = nullptr;
+  doc["contact"] = nullptr;
+  if (r.contact) {
+    const ContactTrack& c = *r.contact;
+    // The penetration's fields null where nothing was measured (the same keys).
+    const auto measured = [&](auto value) {
+      return c.unmeasured() ? nlohmann::json(nullptr) : nlohmann::json(value);
+    };
+    doc["contact"] = {{"max_penetration", measured(c.deepest.depth)},
+                      {"penetration_particle", measured(file_vertex(system, c.deepest.particle))},
+                      {"penetration_collider", measured(c.deepest.collider)},
+                      {"penetration_step", measured(c.step)},
+                      {"contact_epsilon", scene.params.contact_epsilon},
+                      {"max_speed_last_second", c.calm_speed},
+                      {"last_second_from_step", c.calm_from},
+                      {"every", r.contact_every}};
+  }
   if (r.intersections)
     doc["intersections"] = {{"pairs", r.intersections->pairs}, {"triangles", r.intersections->triangles}};
   return doc;
