@@ -72,6 +72,9 @@ public:
   Result<void> set_params(SimParams params);
   const SimParams& params() const;
 
+  /// The positions keep their address across step() and run() (the solver double-buffers them
+  /// inside a step and puts the result back where it was): a host, or a numpy view, may keep the
+  /// span. velocities(), forces() and normals() never move.
   std::span<const Vec3> positions() const;
   std::span<const Vec3> velocities() const;
   /// Forces of the last evaluation (after contact filtering); for RK4 the first stage's.

@@ -523,13 +523,27 @@ template <typename Real> CpuSolver<Real>::~CpuSolver() = default;
 template <typename Real> unsigned CpuSolver<Real>::threads() const {
   return impl_->pool_->size();
 }
+// A step swaps pos_ with pos_next_ (its scratch) an odd or even number of times; the public calls
+// copy the result back into the buffer positions() showed before, so its address never changes.
+template <typename Real> void CpuSolver<Real>::Impl::keep_positions_at(const Vec3* home) {
+  if (pos_.data() == home || pos_next_.data() != home)
+    return;
+  std::copy(pos_.begin(), pos_.end(), pos_next_.begin());
+  std::swap(pos_, pos_next_); // both now hold the result; soa_ (a copy of pos_'s values) stays valid
+}
 template <typename Real> Result<void> CpuSolver<Real>::step() {
-  return impl_->step();
+  const Vec3* home = impl_->pos_.data();
+  auto r = impl_->step();
+  impl_->keep_positions_at(home);
+  return r;
 }
 template <typename Real> Result<void> CpuSolver<Real>::run(std::uint64_t steps) {
-  for (std::uint64_t s = 0; s < steps; ++s)
-    VKCLOTH_TRY(impl_->step());
-  return {};
+  const Vec3* home = impl_->pos_.data();
+  Result<void> r;
+  for (std::uint64_t s = 0; s < steps && r; ++s)
+    r = impl_->step();
+  impl_->keep_positions_at(home);
+  return r;
 }
 template <typename Real> Result<void> CpuSolver<Real>::set_params(SimParams params) {
   return impl_->set_params(std::move(params));

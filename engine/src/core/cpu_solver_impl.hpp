@@ -113,6 +113,8 @@ template <typename Real> struct CpuSolver<Real>::Impl {
 
   // The API's work (CpuSolver forwards here).
   Result<void> step();
+  /// Puts the positions back into the buffer at `home` when the step's swaps left them in the other.
+  void keep_positions_at(const Vec3* home);
   Result<void> set_params(SimParams params);
   Result<void> set_particle(std::uint32_t index, Vec3 position, Vec3 velocity);
   // The targets of substep k (colliders already posed): pinned particles onto them before the
