@@ -15,6 +15,7 @@ packages=(
   mesa-vulkan-drivers vulkan-validationlayers vulkan-tools
   libglfw3-dev libstb-dev xvfb xauth
   libtinyobjloader-dev libtinygltf-dev libmeshoptimizer-dev python3
+  python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib # the Python module, its tests and examples
 )
 validator=false
 for extra in "$@"; do

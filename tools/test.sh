@@ -74,4 +74,9 @@ if [[ $preset == asan ]]; then
 fi
 start=$SECONDS
 ctest --preset "$preset" -j "$(nproc)" "${extra[@]}"
+# pytest's own result line (the test python:pytest, where the Python module is built), for the log.
+log=build/$preset/Testing/Temporary/LastTest.log
+if [[ -f $log ]] && pytest_line=$(grep -E '^=+ .*(passed|failed|error).* in [0-9.]+s' "$log"); then
+  echo "test: python (pytest): $pytest_line" >&2
+fi
 echo "test: $preset suite done in $((SECONDS - start)) s" >&2

@@ -65,6 +65,30 @@ template <typename T> T unwrap(Result<T>&& result) {
     return std::move(*result);
 }
 
+/// `T(**fields)`: each keyword sets the attribute of that name; an unknown one is a TypeError
+/// naming it and the fields there are.
+template <typename T, typename Class> void init_from_keywords(Class& cls, const char* name) {
+  cls.def(py::init([name](const py::kwargs& fields) {
+            auto value = std::make_unique<T>();
+            py::object view = py::cast(value.get(), py::return_value_policy::reference);
+            for (auto [key, field] : fields) {
+              const auto key_name = py::cast<std::string>(key);
+              if (key_name.starts_with('_') || !py::hasattr(view, key_name.c_str())) {
+                std::string known;
+                for (py::handle attr : py::list(py::module_::import("builtins").attr("dir")(view)))
+                  if (auto a = py::cast<std::string>(attr); !a.starts_with('_') &&
+                                                         !PyCallable_Check(view.attr(a.c_str()).ptr()))
+                    known += (known.empty() ? "" : ", ") + a;
+                throw py::type_error(std::string(name) + " has no field '" + key_name + "' (fields: " + known +
+                                     ")");
+              }
+              view.attr(key_name.c_str()) = field;
+            }
+            return value;
+          }),
+          (std::string(name) + "(**fields): every field at its default unless given").c_str());
+}
+
 /// A cloth ready for a World: the system and its topology (ClothTopology::create, once, shared by
 /// every instance and every World it is added to).
 struct Cloth {

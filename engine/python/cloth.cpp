@@ -111,9 +111,8 @@ Cloth mesh_cloth(const std::string& path, const py::object& material, double par
 
 void bind_cloth(py::module_& m) {
   py::class_<ClothStiffness> stiffness(m, "Stiffness", "A grid's spring stiffnesses (N/m): structural, shear, bend");
-  stiffness.def(py::init<>())
-      .def(py::init([](double structural, double shear, double bend) { return ClothStiffness{structural, shear, bend}; }),
-           py::kw_only(), py::arg("structural") = 40.0, py::arg("shear") = 8.0, py::arg("bend") = 8.0)
+  init_from_keywords<ClothStiffness>(stiffness, "Stiffness");
+  stiffness
       .def_readwrite("structural", &ClothStiffness::structural)
       .def_readwrite("shear", &ClothStiffness::shear)
       .def_readwrite("bend", &ClothStiffness::bend);
