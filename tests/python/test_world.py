@@ -113,3 +113,44 @@ def test_materials_and_strain():
     assert vkcloth.structural_strain(cloth, cloth.positions) == pytest.approx(0.0, abs=1e-12)
     stretched = cloth.positions * [1.1, 1.0, 1.0]
     assert vkcloth.structural_strain(cloth, stretched) == pytest.approx(0.1, rel=1e-9)
+
+
+def test_a_second_thread_gets_an_error_not_a_race():
+    import threading
+    world = vkcloth.World("cpu", threads=1)
+    cloth_id = world.add(vkcloth.make_cloth(nx=64, ny=64))
+    errors = []
+    started = threading.Event()
+
+    def step():
+        started.set()
+        world.simulate(400)
+
+    t = threading.Thread(target=step)
+    t.start()
+    started.wait()
+    while t.is_alive():  # while the other thread simulates (it releases the GIL), calls are refused
+        try:
+            world.step_index(cloth_id)
+        except RuntimeError as e:
+            errors.append(str(e))
+            break
+    t.join()
+    assert errors and "busy" in errors[0]
+    assert world.step_index(cloth_id) == 400
+
+
+def test_hostile_values_raise():
+    for bad in (dict(nx=-1), dict(nx=2 ** 40), dict(nx=8193), dict(size=(1.0,)), dict(pins=[(99, 0)])):
+        with pytest.raises((TypeError, ValueError)):
+            vkcloth.make_cloth(**bad)
+    world = vkcloth.World("cpu")
+    cloth_id = world.add(vkcloth.make_chain())
+    with pytest.raises(TypeError):
+        world.simulate(-1)
+    with pytest.raises(TypeError):
+        vkcloth.SimParams(substeps=2 ** 40)
+    with pytest.raises(ValueError):
+        world.add(vkcloth.make_chain(), positions=[(0, 0, 0)])  # one position for two particles
+    with pytest.raises(ValueError, match="substeps"):
+        world.set_params(cloth_id, vkcloth.SimParams(substeps=0))
