@@ -76,11 +76,11 @@ template <typename T, typename Class> void init_from_keywords(Class& cls, const 
               if (key_name.starts_with('_') || !py::hasattr(view, key_name.c_str())) {
                 std::string known;
                 for (py::handle attr : py::list(py::module_::import("builtins").attr("dir")(view)))
-                  if (auto a = py::cast<std::string>(attr); !a.starts_with('_') &&
-                                                         !PyCallable_Check(view.attr(a.c_str()).ptr()))
+                  if (auto a = py::cast<std::string>(attr);
+                      !a.starts_with('_') && !PyCallable_Check(view.attr(a.c_str()).ptr()))
                     known += (known.empty() ? "" : ", ") + a;
-                throw py::type_error(std::string(name) + " has no field '" + key_name + "' (fields: " + known +
-                                     ")");
+                throw py::type_error(std::string(name) + " has no field '" + key_name +
+                                     "' (fields: " + known + ")");
               }
               view.attr(key_name.c_str()) = field;
             }

@@ -29,7 +29,8 @@ std::optional<Material> material_arg(const py::object& material) {
     const auto name = material.cast<std::string>();
     if (auto preset = material_preset(name))
       return preset;
-    throw py::value_error("material: unknown preset \"" + name + "\" (known: " + material_preset_list() + ")");
+    throw py::value_error("material: unknown preset \"" + name + "\" (known: " + material_preset_list() +
+                          ")");
   }
   return material.cast<Material>();
 }
@@ -78,8 +79,9 @@ Cloth make_grid(std::uint32_t nx, std::uint32_t ny, std::array<double, 2> size, 
   return cloth_of(unwrap(make_cloth(desc)));
 }
 
-Cloth make_spring_chain(std::vector<double> masses, std::vector<double> stiffness, std::vector<double> rest_lengths,
-                        std::optional<std::vector<glm::dvec3>> positions, glm::dvec3 anchor, const std::string& up) {
+Cloth make_spring_chain(std::vector<double> masses, std::vector<double> stiffness,
+                        std::vector<double> rest_lengths, std::optional<std::vector<glm::dvec3>> positions,
+                        glm::dvec3 anchor, const std::string& up) {
   ChainDesc desc;
   desc.anchor = anchor;
   desc.masses = std::move(masses);
@@ -92,8 +94,8 @@ Cloth make_spring_chain(std::vector<double> masses, std::vector<double> stiffnes
 
 Cloth mesh_cloth(const std::string& path, const py::object& material, double particle_mass,
                  std::optional<double> density, const py::object& stiffness,
-                 std::vector<std::uint32_t> pin_vertices, glm::dvec3 translate, glm::dvec3 rotate_deg, double scale,
-                 bool reorder) {
+                 std::vector<std::uint32_t> pin_vertices, glm::dvec3 translate, glm::dvec3 rotate_deg,
+                 double scale, bool reorder) {
   Mesh mesh = unwrap(read_mesh(path));
   MeshClothDesc desc;
   desc.transform = {translate, rotate_deg, scale};
@@ -110,10 +112,10 @@ Cloth mesh_cloth(const std::string& path, const py::object& material, double par
 } // namespace
 
 void bind_cloth(py::module_& m) {
-  py::class_<ClothStiffness> stiffness(m, "Stiffness", "A grid's spring stiffnesses (N/m): structural, shear, bend");
+  py::class_<ClothStiffness> stiffness(m, "Stiffness",
+                                       "A grid's spring stiffnesses (N/m): structural, shear, bend");
   init_from_keywords<ClothStiffness>(stiffness, "Stiffness");
-  stiffness
-      .def_readwrite("structural", &ClothStiffness::structural)
+  stiffness.def_readwrite("structural", &ClothStiffness::structural)
       .def_readwrite("shear", &ClothStiffness::shear)
       .def_readwrite("bend", &ClothStiffness::bend);
 
@@ -123,7 +125,8 @@ void bind_cloth(py::module_& m) {
       .def_property_readonly("particle_count", [](const Cloth& c) { return c.system->size(); })
       .def_property_readonly("spring_count", [](const Cloth& c) { return c.system->springs.size(); })
       .def_property_readonly(
-          "positions", [](const Cloth& c) {
+          "positions",
+          [](const Cloth& c) {
             std::vector<glm::dvec3> x;
             for (const Particle& p : c.system->particles)
               x.push_back(p.position);
@@ -138,16 +141,16 @@ void bind_cloth(py::module_& m) {
                                  w(static_cast<py::ssize_t>(p)) = c.system->particles[p].mass;
                                return out;
                              })
-      .def_property_readonly("pinned",
-                             [](const Cloth& c) {
-                               std::vector<std::uint32_t> pinned;
-                               for (std::size_t p = 0; p < c.system->size(); ++p)
-                                 if (c.system->particles[p].pinned)
-                                   pinned.push_back(static_cast<std::uint32_t>(p));
-                               return py::array_t<std::uint32_t>(static_cast<py::ssize_t>(pinned.size()),
-                                                                 pinned.data());
-                             },
-                             "The pinned particles' indices")
+      .def_property_readonly(
+          "pinned",
+          [](const Cloth& c) {
+            std::vector<std::uint32_t> pinned;
+            for (std::size_t p = 0; p < c.system->size(); ++p)
+              if (c.system->particles[p].pinned)
+                pinned.push_back(static_cast<std::uint32_t>(p));
+            return py::array_t<std::uint32_t>(static_cast<py::ssize_t>(pinned.size()), pinned.data());
+          },
+          "The pinned particles' indices")
       .def_property_readonly(
           "grid",
           [](const Cloth& c) -> py::object {

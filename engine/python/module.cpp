@@ -63,7 +63,8 @@ std::shared_ptr<const ClothTopology> Cloth::topology() const {
   return topology_;
 }
 
-template <typename T> static py::array_t<T> copy_points(std::span<const glm::vec<3, T, glm::defaultp>> points) {
+template <typename T>
+static py::array_t<T> copy_points(std::span<const glm::vec<3, T, glm::defaultp>> points) {
   py::array_t<T> out({static_cast<py::ssize_t>(points.size()), py::ssize_t{3}});
   if (!points.empty())
     std::memcpy(out.mutable_data(), points.data(), points.size() * sizeof(points[0]));

@@ -23,7 +23,8 @@ void enum_property(Class& cls, const char* name, Enum Owner::*field, Parse parse
       [field, parse, name, known](Owner& o, const std::string& value) {
         const auto parsed = parse(value);
         if (!parsed)
-          throw py::value_error(std::string(name) + ": unknown value \"" + value + "\" (known: " + known + ")");
+          throw py::value_error(std::string(name) + ": unknown value \"" + value + "\" (known: " + known +
+                                ")");
         o.*field = *parsed;
       });
 }
@@ -92,11 +93,13 @@ void bind_colliders(py::module_& m) {
           },
           py::arg("center"), py::arg("half_extents"), py::arg("rotate_deg") = glm::dvec3(0.0),
           py::arg("friction") = 0.0, "A box turned by rotate_deg (R = Rz Ry Rx, degrees) about its centre")
-      .def("__repr__", [](const Collider& c) { return std::string("<vkcloth.Collider ") + type_name(c.type) + ">"; });
+      .def("__repr__",
+           [](const Collider& c) { return std::string("<vkcloth.Collider ") + type_name(c.type) + ">"; });
 }
 
 void bind_records(py::module_& m) {
-  py::class_<Wind> wind(m, "Wind", "Wind F = Kw <n, u> n on each cloth vertex (strength Kw, unit direction u)");
+  py::class_<Wind> wind(m, "Wind",
+                        "Wind F = Kw <n, u> n on each cloth vertex (strength Kw, unit direction u)");
   init_from_keywords<Wind>(wind, "Wind");
   wind.def_readwrite("strength", &Wind::strength).def_readwrite("direction", &Wind::direction);
 
@@ -144,7 +147,8 @@ void bind_sim_params(py::module_& m) {
       .def_readwrite("gravity", &SimParams::gravity)
       .def_readwrite("damping", &SimParams::damping)
       .def_readwrite("wind", &SimParams::wind)
-      .def_readwrite("colliders", &SimParams::colliders, "A list of Collider (assign a new list to change it)")
+      .def_readwrite("colliders", &SimParams::colliders,
+                     "A list of Collider (assign a new list to change it)")
       .def_readwrite("contact_epsilon", &SimParams::contact_epsilon)
       .def_readwrite("contact_inward_only", &SimParams::contact_inward_only)
       .def_readwrite("divergence_limit", &SimParams::divergence_limit)

@@ -124,8 +124,8 @@ void bind_scene(py::module_& m) {
       .def_property_readonly("up", [](const PyScene& s) { return std::string(to_string(s.scene.up)); })
       .def_property_readonly("warnings", [](const PyScene& s) { return s.scene.warnings; })
       .def("__repr__", [](const PyScene& s) {
-        return "<vkcloth.Scene '" + s.scene.name + "': " + std::to_string(s.scene.system.size()) + " particles, " +
-               std::to_string(s.scene.steps) + " steps>";
+        return "<vkcloth.Scene '" + s.scene.name + "': " + std::to_string(s.scene.system.size()) +
+               " particles, " + std::to_string(s.scene.steps) + " steps>";
       });
   m.def("load_scene", &load, py::arg("source"), py::arg("overrides") = std::vector<std::string>{},
         "A scene from a file path or a dict in the scene format; overrides are \"key.path=value\" strings "

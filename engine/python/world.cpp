@@ -27,7 +27,8 @@ class World {
   struct Busy {
     explicit Busy(World& w) : lock(w.mutex_, std::try_to_lock) {
       if (!lock.owns_lock())
-        throw std::runtime_error("vkcloth.World is busy in a call from another thread (one thread drives a World)");
+        throw std::runtime_error(
+            "vkcloth.World is busy in a call from another thread (one thread drives a World)");
     }
     std::unique_lock<std::mutex> lock;
   };
@@ -38,7 +39,6 @@ class World {
       return f(*cpu);
     return f(*std::get<GpuWorld>(impl_).world);
   }
-
 
 public:
   World(const std::string& backend, unsigned threads) {
@@ -57,7 +57,9 @@ public:
 
   std::string backend() const { return cpu() ? "cpu" : "vulkan"; }
   const std::string& reason() const { return reason_; }
-  std::string device() const { return cpu() ? std::string("cpu") : std::get<GpuWorld>(impl_).context->device_name(); }
+  std::string device() const {
+    return cpu() ? std::string("cpu") : std::get<GpuWorld>(impl_).context->device_name();
+  }
   std::uint64_t validation_messages() const {
     return cpu() ? 0 : std::get<GpuWorld>(impl_).context->validation_message_count();
   }
@@ -81,7 +83,8 @@ public:
   void remove(InstanceId id) {
     const Busy busy(*this);
     if (auto t = tokens_.find(id); t != tokens_.end() && t->second.ref_count() > 1)
-      throw py::value_error("remove(" + std::to_string(id) + "): " + std::to_string(t->second.ref_count() - 1) +
+      throw py::value_error("remove(" + std::to_string(id) +
+                            "): " + std::to_string(t->second.ref_count() - 1) +
                             " positions / velocities view(s) of this instance are still alive; delete them "
                             "(or keep copies: numpy.array(view)) first");
     unwrap(visit([&](auto& w) { return w.remove(id); }));
@@ -110,9 +113,10 @@ public:
       const std::span<const glm::vec3> s = which == State::positions    ? solver->positions()
                                            : which == State::velocities ? solver->velocities()
                                                                         : solver->normals();
-      py::array_t<float> view({static_cast<py::ssize_t>(s.size()), py::ssize_t{3}},
-                              {static_cast<py::ssize_t>(sizeof(glm::vec3)), static_cast<py::ssize_t>(sizeof(float))},
-                              &s.data()->x, py::make_tuple(self, w.tokens_.at(id)));
+      py::array_t<float> view(
+          {static_cast<py::ssize_t>(s.size()), py::ssize_t{3}},
+          {static_cast<py::ssize_t>(sizeof(glm::vec3)), static_cast<py::ssize_t>(sizeof(float))},
+          &s.data()->x, py::make_tuple(self, w.tokens_.at(id)));
       view.attr("setflags")(py::arg("write") = false); // the solver owns them: change them with set_particle
       return view;
     }
@@ -184,9 +188,10 @@ private:
 } // namespace
 
 void bind_world(py::module_& m) {
-  py::class_<World>(m, "World",
-                    "Many cloths stepped together: World(backend=\"auto\" | \"cpu\" | \"vulkan\"). auto takes "
-                    "the Vulkan solver on a GPU and the CPU solver on lavapipe or without a device")
+  py::class_<World>(
+      m, "World",
+      "Many cloths stepped together: World(backend=\"auto\" | \"cpu\" | \"vulkan\"). auto takes "
+      "the Vulkan solver on a GPU and the CPU solver on lavapipe or without a device")
       .def(py::init<const std::string&, unsigned>(), py::arg("backend") = "auto", py::arg("threads") = 0,
            "threads: the CPU solver's threads per cloth (0: the cores this process may use)")
       .def_property_readonly("backend", &World::backend, "\"cpu\" or \"vulkan\": where the steps run")
@@ -202,21 +207,27 @@ void bind_world(py::module_& m) {
       .def("simulate", &World::simulate, py::arg("steps"),
            "Runs `steps` steps of every instance (DivergedError names the instance, step and time)")
       .def(
-          "positions", [](const py::object& self, InstanceId id) { return World::state(self, id, World::State::positions); },
+          "positions",
+          [](const py::object& self, InstanceId id) {
+            return World::state(self, id, World::State::positions);
+          },
           py::arg("id"),
           "(n, 3) float32 positions in particle order: on the CPU a read-only view that shows each later "
           "step (copy it to keep one); on the GPU a new array")
       .def(
           "velocities",
-          [](const py::object& self, InstanceId id) { return World::state(self, id, World::State::velocities); },
+          [](const py::object& self, InstanceId id) {
+            return World::state(self, id, World::State::velocities);
+          },
           py::arg("id"), "(n, 3) float32 velocities, as positions()")
       .def(
-          "normals", [](const py::object& self, InstanceId id) { return World::state(self, id, World::State::normals); },
+          "normals",
+          [](const py::object& self, InstanceId id) { return World::state(self, id, World::State::normals); },
           py::arg("id"), "(n, 3) float32 unit normals of the last step, as positions()")
       .def("set_params", &World::set_params, py::arg("id"), py::arg("params"))
       .def("params", &World::params, py::arg("id"))
-      .def("set_pin_targets", &World::set_pin_targets, py::arg("id"), py::arg("particles"), py::arg("positions"),
-           py::arg("max_distance") = 0.0,
+      .def("set_pin_targets", &World::set_pin_targets, py::arg("id"), py::arg("particles"),
+           py::arg("positions"), py::arg("max_distance") = 0.0,
            "The host's targets of `particles` for the next step (pinned ones sit on them, free ones stay "
            "within max_distance)")
       .def("set_collider_pose", &World::set_collider_pose, py::arg("id"), py::arg("collider"),
