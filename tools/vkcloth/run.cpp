@@ -126,13 +126,14 @@ struct RunOptions {
   std::string positions; ///< empty: no final positions file
   std::string backend = "cpu";
   std::string precision = "float";
-  std::string export_path;                   ///< .glb or .gltf; empty: none
-  std::string obj_frames;                    ///< a directory; empty: none
-  std::optional<std::uint64_t> export_every; ///< K for both; unset: 1
-  std::uint64_t strain_every = 1;            ///< K for "over the run" of the structural strain
-  std::uint64_t contact_every = 1;           ///< K for the contact quality (scenes with colliders)
-  bool check_intersections = false;          ///< count the intersecting triangle pairs at the end
-  std::string json;                          ///< the summary as JSON; empty: none
+  std::string export_path;                          ///< .glb or .gltf; empty: none
+  std::string obj_frames;                           ///< a directory; empty: none
+  std::optional<std::uint64_t> export_every;        ///< K for both; unset: 1
+  std::uint64_t strain_every = 1;                   ///< K for "over the run" of the structural strain
+  std::uint64_t contact_every = 1;                  ///< K for the contact quality (scenes with colliders)
+  bool check_intersections = false;                 ///< count the intersecting triangle pairs at the end
+  std::optional<std::uint64_t> intersections_every; ///< N: also count them at step 0 and every N-th step
+  std::string json;                                 ///< the summary as JSON; empty: none
 };
 
 /// The largest structural strain over the run (cloths): step 0, every K-th step and the last one.
@@ -144,6 +145,25 @@ struct StrainTrack {
       run = s;
       run_step = step;
     }
+  }
+};
+
+/// The most intersecting triangle pairs over the run (--check-intersections-every N): step 0, every
+/// N-th step and the last one.
+struct IntersectionTrack {
+  std::uint64_t every = 1;
+  std::size_t max_pairs = 0;
+  std::uint64_t max_step = 0;
+  std::uint64_t samples = 0;
+  Result<void> add(const ParticleSystem& system, const std::vector<glm::dvec3>& pos, std::uint64_t step) {
+    auto r = intersecting_triangle_pairs(system, std::span<const glm::dvec3>(pos));
+    if (!r)
+      return r.error();
+    if (samples++ == 0 || r->pairs > max_pairs) {
+      max_pairs = r->pairs;
+      max_step = step;
+    }
+    return {};
   }
 };
 
@@ -281,7 +301,8 @@ struct RunSummary {
   std::uint64_t strain_every = 1;
   std::optional<ContactTrack> contact; ///< scenes with colliders
   std::uint64_t contact_every = 1;
-  std::optional<IntersectionStats> intersections; ///< --check-intersections
+  std::optional<IntersectionStats> intersections;     ///< --check-intersections (or -every): at the end
+  std::optional<IntersectionTrack> intersections_run; ///< --check-intersections-every: over the run
 };
 
 void print_summary(const Scene& scene, const RunOptions& opt, const SimBackend& backend,
@@ -329,6 +350,9 @@ void print_summary(const Scene& scene, const RunOptions& opt, const SimBackend& 
       fmt::print("intersections: {} pairs of triangles intersect (of {} triangles)\n", r.intersections->pairs,
                  r.intersections->triangles);
   }
+  if (r.intersections_run)
+    fmt::print("intersections over the run: at most {} pairs (step {}), sampled every {} steps\n",
+               r.intersections_run->max_pairs, r.intersections_run->max_step, r.intersections_run->every);
 }
 
 /// The summary as JSON (schema "vkcloth-run/1", keys in docs/scene-format.md).
@@ -394,6 +418,12 @@ nlohmann::json summary_json(const Scene& scene, const RunOptions& opt, const Sim
   }
   if (r.intersections)
     doc["intersections"] = {{"pairs", r.intersections->pairs}, {"triangles", r.intersections->triangles}};
+  if (r.intersections_run) {
+    doc["intersections"]["run_max_pairs"] = r.intersections_run->max_pairs;
+    doc["intersections"]["run_max_step"] = r.intersections_run->max_step;
+    doc["intersections"]["run_samples"] = r.intersections_run->samples;
+    doc["intersections"]["every"] = r.intersections_run->every;
+  }
   return doc;
 }
 
@@ -419,6 +449,8 @@ Result<void> step_loop(const Scene& scene, SimBackend& backend, FrameExport& fra
       next = std::min(next, next_multiple(done, sum.strain_every));
     if (sum.contact)
       next = std::min(next, next_multiple(done, sum.contact_every));
+    if (sum.intersections_run)
+      next = std::min(next, next_multiple(done, sum.intersections_run->every));
     next = std::min(next, total);
     if (auto r = backend.step(next - done); !r) {
       if (trace)
@@ -431,8 +463,12 @@ Result<void> step_loop(const Scene& scene, SimBackend& backend, FrameExport& fra
     const bool trace_due = trace && done % every == 0;
     const bool frame_due = frames.enabled() && done % frames.every() == 0;
     const bool contact_due = sum.contact && (done % sum.contact_every == 0 || done == total);
-    if (trace_due || frame_due || contact_due)
+    const bool intersections_due =
+        sum.intersections_run && (done % sum.intersections_run->every == 0 || done == total);
+    if (trace_due || frame_due || contact_due || intersections_due)
       VKCLOTH_TRY(backend.read_state(pos, vel));
+    if (intersections_due)
+      VKCLOTH_TRY(sum.intersections_run->add(scene.system, pos, backend.step_index()));
     if (contact_due)
       VKCLOTH_TRY(sum.contact->add(scene.system, backend.colliders(), pos, vel, backend.step_index()));
     if (track_strain && (done % sum.strain_every == 0 || done == total)) {
@@ -494,6 +530,12 @@ int run_command(const RunOptions& opt) {
   if (!scene->params.colliders.empty())
     sum.contact.emplace(scene->steps, scene->params.dt);
   sum.contact_every = std::max<std::uint64_t>(opt.contact_every, 1);
+  if (opt.intersections_every) {
+    sum.intersections_run.emplace();
+    sum.intersections_run->every = *opt.intersections_every;
+    if (auto r = sum.intersections_run->add(scene->system, pos, 0); !r)
+      return report(r.error());
+  }
   const std::vector<std::uint32_t> order = file_order(scene->system);
   if (trace)
     write_trace_rows(trace.get(), 0, backend.time(), pos, vel, scene->system, order);
@@ -533,7 +575,7 @@ int run_command(const RunOptions& opt) {
     sum.end_strain = *s;
     sum.strain.add(*s, backend.step_index()); // already there unless the run had no steps
   }
-  if (opt.check_intersections) { // self-intersections at the final state (the solver's positions)
+  if (opt.check_intersections || opt.intersections_every) { // at the final state (the solver's positions)
     auto r = intersecting_triangle_pairs(scene->system, std::span<const glm::dvec3>(pos));
     if (!r)
       return report(r.error());
@@ -587,6 +629,12 @@ void add_run_command(CLI::App& app, int* exit) {
       "--check-intersections", opt->check_intersections,
       "After the run, count the pairs of the cloth's triangles that intersect each other and share "
       "no vertex (self-intersections at the final state; grids and meshes; JSON \"intersections\")");
+  cmd->add_option("--check-intersections-every", opt->intersections_every,
+                  "Also count them at step 0, every N-th and the last step, and print the most over the run "
+                  "(JSON \"intersections\": run_max_pairs, run_max_step, run_samples, every); implies "
+                  "--check-intersections")
+      ->check(whole_number_at_least_one)
+      ->type_name("N");
   cmd->add_option("--json", opt->json,
                   "Also write the summary as JSON to FILE (keys: docs/scene-format.md; not written on "
                   "divergence)");
