@@ -32,7 +32,7 @@ Result<Scene> build_scene(const json& doc, std::string_view source_name) {
   if (!doc.is_object())
     return sd::shape_error(fmt::format("the scene must be a JSON object, got {}", doc.type_name()));
   VKCLOTH_TRY(sd::check_keys(doc, "",
-                             {"name", "system", "integrator", "physics", "chain", "cloth", "wind",
+                             {"name", "system", "integrator", "physics", "chain", "cloth", "cloths", "wind",
                               "colliders", "contact_epsilon", "contact_inward_only", "divergence_limit",
                               "stretch_limit", "self_collision", "up", "inertia"}));
   Scene scene;
@@ -42,10 +42,16 @@ Result<Scene> build_scene(const json& doc, std::string_view source_name) {
   VKCLOTH_TRY(sd::read(doc, "", "system", kind));
   if (kind != "chain" && kind != "cloth")
     return sd::shape_error(fmt::format("system must be \"chain\" or \"cloth\", got \"{}\"", kind));
-  const char* other = kind == "chain" ? "cloth" : "chain";
-  if (doc.contains(other))
+  const std::vector<const char*> others =
+      kind == "chain" ? std::vector<const char*>{"cloth", "cloths"} : std::vector<const char*>{"chain"};
+  for (const char* other : others)
+    if (doc.contains(other))
+      return sd::shape_error(
+          fmt::format("a \"{}\" section is not allowed in a scene whose system is \"{}\"", other, kind));
+  const bool several = doc.contains("cloths");
+  if (several && doc.contains("cloth"))
     return sd::shape_error(
-        fmt::format("a \"{}\" section is not allowed in a scene whose system is \"{}\"", other, kind));
+        "cloth and cloths exclude each other: give one cloth as \"cloth\" or a list as \"cloths\"");
 
   scene.name = std::filesystem::path(source_name).stem().string();
   VKCLOTH_TRY(sd::read(doc, "", "name", scene.name));
@@ -67,12 +73,14 @@ Result<Scene> build_scene(const json& doc, std::string_view source_name) {
     SCENE_TRY_ASSIGN(m, sd::read_material(*cloth));
     material = m;
   }
-  if (material) {
+  SCENE_TRY_ASSIGN(cloths_damping, sd::read_cloths_damping(doc));
+  if (material || cloths_damping) {
+    const double damping = material ? material->damping : *cloths_damping;
     if (const auto it = doc.find("physics"); it != doc.end() && it->contains("damping"))
-      return sd::shape_error(fmt::format("physics.damping and cloth.material exclude each other: the "
+      return sd::shape_error(fmt::format("physics.damping and {}.material exclude each other: the "
                                          "material's damping ({} 1/s) is mu",
-                                         material->damping));
-    scene.params.damping = material->damping;
+                                         several ? "cloths[k]" : "cloth", damping));
+    scene.params.damping = damping;
   }
   VKCLOTH_TRY(sd::read_wind(doc, scene.params));
   const std::filesystem::path scene_dir = std::filesystem::path(source_name).parent_path();
@@ -85,8 +93,11 @@ Result<Scene> build_scene(const json& doc, std::string_view source_name) {
   VKCLOTH_TRY(sd::read(doc, "", "contact_inward_only", scene.params.contact_inward_only));
   VKCLOTH_TRY(scene.params.validate()); // ranges, before any large allocation below
 
-  if (const json* cloth = kind == "cloth" && doc.contains("cloth") ? &doc["cloth"] : nullptr;
-      cloth && cloth->is_object() && cloth->contains("mesh")) {
+  if (several) {
+    VKCLOTH_TRY(sd::read_cloths(doc, scene_dir, scene));
+    VKCLOTH_TRY(scene.system.validate());
+  } else if (const json* cloth = kind == "cloth" && doc.contains("cloth") ? &doc["cloth"] : nullptr;
+             cloth && cloth->is_object() && cloth->contains("mesh")) {
     VKCLOTH_TRY(sd::read_mesh_cloth(*cloth, scene_dir, material, scene));
   } else {
     auto system = kind == "chain" ? sd::read_chain(doc, scene.up) : sd::read_cloth(doc, material, scene.up);

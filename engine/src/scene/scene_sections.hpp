@@ -49,6 +49,12 @@ Result<ParticleSystem> read_cloth(const json& doc, const std::optional<Material>
 Result<void> read_mesh_cloth(const json& cloth, const std::filesystem::path& scene_dir,
                              const std::optional<Material>& material, Scene& scene);
 
+/// "cloths": the entries' materials' damping mu (they must agree), or nothing.
+Result<std::optional<double>> read_cloths_damping(const json& doc);
+/// "cloths": each entry a "cloth" section, joined into scene.system (particles cloth by cloth, one
+/// surface), their attachments into scene.params (scene_cloths.cpp).
+Result<void> read_cloths(const json& doc, const std::filesystem::path& scene_dir, Scene& scene);
+
 /// "inertia": the collider whose frame the cloth is simulated in, and its scales.
 Result<void> read_inertia(const json& doc, SimParams& params);
 /// "cloth.attach" and "cloth.max_distance" into scene.params.attachments (the system and the
