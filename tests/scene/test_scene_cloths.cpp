@@ -168,6 +168,8 @@ TEST_CASE("cloths: bad input names the key") {
   expect_error(R"({"system": "cloth", "cloths": [{}, {"resolution": [0, 3]}]})", {"cloths[1].resolution"});
   expect_error(R"({"system": "cloth", "cloths": [{}, {"bogus": 1}]})", {"cloths[1].bogus"});
   expect_error(R"({"system": "cloth", "cloths": [{}, 3]})", {"cloths[1] must be an object"});
+  // a file name is not a key: cloths[0]'s missing mesh is named as it is
+  expect_error(R"({"system": "cloth", "cloths": [{"mesh": "no/such/cloth.obj"}]})", {"no/such/cloth.obj"});
   expect_error(R"({"system": "cloth", "cloths": [{"material": "cotton"},
     {"material": {"density": 0.1, "stretch": 500, "shear": 50, "bend": 1e-5, "damping": 0.3}}]})",
                {"cloths[1].material's damping", "cloths[0]"});

@@ -14,16 +14,29 @@
 namespace vkcloth::scene_detail {
 namespace {
 
+/// The keys of a cloth section, a grid's and a mesh's (read_cloth and read_mesh_cloth refuse the
+/// other kind's).
+const std::initializer_list<std::string_view> cloth_keys = {
+    "resolution", "size",           "origin",  "orientation",  "particle_mass",
+    "stiffness",  "material",       "pins",    "attach",       "max_distance",
+    "mesh",       "mesh_transform", "density", "pin_vertices", "pin_region"};
+
 /// `text` about entry k of "cloths": each key path "cloth.<key>" (the section readers' and the
-/// builders' names) becomes "cloths[k].<key>".
+/// builders' names, a key of the cloth section) becomes "cloths[k].<key>"; a file name such as
+/// "cloth.obj" stays.
 std::string in_entry(std::string_view text, std::size_t k) {
-  const std::string entry = fmt::format("cloths[{}].", k);
   const auto identifier = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
+  const std::string entry = fmt::format("cloths[{}].", k);
   std::string out;
   for (std::size_t i = 0; i < text.size();) {
-    const bool key = text.substr(i, 6) == "cloth." && (i == 0 || !identifier(text[i - 1])) &&
-                     i + 6 < text.size() &&
-                     (std::islower(static_cast<unsigned char>(text[i + 6])) || text[i + 6] == '_');
+    bool key = false;
+    if (text.substr(i, 6) == "cloth." && (i == 0 || !identifier(text[i - 1]))) {
+      std::size_t end = i + 6;
+      while (end < text.size() && identifier(text[end]))
+        ++end;
+      key = std::find(cloth_keys.begin(), cloth_keys.end(), text.substr(i + 6, end - i - 6)) !=
+            cloth_keys.end();
+    }
     out += key ? entry : std::string(1, text[i]);
     i += key ? 6 : 1;
   }
@@ -42,6 +55,8 @@ Result<Scene> read_entry(const json& entry, std::size_t k, const std::filesystem
   if (!entry.is_object())
     return shape_error(
         fmt::format("cloths[{}] must be an object (the keys of \"cloth\"), got {}", k, show(entry)));
+  // Unknown keys named here (the readers below name their keys cloth.<key>, renamed by in_entry).
+  VKCLOTH_TRY(check_keys(entry, fmt::format("cloths[{}]", k), cloth_keys));
   Scene part;
   part.params = scene.params; // the colliders the attachments name
   part.params.attachments.clear();
