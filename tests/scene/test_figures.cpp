@@ -197,6 +197,18 @@ void check_self_collision(const nlohmann::json& m, std::uint64_t steps) {
   // (1816 pairs); the drop folds onto itself only later in its full run.
   CHECK(m["self_collision"]["cloth_slide_self_collision"]["off"]["intersecting_pairs"].get<std::size_t>() >
         100);
+  // The frames of the twist and of the five cloths: each run for its time, at most `steps` here.
+  for (const char* name : {"twist", "layered_drop"}) {
+    CAPTURE(name);
+    const auto& frames = m["self_collision"][name]["frames"];
+    REQUIRE(frames.size() >= 3);
+    for (const auto& f : frames) {
+      CHECK_FALSE(f["diverged"].get<bool>());
+      CHECK(f["steps"].get<std::uint64_t>() <= steps);
+      CHECK(f["triangles"].get<std::size_t>() > 0);
+    }
+  }
+  CHECK(m["self_collision"]["layered_drop"]["frames"][0]["intersecting_pairs"] == 0);
 }
 
 /// The stiff-cloth figure's numbers (issue 37; always the CPU solver): cotton dropped onto a sphere
@@ -288,13 +300,14 @@ TEST_CASE("vkcloth figures (cpu): the gallery and the physics behind it") {
   check_stiff(m);
   check_character(m);
   if (have_vulkan_device())
-    for (const char* f : {"cloth_k_struct.png",      "cloth_k_shear.png",       "cloth_k_bend.png",
-                          "cloth_wind.png",          "cloth_contact.png",       "cloth_collisions.png",
-                          "cloth_no_structural.png", "cloth_gpu.png",           "cloth_meshes.png",
-                          "cloth_strain_limit.png",  "cloth_resolution.png",    "cloth_presets.png",
-                          "contact_tablecloth.png",  "contact_sphere.png",      "contact_spinning.png",
-                          "contact_shapes.png",      "self_collision_drop.png", "self_collision_slide.png",
-                          "stiff_final.png",         "character_cape.png"})
+    for (const char* f : {"cloth_k_struct.png",       "cloth_k_shear.png",       "cloth_k_bend.png",
+                          "cloth_wind.png",           "cloth_contact.png",       "cloth_collisions.png",
+                          "cloth_no_structural.png",  "cloth_gpu.png",           "cloth_meshes.png",
+                          "cloth_strain_limit.png",   "cloth_resolution.png",    "cloth_presets.png",
+                          "contact_tablecloth.png",   "contact_sphere.png",      "contact_spinning.png",
+                          "contact_shapes.png",       "self_collision_drop.png", "self_collision_slide.png",
+                          "stiff_final.png",          "character_cape.png",      "self_collision_twist.png",
+                          "self_collision_layers.png"})
       CHECK_MESSAGE(fs::exists(out / f), f);
 }
 

@@ -1,9 +1,11 @@
 // SPDX-License-Identifier: MIT
-// Self-collision (issue 16): the two self-collision samples run to their end without and with it,
-// side by side, each labelled with the pairs of its triangles that intersect at the final state
-// (measure.hpp's intersecting_triangle_pairs).
+// Self-collision: the two self-collision samples run to their end without and with it, side by
+// side, each labelled with the pairs of its triangles that intersect at the final state
+// (measure.hpp's intersecting_triangle_pairs); and frames of the twist and of the layered drop
+// (several cloths), each labelled with its pairs then.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -70,6 +72,46 @@ Result<void> sample_figure(Gallery& G, Drawing& d, nlohmann::json& M, const std:
                      {0.6f, -1.2f, 1.4f});
 }
 
+/// samples/scenes/NAME.json as it is, drawn at each of `times` (s; each a run from the start, at
+/// most G.self_collision_steps steps when set), as one grid FILE and metrics M[NAME]["frames"].
+Result<void> frames_figure(Gallery& G, Drawing& d, nlohmann::json& M, const std::string& name,
+                           const std::string& file, const std::string& title, const std::string& what,
+                           const std::vector<double>& times, glm::vec3 from) {
+  std::vector<Run> runs;
+  std::vector<std::string> labels;
+  nlohmann::json frames = nlohmann::json::array();
+  for (const double t : times) {
+    auto scene = load_scene_file(G.samples / "scenes" / (name + ".json"));
+    if (!scene)
+      return Error{scene.error().code, scene.error().message + " (the self-collision figures: --samples DIR)",
+                   0};
+    std::uint64_t steps = static_cast<std::uint64_t>(std::llround(t / scene->params.dt));
+    if (G.self_collision_steps)
+      steps = std::min(steps, G.self_collision_steps);
+    const double time = double(steps) * scene->params.dt;
+    auto run = simulate_cloth(d, std::move(*scene), steps, "cpu");
+    if (!run)
+      return run.error();
+    auto isect = intersecting_triangle_pairs(run->scene.system, run->pos);
+    if (!isect)
+      return isect.error();
+    frames.push_back({{"steps", steps},
+                      {"time", time},
+                      {"intersecting_pairs", isect->pairs},
+                      {"triangles", isect->triangles},
+                      {"diverged", !run->diverged.empty()}});
+    labels.push_back(fmt::format("{:g} s: {} pairs", time, isect->pairs));
+    runs.push_back(std::move(*run));
+  }
+  M[name] = {{"scene", "samples/scenes/" + name + ".json"}, {"frames", frames}};
+  return grid_figure(G, d, runs, labels, file, sec_self, title,
+                     fmt::format("samples/scenes/{}.json: {}, on the CPU solver. Labels: the pairs of "
+                                 "triangles sharing no vertex that intersect then (vkcloth run "
+                                 "--check-intersections-every; self_collision.{}.frames).",
+                                 name, what, name),
+                     from, true, times.size());
+}
+
 } // namespace
 
 Result<void> self_collision_figures(Gallery& G) {
@@ -87,6 +129,20 @@ Result<void> self_collision_figures(Gallery& G) {
                             "A cloth slides off a sphere: without / with self-collision",
                             "a 0.3 x 0.3 m cloth (48 x 48 points) dropped off-centre onto a sphere "
                             "(r = 15 cm, friction 0.05), off which it slides onto the floor"));
+  progress("the twist, frames");
+  VKCLOTH_TRY(frames_figure(G, d, M, "twist", "self_collision_twist.png",
+                            "The twist: two edges turned against each other",
+                            "a 1 m cotton cloth (50 x 50 points, no gravity, vbd) whose left and right "
+                            "edges turn one turn each in opposite directions over 5.5 s, self-collision "
+                            "thickness 15 mm (below the 20 mm spacing)",
+                            {1.0, 1.5, 3.0, 5.5}, {0.0f, -1.8f, 0.6f}));
+  progress("five cloths dropped onto a sphere, frames");
+  VKCLOTH_TRY(frames_figure(G, d, M, "layered_drop", "self_collision_layers.png",
+                            "Five cloths dropped onto a sphere (a scene's cloths)",
+                            "five 0.6 m cotton cloths (20 x 20 points each, 4-5 cm apart) dropped onto a "
+                            "sphere (r = 20 cm) and the floor, self-collision thickness 35 mm between and "
+                            "within them",
+                            {0.3, 0.8, 2.0}, {0.6f, -1.2f, 1.4f}));
   progress("done");
   return {};
 }
