@@ -7,9 +7,10 @@ import vkcloth
 from conftest import SCENES
 
 # A grid, the report's two chains, a mesh cloth (its outputs in the file's vertex order), a
-# collider scene and vbd; 60 steps each keeps the run short.
+# collider scene, vbd, several cloths (cloths) and keyframed attachments; 60 steps each keeps the
+# run short.
 CPU_SCENES = ["cloth_hanging.json", "spring.json", "double_spring.json", "flag_with_hole.json",
-              "cloth_on_sphere.json", "cotton_drop_self_collision.json"]
+              "cloth_on_sphere.json", "cotton_drop_self_collision.json", "layered_drop.json", "twist.json"]
 STEPS = 60
 
 
