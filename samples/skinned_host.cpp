@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// A host that skins a character's arm every frame and drives the cloth through the API (issue 39;
-// docs/embedding.md "A skinned collider"): a two-bone cylinder (upper arm and forearm, the elbow
+// A host that skins a character's arm every frame and drives the cloth through the API
+// (docs/embedding.md "A skinned collider"): a two-bone cylinder (upper arm and forearm, the elbow
 // bending 0 -> 70 -> 0 degrees and back) skinned with linear blend skinning, handed over as a mesh
 // collider each frame (ColliderMesh::deformed: the hierarchy refitted, the corners' velocities for
 // friction; then set_params); a sleeve of cloth whose top row the host holds on points of the arm's

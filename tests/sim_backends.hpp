@@ -150,7 +150,7 @@ inline std::unique_ptr<Sim> make_sim(Backend b, const ParticleSystem& system, co
 }
 
 /// Steps `solver` through `scene`'s steps (the test fails on an error) and returns the largest
-/// structural strain of every step (the strain targets of issues 37 and 38).
+/// structural strain of every step (the cotton drops' strain targets).
 inline double largest_strain_over_steps(const Scene& scene, CpuSolver<float>& solver) {
   double largest = 0.0;
   for (std::uint64_t k = 0; k < scene.steps; ++k) {

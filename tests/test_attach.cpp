@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Attachments and motion constraints (docs/model.md "Attachments"; issue 39 points 1 and 3):
+// Attachments and motion constraints (docs/model.md "Attachments"):
 // pinned particles that follow a collider's frame or the host's targets, free particles held
 // within reach of theirs, on every backend (CPU float, CPU double, Vulkan with validation).
 #include <doctest/doctest.h>
@@ -47,7 +47,7 @@ glm::dvec3 in_frame(const Collider& c, glm::dvec3 offset) {
 TEST_CASE(
     "attachment: a pinned row follows a keyframed, turning capsule to 1e-5 m at every step, GPU = CPU") {
   // The capsule moves 0.5 m and turns 90 degrees in 0.5 s, then rises and turns on to 180 degrees;
-  // the cloth's pinned top row keeps its rest offset in the capsule's frame (issue 39 point 1).
+  // the cloth's pinned top row keeps its rest offset in the capsule's frame.
   ValidationScope validation;
   const ParticleSystem cloth = hanging_cloth(10);
   auto rod = Collider::capsule({-0.3, 0, 0.6}, {0.3, 0, 0.6}, 0.05)
@@ -95,7 +95,7 @@ TEST_CASE(
 TEST_CASE("motion constraint: free particles held within max_distance of a spinning sphere's frame; "
           "released, they fall") {
   // Two corners of a free horizontal cloth attached at distance 0, the opposite edge's middle within
-  // 0.05 m, to a sphere high above that moves at 0.5 m/s and spins at 1 rad/s (issue 39 point 3).
+  // 0.05 m, to a sphere high above that moves at 0.5 m/s and spins at 1 rad/s.
   ValidationScope validation;
   ClothDesc d;
   d.nx = d.ny = 8;

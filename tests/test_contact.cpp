@@ -262,7 +262,7 @@ TEST_CASE("a moving box carries a resting particle; a frictionless one slides un
 
 TEST_CASE(
     "keyframed collider: the pose between keys (linear, slerp), held outside, velocities from the path") {
-  // A box turned 90 degrees about z and moved 1 m along x between t = 1 and t = 3 (issue 39 point 2).
+  // A box turned 90 degrees about z and moved 1 m along x between t = 1 and t = 3.
   const Collider box = Collider::box({0, 0, 1}, {0.5, 0.5, 0.5});
   auto keyed = box.with_keyframes({{1.0, {0, 0, 0}, {0, 0, 0}}, {3.0, {1, 0, 0}, {0, 0, 90}}});
   REQUIRE(keyed.ok());
@@ -314,7 +314,7 @@ TEST_CASE(
 TEST_CASE("keyframed collider: a box moving along its keys carries a resting particle by friction, every "
           "backend") {
   // The moving-box test below with the box's motion given by two keys (0.3 m/s for 10 s) instead of
-  // a velocity: the path's velocity enters friction (issue 39 point 2), on the CPU and the GPU.
+  // a velocity: the path's velocity enters friction, on the CPU and the GPU.
   ValidationScope validation;
   std::vector<std::vector<glm::dvec3>> ends;
   for (Backend b : backends()) {
@@ -338,8 +338,8 @@ TEST_CASE("keyframed collider: a box moving along its keys carries a resting par
 
 TEST_CASE(
     "keyframed collider: a cloth on a turning, rising capsule, GPU = CPU within 1e-5 m after 100 steps") {
-  // A capsule under a small cloth turns 90 degrees and rises 0.2 m over 1 s, then holds (issue 39
-  // point 2: both backends take the host's pose of each substep, Collider::posed_at).
+  // A capsule under a small cloth turns 90 degrees and rises 0.2 m over 1 s, then holds
+  // (both backends take the host's pose of each substep, Collider::posed_at).
   ValidationScope validation;
   ClothDesc d;
   d.nx = d.ny = 12;

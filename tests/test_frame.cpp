@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// The cloth's frame (docs/model.md "Inertia and teleport"; issue 39 point 4): inertia scales, the
+// The cloth's frame (docs/model.md "Inertia and teleport"): inertia scales, the
 // keyframes' teleport and the host's, on every backend (CPU float, CPU double, Vulkan with
 // validation).
 #include <doctest/doctest.h>
@@ -166,7 +166,7 @@ TEST_CASE("inertia: a host frame (no collider) that the host sets moving carries
 TEST_CASE("teleport: a keyframe's jump moves an attached cloth 10 m unfelt (as its twin that stays); no "
           "particle then faster than its twin; GPU = CPU") {
   // A vertical cloth hangs from a capsule by its pinned top row; the capsule walks at 1 m/s for
-  // 0.5 s, stands 0.1 s, then jumps 10 m (issue 39 points 4 and "Measured, in tests"). Its twin
+  // 0.5 s, stands 0.1 s, then jumps 10 m. Its twin
   // stands where it stopped: the two cloths move alike, 10 m apart.
   ClothDesc d;
   d.nx = d.ny = 8;
@@ -292,7 +292,7 @@ TEST_CASE("inertia and teleport: bad input is an error naming the key and the va
 
 TEST_CASE("sample character_cape: the walk, the 180-degree turn in 0.5 s and the 10 m teleport keep the cape "
           "out of the body, on its shoulders, and calm after the jump") {
-  // samples/scenes/character_cape.json (issue 39 point 7, "Measured, in tests"): a torso and two arms
+  // samples/scenes/character_cape.json : a torso and two arms
   // (capsules) walk 1.5 m at 1 m/s, turn 180 degrees in 0.5 s, walk back 0.5 m, stand, and teleport
   // 10 m at t = 4 s; a cotton cape hangs from the torso by its top row (pinned, attached), in the
   // torso's frame. Every step, on the CPU (float): no particle deeper than contact_epsilon in a body
@@ -333,7 +333,7 @@ TEST_CASE("sample character_cape: the walk, the 180-degree turn in 0.5 s and the
   CHECK(off_target < 1e-5);
   CHECK(fastest_after < 1.0 + 1.0);
   CHECK(s->positions()[0].x > 9.0); // the cape came along
-  // Issue 39's bound; the scene's 6 substeps of 5 sweeps reach 9.7 % in the turn (1 x 5: 36 %, 2 x 5:
+  // The cape's bound; the scene's 6 substeps of 5 sweeps reach 9.7 % in the turn (1 x 5: 36 %, 2 x 5:
   // 15.5 %, 4 x 5: 11 %; docs/performance.md).
   CHECK(strain <= 0.10);
 }

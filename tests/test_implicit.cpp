@@ -134,7 +134,7 @@ TEST_CASE("implicit Euler: CG reaches the tolerance on the test scenes (iteratio
 }
 
 TEST_CASE("implicit Euler: the stiff cloth converges in far fewer CG iterations, to the same positions") {
-  // Issue 18's stiff cloth (K = 10 000 / 2 000 / 2 000, 0.5 kg, dt = 0.02) at 32 x 32: before
+  // The stiff cloth (K = 10 000 / 2 000 / 2 000, 0.5 kg, dt = 0.02) at 32 x 32: before
   // block Jacobi, the warm start and the weight-impulse reference, CG used its whole cap (200
   // iterations) on nearly every step (measured at 48 x 48: 199.4 per step); now ~141 here.
   // Reference: the same steps in double, CG to 1e-10 (cap 5000).

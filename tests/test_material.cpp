@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Materials (docs/model.md "Materials"): the conversion to springs and masses in closed form, and
-// the same material hanging the same at three resolutions (issue 17, 4(a)). CPU solver in double.
+// the same material hanging the same at three resolutions. CPU solver in double.
 #include <doctest/doctest.h>
 
 #include <algorithm>

@@ -3,11 +3,11 @@
 // runs 200 steps on every backend; a hash of the positions' bits must equal the one recorded on the
 // commit before the "one source of truth" redesign (the table below). A refactor that changes one
 // rounding anywhere in the per-particle physics (CPU scalar, SIMD row kernel or shaders) fails here.
-// The implicit_euler rows were recorded again when the method itself changed (issue 18: block-
+// The implicit_euler rows were recorded again when the method itself changed (block-
 // Jacobi preconditioner, warm start, tolerance relative to max(|S b|, |S h M g|)), and those with
-// colliders again when the solve learnt Baraff-Witkin's contact filter (issue 37); the vbd rows
-// were added with vbd's first guess x0 + h v0 (issue 37) and recorded again when friction moved
-// into the vertex step and the step began to end where the sweeps leave each particle (issue 37);
+// colliders again when the solve learnt Baraff-Witkin's contact filter; the vbd rows
+// were added with vbd's first guess x0 + h v0 and recorded again when friction moved
+// into the vertex step and the step began to end where the sweeps leave each particle;
 // every other row is unchanged since the redesign.
 //
 // CPU float and double: the bits are the reference's on any x86-64 (the SIMD kernels are bitwise

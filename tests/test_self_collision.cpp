@@ -164,7 +164,7 @@ TEST_CASE("self-collision: results do not depend on the thread count (the walk, 
 }
 
 TEST_CASE("self-collision samples: no triangle passes through another after the drop settles (3 s)") {
-  // The check of issue 16: 0 intersecting triangle pairs with self-collision on (default thickness
+  // The check: 0 intersecting triangle pairs with self-collision on (default thickness
   // 0.01 m), and many without it, so that the check can fail. CPU float here; the Vulkan run is in
   // tests/gpu/test_gpu_self_collision.cpp.
   for (const char* name :
@@ -195,8 +195,8 @@ TEST_CASE("self-collision samples: no triangle passes through another after the 
 TEST_CASE(
     "self-collision: the cotton drop at 128 x 128 ends with no intersecting pair, its strain within 10 % "
     "at every step") {
-  // Issue 38's drop at 128 x 128 (samples/bench/cotton_drop_self_collision_128.json: vbd's contact
-  // energy, 20 of Provot's sweeps in chain order to 6 %): no intersecting triangle pair after 3 s,
+  // The self-colliding cotton drop at 128 x 128 (samples/bench/cotton_drop_self_collision_128.json: vbd's
+  // contact energy, 20 of Provot's sweeps in chain order to 6 %): no intersecting triangle pair after 3 s,
   // and the largest structural strain of every step at most 10 % (measured 9.4 %). The same 20
   // sweeps colour by colour leave 15.9 %, so the check can fail. The Vulkan run:
   // tests/gpu/test_gpu_self_collision.cpp.
@@ -225,8 +225,8 @@ TEST_CASE(
 }
 
 TEST_CASE("self-collision: the cotton drop keeps its structural strain within 10 % at every step") {
-  // Issue 38's drop at 64 x 64 (cotton_drop_self_collision: vbd with the contact energy, 4 Provot
-  // sweeps to 9.5 %): the largest structural strain of every step stays at most 10 %; without the
+  // The self-colliding cotton drop at 64 x 64 (cotton_drop_self_collision: vbd with the contact energy, 4
+  // Provot sweeps to 9.5 %): the largest structural strain of every step stays at most 10 %; without the
   // sweeps the flaps meeting under the sphere stretch it past that (11.9 %), so the check can fail.
   for (const bool limited : {true, false}) {
     const std::string o = limited ? "stretch_limit.iterations=4" : "stretch_limit.method=off";

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Skinned mesh colliders (issue 39 point 5, docs/model.md "Mesh contact"): ColliderMesh::deformed
+// Skinned mesh colliders (docs/model.md "Mesh contact"): ColliderMesh::deformed
 // refits the same hierarchy over new vertex positions and gives each triangle corner its velocity,
 // which the contact's friction carries, on every backend; a wrong update is an error naming it.
 #include <doctest/doctest.h>
@@ -162,7 +162,7 @@ TEST_CASE("skinned mesh: GPU = CPU for a cloth on a bending sheet, bit for bit o
     for (std::size_t i = 0; i < cpu.size(); ++i)
       worst = std::max(worst, glm::length(other[i] - cpu[i]));
     MESSAGE("bending sheet: max |dp| against the CPU float solver " << worst << " m");
-    CHECK(worst <= 1e-5); // issue 39: GPU = CPU within 1e-5 m
+    CHECK(worst <= 1e-5); // GPU = CPU within 1e-5 m
     if (vulkan_gives_cpu_bits())
       CHECK(other == cpu); // lavapipe: the CPU's bits
   }

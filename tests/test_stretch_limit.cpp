@@ -416,7 +416,7 @@ TEST_CASE("the report's super-elastic cloth (K_struct = 5) keeps its structural 
 }
 
 TEST_CASE("the fast projection holds the report's super-elastic cloth within max_strain + 1e-3 at every "
-          "resolution (issue 17 point 4b)") {
+          "resolution") {
   // The same cloth as above (K_struct = 5, 5 kg, two corners pinned), max_strain 0.1, at 16, 32 and
   // 64: the largest structural strain at every step of the first second stays below 0.1 + 1e-3,
   // where the sweeps leave 0.104 / 0.115 / 0.145 (above). Each Newton iteration solves for every

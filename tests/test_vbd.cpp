@@ -280,8 +280,7 @@ TEST_CASE("vbd: the scene's integrator.iterations, with its range") {
   CHECK(SimParams{}.vbd_iterations == 5);
 }
 
-TEST_CASE(
-    "issue 37's cotton drop at 64 x 64 and 128 x 128 (samples/bench): strain within 10 % at every step") {
+TEST_CASE("the cotton drop at 64 x 64 and 128 x 128 (samples/bench): strain within 10 % at every step") {
   // The drop the peer comparison times (docs/performance.md "Vertex block descent"): 64 x 64 with
   // vbd's 5 sweeps and no limit (measured 9.7 %); 128 x 128 with one sweep and 6 of Provot's sweeps
   // in chain order to 3 % (9.1 %). The same 128 x 128 run with its sweeps colour by colour stretches
@@ -314,7 +313,7 @@ TEST_CASE(
 
 TEST_CASE("implicit solvers on the cotton drop onto a sphere: strain within 10 % without friction (vbd "
           "also with it), no particle flung with friction") {
-  // Issue 37's drop at 32 x 32 and dt 1/300 for 2 s, for both implicit solvers (CG, vbd). CG used to
+  // The cotton drop at 32 x 32 and dt 1/300 for 2 s, for both implicit solvers (CG, vbd). CG used to
   // fling particles at 10-18 m/s here (278 % strain at 64 x 64, now 58 %): its solve pulled contact
   // particles into the sphere; Baraff-Witkin's contact filter (cloth_kernel.h contact_axis) keeps
   // them on it. Frictionless: at most 10 % strain over the run (measured CG 4.8 %, vbd 8.1 %; the

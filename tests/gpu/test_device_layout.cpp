@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// The per-device layout (vkcloth/gpu/layout.hpp, issue 18): choose_layout() per device type,
+// The per-device layout (vkcloth/gpu/layout.hpp): choose_layout() per device type,
 // subgroup size and limits (no device needed), and, on the test device, the two builds of the
 // shaders (texel views, storage buffers) and other workgroup sizes forced through
 // GpuSolverOptions on the same scenes: a grid with its stencil, colliders and wind (fused and

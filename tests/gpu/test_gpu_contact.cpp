@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// The Vulkan solver against CpuSolver<float> with the contact of issue 15: capsule, oriented box
+// The Vulkan solver against CpuSolver<float> with the contact models: capsule, oriented box
 // and mesh colliders, friction, colliders moving (advanced after every substep, on the host for
 // both backends; the GPU records each new pose between substeps) and a host moving them every
 // frame. Tolerance as in test_gpu_solver.cpp: 1e-5 m after 100 steps (bitwise on lavapipe).

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// The contact sample scenes of issue 15 (friction, a spinning sphere, a box, a capsule, a mesh) on
+// The contact sample scenes (friction, a spinning sphere, a box, a capsule, a mesh) on
 // the Vulkan solver against the CPU reference (float), with the validation layer on: the same
 // positions after 100 steps, and after every one of those steps no particle deeper inside a
 // collider than contact_epsilon on either backend.

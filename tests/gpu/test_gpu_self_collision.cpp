@@ -94,7 +94,7 @@ TEST_CASE("GPU matches CPU on the self-collision samples: 100 steps within 1e-5 
 
 TEST_CASE("GPU self-collision: no intersecting triangle pairs after the drop settles (3 s)") {
   VKCLOTH_GPU_TEST_BEGIN(ctx);
-  // The report-soft drop (semi-implicit Euler, the passes) and issue 38's cotton drop (vbd's contact
+  // The report-soft drop (semi-implicit Euler, the passes) and the self-colliding cotton drop (vbd's contact
   // energy with the layers' friction, Provot's sweeps).
   for (const char* name : {"cloth_drop_self_collision", "cotton_drop_self_collision"}) {
     INFO(name);
@@ -110,8 +110,8 @@ TEST_CASE("GPU self-collision: no intersecting triangle pairs after the drop set
 
 TEST_CASE("GPU self-collision: the cotton drop at 128 x 128 ends with no intersecting pair (3 s)") {
   VKCLOTH_GPU_TEST_BEGIN(ctx);
-  // Issue 38's drop at 128 x 128 (samples/bench/: Provot's sweeps in chain order); the CPU run and
-  // its strain at every step: tests/test_self_collision.cpp.
+  // The self-colliding cotton drop at 128 x 128 (samples/bench/: Provot's sweeps in chain order); the CPU run
+  // and its strain at every step: tests/test_self_collision.cpp.
   auto scene = load_scene_file(std::filesystem::path(VKCLOTH_SAMPLES_SCENES_DIR) / ".." / "bench" /
                                "cotton_drop_self_collision_128.json");
   REQUIRE_MESSAGE(scene.ok(), (scene.ok() ? "" : scene.error().message));

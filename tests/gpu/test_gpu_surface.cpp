@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Mesh surfaces on the Vulkan solver (issue 14): vertex normals from the topology's fan lists
+// Mesh surfaces on the Vulkan solver: vertex normals from the topology's fan lists
 // (force_body.glsl fan_normal) and the CSR spring gather on an irregular triangulation with a hole,
 // boundaries, particles in shuffled order, pins and wind, against CpuSolver<float>; the fan path
 // on a grid against the grid's unrolled fan, bit for bit; instances of one surface topology in a

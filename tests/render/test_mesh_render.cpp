@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Mesh surfaces in the renderer (issue 14): a flat, irregularly triangulated patch with a square
+// Mesh surfaces in the renderer: a flat, irregularly triangulated patch with a square
 // hole and particles in shuffled order, drawn from above and from below (two-sided, no culling):
 // the background shows through the hole and past the outer boundary, the cloth everywhere on it;
 // an encoded (PNG) texture colours it; decode_image's errors name the bytes' source.

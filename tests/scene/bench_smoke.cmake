@@ -87,7 +87,7 @@ if("$ENV{CI}" STREQUAL "true" AND vulkan_rows LESS 8)
   message(FATAL_ERROR "bench JSON: CI=true but only ${vulkan_rows} Vulkan rows")
 endif()
 
-# Implicit Euler on the stiff cloth (issue 18): --stiffness, --cloth-mass and both CG dispatch
+# Implicit Euler on the stiff cloth: --stiffness, --cloth-mass and both CG dispatch
 # layouts; the explicit baseline diverges at this dt and is left out with a note.
 run_bench(" (implicit)" --backend all --integrator implicit_euler --sizes 12 --dt 0.02 --stiffness 10000,2000,2000
           --cloth-mass 0.5 --wind 0 --cg-dispatch both --steps 3 --warmup 1 --reps 1 --json "${OUT}.implicit.json")
@@ -120,7 +120,7 @@ if("$ENV{CI}" STREQUAL "true" AND NOT dispatches STREQUAL "one_workgroup;per_ite
   message(FATAL_ERROR "bench JSON (implicit): Vulkan rows ran '${dispatches}', expected one_workgroup;per_iteration")
 endif()
 
-# Contact rows (issue 15): the tablecloth on a box and a floor plane, the cloth on a mesh sphere,
+# Contact rows: the tablecloth on a box and a floor plane, the cloth on a mesh sphere,
 # each with its bare baseline; the contact rows quote the contact phase against it and count the
 # particles in contact (all of them start in contact). No timing is asserted.
 run_bench(" (contact)" --backend all --sizes 4 --contact both --variants fused --steps 2 --warmup 1 --reps 1
@@ -159,7 +159,7 @@ foreach(i RANGE ${last})
     if(name STREQUAL "mesh" AND (triangles LESS 9000 OR triangles GREATER 11000))
       message(FATAL_ERROR "bench JSON (contact): the mesh collider has ${triangles} triangles, expected ~10 000")
     endif()
-    if(name STREQUAL "mesh") # issue 39: the mesh query quoted against the sphere's
+    if(name STREQUAL "mesh") # the mesh query quoted against the sphere's
       require_result_keys(" (contact, mesh)" ${i} contact_phase_over_sphere)
     endif()
   endif()
@@ -168,7 +168,7 @@ endforeach()
 require_rows(" (contact)" "${contact_rows}" contact_free:table contact:table contact_free:mesh contact:mesh
              contact_free:sphere contact:sphere)
 
-# Self-collision rows (issue 16): each size's cloth folded into 4 layers on the floor, self-collision
+# Self-collision rows: each size's cloth folded into 4 layers on the floor, self-collision
 # on vs off, alternated; n = 4 is too small to fold and is left out with a note. The "on" row quotes
 # the ratio and the cost per particle and counts the particles in self-contact (the layers start
 # 0.1 % of the thickness apart, within the count's 5 % band). No timing is asserted.
@@ -217,7 +217,7 @@ foreach(i RANGE ${last})
 endforeach()
 require_rows(" (self-collision)" "${self_rows}" self_collision_free self_collision)
 
-# The same rows with neighbour lists and vbd's self-contact energy (issue 38): the JSON says which.
+# The same rows with neighbour lists and vbd's self-contact energy: the JSON says which.
 run_bench(" (self-collision energy)" --backend all --sizes 32 --self-collision --integrator vbd --self-skin 0.3
           --self-stiffness 200 --variants fused --steps 2 --warmup 2 --reps 1 --json "${OUT}.self_energy.json")
 file(READ "${OUT}.self_energy.json" doc)

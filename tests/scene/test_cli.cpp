@@ -50,7 +50,7 @@ TEST_CASE("cli: bad scene files exit 2 and stderr names the key") {
   CHECK(bad_set.err.find("integrator.dt.x") != std::string::npos);
 }
 
-TEST_CASE("cli: bad colliders (issue 15) exit 2 and stderr names the key, the file and the line") {
+TEST_CASE("cli: bad colliders exit 2 and stderr names the key, the file and the line") {
   const fs::path dir = tmp_dir() / "cli_colliders";
   fs::create_directories(dir);
   std::ofstream(dir / "broken.obj") << "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 9\n";
@@ -101,7 +101,7 @@ TEST_CASE("cli: bad colliders (issue 15) exit 2 and stderr names the key, the fi
   CHECK(set.err.find("colliders[0].friction") != std::string::npos);
 }
 
-TEST_CASE("cli: bad self_collision (issue 16) exits 2 and stderr names the key and the value") {
+TEST_CASE("cli: bad self_collision exits 2 and stderr names the key and the value") {
   for (const char* command : {"run", "info"}) {
     CAPTURE(command);
     const Outcome o = run_cli(std::string("bad_self_collision_") + command,

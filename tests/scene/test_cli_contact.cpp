@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// `vkcloth run`'s contact quality (issue 15: the summary line and --json's "contact"): the deepest
+// `vkcloth run`'s contact quality (the summary line and --json's "contact"): the deepest
 // penetration over the run and the largest speed over its last second, checked against
 // penetration() and the velocities of the trace the same run writes.
 #include <doctest/doctest.h>

@@ -81,7 +81,7 @@ TEST_CASE("cli: run prints the largest structural strain at the end and over eve
   const auto run_step = st["run_step"].get<std::uint64_t>();
   // The cloth hangs from two corners under gravity. At the report's K_struct = 40 the spring under
   // a pinned corner carries about half the 5 kg cloth: ~25 N / 40 N/m = 0.6 m on L0 = 1/9 m, a
-  // strain of several (3.83 at step 40, measured; the super-elasticity issue 17 is about).
+  // strain of several (3.83 at step 40, measured; the report's super-elasticity).
   CHECK(end > 1.0);
   CHECK(end < 10.0);
   const vkcloth::Spring& corner = scene.system.springs[st["end_spring"].get<std::uint32_t>()];

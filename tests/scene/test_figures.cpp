@@ -121,7 +121,7 @@ void check_cloth_physics(const nlohmann::json& m) {
   CHECK(num(c["presets"]["silk"]["min_z"]) < num(c["presets"]["leather"]["min_z"])); // limp hangs lower
 }
 
-/// The contact figures' numbers (issue 15): friction holds what the frictionless contact lets go,
+/// The contact figures' numbers: friction holds what the frictionless contact lets go,
 /// a spinning sphere carries its cloth only through friction, and no sample ever has a particle
 /// deeper than contact_epsilon inside a collider after a step.
 void check_contact_physics(const nlohmann::json& m) {
@@ -177,7 +177,7 @@ void check_contact_physics(const nlohmann::json& m) {
   CHECK(num(c["cloth_on_torus_knot"]["triangles"]) == 1920);
 }
 
-/// The self-collision figures' numbers (issue 16), run for `steps` steps (--self-collision-steps):
+/// The self-collision figures' numbers, run for `steps` steps (--self-collision-steps):
 /// with self-collision no two triangles of either sample intersect; without, the slide's do.
 void check_self_collision(const nlohmann::json& m, std::uint64_t steps) {
   for (const char* name : {"cloth_drop_self_collision", "cloth_slide_self_collision"}) {
@@ -211,7 +211,7 @@ void check_self_collision(const nlohmann::json& m, std::uint64_t steps) {
   CHECK(m["self_collision"]["layered_drop"]["frames"][0]["intersecting_pairs"] == 0);
 }
 
-/// The stiff-cloth figure's numbers (issue 37; always the CPU solver): cotton dropped onto a sphere
+/// The stiff-cloth figure's numbers (always the CPU solver): cotton dropped onto a sphere
 /// at dt 1/300 stays whole under every solver. Semi-implicit Euler with 20 substeps is the stiff
 /// reference (under 10 % strain); the implicit solvers take the whole step, where friction after
 /// the solve holds some stretch (under 30 %, as tests/test_vbd.cpp's drop); vbd's substeps of one
@@ -271,7 +271,7 @@ void check_gallery(const fs::path& dir) {
 constexpr std::uint64_t self_collision_steps = 100;
 const std::string self_collision_option = " --self-collision-steps " + std::to_string(self_collision_steps);
 
-/// The character figure's numbers (issue 39; always the CPU solver): the cape stays out of the body,
+/// The character figure's numbers (always the CPU solver): the cape stays out of the body,
 /// within 10 % strain, and calm after the teleport.
 void check_character(const nlohmann::json& m) {
   const auto& c = m["character"];

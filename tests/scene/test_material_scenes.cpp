@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // cloth.material in scene files (docs/scene-format.md "Materials"): a preset by name, the object
-// form, the --set override, and every bad input of issue 17 point 6 with the key in the message.
+// form, the --set override, and every bad material input with the key in the message.
 #include <doctest/doctest.h>
 
 #include <fstream>
@@ -93,7 +93,7 @@ TEST_CASE("vkcloth run --set cloth.material=denim runs the material sample, an u
       bad.err);
 }
 
-TEST_CASE("cloth.material: bad input names the key and the value (issue 17 point 6)") {
+TEST_CASE("cloth.material: bad input names the key and the value") {
   expect_error(cloth(R"({"material": "wool"})"), {"cloth.material: unknown preset \"wool\"",
                                                   "presets: cotton, silk, denim, leather, rubber, report"});
   expect_error(cloth(R"({"material": {"density": 0.1, "stretch": 500, "shear": 50, "damping": 0.5}})"),

@@ -160,7 +160,7 @@ TEST_CASE("load_scene_file: a missing file is an i/o error naming it") {
   CHECK(s.error().message.find("/nonexistent/dir/scene.json") != std::string::npos);
 }
 
-TEST_CASE("stretch_limit: bad input names the key and the value (issue 17 point 6)") {
+TEST_CASE("stretch_limit: bad input names the key and the value") {
   const std::string base = R"({"system": "cloth", "stretch_limit": )";
   expect_error(base + R"({"method": "both", "max_strain": 0}})",
                {"stretch_limit.max_strain", "> 0", "got 0"});
@@ -199,9 +199,9 @@ TEST_CASE("stretch_limit: bad input names the key and the value (issue 17 point 
   CHECK(!off->params.stretch_limit.enabled()); // off by default: the report's model
 }
 
-// ---- Issue 15: capsule, box and mesh colliders, friction, moving colliders ----
+// ---- Capsule, box and mesh colliders, friction, moving colliders ----
 
-TEST_CASE("self_collision: bad input names the key and the value (issue 16 item 6)") {
+TEST_CASE("self_collision: bad input names the key and the value") {
   const std::string base = R"({"system": "cloth", "self_collision": )";
   const auto expect = [&](const std::string& body, ErrorCode code, std::initializer_list<std::string> needles,
                           std::vector<std::string> overrides = {}) {
@@ -283,7 +283,7 @@ std::string attached(const std::string& attach) {
 }
 } // namespace
 
-TEST_CASE("cloth.attach and cloth.max_distance: bad entries name the key and the value (issue 39 point 8)") {
+TEST_CASE("cloth.attach and cloth.max_distance: bad entries name the key and the value") {
   expect_error(attached(R"("attach": [{"collider": 7, "vertices": [[0, 3]]}])"),
                {"cloth.attach[0].collider is 7", "2 colliders"});
   expect_error(attached(R"("attach": [{"collider": 1, "vertices": [[0, 3]]}])"),
@@ -347,7 +347,7 @@ TEST_CASE("cloth.attach: a region pins the particles it selects, max_distance le
   CHECK(framed->params.colliders[0].path->keys[1].teleport);
 }
 
-TEST_CASE("inertia and keyframes' teleport: bad entries name the key and the value (issue 39 point 8)") {
+TEST_CASE("inertia and keyframes' teleport: bad entries name the key and the value") {
   const std::string sphere_json = R"({"type": "sphere", "center": [0, 0, 2], "radius": 0.1})";
   const auto scene = [&](const std::string& inertia) {
     return R"({"system": "cloth", "colliders": [)" + sphere_json + R"(, {"type": "plane"}], "inertia": )" +

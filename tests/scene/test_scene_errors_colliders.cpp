@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Colliders in scene files that must be refused (issues 15 and 39), each with a message naming the
+// Colliders in scene files that must be refused, each with a message naming the
 // key and the value.
 #include <doctest/doctest.h>
 
@@ -81,7 +81,7 @@ TEST_CASE("colliders: friction out of range names the key and the value") {
                {"colliders[1].friction", "-2"});
 }
 
-TEST_CASE("colliders: keyframes name the key, the index and the value (issue 39 point 8)") {
+TEST_CASE("colliders: keyframes name the key, the index and the value") {
   const std::string box = R"({"type": "box", "center": [0,0,0], "half_extents": [1,1,1], "keyframes": )";
   expect_error(colliders(box + R"([{"t": 0}, {"t": 2}, {"t": 1}]})"),
                {"colliders[0].keyframes[2].t", "greater than keyframes[1].t (2)", "time order", "got 1"});
@@ -204,4 +204,4 @@ TEST_CASE("colliders: a mesh collider's thickness, scale and file") {
                   {"colliders[0].path: ", "flat.obj", "zero area"});
 }
 
-// ---- Issue 16: self-collision ----
+// ---- Self-collision ----

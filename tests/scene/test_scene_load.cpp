@@ -234,7 +234,7 @@ TEST_CASE("contact_inward_only: defaults to true (report §4), reads a boolean, 
   CHECK(bad.error().message.find("contact_inward_only") != std::string::npos);
 }
 
-// ---- Issue 15: capsule, box and mesh colliders, friction, moving colliders ----
+// ---- Capsule, box and mesh colliders, friction, moving colliders ----
 
 namespace {
 
@@ -408,7 +408,7 @@ TEST_CASE("colliders: overrides reach the new keys and the new types") {
   CHECK(same(c[3].rotation, Collider::rotation_from_degrees({0, 0, 45})));
 }
 
-// ---- Issue 16: self-collision ----
+// ---- Self-collision ----
 
 TEST_CASE("self_collision: absent is off with the defaults; present is read into SimParams") {
   const SelfCollision def;

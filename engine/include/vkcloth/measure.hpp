@@ -51,7 +51,7 @@ Result<PenetrationStats> penetration(const ParticleSystem& system, std::span<con
 /// The largest |v| of the free particles (0 for none): the jitter of a cloth that should be at rest.
 double max_free_speed(const ParticleSystem& system, std::span<const glm::dvec3> velocities);
 
-/// Self-intersections of a cloth (issue 16; docs/model.md "Self-intersections"): the pairs of its
+/// Self-intersections of a cloth (docs/model.md "Self-intersections"): the pairs of its
 /// triangles that intersect each other and share no vertex. Computed in double on the positions
 /// given (float ones are widened exactly).
 struct IntersectionStats {

@@ -46,8 +46,8 @@ struct BenchOptions {
   std::optional<double> cloth_mass; // kg, the whole grid's (default: 0.05 kg per particle at 64 x 64)
   double wind = 2.0; // m/s^2 on a particle facing the wind (the wind force scales with the mass)
   std::string cg_dispatch = "auto"; // implicit on Vulkan: auto | one_workgroup | per_iteration | both
-  std::string contact;              // also time the contact scenes (issue 15): table | mesh (+ sphere) | both
-  bool self_collision = false;      // also time each size folded, self-collision on vs off (issue 16)
+  std::string contact;              // also time the contact scenes: table | mesh (+ sphere) | both
+  bool self_collision = false;      // also time each size folded, self-collision on vs off
   double self_skin = 0.0;      // its neighbour lists' skin, in thicknesses (0: every pass walks the cells)
   double self_stiffness = 0.0; // with vbd: self-contact as an energy of this stiffness (N/m; 0: the passes)
 };
@@ -68,7 +68,7 @@ Result<BenchScene> bench_scene(std::uint32_t n, Integrator integrator, double dt
 Result<BenchScene> mesh_bench_scene(const Mesh& file, const std::string& order, Integrator integrator,
                                     double dt);
 
-// ---- Contact scenes (issue 15) -----------------------------------------------------------------
+// ---- Contact scenes -----------------------------------------------------------------
 
 /// A cloth resting on colliders, and what the contact rows report about it. `params` has the
 /// colliders; the baseline row times the same system with params.colliders cleared.
@@ -89,7 +89,7 @@ Result<ContactScene> table_scene(Integrator integrator, double dt, const BenchOp
 Result<ContactScene> mesh_scene(Integrator integrator, double dt, const BenchOptions& o, bool analytic);
 Result<std::size_t> particles_in_contact(const ContactScene& sc, std::span<const glm::dvec3> positions);
 
-// ---- Self-collision scene (issue 16) -----------------------------------------------------------
+// ---- Self-collision scene -----------------------------------------------------------
 
 /// The self-collision rows' parameters: thickness = 1.5 x the grid spacing, the thickness that closes
 /// the gaps between particles (a particle of another layer is pushed off anywhere in a grid square,

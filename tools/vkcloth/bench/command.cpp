@@ -343,7 +343,7 @@ int contact_rows(BenchRun& run) {
   return exit_ok;
 }
 
-/// --self-collision: each size folded on the floor, self-collision on vs off (issue 16).
+/// --self-collision: each size folded on the floor, self-collision on vs off.
 int self_collision_rows(BenchRun& run) {
   const BenchOptions& o = run.o;
   if (!o.self_collision)
@@ -454,13 +454,13 @@ void add_bench_command(CLI::App& app, int* exit) {
       ->check(CLI::IsMember({"tethers", "provot", "both", "projection", "chains"}));
   cmd->add_option(
          "--contact", opt->contact,
-         "Also time the contact scenes (issue 15): a 256 x 256 cloth on a table (box on a floor plane), "
+         "Also time the contact scenes: a 256 x 256 cloth on a table (box on a floor plane), "
          "a 64 x 64 cloth on a ~10 000-triangle mesh sphere (and on a sphere collider of the same size, the "
          "mesh query's yardstick), or both; each against the same cloth without colliders, alternated")
       ->check(CLI::IsMember({"table", "mesh", "both"}));
   cmd->add_flag(
       "--self-collision", opt->self_collision,
-      "Also time each size's cloth folded into 4 layers on the floor with self-collision on (issue 16; "
+      "Also time each size's cloth folded into 4 layers on the floor with self-collision on ("
       "thickness 1.5 x the grid spacing, friction 0.2, 1 iteration) against the same cloth with it off, "
       "alternated (n >= 16)");
   cmd->add_option("--self-skin", opt->self_skin,

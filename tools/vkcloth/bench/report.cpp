@@ -70,7 +70,7 @@ double contact_phase_ms(const std::vector<Row>& rows, const Row& r) {
 }
 
 /// The sphere row timed with a mesh contact row (same backend, variant, layout and integrator): the
-/// mesh query's cost is quoted against the sphere's (issue 39: at most 3x).
+/// mesh query's cost is quoted against the sphere's (at most 3x).
 const Row* sphere_of(const std::vector<Row>& rows, const Row& r) {
   for (const Row& e : rows)
     if (e.scene == "contact" && e.contact == "sphere" && e.backend == r.backend && e.variant == r.variant &&

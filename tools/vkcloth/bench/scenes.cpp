@@ -108,7 +108,7 @@ Result<BenchScene> mesh_bench_scene(const Mesh& file, const std::string& order, 
   return BenchScene{std::move(cloth->system), p};
 }
 
-// ---- Contact scenes (issue 15) -----------------------------------------------------------------
+// ---- Contact scenes -----------------------------------------------------------------
 
 namespace {
 
@@ -289,7 +289,7 @@ Result<std::size_t> particles_in_contact(const ContactScene& sc, std::span<const
   return count;
 }
 
-// ---- Self-collision scene (issue 16) -----------------------------------------------------------
+// ---- Self-collision scene -----------------------------------------------------------
 
 /// The bench's horizontal n x n cloth (grid rows' mass scaling and stiffness; no pins, no wind),
 /// folded like an accordion into 4 layers stacked on the floor plane z = 0 (friction 0.6), with

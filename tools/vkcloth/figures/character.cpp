@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Cloth on a moving character (issue 39): samples/scenes/character_cape.json, a torso and two arms
+// Cloth on a moving character: samples/scenes/character_cape.json, a torso and two arms
 // of capsules that walk, turn 180 degrees in 0.5 s and teleport 10 m, wearing a cotton cape attached
 // at the shoulders in the torso's frame. Always on the CPU solver, measured after every step as
 // tests/test_frame.cpp measures it; drawn at four instants, each panel centred on the torso.

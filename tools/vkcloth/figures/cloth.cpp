@@ -413,7 +413,7 @@ Result<void> gpu_figure(Gallery& G, Drawing& d, nlohmann::json& M, const std::st
   return {};
 }
 
-/// The mesh samples (issue 14): a round tablecloth of irregular triangles falling onto a sphere,
+/// The mesh samples: a round tablecloth of irregular triangles falling onto a sphere,
 /// a quad flag with a hole in the wind, a skirt pinned at its waist over a sphere; each scene file
 /// as it is, its full run.
 Result<void> mesh_figure(Gallery& G, Drawing& d, nlohmann::json& M) {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Contact that holds (issue 15): the sample scenes with friction, moving colliders, capsules, boxes
+// Contact that holds: the sample scenes with friction, moving colliders, capsules, boxes
 // and meshes, each drawn and measured as `vkcloth run` measures it (the deepest penetration after
 // any step, the largest speed over the last second), with what each picture is about in numbers:
 // the tablecloth with and without friction, the cloth on the sphere with and without, the cloth

@@ -59,24 +59,24 @@ Result<void> spring_figures(Gallery& gallery);
 /// material presets over the sphere: labelled image grids (rendered offscreen; skipped without a Vulkan
 /// device on the CPU backend, the numbers are computed either way) and metrics["cloth"].
 Result<void> cloth_figures(Gallery& gallery);
-/// Contact that holds (issue 15): samples/scenes/{tablecloth_on_table (friction 0.6 and 0),
+/// Contact that holds: samples/scenes/{tablecloth_on_table (friction 0.6 and 0),
 /// cloth_on_sphere and cloth_on_sphere_friction, cloth_on_rotating_sphere (friction 0.8 and 0),
 /// flag_on_pole, cloth_on_mesh (the chair, and the torus knot by an override)}.json, each run to its
 /// end on G.backend with the contact measured after every step: image grids (contact.cpp) and
 /// metrics["contact"].
 Result<void> contact_figures(Gallery& gallery);
-/// Self-collision (issue 16): samples/scenes/{cloth_drop_self_collision, cloth_slide_self_collision}.json,
+/// Self-collision: samples/scenes/{cloth_drop_self_collision, cloth_slide_self_collision}.json,
 /// each run for its own steps on the CPU solver without (--set self_collision.enabled=false) and with
 /// self-collision: two-panel image grids (self_collision.cpp) and metrics["self_collision"], with the
 /// intersecting triangle pairs of each final state.
 Result<void> self_collision_figures(Gallery& gallery);
 /// The (K_struct, dt) stability map of semi-implicit Euler, RK4 and implicit Euler (stability.cpp).
 Result<void> stability_figures(Gallery& gallery);
-/// Cloth on a moving character (issue 39): samples/scenes/character_cape.json on the CPU solver,
+/// Cloth on a moving character: samples/scenes/character_cape.json on the CPU solver,
 /// measured every step, drawn at four instants centred on the torso (character.cpp) and
 /// metrics["character"].
 Result<void> character_figures(Gallery& gallery);
-/// Real fabric (issue 37): a cotton drop onto a sphere by semi-implicit Euler with substeps, implicit
+/// Real fabric: a cotton drop onto a sphere by semi-implicit Euler with substeps, implicit
 /// Euler by CG and vbd (two settings), always on the CPU solver: the largest strain and the wall time
 /// over the run (SVG), the final states (an image grid) and metrics["stiff"] (stiff.cpp).
 Result<void> stiff_figures(Gallery& gallery);

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Real fabric (issue 37): issue 37's cotton drop onto a sphere at 32 x 32, by semi-implicit Euler
+// Real fabric: the cotton drop onto a sphere at 32 x 32, by semi-implicit Euler
 // with substeps, implicit Euler by CG and vertex block descent, always on the CPU solver (the cost
 // is what is drawn). Two plots over the run (the largest structural strain, and the wall time spent
 // so far), the final states side by side, and metrics["stiff"].
@@ -21,7 +21,7 @@ namespace {
 
 const char* const sec_stiff = "Real fabric: a stiff cloth";
 
-// Issue 37's scene at 32 x 32 for 1.5 s: 1 m of cotton 0.25 m above a sphere of radius 0.25
+// The cotton drop at 32 x 32 for 1.5 s: 1 m of cotton 0.25 m above a sphere of radius 0.25
 // (friction 0.5), dt 1/300. The sphere's top is hit at ~0.23 s.
 constexpr const char* drop_scene = R"({
   "name": "cotton_drop", "system": "cloth",
