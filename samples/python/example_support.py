@@ -3,10 +3,26 @@
 their numbers (JSON) and their picture (PNG, when matplotlib is installed)."""
 import argparse
 import json
+import os
 import pathlib
 import sys
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
+
+
+def _run_where_numpy_is():
+    """apt's numpy serves Debian's /usr/bin/python3; a pyenv or venv python3 earlier on PATH has
+    none, so the example runs again there."""
+    try:
+        import numpy  # noqa: F401
+    except ImportError:
+        debian = "/usr/bin/python3"
+        if os.access(debian, os.X_OK) and os.path.realpath(sys.executable) != os.path.realpath(debian):
+            os.execv(debian, [debian] + sys.argv)
+        sys.exit("numpy is not installed (Debian: apt install python3-numpy, or run tools/setup.sh)")
+
+
+_run_where_numpy_is()
 
 
 def import_vkcloth():

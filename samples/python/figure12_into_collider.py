@@ -4,9 +4,9 @@
 (r = 3 m, centre z = 3.4 m); the first projection puts it on the sphere's bottom cap, where gravity
 points out of the sphere. Removing only the inward part of v and F (contact_inward_only, the
 default) lets it fall; removing the whole normal part cancels gravity too and glues it there."""
-import numpy as np
+from example_support import arguments, import_vkcloth, save  # first: it finds an interpreter with numpy
 
-from example_support import arguments, import_vkcloth, save
+import numpy as np
 
 vkcloth = import_vkcloth()
 CENTRE, RADIUS, STEPS = np.array([0.0, 0.0, 3.4]), 3.0, 20  # 0.4 s

@@ -3,9 +3,9 @@
 """The report's Figure 7: the cloth with structural springs alone, hanging from its two top
 corners, for K_struct = 5 ... 50 N/m (10 x 10 points, 0.05 kg each, dt = 0.02 s, mu = 0.5, 10 s).
 The softer it is, the lower its lowest point: at K_struct = 5 it stretches to several metres."""
-import numpy as np
+from example_support import arguments, import_vkcloth, save  # first: it finds an interpreter with numpy
 
-from example_support import arguments, import_vkcloth, save
+import numpy as np
 
 vkcloth = import_vkcloth()
 STIFFNESSES = [5, 10, 20, 30, 40, 50]

@@ -4,9 +4,9 @@
 no finer grid) hanging from its two top corners, with vertex block descent (dt = 1/120 s, 2 s): its largest structural strain over time. Leather
 stretches least and rubber most of the physical ones; the report's own cloth (the "report"
 preset, its springs' K = 40 N/m) stretches to several times its length."""
-import numpy as np
+from example_support import arguments, import_vkcloth, save  # first: it finds an interpreter with numpy
 
-from example_support import arguments, import_vkcloth, save
+import numpy as np
 
 vkcloth = import_vkcloth()
 DT, STEPS = 1 / 120, 240

@@ -6,9 +6,9 @@ its closed form, the damped oscillator about the equilibrium m g / K lower: the 
 with dt); RK4 is fourth order until float32's rounding floor."""
 import math
 
-import numpy as np
+from example_support import arguments, import_vkcloth, save  # first: it finds an interpreter with numpy
 
-from example_support import arguments, import_vkcloth, save
+import numpy as np
 
 vkcloth = import_vkcloth()
 K, M, MU, G, L0, T = 20.0, 1.0, 0.5, 9.81, 0.4, 5.0

@@ -45,3 +45,17 @@ def test_material_sweep_orders_the_materials(tmp_path):
     r = run_example("material_sweep", tmp_path)
     peak = {name: max(s) for name, s in r["strain"].items()}
     assert peak["leather"] < peak["cotton"] < peak["rubber"] < 0.15 < peak["report"]
+
+
+def test_without_matplotlib_the_numbers_are_written(tmp_path):
+    script = EXAMPLES / "figure12_into_collider.py"
+    code = ("import runpy, sys\n"
+            "sys.modules['matplotlib'] = None  # import matplotlib now raises ImportError\n"
+            f"sys.path.insert(0, {str(EXAMPLES)!r})\n"
+            f"sys.argv = [{str(script)!r}, '--out', {str(tmp_path)!r}]\n"
+            f"runpy.run_path({str(script)!r}, run_name='__main__')\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "matplotlib is not installed" in done.stdout
+    assert not (tmp_path / "figure12_into_collider.png").exists()
+    assert json.loads((tmp_path / "figure12_into_collider.json").read_text())["cancel_all"]["on_sphere_fraction"] == 1.0
