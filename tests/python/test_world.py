@@ -117,6 +117,7 @@ def test_materials_and_strain():
 
 def test_a_second_thread_gets_an_error_not_a_race():
     import threading
+    import time
     world = vkcloth.World("cpu", threads=1)
     cloth_id = world.add(vkcloth.make_cloth(nx=64, ny=64))
     errors = []
@@ -124,7 +125,7 @@ def test_a_second_thread_gets_an_error_not_a_race():
 
     def step():
         started.set()
-        world.simulate(400)
+        world.simulate(1500)  # ~0.5 s: long enough to be caught in the act on a loaded machine
 
     t = threading.Thread(target=step)
     t.start()
@@ -135,9 +136,10 @@ def test_a_second_thread_gets_an_error_not_a_race():
         except RuntimeError as e:
             errors.append(str(e))
             break
+        time.sleep(0.0005)
     t.join()
     assert errors and "busy" in errors[0]
-    assert world.step_index(cloth_id) == 400
+    assert world.step_index(cloth_id) == 1500
 
 
 def test_hostile_values_raise():
