@@ -110,6 +110,8 @@ Result<Scene> build_scene(const json& doc, std::string_view source_name) {
     VKCLOTH_TRY(sd::read_attachments(*cloth, scene));
     VKCLOTH_TRY(scene.system.validate());
   }
+  VKCLOTH_TRY(sd::carry_attached_teleports(scene, several));
+  VKCLOTH_TRY(scene.params.validate()); // the frame it may have set
   VKCLOTH_TRY(check_scene_self_collision(scene));
   return scene;
 }

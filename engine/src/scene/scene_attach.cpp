@@ -7,6 +7,7 @@
 // positions in the collider's frame at t = 0 (Attachment::at_rest).
 #include <limits>
 #include <map>
+#include <optional>
 #include <unordered_map>
 
 #include <fmt/format.h>
@@ -173,6 +174,49 @@ Result<void> read_attachments(const json& cloth, Scene& scene) {
     scene.params.attachments.push_back(std::move(*a));
   }
   return check_attachments(scene.params, scene.system.size());
+}
+
+namespace {
+
+/// The first teleport key of collider `c`, if it has one.
+std::optional<std::size_t> teleport_key(const Collider& c) {
+  if (c.path)
+    for (std::size_t j = 0; j < c.path->keys.size(); ++j)
+      if (c.path->keys[j].teleport)
+        return j;
+  return std::nullopt;
+}
+
+} // namespace
+
+Result<void> carry_attached_teleports(Scene& scene, bool several_cloths) {
+  SimParams& params = scene.params;
+  for (std::size_t a = 0; a < params.attachments.size(); ++a) {
+    const std::uint32_t k = params.attachments[a].collider;
+    const auto key = teleport_key(params.colliders[k]);
+    if (!key)
+      continue;
+    const std::string teleport = fmt::format("colliders[{}].keyframes[{}].teleport", k, *key);
+    const std::string attach = several_cloths ? "an entry of cloths" : fmt::format("cloth.attach[{}]", a);
+    if (params.inertia.collider == k)
+      continue; // already the cloth's frame: it jumps with it
+    if (params.inertia.enabled())
+      return bad(
+          fmt::format("{} jumps collider {}, which {} attaches the cloth to, but inertia.collider is {}: a "
+                      "cloth jumps with its frame only (make collider {} the inertia collider, or drop the "
+                      "teleport)",
+                      teleport, k, attach, *params.inertia.collider, k));
+    if (several_cloths)
+      return bad(fmt::format("{} jumps collider {}, which {} attaches to: with several cloths set "
+                             "inertia.collider to {} (every cloth then jumps with it), or drop the teleport",
+                             teleport, k, attach, k));
+    // The collider the cloth hangs from becomes its frame at full inertia: the same motion as world
+    // space, and its teleport carries the cloth, unfelt.
+    params.inertia.collider = k;
+    params.inertia.linear = 1.0;
+    params.inertia.angular = 1.0;
+  }
+  return {};
 }
 
 } // namespace vkcloth::scene_detail

@@ -61,6 +61,11 @@ Result<void> read_inertia(const json& doc, SimParams& params);
 /// colliders built; pins the attached particles that have no max_distance).
 Result<void> read_attachments(const json& cloth, Scene& scene);
 
+/// A teleport key on a collider the cloth is attached to: the cloth jumps with it, unfelt. Without
+/// an "inertia" that collider becomes the cloth's frame at full inertia (linear = angular = 1: the
+/// motion of world space); another inertia collider, or several cloths, are refused naming both keys.
+Result<void> carry_attached_teleports(Scene& scene, bool several_cloths);
+
 /// A file a scene names ("cloth.mesh", "colliders[k].path"): relative to the scene file's directory,
 /// or absolute.
 inline std::filesystem::path scene_relative(const std::string& file, const std::filesystem::path& scene_dir) {
