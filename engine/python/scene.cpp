@@ -123,6 +123,15 @@ void bind_scene(py::module_& m) {
           "cloth", [](const PyScene& s) { return s.cloth; }, "The scene's system, for World.add")
       .def_property_readonly("up", [](const PyScene& s) { return std::string(to_string(s.scene.up)); })
       .def_property_readonly("warnings", [](const PyScene& s) { return s.scene.warnings; })
+      .def_property_readonly(
+          "cloths",
+          [](const PyScene& s) {
+            std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges;
+            for (std::size_t k = 0; k + 1 < s.scene.cloths.size(); ++k)
+              ranges.emplace_back(s.scene.cloths[k], s.scene.cloths[k + 1]);
+            return ranges;
+          },
+          "A \"cloths\" scene's cloths as (first, end) particle ranges of Scene.cloth; [] for one cloth")
       .def("__repr__", [](const PyScene& s) {
         return "<vkcloth.Scene '" + s.scene.name + "': " + std::to_string(s.scene.system.size()) +
                " particles, " + std::to_string(s.scene.steps) + " steps>";

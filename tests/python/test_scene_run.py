@@ -73,3 +73,11 @@ def test_vulkan_world_reads_back_under_validation(vulkan):
 def test_auto_backend_says_why():
     world = vkcloth.World("auto")
     assert world.backend in ("cpu", "vulkan") and world.backend_reason
+
+
+def test_a_scene_of_several_cloths_says_where_each_is():
+    scene = vkcloth.load_scene(SCENES / "layered_drop.json")
+    ranges = scene.cloths
+    assert len(ranges) == 5 and ranges[0][0] == 0 and ranges[-1][1] == scene.cloth.particle_count
+    assert all(a[1] == b[0] for a, b in zip(ranges, ranges[1:]))
+    assert vkcloth.load_scene(SCENES / "cloth_hanging.json").cloths == []

@@ -62,6 +62,9 @@ TEST_CASE("cloths: the entries' particles, springs, faces and attachments, shift
   CHECK(both.system.surface->triangles.size() == 3 * (2 * 5 * 4 + 2 * 3 * 3));
   CHECK(both.system.surface->face_offsets.size() == 1 + 5 * 4 + 3 * 3); // the grids' quads
   CHECK(both.params.damping == b.params.damping);                       // the material's mu
+  CHECK(both.cloths ==
+        std::vector<std::uint32_t>{0, static_cast<std::uint32_t>(na), static_cast<std::uint32_t>(na + nb)});
+  CHECK(a.cloths.empty());
   REQUIRE(both.params.attachments.size() == 1);
   CHECK(both.params.attachments[0].particles ==
         std::vector<std::uint32_t>{static_cast<std::uint32_t>(na), static_cast<std::uint32_t>(na + 15)});

@@ -88,6 +88,12 @@ int info_command(const SceneArgs& opt) {
   fmt::print("system      {}", s.system.grid || s.system.surface ? "cloth" : "chain");
   if (s.system.grid)
     fmt::print(" ({} x {} grid, index j*nx+i)", s.system.grid->nx, s.system.grid->ny);
+  if (s.cloths.size() > 1) {
+    std::string ranges;
+    for (std::size_t k = 0; k + 1 < s.cloths.size(); ++k)
+      ranges += fmt::format("{}{}-{}", k ? ", " : "", s.cloths[k], s.cloths[k + 1] - 1);
+    fmt::print(" ({} cloths, particles {})", s.cloths.size() - 1, ranges);
+  }
   if (const auto& surface = s.system.surface) {
     const std::size_t faces =
         surface->face_offsets.empty() ? surface->triangles.size() / 3 : surface->face_offsets.size() - 1;

@@ -33,6 +33,10 @@ struct Scene {
   /// The file's "up" ("z" by default): the grid's plane, gravity's and a plane's default follow it.
   /// Last, so that hosts' aggregate initialisers of the fields above keep compiling.
   UpAxis up = UpAxis::z;
+  /// A "cloths" scene (several cloths joined into `system`, cloth by cloth): the first particle of
+  /// each cloth, then the particle count (cloth k is particles cloths[k] .. cloths[k+1]). Empty for
+  /// a scene of one cloth or a chain.
+  std::vector<std::uint32_t> cloths = {}; // "= {}": hosts' aggregate initialisers need not name it
   // The file's "system" key ("chain" | "cloth") is not stored: a cloth is system.grid.has_value().
 };
 

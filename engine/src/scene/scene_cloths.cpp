@@ -186,6 +186,7 @@ Result<void> read_cloths(const json& doc, const std::filesystem::path& scene_dir
       return make_error(ErrorCode::invalid_argument,
                         fmt::format("cloths: {} particles up to cloths[{}], more than the limit {}",
                                     std::uint64_t(base) + s.size(), k, max_particles));
+    scene.cloths.push_back(base);
     append(s, base, file_base, merged, surface);
     for (Attachment a : part.params.attachments) {
       for (std::uint32_t& p : a.particles)
@@ -200,6 +201,7 @@ Result<void> read_cloths(const json& doc, const std::filesystem::path& scene_dir
     base += static_cast<std::uint32_t>(s.size());
     file_base += file_vertices(s);
   }
+  scene.cloths.push_back(base);
   merged.surface = std::move(surface);
   merged.finalize();
   scene.system = std::move(merged);
