@@ -92,7 +92,7 @@ TEST_CASE(
   }
 }
 
-TEST_CASE("motion constraint: free particles held within max_distance of a spinning sphere's frame; "
+TEST_CASE("motion constraint: free particles held within max_distance of a spinning sphere's frame, "
           "released, they fall") {
   // Two corners of a free horizontal cloth attached at distance 0, the opposite edge's middle within
   // 0.05 m, to a sphere high above that moves at 0.5 m/s and spins at 1 rad/s.

@@ -172,7 +172,7 @@ TEST_CASE("kinetic friction slows a sliding particle by mu_k g h per step and st
   }
 }
 
-TEST_CASE("static friction holds on a slope when tan(theta) <= mu_s; kinetic friction sets the slide") {
+TEST_CASE("static friction holds on a slope when tan(theta) <= mu_s, kinetic friction sets the slide") {
   // A slope with tan(theta) = 0.5: a particle at rest stays with mu_s = 0.6, and with mu = 0.4
   // accelerates at g (sin theta - mu_k cos theta) along it.
   ValidationScope validation;
@@ -238,7 +238,7 @@ TEST_CASE("vbd: friction in the vertex step holds on a slope when tan(theta) <= 
   }
 }
 
-TEST_CASE("a moving box carries a resting particle; a frictionless one slides under it") {
+TEST_CASE("a moving box carries a resting particle, a frictionless one slides under it") {
   // Friction acts on the velocity relative to the surface: with mu = 1 the particle picks up the
   // box's 0.3 m/s within two steps (kinetic, then static) and keeps it; with mu = 0 it stays put.
   ValidationScope validation;

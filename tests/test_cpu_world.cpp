@@ -109,7 +109,7 @@ TEST_CASE("CpuWorld: two instances of one topology, different params == two CpuS
   CHECK(world->solver(*b)->time() == alone_b.time());
 }
 
-TEST_CASE("CpuWorld: remove keeps the others' state; unknown ids are errors naming the id") {
+TEST_CASE("CpuWorld: remove keeps the others' state, unknown ids are errors naming the id") {
   auto topo = topology_of(9, 7);
   const SimParams p0;
   auto world = CpuWorld::create();
@@ -224,7 +224,7 @@ TEST_CASE("CpuWorld: set_params and set_step_params apply as CpuSolver::set_para
   CHECK(world->params(*a)->dt == 0.008);
 }
 
-TEST_CASE("CpuWorld: an initial state starts there; wrong sizes are errors naming both counts") {
+TEST_CASE("CpuWorld: an initial state starts there, wrong sizes are errors naming both counts") {
   auto topo = topology_of(7, 5); // 35 particles
   const SimParams p0;
   auto world = CpuWorld::create();

@@ -215,7 +215,7 @@ TEST_CASE("export: a shuffled mesh cloth is written in its file's vertex order")
 }
 
 TEST_CASE("export: NORMAL and its morph deltas are the renderer's smooth normals of each frame, unit "
-          "length; the positions are unchanged") {
+          "length, the positions are unchanged") {
   // The renderer draws the solver's normals buffer; CpuSolver<float>::normals() is what the GPU
   // tests compare it with. A step's normals are those of the positions it starts from (the force
   // pass), so frame f's reference normals are read after the step that starts at frame f.

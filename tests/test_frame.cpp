@@ -44,7 +44,7 @@ SimParams weightless() {
 
 } // namespace
 
-TEST_CASE("inertia: a frame that starts moving at 1 m/s carries the cloth by 1 - linear; linear 1 is "
+TEST_CASE("inertia: a frame that starts moving at 1 m/s carries the cloth by 1 - linear, linear 1 is "
           "world space, bit for bit") {
   const ParticleSystem cloth = free_cloth();
   auto frame = Collider::sphere({0, 0, 5}, 0.1).with_keyframes({{0.0, {}, {}}, {10.0, {10, 0, 0}, {}}});
@@ -163,8 +163,8 @@ TEST_CASE("inertia: a host frame (no collider) that the host sets moving carries
   CHECK(s.error().message.find("inertia.frame: pose.rotation") != std::string::npos);
 }
 
-TEST_CASE("teleport: a keyframe's jump moves an attached cloth 10 m unfelt (as its twin that stays); no "
-          "particle then faster than its twin; GPU = CPU") {
+TEST_CASE("teleport: a keyframe's jump moves an attached cloth 10 m unfelt (as its twin that stays), no "
+          "particle then faster than its twin, GPU = CPU") {
   // A vertical cloth hangs from a capsule by its pinned top row; the capsule walks at 1 m/s for
   // 0.5 s, stands 0.1 s, then jumps 10 m. Its twin
   // stands where it stopped: the two cloths move alike, 10 m apart.

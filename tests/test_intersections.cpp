@@ -233,7 +233,7 @@ TEST_CASE("intersections: coplanar triangles count when they overlap, including 
 }
 
 TEST_CASE(
-    "intersections: a flat grid has none; folded through itself it has at least the crossed triangles") {
+    "intersections: a flat grid has none, folded through itself it has at least the crossed triangles") {
   const ParticleSystem s = flat_grid(20); // dx = 1/19: x = 0.25 and 0.75 are inside columns of cells
   const std::vector<glm::dvec3> rest = rest_positions(s);
   std::shared_ptr<const ClothTopology> topology;

@@ -121,7 +121,7 @@ TEST_CASE("self-collision: a falling particle rests on a pinned layer and Coulom
   }
 }
 
-TEST_CASE("self-collision: pairs close at rest never collide; a pinned partner gives way to nothing") {
+TEST_CASE("self-collision: pairs close at rest never collide, a pinned partner gives way to nothing") {
   ValidationScope validation;
   const double t = 0.01;
   for (Backend b : backends()) {

@@ -74,7 +74,7 @@ TEST_CASE("strain links: every structural spring once, each colour a matching, a
 }
 
 TEST_CASE(
-    "strain chains: a grid's rows then its columns, each link in order; a missing spring never moves; none "
+    "strain chains: a grid's rows then its columns, each link in order, a missing spring never moves, none "
     "without a grid") {
   const std::uint32_t nx = 5, ny = 3;
   ClothDesc d;

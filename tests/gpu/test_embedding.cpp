@@ -304,7 +304,7 @@ TEST_CASE("Queue-family hand-over between a compute-only family and a graphics f
 }
 
 TEST_CASE("interleaved_vertices: one 32-byte vertex per particle holds the current position, the "
-          "stored normal and the uv, in every integrator; the state is unchanged") {
+          "stored normal and the uv, in every integrator, the state is unchanged") {
   VKCLOTH_GPU_TEST_BEGIN(ctx);
   ClothDesc d;
   d.nx = 9;

@@ -201,7 +201,7 @@ std::vector<glm::vec3> posed_frames(World& world, InstanceId id, int frames, Run
 } // namespace
 
 TEST_CASE("set_collider_pose: a pose per frame with two frames in flight on the GPU, the CPU world's "
-          "positions within 1e-5 m; shape and friction kept, bad poses refused") {
+          "positions within 1e-5 m, shape and friction kept, bad poses refused") {
   VKCLOTH_GPU_TEST_BEGIN(ctx);
   std::string error;
   auto host = host_or_skip(error);
@@ -286,7 +286,7 @@ TEST_CASE("set_collider_pose: a pose per frame with two frames in flight on the 
 }
 
 TEST_CASE("set_pin_targets: targets every frame with two frames in flight on the GPU, the CPU world's "
-          "positions within 1e-5 m; pinned corners on their targets, a free edge held within reach") {
+          "positions within 1e-5 m, pinned corners on their targets, a free edge held within reach") {
   VKCLOTH_GPU_TEST_BEGIN(ctx);
   std::string error;
   auto host = host_or_skip(error);

@@ -216,7 +216,7 @@ TEST_CASE("cli: info prints the parsed scene") {
   CHECK(o.out.find("semi_implicit_euler") != std::string::npos);
 }
 
-TEST_CASE("cli: info prints each collider: shape, friction, velocities; a mesh's triangles and depth") {
+TEST_CASE("cli: info prints each collider: shape, friction, velocities, a mesh's triangles and depth") {
   const fs::path dir = tmp_dir() / "cli_info_colliders";
   fs::create_directories(dir);
   std::ofstream(dir / "scene.json") << R"({"system": "cloth", "colliders": [

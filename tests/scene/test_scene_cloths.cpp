@@ -97,7 +97,7 @@ TEST_CASE("cloths: one entry moves as the same cloth does, a quad surface giving
   CHECK(worst < 1e-9); // double: the same physics, summed in another order
 }
 
-TEST_CASE("cloths: self-collision keeps two dropped cloths apart; without it they pass through") {
+TEST_CASE("cloths: self-collision keeps two dropped cloths apart, without it they pass through") {
   // Two 12 x 12 cloths of 0.4 m (spacing 3.6 cm) 6 cm apart, dropped onto a small sphere; the
   // thickness is the spacing.
   const auto layer = [](double dx, double z) {

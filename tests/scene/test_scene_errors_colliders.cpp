@@ -119,7 +119,7 @@ TEST_CASE("colliders: capsule radius and box half_extents must be > 0") {
                {"colliders[0].a", "3 numbers"});
 }
 
-TEST_CASE("colliders: velocities must be finite; a plane takes linear_velocity only") {
+TEST_CASE("colliders: velocities must be finite, a plane takes linear_velocity only") {
   // JSON has no NaN; 1e999 is what overflows (nlohmann's parser refuses it, naming the element).
   const Error e = expect_error(colliders(sphere + R"(, "linear_velocity": [0, 1e999, 0]})"),
                                {"colliders[0].linear_velocity[1]", "1e999"});

@@ -410,7 +410,7 @@ TEST_CASE("colliders: overrides reach the new keys and the new types") {
 
 // ---- Self-collision ----
 
-TEST_CASE("self_collision: absent is off with the defaults; present is read into SimParams") {
+TEST_CASE("self_collision: absent is off with the defaults, present is read into SimParams") {
   const SelfCollision def;
   for (const char* text : {R"({"system": "cloth"})", R"({"system": "chain"})"}) {
     CAPTURE(text);
