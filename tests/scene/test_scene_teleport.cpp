@@ -100,6 +100,11 @@ TEST_CASE("the cape without its inertia key is the cape with it: the same frame,
 TEST_CASE("a teleport the cloth cannot follow is refused, naming both keys") {
   expect_error(hanging_from_a_teleport(R"(, "inertia": {"collider": 1})"),
                {"colliders[0].keyframes[1].teleport", "cloth.attach[0]", "inertia.collider is 1"});
+  // Hanging from two colliders that both jump, with no frame named.
+  std::string two = hanging_from_a_teleport("");
+  two.replace(two.find(R"(}}]},)"), 5,
+              R"(}}, {"collider": 1, "region": {"min": [-1, -1, 0.49], "max": [1, 1, 0.51]}}]},)");
+  expect_error(two, {"colliders[0].keyframes[1].teleport and colliders[1].keyframes[1].teleport"});
   expect_error(R"({"system": "cloth", "cloths": [
       {"resolution": [4, 4], "size": [0.3, 0.3], "origin": [-0.15, 0, 0.5], "pins": [],
        "attach": [{"collider": 0, "region": {"min": [-1, -1, 0.79], "max": [1, 1, 1]}}]}, {}],

@@ -191,6 +191,8 @@ std::optional<std::size_t> teleport_key(const Collider& c) {
 
 Result<void> carry_attached_teleports(Scene& scene, bool several_cloths) {
   SimParams& params = scene.params;
+  const bool given = params.inertia.enabled(); // the scene's "inertia", not one set below
+  std::string implied;                         // the teleport key that set it
   for (std::size_t a = 0; a < params.attachments.size(); ++a) {
     const std::uint32_t k = params.attachments[a].collider;
     const auto key = teleport_key(params.colliders[k]);
@@ -200,7 +202,11 @@ Result<void> carry_attached_teleports(Scene& scene, bool several_cloths) {
     const std::string attach = several_cloths ? "an entry of cloths" : fmt::format("cloth.attach[{}]", a);
     if (params.inertia.collider == k)
       continue; // already the cloth's frame: it jumps with it
-    if (params.inertia.enabled())
+    if (!implied.empty())
+      return bad(fmt::format("{} and {} both jump a collider the cloth is attached to: it can jump with one "
+                             "(name it as inertia.collider) or drop a teleport",
+                             implied, teleport));
+    if (given)
       return bad(
           fmt::format("{} jumps collider {}, which {} attaches the cloth to, but inertia.collider is {}: a "
                       "cloth jumps with its frame only (make collider {} the inertia collider, or drop the "
@@ -212,6 +218,7 @@ Result<void> carry_attached_teleports(Scene& scene, bool several_cloths) {
                              teleport, k, attach, k));
     // The collider the cloth hangs from becomes its frame at full inertia: the same motion as world
     // space, and its teleport carries the cloth, unfelt.
+    implied = teleport;
     params.inertia.collider = k;
     params.inertia.linear = 1.0;
     params.inertia.angular = 1.0;
