@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Implicit Euler (issue #8) and substeps: closed form and order, stability far beyond the
+// Implicit Euler and substeps: closed form and order, stability far beyond the
 // explicit limit, the stiff hanging cloth, CG convergence, substeps = k equals k small steps.
 #include <doctest/doctest.h>
 

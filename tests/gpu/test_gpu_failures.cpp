@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Vulkan failure paths (issue #9): an allocation failing at any point of a solver's life is a clear
+// Vulkan failure paths: an allocation failing at any point of a solver's life is a clear
 // error, everything allocated before it is released, and the Context stays usable.
 #include <string>
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Hostile inputs (issue #9): each must be a clear error naming the field and the value, never a
+// Hostile inputs: each must be a clear error naming the field and the value, never a
 // crash, a hang, a silent clamp or an unbounded allocation. docs/errors.md lists them in a table.
 #include <doctest/doctest.h>
 

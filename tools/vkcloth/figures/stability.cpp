@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Stability map (issue #8): a 10 x 10 hanging cloth over a (K_struct, dt) grid, each cell stable
+// Stability map: a 10 x 10 hanging cloth over a (K_struct, dt) grid, each cell stable
 // or not for semi-implicit Euler, RK4 and implicit Euler; three panels of coloured cells.
 #include <algorithm>
 #include <array>
@@ -106,7 +106,7 @@ Result<void> stability_figures(Gallery& G) {
       height - 8, kSteps, kStrainLimit);
   VKCLOTH_TRY(G.write_text("stability_map.svg", svg));
   G.figures.push_back(
-      {"stability_map.svg", "Stiff cloth (issue #8): stability", "Stability map: K_struct x dt",
+      {"stability_map.svg", "Stiff cloth: stability", "Stability map: K_struct x dt",
        fmt::format("10 x 10 cloth, 0.05 kg per particle, K_shear = K_bend = K_struct / 5, damping 0.5, "
                    "{} steps per cell (CPU float, whatever --backend). A cell is stable when the run "
                    "does not blow up (|p| > 100 m or NaN) and no structural spring ends stretched past {:g} "
