@@ -13,6 +13,7 @@
 
 #include "cloth_drawing.hpp"
 #include "figures.hpp"
+#include "vkcloth/cpu_solver.hpp"
 #include "vkcloth/measure.hpp"
 #include "vkcloth_plot/svg_plot.hpp"
 
