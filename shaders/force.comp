@@ -5,7 +5,7 @@
 // Force pass of the two-pass layout, one invocation per particle (CpuSolver::normal_at, force_at
 // and contact_at for one particle; the body is in force_body.glsl, shared with fused.comp).
 // Reads POS_IN (all particles) and VEL_IN (own); writes FORCE_OUT, VEL_FILT, NORMAL (own).
-#include "vkcloth_shared.h"
+#include "kernel/layout/vkcloth_shared.h"
 #define VKCLOTH_PC_COPY
 #include "common.glsl"
 #include "force_body.glsl"

@@ -11,7 +11,7 @@
 // per step. Same float expressions, in the same order, as force.comp + integrate.comp.
 // Reads POS_IN (all), VEL (own); writes POS_OUT, VEL (own), and FORCE_OUT, NORMAL (own) in the
 // last substep of a recorded batch (SC_WRITE_AUX).
-#include "vkcloth_shared.h"
+#include "kernel/layout/vkcloth_shared.h"
 #define VKCLOTH_PC_COPY
 #include "common.glsl"
 #include "force_body.glsl"

@@ -10,7 +10,7 @@
 // invocation strides over the particles; workgroup barriers between the phases), for systems
 // small enough that the dispatches of the per-iteration passes cost more than their work.
 #define VKCLOTH_FRICTION_AFTER_SOLVE // force_body.glsl: friction once, in the FINISH pass
-#include "implicit_shared.h"
+#include "kernel/layout/implicit_shared.h"
 #define VKCLOTH_PUSH_STRUCT ImplicitPush
 #include "common.glsl"
 #include "force_body.glsl"

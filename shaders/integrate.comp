@@ -7,7 +7,7 @@
 // step. RK4: one pass per stage;
 // stages 0..2 write the next stage's (STAGE_POS, STAGE_VEL) and the running sums, stage 3
 // writes the new state. Reads FORCE_OUT, VEL_FILT (own), POS_BASE, VEL; writes POS_OUT, VEL.
-#include "vkcloth_shared.h"
+#include "kernel/layout/vkcloth_shared.h"
 #define VKCLOTH_PC_COPY
 #include "common.glsl"
 

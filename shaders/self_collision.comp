@@ -10,8 +10,8 @@
 // bucket's particles in increasing index): integer work only, so the table is the same on every
 // run and the same as the CPU's. COLLIDE and APPLY are then cloth_kernel.h self_collide and
 // self_apply per particle, each invocation writing only its own particle.
-#include "vkcloth_shared.h"
-#include "self_collision_shared.h"
+#include "kernel/layout/vkcloth_shared.h"
+#include "kernel/layout/self_collision_shared.h"
 
 // cloth_kernel.h self_collide's accessors (defined below, after common.glsl's globals).
 #define SELF_DATA_PARAM uint self_data

@@ -8,7 +8,7 @@
 // reads); pc.stage 1, after the sweeps: the colliders' projection again (a correction may have
 // pulled the particle into one); pc.stage 2, after self-collision (self_collision.comp): the same
 // projection.
-#include "vkcloth_shared.h"
+#include "kernel/layout/vkcloth_shared.h"
 #define VKCLOTH_PC_COPY
 #include "common.glsl"
 

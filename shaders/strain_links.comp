@@ -11,7 +11,7 @@
 // (VKCLOTH_STRETCH_CHAINS, pc.chain_links > 0): one invocation per chain of a family (a grid's rows,
 // or its columns), which projects the chain's links one after the other, forward then back; the
 // chains of a family share no particle.
-#include "vkcloth_shared.h"
+#include "kernel/layout/vkcloth_shared.h"
 #define VKCLOTH_PC_COPY
 #define VKCLOTH_PUSH_STRUCT StrainLinksPush
 #include "common.glsl"

@@ -12,8 +12,8 @@
 // pc.phase_budget phases and leaves the rest to the next dispatch, its state in ProjState; the host records
 // enough indirect dispatches for the worst case, and the last instance to finish sets their group
 // count to zero (ProjArgsHead), so that the dispatches left are empty.
-#include "vkcloth_shared.h"
-#include "strain_projection_shared.h"
+#include "kernel/layout/vkcloth_shared.h"
+#include "kernel/layout/strain_projection_shared.h"
 #define VKCLOTH_PUSH_STRUCT ProjectionPush
 #include "common.glsl"
 

@@ -13,7 +13,7 @@
 // invocation per particle, FRAMES[inst] uploaded before the substep: VKCLOTH_FRAME_JUMP, first,
 // every particle moved by the frame's jump in positions[read]; VKCLOTH_FRAME_CARRY, last, free
 // particles carried with the frame (from positions[read] to positions[write]).
-#include "vkcloth_shared.h"
+#include "kernel/layout/vkcloth_shared.h"
 #define VKCLOTH_PUSH_STRUCT TargetsPush
 #include "common.glsl"
 

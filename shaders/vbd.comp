@@ -15,7 +15,7 @@
 //           projection, less its inward part (the contact response without friction); projection
 //           and divergence flags (finish.glsl), the net force.
 // Reads POS_IN (= POS_BASE: positions[read], the start), VEL; writes POS_OUT, VEL, NORMAL, FORCE_OUT.
-#include "vkcloth_shared.h"
+#include "kernel/layout/vkcloth_shared.h"
 #define VKCLOTH_PUSH_STRUCT VbdPush
 #include "common.glsl"
 #include "force_body.glsl"

@@ -6,7 +6,7 @@
 // particle, after the last step of a recording: the current position, the normal as stored and
 // the uv, packed into one Vertex (32 bytes) for hosts whose pipeline reads one vertex binding.
 // Reads POS_IN (bound to the current positions), NORMAL, UV; writes VERTICES.
-#include "vkcloth_shared.h"
+#include "kernel/layout/vkcloth_shared.h"
 #include "common.glsl"
 
 layout(std430, set = 0, binding = VKCLOTH_BINDING_POS_IN) readonly buffer PosIn { vec4 pos_in[]; };

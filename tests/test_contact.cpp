@@ -10,7 +10,7 @@
 
 #include <glm/geometric.hpp>
 
-#include "kernel.hpp"
+#include "internal/kernel.hpp"
 #include "grid_meshes.hpp"
 #include "sim_backends.hpp"
 

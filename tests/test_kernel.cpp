@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: MIT
 // Closed-form checks of cloth_kernel.h's implicit-Euler blocks (the one source the CPU solver and
-// the shaders share), compiled here through engine/src/core/kernel.hpp in double precision.
+// the shaders share), compiled here through engine/src/internal/kernel.hpp in double precision.
 #include <doctest/doctest.h>
 
 #include <cmath>
 
-#include "kernel.hpp"
+#include "internal/kernel.hpp"
 
 using namespace vkcloth;
 

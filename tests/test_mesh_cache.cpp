@@ -14,7 +14,7 @@
 #include <glm/geometric.hpp>
 
 #include "grid_meshes.hpp"
-#include "kernel.hpp"
+#include "internal/kernel.hpp"
 #include "vkcloth/collider_mesh.hpp"
 #include "vkcloth/params.hpp"
 

@@ -12,7 +12,7 @@
 
 #include <glm/geometric.hpp>
 
-#include "kernel.hpp"
+#include "internal/kernel.hpp"
 #include "vkcloth/measure.hpp"
 #include "sim_backends.hpp"
 

@@ -15,7 +15,7 @@
 
 #include <glm/geometric.hpp>
 
-#include "kernel.hpp"
+#include "internal/kernel.hpp"
 #include "sim_backends.hpp"
 
 using namespace vkcloth;

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The per-particle physics of vkcloth, written ONCE for both backends: the compute shaders
 // include this file as GLSL (through common.glsl) and the CPU reference solver compiles it as
-// C++ (through engine/src/core/kernel.hpp, with GLM, for float and for double), as Jolt's
+// C++ (through engine/src/internal/kernel.hpp, with GLM, for float and for double), as Jolt's
 // HairIntegrate.h is shared by its HLSL and its C++ solver. The equations: docs/model.md.
 //
 // Rules that keep CPU and GPU bit-identical (on lavapipe; a real GPU may round sqrt/division
@@ -25,8 +25,9 @@
 //   file's accessors), no loop over particles or colliders. Each caller
 //   gathers its inputs its own way (texel fetches, std::vector) and loops itself.
 //
-// Provided by the including file: real, vec3, uint, KFN (function prefix: `inline` and always
-// inlined in C++), KFN_NOINLINE (the mesh search's prefix: kept out of line in C++),
+// The language macros below are defined once, per language, in kernel/language.h, which the
+// including file includes first. Provided by the including file: real, vec3, uint, KFN (function prefix:
+// `inline` and always inlined in C++), KFN_NOINLINE (the mesh search's prefix: kept out of line in C++),
 // OUT(T) / INOUT(T) (out / inout parameters: T& in C++), precise, VARYING(T) (T; see above),
 // select(c, a, b) (c ? a : b), any_particle(c) and maybe_any_particle(c) (c), sqrt, abs, min, max, and
 // all_finite(vec3) (no component is NaN or inf); for mesh colliders MESH_DATA_PARAM / MESH_DATA

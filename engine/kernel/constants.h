@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
 // vkcloth kernel: the constants of the physics, shared by the kernel (GLSL and C++), the CPU
 // solver and the GPU passes. Only #defines, so it is valid GLSL and C++; the C++ enums they mirror
-// are asserted equal in engine/src/core/kernel.hpp. The GPU's binding layout is elsewhere
-// (shaders/include/vkcloth_shared.h): the CPU includes this file, never that one.
+// are asserted equal in engine/src/internal/kernel.hpp. The GPU's binding layout is elsewhere
+// (engine/kernel/layout/vkcloth_shared.h): the CPU includes this file, never that one.
 #ifndef VKCLOTH_KERNEL_CONSTANTS_H
 #define VKCLOTH_KERNEL_CONSTANTS_H
 
@@ -36,14 +36,14 @@
 #define VKCLOTH_PROJECTION_TOLERANCE 1.0e-4
 #define VKCLOTH_PROJECTION_CG_TOL2 1.0e-8
 
-// InstanceParams::integrator (the vkcloth::Integrator values; engine/src/core/kernel.hpp asserts it).
+// InstanceParams::integrator (the vkcloth::Integrator values; engine/src/internal/kernel.hpp asserts it).
 #define VKCLOTH_INTEGRATOR_EXPLICIT_EULER 0u
 #define VKCLOTH_INTEGRATOR_SEMI_IMPLICIT_EULER 1u
 #define VKCLOTH_INTEGRATOR_RK4 2u
 #define VKCLOTH_INTEGRATOR_IMPLICIT_EULER 3u
 #define VKCLOTH_INTEGRATOR_VBD 4u
 
-// Collider::type (the vkcloth::Collider::Type values; engine/src/core/kernel.hpp asserts it).
+// Collider::type (the vkcloth::Collider::Type values; engine/src/internal/kernel.hpp asserts it).
 #define VKCLOTH_COLLIDER_PLANE 0u
 #define VKCLOTH_COLLIDER_SPHERE 1u
 #define VKCLOTH_COLLIDER_CAPSULE 2u

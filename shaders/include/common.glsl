@@ -86,16 +86,8 @@ uint particle_index() {
 bool frozen() { return flags[inst].first_bad_step < pc.step; }
 
 // The per-particle physics shared with the CPU reference (cloth_kernel.h, also compiled as C++
-// by engine/src/core/kernel.hpp): its language prelude for GLSL.
-#define real float
-#define KFN
-#define KFN_NOINLINE
-#define OUT(T) out T
-#define INOUT(T) inout T
-#define VARYING(T) T
-#define select(c, a, b) ((c) ? (a) : (b))
-#define any_particle(c) (c)
-#define maybe_any_particle(c) (c)
+// by engine/src/internal/kernel.hpp): its language prelude for GLSL.
+#include "kernel/language.h" // the kernel's macros, GLSL
 // No component is NaN or inf, from the bits: a compiler that assumes finite floats cannot fold it.
 bool all_finite(vec3 v) {
   const uvec3 bits = floatBitsToUint(v) & 0x7f800000u; // exponent all ones: inf or NaN
@@ -103,8 +95,6 @@ bool all_finite(vec3 v) {
 }
 // Mesh colliders' hierarchies and triangles: global buffers; MESH_DATA is the particle (its index in
 // the batch), whose search entries (cloth_kernel.h mesh_contact) it reads and writes.
-#define MESH_DATA_PARAM uint mesh_data
-#define MESH_DATA mesh_data
 void mesh_node(uint particle, uint i, out vec3 lo, out uint first, out vec3 hi, out uint count) {
   const MeshNode n = read_mesh_node(i);
   lo = n.lo_first.xyz;

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Many cloths in a ClothWorld (issue #7): shared topology, add / remove, per-instance parameters, one
+// Many cloths in a ClothWorld: shared topology, add / remove, per-instance parameters, one
 // dispatch per pass for every instance of a topology, the fast projection and a diverging instance in
 // a batch; each instance bitwise what it gives alone.
 #include "gpu_test_util.hpp"

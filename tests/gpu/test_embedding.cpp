@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Embedding (issue #7): a host-created device and command buffer, record_step / record_steps in
+// Embedding: a host-created device and command buffer, record_step / record_steps in
 // the host's own submission, the host's VkAllocationCallbacks, the queue-family hand-over; many
 // cloths in a ClothWorld: test_cloth_world.cpp.
 #include "embedding_host.hpp"

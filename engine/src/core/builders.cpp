@@ -7,7 +7,7 @@
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
 
-#include "argument_checks.hpp"
+#include "internal/argument_checks.hpp"
 
 namespace vkcloth {
 using detail::bad_argument;

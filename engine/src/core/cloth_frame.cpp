@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "cloth_frame.hpp"
+#include "internal/cloth_frame.hpp"
 
 #include <glm/mat3x3.hpp>
 

@@ -13,7 +13,7 @@
 
 #include "vkcloth/collider_mesh.hpp"
 
-#include "argument_checks.hpp"
+#include "internal/argument_checks.hpp"
 
 namespace vkcloth {
 using detail::bad_argument;

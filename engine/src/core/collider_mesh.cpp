@@ -14,7 +14,7 @@
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
 
-#include "kernel.hpp"
+#include "internal/kernel.hpp"
 #include "vkcloth/mesh.hpp"
 
 namespace vkcloth {

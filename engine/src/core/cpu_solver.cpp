@@ -10,13 +10,13 @@
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
 
-#include "argument_checks.hpp"
+#include "internal/argument_checks.hpp"
 #include "cpu_solver_impl.hpp"
-#include "stretch_topology.hpp"
+#include "internal/stretch_topology.hpp"
 #include "implicit_euler.hpp"
-#include "kernel.hpp"
+#include "internal/kernel.hpp"
 #include "row_kernel.hpp"
-#include "self_collision.hpp"
+#include "internal/self_collision.hpp"
 #include "strain_projection.hpp"
 #include "thread_pool.hpp"
 

@@ -11,9 +11,9 @@
 #include <span>
 #include <vector>
 
-#include "cloth_frame.hpp"
-#include "kernel.hpp"
-#include "pin_targets.hpp"
+#include "internal/cloth_frame.hpp"
+#include "internal/kernel.hpp"
+#include "internal/pin_targets.hpp"
 #include "row_kernel.hpp"
 #include "vkcloth/cpu_solver.hpp"
 

@@ -34,7 +34,7 @@
 // kept unless contact_inward_only is false), then x' = x + h v' is projected as usual.
 #pragma once
 
-#include "kernel.hpp"
+#include "internal/kernel.hpp"
 
 #include <array>
 #include <vector>

@@ -8,7 +8,7 @@
 
 #include <fmt/format.h>
 
-#include "argument_checks.hpp"
+#include "internal/argument_checks.hpp"
 
 namespace vkcloth {
 using detail::bad_argument;

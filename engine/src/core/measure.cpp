@@ -7,7 +7,7 @@
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
 
-#include "kernel.hpp"
+#include "internal/kernel.hpp"
 
 namespace vkcloth {
 namespace {

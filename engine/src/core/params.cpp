@@ -13,7 +13,7 @@
 #include <glm/geometric.hpp>
 #include <glm/matrix.hpp>
 
-#include "argument_checks.hpp"
+#include "internal/argument_checks.hpp"
 #include "system_triangles.hpp"
 
 namespace vkcloth {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "pin_targets.hpp"
+#include "internal/pin_targets.hpp"
 
 #include <cmath>
 #include <cstdint>
@@ -9,7 +9,7 @@
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
 
-#include "argument_checks.hpp"
+#include "internal/argument_checks.hpp"
 
 namespace vkcloth::detail {
 

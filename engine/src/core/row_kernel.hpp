@@ -10,7 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "kernel.hpp"
+#include "internal/kernel.hpp"
 #include "kernel/constants.h" // VKCLOTH_RING_*
 
 namespace vkcloth::detail {

@@ -14,7 +14,7 @@
 // (simd_lanes.inl); tests/test_cloth.cpp "the SIMD row kernels ... give the shared reference's
 // bits" and "the SIMD list kernel ..." fail when they differ.
 
-#include "kernel.hpp" // the scalar kernel: a mesh collider's search, lane by lane
+#include "internal/kernel.hpp" // the scalar kernel: a mesh collider's search, lane by lane
 
 /// MESH_DATA on lanes: a mesh collider's hierarchy and search entries and its shape as the scalar
 /// kernel takes them (null for the other shapes), and the lanes' particles: index[l], or first + l.
@@ -26,15 +26,8 @@ template <typename Isa> struct LaneMesh {
   std::uint32_t particle(int l) const { return index ? index[l] : first + std::uint32_t(l); }
 };
 
-#define KFN inline __attribute__((always_inline))
-#define OUT(T) T&
-#define INOUT(T) T&
-#define precise
-#define VARYING(T) varying<T>
-#define MESH_DATA_PARAM const LaneMesh<Isa>& mesh_data
-#define MESH_DATA mesh_data
-#define VKCLOTH_COLLIDER_PRESENT(type) true
-#define VKCLOTH_KERNEL_NO_MESH
+#define VKCLOTH_KERNEL_LANES // the kernel's macros on lanes (kernel/language.h)
+#include "kernel/language.h"
 
 namespace {
 namespace lanes_f32 {
@@ -47,15 +40,10 @@ using Isa = IsaD;
 } // namespace lanes_f64
 } // namespace
 
-#undef KFN
-#undef OUT
-#undef INOUT
-#undef precise
-#undef VARYING
-#undef MESH_DATA_PARAM
-#undef MESH_DATA
-#undef VKCLOTH_COLLIDER_PRESENT
-#undef VKCLOTH_KERNEL_NO_MESH
+#undef VKCLOTH_KERNEL_LANES
+#define VKCLOTH_KERNEL_LANGUAGE_END
+#include "kernel/language.h"
+#undef VKCLOTH_KERNEL_LANGUAGE_END
 
 namespace {
 

@@ -9,8 +9,8 @@
 #include <atomic>
 #include <limits>
 
-#include "kernel.hpp"
-#include "self_collision.hpp"
+#include "internal/kernel.hpp"
+#include "internal/self_collision.hpp"
 #include "thread_pool.hpp"
 #include "cpu_solver_impl.hpp"
 #include "vkcloth/cpu_solver.hpp"

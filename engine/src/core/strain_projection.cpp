@@ -8,7 +8,7 @@
 #include <array>
 #include <utility>
 
-#include "kernel.hpp"
+#include "internal/kernel.hpp"
 #include "strain_projection.hpp"
 #include "thread_pool.hpp"
 #include "cpu_solver_impl.hpp"

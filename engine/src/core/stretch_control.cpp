@@ -5,7 +5,7 @@
 #include <utility>
 
 #include "cpu_solver_impl.hpp"
-#include "kernel.hpp"
+#include "internal/kernel.hpp"
 #include "thread_pool.hpp"
 #include "vkcloth/cpu_solver.hpp"
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "stretch_topology.hpp"
+#include "internal/stretch_topology.hpp"
 #include "vertex_colouring.hpp"
 
 #include <algorithm>

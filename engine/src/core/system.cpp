@@ -5,7 +5,7 @@
 
 #include <fmt/format.h>
 
-#include "argument_checks.hpp"
+#include "internal/argument_checks.hpp"
 
 namespace vkcloth {
 

@@ -2,10 +2,10 @@
 #include "vkcloth/topology.hpp"
 
 #include "vkcloth/builders.hpp"
-#include "kernel.hpp"         // add_fan_triangle, unit_or_zero: the solvers' normal
-#include "kernel/constants.h" // VKCLOTH_RING_*
+#include "internal/kernel.hpp" // add_fan_triangle, unit_or_zero: the solvers' normal
+#include "kernel/constants.h"  // VKCLOTH_RING_*
 
-#include "stretch_topology.hpp"
+#include "internal/stretch_topology.hpp"
 #include "vertex_colouring.hpp"
 
 #include <fmt/format.h>

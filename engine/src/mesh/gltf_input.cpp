@@ -10,7 +10,7 @@
 // encoded bytes (an image in a bufferView is read later, once that view is checked).
 #include <cstring>
 
-#include "../scene/json_parse.hpp"
+#include "internal/json_parse.hpp"
 #include "gltf_detail.hpp"
 
 namespace vkcloth::gltf_detail {

@@ -15,9 +15,9 @@
 #include <glm/mat4x4.hpp>
 #include <glm/vec4.hpp>
 
-#include "../vulkan/barriers.hpp"
+#include "internal/barriers.hpp"
 #include "collider_shapes.hpp"
-#include "../vulkan/pipelines.hpp"
+#include "internal/pipelines.hpp"
 #include "vkcloth/collider_mesh.hpp"
 #include "vkcloth/gpu/world.hpp"
 #include "vkcloth/render/cloth_renderer.hpp"

@@ -3,7 +3,7 @@
 
 #include <glm/vec4.hpp>
 
-#include "../vulkan/barriers.hpp"
+#include "internal/barriers.hpp"
 #include "vkcloth/render/interaction.hpp"
 
 namespace vkcloth::render {

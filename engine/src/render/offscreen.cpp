@@ -6,7 +6,7 @@
 
 #include <fmt/format.h>
 
-#include "../vulkan/barriers.hpp"
+#include "internal/barriers.hpp"
 #include "vkcloth/render/offscreen.hpp"
 
 namespace vkcloth::render {

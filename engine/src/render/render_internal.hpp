@@ -3,7 +3,7 @@
 // table, owned objects and their creation in resources.hpp, barriers, errors).
 #pragma once
 
-#include "../vulkan/resources.hpp"
+#include "internal/resources.hpp"
 
 namespace vkcloth::render::detail {
 

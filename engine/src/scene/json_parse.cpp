@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "json_parse.hpp"
+#include "internal/json_parse.hpp"
 
 #include <string>
 #include <unordered_set>

@@ -7,7 +7,7 @@
 
 #include <fmt/format.h>
 
-#include "json_parse.hpp"
+#include "internal/json_parse.hpp"
 #include "json_read.hpp"
 
 namespace vkcloth::scene_detail {

@@ -11,7 +11,7 @@
 
 #include <fmt/format.h>
 
-#include "json_parse.hpp"
+#include "internal/json_parse.hpp"
 #include "overrides.hpp"
 #include "scene_sections.hpp"
 

@@ -6,7 +6,7 @@
 
 #include <cstdint>
 
-#include "vk_internal.hpp"
+#include "internal/vk_internal.hpp"
 #include "vkcloth/gpu/testing.hpp"
 #include "vkcloth/result.hpp"
 

@@ -6,7 +6,7 @@
 // context_devices.cpp.
 #include "context_setup.hpp"
 
-#include "pipelines.hpp"
+#include "internal/pipelines.hpp"
 
 #include <algorithm>
 #include <cstdlib>

@@ -6,7 +6,7 @@
 // substring), else the best type, discrete GPUs first.
 #include "context_setup.hpp"
 
-#include "pipelines.hpp" // PipelineRegistry, for the Impl that list_devices() makes
+#include "internal/pipelines.hpp" // PipelineRegistry, for the Impl that list_devices() makes
 
 #include <algorithm>
 #include <cctype>

@@ -6,7 +6,7 @@
 // Context's members.
 #pragma once
 
-#include "vk_internal.hpp"
+#include "internal/vk_internal.hpp"
 
 #include <cstdint>
 #include <mutex>

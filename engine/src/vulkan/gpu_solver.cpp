@@ -3,12 +3,12 @@
 // the world's and its batch's (solver_batch.cpp); this file only maps the single-cloth API onto
 // them: the instance's own divergence error (without the world's "cloth instance N" prefix),
 // its buffers by index, the forces and timings the world does not expose.
-#include "resources.hpp"
+#include "internal/resources.hpp"
 
 #include <memory>
 #include <utility>
 
-#include "barriers.hpp"
+#include "internal/barriers.hpp"
 #include "passes/implicit_gpu.hpp"
 #include "vkcloth/gpu/gpu_solver.hpp"
 #include "vkcloth/gpu/testing.hpp"

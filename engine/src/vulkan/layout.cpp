@@ -1,15 +1,15 @@
 // SPDX-License-Identifier: MIT
 // The per-device layout (vkcloth/gpu/layout.hpp): the one place that decides how the solver's
 // shaders read their buffers and how large their workgroups are.
-#include "vk_internal.hpp"
+#include "internal/vk_internal.hpp"
 
 #include <algorithm>
 
 #include <fmt/format.h>
 
-#include "pipelines.hpp"
+#include "internal/pipelines.hpp"
 #include "vkcloth/gpu/layout.hpp"
-#include "vkcloth_shared.h"
+#include "kernel/layout/vkcloth_shared.h"
 
 namespace vkcloth::gpu {
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "pipelines.hpp"
+#include "internal/pipelines.hpp"
 
 #include <array>
 #include <string>
@@ -7,7 +7,7 @@
 
 #include <fmt/format.h>
 
-#include "vkcloth_shared.h"
+#include "kernel/layout/vkcloth_shared.h"
 
 namespace vkcloth::gpu {
 

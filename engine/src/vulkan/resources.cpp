@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
-#include "resources.hpp"
+#include "internal/resources.hpp"
 
-#include "barriers.hpp"
+#include "internal/barriers.hpp"
 
 #include <algorithm>
 #include <string>

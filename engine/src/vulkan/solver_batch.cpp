@@ -16,14 +16,14 @@
 
 #include <fmt/format.h>
 
-#include "../core/argument_checks.hpp"
-#include "../core/kernel.hpp"
-#include "../core/self_collision.hpp"
-#include "barriers.hpp"
+#include "internal/argument_checks.hpp"
+#include "internal/kernel.hpp"
+#include "internal/self_collision.hpp"
+#include "internal/barriers.hpp"
 #include "batch_limits.hpp"
 #include "passes/implicit_update.hpp"
 #include "vkcloth/gpu/world.hpp"
-#include "vkcloth_shared.h"
+#include "kernel/layout/vkcloth_shared.h"
 
 namespace vkcloth::gpu {
 

@@ -24,17 +24,17 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
-#include "../core/cloth_frame.hpp"
-#include "../core/pin_targets.hpp"
+#include "internal/cloth_frame.hpp"
+#include "internal/pin_targets.hpp"
 #include "passes/implicit_gpu.hpp"
 #include "passes/pass.hpp"
-#include "pipelines.hpp"
-#include "resources.hpp"
+#include "internal/pipelines.hpp"
+#include "internal/resources.hpp"
 #include "vkcloth/collider_mesh.hpp"
 #include "vkcloth/gpu/gpu_solver.hpp"
 #include "vkcloth/gpu/testing.hpp"
 #include "vkcloth/topology.hpp"
-#include "vkcloth_shared.h"
+#include "kernel/layout/vkcloth_shared.h"
 
 namespace vkcloth::gpu {
 

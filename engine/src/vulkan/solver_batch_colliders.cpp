@@ -16,9 +16,9 @@
 
 #include <fmt/format.h>
 
-#include "../core/kernel.hpp"
+#include "internal/kernel.hpp"
 #include "batch_limits.hpp"
-#include "vkcloth_shared.h"
+#include "kernel/layout/vkcloth_shared.h"
 
 namespace vkcloth::gpu {
 

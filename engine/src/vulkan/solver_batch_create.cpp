@@ -11,10 +11,10 @@
 
 #include <fmt/format.h>
 
-#include "../core/kernel.hpp"
-#include "barriers.hpp"
+#include "internal/kernel.hpp"
+#include "internal/barriers.hpp"
 #include "batch_limits.hpp"
-#include "vkcloth_shared.h"
+#include "kernel/layout/vkcloth_shared.h"
 
 namespace vkcloth::gpu {
 

@@ -8,8 +8,8 @@
 #include <algorithm>
 #include <utility>
 
-#include "barriers.hpp"
-#include "vkcloth_shared.h"
+#include "internal/barriers.hpp"
+#include "kernel/layout/vkcloth_shared.h"
 
 namespace vkcloth::gpu {
 

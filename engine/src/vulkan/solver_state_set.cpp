@@ -4,7 +4,7 @@
 // state passes (the grid stencil, the fused variant, the fan-normal switch). The passes' pipelines
 // are theirs (passes/); the buffers and readbacks are in solver_batch.cpp, the recording of the
 // steps in solver_batch_record.cpp.
-#include "resources.hpp"
+#include "internal/resources.hpp"
 
 #include <algorithm>
 #include <array>
@@ -14,10 +14,10 @@
 
 #include <fmt/format.h>
 
-#include "pipelines.hpp"
+#include "internal/pipelines.hpp"
 #include "passes/state_set.hpp"
 #include "solver_batch.hpp"
-#include "vkcloth_shared.h"
+#include "kernel/layout/vkcloth_shared.h"
 
 namespace vkcloth::gpu {
 

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
-#include "vk_internal.hpp"
+#include "internal/vk_internal.hpp"
 
-#include "pipelines.hpp"
+#include "internal/pipelines.hpp"
 #include "vkcloth/gpu/testing.hpp"
 
 namespace vkcloth::gpu::testing {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "resources.hpp"
+#include "internal/resources.hpp"
 
 #include <algorithm>
 #include <map>
@@ -9,10 +9,10 @@
 
 #include <fmt/format.h>
 
-#include "barriers.hpp"
+#include "internal/barriers.hpp"
 #include "world_impl.hpp"
-#include "../core/argument_checks.hpp"
-#include "../core/stretch_topology.hpp"
+#include "internal/argument_checks.hpp"
+#include "internal/stretch_topology.hpp"
 
 namespace vkcloth::gpu {
 

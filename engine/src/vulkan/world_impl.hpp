@@ -7,7 +7,7 @@
 #include <memory>
 #include <vector>
 
-#include "resources.hpp"
+#include "internal/resources.hpp"
 #include "solver_batch.hpp"
 #include "vkcloth/gpu/testing.hpp"
 #include "vkcloth/gpu/world.hpp"

@@ -6,7 +6,7 @@
 // recording's last substep stores the forces and normals a host can observe.
 #include <memory>
 
-#include "../barriers.hpp"
+#include "internal/barriers.hpp"
 #include "../solver_batch.hpp"
 #include "pass.hpp"
 #include "state_set.hpp"

@@ -12,9 +12,9 @@
 
 #include <fmt/format.h>
 
-#include "../barriers.hpp"
-#include "../pipelines.hpp"
-#include "implicit_shared.h"
+#include "internal/barriers.hpp"
+#include "internal/pipelines.hpp"
+#include "kernel/layout/implicit_shared.h"
 #include "vkcloth/shaders/implicit_comp_spv.hpp"
 
 namespace vkcloth::gpu {

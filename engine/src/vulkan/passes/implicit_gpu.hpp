@@ -22,10 +22,10 @@
 #include <memory>
 #include <span>
 
-#include "../resources.hpp"
+#include "internal/resources.hpp"
 #include "vkcloth/params.hpp"
-#include "implicit_shared.h"
-#include "vkcloth_shared.h"
+#include "kernel/layout/implicit_shared.h"
+#include "kernel/layout/vkcloth_shared.h"
 
 namespace vkcloth::gpu {
 

@@ -13,8 +13,8 @@
 #include <memory>
 #include <vector>
 
-#include "../resources.hpp"
-#include "vkcloth_shared.h"
+#include "internal/resources.hpp"
+#include "kernel/layout/vkcloth_shared.h"
 
 namespace vkcloth::gpu {
 

@@ -8,7 +8,7 @@
 #include <memory>
 #include <vector>
 
-#include "../../core/kernel.hpp"
+#include "internal/kernel.hpp"
 #include "../batch_limits.hpp"
 #include "self_collision_gpu.hpp"
 #include "../solver_batch.hpp"

@@ -6,10 +6,10 @@
 #include <utility>
 #include <tuple>
 
-#include "../../core/kernel.hpp"
-#include "../../core/self_collision.hpp"
-#include "../barriers.hpp"
-#include "../pipelines.hpp"
+#include "internal/kernel.hpp"
+#include "internal/self_collision.hpp"
+#include "internal/barriers.hpp"
+#include "internal/pipelines.hpp"
 #include "vkcloth/shaders/self_collision_storage_comp_spv.hpp"
 #include "vkcloth/shaders/self_collision_texel_comp_spv.hpp"
 

@@ -25,9 +25,9 @@
 
 #include <glm/vec3.hpp>
 
-#include "../pipelines.hpp"
-#include "../resources.hpp"
-#include "self_collision_shared.h"
+#include "internal/pipelines.hpp"
+#include "internal/resources.hpp"
+#include "kernel/layout/self_collision_shared.h"
 #include "vkcloth/params.hpp"
 
 namespace vkcloth::gpu {

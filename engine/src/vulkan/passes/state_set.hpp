@@ -7,8 +7,8 @@
 #include <array>
 #include <cstdint>
 
-#include "../pipelines.hpp"
-#include "vkcloth_shared.h"
+#include "internal/pipelines.hpp"
+#include "kernel/layout/vkcloth_shared.h"
 
 namespace vkcloth::gpu {
 

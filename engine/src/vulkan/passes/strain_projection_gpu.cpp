@@ -6,9 +6,9 @@
 
 #include <fmt/format.h>
 
-#include "../../core/kernel.hpp"
-#include "../barriers.hpp"
-#include "../pipelines.hpp"
+#include "internal/kernel.hpp"
+#include "internal/barriers.hpp"
+#include "internal/pipelines.hpp"
 #include "vkcloth/shaders/strain_project_comp_spv.hpp"
 
 namespace vkcloth::gpu {

@@ -13,9 +13,9 @@
 #include <span>
 #include <vector>
 
-#include "../pipelines.hpp"
-#include "../resources.hpp"
-#include "strain_projection_shared.h"
+#include "internal/pipelines.hpp"
+#include "internal/resources.hpp"
+#include "kernel/layout/strain_projection_shared.h"
 #include "vkcloth/topology.hpp"
 
 namespace vkcloth::gpu {

@@ -7,7 +7,7 @@
 #include <memory>
 #include <tuple>
 
-#include "../barriers.hpp"
+#include "internal/barriers.hpp"
 #include "../batch_limits.hpp"
 #include "../solver_batch.hpp"
 #include "strain_projection_gpu.hpp"

@@ -7,7 +7,7 @@
 // the list, two classes.
 #include <memory>
 
-#include "../barriers.hpp"
+#include "internal/barriers.hpp"
 #include "../solver_batch.hpp"
 #include "pass.hpp"
 #include "state_set.hpp"

@@ -8,7 +8,7 @@
 // stiffness, which SelfCollisionGpu's CONTACT pass writes before the sweep's colours.
 #include <memory>
 
-#include "../barriers.hpp"
+#include "internal/barriers.hpp"
 #include "../solver_batch.hpp"
 #include "pass.hpp"
 #include "self_collision_gpu.hpp"

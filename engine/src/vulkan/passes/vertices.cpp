@@ -4,7 +4,7 @@
 // reading POS_IN of the state set whose read index is the current one.
 #include <memory>
 
-#include "../barriers.hpp"
+#include "internal/barriers.hpp"
 #include "../solver_batch.hpp"
 #include "pass.hpp"
 #include "state_set.hpp"

@@ -10,8 +10,8 @@
 // engine/src/vulkan.
 #pragma once
 
-#include "resources.hpp"
-#include "vkcloth_shared.h"
+#include "internal/resources.hpp"
+#include "kernel/layout/vkcloth_shared.h"
 #include "vkcloth/gpu/layout.hpp"
 
 #include <map>

@@ -7,7 +7,7 @@
 // image() / buffer() build them, pipeline() records them (as niagara's resources.h).
 #pragma once
 
-#include "vk_internal.hpp"
+#include "internal/vk_internal.hpp"
 
 #include <array>
 #include <span>

@@ -8,7 +8,7 @@
 #ifndef VKCLOTH_IMPLICIT_SHARED_H
 #define VKCLOTH_IMPLICIT_SHARED_H
 
-#include "vkcloth_shared.h"
+#include "kernel/layout/vkcloth_shared.h"
 
 #ifdef __cplusplus
 namespace vkcloth::gpu::shared {

@@ -31,21 +31,7 @@ static_assert(VKCLOTH_INTEGRATOR_RK4 == std::uint32_t(vkcloth::Integrator::rk4))
 static_assert(VKCLOTH_INTEGRATOR_IMPLICIT_EULER == std::uint32_t(vkcloth::Integrator::implicit_euler));
 static_assert(VKCLOTH_INTEGRATOR_VBD == std::uint32_t(vkcloth::Integrator::vbd));
 
-// Every kernel function inlined into its caller (GCC's own choice varies with their size, and an
-// out-of-line collider_contact costs the contact path ~40 %), but the mesh search.
-#define KFN inline __attribute__((always_inline))
-#define KFN_NOINLINE inline __attribute__((noinline))
-#define OUT(T) T&
-#define INOUT(T) T&
-#define precise
-#define VARYING(T) T
-#define any_particle(c) (c)
-#define maybe_any_particle(c) (c)
-#define MESH_DATA_PARAM const MeshData& mesh_data
-#define MESH_DATA mesh_data
-#define VKCLOTH_COLLIDER_PRESENT(type) true
-#define SELF_DATA_PARAM const SelfData& self_data
-#define SELF_DATA self_data
+#include "kernel/language.h" // the kernel's macros, scalar C++
 
 namespace vkcloth::kernel {
 
@@ -300,13 +286,6 @@ kernel::ColliderShape<Real> kernel_shape(const Collider& c, std::uint32_t mesh_r
 
 } // namespace vkcloth::kernel
 
-#undef KFN
-#undef KFN_NOINLINE
-#undef OUT
-#undef INOUT
-#undef precise
-#undef VARYING
-#undef any_particle
-#undef maybe_any_particle
-#undef MESH_DATA_PARAM
-#undef MESH_DATA
+#define VKCLOTH_KERNEL_LANGUAGE_END // no kernel macro past the bridge
+#include "kernel/language.h"
+#undef VKCLOTH_KERNEL_LANGUAGE_END

@@ -6,7 +6,7 @@
 // Internal to engine/src/vulkan and engine/src/render. Modelled on niagara's resources.h.
 #pragma once
 
-#include "vk_internal.hpp"
+#include "internal/vk_internal.hpp"
 
 #include <cstdint>
 #include <functional>

@@ -6,7 +6,7 @@
 #ifndef VKCLOTH_STRAIN_PROJECTION_SHARED_H
 #define VKCLOTH_STRAIN_PROJECTION_SHARED_H
 
-#include "self_collision_shared.h"
+#include "kernel/layout/self_collision_shared.h"
 
 #ifdef __cplusplus
 namespace vkcloth::gpu::shared {

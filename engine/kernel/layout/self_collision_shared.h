@@ -6,7 +6,7 @@
 #ifndef VKCLOTH_SELF_COLLISION_SHARED_H
 #define VKCLOTH_SELF_COLLISION_SHARED_H
 
-#include "implicit_shared.h"
+#include "kernel/layout/implicit_shared.h"
 
 #ifdef __cplusplus
 namespace vkcloth::gpu::shared {
