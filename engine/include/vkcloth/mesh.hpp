@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// Meshes: a polygon mesh as a file holds it (OBJ or glTF 2.0, read with tinyobjloader and
-// tinygltf), the cloth built from it (springs matching the report's grid, docs/model.md "Mesh
+// Meshes: the readers of a polygon mesh (vkcloth/polygon_mesh.hpp) from a file (OBJ or glTF 2.0,
+// with tinyobjloader and tinygltf), the cloth built from it (springs matching the report's grid, docs/model.md "Mesh
 // springs"), and the animated cloth written back out (glTF 2.0, OBJ).
 #pragma once
 
@@ -16,30 +16,11 @@
 #include <glm/vec3.hpp>
 
 #include "vkcloth/builders.hpp"
+#include "vkcloth/polygon_mesh.hpp"
 #include "vkcloth/result.hpp"
 #include "vkcloth/system.hpp"
 
 namespace vkcloth {
-
-/// A base-colour texture as the file holds it (PNG or JPEG bytes); the renderer decodes it.
-struct MeshTexture {
-  std::string source;                ///< where it came from, for messages ("flag.glb images[0]")
-  std::vector<std::uint8_t> encoded; ///< the PNG or JPEG file's bytes
-};
-
-/// A polygon mesh in the file's vertex order. Face f is indices[face_offsets[f] ..
-/// face_offsets[f+1]), counter-clockwise seen from the front; faces have 3 or more vertices.
-struct Mesh {
-  std::vector<glm::dvec3> positions;
-  /// Empty, or one per vertex, glTF's convention: (0, 0) is the image's top-left corner, v grows
-  /// downwards (the OBJ reader and writers flip OBJ's upward v).
-  std::vector<glm::dvec2> uvs;
-  std::vector<std::uint32_t> face_offsets{0};
-  std::vector<std::uint32_t> indices;
-  std::optional<MeshTexture> texture; ///< a glTF material's base-colour texture
-
-  std::size_t face_count() const { return face_offsets.empty() ? 0 : face_offsets.size() - 1; }
-};
 
 /// Largest mesh file the readers accept (checked before reading).
 inline constexpr std::size_t max_mesh_bytes = std::size_t{256} << 20;

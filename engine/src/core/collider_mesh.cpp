@@ -15,7 +15,7 @@
 #include <glm/geometric.hpp>
 
 #include "internal/kernel.hpp"
-#include "vkcloth/mesh.hpp"
+#include "vkcloth/polygon_mesh.hpp"
 
 namespace vkcloth {
 namespace {

@@ -10,7 +10,7 @@ const char* to_string(Backend backend) {
 }
 
 BackendChoice choose_backend(VkPhysicalDeviceType type, std::string_view device_name) {
-  // The ratio is `vkcloth bench` on lavapipe (docs/performance.md, README): the CPU solver's SIMD
+  // The ratio is `vkcloth bench` on lavapipe (docs/performance.md "Backend auto"): the CPU solver's SIMD
   // rows against the same kernel compiled by llvmpipe, on the same cores.
   if (type == VK_PHYSICAL_DEVICE_TYPE_CPU)
     return {Backend::cpu,
