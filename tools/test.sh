@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
-# Builds vkcloth and runs the whole test suite (CPU physics, scene files, CLI, GPU on lavapipe
-# with the Khronos validation layer). Usage: tools/test.sh [preset]   (release | debug | asan)
+# Builds vkcloth and runs the test suite (CPU physics, scene files, CLI, GPU on lavapipe with the
+# Khronos validation layer). Usage: tools/test.sh [preset | long]   (release | debug | asan | long)
+# The default (release) runs every test but the long ones below; `long` builds the same release
+# tree and runs only those (CI runs both, .ci/run).
 # asan: clang's ASan + UBSan + LeakSanitizer (the tree also builds the libFuzzer targets of
 # tools/fuzz.sh), less the tests in asan_skips below, each skipped for the reason given there.
 # Prints the build's and the suite's times ("test: <preset> build done in N s").
@@ -19,6 +21,8 @@ asan_skips=(
   'they configure and build a consumer project against this build (one compiles the whole engine again); under the sanitizers that project would need the same runtime flags, and the release run covers packaging'
   'implicit Euler matches the CPU implicit solver on the sample scenes'
   'the GPU implicit solver on every sample scene: lavapipe-bound; the other GPU implicit tests run the same host code'
+  'GPU vbd matches the CPU vbd on every sample scene'
+  'vbd on every sample scene on lavapipe; "instances with different sweeps" and the vbd GPU = CPU tests run the same host code'
   'compare passes on every sample scene'
   'vkcloth compare on every sample scene: lavapipe-bound; "every mesh sample: GPU = CPU" runs the same compare code'
   'no intersecting triangle pairs after the drop settles'
@@ -55,6 +59,32 @@ asan_skips=(
   "its RSS-growth limit (1 MiB over 500 steps) measures the sanitizer's allocator: under clang's ASan the RSS grows 2.5 MiB there whatever the quarantine (0.2 MiB under GCC's), under both ~55 MiB over 400 000 steps; the release run keeps it"
 )
 
+# The long suite (pairs: a ctest regex, then why it is long): minutes of lavapipe or of a second
+# engine build each, whose code the default suite's shorter tests run too.
+long_tests=(
+  '^package:add_subdirectory$'
+  'configures and builds a consumer project that compiles the whole engine again, file by file'
+  'GPU self-collision: the cotton drop at 128 x 128'
+  '3 s of a 128 x 128 self-colliding drop on lavapipe; the 64 x 64 drop runs the same passes'
+  'vkcloth figures --backend vulkan'
+  'every figure of the report on lavapipe; the figures on the CPU and the GPU = CPU tests run the same code'
+  'GPU matches CPU on the self-collision samples: 100 steps'
+  'every self-collision sample on lavapipe; the per-instance self-collision tests run the same passes'
+  'implicit Euler matches the CPU implicit solver on the sample scenes'
+  'the GPU implicit solver on every sample scene; the other GPU implicit tests run the same host code'
+  'implicit Euler: the stiff 64x64 cloth hangs stably'
+  'a long CPU run of the implicit solver; the smaller implicit tests run the same code'
+  'compare passes on every sample scene'
+  'vkcloth compare on every sample scene on lavapipe; "every mesh sample: GPU = CPU" runs the same compare code'
+)
+long_regex=""
+for ((i = 0; i < ${#long_tests[@]}; i += 2)); do long_regex+="${long_regex:+|}${long_tests[i]}"; done
+suite=default
+if [[ $preset == long ]]; then
+  suite=long
+  preset=release
+fi
+
 start=$SECONDS
 if [[ $preset == asan ]]; then tools/setup.sh fuzz; else tools/setup.sh; fi # fuzz: clang, its runtimes
 cmake --preset "$preset" >/dev/null
@@ -71,6 +101,12 @@ if [[ $preset == asan ]]; then
     exclude+="${exclude:+|}${asan_skips[i]}"
   done
   extra=(-E "$exclude")
+elif [[ $suite == long ]]; then
+  for ((i = 0; i < ${#long_tests[@]}; i += 2)); do echo "test: long: /${long_tests[i]}/: ${long_tests[i + 1]}" >&2; done
+  extra=(-R "$long_regex")
+elif [[ $preset == release ]]; then
+  echo "test: the long tests run with tools/test.sh long (CI runs both)" >&2
+  extra=(-E "$long_regex")
 fi
 start=$SECONDS
 ctest --preset "$preset" -j "$(nproc)" "${extra[@]}"
@@ -79,4 +115,5 @@ log=build/$preset/Testing/Temporary/LastTest.log
 if [[ -f $log ]] && pytest_line=$(grep -E '^=+ .*(passed|failed|error).* in [0-9.]+s' "$log"); then
   echo "test: python (pytest): $pytest_line" >&2
 fi
-echo "test: $preset suite done in $((SECONDS - start)) s" >&2
+label=$preset; [[ $suite == long ]] && label="$preset long"
+echo "test: $label suite done in $((SECONDS - start)) s" >&2

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Meshes: the readers of a polygon mesh (vkcloth/polygon_mesh.hpp) from a file (OBJ or glTF 2.0,
-// with tinyobjloader and tinygltf), the cloth built from it (springs matching the report's grid, docs/model.md "Mesh
-// springs"), and the animated cloth written back out (glTF 2.0, OBJ).
+// with tinyobjloader and tinygltf), the cloth built from it (springs matching the report's grid,
+// docs/model.md "Mesh springs"), and the animated cloth written back out (glTF 2.0, OBJ).
 #pragma once
 
 #include <cstdint>
